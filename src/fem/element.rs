@@ -1,0 +1,149 @@
+//! The linear tetrahedron: constant shape-function gradients, and the element force and
+//! stiffness of both material laws.
+//!
+//! With `g_a = ∇N_a` and `F = I + Σ_a u_a ⊗ g_a`, the Kirchhoff–Saint Venant element gives
+//! `f_a = V · P g_a`, with `P = F S`, `S = λ tr(E) I + 2μ E`, `E = ½(FᵀF − I)`, and the
+//! consistent tangent block
+//! `K_ab = V [ (g_a·S g_b) I + λ (F g_a)(F g_b)ᵀ + μ (g_a·g_b) F Fᵀ + μ (F g_b)(F g_a)ᵀ ]`.
+//! At `F = I` this is the linear-elastic block `V [λ g_a g_bᵀ + μ g_b g_aᵀ + μ (g_a·g_b) I]`.
+
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+
+use super::Law;
+use crate::mesh::TetMesh;
+
+pub type ElementMatrix = SMatrix<f64, 12, 12>;
+pub type ElementVector = SVector<f64, 12>;
+
+/// Per-tetrahedron constants of the reference configuration.
+#[derive(Clone, Copy, Debug)]
+pub struct TetGeometry {
+    /// Gradients of the four shape functions, constant over the element (1/m).
+    pub grads: [Vector3<f64>; 4],
+    pub volume_m3: f64,
+}
+
+impl TetGeometry {
+    /// Precomputes the gradients of every tetrahedron of a (validated, positively oriented) mesh.
+    pub fn of_mesh(mesh: &TetMesh) -> Vec<Self> {
+        (0..mesh.tet_count())
+            .map(|t| {
+                let p = mesh.tet_points(t);
+                let edges = Matrix3::from_columns(&[p[1] - p[0], p[2] - p[0], p[3] - p[0]]);
+                let volume_m3 = edges.determinant() / 6.0;
+                // Rows of edges⁻¹ are the gradients of N_1..N_3; N_0 = 1 − N_1 − N_2 − N_3.
+                let inverse = edges
+                    .try_inverse()
+                    .expect("a validated mesh has no degenerate tetrahedra");
+                let g1 = inverse.row(0).transpose();
+                let g2 = inverse.row(1).transpose();
+                let g3 = inverse.row(2).transpose();
+                Self {
+                    grads: [-(g1 + g2 + g3), g1, g2, g3],
+                    volume_m3,
+                }
+            })
+            .collect()
+    }
+
+    /// Displacement gradient `∇u = Σ_a u_a ⊗ g_a`.
+    pub fn displacement_gradient(&self, u: &ElementVector) -> Matrix3<f64> {
+        let mut h = Matrix3::zeros();
+        for a in 0..4 {
+            h += u.fixed_rows::<3>(3 * a) * self.grads[a].transpose();
+        }
+        h
+    }
+
+    /// Internal force and tangent stiffness of this element for the element displacement `u`.
+    pub fn force_and_tangent(
+        &self,
+        law: Law,
+        lambda: f64,
+        mu: f64,
+        u: &ElementVector,
+    ) -> (ElementVector, ElementMatrix) {
+        match law {
+            Law::Linear => {
+                let k = self.linear_stiffness(lambda, mu);
+                (k * u, k)
+            }
+            Law::KirchhoffSaintVenant => self.ksv_force_and_tangent(lambda, mu, u),
+        }
+    }
+
+    /// Internal force only, for residual evaluations in line searches.
+    pub fn force(&self, law: Law, lambda: f64, mu: f64, u: &ElementVector) -> ElementVector {
+        match law {
+            Law::Linear => self.linear_stiffness(lambda, mu) * u,
+            Law::KirchhoffSaintVenant => {
+                let (f, s) = self.ksv_stress(lambda, mu, u);
+                self.nodal_forces(&(f * s))
+            }
+        }
+    }
+
+    /// Linear-elastic element stiffness.
+    pub fn linear_stiffness(&self, lambda: f64, mu: f64) -> ElementMatrix {
+        let mut k = ElementMatrix::zeros();
+        for a in 0..4 {
+            for b in 0..4 {
+                let (ga, gb) = (self.grads[a], self.grads[b]);
+                let block = (ga * gb.transpose()) * lambda
+                    + (gb * ga.transpose()) * mu
+                    + Matrix3::identity() * (mu * ga.dot(&gb));
+                k.fixed_view_mut::<3, 3>(3 * a, 3 * b)
+                    .copy_from(&(block * self.volume_m3));
+            }
+        }
+        k
+    }
+
+    /// Deformation gradient F and second Piola–Kirchhoff stress S of the KSV law.
+    fn ksv_stress(&self, lambda: f64, mu: f64, u: &ElementVector) -> (Matrix3<f64>, Matrix3<f64>) {
+        let h = self.displacement_gradient(u);
+        // E = ½(H + Hᵀ + HᵀH) rather than ½(FᵀF − I): the latter cancels catastrophically for
+        // small strains, which would put a floor of ~1e-8 on the relative residual.
+        let e = (h + h.transpose() + h.transpose() * h) * 0.5;
+        let f = Matrix3::identity() + h;
+        let s = Matrix3::identity() * (lambda * e.trace()) + e * (2.0 * mu);
+        (f, s)
+    }
+
+    /// `f_a = V · P g_a` for a first Piola–Kirchhoff stress `P`.
+    fn nodal_forces(&self, p: &Matrix3<f64>) -> ElementVector {
+        let mut force = ElementVector::zeros();
+        for a in 0..4 {
+            force
+                .fixed_rows_mut::<3>(3 * a)
+                .copy_from(&(p * self.grads[a] * self.volume_m3));
+        }
+        force
+    }
+
+    fn ksv_force_and_tangent(
+        &self,
+        lambda: f64,
+        mu: f64,
+        u: &ElementVector,
+    ) -> (ElementVector, ElementMatrix) {
+        let (f, s) = self.ksv_stress(lambda, mu, u);
+        let force = self.nodal_forces(&(f * s));
+        let fft = f * f.transpose();
+        let fg: [Vector3<f64>; 4] = self.grads.map(|g| f * g);
+        let sg: [Vector3<f64>; 4] = self.grads.map(|g| s * g);
+        let mut k = ElementMatrix::zeros();
+        for a in 0..4 {
+            for b in 0..4 {
+                let ga_gb = self.grads[a].dot(&self.grads[b]);
+                let block = Matrix3::identity() * self.grads[a].dot(&sg[b])
+                    + (fg[a] * fg[b].transpose()) * lambda
+                    + fft * (mu * ga_gb)
+                    + (fg[b] * fg[a].transpose()) * mu;
+                k.fixed_view_mut::<3, 3>(3 * a, 3 * b)
+                    .copy_from(&(block * self.volume_m3));
+            }
+        }
+        (force, k)
+    }
+}

@@ -1,0 +1,79 @@
+//! Sparse direct solves over the free-dof pattern, with the symbolic analysis done once.
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::LltError;
+use faer::sparse::{
+    SparseColMat,
+    linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu},
+};
+use faer::{MatMut, Side};
+
+use super::FemError;
+use super::pattern::FreePattern;
+
+/// Symbolic factorizations of one pattern, reused for every numeric factorization.
+pub struct DirectSolver {
+    llt: SymbolicLlt<usize>,
+    lu: Option<SymbolicLu<usize>>,
+}
+
+/// A numeric factorization ready to solve.
+pub enum Factorization {
+    /// Cholesky, for symmetric positive definite matrices (every stable elastic state).
+    Llt(Llt<usize, f64>),
+    /// LU, the fallback for a tangent that is indefinite under strong compression.
+    Lu(Lu<usize, f64>),
+}
+
+impl DirectSolver {
+    pub fn new(pattern: &FreePattern) -> Result<Self, FemError> {
+        let llt = SymbolicLlt::try_new(pattern.symbolic().as_ref(), Side::Lower)
+            .map_err(|e| FemError::Factorization(format!("{e:?}")))?;
+        Ok(Self { llt, lu: None })
+    }
+
+    /// Cholesky factorization; fails with [`FemError::NotPositiveDefinite`] on a singular or
+    /// unstable matrix.
+    pub fn cholesky(&self, matrix: &SparseColMat<usize, f64>) -> Result<Factorization, FemError> {
+        match Llt::try_new_with_symbolic(self.llt.clone(), matrix.as_ref(), Side::Lower) {
+            Ok(llt) => Ok(Factorization::Llt(llt)),
+            Err(LltError::Numeric(_)) => Err(FemError::NotPositiveDefinite),
+            Err(e) => Err(FemError::Factorization(format!("{e:?}"))),
+        }
+    }
+
+    /// Cholesky when the matrix allows it, LU otherwise (Newton tangents past a limit point).
+    pub fn cholesky_or_lu(
+        &mut self,
+        matrix: &SparseColMat<usize, f64>,
+    ) -> Result<Factorization, FemError> {
+        match self.cholesky(matrix) {
+            Err(FemError::NotPositiveDefinite) => self.lu(matrix),
+            other => other,
+        }
+    }
+
+    fn lu(&mut self, matrix: &SparseColMat<usize, f64>) -> Result<Factorization, FemError> {
+        if self.lu.is_none() {
+            let symbolic = SymbolicLu::try_new(matrix.symbolic())
+                .map_err(|e| FemError::Factorization(format!("{e:?}")))?;
+            self.lu = Some(symbolic);
+        }
+        let symbolic = self.lu.clone().expect("set above");
+        Lu::try_new_with_symbolic(symbolic, matrix.as_ref())
+            .map(Factorization::Lu)
+            .map_err(|_| FemError::NotPositiveDefinite)
+    }
+}
+
+impl Factorization {
+    /// Overwrites `rhs` with the solution.
+    pub fn solve_in_place(&self, rhs: &mut [f64]) {
+        let n = rhs.len();
+        let rhs = MatMut::from_column_major_slice_mut(rhs, n, 1);
+        match self {
+            Self::Llt(f) => f.solve_in_place(rhs),
+            Self::Lu(f) => f.solve_in_place(rhs),
+        }
+    }
+}

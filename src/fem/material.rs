@@ -1,0 +1,100 @@
+//! Isotropic hyperelastic materials for soft tissue.
+
+use serde::{Deserialize, Serialize};
+
+use super::FemError;
+
+/// Which strain measure and energy the material uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Law {
+    /// Small-strain isotropic linear elasticity: exact only for vanishing loads.
+    Linear,
+    /// Kirchhoff–Saint Venant: the linear law applied to the Green–Lagrange strain, so it is
+    /// exact under large rotations. It stiffens under stretch and softens (and finally loses
+    /// stability) under strong compression.
+    KirchhoffSaintVenant,
+}
+
+/// An isotropic elastic material in SI units.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Material {
+    pub law: Law,
+    pub young_pa: f64,
+    pub poisson: f64,
+    pub density_kg_m3: f64,
+}
+
+/// Soft tissue is close to water.
+pub const TISSUE_DENSITY_KG_M3: f64 = 1060.0;
+
+impl Material {
+    /// A validated material. Young's modulus and density must be positive and finite; Poisson's
+    /// ratio must lie in (−1, 0.5), where the strain energy is positive definite.
+    pub fn new(
+        law: Law,
+        young_pa: f64,
+        poisson: f64,
+        density_kg_m3: f64,
+    ) -> Result<Self, FemError> {
+        let material = Self {
+            law,
+            young_pa,
+            poisson,
+            density_kg_m3,
+        };
+        material.validate()?;
+        Ok(material)
+    }
+
+    /// The liver of paper 000: E = 1.60 kPa, ν = 0.48.
+    pub fn liver(law: Law) -> Self {
+        Self {
+            law,
+            young_pa: 1600.0,
+            poisson: 0.48,
+            density_kg_m3: TISSUE_DENSITY_KG_M3,
+        }
+    }
+
+    /// Checks the constants; called by every constructor and by the assembler, since the
+    /// fields are public for serialization.
+    pub fn validate(&self) -> Result<(), FemError> {
+        let bad = |field: &'static str, value: f64, expected: &'static str| {
+            Err(FemError::Material {
+                field,
+                value,
+                expected,
+            })
+        };
+        if !(self.young_pa.is_finite() && self.young_pa > 0.0) {
+            return bad(
+                "young_pa",
+                self.young_pa,
+                "a positive, finite modulus in pascals",
+            );
+        }
+        if !(self.poisson > -1.0 && self.poisson < 0.5) {
+            return bad(
+                "poisson",
+                self.poisson,
+                "a ratio strictly between -1 and 0.5 (0.5 is incompressible, which linear tetrahedra cannot represent)",
+            );
+        }
+        if !(self.density_kg_m3.is_finite() && self.density_kg_m3 > 0.0) {
+            return bad(
+                "density_kg_m3",
+                self.density_kg_m3,
+                "a positive, finite density in kg/m³",
+            );
+        }
+        Ok(())
+    }
+
+    /// Lamé constants (λ, μ) in pascals.
+    pub fn lame(&self) -> (f64, f64) {
+        let (e, nu) = (self.young_pa, self.poisson);
+        let mu = e / (2.0 * (1.0 + nu));
+        let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+        (lambda, mu)
+    }
+}

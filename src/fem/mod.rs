@@ -1,0 +1,25 @@
+//! The finite-element core: linear tetrahedra, isotropic linear elasticity and
+//! Kirchhoff–Saint Venant, sparse assembly, loads, mass, and static solvers. Plain Rust on
+//! faer and nalgebra, no Bevy: the offline PGD builder and every validation stand on it.
+
+mod dofs;
+mod element;
+mod error;
+mod linear_solver;
+mod loads;
+mod mass;
+mod material;
+mod model;
+mod newton;
+mod pattern;
+
+pub use dofs::{Dirichlet, DofMap, PRESCRIBED};
+pub use element::{ElementMatrix, ElementVector, TetGeometry};
+pub use error::FemError;
+pub use linear_solver::{DirectSolver, Factorization};
+pub use loads::Loads;
+pub use mass::{consistent_mass, lumped_mass};
+pub use material::{Law, Material, TISSUE_DENSITY_KG_M3};
+pub use model::FemModel;
+pub use newton::{NewtonSettings, StaticSolution, StepReport};
+pub use pattern::FreePattern;

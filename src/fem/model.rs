@@ -1,0 +1,208 @@
+//! A finite-element model: mesh, material and Dirichlet conditions, with the precomputed
+//! element geometry and sparsity pattern that every assembly reuses.
+
+use nalgebra::{SMatrix, SymmetricEigen, Vector3};
+
+use super::element::{ElementVector, TetGeometry};
+use super::pattern::FreePattern;
+use super::{Dirichlet, DofMap, FemError, Material, consistent_mass, lumped_mass};
+use crate::mesh::TetMesh;
+
+/// Rigid-mode ranks are read off a normalized 6×6 Gram matrix; eigenvalues below this
+/// fraction of the largest count as zero.
+const RANK_TOLERANCE: f64 = 1e-9;
+
+pub struct FemModel {
+    mesh: TetMesh,
+    geometry: Vec<TetGeometry>,
+    material: Material,
+    dirichlet: Dirichlet,
+    dofs: DofMap,
+    pattern: FreePattern,
+}
+
+impl FemModel {
+    /// Builds a model, refusing an invalid material and constraints that leave any connected
+    /// part of the mesh free to move rigidly (the stiffness would be singular).
+    pub fn new(mesh: TetMesh, material: Material, dirichlet: Dirichlet) -> Result<Self, FemError> {
+        material.validate()?;
+        if dirichlet.dof_count() != 3 * mesh.node_count() {
+            return Err(FemError::InvalidInput {
+                what: "Dirichlet conditions: dof count",
+                value: dirichlet.dof_count() as f64,
+                problem: "not three times the mesh's node count",
+            });
+        }
+        check_rigid_modes(&mesh, &dirichlet)?;
+        let geometry = TetGeometry::of_mesh(&mesh);
+        let dofs = DofMap::new(&dirichlet);
+        let pattern = FreePattern::new(&mesh, &dofs);
+        Ok(Self {
+            mesh,
+            geometry,
+            material,
+            dirichlet,
+            dofs,
+            pattern,
+        })
+    }
+
+    pub fn mesh(&self) -> &TetMesh {
+        &self.mesh
+    }
+
+    pub fn material(&self) -> &Material {
+        &self.material
+    }
+
+    pub fn dirichlet(&self) -> &Dirichlet {
+        &self.dirichlet
+    }
+
+    pub fn dofs(&self) -> &DofMap {
+        &self.dofs
+    }
+
+    pub fn pattern(&self) -> &FreePattern {
+        &self.pattern
+    }
+
+    pub fn geometry(&self) -> &[TetGeometry] {
+        &self.geometry
+    }
+
+    /// Internal force (N) on every dof for the full displacement `u_m`.
+    pub fn internal_force(&self, u_m: &[f64]) -> Vec<f64> {
+        let (lambda, mu) = self.material.lame();
+        let mut force = vec![0.0; u_m.len()];
+        for (tet, geo) in self.mesh.tets().iter().zip(&self.geometry) {
+            let ue = gather(tet, u_m);
+            let fe = geo.force(self.material.law, lambda, mu, &ue);
+            scatter_vector(tet, &fe, &mut force);
+        }
+        force
+    }
+
+    /// Internal force on every dof, and the tangent stiffness over free dofs as values of
+    /// [`Self::pattern`], both at the full displacement `u_m`.
+    pub fn force_and_tangent(&self, u_m: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let (lambda, mu) = self.material.lame();
+        let mut force = vec![0.0; u_m.len()];
+        let mut values = self.pattern.zero_values();
+        for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
+            let ue = gather(tet, u_m);
+            let (fe, ke) = geo.force_and_tangent(self.material.law, lambda, mu, &ue);
+            scatter_vector(tet, &fe, &mut force);
+            self.pattern.scatter(t, &ke, &mut values);
+        }
+        (force, values)
+    }
+
+    /// The stiffness at rest (free dofs): the linear-elastic stiffness for both laws.
+    pub fn rest_stiffness(&self) -> Vec<f64> {
+        self.force_and_tangent(&vec![0.0; 3 * self.mesh.node_count()])
+            .1
+    }
+
+    /// Lumped mass per node (kg).
+    pub fn lumped_mass(&self) -> Vec<f64> {
+        lumped_mass(
+            self.mesh.tets(),
+            &self.geometry,
+            self.mesh.node_count(),
+            self.material.density_kg_m3,
+        )
+    }
+
+    /// Consistent mass over free dofs, as values of [`Self::pattern`].
+    pub fn consistent_mass(&self) -> Vec<f64> {
+        consistent_mass(&self.pattern, &self.geometry, self.material.density_kg_m3)
+    }
+}
+
+fn gather(tet: &[usize; 4], u: &[f64]) -> ElementVector {
+    ElementVector::from_fn(|i, _| u[3 * tet[i / 3] + i % 3])
+}
+
+fn scatter_vector(tet: &[usize; 4], fe: &ElementVector, out: &mut [f64]) {
+    for (i, value) in fe.iter().enumerate() {
+        out[3 * tet[i / 3] + i % 3] += value;
+    }
+}
+
+/// For every connected part of the mesh, the six rigid modes restricted to its prescribed dofs
+/// must have the same rank as on all its dofs (6 for any solid part, 3 for a lone node).
+fn check_rigid_modes(mesh: &TetMesh, dirichlet: &Dirichlet) -> Result<(), FemError> {
+    for component in connected_parts(mesh) {
+        let centroid = component
+            .iter()
+            .fold(Vector3::zeros(), |acc, &n| acc + mesh.nodes()[n].coords)
+            / component.len() as f64;
+        let scale = component
+            .iter()
+            .map(|&n| (mesh.nodes()[n].coords - centroid).norm())
+            .fold(f64::MIN_POSITIVE, f64::max);
+        let mut all = SMatrix::<f64, 6, 6>::zeros();
+        let mut held = SMatrix::<f64, 6, 6>::zeros();
+        for &n in &component {
+            let r = (mesh.nodes()[n].coords - centroid) / scale;
+            for c in 0..3 {
+                // Value at dof (n, c) of the translations e_k and the rotations e_k × r.
+                let mut mode = SMatrix::<f64, 6, 1>::zeros();
+                mode[c] = 1.0;
+                for k in 0..3 {
+                    mode[3 + k] = Vector3::ith(k, 1.0).cross(&r)[c];
+                }
+                let outer = mode * mode.transpose();
+                all += outer;
+                if dirichlet.value(3 * n + c).is_some() {
+                    held += outer;
+                }
+            }
+        }
+        let (needed, rank) = (rank(all), rank(held));
+        if rank < needed {
+            return Err(FemError::Unconstrained {
+                example_node: component[0],
+                component_nodes: component.len(),
+                rank,
+            });
+        }
+    }
+    Ok(())
+}
+
+fn rank(gram: SMatrix<f64, 6, 6>) -> usize {
+    let eigen = SymmetricEigen::new(gram).eigenvalues;
+    let largest = eigen.iter().cloned().fold(0.0, f64::max);
+    eigen
+        .iter()
+        .filter(|&&e| e > RANK_TOLERANCE * largest.max(1.0))
+        .count()
+}
+
+/// Node sets of the connected parts (through shared tetrahedra); a node in no tetrahedron is a
+/// part of its own.
+fn connected_parts(mesh: &TetMesh) -> Vec<Vec<usize>> {
+    let mut parent: Vec<usize> = (0..mesh.node_count()).collect();
+    fn root(parent: &mut [usize], mut n: usize) -> usize {
+        while parent[n] != n {
+            parent[n] = parent[parent[n]];
+            n = parent[n];
+        }
+        n
+    }
+    for tet in mesh.tets() {
+        let first = root(&mut parent, tet[0]);
+        for &n in &tet[1..] {
+            let r = root(&mut parent, n);
+            parent[r] = first;
+        }
+    }
+    let mut parts: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+    for n in 0..mesh.node_count() {
+        let r = root(&mut parent, n);
+        parts.entry(r).or_default().push(n);
+    }
+    parts.into_values().collect()
+}

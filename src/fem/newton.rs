@@ -1,0 +1,227 @@
+//! Static equilibrium `f_int(u) = λ f_ext` by load stepping and Newton–Raphson with an
+//! energy line search. The linear law is the special case that converges in one step.
+//!
+//! The line search works on `G(α) = du · r(u + α du)`, the slope of the potential energy along
+//! the Newton direction, not on the residual norm: for bending-dominated bodies a good Newton
+//! step briefly raises the stiff axial residuals, and a norm-based search would keep cutting
+//! it, stalling far from equilibrium.
+
+use super::linear_solver::DirectSolver;
+use super::{FemError, FemModel, Loads};
+
+/// How a static solve proceeds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonSettings {
+    /// The load (and prescribed displacement) is applied in this many equal increments.
+    pub load_steps: usize,
+    /// Newton iterations allowed per load step.
+    pub max_iterations: usize,
+    /// Converged when ‖r_free‖ ≤ tol · ‖reference force‖ (the reference is the larger of the
+    /// external load and the reactions at prescribed dofs).
+    pub relative_tolerance: f64,
+    /// Secant iterations of the line search, accepting a step once `|G(α)| ≤ ½ G(0)`
+    /// (0 = always take the full Newton step).
+    pub max_line_search_iterations: usize,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        Self {
+            load_steps: 1,
+            max_iterations: 30,
+            relative_tolerance: 1e-10,
+            max_line_search_iterations: 6,
+        }
+    }
+}
+
+/// What happened in one load step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepReport {
+    /// Relative residual before each iteration, and after the last (so its last entry is the
+    /// converged value).
+    pub relative_residuals: Vec<f64>,
+    /// Line-search factor of each accepted update (1 = full Newton step).
+    pub step_lengths: Vec<f64>,
+}
+
+/// A converged equilibrium.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StaticSolution {
+    /// Displacement of every dof (m), prescribed values included.
+    pub displacement_m: Vec<f64>,
+    pub steps: Vec<StepReport>,
+}
+
+impl StaticSolution {
+    /// Displacement of one node (m).
+    pub fn node(&self, n: usize) -> [f64; 3] {
+        [0, 1, 2].map(|c| self.displacement_m[3 * n + c])
+    }
+}
+
+impl FemModel {
+    /// Solves for static equilibrium under `loads` and the model's prescribed displacements.
+    pub fn solve_static(
+        &self,
+        loads: &Loads,
+        settings: &NewtonSettings,
+    ) -> Result<StaticSolution, FemError> {
+        check_settings(settings)?;
+        if loads.node_count() != self.mesh().node_count() {
+            return Err(FemError::InvalidInput {
+                what: "loads: node count",
+                value: loads.node_count() as f64,
+                problem: "not the mesh's node count",
+            });
+        }
+        let mut solver = DirectSolver::new(self.pattern())?;
+        let mut u = vec![0.0; loads.as_slice().len()];
+        let mut steps = Vec::with_capacity(settings.load_steps);
+        for step in 1..=settings.load_steps {
+            let factor = step as f64 / settings.load_steps as f64;
+            let report = self.load_step(&mut solver, &mut u, loads, factor, step, settings)?;
+            steps.push(report);
+        }
+        Ok(StaticSolution {
+            displacement_m: u,
+            steps,
+        })
+    }
+
+    fn load_step(
+        &self,
+        solver: &mut DirectSolver,
+        u: &mut [f64],
+        loads: &Loads,
+        factor: f64,
+        step: usize,
+        settings: &NewtonSettings,
+    ) -> Result<StepReport, FemError> {
+        let f_ext: Vec<f64> = loads.as_slice().iter().map(|f| f * factor).collect();
+        let prescribed = self.dirichlet().scaled_values(factor);
+        for dof in (0..u.len()).filter(|&d| self.dirichlet().value(d).is_some()) {
+            u[dof] = prescribed[dof];
+        }
+        let mut report = StepReport {
+            relative_residuals: Vec::new(),
+            step_lengths: Vec::new(),
+        };
+        for iteration in 0..=settings.max_iterations {
+            let (f_int, tangent) = self.force_and_tangent(u);
+            let (residual, relative) = self.residual(&f_ext, &f_int);
+            report.relative_residuals.push(relative);
+            if !relative.is_finite() {
+                return Err(FemError::NonFiniteSolution {
+                    step,
+                    steps: settings.load_steps,
+                    iteration,
+                });
+            }
+            if relative <= settings.relative_tolerance {
+                return Ok(report);
+            }
+            if iteration == settings.max_iterations {
+                break;
+            }
+            let mut du = residual.clone();
+            solver
+                .cholesky_or_lu(&self.pattern().matrix(tangent))?
+                .solve_in_place(&mut du);
+            let length = self.line_search(u, &du, &f_ext, &residual, settings);
+            report.step_lengths.push(length);
+        }
+        Err(FemError::NewtonNotConverged {
+            step,
+            steps: settings.load_steps,
+            iterations: settings.max_iterations,
+            relative_residual: *report.relative_residuals.last().unwrap_or(&f64::NAN),
+            tolerance: settings.relative_tolerance,
+        })
+    }
+
+    /// Applies `α · du` to `u`, with α from a secant search for the root of `G(α)`.
+    fn line_search(
+        &self,
+        u: &mut [f64],
+        du: &[f64],
+        f_ext: &[f64],
+        r0: &[f64],
+        settings: &NewtonSettings,
+    ) -> f64 {
+        let start = u.to_vec();
+        let slope_at = |u: &mut [f64], alpha: f64| {
+            for (free, &dof) in self.dofs().free_dofs.iter().enumerate() {
+                u[dof] = start[dof] + alpha * du[free];
+            }
+            let (r, _) = self.residual(f_ext, &self.internal_force(u));
+            dot(du, &r)
+        };
+        let g0 = dot(du, r0);
+        let mut alpha = 1.0;
+        let mut g = slope_at(u, alpha);
+        // G(0) ≤ 0 means an indefinite tangent gave no descent direction: take the full step.
+        for _ in 0..settings.max_line_search_iterations {
+            if g0 <= 0.0 || g >= 0.0 || g.abs() <= 0.5 * g0 {
+                break;
+            }
+            // Overshoot: G changed sign between 0 and α; move to the secant root.
+            alpha *= (g0 / (g0 - g)).clamp(0.1, 0.9);
+            g = slope_at(u, alpha);
+        }
+        alpha
+    }
+
+    /// Free-dof residual `f_ext − f_int` and its norm relative to the larger of the external
+    /// load and the reactions at prescribed dofs (which carry the load of a displacement-driven
+    /// problem).
+    fn residual(&self, f_ext: &[f64], f_int: &[f64]) -> (Vec<f64>, f64) {
+        let dofs = self.dofs();
+        let residual: Vec<f64> = dofs
+            .free_dofs
+            .iter()
+            .map(|&d| f_ext[d] - f_int[d])
+            .collect();
+        let load = norm(dofs.free_dofs.iter().map(|&d| f_ext[d]));
+        let reactions = norm(
+            (0..f_int.len())
+                .filter(|&d| self.dirichlet().value(d).is_some())
+                .map(|d| f_int[d] - f_ext[d]),
+        );
+        let reference = load.max(reactions);
+        let r = norm(residual.iter().copied());
+        let relative = if reference > 0.0 { r / reference } else { r };
+        (residual, relative)
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn norm(values: impl Iterator<Item = f64>) -> f64 {
+    values.map(|v| v * v).sum::<f64>().sqrt()
+}
+
+fn check_settings(settings: &NewtonSettings) -> Result<(), FemError> {
+    let bad = |what, value: usize| FemError::InvalidInput {
+        what,
+        value: value as f64,
+        problem: "zero; it must be at least 1",
+    };
+    if settings.load_steps == 0 {
+        return Err(bad("load_steps", 0));
+    }
+    if settings.max_iterations == 0 {
+        return Err(bad("max_iterations", 0));
+    }
+    let tol = settings.relative_tolerance;
+    if !(tol.is_finite() && tol > 0.0) {
+        return Err(FemError::InvalidInput {
+            what: "relative_tolerance",
+            value: tol,
+            problem: "not a positive, finite number",
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,2 @@
+pub mod fem;
+pub mod mesh;

@@ -1,0 +1,12 @@
+//! Tetrahedral meshes: the validated volume mesh, its named regions, its boundary surface,
+//! and structured meshes for reference problems. Plain Rust, no Bevy.
+
+mod boundary;
+mod box_mesh;
+mod error;
+mod tet_mesh;
+
+pub use boundary::{NOT_ON_SURFACE, Surface, area_vector};
+pub use box_mesh::box_mesh;
+pub use error::MeshError;
+pub use tet_mesh::{DEGENERATE_QUALITY, Regions, TetMesh, quality, signed_volume};

@@ -1,0 +1,10 @@
+//! Finite-element core against independent references: analytic fields and beam theory,
+//! finite differences, conservation laws, and the errors bad input must produce.
+
+mod bad_input;
+mod beams;
+mod cantilever;
+mod ksv;
+mod loads_and_mass;
+mod patch;
+mod surface;
