@@ -99,6 +99,24 @@ impl Surface {
     }
 }
 
+/// Area-weighted vertex normals of a triangle soup, for shading a deformed surface: summing
+/// the unnormalized face normals weights each face by its area, so slivers do not tilt the
+/// result. `triangles` index `positions`; a vertex in no triangle gets a zero normal.
+pub fn vertex_normals(triangles: &[[usize; 3]], positions: &[[f32; 3]]) -> Vec<[f32; 3]> {
+    let mut normals = vec![Vector3::<f32>::zeros(); positions.len()];
+    for f in triangles {
+        let [a, b, c] = f.map(|i| Vector3::from(positions[i]));
+        let n = (b - a).cross(&(c - a));
+        for &i in f {
+            normals[i] += n;
+        }
+    }
+    normals
+        .into_iter()
+        .map(|n| n.try_normalize(0.0).unwrap_or_default().into())
+        .collect()
+}
+
 /// `½ (b − a) × (c − a)`: the outward normal scaled by the triangle's area.
 pub fn area_vector(nodes: &[Point3<f64>], f: &[usize; 3]) -> Vector3<f64> {
     let (a, b, c) = (nodes[f[0]], nodes[f[1]], nodes[f[2]]);

@@ -4,9 +4,13 @@
 mod boundary;
 mod box_mesh;
 mod error;
+mod quality;
+mod stuffing;
 mod tet_mesh;
 
-pub use boundary::{NOT_ON_SURFACE, Surface, area_vector};
+pub use boundary::{NOT_ON_SURFACE, Surface, area_vector, vertex_normals};
 pub use box_mesh::box_mesh;
 pub use error::MeshError;
+pub use quality::{QualityReport, aspect_ratio, dihedral_range_deg};
+pub use stuffing::{Implicit, stuff};
 pub use tet_mesh::{DEGENERATE_QUALITY, Regions, TetMesh, quality, signed_volume};

@@ -68,3 +68,35 @@ fn surface_and_volume_numbering_map_both_ways() {
         );
     }
 }
+
+#[test]
+fn vertex_normals_of_a_box_corner_point_along_the_diagonal_and_faces_are_flat() {
+    let mesh = box_mesh([1.0, 1.0, 1.0], [2, 2, 2]).unwrap();
+    let surface = Surface::extract(&mesh);
+    let positions: Vec<[f32; 3]> = surface
+        .nodes
+        .iter()
+        .map(|&n| mesh.nodes()[n].coords.map(|c| c as f32).into())
+        .collect();
+    let normals = pgd_surgery::mesh::vertex_normals(&surface.local_triangles(), &positions);
+    for (p, n) in positions.iter().zip(&normals) {
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        assert!((len - 1.0).abs() < 1e-6);
+        // The centre of a side: the normal is that side's outward axis.
+        let on_side_centre = p.iter().filter(|&&c| c == 0.5).count() == 2;
+        if on_side_centre {
+            let axis = p.iter().position(|&c| c != 0.5).unwrap();
+            let sign = if p[axis] == 1.0 { 1.0 } else { -1.0 };
+            assert!((n[axis] - sign).abs() < 1e-6, "normal {n:?} at {p:?}");
+        }
+        // A corner of the cube: every component points outward.
+        if p.iter().all(|&c| c == 0.0 || c == 1.0) {
+            for k in 0..3 {
+                assert!(
+                    n[k] * (p[k] - 0.5) > 0.0,
+                    "corner normal {n:?} at {p:?} not outward"
+                );
+            }
+        }
+    }
+}

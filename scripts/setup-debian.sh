@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs the system packages the trainer needs on Debian/Ubuntu: the X11 and Vulkan runtime
+# libraries its window loads, and Mesa's Vulkan drivers (software rendering where there is no
+# GPU driver). Building needs nothing beyond the Rust toolchain and a C compiler.
+set -euo pipefail
+packages=(
+  pkg-config
+  libx11-6 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0
+  libvulkan1 mesa-vulkan-drivers
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "setup: need root (or sudo) to install: ${missing[*]}" >&2; exit 1; }
+  sudo="sudo"
+fi
+echo "setup: installing ${missing[*]}"
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
