@@ -8,3 +8,4 @@ pub mod app;
 pub mod bench;
 pub mod fem;
 pub mod mesh;
+pub mod seam;

@@ -102,8 +102,11 @@ impl Surface {
 /// Area-weighted vertex normals of a triangle soup, for shading a deformed surface: summing
 /// the unnormalized face normals weights each face by its area, so slivers do not tilt the
 /// result. `triangles` index `positions`; a vertex in no triangle gets a zero normal.
-pub fn vertex_normals(triangles: &[[usize; 3]], positions: &[[f32; 3]]) -> Vec<[f32; 3]> {
-    let mut normals = vec![Vector3::<f32>::zeros(); positions.len()];
+pub fn vertex_normals<T: nalgebra::RealField + Copy>(
+    triangles: &[[usize; 3]],
+    positions: &[[T; 3]],
+) -> Vec<[T; 3]> {
+    let mut normals = vec![Vector3::<T>::zeros(); positions.len()];
     for f in triangles {
         let [a, b, c] = f.map(|i| Vector3::from(positions[i]));
         let n = (b - a).cross(&(c - a));
@@ -113,7 +116,11 @@ pub fn vertex_normals(triangles: &[[usize; 3]], positions: &[[f32; 3]]) -> Vec<[
     }
     normals
         .into_iter()
-        .map(|n| n.try_normalize(0.0).unwrap_or_default().into())
+        .map(|n| {
+            n.try_normalize(T::zero())
+                .unwrap_or_else(Vector3::zeros)
+                .into()
+        })
         .collect()
 }
 

@@ -4,7 +4,11 @@
 mod boundary;
 mod box_mesh;
 mod error;
+pub mod io;
+pub mod organs;
 mod quality;
+mod shell;
+mod split;
 mod stuffing;
 mod tet_mesh;
 
@@ -12,5 +16,6 @@ pub use boundary::{NOT_ON_SURFACE, Surface, area_vector, vertex_normals};
 pub use box_mesh::box_mesh;
 pub use error::MeshError;
 pub use quality::{QualityReport, aspect_ratio, dihedral_range_deg};
-pub use stuffing::{Implicit, stuff};
+pub use shell::{MidSurface, extrude, revolution, spherical_cap};
+pub use stuffing::{Implicit, stuff, stuff_to_node_count};
 pub use tet_mesh::{DEGENERATE_QUALITY, Regions, TetMesh, quality, signed_volume};

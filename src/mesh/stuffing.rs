@@ -5,8 +5,8 @@
 //! well shaped. Lattice vertices that lie too close to the surface along an edge are *warped*
 //! onto it, which removes the slivers that clipping would otherwise create; the remaining
 //! lattice tetrahedra are clipped by the surface and the clipped pieces split into tetrahedra.
-//! Pieces with quadrilateral faces are split by pulling from their lowest-numbered vertex, which
-//! gives neighbouring pieces the same diagonal on a shared face, so the mesh is conforming.
+//! Pieces with quadrilateral faces are split by [`split::pull`], which gives neighbouring pieces
+//! the same diagonal on a shared face, so the mesh is conforming.
 //! The method is pure Rust and permissively licensed; it needs only the sign of the implicit
 //! function, so any continuous function that is negative inside works, not just true distances.
 
@@ -14,7 +14,7 @@ use std::collections::HashMap;
 
 use nalgebra::{Point3, Vector3};
 
-use super::{MeshError, Regions, TetMesh};
+use super::{MeshError, Regions, TetMesh, split};
 
 /// Warp thresholds, as a fraction of the edge length from the vertex: a vertex closer than this
 /// to a cut point on one of its edges is moved onto the surface. Labelle & Shewchuk's values for
@@ -52,6 +52,20 @@ pub fn stuff(name: &str, solid: &Implicit, spacing_m: f64) -> Result<TetMesh, Me
     }
     let (nodes, tets) = compact(&pieces.points, &pieces.tets);
     TetMesh::new(name, nodes, tets, Regions::default())
+}
+
+/// Stuffs a solid, choosing the lattice spacing so the node count lands near `target`: a
+/// first pass from a rough estimate, then one correction by the cube root of the miss.
+pub fn stuff_to_node_count(
+    name: &str,
+    solid: &Implicit,
+    target: usize,
+) -> Result<TetMesh, MeshError> {
+    let extent = solid.max - solid.min;
+    let guess = (extent.x * extent.y * extent.z * 0.6 / target as f64).cbrt();
+    let first = stuff(name, solid, guess)?;
+    let spacing = guess * (first.node_count() as f64 / target as f64).cbrt();
+    stuff(name, solid, spacing)
 }
 
 /// Which side of the surface a lattice vertex is on; warped vertices are exactly on it.
@@ -317,43 +331,12 @@ impl Pieces {
         self.points.len() - 1
     }
 
-    /// Splits a convex piece given by its faces (cyclic vertex lists) into tetrahedra by
-    /// joining its lowest-numbered vertex to the faces that do not contain it; quadrilaterals
-    /// are split along the diagonal through their lowest-numbered vertex.
     fn pull(&mut self, faces: &[&[usize]]) {
-        let apex = faces
-            .iter()
-            .flat_map(|f| f.iter())
-            .copied()
-            .min()
-            .expect("pieces have faces");
-        for face in faces.iter().filter(|f| !f.contains(&apex)) {
-            match face.len() {
-                3 => self.emit([apex, face[0], face[1], face[2]]),
-                _ => {
-                    let m = (0..4)
-                        .min_by_key(|&i| face[i])
-                        .expect("a quad has four corners");
-                    let q = |k: usize| face[(m + k) % 4];
-                    self.emit([apex, q(0), q(1), q(2)]);
-                    self.emit([apex, q(0), q(2), q(3)]);
-                }
-            }
-        }
+        split::pull(faces, &self.points, &mut self.tets);
     }
 
-    /// Adds a tetrahedron, positively oriented; flat ones (a vertex on the plane of the
-    /// opposite face, possible only where warped vertices coincide) are dropped.
-    fn emit(&mut self, mut tet: [usize; 4]) {
-        let corners = tet.map(|v| self.points[v]);
-        let q = super::quality(&corners);
-        if q.abs() < super::DEGENERATE_QUALITY {
-            return;
-        }
-        if q < 0.0 {
-            tet.swap(2, 3);
-        }
-        self.tets.push(tet);
+    fn emit(&mut self, tet: [usize; 4]) {
+        split::push_oriented(tet, &self.points, &mut self.tets);
     }
 }
 

@@ -1,0 +1,164 @@
+//! Reading real meshes (Gmsh `.msh` v2/v4 ASCII, VTK legacy `.vtk`, `.vtu`, closed OBJ/STL
+//! surfaces, which are tetrahedralized) and writing `.vtu` for ParaView.
+//!
+//! Every error names the file, and for text formats the line. A mesh that parses but cannot be
+//! simulated (inverted or flat elements, a surface with holes) is refused with its quality
+//! report's reason.
+
+mod msh;
+mod surface;
+mod tokens;
+mod vtk;
+mod vtu;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use nalgebra::Point3;
+use thiserror::Error;
+
+use super::{MeshError, QualityReport, Regions, TetMesh};
+pub use surface::{SurfaceMesh, read_obj, read_stl, tetrahedralize};
+pub use vtu::write_vtu;
+
+#[derive(Debug, Error)]
+pub enum ImportError {
+    #[error("{file}: {source}")]
+    Io {
+        file: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{file}:{line}: {message}")]
+    Syntax {
+        file: String,
+        line: usize,
+        message: String,
+    },
+    #[error("{file}: {message}")]
+    Unsupported { file: String, message: String },
+    #[error("{file}: the mesh cannot be simulated: {reason}")]
+    Unusable { file: String, reason: String },
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+}
+
+/// What a volume-mesh reader produces before validation.
+#[derive(Default)]
+struct RawMesh {
+    nodes: Vec<Point3<f64>>,
+    tets: Vec<[usize; 4]>,
+    face_sets: BTreeMap<String, Vec<[usize; 3]>>,
+    node_sets: BTreeMap<String, Vec<usize>>,
+}
+
+impl RawMesh {
+    /// Checks indices, measures quality, and refuses what cannot be simulated.
+    fn into_mesh(self, file: &str) -> Result<TetMesh, ImportError> {
+        if let Some((t, _)) = self
+            .tets
+            .iter()
+            .enumerate()
+            .find(|(_, tet)| tet.iter().any(|&n| n >= self.nodes.len()))
+        {
+            return Err(ImportError::Unusable {
+                file: file.to_owned(),
+                reason: format!("tetrahedron {t} refers to a node that does not exist"),
+            });
+        }
+        if self.tets.is_empty() {
+            return Err(ImportError::Unusable {
+                file: file.to_owned(),
+                reason: "it has no tetrahedra (is it a surface mesh? OBJ and STL surfaces are tetrahedralized; other formats must hold a volume mesh)".into(),
+            });
+        }
+        let report = QualityReport::measure(&self.nodes, &self.tets);
+        if let Some(reason) = report.refusal() {
+            return Err(ImportError::Unusable {
+                file: file.to_owned(),
+                reason,
+            });
+        }
+        let mut node_sets = self.node_sets;
+        for (name, faces) in &self.face_sets {
+            let mut nodes: Vec<usize> = faces.iter().flatten().copied().collect();
+            nodes.sort_unstable();
+            nodes.dedup();
+            node_sets.entry(name.clone()).or_insert(nodes);
+        }
+        let regions = Regions {
+            node_sets,
+            face_sets: self.face_sets,
+        };
+        Ok(TetMesh::new(file, self.nodes, self.tets, regions)?)
+    }
+}
+
+/// Options for reading surfaces, which must be tetrahedralized.
+#[derive(Clone, Copy, Debug)]
+pub struct ImportOptions {
+    /// Multiplies coordinates: 0.001 for files in millimetres.
+    pub scale: f64,
+    /// Target node count when tetrahedralizing a surface.
+    pub surface_nodes: usize,
+}
+
+impl Default for ImportOptions {
+    fn default() -> Self {
+        Self {
+            scale: 1.0,
+            surface_nodes: 4_000,
+        }
+    }
+}
+
+/// Reads a mesh file, choosing the format by extension.
+pub fn load(path: &Path, options: &ImportOptions) -> Result<TetMesh, ImportError> {
+    let file = path.display().to_string();
+    let read = || {
+        std::fs::read(path).map_err(|source| ImportError::Io {
+            file: file.clone(),
+            source,
+        })
+    };
+    let text = |bytes: Vec<u8>| {
+        String::from_utf8(bytes).map_err(|e| ImportError::Unsupported {
+            file: file.clone(),
+            message: format!(
+                "not UTF-8 text (byte {}); only ASCII files are read",
+                e.utf8_error().valid_up_to()
+            ),
+        })
+    };
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let raw = match extension.as_str() {
+        "msh" => msh::read(&file, &text(read()?)?)?,
+        "vtk" => vtk::read(&file, &text(read()?)?)?,
+        "vtu" => vtu::read(&file, &text(read()?)?)?,
+        "obj" => {
+            let surface = read_obj(&file, &text(read()?)?)?;
+            return tetrahedralize(&file, surface.scaled(options.scale), options.surface_nodes);
+        }
+        "stl" => {
+            let surface = read_stl(&file, &read()?)?;
+            return tetrahedralize(&file, surface.scaled(options.scale), options.surface_nodes);
+        }
+        _ => {
+            return Err(ImportError::Unsupported {
+                file,
+                message: format!(
+                    "unknown mesh format '.{extension}'; expected .msh, .vtk, .vtu, .obj or .stl"
+                ),
+            });
+        }
+    };
+    let mut raw = raw;
+    for p in &mut raw.nodes {
+        *p = Point3::from(p.coords * options.scale);
+    }
+    raw.into_mesh(&file)
+}
