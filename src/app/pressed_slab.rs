@@ -84,7 +84,7 @@ impl PressedSlab {
     /// One line for the console and the on-screen HUD.
     pub fn summary(&self) -> String {
         format!(
-            "liver-tissue slab ({} nodes, {} tets, KSV, E = 1.6 kPa, ν = 0.48) pressed with {:.2} N: \
+            "liver-tissue slab ({} nodes, {} tets, KSV, E = 1.6 kPa, Poisson ratio 0.48) pressed with {:.2} N: \
              max displacement {:.1} mm after {} Newton iterations",
             self.nodes,
             self.tets,

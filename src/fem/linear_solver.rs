@@ -22,7 +22,7 @@ pub enum Factorization {
     /// Cholesky, for symmetric positive definite matrices (every stable elastic state).
     Llt(Llt<usize, f64>),
     /// LU, the fallback for a tangent that is indefinite under strong compression.
-    Lu(Lu<usize, f64>),
+    Lu(Box<Lu<usize, f64>>),
 }
 
 impl DirectSolver {
@@ -61,7 +61,7 @@ impl DirectSolver {
         }
         let symbolic = self.lu.clone().expect("set above");
         Lu::try_new_with_symbolic(symbolic, matrix.as_ref())
-            .map(Factorization::Lu)
+            .map(|lu| Factorization::Lu(Box::new(lu)))
             .map_err(|_| FemError::NotPositiveDefinite)
     }
 }

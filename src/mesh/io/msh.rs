@@ -30,11 +30,7 @@ pub(super) fn read(file: &str, text: &str) -> Result<RawMesh, ImportError> {
         )));
     }
     let mut reader = Reader::default();
-    loop {
-        let section = match t.next("a section") {
-            Ok(section) => section,
-            Err(_) => break,
-        };
+    while let Ok(section) = t.next("a section") {
         match (section, major) {
             ("$PhysicalNames", _) => reader.physical_names(&mut t)?,
             ("$Entities", 4) => reader.entities(&mut t)?,
