@@ -148,7 +148,8 @@ impl Abdomen {
             .max(GAP_M - self.gallbladder_outer(p))
     }
 
-    /// The implicit function of an abdominal organ's final shape (negative inside).
+    /// The implicit function of an organ's final shape (negative inside); the cornea, which
+    /// is not in the abdomen, is outside everywhere.
     pub fn value(&self, organ: Organ, p: &Point3<f64>) -> f64 {
         match organ {
             Organ::Liver => self.liver(p),
@@ -159,10 +160,11 @@ impl Abdomen {
         }
     }
 
-    /// Meshes one abdominal organ and tags its regions.
+    /// Meshes one organ and tags its regions (the cornea stands apart from the abdomen).
     pub fn mesh(&self, organ: Organ, settings: &OrganSettings) -> Result<TetMesh, MeshError> {
         let target = target_nodes(organ, settings);
         let mut mesh = match organ {
+            Organ::Cornea => return cornea(settings),
             Organ::Gallbladder => self.gallbladder_mesh(target)?,
             _ => {
                 let (min, max) = self.bounds(organ);
@@ -307,7 +309,7 @@ fn outer_faces_without(
 }
 
 /// The cornea of paper 001: a thin spherical cap, rim clamped, anterior face accessible.
-pub fn cornea(settings: &OrganSettings) -> Result<TetMesh, MeshError> {
+fn cornea(settings: &OrganSettings) -> Result<TetMesh, MeshError> {
     let per_layer = target_nodes(Organ::Cornea, settings) / (SHELL_LAYERS + 1);
     // A hexagonal disc of r rings has 1 + 3r(r + 1) vertices.
     let rings = (((per_layer as f64 / 3.0).sqrt()).round() as usize).max(2);

@@ -94,12 +94,8 @@ impl Default for OrganSettings {
     }
 }
 
-/// Generates one organ with its regions. The abdominal organs are built together (their
-/// shapes depend on each other); this returns the one asked for.
+/// Generates one organ with its regions. The abdominal organs' shapes depend on each other,
+/// so the whole layout is set up and the organ asked for is meshed.
 pub fn generate(organ: Organ, settings: &OrganSettings) -> Result<TetMesh, MeshError> {
-    if organ == Organ::Cornea {
-        return abdomen::cornea(settings);
-    }
-    let abdomen = Abdomen::new(settings);
-    abdomen.mesh(organ, settings)
+    Abdomen::new(settings).mesh(organ, settings)
 }

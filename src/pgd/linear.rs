@@ -1,0 +1,184 @@
+//! The linear vademecum by greedy enrichment: one product `R(x) S(p)` per step, each found by
+//! an alternating-directions fixed point (paper 002, eq. 3).
+//!
+//! In matrix form the problem is `K U W = F W`, with `K` the stiffness over free dofs, `F` the
+//! regularized unit loads (one column per parameter) and `W` the parameter space's quadrature
+//! weights (the accessible surface area of each load position). With `U_n = Σ X^k Y^kᵀ` known:
+//! - `S` fixed: `K R = (F W S − K U_n W S) / (Sᵀ W S)` — one solve with the factorization of
+//!   `K`, computed once for the whole build;
+//! - `R` fixed: `S = (Fᵀ R − U_nᵀ K R) / (Rᵀ K R)` — closed form, no solve.
+
+use super::LoadPatches;
+use super::separated::{SeparatedField, dot};
+use crate::fem::{DirectSolver, FemError, FemModel};
+
+/// How the enrichment proceeds and when it stops.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PgdSettings {
+    /// Stop once a new mode's amplitude falls below this fraction of the first mode's.
+    pub tolerance: f64,
+    /// At most this many modes.
+    pub max_modes: usize,
+    /// The fixed point has converged when the product changes by less than this (relative).
+    pub fixed_point_tolerance: f64,
+    pub max_fixed_point_iterations: usize,
+}
+
+impl Default for PgdSettings {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-3,
+            max_modes: 60,
+            fixed_point_tolerance: 1e-6,
+            max_fixed_point_iterations: 30,
+        }
+    }
+}
+
+/// One enrichment step, as reported to the user and to the convergence curve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModeReport {
+    pub fixed_point_iterations: usize,
+    pub fixed_point_converged: bool,
+    /// `√(Rᵀ K R) · √(Sᵀ W S)`: the energy the mode carries.
+    pub amplitude: f64,
+    /// Amplitude relative to the first mode's: the stopping criterion.
+    pub relative_amplitude: f64,
+}
+
+/// Builds the linear vademecum of `model` for the unit loads of `patches`. `progress` is called
+/// after each mode with its number and report.
+pub fn build_linear(
+    model: &FemModel,
+    patches: &LoadPatches,
+    settings: &PgdSettings,
+    progress: &mut dyn FnMut(usize, &ModeReport),
+) -> Result<(SeparatedField, Vec<ModeReport>), FemError> {
+    let stiffness = model.rest_stiffness();
+    let solver = DirectSolver::new(model.pattern())?;
+    let factor = solver.cholesky(&model.pattern().matrix(stiffness.clone()))?;
+    let weights: Vec<f64> = patches.areas_m2.iter().flat_map(|&a| [a; 3]).collect();
+    let dofs = model.dofs();
+    let full = 3 * model.mesh().node_count();
+
+    let mut field = SeparatedField::default();
+    // K X^k over free dofs, kept so the S-step needs no product with K per old mode.
+    let mut stiff_modes: Vec<Vec<f64>> = Vec::new();
+    let mut reports = Vec::new();
+    let mut first_amplitude = None;
+    while field.modes() < settings.max_modes {
+        let mut s = starting_guess(patches.parameter_count(), field.modes());
+        let mut r_free = vec![0.0; dofs.free_count()];
+        let mut iterations = 0;
+        let mut converged = false;
+        while iterations < settings.max_fixed_point_iterations {
+            iterations += 1;
+            let (previous_r, previous_s) = (r_free.clone(), s.clone());
+            // R-step: one solve.
+            let ws: Vec<f64> = s.iter().zip(&weights).map(|(a, w)| a * w).collect();
+            let alpha = dot(&s, &ws);
+            let mut load = vec![0.0; full];
+            patches.apply(&ws, &mut load);
+            let mut r = dofs.restrict(&load);
+            factor.solve_in_place(&mut r);
+            for (k, y) in field.parametric.iter().enumerate() {
+                let c = dot(y, &ws);
+                let x = &field.spatial[k];
+                for (ri, &d) in r.iter_mut().zip(&dofs.free_dofs) {
+                    *ri -= c * x[d];
+                }
+            }
+            r.iter_mut().for_each(|v| *v /= alpha);
+            r_free = r;
+            // S-step: closed form.
+            let mut kr = vec![0.0; dofs.free_count()];
+            model.pattern().mul(&stiffness, &r_free, &mut kr);
+            let beta = dot(&r_free, &kr);
+            let mut r_full = vec![0.0; full];
+            for (v, &d) in r_free.iter().zip(&dofs.free_dofs) {
+                r_full[d] = *v;
+            }
+            patches.apply_transpose(&r_full, &mut s);
+            for (y, kx) in field.parametric.iter().zip(&stiff_modes) {
+                let c = dot(kx, &r_free);
+                for (si, yi) in s.iter_mut().zip(y) {
+                    *si -= c * yi;
+                }
+            }
+            s.iter_mut().for_each(|v| *v /= beta);
+            if product_change(&r_free, &s, &previous_r, &previous_s)
+                < settings.fixed_point_tolerance
+            {
+                converged = true;
+                break;
+            }
+        }
+        let mut kr = vec![0.0; dofs.free_count()];
+        model.pattern().mul(&stiffness, &r_free, &mut kr);
+        let energy_r = dot(&r_free, &kr).sqrt();
+        let energy_s = s
+            .iter()
+            .zip(&weights)
+            .map(|(a, w)| a * a * w)
+            .sum::<f64>()
+            .sqrt();
+        let amplitude = energy_r * energy_s;
+        let first = *first_amplitude.get_or_insert(amplitude);
+        let report = ModeReport {
+            fixed_point_iterations: iterations,
+            fixed_point_converged: converged,
+            amplitude,
+            relative_amplitude: if first > 0.0 { amplitude / first } else { 0.0 },
+        };
+        if !amplitude.is_finite() {
+            return Err(FemError::NonFiniteSolution {
+                step: field.modes() + 1,
+                steps: settings.max_modes,
+                iteration: iterations,
+            });
+        }
+        // Store X with unit energy and the amplitude in Y, so mode sizes are comparable.
+        let scale = if energy_r > 0.0 { 1.0 / energy_r } else { 0.0 };
+        let mut x = vec![0.0; full];
+        for (v, &d) in r_free.iter().zip(&dofs.free_dofs) {
+            x[d] = v * scale;
+        }
+        field.push(
+            x,
+            s.iter().map(|v| v / scale.max(f64::MIN_POSITIVE)).collect(),
+        );
+        stiff_modes.push(kr.iter().map(|v| v * scale).collect());
+        reports.push(report);
+        progress(field.modes(), &report);
+        if report.relative_amplitude < settings.tolerance {
+            break;
+        }
+    }
+    Ok((field, reports))
+}
+
+/// A deterministic, non-degenerate start for the fixed point, different for every mode.
+fn starting_guess(len: usize, mode: usize) -> Vec<f64> {
+    let mut state = 0x2545_F491_4F6C_DD1D_u64 ^ (mode as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    (0..len)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 + 0.5
+        })
+        .collect()
+}
+
+/// `‖R Sᵀ − R₀ S₀ᵀ‖ / ‖R Sᵀ‖` in the Frobenius norm, from inner products only.
+fn product_change(r: &[f64], s: &[f64], r0: &[f64], s0: &[f64]) -> f64 {
+    let now = dot(r, r) * dot(s, s);
+    let before = dot(r0, r0) * dot(s0, s0);
+    let cross = dot(r, r0) * dot(s, s0);
+    let diff = (now + before - 2.0 * cross).max(0.0);
+    if now > 0.0 {
+        (diff / now).sqrt()
+    } else {
+        f64::INFINITY
+    }
+}
