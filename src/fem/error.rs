@@ -65,6 +65,9 @@ pub enum FemError {
         tolerance: f64,
     },
 
+    #[error("PGD mode {mode} became non-finite; check the material and the loads")]
+    NonFiniteMode { mode: usize },
+
     #[error("the solution became non-finite in load step {step} of {steps}, iteration {iteration}")]
     NonFiniteSolution {
         step: usize,

@@ -131,22 +131,21 @@ pub fn build_linear(
             relative_amplitude: if first > 0.0 { amplitude / first } else { 0.0 },
         };
         if !amplitude.is_finite() {
-            return Err(FemError::NonFiniteSolution {
-                step: field.modes() + 1,
-                steps: settings.max_modes,
-                iteration: iterations,
+            return Err(FemError::NonFiniteMode {
+                mode: field.modes() + 1,
             });
         }
+        if energy_r == 0.0 {
+            // Nothing left that the loads can excite: the vademecum is exact.
+            break;
+        }
         // Store X with unit energy and the amplitude in Y, so mode sizes are comparable.
-        let scale = if energy_r > 0.0 { 1.0 / energy_r } else { 0.0 };
+        let scale = 1.0 / energy_r;
         let mut x = vec![0.0; full];
         for (v, &d) in r_free.iter().zip(&dofs.free_dofs) {
             x[d] = v * scale;
         }
-        field.push(
-            x,
-            s.iter().map(|v| v / scale.max(f64::MIN_POSITIVE)).collect(),
-        );
+        field.push(x, s.iter().map(|v| v * energy_r).collect());
         stiff_modes.push(kr.iter().map(|v| v * scale).collect());
         reports.push(report);
         progress(field.modes(), &report);
