@@ -44,12 +44,9 @@ fn errors_by_mode_count(
         .map(|m| {
             let mut err = 0.0;
             for (p, u) in reference.iter().enumerate() {
+                // `field` uses as many modes as it is given coefficients.
                 let coefficients: Vec<f64> = field.parametric[..m].iter().map(|y| y[p]).collect();
-                let truncated = pgd_surgery::pgd::SeparatedField {
-                    spatial: field.spatial[..m].to_vec(),
-                    parametric: field.parametric[..m].to_vec(),
-                };
-                let approx = truncated.field(&coefficients);
+                let approx = field.field(&coefficients);
                 err += u
                     .iter()
                     .zip(&approx)

@@ -238,6 +238,11 @@ fn malformed_files_name_file_and_line() {
     assert_eq!(line, 7, "{message}");
     assert!(message.contains("endloop"), "{message}");
 
+    let misspelled = "solid x\nfacett normal 0 0 1\n";
+    let (message, line) = syntax_line(import("typo.stl", misspelled).unwrap_err());
+    assert_eq!(line, 2, "{message}");
+    assert!(message.contains("'facett'"), "{message}");
+
     let vtu = "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"1\" NumberOfCells=\"0\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"binary\">AAAA</DataArray>\n";
     let (message, line) = syntax_line(import("bin.vtu", vtu).unwrap_err());
     assert_eq!(line, 6, "{message}");

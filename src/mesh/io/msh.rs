@@ -49,7 +49,7 @@ pub(super) fn read(file: &str, text: &str) -> Result<RawMesh, ImportError> {
             }
         }
     }
-    reader.finish(file)
+    Ok(reader.finish())
 }
 
 #[derive(Default)]
@@ -247,7 +247,7 @@ impl Reader {
         t.expect("$EndElements")
     }
 
-    fn finish(mut self, _file: &str) -> Result<RawMesh, ImportError> {
+    fn finish(mut self) -> RawMesh {
         for (physical, faces) in self.faces {
             let name = self
                 .names
@@ -256,6 +256,6 @@ impl Reader {
                 .unwrap_or_else(|| format!("physical_{physical}"));
             self.mesh.face_sets.insert(name, faces);
         }
-        Ok(self.mesh)
+        self.mesh
     }
 }

@@ -132,17 +132,13 @@ pub fn read_stl(file: &str, bytes: &[u8]) -> Result<SurfaceMesh, ImportError> {
 fn ascii_stl(file: &str, text: &str) -> Result<Vec<[Point3<f64>; 3]>, ImportError> {
     let mut t = Tokens::new(file, text);
     t.expect("solid")?;
+    // The rest of the first line is the solid's name.
+    t.rest_of_line();
     let mut triangles = Vec::new();
     loop {
         match t.next("'facet' or 'endsolid'")? {
             "facet" => {}
             "endsolid" => return Ok(triangles),
-            "solid" => continue,
-            other if triangles.is_empty() => {
-                // The solid's name, on the 'solid' line.
-                let _ = other;
-                continue;
-            }
             other => {
                 return Err(t.error(format!("expected 'facet' or 'endsolid', found '{other}'")));
             }
