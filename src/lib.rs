@@ -7,6 +7,7 @@
 
 pub mod app;
 pub mod bench;
+pub mod cli;
 pub mod fem;
 pub mod mesh;
 pub mod pgd;

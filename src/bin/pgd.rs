@@ -1,13 +1,15 @@
-//! `pgd`: offline work — organ meshes, benchmarks; vademecum builds and validation to come.
+//! `pgd`: offline work — organ meshes, vademecum builds, benchmarks.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
-use pgd_surgery::bench;
-use pgd_surgery::mesh::io::{ImportOptions, load, write_vtu};
-use pgd_surgery::mesh::organs::{self, Organ, OrganSettings};
+use clap::{Args, Parser, Subcommand};
+use pgd_surgery::fem::{Law, Material, TISSUE_DENSITY_KG_M3};
+use pgd_surgery::mesh::io::{ImportOptions, write_vtu};
+use pgd_surgery::mesh::organs::{Organ, OrganSettings, region};
 use pgd_surgery::mesh::{QualityReport, TetMesh};
+use pgd_surgery::pgd::{self, BuildReport, BuildSettings, OrganModel, PgdSettings};
+use pgd_surgery::{bench, cli};
 
 #[derive(Parser)]
 #[command(
@@ -26,32 +28,136 @@ enum Command {
     /// (.msh, .vtk, .vtu, or a closed .obj/.stl surface, which is tetrahedralized), and print
     /// its statistics and quality report. Exits with status 1 if the mesh cannot be simulated.
     Mesh {
-        /// An organ name or a mesh file.
-        source: String,
+        #[command(flatten)]
+        mesh: MeshArgs,
         /// Also write the mesh (with its regions) as .vtu for ParaView.
         #[arg(long, value_name = "FILE.vtu")]
         out: Option<PathBuf>,
         /// Print the report as JSON.
         #[arg(long)]
         json: bool,
-        /// Organs: multiplies the node count (1 = the papers' sizes).
-        #[arg(long, default_value_t = 1.0)]
-        resolution: f64,
-        /// Organs: varies proportions deterministically (another patient).
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Files: multiplies coordinates (0.001 for files in millimetres).
-        #[arg(long, default_value_t = 1.0)]
-        scale: f64,
-        /// Surfaces (.obj, .stl): target node count of the tetrahedralization.
-        #[arg(long, default_value_t = 4000)]
-        nodes: usize,
+    },
+    /// Build the vademecum of an organ or of a mesh file with `clamped` and `accessible`
+    /// regions: exact local responses, PGD global modes, and the brute-force baseline measured
+    /// in the same run. Writes vademecums/<name>.vdm unless --out says otherwise.
+    Build {
+        #[command(flatten)]
+        mesh: MeshArgs,
+        #[command(flatten)]
+        material: MaterialArgs,
+        #[command(flatten)]
+        build: BuildArgs,
+        /// Where to write the vademecum.
+        #[arg(long, value_name = "FILE.vdm")]
+        out: Option<PathBuf>,
+        /// Print the build report as JSON.
+        #[arg(long)]
+        json: bool,
     },
     /// Time the numerical core and print medians (and ratios to a baseline run alongside).
     Bench {
         #[command(subcommand)]
         what: BenchTarget,
     },
+}
+
+/// Where the mesh comes from.
+#[derive(Args)]
+struct MeshArgs {
+    /// An organ (liver, gallbladder, pancreas, duodenum, cornea) or a mesh file.
+    source: String,
+    /// Organs: multiplies the node count (1 = the papers' sizes).
+    #[arg(long, default_value_t = 1.0)]
+    resolution: f64,
+    /// Organs: varies proportions deterministically (another patient).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Files: multiplies coordinates (0.001 for files in millimetres).
+    #[arg(long, default_value_t = 1.0)]
+    scale: f64,
+    /// Surfaces (.obj, .stl): target node count of the tetrahedralization.
+    #[arg(long, default_value_t = 4000)]
+    nodes: usize,
+}
+
+impl MeshArgs {
+    fn load(&self) -> Result<(Option<Organ>, TetMesh), String> {
+        cli::load_source(&cli::MeshSource {
+            name: &self.source,
+            organ: OrganSettings {
+                resolution: self.resolution,
+                seed: self.seed,
+            },
+            import: ImportOptions {
+                scale: self.scale,
+                surface_nodes: self.nodes,
+            },
+        })
+    }
+
+    /// The file name a vademecum of this source gets by default.
+    fn stem(&self) -> String {
+        Path::new(&self.source)
+            .file_stem()
+            .map_or_else(|| self.source.clone(), |s| s.to_string_lossy().into_owned())
+    }
+}
+
+#[derive(Args)]
+struct MaterialArgs {
+    /// Material law: linear, or ksv (Kirchhoff–Saint Venant, by load steps).
+    #[arg(long, default_value = "linear", value_parser = ["linear", "ksv"])]
+    law: String,
+    /// Young's modulus in Pa (default: the organ's, or the liver's 1.6 kPa for mesh files).
+    #[arg(long)]
+    young_pa: Option<f64>,
+    /// Poisson's ratio.
+    #[arg(long, default_value_t = pgd::organ::POISSON)]
+    poisson: f64,
+}
+
+impl MaterialArgs {
+    fn material(&self, organ: Option<Organ>) -> Result<Material, String> {
+        let law = if self.law == "ksv" {
+            Law::KirchhoffSaintVenant
+        } else {
+            Law::Linear
+        };
+        let young_pa = self
+            .young_pa
+            .unwrap_or_else(|| pgd::organ::young_pa(organ.unwrap_or(Organ::Liver)));
+        Material::new(law, young_pa, self.poisson, TISSUE_DENSITY_KG_M3).map_err(|e| e.to_string())
+    }
+}
+
+#[derive(Args)]
+struct BuildArgs {
+    /// Radius of the tool tip's contact patch, in millimetres: loads are spread over it.
+    #[arg(long, default_value_t = 6.0)]
+    tool_radius_mm: f64,
+    /// Radius around the load, in millimetres, where the exact response is stored.
+    #[arg(long, default_value_t = 20.0)]
+    local_radius_mm: f64,
+    /// Target relative L2 error of the field (global modes + exact near field).
+    #[arg(long, default_value_t = BuildSettings::default().target_error)]
+    target_error: f64,
+    /// At most this many PGD modes per load step.
+    #[arg(long, default_value_t = PgdSettings::default().max_modes)]
+    max_modes: usize,
+}
+
+impl BuildArgs {
+    fn settings(&self) -> BuildSettings {
+        BuildSettings {
+            tool_tip_radius_m: self.tool_radius_mm * 1e-3,
+            local_radius_m: self.local_radius_mm * 1e-3,
+            target_error: self.target_error,
+            pgd: PgdSettings {
+                max_modes: self.max_modes,
+                ..PgdSettings::default()
+            },
+        }
+    }
 }
 
 #[derive(Subcommand)]
@@ -72,30 +178,27 @@ enum BenchTarget {
 
 fn main() -> ExitCode {
     match Cli::parse().command {
-        Command::Mesh {
-            source,
+        Command::Mesh { mesh, out, json } => match mesh.load() {
+            Ok((_, m)) => report_mesh(&mesh.source, &m, out.as_deref(), json),
+            Err(e) => fail("pgd mesh", &e),
+        },
+        Command::Build {
+            mesh,
+            material,
+            build,
             out,
             json,
-            resolution,
-            seed,
-            scale,
-            nodes,
         } => {
-            let mesh = match Organ::from_name(&source) {
-                Some(organ) => organs::generate(organ, &OrganSettings { resolution, seed })
-                    .map_err(|e| e.to_string()),
-                None => load(
-                    Path::new(&source),
-                    &ImportOptions {
-                        scale,
-                        surface_nodes: nodes,
-                    },
-                )
-                .map_err(|e| e.to_string()),
-            };
-            match mesh {
-                Ok(mesh) => report_mesh(&source, &mesh, out.as_deref(), json),
-                Err(e) => fail("pgd mesh", &e),
+            let out = out.unwrap_or_else(|| {
+                PathBuf::from("vademecums").join(format!("{}.vdm", mesh.stem()))
+            });
+            match build_vademecum(&mesh, &material, &build, &out) {
+                Ok(report) if json => print_json(&report),
+                Ok(report) => {
+                    print_build_report(&report, &out);
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail("pgd build", &e),
             }
         }
         Command::Bench {
@@ -117,6 +220,67 @@ fn main() -> ExitCode {
             }
         }
     }
+}
+
+fn build_vademecum(
+    mesh: &MeshArgs,
+    material: &MaterialArgs,
+    build: &BuildArgs,
+    out: &Path,
+) -> Result<BuildReport, String> {
+    let (organ, tet_mesh) = mesh.load()?;
+    let material = material.material(organ)?;
+    let model = pgd::organ::clamped_model(tet_mesh, material)
+        .map_err(|e| format!("{}: {e}", mesh.source))?;
+    let organ_model = OrganModel {
+        source: mesh.source.clone(),
+        model: &model,
+        clamped_region: region::CLAMPED.into(),
+        accessible_region: region::ACCESSIBLE.into(),
+    };
+    let (vademecum, report) = pgd::build(&organ_model, &build.settings(), &cli::Bar::default())
+        .map_err(|e| format!("{}: {e}", mesh.source))?;
+    pgd::save(out, &vademecum).map_err(|e| e.to_string())?;
+    Ok(report)
+}
+
+fn print_build_report(report: &BuildReport, out: &Path) {
+    println!(
+        "{} load positions x 3 directions = {} parameters, {} free dofs",
+        report.positions, report.parameters, report.free_dofs
+    );
+    for (k, step) in report.steps.iter().enumerate() {
+        let n = step.modes_kept;
+        let pgd_error = step.curve.separated.last().copied().unwrap_or(f64::NAN);
+        let optimal = step
+            .curve
+            .optimal
+            .get(n.wrapping_sub(1))
+            .copied()
+            .unwrap_or(f64::NAN);
+        println!(
+            "step {k} (indentation {:.1} mm): {n} modes, global-part energy error {:.1} % \
+             (optimal rank-{n}: {:.1} %, ratio {:.2})",
+            step.indentation_m * 1e3,
+            100.0 * pgd_error,
+            100.0 * optimal,
+            pgd_error / optimal
+        );
+        println!(
+            "  time: PGD {:.1} s, brute force (solves + SVD) {:.1} s (PGD/brute force {:.2}), local part {:.1} s",
+            step.pgd_seconds,
+            step.brute_force_seconds,
+            step.pgd_seconds / step.brute_force_seconds,
+            step.local_seconds
+        );
+    }
+    let size = std::fs::metadata(out).map_or(0, |m| m.len());
+    println!(
+        "wrote {} ({:.1} MB) in {:.1} s",
+        out.display(),
+        size as f64 / 1e6,
+        report.total_seconds
+    );
 }
 
 /// Prints a mesh's statistics, regions and quality, writes it if asked, and fails if the mesh

@@ -76,4 +76,15 @@ impl Factorization {
             Self::Lu(f) => f.solve_in_place(rhs),
         }
     }
+
+    /// Overwrites the column-major block `rhs` (`rows` rows) with the solutions: one pass over
+    /// the factor for all columns, much faster than column by column.
+    pub fn solve_block_in_place(&self, rhs: &mut [f64], rows: usize) {
+        let cols = rhs.len() / rows;
+        let rhs = MatMut::from_column_major_slice_mut(rhs, rows, cols);
+        match self {
+            Self::Llt(f) => f.solve_in_place(rhs),
+            Self::Lu(f) => f.solve_in_place(rhs),
+        }
+    }
 }

@@ -114,10 +114,8 @@ impl Loads {
         Ok(())
     }
 
-    /// Adds a point force (N) at `point`, regularized over the surface patch within `radius_m`:
-    /// each surface node within the radius gets a share proportional to its lumped area times
-    /// the smooth kernel `(1 − (d/r)²)²`. The shares sum to one, so the total force is exact, and
-    /// the load moves smoothly as `point` slides along the surface.
+    /// Adds a point force (N) at `point`, regularized over the surface patch within `radius_m`
+    /// (see [`PatchKernel`]).
     pub fn add_point_load(
         &mut self,
         mesh: &TetMesh,
@@ -126,6 +124,28 @@ impl Loads {
         force_n: [f64; 3],
         radius_m: f64,
     ) -> Result<(), FemError> {
+        let kernel = PatchKernel::new(mesh, surface, radius_m)?;
+        for (node, share) in kernel.shares(point)? {
+            self.add_nodal_force(node, force_n.map(|f| f * share))?;
+        }
+        Ok(())
+    }
+}
+
+/// The regularized Dirac load of a tool tip: a point force spread over the surface nodes within
+/// `radius_m` (the contact patch), each getting a share proportional to its lumped area times
+/// the smooth kernel `(1 − (d/r)²)²`. The shares sum to one, so the total force is exact, and
+/// the load moves smoothly as its point slides along the surface.
+#[derive(Clone, Debug)]
+pub struct PatchKernel {
+    nodes: Vec<usize>,
+    positions: Vec<Point3<f64>>,
+    areas_m2: Vec<f64>,
+    radius_m: f64,
+}
+
+impl PatchKernel {
+    pub fn new(mesh: &TetMesh, surface: &Surface, radius_m: f64) -> Result<Self, FemError> {
         if !(radius_m.is_finite() && radius_m > 0.0) {
             return Err(FemError::InvalidInput {
                 what: "point load radius_m",
@@ -133,37 +153,44 @@ impl Loads {
                 problem: "not a positive, finite length",
             });
         }
-        let weights = patch_weights(mesh, surface, point, radius_m);
+        Ok(Self {
+            nodes: surface.nodes.clone(),
+            positions: surface.nodes.iter().map(|&n| mesh.nodes()[n]).collect(),
+            areas_m2: surface.vertex_areas(mesh),
+            radius_m,
+        })
+    }
+
+    pub fn radius_m(&self) -> f64 {
+        self.radius_m
+    }
+
+    /// Lumped area (m²) of the `i`-th surface node.
+    pub fn area_m2(&self, surface_index: usize) -> f64 {
+        self.areas_m2[surface_index]
+    }
+
+    /// The surface nodes (volume numbering) loaded by a unit force at `point`, with their
+    /// shares, which sum to one.
+    pub fn shares(&self, point: Point3<f64>) -> Result<Vec<(usize, f64)>, FemError> {
+        let weights: Vec<(usize, f64)> = self
+            .positions
+            .iter()
+            .zip(&self.areas_m2)
+            .zip(&self.nodes)
+            .filter_map(|((p, area), &node)| {
+                let t = (p - point).norm() / self.radius_m;
+                (t < 1.0).then(|| (node, area * (1.0 - t * t).powi(2)))
+            })
+            .collect();
         let total: f64 = weights.iter().map(|&(_, w)| w).sum();
         if total <= 0.0 {
             return Err(FemError::InvalidInput {
                 what: "point load radius_m",
-                value: radius_m,
+                value: self.radius_m,
                 problem: "smaller than the distance from the load point to any surface node; use a radius at least the local edge length",
             });
         }
-        for (node, w) in weights {
-            self.add_nodal_force(node, force_n.map(|f| f * w / total))?;
-        }
-        Ok(())
+        Ok(weights.into_iter().map(|(n, w)| (n, w / total)).collect())
     }
-}
-
-/// Unnormalized kernel weights of the surface nodes within `radius_m` of `point`.
-fn patch_weights(
-    mesh: &TetMesh,
-    surface: &Surface,
-    point: Point3<f64>,
-    radius_m: f64,
-) -> Vec<(usize, f64)> {
-    let areas = surface.vertex_areas(mesh);
-    surface
-        .nodes
-        .iter()
-        .zip(areas)
-        .filter_map(|(&node, area)| {
-            let t = (mesh.nodes()[node] - point).norm() / radius_m;
-            (t < 1.0).then(|| (node, area * (1.0 - t * t).powi(2)))
-        })
-        .collect()
 }

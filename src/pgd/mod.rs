@@ -1,10 +1,75 @@
-//! Proper generalized decomposition: computational vademecums `u(x, p) ≈ Σ X^k(x) Y^k(p)` for a
-//! unit load at any accessible surface point in any direction. Plain Rust, no Bevy.
+//! Proper generalized decomposition: computational vademecums `u(x, s) ≈ Σ X^k(x) Y^k(s)` for a
+//! load at any accessible surface point in any direction, plus the local part a truncated sum
+//! cannot carry (see `docs/pgd.md`). Plain Rust, no Bevy.
 
-mod linear;
+mod build;
+mod enrichment;
+mod error_curve;
+mod file;
 mod load_patches;
+mod local;
+pub mod organ;
+mod responses;
 mod separated;
+mod stiffness;
+mod vademecum;
 
-pub use linear::{ModeReport, PgdSettings, build_linear};
-pub use load_patches::LoadPatches;
+pub use build::{BuildReport, BuildSettings, OrganModel, StepReport, build};
+pub use enrichment::{ModeReport, PgdSettings, enrich};
+pub use error_curve::{EnergyError, ErrorCurve, optimal_errors};
+pub use file::{FORMAT_VERSION, VademecumError, load, read_header, save};
+pub use load_patches::{LoadOperator, LoadPatches};
+pub use local::LocalPart;
+pub use responses::Responses;
 pub use separated::SeparatedField;
+pub use stiffness::RestStiffness;
+pub use vademecum::{Header, Step, SurfacePoint, Vademecum};
+
+use crate::mesh::TetMesh;
+
+/// Reports the progress of long offline work: a stage with a known amount of work, steps of
+/// it, and free-form messages.
+pub trait Progress: Sync {
+    fn start(&self, stage: &str, total: u64);
+    fn advance(&self, amount: u64);
+    fn message(&self, text: &str);
+}
+
+/// Progress that goes nowhere (tests, library use).
+pub struct Silent;
+
+impl Progress for Silent {
+    fn start(&self, _: &str, _: u64) {}
+    fn advance(&self, _: u64) {}
+    fn message(&self, _: &str) {}
+}
+
+/// A hash of the mesh and its named regions (hex): a vademecum is valid only for the mesh it
+/// was built on, down to the last bit of a coordinate.
+pub fn mesh_hash(mesh: &TetMesh) -> String {
+    let mut hasher = blake3::Hasher::new();
+    for p in mesh.nodes() {
+        for c in p.iter() {
+            hasher.update(&c.to_le_bytes());
+        }
+    }
+    for t in mesh.tets() {
+        for &n in t {
+            hasher.update(&(n as u64).to_le_bytes());
+        }
+    }
+    let regions = mesh.regions();
+    for (name, nodes) in &regions.node_sets {
+        hasher.update(format!("node set {name} {}", nodes.len()).as_bytes());
+        for &n in nodes {
+            hasher.update(&(n as u64).to_le_bytes());
+        }
+    }
+    for (name, faces) in &regions.face_sets {
+        hasher.update(format!("face set {name} {}", faces.len()).as_bytes());
+        for &n in faces.iter().flatten() {
+            hasher.update(&(n as u64).to_le_bytes());
+        }
+    }
+    hasher.finalize().to_hex().to_string()
+}

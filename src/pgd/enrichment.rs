@@ -8,12 +8,13 @@
 //!   `K`, computed once for the whole build;
 //! - `R` fixed: `S = (Fᵀ R − U_nᵀ K R) / (Rᵀ K R)` — closed form, no solve.
 
-use super::LoadPatches;
+use super::load_patches::LoadOperator;
 use super::separated::{SeparatedField, dot};
-use crate::fem::{DirectSolver, FemError, FemModel};
+use super::stiffness::RestStiffness;
+use crate::fem::FemError;
 
 /// How the enrichment proceeds and when it stops.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PgdSettings {
     /// Stop once a new mode's amplitude falls below this fraction of the first mode's.
     pub tolerance: f64,
@@ -29,8 +30,8 @@ impl Default for PgdSettings {
         Self {
             tolerance: 1e-3,
             max_modes: 60,
-            fixed_point_tolerance: 1e-6,
-            max_fixed_point_iterations: 30,
+            fixed_point_tolerance: 1e-3,
+            max_fixed_point_iterations: 15,
         }
     }
 }
@@ -46,59 +47,52 @@ pub struct ModeReport {
     pub relative_amplitude: f64,
 }
 
-/// Builds the linear vademecum of `model` for the unit loads of `patches`. `progress` is called
-/// after each mode with its number and report.
-pub fn build_linear(
-    model: &FemModel,
-    patches: &LoadPatches,
+/// Builds the separated representation of `K⁻¹ F` for the loads `F` of `loads`, with parameter
+/// quadrature weights `weights`. `progress` is called after each mode with its number and
+/// report; the enrichment stops at the tolerance, the cap, or when `progress` returns false
+/// (the caller's error estimator is satisfied).
+pub fn enrich(
+    stiffness: &RestStiffness,
+    loads: &dyn LoadOperator,
+    weights: &[f64],
     settings: &PgdSettings,
-    progress: &mut dyn FnMut(usize, &ModeReport),
+    progress: &mut dyn FnMut(&SeparatedField, &ModeReport) -> bool,
 ) -> Result<(SeparatedField, Vec<ModeReport>), FemError> {
-    let stiffness = model.rest_stiffness();
-    let solver = DirectSolver::new(model.pattern())?;
-    let factor = solver.cholesky(&model.pattern().matrix(stiffness.clone()))?;
-    let weights: Vec<f64> = patches.areas_m2.iter().flat_map(|&a| [a; 3]).collect();
-    let dofs = model.dofs();
-    let full = 3 * model.mesh().node_count();
-
     let mut field = SeparatedField::default();
     // K X^k over free dofs, kept so the S-step needs no product with K per old mode.
     let mut stiff_modes: Vec<Vec<f64>> = Vec::new();
     let mut reports = Vec::new();
     let mut first_amplitude = None;
+    let free_dofs = &stiffness.model.dofs().free_dofs;
     while field.modes() < settings.max_modes {
-        let mut s = starting_guess(patches.parameter_count(), field.modes());
-        let mut r_free = vec![0.0; dofs.free_count()];
+        let mut s = starting_guess(loads.parameter_count(), field.modes());
+        let mut r_free = vec![0.0; stiffness.free_count()];
         let mut iterations = 0;
         let mut converged = false;
         while iterations < settings.max_fixed_point_iterations {
             iterations += 1;
             let (previous_r, previous_s) = (r_free.clone(), s.clone());
             // R-step: one solve.
-            let ws: Vec<f64> = s.iter().zip(&weights).map(|(a, w)| a * w).collect();
+            let ws: Vec<f64> = s.iter().zip(weights).map(|(a, w)| a * w).collect();
             let alpha = dot(&s, &ws);
-            let mut load = vec![0.0; full];
-            patches.apply(&ws, &mut load);
-            let mut r = dofs.restrict(&load);
-            factor.solve_in_place(&mut r);
+            let mut load = vec![0.0; stiffness.full_count()];
+            loads.apply(&ws, &mut load);
+            let mut r = stiffness.restrict(&load);
+            stiffness.solve_block(&mut r);
             for (k, y) in field.parametric.iter().enumerate() {
                 let c = dot(y, &ws);
                 let x = &field.spatial[k];
-                for (ri, &d) in r.iter_mut().zip(&dofs.free_dofs) {
+                for (ri, &d) in r.iter_mut().zip(free_dofs) {
                     *ri -= c * x[d];
                 }
             }
             r.iter_mut().for_each(|v| *v /= alpha);
             r_free = r;
             // S-step: closed form.
-            let mut kr = vec![0.0; dofs.free_count()];
-            model.pattern().mul(&stiffness, &r_free, &mut kr);
+            let mut kr = vec![0.0; stiffness.free_count()];
+            stiffness.mul(&r_free, &mut kr);
             let beta = dot(&r_free, &kr);
-            let mut r_full = vec![0.0; full];
-            for (v, &d) in r_free.iter().zip(&dofs.free_dofs) {
-                r_full[d] = *v;
-            }
-            patches.apply_transpose(&r_full, &mut s);
+            loads.apply_transpose(&stiffness.extend(&r_free), &mut s);
             for (y, kx) in field.parametric.iter().zip(&stiff_modes) {
                 let c = dot(kx, &r_free);
                 for (si, yi) in s.iter_mut().zip(y) {
@@ -113,12 +107,12 @@ pub fn build_linear(
                 break;
             }
         }
-        let mut kr = vec![0.0; dofs.free_count()];
-        model.pattern().mul(&stiffness, &r_free, &mut kr);
+        let mut kr = vec![0.0; stiffness.free_count()];
+        stiffness.mul(&r_free, &mut kr);
         let energy_r = dot(&r_free, &kr).sqrt();
         let energy_s = s
             .iter()
-            .zip(&weights)
+            .zip(weights)
             .map(|(a, w)| a * a * w)
             .sum::<f64>()
             .sqrt();
@@ -136,20 +130,21 @@ pub fn build_linear(
             });
         }
         if energy_r == 0.0 {
-            // Nothing left that the loads can excite: the vademecum is exact.
+            // Nothing left that the loads can excite: the representation is exact.
             break;
         }
         // Store X with unit energy and the amplitude in Y, so mode sizes are comparable.
         let scale = 1.0 / energy_r;
-        let mut x = vec![0.0; full];
-        for (v, &d) in r_free.iter().zip(&dofs.free_dofs) {
-            x[d] = v * scale;
-        }
+        let x: Vec<f64> = stiffness
+            .extend(&r_free)
+            .iter()
+            .map(|v| v * scale)
+            .collect();
         field.push(x, s.iter().map(|v| v * energy_r).collect());
         stiff_modes.push(kr.iter().map(|v| v * scale).collect());
         reports.push(report);
-        progress(field.modes(), &report);
-        if report.relative_amplitude < settings.tolerance {
+        let go_on = progress(&field, &report);
+        if !go_on || report.relative_amplitude < settings.tolerance {
             break;
         }
     }

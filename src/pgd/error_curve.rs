@@ -1,0 +1,170 @@
+//! Errors of a separated representation in the energy norm over the parameter space,
+//! `‖U − X Yᵀ‖² = tr(W Uᵀ K U) − 2 tr(W Fᵀ X Yᵀ) + tr(W Y Xᵀ K X Yᵀ)` (using `K U = F`), so they
+//! need the compliance Gram `G = Fᵀ U` and the modes, never the response fields themselves.
+//! The optimal rank-n error in the same norm (Eckart–Young) comes from the eigenvalues of
+//! `W^½ G W^½`: the best ANY n-term separated sum can reach on these loads.
+
+use faer::{Mat, Side};
+use rayon::prelude::*;
+
+use super::load_patches::LoadOperator;
+use super::responses::Responses;
+use super::separated::{SeparatedField, dot};
+use super::stiffness::RestStiffness;
+
+/// Relative errors by number of modes, index `n − 1` for `n` modes.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ErrorCurve {
+    /// Energy error of the PGD's separated sum.
+    pub separated: Vec<f64>,
+    /// The best energy error any separated sum of as many terms can reach (Eckart–Young).
+    pub optimal: Vec<f64>,
+    /// L2 error of the whole vademecum (separated sum + exact near field): the estimator.
+    pub field: Vec<f64>,
+}
+
+/// Tracks the energy error of a separated field as modes are added, for the error estimator.
+pub struct EnergyError {
+    weights: Vec<f64>,
+    total: f64,
+    /// Running `Σ_{k,l} M_kl N_kl − 2 Σ_k a_k`.
+    captured: f64,
+    stiff_modes: Vec<Vec<f64>>,
+}
+
+impl EnergyError {
+    /// `self_compliance[p] = G_pp`: only the diagonal of the Gram is needed for the total.
+    pub fn new(weights: &[f64], self_compliance: &[f64]) -> Self {
+        Self {
+            weights: weights.to_vec(),
+            total: dot(weights, self_compliance),
+            captured: 0.0,
+            stiff_modes: Vec::new(),
+        }
+    }
+
+    /// Accounts for the newest mode of `field` and returns the relative error with all modes.
+    pub fn add_mode(
+        &mut self,
+        field: &SeparatedField,
+        stiffness: &RestStiffness,
+        loads: &dyn LoadOperator,
+    ) -> f64 {
+        let k = field.modes() - 1;
+        let x = &field.spatial[k];
+        let y = &field.parametric[k];
+        let x_free = stiffness.restrict(x);
+        let mut kx = vec![0.0; x_free.len()];
+        stiffness.mul(&x_free, &mut kx);
+        let mut ftx = vec![0.0; loads.parameter_count()];
+        loads.apply_transpose(x, &mut ftx);
+        let wy: Vec<f64> = y.iter().zip(&self.weights).map(|(a, w)| a * w).collect();
+        let mut delta = -2.0 * dot(&wy, &ftx) + dot(&kx, &x_free) * dot(y, &wy);
+        for (l, kxl) in self.stiff_modes.iter().enumerate() {
+            delta += 2.0 * dot(kxl, &x_free) * dot(&field.parametric[l], &wy);
+        }
+        self.stiff_modes.push(kx);
+        self.captured += delta;
+        self.relative()
+    }
+
+    pub fn relative(&self) -> f64 {
+        ((self.total + self.captured).max(0.0) / self.total).sqrt()
+    }
+}
+
+/// Optimal relative errors for 1..=`max_modes` terms, from the Gram `G` (column-major).
+pub fn optimal_errors(gram: &[f64], weights: &[f64], max_modes: usize) -> Vec<f64> {
+    let n = weights.len();
+    let root: Vec<f64> = weights.iter().map(|w| w.sqrt()).collect();
+    let scaled = Mat::from_fn(n, n, |i, j| {
+        0.5 * (gram[j * n + i] + gram[i * n + j]) * root[i] * root[j]
+    });
+    let mut eigenvalues = scaled
+        .self_adjoint_eigenvalues(Side::Lower)
+        .expect("a symmetric matrix has real eigenvalues");
+    eigenvalues.sort_by(|a, b| b.total_cmp(a));
+    let total: f64 = eigenvalues.iter().map(|l| l.max(0.0)).sum();
+    let mut tail = total;
+    eigenvalues
+        .iter()
+        .take(max_modes)
+        .map(|l| {
+            tail -= l.max(0.0);
+            (tail.max(0.0) / total).sqrt()
+        })
+        .collect()
+}
+
+/// The error estimator of a build: the relative L2 error of the whole vademecum (separated sum
+/// plus the exact near field) over every node-centred load, weighted by area. It is exact, not
+/// estimated: the exact responses are at hand, and are turned into the residual of the
+/// separated sum one mode at a time.
+pub struct FieldError<'a> {
+    weights: &'a [f64],
+    near: &'a [Vec<u32>],
+    free_index: &'a [usize],
+    total: f64,
+}
+
+impl<'a> FieldError<'a> {
+    pub fn new(
+        stiffness: &'a RestStiffness,
+        responses: &Responses,
+        weights: &'a [f64],
+        near: &'a [Vec<u32>],
+    ) -> Self {
+        let mut estimator = Self {
+            weights,
+            near,
+            free_index: &stiffness.model.dofs().free_index,
+            total: 1.0,
+        };
+        estimator.total = estimator.weighted_far_norm(responses, false);
+        estimator
+    }
+
+    /// Subtracts mode `X Yᵀ` (X over all dofs) from `residual`, returns the relative error.
+    pub fn subtract_mode(&self, residual: &mut Responses, x: &[f64], y: &[f64]) -> f64 {
+        let x_free: Vec<f64> = self
+            .free_index
+            .iter()
+            .zip(x)
+            .filter(|(f, _)| **f != crate::fem::PRESCRIBED)
+            .map(|(_, v)| *v)
+            .collect();
+        let rows = residual.rows;
+        residual
+            .columns
+            .par_chunks_mut(rows)
+            .zip(y)
+            .for_each(|(r, &yp)| {
+                r.iter_mut()
+                    .zip(&x_free)
+                    .for_each(|(ri, xi)| *ri -= yp * xi);
+            });
+        (self.weighted_far_norm(residual, true) / self.total).sqrt()
+    }
+
+    /// `Σ_p w_p ‖r_p‖²`, leaving out each load's near field when `far_only`.
+    fn weighted_far_norm(&self, columns: &Responses, far_only: bool) -> f64 {
+        (0..columns.count())
+            .into_par_iter()
+            .map(|p| {
+                let r = columns.column(p);
+                let mut sum = dot(r, r);
+                if far_only {
+                    for &node in &self.near[p / 3] {
+                        for c in 0..3 {
+                            let free = self.free_index[3 * node as usize + c];
+                            if free != crate::fem::PRESCRIBED {
+                                sum -= r[free] * r[free];
+                            }
+                        }
+                    }
+                }
+                self.weights[p] * sum
+            })
+            .sum()
+    }
+}
