@@ -178,9 +178,9 @@ impl PatchKernel {
             .iter()
             .zip(&self.areas_m2)
             .zip(&self.nodes)
-            .filter_map(|((p, area), &node)| {
-                let t = (p - point).norm() / self.radius_m;
-                (t < 1.0).then(|| (node, area * (1.0 - t * t).powi(2)))
+            .filter_map(|((p, &area), &node)| {
+                let w = patch_weight(area, (p - point).norm(), self.radius_m);
+                (w > 0.0).then_some((node, w))
             })
             .collect();
         let total: f64 = weights.iter().map(|&(_, w)| w).sum();
@@ -192,5 +192,16 @@ impl PatchKernel {
             });
         }
         Ok(weights.into_iter().map(|(n, w)| (n, w / total)).collect())
+    }
+}
+
+/// The unnormalized share of a node of lumped area `area_m2` at `distance_m` from the load:
+/// `area · (1 − (d/r)²)²` inside the patch, zero outside.
+pub fn patch_weight(area_m2: f64, distance_m: f64, radius_m: f64) -> f64 {
+    let t = distance_m / radius_m;
+    if t < 1.0 {
+        area_m2 * (1.0 - t * t).powi(2)
+    } else {
+        0.0
     }
 }

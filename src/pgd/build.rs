@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use super::enrichment::{ModeReport, PgdSettings, enrich};
 use super::error_curve::{EnergyError, ErrorCurve, FieldError, optimal_errors};
 use super::load_patches::{LoadOperator, LoadPatches};
-use super::local::{LocalPart, near_nodes, triangle_neighbours};
+use super::local::{LocalPart, distance_neighbours, near_nodes};
 use super::responses::Responses;
 use super::separated::SeparatedField;
 use super::stiffness::RestStiffness;
@@ -75,20 +75,50 @@ pub struct BuildReport {
     pub total_seconds: f64,
 }
 
-/// The load positions (every node of the accessible faces) and the accessible triangles in
-/// position numbering.
-fn accessible(organ: &OrganModel) -> Result<(Vec<usize>, Vec<[u32; 3]>), FemError> {
+/// Where the tool may press, in load-position numbering.
+struct Accessible {
+    /// The nodes of the accessible faces plus every surface node a tool patch on them reaches.
+    positions: Vec<usize>,
+    triangles: Vec<[u32; 3]>,
+    longest_edge_m: f64,
+}
+
+fn accessible(
+    organ: &OrganModel,
+    surface: &Surface,
+    radius_m: f64,
+) -> Result<Accessible, FemError> {
     let mesh = organ.model.mesh();
     let faces = mesh.face_set(&organ.accessible_region)?;
-    let mut positions: Vec<usize> = faces.iter().flatten().copied().collect();
-    positions.sort_unstable();
-    positions.dedup();
+    let longest_edge_m = faces
+        .iter()
+        .flat_map(|f| {
+            (0..3).map(move |k| (mesh.nodes()[f[k]] - mesh.nodes()[f[(k + 1) % 3]]).norm())
+        })
+        .fold(0.0, f64::max);
+    let mut core: Vec<usize> = faces.iter().flatten().copied().collect();
+    core.sort_unstable();
+    core.dedup();
+    let reach = radius_m + longest_edge_m;
+    let positions: Vec<usize> = surface
+        .nodes
+        .iter()
+        .copied()
+        .filter(|&n| {
+            core.iter()
+                .any(|&c| (mesh.nodes()[c] - mesh.nodes()[n]).norm() <= reach)
+        })
+        .collect();
     let mut index = vec![u32::MAX; mesh.node_count()];
     for (m, &n) in positions.iter().enumerate() {
         index[n] = m as u32;
     }
     let triangles = faces.iter().map(|f| f.map(|n| index[n])).collect();
-    Ok((positions, triangles))
+    Ok(Accessible {
+        positions,
+        triangles,
+        longest_edge_m,
+    })
 }
 
 /// Builds the linear vademecum of `organ`.
@@ -102,9 +132,21 @@ pub fn build(
     let mesh = model.mesh();
     let surface = Surface::extract(mesh);
     let kernel = PatchKernel::new(mesh, &surface, settings.tool_tip_radius_m)?;
-    let (positions, triangles) = accessible(organ)?;
-    let patches = LoadPatches::new(mesh, &surface, &kernel, positions)?;
-    let neighbours = triangle_neighbours(patches.positions.len(), &triangles);
+    let radius_m = settings.tool_tip_radius_m;
+    let Accessible {
+        positions,
+        triangles,
+        longest_edge_m,
+    } = accessible(organ, &surface, radius_m)?;
+    let patches = LoadPatches::new(&surface, &kernel, positions)?;
+    let coords: Vec<[f32; 3]> = patches
+        .positions
+        .iter()
+        .map(|&n| mesh.nodes()[n].coords.map(|c| c as f32).into())
+        .collect();
+    // Wide enough to couple any two nodes of one patch, and to find a patch's nodes from the
+    // corners of the triangle it is centred in.
+    let neighbours = distance_neighbours(&coords, 2.0 * radius_m + longest_edge_m);
     progress.message("factorizing the stiffness");
     let stiffness = RestStiffness::new(model)?;
 
@@ -127,6 +169,8 @@ pub fn build(
     let vademecum = Vademecum {
         header,
         positions: patches.positions.iter().map(|&n| n as u32).collect(),
+        position_coords_m: coords,
+        position_areas_m2: patches.areas_m2.iter().map(|&a| a as f32).collect(),
         triangles,
         reference_compliance_m_per_n,
         steps: vec![step],

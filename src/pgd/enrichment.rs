@@ -16,7 +16,8 @@ use crate::fem::FemError;
 /// How the enrichment proceeds and when it stops.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PgdSettings {
-    /// Stop once a new mode's amplitude falls below this fraction of the first mode's.
+    /// Stop once a new mode's amplitude falls below this fraction of the first mode's: a guard
+    /// for a representation that is already exact. The build's error estimator decides first.
     pub tolerance: f64,
     /// At most this many modes.
     pub max_modes: usize,
@@ -28,7 +29,7 @@ pub struct PgdSettings {
 impl Default for PgdSettings {
     fn default() -> Self {
         Self {
-            tolerance: 1e-3,
+            tolerance: 1e-7,
             max_modes: 60,
             fixed_point_tolerance: 1e-3,
             max_fixed_point_iterations: 15,
@@ -153,15 +154,8 @@ pub fn enrich(
 
 /// A deterministic, non-degenerate start for the fixed point, different for every mode.
 fn starting_guess(len: usize, mode: usize) -> Vec<f64> {
-    let mut state = 0x2545_F491_4F6C_DD1D_u64 ^ (mode as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    (0..len)
-        .map(|_| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 + 0.5
-        })
-        .collect()
+    let mut rng = fastrand::Rng::with_seed(mode as u64);
+    (0..len).map(|_| rng.f64() + 0.5).collect()
 }
 
 /// `‖R Sᵀ − R₀ S₀ᵀ‖ / ‖R Sᵀ‖` in the Frobenius norm, from inner products only.

@@ -167,6 +167,8 @@ fn checked_parts<'a>(path: &Path, bytes: &'a [u8]) -> Result<(Header, &'a [u8]),
 fn payload(v: &Vademecum) -> Vec<u8> {
     let mut out = Vec::new();
     put(&mut out, &v.positions);
+    put(&mut out, v.position_coords_m.as_flattened());
+    put(&mut out, &v.position_areas_m2);
     put(&mut out, v.triangles.as_flattened());
     put(&mut out, &v.reference_compliance_m_per_n);
     put(&mut out, &[v.steps.len() as u32]);
@@ -249,8 +251,11 @@ impl Reader<'_> {
 
 fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumError> {
     let positions = r.take("positions")?;
+    let coords: Vec<f32> = r.take("position coordinates")?;
+    let position_coords_m = coords.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let position_areas_m2 = r.take("position areas")?;
     let flat: Vec<u32> = r.take("triangles")?;
-    if flat.len() % 3 != 0 {
+    if !flat.len().is_multiple_of(3) {
         return Err(r.malformed("triangles"));
     }
     let triangles = flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
@@ -278,6 +283,8 @@ fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumEr
     Ok(Vademecum {
         header,
         positions,
+        position_coords_m,
+        position_areas_m2,
         triangles,
         reference_compliance_m_per_n,
         steps,
@@ -299,6 +306,9 @@ fn validate(path: &Path, v: &Vademecum) -> Result<(), VademecumError> {
     }
     if v.triangles.iter().flatten().any(|&i| i as usize >= m) {
         return fail("triangles (an index beyond the positions)");
+    }
+    if v.position_coords_m.len() != m || v.position_areas_m2.len() != m {
+        return fail("position coordinates or areas (one per position expected)");
     }
     if v.reference_compliance_m_per_n.len() != m {
         return fail("reference compliances (one per position expected)");

@@ -1,12 +1,14 @@
-//! The load side of the vademecum: a regularized unit point load at every accessible surface
-//! node, in each of the three directions.
+//! The load side of the vademecum: a unit nodal force at every load position, in each of the
+//! three directions.
 //!
-//! Parameter `p = 3m + d` is "a unit force in direction `d` at accessible node `m`". Its nodal
-//! force vector is sparse (the nodes of the patch around `m`), so the load matrix `F` (dofs ×
-//! parameters) is never formed: it is applied, and transposed, patch by patch.
+//! Parameter `p = 3m + d` is "a unit force in direction `d` at position `m`". The tool's
+//! regularized load at any point `s` is a combination of these, `Σ_m β_m(s) e_m`, with the
+//! shares `β` of its contact patch, so by linearity the vademecum answers for the patch centred
+//! exactly at `s`, not for an interpolation of patches centred on nodes. The load matrix `F`
+//! (dofs × parameters) is never formed: it is applied, and transposed, node by node.
 
 use crate::fem::{FemError, PatchKernel};
-use crate::mesh::{NOT_ON_SURFACE, Surface, TetMesh};
+use crate::mesh::{NOT_ON_SURFACE, Surface};
 
 /// A load matrix `F` (full dofs × parameters) that can be applied and transposed: the PGD's
 /// right-hand side, whether unit point loads or a step's nonlinear loads.
@@ -21,21 +23,17 @@ pub trait LoadOperator {
 pub struct LoadPatches {
     /// The accessible surface nodes (volume numbering), one per load position.
     pub positions: Vec<usize>,
-    /// Per position, the nodes of its patch and their share of a unit load (summing to 1).
-    pub patches: Vec<Vec<(usize, f64)>>,
     /// Per position, its lumped surface area (m²): the quadrature weight of the parameter space.
     pub areas_m2: Vec<f64>,
 }
 
 impl LoadPatches {
-    /// Regularizes a unit load with `kernel` around each of `positions` (surface nodes).
+    /// Unit loads at `positions` (surface nodes), weighted by their lumped areas in `kernel`.
     pub fn new(
-        mesh: &TetMesh,
         surface: &Surface,
         kernel: &PatchKernel,
         positions: Vec<usize>,
     ) -> Result<Self, FemError> {
-        let mut patches = Vec::with_capacity(positions.len());
         let mut areas_m2 = Vec::with_capacity(positions.len());
         for &node in &positions {
             let local = surface.surface_index_of[node];
@@ -47,11 +45,9 @@ impl LoadPatches {
                 });
             }
             areas_m2.push(kernel.area_m2(local));
-            patches.push(kernel.shares(mesh.nodes()[node])?);
         }
         Ok(Self {
             positions,
-            patches,
             areas_m2,
         })
     }
@@ -64,9 +60,7 @@ impl LoadPatches {
     /// The nodal force vector of parameter `p` (full dofs).
     pub fn column(&self, p: usize, node_count: usize) -> Vec<f64> {
         let mut f = vec![0.0; 3 * node_count];
-        for &(node, share) in &self.patches[p / 3] {
-            f[3 * node + p % 3] = share;
-        }
+        f[3 * self.positions[p / 3] + p % 3] = 1.0;
         f
     }
 }
@@ -77,26 +71,16 @@ impl LoadOperator for LoadPatches {
     }
 
     fn apply(&self, s: &[f64], out: &mut [f64]) {
-        for (m, patch) in self.patches.iter().enumerate() {
+        for (m, &node) in self.positions.iter().enumerate() {
             for d in 0..3 {
-                let weight = s[3 * m + d];
-                if weight != 0.0 {
-                    for &(node, share) in patch {
-                        out[3 * node + d] += share * weight;
-                    }
-                }
+                out[3 * node + d] += s[3 * m + d];
             }
         }
     }
 
     fn apply_transpose(&self, r: &[f64], out: &mut [f64]) {
-        for (m, patch) in self.patches.iter().enumerate() {
-            for d in 0..3 {
-                out[3 * m + d] = patch
-                    .iter()
-                    .map(|&(node, share)| share * r[3 * node + d])
-                    .sum();
-            }
+        for (m, &node) in self.positions.iter().enumerate() {
+            out[3 * m..3 * m + 3].copy_from_slice(&r[3 * node..3 * node + 3]);
         }
     }
 }

@@ -2,9 +2,9 @@
 //!
 //! A separated sum truncated to n modes is far too stiff under the tool (the response to a
 //! point load is not low-rank), so each load position also stores, from its exact response:
-//! - its **compliance blocks** `C_mj = B_mᵀ u_j` (3 × 3) with itself and with every position
-//!   sharing an accessible triangle: the patch-averaged displacement under the tool, exact for
-//!   any load interpolated over a triangle, so the felt force needs no mode at all;
+//! - its **compliance blocks** `C_mj` (3 × 3: its displacement under a unit load at `j`) with
+//!   every position close enough to share a tool patch: the displacement under the tool for
+//!   a patch `β` at any point is `Σ_mj β_m β_j C_mj`, exact, so the felt force needs no mode;
 //! - its **near-field correction**: the exact response minus the separated sum, at every node
 //!   within the local radius, so the dimple under the tool has the exact shape.
 
@@ -31,19 +31,25 @@ pub struct LocalPart {
     pub correction: Vec<f32>,
 }
 
-/// Per position, the positions it shares an accessible triangle with (itself first).
-pub fn triangle_neighbours(positions: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
-    let mut neighbours: Vec<Vec<u32>> = (0..positions as u32).map(|m| vec![m]).collect();
-    for t in triangles {
-        for &a in t {
-            for &b in t {
-                if !neighbours[a as usize].contains(&b) {
-                    neighbours[a as usize].push(b);
-                }
-            }
-        }
-    }
-    neighbours
+/// Per position, the positions within `radius_m` of it (itself first): every pair two
+/// patches can couple.
+pub fn distance_neighbours(coords: &[[f32; 3]], radius_m: f64) -> Vec<Vec<u32>> {
+    let r2 = (radius_m * radius_m) as f32;
+    (0..coords.len())
+        .into_par_iter()
+        .map(|m| {
+            let a = coords[m];
+            let mut list = vec![m as u32];
+            list.extend(
+                (0..coords.len())
+                    .filter(|&j| {
+                        j != m && (0..3).map(|c| (coords[j][c] - a[c]).powi(2)).sum::<f32>() <= r2
+                    })
+                    .map(|j| j as u32),
+            );
+            list
+        })
+        .collect()
 }
 
 impl LocalPart {
@@ -122,7 +128,7 @@ pub fn near_nodes(mesh: &TetMesh, positions: &[usize], radius_m: f64) -> Vec<Vec
         .collect()
 }
 
-/// `C_mj[c][d] = Σ_patch(m) share · u_(j,d)[node, c]`.
+/// `C_mj[c][d] = u_(j,d)[node m, c]`: displacement of position m under a unit load at j.
 fn compliance_block(
     stiffness: &RestStiffness,
     patches: &LoadPatches,
@@ -131,18 +137,15 @@ fn compliance_block(
     j: usize,
 ) -> [f32; 9] {
     let free_index = &stiffness.model.dofs().free_index;
+    let node = patches.positions[m];
     let mut block = [0.0f32; 9];
     for d in 0..3 {
         let u = responses.column(3 * j + d);
         for c in 0..3 {
-            let value: f64 = patches.patches[m]
-                .iter()
-                .filter_map(|&(node, share)| {
-                    let free = free_index[3 * node + c];
-                    (free != crate::fem::PRESCRIBED).then(|| share * u[free])
-                })
-                .sum();
-            block[c * 3 + d] = value as f32;
+            block[c * 3 + d] = match free_index[3 * node + c] {
+                crate::fem::PRESCRIBED => 0.0,
+                free => u[free] as f32,
+            };
         }
     }
     block

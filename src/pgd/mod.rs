@@ -13,6 +13,7 @@ mod responses;
 mod separated;
 mod stiffness;
 mod vademecum;
+mod validate;
 
 pub use build::{BuildReport, BuildSettings, OrganModel, StepReport, build};
 pub use enrichment::{ModeReport, PgdSettings, enrich};
@@ -24,6 +25,7 @@ pub use responses::Responses;
 pub use separated::SeparatedField;
 pub use stiffness::RestStiffness;
 pub use vademecum::{Header, Step, SurfacePoint, Vademecum};
+pub use validate::{Sample, Statistics, ValidationReport, ValidationSettings, validate};
 
 use crate::mesh::TetMesh;
 

@@ -42,11 +42,9 @@ impl Responses {
                 let first = block * BLOCK_COLUMNS;
                 for (j, column) in chunk.chunks_exact_mut(rows).enumerate() {
                     let p = first + j;
-                    for &(node, share) in &patches.patches[p / 3] {
-                        let free = free_index[3 * node + p % 3];
-                        if free != crate::fem::PRESCRIBED {
-                            column[free] = share;
-                        }
+                    let free = free_index[3 * patches.positions[p / 3] + p % 3];
+                    if free != crate::fem::PRESCRIBED {
+                        column[free] = 1.0;
                     }
                 }
                 stiffness.solve_block(chunk);

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::BuildSettings;
 use super::local::LocalPart;
-use crate::fem::Material;
+use crate::fem::{Material, patch_weight};
 
 /// What the vademecum was built from and how: enough to refuse a stale file and to say how it
 /// was made.
@@ -55,6 +55,10 @@ pub struct Vademecum {
     pub header: Header,
     /// Volume node of each load position.
     pub positions: Vec<u32>,
+    /// Rest position (m) of each load position.
+    pub position_coords_m: Vec<[f32; 3]>,
+    /// Lumped surface area (m²) of each load position: its weight in a tool patch.
+    pub position_areas_m2: Vec<f32>,
     /// The accessible triangles, as position indices.
     pub triangles: Vec<[u32; 3]>,
     /// Per position, the largest self-compliance of the linear step (m/N): turns a force into
@@ -87,22 +91,61 @@ impl Vademecum {
             .unwrap_or(0.0)
     }
 
-    fn vertices(&self, at: &SurfacePoint) -> [(usize, f64); 3] {
-        let t = self.triangles[at.triangle];
-        [0, 1, 2].map(|k| (t[k] as usize, at.barycentric[k]))
+    /// Rest coordinates (m) of a surface point.
+    pub fn point(&self, at: &SurfacePoint) -> Vector3<f64> {
+        self.triangles[at.triangle]
+            .iter()
+            .zip(at.barycentric)
+            .map(|(&m, l)| Vector3::from(self.position_coords_m[m as usize].map(f64::from)) * l)
+            .sum()
+    }
+
+    /// The tool's contact patch centred at `at`: positions and their shares of the load
+    /// (summing to one), the same kernel as the full FEM load. A patch narrower than the mesh
+    /// (no node inside it) falls back to the triangle's corners.
+    pub fn shares(&self, at: &SurfacePoint) -> Vec<(usize, f64)> {
+        let centre = self.point(at);
+        let radius_m = self.header.settings.tool_tip_radius_m;
+        let local = &self.steps[0].local;
+        let corners = self.triangles[at.triangle];
+        let mut shares: Vec<(usize, f64)> = Vec::new();
+        for &corner in &corners {
+            for e in local.neighbours_of(corner as usize) {
+                let m = local.neighbours[e] as usize;
+                if shares.iter().any(|&(j, _)| j == m) {
+                    continue;
+                }
+                let p = Vector3::from(self.position_coords_m[m].map(f64::from));
+                let w = patch_weight(
+                    self.position_areas_m2[m] as f64,
+                    (p - centre).norm(),
+                    radius_m,
+                );
+                if w > 0.0 {
+                    shares.push((m, w));
+                }
+            }
+        }
+        let total: f64 = shares.iter().map(|s| s.1).sum();
+        if total <= 0.0 {
+            return (0..3)
+                .map(|k| (corners[k] as usize, at.barycentric[k]))
+                .collect();
+        }
+        shares.iter_mut().for_each(|s| s.1 /= total);
+        shares
     }
 
     /// Weights of the load steps for a force of `force_n` at `at`: piecewise linear in the
     /// indentation level, held at the last step beyond it.
-    fn step_weights(&self, at: &SurfacePoint, force_n: &Vector3<f64>) -> Vec<f64> {
+    fn step_weights(&self, shares: &[(usize, f64)], force_n: &Vector3<f64>) -> Vec<f64> {
         let levels = &self.header.indentation_levels_m;
         let mut weights = vec![0.0; levels.len()];
         if levels.len() == 1 {
             weights[0] = 1.0;
             return weights;
         }
-        let compliance: f64 = self
-            .vertices(at)
+        let compliance: f64 = shares
             .iter()
             .map(|&(i, l)| l * self.reference_compliance_m_per_n[i] as f64)
             .sum();
@@ -119,16 +162,15 @@ impl Vademecum {
         weights
     }
 
-    /// The 3 × 3 compliance (m/N) of load step `step` at `at`: the displacement under the tool
-    /// per unit force, `Σ_ij λ_i λ_j C_ij`.
-    pub fn step_compliance(&self, step: usize, at: &SurfacePoint) -> Matrix3<f64> {
+    /// The 3 × 3 compliance (m/N) of load step `step` for the patch `shares`: the
+    /// patch-averaged displacement under the tool per unit force, `Σ_ij β_i β_j C_ij`.
+    pub fn step_compliance(&self, step: usize, shares: &[(usize, f64)]) -> Matrix3<f64> {
         let local = &self.steps[step].local;
-        let vertices = self.vertices(at);
         let mut c = Matrix3::zeros();
-        for &(i, li) in &vertices {
+        for &(i, li) in shares {
             for e in local.neighbours_of(i) {
                 let j = local.neighbours[e] as usize;
-                if let Some(&(_, lj)) = vertices.iter().find(|(v, _)| *v == j) {
+                if let Some(&(_, lj)) = shares.iter().find(|(v, _)| *v == j) {
                     let block = &local.compliance[9 * e..9 * e + 9];
                     c += Matrix3::from_row_iterator(block.iter().map(|&v| v as f64)) * (li * lj);
                 }
@@ -137,19 +179,20 @@ impl Vademecum {
         c
     }
 
-    /// The compliance for a force `force_n` (its load steps blended).
-    pub fn compliance(&self, at: &SurfacePoint, force_n: &Vector3<f64>) -> Matrix3<f64> {
-        self.step_weights(at, force_n)
+    /// The compliance for a force `force_n` on the patch `shares` (load steps blended).
+    pub fn compliance(&self, shares: &[(usize, f64)], force_n: &Vector3<f64>) -> Matrix3<f64> {
+        self.step_weights(shares, force_n)
             .iter()
             .enumerate()
             .filter(|(_, w)| **w > 0.0)
-            .map(|(k, w)| self.step_compliance(k, at) * *w)
+            .map(|(k, w)| self.step_compliance(k, shares) * *w)
             .sum()
     }
 
     /// Displacement (m) of the surface under the tool for a force (N) at `at`.
     pub fn tool_displacement(&self, at: &SurfacePoint, force_n: &Vector3<f64>) -> Vector3<f64> {
-        self.compliance(at, force_n) * force_n
+        let shares = self.shares(at);
+        self.compliance(&shares, force_n) * force_n
     }
 
     /// The force (N) that pushes the surface at `at` by `indentation_m`: the force the trainee
@@ -163,10 +206,11 @@ impl Vademecum {
             c.try_inverse()
                 .map_or_else(Vector3::zeros, |inverse| inverse * indentation_m)
         };
-        let mut force = solve(self.step_compliance(0, at));
+        let shares = self.shares(at);
+        let mut force = solve(self.step_compliance(0, &shares));
         if self.steps.len() > 1 {
             for _ in 0..SECANT_ITERATIONS {
-                force = solve(self.compliance(at, &force));
+                force = solve(self.compliance(&shares, &force));
             }
         }
         force
@@ -174,19 +218,25 @@ impl Vademecum {
 
     /// The displacement field (m, all dofs) for a force (N) at `at`.
     pub fn field(&self, at: &SurfacePoint, force_n: &Vector3<f64>) -> Vec<f64> {
+        let shares = self.shares(at);
         let mut u = vec![0.0; self.dof_count()];
-        for (k, w) in self.step_weights(at, force_n).into_iter().enumerate() {
+        for (k, w) in self.step_weights(&shares, force_n).into_iter().enumerate() {
             if w > 0.0 {
-                self.add_step_field(k, at, &(force_n * w), &mut u);
+                self.add_step_field(k, &shares, &(force_n * w), &mut u);
             }
         }
         u
     }
 
-    fn add_step_field(&self, k: usize, at: &SurfacePoint, force_n: &Vector3<f64>, u: &mut [f64]) {
+    fn add_step_field(
+        &self,
+        k: usize,
+        vertices: &[(usize, f64)],
+        force_n: &Vector3<f64>,
+        u: &mut [f64],
+    ) {
         let step = &self.steps[k];
         let (dofs, params) = (self.dof_count(), self.parameter_count());
-        let vertices = self.vertices(at);
         for (x, y) in step
             .spatial
             .chunks_exact(dofs)
@@ -204,7 +254,7 @@ impl Vademecum {
                 *ui += c * xi as f64;
             }
         }
-        for &(i, l) in &vertices {
+        for &(i, l) in vertices {
             for e in step.local.corrections_of(i) {
                 let node = step.local.correction_nodes[e] as usize;
                 let r = &step.local.correction[9 * e..9 * e + 9];

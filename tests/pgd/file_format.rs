@@ -1,0 +1,66 @@
+//! The vademecum file: a round trip is lossless, and every kind of bad file is refused with a
+//! message that names the file and the problem.
+
+use std::path::PathBuf;
+
+use pgd_surgery::pgd::{FORMAT_VERSION, VademecumError, load, save};
+
+use crate::common::{block_mesh, block_model, build_block};
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("pgd-file-format-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn a_saved_vademecum_loads_back_identical_and_fits_its_mesh_only() {
+    let model = block_model(block_mesh([4, 3, 2]));
+    let vademecum = build_block(&model, 4);
+    let path = temp("roundtrip.vdm");
+    save(&path, &vademecum).unwrap();
+    let back = load(&path).unwrap();
+    assert_eq!(back, vademecum);
+    back.check_mesh(&path, model.mesh()).unwrap();
+    let other = block_mesh([4, 3, 3]);
+    let err = back.check_mesh(&path, &other).unwrap_err();
+    assert!(matches!(err, VademecumError::OtherMesh { .. }), "{err}");
+    assert!(err.to_string().contains("roundtrip.vdm") && err.to_string().contains("pgd build"));
+}
+
+#[test]
+fn truncated_corrupted_foreign_and_old_files_are_refused() {
+    let model = block_model(block_mesh([4, 3, 2]));
+    let path = temp("good.vdm");
+    save(&path, &build_block(&model, 2)).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+
+    let truncated = temp("truncated.vdm");
+    std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
+    let err = load(&truncated).unwrap_err();
+    assert!(matches!(err, VademecumError::Truncated { .. }), "{err}");
+    assert!(err.to_string().contains("truncated.vdm"));
+
+    let mut flipped = bytes.clone();
+    let middle = flipped.len() - 100;
+    flipped[middle] ^= 1;
+    let corrupted = temp("corrupted.vdm");
+    std::fs::write(&corrupted, &flipped).unwrap();
+    let err = load(&corrupted).unwrap_err();
+    assert!(matches!(err, VademecumError::Corrupted { .. }), "{err}");
+
+    let mut old = bytes.clone();
+    old[8..12].copy_from_slice(&(FORMAT_VERSION + 1).to_le_bytes());
+    let other_version = temp("version.vdm");
+    std::fs::write(&other_version, &old).unwrap();
+    let err = load(&other_version).unwrap_err();
+    assert!(matches!(err, VademecumError::Version { .. }), "{err}");
+
+    let foreign = temp("foreign.vdm");
+    std::fs::write(&foreign, b"solid cube\nendsolid cube\n").unwrap();
+    let err = load(&foreign).unwrap_err();
+    assert!(matches!(err, VademecumError::NotAVademecum { .. }), "{err}");
+
+    let missing = load(&temp("missing.vdm")).unwrap_err();
+    assert!(matches!(missing, VademecumError::Io { .. }), "{missing}");
+}
