@@ -161,10 +161,6 @@ impl PatchKernel {
         })
     }
 
-    pub fn radius_m(&self) -> f64 {
-        self.radius_m
-    }
-
     /// Lumped area (m²) of the `i`-th surface node.
     pub fn area_m2(&self, surface_index: usize) -> f64 {
         self.areas_m2[surface_index]

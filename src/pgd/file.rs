@@ -84,20 +84,14 @@ pub fn save(path: &Path, vademecum: &Vademecum) -> Result<(), VademecumError> {
 
 /// Reads only the header of `path` (cheap: for staleness checks and listings).
 pub fn read_header(path: &Path) -> Result<Header, VademecumError> {
-    let bytes = std::fs::read(path).map_err(|source| VademecumError::Io {
-        file: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = read_bytes(path)?;
     let (header, _) = checked_parts(path, &bytes)?;
     Ok(header)
 }
 
 /// Reads and checks a vademecum file.
 pub fn load(path: &Path) -> Result<Vademecum, VademecumError> {
-    let bytes = std::fs::read(path).map_err(|source| VademecumError::Io {
-        file: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = read_bytes(path)?;
     let (header, payload) = checked_parts(path, &bytes)?;
     let mut reader = Reader {
         file: path,
@@ -106,6 +100,13 @@ pub fn load(path: &Path) -> Result<Vademecum, VademecumError> {
     let vademecum = read_payload(&mut reader, header)?;
     validate(path, &vademecum)?;
     Ok(vademecum)
+}
+
+fn read_bytes(path: &Path) -> Result<Vec<u8>, VademecumError> {
+    std::fs::read(path).map_err(|source| VademecumError::Io {
+        file: path.to_path_buf(),
+        source,
+    })
 }
 
 impl Vademecum {

@@ -56,13 +56,6 @@ impl LoadPatches {
     pub fn weights(&self) -> Vec<f64> {
         self.areas_m2.iter().flat_map(|&a| [a; 3]).collect()
     }
-
-    /// The nodal force vector of parameter `p` (full dofs).
-    pub fn column(&self, p: usize, node_count: usize) -> Vec<f64> {
-        let mut f = vec![0.0; 3 * node_count];
-        f[3 * self.positions[p / 3] + p % 3] = 1.0;
-        f
-    }
 }
 
 impl LoadOperator for LoadPatches {
