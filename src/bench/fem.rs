@@ -125,7 +125,7 @@ fn linear_displacement(model: &FemModel, loads: &Loads) -> Result<Vec<f64>, FemE
         .displacement_m)
 }
 
-fn median_ms(repeats: usize, f: &mut dyn FnMut()) -> f64 {
+pub(crate) fn median_ms(repeats: usize, f: &mut dyn FnMut()) -> f64 {
     let mut samples: Vec<f64> = (0..repeats)
         .map(|_| {
             let start = Instant::now();

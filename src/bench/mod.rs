@@ -2,3 +2,4 @@
 //! baseline measured in the same run. Run them with `pgd bench …`.
 
 pub mod fem;
+pub mod vademecum;

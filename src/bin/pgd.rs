@@ -127,8 +127,29 @@ impl MeshArgs {
     }
 }
 
+/// The material law of a build.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum LawArg {
+    /// Linear elasticity: one load step.
+    Linear,
+    /// Kirchhoff–Saint Venant by load steps: stiffens as the tool presses deeper.
+    Ksv,
+}
+
+impl LawArg {
+    fn law(self) -> Law {
+        match self {
+            LawArg::Linear => Law::Linear,
+            LawArg::Ksv => Law::KirchhoffSaintVenant,
+        }
+    }
+}
+
 #[derive(Args)]
 struct MaterialArgs {
+    /// Material law.
+    #[arg(long, value_enum, default_value = "linear")]
+    law: LawArg,
     /// Young's modulus in Pa (default: the organ's, or the liver's 1.6 kPa for mesh files).
     #[arg(long)]
     young_pa: Option<f64>,
@@ -139,12 +160,11 @@ struct MaterialArgs {
 
 impl MaterialArgs {
     fn material(&self, organ: Option<Organ>) -> Result<Material, String> {
-        // Linear elasticity only, for now: the KSV load-step vademecum is still to come.
+        let law = self.law.law();
         let young_pa = self
             .young_pa
             .unwrap_or_else(|| pgd::organ::young_pa(organ.unwrap_or(Organ::Liver)));
-        Material::new(Law::Linear, young_pa, self.poisson, TISSUE_DENSITY_KG_M3)
-            .map_err(|e| e.to_string())
+        Material::new(law, young_pa, self.poisson, TISSUE_DENSITY_KG_M3).map_err(|e| e.to_string())
     }
 }
 
@@ -162,11 +182,23 @@ struct BuildArgs {
     /// At most this many PGD modes per load step.
     #[arg(long, default_value_t = PgdSettings::default().max_modes)]
     max_modes: usize,
+    /// KSV: indentation under the tool at each load step after the linear one, in
+    /// millimetres, increasing. The deepest is the range the vademecum is valid over.
+    #[arg(long, value_delimiter = ',', default_values_t = pgd::DEFAULT_LOAD_STEPS_M.map(|m| m * 1e3))]
+    load_steps_mm: Vec<f64>,
 }
 
 impl BuildArgs {
-    fn settings(&self) -> BuildSettings {
-        BuildSettings {
+    fn settings(&self) -> Result<BuildSettings, String> {
+        let steps = &self.load_steps_mm;
+        if steps.iter().any(|s| !(s.is_finite() && *s > 0.0))
+            || steps.windows(2).any(|w| w[1] <= w[0])
+        {
+            return Err(format!(
+                "--load-steps-mm {steps:?}: expected positive indentations in increasing order"
+            ));
+        }
+        Ok(BuildSettings {
             tool_tip_radius_m: self.tool_radius_mm * 1e-3,
             local_radius_m: self.local_radius_mm * 1e-3,
             target_error: self.target_error,
@@ -174,7 +206,9 @@ impl BuildArgs {
                 max_modes: self.max_modes,
                 ..PgdSettings::default()
             },
-        }
+            load_steps_m: steps.iter().map(|s| s * 1e-3).collect(),
+            ..BuildSettings::default()
+        })
     }
 }
 
@@ -191,6 +225,22 @@ enum BenchTarget {
         /// Cubes along x, y, z of the benchmark box (six tets each).
         #[arg(long, num_args = 3, value_names = ["NX", "NY", "NZ"])]
         cells: Option<Vec<usize>>,
+    },
+    /// Build time and peak memory of an organ's vademecum (linear and KSV), and the online
+    /// evaluations: displacement under the tool, felt force, whole field, file load.
+    Vademecum {
+        /// The organ (liver, gallbladder, pancreas, duodenum, cornea).
+        #[arg(default_value = "liver")]
+        organ: String,
+        /// Material laws to build, in order (peak memory is the process's, so it only grows).
+        #[arg(long, value_enum, value_delimiter = ',', default_values = ["linear", "ksv"])]
+        laws: Vec<LawArg>,
+        /// Batches timed for each online evaluation; the median is reported.
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
     },
 }
 
@@ -243,6 +293,33 @@ fn main() -> ExitCode {
         }
         Command::Bench {
             what:
+                BenchTarget::Vademecum {
+                    organ,
+                    laws,
+                    repeats,
+                    json,
+                },
+        } => {
+            let Some(organ) = Organ::from_name(&organ) else {
+                return fail(
+                    "pgd bench vademecum",
+                    &format!(
+                        "{organ}: not an organ (liver, gallbladder, pancreas, duodenum, cornea)"
+                    ),
+                );
+            };
+            let laws: Vec<Law> = laws.into_iter().map(LawArg::law).collect();
+            match bench::vademecum::run(organ, &laws, repeats) {
+                Ok(report) if json => print_json(&report),
+                Ok(report) => {
+                    print!("{report}");
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail("pgd bench vademecum", &e.to_string()),
+            }
+        }
+        Command::Bench {
+            what:
                 BenchTarget::Fem {
                     json,
                     repeats,
@@ -272,6 +349,7 @@ fn validate_vademecum(
     settings: &ValidationSettings,
 ) -> Result<ValidationReport, String> {
     let vademecum = pgd::load(file).map_err(|e| e.to_string())?;
+    write_convergence(file, &vademecum.header)?;
     let (_, tet_mesh) = mesh.load()?;
     vademecum
         .check_mesh(file, &tet_mesh)
@@ -280,6 +358,27 @@ fn validate_vademecum(
         .map_err(|e| format!("{}: {e}", mesh.source))?;
     pgd::validate(&model, &vademecum, settings, &cli::Bar::default())
         .map_err(|e| format!("{}: {e}", mesh.source))
+}
+
+/// Writes the build's convergence curves beside the vademecum (to stderr, so `--json` output
+/// stays parseable).
+fn write_convergence(vademecum: &Path, header: &pgd::Header) -> Result<(), String> {
+    let steps: Vec<cli::StepCurve> = header
+        .indentation_levels_m
+        .iter()
+        .zip(&header.convergence)
+        .map(|(&indentation_m, curve)| cli::StepCurve {
+            indentation_m,
+            curve,
+        })
+        .collect();
+    let [csv, png] = cli::write_convergence(vademecum, &steps)?;
+    eprintln!(
+        "convergence curves: {} and {}",
+        csv.display(),
+        png.display()
+    );
+    Ok(())
 }
 
 fn print_validation(report: &ValidationReport) {
@@ -318,9 +417,10 @@ fn build_vademecum(
         clamped_region: region::CLAMPED.into(),
         accessible_region: region::ACCESSIBLE.into(),
     };
-    let (vademecum, report) = pgd::build(&organ_model, &build.settings(), &cli::Bar::default())
+    let (vademecum, report) = pgd::build(&organ_model, &build.settings()?, &cli::Bar::default())
         .map_err(|e| format!("{}: {e}", mesh.source))?;
     pgd::save(out, &vademecum).map_err(|e| e.to_string())?;
+    write_convergence(out, &vademecum.header)?;
     Ok(report)
 }
 
@@ -353,6 +453,20 @@ fn print_build_report(report: &BuildReport, out: &Path) {
             step.pgd_seconds / step.brute_force_seconds,
             step.local_seconds
         );
+        if let Some(fixed_point) = &step.fixed_point {
+            print_fixed_point(fixed_point);
+        }
+    }
+    if let Some(failed) = &report.failed_step {
+        println!(
+            "KSV step {:.1} mm left out: its fixed point did not converge (the law loses \
+             stability under the tool); the vademecum is valid to {:.1} mm",
+            failed.indentation_m * 1e3,
+            report.steps.last().map_or(0.0, |s| s.indentation_m * 1e3)
+        );
+        if let Some(fixed_point) = &failed.fixed_point {
+            print_fixed_point(fixed_point);
+        }
     }
     let size = std::fs::metadata(out).map_or(0, |m| m.len());
     println!(
@@ -360,6 +474,18 @@ fn print_build_report(report: &BuildReport, out: &Path) {
         out.display(),
         size as f64 / 1e6,
         report.total_seconds
+    );
+}
+
+fn print_fixed_point(report: &pgd::SecantReport) {
+    println!(
+        "  secant fixed point: {:.1} iterations per load on average, at most {}; \
+         {} of {} loads unconverged (largest last change {:.1e})",
+        report.mean_iterations(),
+        report.max_iterations,
+        report.unconverged,
+        report.responses,
+        report.worst_change
     );
 }
 

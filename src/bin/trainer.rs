@@ -1,9 +1,13 @@
 //! `trainer`: the surgical trainee's application.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Parser;
 use pgd_surgery::app::{self, PressedSlab};
+use pgd_surgery::cli::{self, OnStale};
+use pgd_surgery::fem::Law;
+use pgd_surgery::mesh::organs::Organ;
 
 #[derive(Parser)]
 #[command(
@@ -15,6 +19,12 @@ struct Cli {
     /// Run without a window: solve the default scene and print a summary.
     #[arg(long)]
     headless: bool,
+    /// Where the organs' vademecums are kept.
+    #[arg(long, default_value = "vademecums")]
+    vademecums: PathBuf,
+    /// Fail (with the command to run) instead of rebuilding a missing or stale vademecum.
+    #[arg(long)]
+    no_rebuild: bool,
 }
 
 fn main() -> ExitCode {
@@ -28,6 +38,23 @@ fn main() -> ExitCode {
              (for example `Xvfb :99 & DISPLAY=:99 cargo run --release`)."
         );
         return ExitCode::from(2);
+    }
+    let on_stale = if cli.no_rebuild {
+        OnStale::Refuse
+    } else {
+        OnStale::Rebuild
+    };
+    match cli::ensure_vademecum(&cli.vademecums, Organ::Liver, Law::Linear, on_stale) {
+        Ok(vademecum) => println!(
+            "liver vademecum: {} load positions, {} modes, built in {:.0} s",
+            vademecum.positions.len(),
+            vademecum.modes(0),
+            vademecum.header.build_seconds
+        ),
+        Err(e) => {
+            eprintln!("trainer: {e}");
+            return ExitCode::FAILURE;
+        }
     }
     let scene = match PressedSlab::solve() {
         Ok(scene) => scene,

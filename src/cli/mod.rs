@@ -1,8 +1,12 @@
 //! Terminal helpers shared by the binaries: progress bars and organ/mesh lookup. Kept out of
 //! the binaries so they stay thin, and out of the numerical core so it stays quiet.
 
+mod convergence;
 mod progress;
 mod source;
+mod vademecums;
 
+pub use convergence::{StepCurve, write as write_convergence};
 pub use progress::Bar;
 pub use source::{MeshSource, load_source};
+pub use vademecums::{OnStale, build_command, ensure_vademecum, vademecum_path};

@@ -83,6 +83,28 @@ impl TetGeometry {
         }
     }
 
+    /// The KSV internal force minus the linear one, `f_KSV(u) − K_e u`: the nonlinear terms
+    /// that the load-step scheme of paper 000 moves to the right-hand side. Zero for the
+    /// linear law.
+    pub fn nonlinear_force(
+        &self,
+        law: Law,
+        lambda: f64,
+        mu: f64,
+        u: &ElementVector,
+    ) -> ElementVector {
+        match law {
+            Law::Linear => ElementVector::zeros(),
+            Law::KirchhoffSaintVenant => {
+                let (f, s) = self.ksv_stress(lambda, mu, u);
+                let h = self.displacement_gradient(u);
+                let strain = (h + h.transpose()) * 0.5;
+                let linear = Matrix3::identity() * (lambda * strain.trace()) + strain * (2.0 * mu);
+                self.nodal_forces(&(f * s - linear))
+            }
+        }
+    }
+
     /// Linear-elastic element stiffness.
     pub fn linear_stiffness(&self, lambda: f64, mu: f64) -> ElementMatrix {
         let mut k = ElementMatrix::zeros();

@@ -5,7 +5,7 @@ use nalgebra::{SMatrix, SymmetricEigen, Vector3};
 
 use super::element::{ElementVector, TetGeometry};
 use super::pattern::FreePattern;
-use super::{Dirichlet, DofMap, FemError, Material, consistent_mass, lumped_mass};
+use super::{Dirichlet, DofMap, FemError, Law, Material, consistent_mass, lumped_mass};
 use crate::mesh::TetMesh;
 
 /// Rigid-mode ranks are read off a normalized 6×6 Gram matrix; eigenvalues below this
@@ -81,6 +81,20 @@ impl FemModel {
             scatter_vector(tet, &fe, &mut force);
         }
         force
+    }
+
+    /// The nonlinear part of the internal force (N) on every dof, `f_int(u) − K₀ u` with `K₀`
+    /// the rest stiffness: zero for the linear law. Adds into `out` (length: all dofs).
+    pub fn add_nonlinear_force(&self, u_m: &[f64], out: &mut [f64]) {
+        if self.material.law == Law::Linear {
+            return;
+        }
+        let (lambda, mu) = self.material.lame();
+        for (tet, geo) in self.mesh.tets().iter().zip(&self.geometry) {
+            let ue = gather(tet, u_m);
+            let fe = geo.nonlinear_force(self.material.law, lambda, mu, &ue);
+            scatter_vector(tet, &fe, out);
+        }
     }
 
     /// Internal force on every dof, and the tangent stiffness over free dofs as values of

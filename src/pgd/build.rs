@@ -1,10 +1,13 @@
 //! `pgd build`: from an organ model to its vademecum, with the brute-force baseline measured
 //! alongside.
 //!
-//! Linear step: the exact responses to every unit load are computed in blocks with the
-//! stiffness factorized once (they give the local part and the baseline), the global part is
-//! built by PGD enrichment, and the error estimator (the energy error of the separated part,
-//! exact here) picks the number of modes.
+//! Every load step: the exact responses to every unit load are computed in blocks with the
+//! rest stiffness factorized once (they give the local part and the baseline), the global part
+//! is built by PGD enrichment, and the error estimator (the L2 error of the whole vademecum,
+//! exact here) picks the number of modes. The linear step is step 0; a Kirchhoff–Saint Venant
+//! material adds one step per indentation level, whose secant responses are found by the
+//! fixed point of paper 000 (nonlinear terms of the previous iterate on the right-hand side),
+//! starting from the step before.
 
 use std::time::Instant;
 
@@ -12,15 +15,16 @@ use serde::{Deserialize, Serialize};
 
 use super::enrichment::{ModeReport, PgdSettings, enrich};
 use super::error_curve::{EnergyError, ErrorCurve, FieldError, optimal_errors};
-use super::load_patches::{LoadOperator, LoadPatches};
+use super::load_patches::{LoadOperator, LoadPatches, SecantLoads};
 use super::local::{LocalPart, distance_neighbours, near_nodes};
-use super::responses::Responses;
+use super::responses::{Responses, SecantReport, SecantSettings};
 use super::separated::SeparatedField;
 use super::stiffness::RestStiffness;
 use super::vademecum::{Header, Step, Vademecum};
 use super::{Progress, mesh_hash};
-use crate::fem::{FemError, FemModel, PatchKernel};
-use crate::mesh::Surface;
+use crate::fem::{FemError, FemModel, Law, PatchKernel};
+use crate::mesh::{Surface, TetMesh, area_vector};
+use nalgebra::Vector3;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BuildSettings {
@@ -32,6 +36,10 @@ pub struct BuildSettings {
     /// estimator); enrichment stops there or at the cap.
     pub target_error: f64,
     pub pgd: PgdSettings,
+    /// Kirchhoff–Saint Venant only: the indentation (m) under the tool at each load step after
+    /// the linear one, increasing. The deepest is the vademecum's valid range.
+    pub load_steps_m: Vec<f64>,
+    pub secant: SecantSettings,
 }
 
 impl Default for BuildSettings {
@@ -41,9 +49,16 @@ impl Default for BuildSettings {
             local_radius_m: 0.02,
             target_error: 0.05,
             pgd: PgdSettings::default(),
+            load_steps_m: DEFAULT_LOAD_STEPS_M.to_vec(),
+            secant: SecantSettings::default(),
         }
     }
 }
+
+/// KSV load steps: three, as in paper 000, up to the deepest indentation over which the KSV
+/// law stays stable under a 6 mm tool on the organs here: beyond about 1.5 mm the elements
+/// under the tool lose stability in compression (measured in docs/pgd.md).
+pub const DEFAULT_LOAD_STEPS_M: [f64; 3] = [0.5e-3, 1.0e-3, 1.5e-3];
 
 /// What the model is, beyond its mesh: the names written into the header.
 pub struct OrganModel<'a> {
@@ -64,6 +79,8 @@ pub struct StepReport {
     /// Exact responses, their Gram and its eigenvalues: the brute-force baseline.
     pub brute_force_seconds: f64,
     pub local_seconds: f64,
+    /// KSV steps: how the fixed point of the secant responses went.
+    pub fixed_point: Option<SecantReport>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -72,6 +89,9 @@ pub struct BuildReport {
     pub parameters: usize,
     pub free_dofs: usize,
     pub steps: Vec<StepReport>,
+    /// KSV load steps left out because their fixed point did not converge: the vademecum's
+    /// valid range stops before them.
+    pub failed_step: Option<StepReport>,
     pub total_seconds: f64,
 }
 
@@ -149,9 +169,15 @@ pub fn build(
     let neighbours = distance_neighbours(&coords, 2.0 * radius_m + longest_edge_m);
     progress.message("factorizing the stiffness");
     let stiffness = RestStiffness::new(model)?;
-
-    let (step, report) = linear_step(&stiffness, &patches, &neighbours, settings, progress)?;
-    let reference_compliance_m_per_n = self_compliances(&step.local);
+    let context = StepContext {
+        stiffness: &stiffness,
+        push_signs: push_signs(mesh, &surface, &patches.positions),
+        patches: &patches,
+        neighbours: &neighbours,
+        settings,
+        progress,
+    };
+    let (steps, reports, failed_step) = load_steps(&context)?;
     let header = Header {
         source: organ.source.clone(),
         mesh_hash: mesh_hash(mesh),
@@ -162,8 +188,9 @@ pub fn build(
         accessible_region: organ.accessible_region.clone(),
         load_directions: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         settings: settings.clone(),
-        indentation_levels_m: vec![0.0],
-        modes_per_step: vec![report.modes_kept],
+        indentation_levels_m: reports.iter().map(|r| r.indentation_m).collect(),
+        modes_per_step: reports.iter().map(|r| r.modes_kept).collect(),
+        convergence: reports.iter().map(|r| r.curve.clone()).collect(),
         build_seconds: started.elapsed().as_secs_f64(),
     };
     let vademecum = Vademecum {
@@ -172,38 +199,125 @@ pub fn build(
         position_coords_m: coords,
         position_areas_m2: patches.areas_m2.iter().map(|&a| a as f32).collect(),
         triangles,
-        reference_compliance_m_per_n,
-        steps: vec![step],
+        reference_compliance_m_per_n: self_compliances(&steps[0].local),
+        steps,
     };
     let report = BuildReport {
         positions: patches.positions.len(),
         parameters: patches.parameter_count(),
         free_dofs: stiffness.free_count(),
-        steps: vec![report],
+        steps: reports,
+        failed_step,
         total_seconds: started.elapsed().as_secs_f64(),
     };
     Ok((vademecum, report))
 }
 
-/// The linear step: exact responses, baseline, PGD global part, local part.
-fn linear_step(
-    stiffness: &RestStiffness,
-    patches: &LoadPatches,
-    neighbours: &[Vec<u32>],
-    settings: &BuildSettings,
-    progress: &dyn Progress,
-) -> Result<(Step, StepReport), FemError> {
+/// What every load step is built with.
+struct StepContext<'a> {
+    stiffness: &'a RestStiffness<'a>,
+    /// Per parameter, the sign of a force along its axis that pushes into the organ.
+    push_signs: Vec<f64>,
+    patches: &'a LoadPatches,
+    neighbours: &'a [Vec<u32>],
+    settings: &'a BuildSettings,
+    progress: &'a dyn Progress,
+}
+
+/// The steps built, their reports, and the report of a step left out.
+type LoadSteps = (Vec<Step>, Vec<StepReport>, Option<StepReport>);
+
+/// The linear step, then (KSV) one step per indentation level until the last or the first
+/// whose fixed point fails.
+fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
+    let (stiffness, patches, progress) = (context.stiffness, context.patches, context.progress);
     let clock = Instant::now();
     progress.start("exact responses", patches.parameter_count() as u64);
-    let responses = Responses::linear(stiffness, patches, &|n| progress.advance(n as u64));
-    let gram = responses.gram(stiffness, patches);
+    let mut exact = Responses::linear(stiffness, patches, &|n| progress.advance(n as u64));
+    let gram = exact.gram(stiffness, patches);
+    let (step, report) = separated_step(context, &exact, patches, gram, clock)?;
+    let reference: Vec<f32> = self_compliances(&step.local);
+    let (mut steps, mut reports) = (vec![step], vec![report]);
+    if stiffness.model.material().law == Law::Linear {
+        return Ok((steps, reports, None));
+    }
+    for &level_m in &context.settings.load_steps_m {
+        let clock = Instant::now();
+        // Each position's load is sized so that its linear response is `level_m` deep, and
+        // pushes into the organ: KSV answers a push and a pull differently.
+        let magnitudes: Vec<f64> = reference
+            .iter()
+            .flat_map(|&c| [if c > 0.0 { level_m / c as f64 } else { 0.0 }; 3])
+            .zip(&context.push_signs)
+            .map(|(m, sign)| m * sign)
+            .collect();
+        progress.start(
+            &format!("KSV step {:.1} mm", level_m * 1e3),
+            patches.parameter_count() as u64,
+        );
+        let fixed_point;
+        (exact, fixed_point) = exact.secant(
+            stiffness,
+            patches,
+            &magnitudes,
+            &context.settings.secant,
+            &|n| progress.advance(n as u64),
+        );
+        if !fixed_point.acceptable(&context.settings.secant) {
+            progress.message(&format!(
+                "KSV step {:.1} mm: the fixed point did not converge for {} of {} loads; \
+                 the vademecum stops at the step before",
+                level_m * 1e3,
+                fixed_point.unconverged,
+                fixed_point.responses
+            ));
+            let failed = StepReport {
+                indentation_m: level_m,
+                brute_force_seconds: clock.elapsed().as_secs_f64(),
+                fixed_point: Some(fixed_point),
+                ..StepReport::default()
+            };
+            return Ok((steps, reports, Some(failed)));
+        }
+        let gram = exact.energy_gram(stiffness);
+        let loads = SecantLoads {
+            stiffness,
+            responses: &exact,
+        };
+        let (step, mut report) = separated_step(context, &exact, &loads, gram, clock)?;
+        report.indentation_m = level_m;
+        report.fixed_point = Some(fixed_point);
+        steps.push(step);
+        reports.push(report);
+    }
+    Ok((steps, reports, None))
+}
+
+/// One load step from its exact responses: baseline, PGD global part, local part. `loads` is
+/// the step's right-hand side, `gram` its responses' energy Gram, `clock` started when its
+/// exact responses did.
+fn separated_step(
+    context: &StepContext,
+    exact: &Responses,
+    loads: &(dyn LoadOperator + Sync),
+    gram: Vec<f64>,
+    clock: Instant,
+) -> Result<(Step, StepReport), FemError> {
+    let StepContext {
+        stiffness,
+        patches,
+        neighbours,
+        settings,
+        progress,
+        ..
+    } = *context;
     let weights = patches.weights();
     let optimal = optimal_errors(&gram, &weights, settings.pgd.max_modes);
     let brute_force_seconds = clock.elapsed().as_secs_f64();
 
     let clock = Instant::now();
     progress.message("local compliances");
-    let mut local = LocalPart::with_compliances(stiffness, patches, &responses, neighbours);
+    let mut local = LocalPart::with_compliances(stiffness, patches, exact, neighbours);
     let near = near_nodes(
         stiffness.model.mesh(),
         &patches.positions,
@@ -215,10 +329,14 @@ fn linear_step(
     let self_compliance: Vec<f64> = (0..weights.len())
         .map(|p| gram[p * weights.len() + p])
         .collect();
-    let mut residual = responses;
+    drop(gram);
+    let mut residual = Responses {
+        rows: exact.rows,
+        columns: exact.columns.clone(),
+    };
     let (field, modes, mut curve) = separated_part(
         stiffness,
-        patches,
+        loads,
         (&weights, &self_compliance, &near),
         &mut residual,
         settings,
@@ -238,6 +356,7 @@ fn linear_step(
         pgd_seconds,
         brute_force_seconds,
         local_seconds,
+        fixed_point: None,
     };
     Ok((step_of(&field, local), report))
 }
@@ -285,6 +404,27 @@ fn step_of(field: &SeparatedField, local: LocalPart) -> Step {
             .collect(),
         local,
     }
+}
+
+/// Per parameter (position, axis), the sign of a force along the axis that points into the
+/// organ at the position, from the outward normals of the surface triangles around it.
+fn push_signs(mesh: &TetMesh, surface: &Surface, positions: &[usize]) -> Vec<f64> {
+    let mut outward = vec![Vector3::zeros(); mesh.node_count()];
+    for t in &surface.triangles {
+        let a = area_vector(mesh.nodes(), t);
+        t.iter().for_each(|&n| outward[n] += a);
+    }
+    positions
+        .iter()
+        .flat_map(|&n| (0..3).map(move |d| n * 3 + d))
+        .map(|dof| {
+            if outward[dof / 3][dof % 3] > 0.0 {
+                -1.0
+            } else {
+                1.0
+            }
+        })
+        .collect()
 }
 
 /// Per position, the largest diagonal entry of its self-compliance block (m/N).

@@ -13,7 +13,7 @@ use super::separated::{SeparatedField, dot};
 use super::stiffness::RestStiffness;
 
 /// Relative errors by number of modes, index `n − 1` for `n` modes.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ErrorCurve {
     /// Energy error of the PGD's separated sum.
     pub separated: Vec<f64>,

@@ -12,10 +12,11 @@ use thiserror::Error;
 
 use super::local::LocalPart;
 use super::vademecum::{Header, Step, Vademecum};
+use crate::fem::Material;
 use crate::mesh::TetMesh;
 
 /// Bumped on any change of layout or meaning; older files are refused, not misread.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 const MAGIC: &[u8; 8] = b"PGDVADEM";
 const PREFIX_BYTES: usize = 8 + 4 + 8 + 8;
 const CHECKSUM_BYTES: usize = 32;
@@ -55,6 +56,14 @@ pub enum VademecumError {
         expected: String,
         found: String,
     },
+    #[error(
+        "{file}: built for another material ({found}, wanted {expected}); rebuild it with `pgd build`"
+    )]
+    OtherMaterial {
+        file: PathBuf,
+        expected: String,
+        found: String,
+    },
 }
 
 /// Writes `vademecum` to `path` atomically.
@@ -63,6 +72,17 @@ pub fn save(path: &Path, vademecum: &Vademecum) -> Result<(), VademecumError> {
         file: path.to_path_buf(),
         source,
     };
+    let bytes = encode(vademecum);
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(io)?;
+    }
+    let temporary = path.with_extension("vdm.partial");
+    std::fs::write(&temporary, &bytes).map_err(io)?;
+    std::fs::rename(&temporary, path).map_err(io)
+}
+
+/// The bytes of the file `save` writes.
+pub fn encode(vademecum: &Vademecum) -> Vec<u8> {
     let header = serde_json::to_vec_pretty(&vademecum.header).expect("plain data serializes");
     let payload = payload(vademecum);
     let mut bytes = Vec::with_capacity(PREFIX_BYTES + header.len() + payload.len() + 32);
@@ -74,12 +94,7 @@ pub fn save(path: &Path, vademecum: &Vademecum) -> Result<(), VademecumError> {
     bytes.extend_from_slice(&payload);
     let checksum = blake3::hash(&bytes);
     bytes.extend_from_slice(checksum.as_bytes());
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(io)?;
-    }
-    let temporary = path.with_extension("vdm.partial");
-    std::fs::write(&temporary, &bytes).map_err(io)?;
-    std::fs::rename(&temporary, path).map_err(io)
+    bytes
 }
 
 /// Reads only the header of `path` (cheap: for staleness checks and listings).
@@ -91,8 +106,12 @@ pub fn read_header(path: &Path) -> Result<Header, VademecumError> {
 
 /// Reads and checks a vademecum file.
 pub fn load(path: &Path) -> Result<Vademecum, VademecumError> {
-    let bytes = read_bytes(path)?;
-    let (header, payload) = checked_parts(path, &bytes)?;
+    decode(path, &read_bytes(path)?)
+}
+
+/// Checks and reads the bytes of a vademecum file; `path` names it in errors.
+pub fn decode(path: &Path, bytes: &[u8]) -> Result<Vademecum, VademecumError> {
+    let (header, payload) = checked_parts(path, bytes)?;
     let mut reader = Reader {
         file: path,
         bytes: payload,
@@ -118,6 +137,18 @@ impl Vademecum {
                 file: file.to_path_buf(),
                 expected,
                 found: self.header.mesh_hash.clone(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Refuses a vademecum built for another material law or constants than `material`.
+    pub fn check_material(&self, file: &Path, material: &Material) -> Result<(), VademecumError> {
+        if self.header.material != *material {
+            return Err(VademecumError::OtherMaterial {
+                file: file.to_path_buf(),
+                expected: format!("{material:?}"),
+                found: format!("{:?}", self.header.material),
             });
         }
         Ok(())

@@ -15,13 +15,13 @@ mod stiffness;
 mod vademecum;
 mod validate;
 
-pub use build::{BuildReport, BuildSettings, OrganModel, StepReport, build};
+pub use build::{BuildReport, BuildSettings, DEFAULT_LOAD_STEPS_M, OrganModel, StepReport, build};
 pub use enrichment::{ModeReport, PgdSettings, enrich};
 pub use error_curve::{EnergyError, ErrorCurve, optimal_errors};
-pub use file::{FORMAT_VERSION, VademecumError, load, read_header, save};
-pub use load_patches::{LoadOperator, LoadPatches};
+pub use file::{FORMAT_VERSION, VademecumError, decode, encode, load, read_header, save};
+pub use load_patches::{LoadOperator, LoadPatches, SecantLoads};
 pub use local::LocalPart;
-pub use responses::Responses;
+pub use responses::{Responses, SecantReport, SecantSettings};
 pub use separated::SeparatedField;
 pub use stiffness::RestStiffness;
 pub use vademecum::{Header, Step, SurfacePoint, Vademecum};

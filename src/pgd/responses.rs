@@ -1,8 +1,11 @@
-//! Exact responses `U = K⁻¹ F`, one column per load parameter: what the brute-force baseline
-//! computes, and what the vademecum's local part (compliances, near-field corrections) is cut
-//! from.
+//! Exact responses, one column per load parameter: `U = K⁻¹ F` for the linear law, and the
+//! secant responses of a Kirchhoff–Saint Venant load step. They are what the brute-force
+//! baseline computes, and what the vademecum's local part (compliances, near-field
+//! corrections) is cut from.
 
+use faer::MatRef;
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use super::load_patches::{LoadOperator, LoadPatches};
 use super::stiffness::RestStiffness;
@@ -33,24 +36,71 @@ impl Responses {
         progress: &(dyn Fn(usize) + Sync),
     ) -> Self {
         let rows = stiffness.free_count();
-        let free_index = &stiffness.model.dofs().free_index;
         let mut columns = vec![0.0; rows * patches.parameter_count()];
         columns
             .par_chunks_mut(rows * BLOCK_COLUMNS)
             .enumerate()
             .for_each(|(block, chunk)| {
-                let first = block * BLOCK_COLUMNS;
                 for (j, column) in chunk.chunks_exact_mut(rows).enumerate() {
-                    let p = first + j;
-                    let free = free_index[3 * patches.positions[p / 3] + p % 3];
-                    if free != crate::fem::PRESCRIBED {
-                        column[free] = 1.0;
-                    }
+                    add_unit_load(stiffness, patches, block * BLOCK_COLUMNS + j, column);
                 }
                 stiffness.solve_block(chunk);
                 progress(chunk.len() / rows);
             });
         Self { rows, columns }
+    }
+
+    /// Turns linear (or previous-step) responses into the secant responses of a KSV load step:
+    /// per unit force, the response to a force of `magnitudes_n[p]` along parameter `p`,
+    /// `ũ = u / λ` with `K u = λ e_p − N(u)`. The nonlinear terms `N` of the previous iterate
+    /// go to the right-hand side (paper 000), so every iteration reuses the factorization of
+    /// the rest stiffness; `self` is the starting iterate.
+    pub fn secant(
+        mut self,
+        stiffness: &RestStiffness,
+        patches: &LoadPatches,
+        magnitudes_n: &[f64],
+        settings: &SecantSettings,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> (Self, SecantReport) {
+        let rows = self.rows;
+        let report = self
+            .columns
+            .par_chunks_mut(rows * BLOCK_COLUMNS)
+            .enumerate()
+            .map(|(block, chunk)| {
+                let first = block * BLOCK_COLUMNS;
+                let report = secant_block(
+                    stiffness,
+                    patches,
+                    (first, &magnitudes_n[first..]),
+                    chunk,
+                    settings,
+                );
+                progress(chunk.len() / rows);
+                report
+            })
+            .reduce(SecantReport::default, SecantReport::merge);
+        (self, report)
+    }
+
+    /// The energy Gram `Uᵀ K U` (column-major) of responses that need not satisfy `K U = F`
+    /// for unit loads `F` (the secant responses of a KSV step): a sparse product and a dense
+    /// one.
+    pub fn energy_gram(&self, stiffness: &RestStiffness) -> Vec<f64> {
+        let n = self.count();
+        let mut stiff = vec![0.0; self.columns.len()];
+        stiff
+            .par_chunks_mut(self.rows)
+            .enumerate()
+            .for_each(|(p, out)| stiffness.mul(self.column(p), out));
+        let u = MatRef::from_column_major_slice(&self.columns, self.rows, n);
+        let ku = MatRef::from_column_major_slice(&stiff, self.rows, n);
+        let gram = u.transpose() * ku;
+        (0..n)
+            .flat_map(|j| (0..n).map(move |i| (i, j)))
+            .map(|(i, j)| gram[(i, j)])
+            .collect()
     }
 
     /// The compliance between all pairs of loads, `G = Fᵀ U` (parameters × parameters,
@@ -62,5 +112,188 @@ impl Responses {
             loads.apply_transpose(&stiffness.extend(self.column(p)), out);
         });
         gram
+    }
+}
+
+/// The fixed point of a KSV load step, per response.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SecantSettings {
+    /// Converged when an iteration changes the response by less than this (relative).
+    pub tolerance: f64,
+    pub max_iterations: usize,
+    /// A step is kept while at most this fraction of its loads fail to converge; those keep
+    /// the previous step's secant response (reported, never silent).
+    pub max_unconverged_fraction: f64,
+}
+
+impl Default for SecantSettings {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-3,
+            max_iterations: 40,
+            max_unconverged_fraction: 0.005,
+        }
+    }
+}
+
+/// How the fixed points of one load step went.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SecantReport {
+    pub responses: usize,
+    pub total_iterations: usize,
+    pub max_iterations: usize,
+    /// Responses whose last change stayed above the tolerance (or became non-finite): there
+    /// the load step is beyond what the fixed point (and, usually, the KSV law) can carry.
+    /// They keep their starting iterate, the previous step's secant response.
+    pub unconverged: usize,
+    /// The largest final relative change over all responses.
+    pub worst_change: f64,
+}
+
+impl SecantReport {
+    fn merge(self, other: Self) -> Self {
+        Self {
+            responses: self.responses + other.responses,
+            total_iterations: self.total_iterations + other.total_iterations,
+            max_iterations: self.max_iterations.max(other.max_iterations),
+            unconverged: self.unconverged + other.unconverged,
+            worst_change: self.worst_change.max(other.worst_change),
+        }
+    }
+
+    /// Whether the step may be kept: few enough responses failed.
+    pub fn acceptable(&self, settings: &SecantSettings) -> bool {
+        self.unconverged as f64 <= settings.max_unconverged_fraction * self.responses as f64
+    }
+
+    pub fn mean_iterations(&self) -> f64 {
+        self.total_iterations as f64 / self.responses.max(1) as f64
+    }
+}
+
+/// `column[free dof of parameter p] += 1`: the unit load of parameter `p`.
+fn add_unit_load(stiffness: &RestStiffness, patches: &LoadPatches, p: usize, column: &mut [f64]) {
+    let free = stiffness.model.dofs().free_index[3 * patches.positions[p / 3] + p % 3];
+    if free != crate::fem::PRESCRIBED {
+        column[free] += 1.0;
+    }
+}
+
+/// The fixed point for the columns of one block (`first` is the first column's parameter),
+/// iterating only the columns still moving. Each column is relaxed by Aitken's dynamic factor
+/// (Irons–Tuck): where the law softens, the plain iteration with the rest stiffness overshoots
+/// and crawls; the factor, measured from the last two updates, takes most of that away.
+fn secant_block(
+    stiffness: &RestStiffness,
+    patches: &LoadPatches,
+    (first, magnitudes_n): (usize, &[f64]),
+    chunk: &mut [f64],
+    settings: &SecantSettings,
+) -> SecantReport {
+    let rows = stiffness.free_count();
+    let columns = chunk.len() / rows;
+    // A load on a clamped node has no response and no magnitude: nothing to iterate.
+    let mut active: Vec<usize> = (0..columns).filter(|&j| magnitudes_n[j] != 0.0).collect();
+    let mut change = vec![0.0; columns];
+    let mut relaxation = vec![1.0; columns];
+    let mut last_update: Vec<Vec<f64>> = vec![Vec::new(); columns];
+    let mut report = SecantReport {
+        responses: columns,
+        ..SecantReport::default()
+    };
+    let start = chunk.to_vec();
+    let mut work = NonlinearWork::new(stiffness);
+    for iteration in 1..=settings.max_iterations {
+        let mut rhs = Vec::with_capacity(active.len() * rows);
+        for &j in &active {
+            let column = &chunk[j * rows..(j + 1) * rows];
+            let start = rhs.len();
+            rhs.extend(work.right_hand_side(column, magnitudes_n[j]));
+            add_unit_load(stiffness, patches, first + j, &mut rhs[start..]);
+        }
+        stiffness.solve_block(&mut rhs);
+        for (&j, target) in active.iter().zip(rhs.chunks_exact(rows)) {
+            let column = &mut chunk[j * rows..(j + 1) * rows];
+            let update: Vec<f64> = target
+                .iter()
+                .zip(column.iter())
+                .map(|(t, u)| t - u)
+                .collect();
+            relaxation[j] = aitken(relaxation[j], &last_update[j], &update);
+            column
+                .iter_mut()
+                .zip(&update)
+                .for_each(|(u, d)| *u += relaxation[j] * d);
+            let norm = column.iter().map(|u| u * u).sum::<f64>();
+            let step = update.iter().map(|d| d * d).sum::<f64>();
+            change[j] = relaxation[j].abs() * (step / norm).sqrt();
+            last_update[j] = update;
+        }
+        report.total_iterations += active.len();
+        report.max_iterations = iteration;
+        // A non-finite change is a divergence: stop iterating it, it stays unconverged.
+        active.retain(|&j| change[j].is_finite() && change[j] >= settings.tolerance);
+        if active.is_empty() {
+            break;
+        }
+    }
+    for j in (0..columns).filter(|&j| change[j].is_nan() || change[j] >= settings.tolerance) {
+        report.unconverged += 1;
+        chunk[j * rows..(j + 1) * rows].copy_from_slice(&start[j * rows..(j + 1) * rows]);
+    }
+    report.worst_change = change
+        .iter()
+        .map(|c| if c.is_finite() { *c } else { f64::INFINITY })
+        .fold(0.0, f64::max);
+    report
+}
+
+/// Aitken's relaxation factor for the next update, from the previous factor and the last two
+/// unrelaxed updates; 1 on the first iteration, clamped to keep a bad estimate harmless.
+fn aitken(previous: f64, last: &[f64], update: &[f64]) -> f64 {
+    if last.is_empty() {
+        return 1.0;
+    }
+    let (mut num, mut den) = (0.0, 0.0);
+    for (a, b) in last.iter().zip(update) {
+        let d = b - a;
+        num += a * d;
+        den += d * d;
+    }
+    if den > 0.0 {
+        (-previous * num / den).clamp(0.05, 2.0)
+    } else {
+        previous
+    }
+}
+
+/// Buffers for evaluating the nonlinear terms of one response at a time.
+struct NonlinearWork<'a> {
+    stiffness: &'a RestStiffness<'a>,
+    full: Vec<f64>,
+    force: Vec<f64>,
+}
+
+impl<'a> NonlinearWork<'a> {
+    fn new(stiffness: &'a RestStiffness<'a>) -> Self {
+        Self {
+            stiffness,
+            full: vec![0.0; stiffness.full_count()],
+            force: vec![0.0; stiffness.full_count()],
+        }
+    }
+
+    /// `−N(λ ũ) / λ` over free dofs, for a secant response `ũ` at force magnitude `λ`.
+    fn right_hand_side(&mut self, secant: &[f64], lambda: f64) -> impl Iterator<Item = f64> {
+        let free_dofs = &self.stiffness.model.dofs().free_dofs;
+        self.full.fill(0.0);
+        for (&d, &v) in free_dofs.iter().zip(secant) {
+            self.full[d] = lambda * v;
+        }
+        self.force.fill(0.0);
+        self.stiffness
+            .model
+            .add_nonlinear_force(&self.full, &mut self.force);
+        free_dofs.iter().map(move |&d| -self.force[d] / lambda)
     }
 }

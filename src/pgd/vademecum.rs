@@ -6,6 +6,7 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::BuildSettings;
+use super::error_curve::ErrorCurve;
 use super::local::LocalPart;
 use crate::fem::{Material, patch_weight};
 
@@ -30,6 +31,8 @@ pub struct Header {
     /// Per load step: the indentation (m) its loads make under the tool (0 for the linear step).
     pub indentation_levels_m: Vec<f64>,
     pub modes_per_step: Vec<usize>,
+    /// Per load step, the error against the number of modes (for the convergence plot).
+    pub convergence: Vec<ErrorCurve>,
     pub build_seconds: f64,
 }
 
@@ -136,41 +139,64 @@ impl Vademecum {
         shares
     }
 
-    /// Weights of the load steps for a force of `force_n` at `at`: piecewise linear in the
-    /// indentation level, held at the last step beyond it.
-    fn step_weights(&self, shares: &[(usize, f64)], force_n: &Vector3<f64>) -> Vec<f64> {
+    /// Weight of load step `step` for a nodal load whose linear response is `level_m` deep:
+    /// piecewise linear between the steps' levels, held at the last step beyond it.
+    fn step_weight(&self, step: usize, level_m: f64) -> f64 {
         let levels = &self.header.indentation_levels_m;
-        let mut weights = vec![0.0; levels.len()];
-        if levels.len() == 1 {
-            weights[0] = 1.0;
-            return weights;
-        }
-        let compliance: f64 = shares
-            .iter()
-            .map(|&(i, l)| l * self.reference_compliance_m_per_n[i] as f64)
-            .sum();
-        let level = force_n.norm() * compliance;
-        match levels.iter().position(|&l| l >= level) {
-            Some(0) => weights[0] = 1.0,
+        let last = levels.len() - 1;
+        match levels.iter().position(|&l| l >= level_m) {
+            None => f64::from(step == last),
+            Some(0) => f64::from(step == 0),
             Some(k) => {
-                let t = (level - levels[k - 1]) / (levels[k] - levels[k - 1]);
-                weights[k - 1] = 1.0 - t;
-                weights[k] = t;
+                let t = (level_m - levels[k - 1]) / (levels[k] - levels[k - 1]);
+                if step == k {
+                    t
+                } else if step == k - 1 {
+                    1.0 - t
+                } else {
+                    0.0
+                }
             }
-            None => *weights.last_mut().expect("at least one step") = 1.0,
         }
-        weights
+    }
+
+    /// Per position of the patch `shares`, its share scaled by the weight of `step` for the
+    /// nodal load it carries of a total force `force_n`: each nodal load picks its own load
+    /// step, as the secant responses were built per nodal load.
+    fn step_shares(
+        &self,
+        step: usize,
+        shares: &[(usize, f64)],
+        force_n: &Vector3<f64>,
+    ) -> Vec<(usize, f64)> {
+        shares
+            .iter()
+            .map(|&(j, l)| {
+                let level = l * force_n.norm() * self.reference_compliance_m_per_n[j] as f64;
+                (j, l * self.step_weight(step, level))
+            })
+            .collect()
     }
 
     /// The 3 × 3 compliance (m/N) of load step `step` for the patch `shares`: the
     /// patch-averaged displacement under the tool per unit force, `Σ_ij β_i β_j C_ij`.
     pub fn step_compliance(&self, step: usize, shares: &[(usize, f64)]) -> Matrix3<f64> {
+        self.weighted_compliance(step, shares, shares)
+    }
+
+    /// `Σ_ij β_i γ_j C_ij`: the displacement averaged with `observed` under loads `loaded`.
+    fn weighted_compliance(
+        &self,
+        step: usize,
+        observed: &[(usize, f64)],
+        loaded: &[(usize, f64)],
+    ) -> Matrix3<f64> {
         let local = &self.steps[step].local;
         let mut c = Matrix3::zeros();
-        for &(i, li) in shares {
+        for &(i, li) in observed {
             for e in local.neighbours_of(i) {
                 let j = local.neighbours[e] as usize;
-                if let Some(&(_, lj)) = shares.iter().find(|(v, _)| *v == j) {
+                if let Some(&(_, lj)) = loaded.iter().find(|(v, _)| *v == j) {
                     let block = &local.compliance[9 * e..9 * e + 9];
                     c += Matrix3::from_row_iterator(block.iter().map(|&v| v as f64)) * (li * lj);
                 }
@@ -181,11 +207,11 @@ impl Vademecum {
 
     /// The compliance for a force `force_n` on the patch `shares` (load steps blended).
     pub fn compliance(&self, shares: &[(usize, f64)], force_n: &Vector3<f64>) -> Matrix3<f64> {
-        self.step_weights(shares, force_n)
-            .iter()
-            .enumerate()
-            .filter(|(_, w)| **w > 0.0)
-            .map(|(k, w)| self.step_compliance(k, shares) * *w)
+        if self.steps.len() == 1 {
+            return self.step_compliance(0, shares);
+        }
+        (0..self.steps.len())
+            .map(|k| self.weighted_compliance(k, shares, &self.step_shares(k, shares, force_n)))
             .sum()
     }
 
@@ -220,9 +246,10 @@ impl Vademecum {
     pub fn field(&self, at: &SurfacePoint, force_n: &Vector3<f64>) -> Vec<f64> {
         let shares = self.shares(at);
         let mut u = vec![0.0; self.dof_count()];
-        for (k, w) in self.step_weights(&shares, force_n).into_iter().enumerate() {
-            if w > 0.0 {
-                self.add_step_field(k, &shares, &(force_n * w), &mut u);
+        for k in 0..self.steps.len() {
+            let loaded = self.step_shares(k, &shares, force_n);
+            if loaded.iter().any(|s| s.1 > 0.0) {
+                self.add_step_field(k, &loaded, force_n, &mut u);
             }
         }
         u

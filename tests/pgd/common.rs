@@ -9,9 +9,13 @@ pub fn block_mesh(cells: [usize; 3]) -> TetMesh {
 }
 
 pub fn block_model(mesh: TetMesh) -> FemModel {
+    block_model_of(mesh, Law::Linear)
+}
+
+pub fn block_model_of(mesh: TetMesh, law: Law) -> FemModel {
     let mut dirichlet = Dirichlet::new(mesh.node_count());
     dirichlet.clamp(mesh.node_set("z0").unwrap()).unwrap();
-    FemModel::new(mesh, Material::liver(Law::Linear), dirichlet).unwrap()
+    FemModel::new(mesh, Material::liver(law), dirichlet).unwrap()
 }
 
 pub fn organ(model: &FemModel) -> OrganModel<'_> {
@@ -33,6 +37,7 @@ pub fn settings(max_modes: usize, target_error: f64) -> BuildSettings {
             max_modes,
             ..PgdSettings::default()
         },
+        ..BuildSettings::default()
     }
 }
 

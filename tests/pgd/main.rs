@@ -3,3 +3,5 @@
 mod common;
 mod convergence;
 mod file_format;
+mod nonlinear;
+mod outputs;

@@ -1,0 +1,194 @@
+//! The convergence curves of a vademecum build, as a CSV table and a PNG plot in the manner of
+//! figures 13–14 of paper 000: error against the total number of modes over all load steps
+//! (the plateaus of the load-step scheme), and error against modes per load step, with the
+//! optimal rank-n error (the brute-force SVD) for comparison.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use plotters::prelude::*;
+
+use crate::pgd::ErrorCurve;
+
+/// The plot's font, shipped with the crate so that plots need nothing from the system.
+const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+
+const SIZE: (u32, u32) = (1400, 560);
+
+/// One load step's curve and the indentation it stands for.
+pub struct StepCurve<'a> {
+    pub indentation_m: f64,
+    pub curve: &'a ErrorCurve,
+}
+
+/// Writes `<stem>.convergence.csv` and `<stem>.convergence.png` beside `vademecum`; returns
+/// their paths.
+pub fn write(vademecum: &Path, steps: &[StepCurve]) -> Result<[PathBuf; 2], String> {
+    let csv = vademecum.with_extension("convergence.csv");
+    let png = vademecum.with_extension("convergence.png");
+    std::fs::write(&csv, table(steps)).map_err(|e| format!("{}: {e}", csv.display()))?;
+    plot(&png, steps).map_err(|e| format!("{}: {e}", png.display()))?;
+    Ok([csv, png])
+}
+
+/// One row per step and mode count: the PGD's energy error, the optimal one, their ratio and
+/// the whole vademecum's field error (the estimator).
+pub fn table(steps: &[StepCurve]) -> String {
+    let mut out = String::from(
+        "step,indentation_mm,modes,total_modes,pgd_energy_error,optimal_energy_error,ratio,vademecum_field_error\n",
+    );
+    let mut total = 0;
+    for (k, step) in steps.iter().enumerate() {
+        let c = step.curve;
+        for n in 0..c.separated.len() {
+            total += 1;
+            let optimal = c.optimal.get(n).copied().unwrap_or(f64::NAN);
+            let field = c.field.get(n).copied().unwrap_or(f64::NAN);
+            let _ = writeln!(
+                out,
+                "{k},{:.3},{},{total},{:.6e},{:.6e},{:.4},{:.6e}",
+                step.indentation_m * 1e3,
+                n + 1,
+                c.separated[n],
+                optimal,
+                c.separated[n] / optimal,
+                field
+            );
+        }
+    }
+    out
+}
+
+fn plot(path: &Path, steps: &[StepCurve]) -> Result<(), Box<dyn std::error::Error>> {
+    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+        .map_err(|_| "the embedded font could not be read")?;
+    let (width, height) = SIZE;
+    let mut pixels = vec![0u8; (width * height * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
+        root.fill(&WHITE)?;
+        let (left, right) = root.split_horizontally(width / 2);
+        let lowest = steps
+            .iter()
+            .flat_map(|s| {
+                s.curve
+                    .separated
+                    .iter()
+                    .chain(&s.curve.optimal)
+                    .chain(&s.curve.field)
+            })
+            .copied()
+            .filter(|e| *e > 0.0)
+            .fold(1.0, f64::min);
+        let floor = 10f64.powf(lowest.log10().floor());
+        all_steps(&left, steps, floor)?;
+        per_step(&right, steps, floor)?;
+        root.present()?;
+    }
+    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut encoder = png::Encoder::new(file, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.write_header()?.write_image_data(&pixels)?;
+    Ok(())
+}
+
+type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+
+/// Figure 13: the energy error of the separated part against all modes so far.
+fn all_steps(
+    area: &Area,
+    steps: &[StepCurve],
+    floor: f64,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let total: usize = steps.iter().map(|s| s.curve.separated.len()).sum();
+    let mut chart = ChartBuilder::on(area)
+        .caption("Error against total number of modes", ("sans-serif", 24))
+        .margin(16)
+        .x_label_area_size(44)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0usize..total.max(1), (floor..1.0).log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc("modes (all load steps)")
+        .y_desc("relative error")
+        .draw()?;
+    let points = steps
+        .iter()
+        .flat_map(|s| s.curve.separated.iter().copied())
+        .enumerate()
+        .map(|(n, e)| (n + 1, e.max(floor)));
+    chart
+        .draw_series(LineSeries::new(points, BLUE.stroke_width(2)))?
+        .label("PGD separated part (energy norm)")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE.stroke_width(2)));
+    let field = steps
+        .iter()
+        .flat_map(|s| s.curve.field.iter().copied())
+        .enumerate()
+        .map(|(n, e)| (n + 1, e.max(floor)));
+    chart
+        .draw_series(LineSeries::new(field, RED.stroke_width(2)))?
+        .label("whole vademecum, modes + exact near field (L2)")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
+}
+
+/// Figure 14: per load step, the PGD's error and the optimal rank-n error.
+fn per_step(
+    area: &Area,
+    steps: &[StepCurve],
+    floor: f64,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let longest = steps
+        .iter()
+        .map(|s| s.curve.separated.len())
+        .max()
+        .unwrap_or(1);
+    let mut chart = ChartBuilder::on(area)
+        .caption("Error against modes per load step", ("sans-serif", 24))
+        .margin(16)
+        .x_label_area_size(44)
+        .y_label_area_size(70)
+        .build_cartesian_2d(1usize..longest.max(2), (floor..1.0).log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc("modes in the step")
+        .y_desc("relative energy error")
+        .draw()?;
+    for (k, step) in steps.iter().enumerate() {
+        let colour = Palette99::pick(k).to_rgba();
+        let label = format!("step {k} ({:.1} mm)", step.indentation_m * 1e3);
+        let curve = step.curve.separated.iter().enumerate();
+        chart
+            .draw_series(LineSeries::new(
+                curve.map(|(n, e)| (n + 1, e.max(floor))),
+                colour.stroke_width(2),
+            ))?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
+        let optimal = step.curve.optimal.iter().enumerate();
+        chart.draw_series(DashedLineSeries::new(
+            optimal.map(|(n, e)| (n + 1, e.max(floor))),
+            6,
+            4,
+            colour.stroke_width(1),
+        ))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    chart.plotting_area().draw(&Text::new(
+        "dashed: optimal rank-n (SVD)",
+        (longest.max(2) * 2 / 3, 0.5),
+        ("sans-serif", 16),
+    ))?;
+    Ok(())
+}

@@ -1,0 +1,137 @@
+//! The Kirchhoff–Saint Venant vademecum by load steps: its secant responses are KSV
+//! equilibria, it follows full KSV FEM better than the linear vademecum does, and a load step
+//! beyond the law's stability is left out and bounds the valid range.
+
+use pgd_surgery::fem::{FemModel, Law, Loads, NewtonSettings, PatchKernel};
+use pgd_surgery::mesh::Surface;
+use pgd_surgery::pgd::{
+    BuildSettings, LoadPatches, Responses, RestStiffness, SecantSettings, Silent,
+    ValidationSettings, build, validate,
+};
+
+use crate::common::{block_mesh, block_model_of, organ, settings};
+
+/// Interior nodes of the block's top face.
+fn top_nodes(model: &FemModel) -> Vec<usize> {
+    let mesh = model.mesh();
+    mesh.node_set("z1")
+        .unwrap()
+        .iter()
+        .copied()
+        .filter(|&n| {
+            let p = mesh.nodes()[n];
+            p.x > 0.015 && p.x < 0.045 && p.y > 0.01 && p.y < 0.03
+        })
+        .take(2)
+        .collect()
+}
+
+/// For a force of magnitude λ along parameter p, `λ ũ_p` must be the KSV equilibrium that
+/// Newton finds for the same nodal force: tolerance 1e-6 relative, with the fixed point run to
+/// 1e-9 (the Newton solve converges to 1e-10 of the load).
+#[test]
+fn a_secant_response_is_the_ksv_equilibrium_per_unit_force() {
+    let model = block_model_of(block_mesh([6, 4, 3]), Law::KirchhoffSaintVenant);
+    let mesh = model.mesh();
+    let surface = Surface::extract(mesh);
+    let kernel = PatchKernel::new(mesh, &surface, 0.012).unwrap();
+    let patches = LoadPatches::new(&surface, &kernel, top_nodes(&model)).unwrap();
+    let stiffness = RestStiffness::new(&model).unwrap();
+    let linear = Responses::linear(&stiffness, &patches, &|_| {});
+    let own_dof = |p: usize| model.dofs().free_index[3 * patches.positions[p / 3] + p % 3];
+    // Each force pushes its own node 3 mm in the linear response.
+    let magnitudes: Vec<f64> = (0..linear.count())
+        .map(|p| 3e-3 / linear.column(p)[own_dof(p)])
+        .collect();
+    let fixed_point = SecantSettings {
+        tolerance: 1e-9,
+        max_iterations: 300,
+        ..SecantSettings::default()
+    };
+    let before = linear.columns.clone();
+    let (secant, report) = linear.secant(&stiffness, &patches, &magnitudes, &fixed_point, &|_| {});
+    assert_eq!(report.unconverged, 0, "{report:?}");
+    for p in 0..secant.count() {
+        let mut loads = Loads::new(mesh.node_count());
+        let mut force = [0.0; 3];
+        force[p % 3] = magnitudes[p];
+        loads
+            .add_nodal_force(patches.positions[p / 3], force)
+            .unwrap();
+        let newton = model
+            .solve_static(&loads, &NewtonSettings::default())
+            .unwrap();
+        let reference: Vec<f64> = model
+            .dofs()
+            .restrict(&newton.displacement_m)
+            .iter()
+            .map(|u| u / magnitudes[p])
+            .collect();
+        let error = relative(secant.column(p), &reference);
+        let nonlinearity = relative(&before[p * secant.rows..(p + 1) * secant.rows], &reference);
+        eprintln!(
+            "parameter {p}: secant vs Newton {error:.2e}, linear vs Newton {nonlinearity:.3}"
+        );
+        assert!(error < 1e-6, "parameter {p}: {error}");
+        assert!(
+            nonlinearity > 0.01,
+            "the load should be in the nonlinear range"
+        );
+    }
+}
+
+fn relative(a: &[f64], b: &[f64]) -> f64 {
+    let diff: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum();
+    let norm: f64 = b.iter().map(|y| y * y).sum();
+    (diff / norm).sqrt()
+}
+
+fn ksv_settings(load_steps_m: Vec<f64>) -> BuildSettings {
+    BuildSettings {
+        load_steps_m,
+        ..settings(60, 1e-3)
+    }
+}
+
+/// Against full KSV FEM (Newton) at indentations up to the deepest load step, the KSV
+/// vademecum's felt force must be at least twice as close (p95) as the linear vademecum's:
+/// the load steps carry the nonlinearity. Measured: 12.7 % against 30.8 %; the 7 %
+/// is not reached yet (nodal secant responses superposed over the patch, see docs/pgd.md).
+#[test]
+fn the_ksv_vademecum_follows_full_ksv_fem_better_than_the_linear_one() {
+    let ksv_model = block_model_of(block_mesh([6, 4, 3]), Law::KirchhoffSaintVenant);
+    let linear_model = block_model_of(block_mesh([6, 4, 3]), Law::Linear);
+    let steps = vec![1e-3, 2e-3, 3e-3];
+    let (ksv, report) = build(&organ(&ksv_model), &ksv_settings(steps), &Silent).unwrap();
+    assert!(report.failed_step.is_none(), "{:?}", report.failed_step);
+    assert_eq!(ksv.steps.len(), 4);
+    assert_eq!(ksv.valid_indentation_m(), 3e-3);
+    let (linear, _) = build(&organ(&linear_model), &settings(60, 1e-3), &Silent).unwrap();
+    let loads = ValidationSettings {
+        samples: 12,
+        near_radius_m: 0.015,
+        indentation_range_m: (0.5e-3, 3e-3),
+        ..ValidationSettings::default()
+    };
+    let with_ksv = validate(&ksv_model, &ksv, &loads, &Silent).unwrap();
+    let with_linear = validate(&ksv_model, &linear, &loads, &Silent).unwrap();
+    eprintln!(
+        "felt-force error against full KSV, p95: KSV vademecum {:.4}, linear vademecum {:.4}",
+        with_ksv.force_error.p95, with_linear.force_error.p95
+    );
+    assert!(with_ksv.force_error.p95 < 0.5 * with_linear.force_error.p95);
+}
+
+/// A load step deeper than the law can carry (4 cm into a 3 cm block) fails its fixed point;
+/// it is reported and left out, and the vademecum is valid to the step before.
+#[test]
+fn a_load_step_beyond_stability_is_left_out() {
+    let model = block_model_of(block_mesh([4, 3, 2]), Law::KirchhoffSaintVenant);
+    let (vademecum, report) =
+        build(&organ(&model), &ksv_settings(vec![1e-3, 0.04]), &Silent).unwrap();
+    let failed = report.failed_step.expect("the 4 cm step cannot converge");
+    assert_eq!(failed.indentation_m, 0.04);
+    assert!(failed.fixed_point.unwrap().unconverged > 0);
+    assert_eq!(vademecum.steps.len(), 2);
+    assert_eq!(vademecum.valid_indentation_m(), 1e-3);
+}

@@ -1,0 +1,62 @@
+//! What the offline tools hand to users: the convergence table and plot, and the trainer's
+//! refusal of a vademecum that does not fit its organ.
+
+use pgd_surgery::cli::{self, OnStale, StepCurve};
+use pgd_surgery::fem::Law;
+use pgd_surgery::mesh::organs::Organ;
+use pgd_surgery::pgd::save;
+
+use crate::common::{block_mesh, block_model, build_block};
+
+fn temp_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("pgd-outputs-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// One CSV row per mode with the curve's own numbers, and a real PNG beside the vademecum.
+#[test]
+fn the_convergence_curves_are_written_as_csv_and_png() {
+    let model = block_model(block_mesh([4, 3, 2]));
+    let vademecum = build_block(&model, 5);
+    let curve = &vademecum.header.convergence[0];
+    let file = temp_dir("curves").join("block.vdm");
+    let steps = [StepCurve {
+        indentation_m: 0.0,
+        curve,
+    }];
+    let [csv, png] = cli::write_convergence(&file, &steps).unwrap();
+    let table = std::fs::read_to_string(csv).unwrap();
+    let rows: Vec<&str> = table.lines().skip(1).collect();
+    assert_eq!(rows.len(), vademecum.modes(0));
+    let last: Vec<&str> = rows.last().unwrap().split(',').collect();
+    let pgd_error: f64 = last[4].parse().unwrap();
+    assert!((pgd_error - curve.separated[rows.len() - 1]).abs() < 1e-6 * pgd_error);
+    let bytes = std::fs::read(png).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+}
+
+/// A vademecum of another mesh under the liver's name is refused, naming the file, the
+/// problem and the command that builds the right one; a missing one too.
+#[test]
+fn the_trainer_refuses_a_stale_or_missing_vademecum_with_the_command_to_run() {
+    let dir = temp_dir("stale");
+    let missing =
+        cli::ensure_vademecum(&dir, Organ::Liver, Law::Linear, OnStale::Refuse).unwrap_err();
+    assert!(
+        missing.contains("liver.vdm") && missing.contains("pgd -- build liver"),
+        "{missing}"
+    );
+    let model = block_model(block_mesh([4, 3, 2]));
+    save(
+        &cli::vademecum_path(&dir, Organ::Liver),
+        &build_block(&model, 2),
+    )
+    .unwrap();
+    let stale =
+        cli::ensure_vademecum(&dir, Organ::Liver, Law::Linear, OnStale::Refuse).unwrap_err();
+    assert!(
+        stale.contains("another mesh") && stale.contains("pgd -- build liver"),
+        "{stale}"
+    );
+}
