@@ -330,10 +330,7 @@ fn separated_step(
         .map(|p| gram[p * weights.len() + p])
         .collect();
     drop(gram);
-    let mut residual = Responses {
-        rows: exact.rows,
-        columns: exact.columns.clone(),
-    };
+    let mut residual = exact.clone();
     let (field, modes, mut curve) = separated_part(
         stiffness,
         loads,

@@ -14,6 +14,7 @@ use super::stiffness::RestStiffness;
 const BLOCK_COLUMNS: usize = 48;
 
 /// Free-dof columns of the responses, column-major (`free_count` rows).
+#[derive(Clone)]
 pub struct Responses {
     pub rows: usize,
     pub columns: Vec<f64>,
