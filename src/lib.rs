@@ -8,7 +8,9 @@
 pub mod app;
 pub mod bench;
 pub mod cli;
+pub mod contact;
 pub mod fem;
+pub mod haptics;
 pub mod mesh;
 pub mod pgd;
 pub mod seam;

@@ -1,6 +1,9 @@
 //! The Bevy layer: plugins and systems that wrap the numerical core for the trainer window.
 
+pub mod haptic;
+pub mod headless;
 mod pressed_slab;
+pub mod scene;
 mod view;
 
 use bevy::prelude::*;

@@ -4,10 +4,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Parser;
-use pgd_surgery::app::{self, PressedSlab};
-use pgd_surgery::cli::{self, OnStale};
-use pgd_surgery::fem::Law;
-use pgd_surgery::mesh::organs::Organ;
+use pgd_surgery::app::{self, PressedSlab, headless};
+use pgd_surgery::cli::OnStale;
+use pgd_surgery::haptics::{DeviceSpec, TimerMode};
 
 #[derive(Parser)]
 #[command(
@@ -16,15 +15,46 @@ use pgd_surgery::mesh::organs::Organ;
     about = "Real-time surgery trainer: organs deform under a haptic tool through PGD vademecums"
 )]
 struct Cli {
-    /// Run without a window: solve the default scene and print a summary.
+    /// Run the haptic loop without a window and print a summary.
     #[arg(long)]
     headless: bool,
+    /// The haptic device: `scripted:FILE` replays a trajectory CSV (time_s,x_m,y_m,z_m,buttons);
+    /// `virtual` is the mouse. Headless default: a built-in press-and-slide on every organ.
+    #[arg(long)]
+    device: Option<DeviceSpec>,
+    /// Record what the device reports to this trajectory file (replayable with scripted:FILE).
+    #[arg(long)]
+    record: Option<PathBuf>,
+    /// Headless: ticks to run (default: the script's length plus 100 ms).
+    #[arg(long)]
+    ticks: Option<u64>,
+    /// Headless: print the summary as JSON.
+    #[arg(long)]
+    json: bool,
+    /// Headless: tick on the real clock (1 kHz on a thread of its own) instead of a simulated
+    /// one, and report how well it kept time.
+    #[arg(long)]
+    realtime: bool,
+    /// Real-time pacing: `hybrid` sleeps then spins to the deadline, `sleep` only sleeps.
+    #[arg(long, default_value = "hybrid", value_parser = parse_timer)]
+    timer: TimerMode,
+    /// The largest force (N) sent to the device (also capped by the device's own limit).
+    #[arg(long, default_value_t = 3.3)]
+    max_force_n: f64,
     /// Where the organs' vademecums are kept.
     #[arg(long, default_value = "vademecums")]
     vademecums: PathBuf,
     /// Fail (with the command to run) instead of rebuilding a missing or stale vademecum.
     #[arg(long)]
     no_rebuild: bool,
+}
+
+fn parse_timer(s: &str) -> Result<TimerMode, String> {
+    match s {
+        "sleep" => Ok(TimerMode::Sleep),
+        "hybrid" => Ok(TimerMode::default()),
+        _ => Err(format!("unknown timer `{s}`: expected `hybrid` or `sleep`")),
+    }
 }
 
 fn main() -> ExitCode {
@@ -44,17 +74,26 @@ fn main() -> ExitCode {
     } else {
         OnStale::Rebuild
     };
-    match cli::ensure_vademecum(&cli.vademecums, Organ::Liver, Law::Linear, on_stale) {
-        Ok(vademecum) => println!(
-            "liver vademecum: {} load positions, {} modes, built in {:.0} s",
-            vademecum.positions.len(),
-            vademecum.modes(0),
-            vademecum.header.build_seconds
-        ),
-        Err(e) => {
-            eprintln!("trainer: {e}");
-            return ExitCode::FAILURE;
-        }
+    if cli.headless {
+        let options = headless::Options {
+            vademecums: cli.vademecums,
+            on_stale,
+            device: cli.device,
+            record: cli.record,
+            ticks: cli.ticks,
+            realtime: cli.realtime.then_some(cli.timer),
+            max_force_n: cli.max_force_n,
+        };
+        return match headless::run(&options) {
+            Ok(report) => {
+                report.print(cli.json);
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("trainer: {e}");
+                ExitCode::FAILURE
+            }
+        };
     }
     let scene = match PressedSlab::solve() {
         Ok(scene) => scene,
@@ -64,9 +103,6 @@ fn main() -> ExitCode {
         }
     };
     println!("{}", scene.summary());
-    if cli.headless {
-        return ExitCode::SUCCESS;
-    }
     match app::run_window(scene) {
         bevy::app::AppExit::Success => ExitCode::SUCCESS,
         bevy::app::AppExit::Error(code) => ExitCode::from(code.get()),

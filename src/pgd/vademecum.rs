@@ -94,6 +94,24 @@ impl Vademecum {
             .unwrap_or(0.0)
     }
 
+    /// Outward unit normals of the accessible surface at rest, per position (area-weighted).
+    pub fn rest_normals(&self) -> Vec<Vector3<f64>> {
+        let coords: Vec<[f64; 3]> = self
+            .position_coords_m
+            .iter()
+            .map(|p| p.map(f64::from))
+            .collect();
+        let triangles: Vec<[usize; 3]> = self
+            .triangles
+            .iter()
+            .map(|t| t.map(|m| m as usize))
+            .collect();
+        crate::mesh::vertex_normals(&triangles, &coords)
+            .into_iter()
+            .map(Vector3::from)
+            .collect()
+    }
+
     /// Rest coordinates (m) of a surface point.
     pub fn point(&self, at: &SurfacePoint) -> Vector3<f64> {
         self.triangles[at.triangle]
@@ -107,11 +125,19 @@ impl Vademecum {
     /// (summing to one), the same kernel as the full FEM load. A patch narrower than the mesh
     /// (no node inside it) falls back to the triangle's corners.
     pub fn shares(&self, at: &SurfacePoint) -> Vec<(usize, f64)> {
+        let mut shares = Vec::new();
+        self.shares_into(at, &mut shares);
+        shares
+    }
+
+    /// [`Self::shares`] into a buffer the caller keeps: a haptic tick allocates nothing once
+    /// the buffer has grown to the largest patch.
+    pub fn shares_into(&self, at: &SurfacePoint, shares: &mut Vec<(usize, f64)>) {
+        shares.clear();
         let centre = self.point(at);
         let radius_m = self.header.settings.tool_tip_radius_m;
         let local = &self.steps[0].local;
         let corners = self.triangles[at.triangle];
-        let mut shares: Vec<(usize, f64)> = Vec::new();
         for &corner in &corners {
             for e in local.neighbours_of(corner as usize) {
                 let m = local.neighbours[e] as usize;
@@ -131,12 +157,11 @@ impl Vademecum {
         }
         let total: f64 = shares.iter().map(|s| s.1).sum();
         if total <= 0.0 {
-            return (0..3)
-                .map(|k| (corners[k] as usize, at.barycentric[k]))
-                .collect();
+            shares.clear();
+            shares.extend((0..3).map(|k| (corners[k] as usize, at.barycentric[k])));
+            return;
         }
         shares.iter_mut().for_each(|s| s.1 /= total);
-        shares
     }
 
     /// Weight of load step `step` for a nodal load whose linear response is `level_m` deep:
@@ -160,45 +185,40 @@ impl Vademecum {
         }
     }
 
-    /// Per position of the patch `shares`, its share scaled by the weight of `step` for the
-    /// nodal load it carries of a total force `force_n`: each nodal load picks its own load
-    /// step, as the secant responses were built per nodal load.
-    fn step_shares(
-        &self,
-        step: usize,
-        shares: &[(usize, f64)],
-        force_n: &Vector3<f64>,
-    ) -> Vec<(usize, f64)> {
-        shares
-            .iter()
-            .map(|&(j, l)| {
-                let level = l * force_n.norm() * self.reference_compliance_m_per_n[j] as f64;
-                (j, l * self.step_weight(step, level))
-            })
-            .collect()
+    /// The share of a total force `force_n` that position `j` (share `l` of the patch) carries
+    /// in load step `step`: each nodal load picks its own load step, as the secant responses
+    /// were built per nodal load.
+    pub(crate) fn step_share(&self, step: usize, j: usize, l: f64, force_n: &Vector3<f64>) -> f64 {
+        if self.steps.len() == 1 {
+            return l;
+        }
+        let level = l * force_n.norm() * self.reference_compliance_m_per_n[j] as f64;
+        l * self.step_weight(step, level)
     }
 
     /// The 3 × 3 compliance (m/N) of load step `step` for the patch `shares`: the
     /// patch-averaged displacement under the tool per unit force, `Σ_ij β_i β_j C_ij`.
     pub fn step_compliance(&self, step: usize, shares: &[(usize, f64)]) -> Matrix3<f64> {
-        self.weighted_compliance(step, shares, shares)
+        self.weighted_compliance(step, shares, |_, l| l)
     }
 
-    /// `Σ_ij β_i γ_j C_ij`: the displacement averaged with `observed` under loads `loaded`.
+    /// `Σ_ij β_i γ_j C_ij`: the displacement averaged with `observed` under loads whose shares
+    /// are `loaded(j, β_j)`, over the same patch.
     fn weighted_compliance(
         &self,
         step: usize,
         observed: &[(usize, f64)],
-        loaded: &[(usize, f64)],
+        loaded: impl Fn(usize, f64) -> f64,
     ) -> Matrix3<f64> {
         let local = &self.steps[step].local;
         let mut c = Matrix3::zeros();
         for &(i, li) in observed {
             for e in local.neighbours_of(i) {
                 let j = local.neighbours[e] as usize;
-                if let Some(&(_, lj)) = loaded.iter().find(|(v, _)| *v == j) {
+                if let Some(&(_, lj)) = observed.iter().find(|(v, _)| *v == j) {
                     let block = &local.compliance[9 * e..9 * e + 9];
-                    c += Matrix3::from_row_iterator(block.iter().map(|&v| v as f64)) * (li * lj);
+                    c += Matrix3::from_row_iterator(block.iter().map(|&v| v as f64))
+                        * (li * loaded(j, lj));
                 }
             }
         }
@@ -211,7 +231,7 @@ impl Vademecum {
             return self.step_compliance(0, shares);
         }
         (0..self.steps.len())
-            .map(|k| self.weighted_compliance(k, shares, &self.step_shares(k, shares, force_n)))
+            .map(|k| self.weighted_compliance(k, shares, |j, l| self.step_share(k, j, l, force_n)))
             .sum()
     }
 
@@ -222,21 +242,30 @@ impl Vademecum {
     }
 
     /// The force (N) that pushes the surface at `at` by `indentation_m`: the force the trainee
-    /// feels is its opposite. A secant iteration over the load steps; one solve when linear.
+    /// feels is its opposite.
     pub fn force_for_indentation(
         &self,
         at: &SurfacePoint,
+        indentation_m: &Vector3<f64>,
+    ) -> Vector3<f64> {
+        self.patch_force_for_indentation(&self.shares(at), indentation_m)
+    }
+
+    /// [`Self::force_for_indentation`] on a patch already found: a secant iteration over the
+    /// load steps, one 3 × 3 solve when linear. Zero if the patch's compliance is singular.
+    pub fn patch_force_for_indentation(
+        &self,
+        shares: &[(usize, f64)],
         indentation_m: &Vector3<f64>,
     ) -> Vector3<f64> {
         let solve = |c: Matrix3<f64>| {
             c.try_inverse()
                 .map_or_else(Vector3::zeros, |inverse| inverse * indentation_m)
         };
-        let shares = self.shares(at);
-        let mut force = solve(self.step_compliance(0, &shares));
+        let mut force = solve(self.step_compliance(0, shares));
         if self.steps.len() > 1 {
             for _ in 0..SECANT_ITERATIONS {
-                force = solve(self.compliance(&shares, &force));
+                force = solve(self.compliance(shares, &force));
             }
         }
         force
@@ -244,53 +273,95 @@ impl Vademecum {
 
     /// The displacement field (m, all dofs) for a force (N) at `at`.
     pub fn field(&self, at: &SurfacePoint, force_n: &Vector3<f64>) -> Vec<f64> {
-        let shares = self.shares(at);
         let mut u = vec![0.0; self.dof_count()];
-        for k in 0..self.steps.len() {
-            let loaded = self.step_shares(k, &shares, force_n);
-            if loaded.iter().any(|s| s.1 > 0.0) {
-                self.add_step_field(k, &loaded, force_n, &mut u);
-            }
-        }
+        self.add_patch_field(&self.shares(at), force_n, &mut u);
         u
     }
 
-    fn add_step_field(
+    /// Adds the displacement field of a force `force_n` on the patch `shares` to `u`.
+    pub fn add_patch_field(&self, shares: &[(usize, f64)], force_n: &Vector3<f64>, u: &mut [f64]) {
+        for k in 0..self.steps.len() {
+            if shares
+                .iter()
+                .any(|&(j, l)| self.step_share(k, j, l, force_n) > 0.0)
+            {
+                self.add_step_field(k, shares, force_n, u);
+            }
+        }
+    }
+
+    /// The modal coefficients of load step `step` for a force on the patch `shares`:
+    /// `c_k = Σ_i γ_i Y^k_i · F`, added to `coefficients` (one per mode of the step).
+    pub fn add_coefficients(
         &self,
-        k: usize,
-        vertices: &[(usize, f64)],
+        step: usize,
+        shares: &[(usize, f64)],
+        force_n: &Vector3<f64>,
+        coefficients: &mut [f64],
+    ) {
+        let params = self.parameter_count();
+        let modes = self.steps[step].parametric.chunks_exact(params);
+        for (c, y) in coefficients.iter_mut().zip(modes) {
+            *c += shares
+                .iter()
+                .map(|&(i, l)| {
+                    self.step_share(step, i, l, force_n)
+                        * (0..3)
+                            .map(|d| y[3 * i + d] as f64 * force_n[d])
+                            .sum::<f64>()
+                })
+                .sum::<f64>();
+        }
+    }
+
+    /// Adds `Σ_k c_k X^k` of load step `step` to `u`.
+    pub fn add_modes(&self, step: usize, coefficients: &[f64], u: &mut [f64]) {
+        let spatial = self.steps[step].spatial.chunks_exact(self.dof_count());
+        for (x, &c) in spatial.zip(coefficients) {
+            if c != 0.0 {
+                for (ui, &xi) in u.iter_mut().zip(x) {
+                    *ui += c * xi as f64;
+                }
+            }
+        }
+    }
+
+    /// Adds the near-field correction of load step `step` for a force on `shares` to `u`.
+    pub fn add_corrections(
+        &self,
+        step: usize,
+        shares: &[(usize, f64)],
         force_n: &Vector3<f64>,
         u: &mut [f64],
     ) {
-        let step = &self.steps[k];
-        let (dofs, params) = (self.dof_count(), self.parameter_count());
-        for (x, y) in step
-            .spatial
-            .chunks_exact(dofs)
-            .zip(step.parametric.chunks_exact(params))
-        {
-            let c: f64 = vertices
-                .iter()
-                .map(|&(i, l)| {
-                    l * (0..3)
-                        .map(|d| y[3 * i + d] as f64 * force_n[d])
-                        .sum::<f64>()
-                })
-                .sum();
-            for (ui, &xi) in u.iter_mut().zip(x) {
-                *ui += c * xi as f64;
+        let local = &self.steps[step].local;
+        for &(i, l) in shares {
+            let l = self.step_share(step, i, l, force_n);
+            if l == 0.0 {
+                continue;
             }
-        }
-        for &(i, l) in vertices {
-            for e in step.local.corrections_of(i) {
-                let node = step.local.correction_nodes[e] as usize;
-                let r = &step.local.correction[9 * e..9 * e + 9];
+            for e in local.corrections_of(i) {
+                let node = local.correction_nodes[e] as usize;
+                let r = &local.correction[9 * e..9 * e + 9];
                 for c in 0..3 {
                     let value: f64 = (0..3).map(|d| r[3 * d + c] as f64 * force_n[d]).sum();
                     u[3 * node + c] += l * value;
                 }
             }
         }
+    }
+
+    fn add_step_field(
+        &self,
+        k: usize,
+        shares: &[(usize, f64)],
+        force_n: &Vector3<f64>,
+        u: &mut [f64],
+    ) {
+        let mut coefficients = vec![0.0; self.modes(k)];
+        self.add_coefficients(k, shares, force_n, &mut coefficients);
+        self.add_modes(k, &coefficients, u);
+        self.add_corrections(k, shares, force_n, u);
     }
 }
 

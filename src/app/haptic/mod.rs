@@ -1,0 +1,70 @@
+//! The haptic side of the trainer as Bevy ECS: a `World` of organ entities and a `Schedule`
+//! of ordered systems, one run per 1 kHz tick, on a thread of its own ([`HapticThread`]) or on
+//! a simulated clock ([`HapticLoop::run_simulated`], for `--headless`, tests and benchmarks).
+//! The render side only ever reads the latest [`HapticSnapshot`].
+
+mod components;
+mod report;
+mod resources;
+mod runner;
+mod snapshot;
+mod systems;
+mod thread;
+
+use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
+use bevy::prelude::*;
+
+pub use components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
+pub use report::{ForceSummary, HeadlessReport, TickTimes};
+pub use resources::{Device, DeviceForce, FaultLog, ForceTrace, TickClock, Tool};
+pub use runner::{HapticLoop, HapticScene, SceneError};
+pub use snapshot::{HapticSnapshot, OrganSnapshot};
+pub use thread::{HapticThread, RealTimeReport};
+
+/// The schedule run once per haptic tick.
+#[derive(ScheduleLabel, Clone, Debug, PartialEq, Eq, Hash)]
+pub struct HapticTick;
+
+/// The stages of a tick, in order.
+#[derive(SystemSet, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum HapticSet {
+    ReadDevice,
+    ToolContact,
+    EvaluateModes,
+    /// Organ/organ contact slots in here.
+    OrganContact,
+    ComputeForce,
+    Safety,
+    WriteDevice,
+    Publish,
+}
+
+/// The tick's systems, chained through [`HapticSet`], on one thread: a tick is a few tens of
+/// microseconds of work, which a multi-threaded executor would only slow down.
+pub fn haptic_schedule() -> Schedule {
+    let mut schedule = Schedule::new(HapticTick);
+    schedule.set_executor(SingleThreadedExecutor::new());
+    schedule.configure_sets(
+        (
+            HapticSet::ReadDevice,
+            HapticSet::ToolContact,
+            HapticSet::EvaluateModes,
+            HapticSet::OrganContact,
+            HapticSet::ComputeForce,
+            HapticSet::Safety,
+            HapticSet::WriteDevice,
+            HapticSet::Publish,
+        )
+            .chain(),
+    );
+    schedule.add_systems((
+        systems::read_device.in_set(HapticSet::ReadDevice),
+        systems::tool_contact.in_set(HapticSet::ToolContact),
+        systems::evaluate_modes.in_set(HapticSet::EvaluateModes),
+        systems::compute_force.in_set(HapticSet::ComputeForce),
+        systems::apply_safety.in_set(HapticSet::Safety),
+        systems::write_device.in_set(HapticSet::WriteDevice),
+        (systems::trace_force, systems::publish_snapshot).in_set(HapticSet::Publish),
+    ));
+    schedule
+}

@@ -1,0 +1,131 @@
+//! The summary of a headless run: ticks, forces, tick compute times, overruns, faults.
+
+use std::fmt;
+use std::time::Duration;
+
+use serde::Serialize;
+
+use super::resources::{DeviceForce, FaultLog};
+use super::runner::HapticLoop;
+use crate::haptics::{Histogram, TICK_S};
+
+/// Quantiles of a tick duration (µs).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct TickTimes {
+    pub count: u64,
+    pub p50_us: f64,
+    pub p99_us: f64,
+    pub max_us: f64,
+}
+
+impl TickTimes {
+    pub fn of(histogram: &Histogram) -> Self {
+        let us = |d: Duration| d.as_secs_f64() * 1e6;
+        Self {
+            count: histogram.count(),
+            p50_us: us(histogram.quantile(0.5)),
+            p99_us: us(histogram.quantile(0.99)),
+            max_us: us(histogram.max()),
+        }
+    }
+}
+
+/// What the device was sent over a run (N).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct ForceSummary {
+    pub contact_ticks: u64,
+    pub max_desired_n: f64,
+    pub max_sent_n: f64,
+    /// Mean magnitude of the sent force over the ticks in contact.
+    pub mean_sent_in_contact_n: f64,
+    /// The largest change of the sent force from one tick to the next.
+    pub max_change_n_per_tick: f64,
+    pub final_n: [f64; 3],
+}
+
+impl ForceSummary {
+    pub(super) fn record(&mut self, force: &DeviceForce, touching: bool) {
+        let sent = force.sent_n.norm();
+        let change = (force.sent_n - nalgebra::Vector3::from(self.final_n)).norm();
+        self.max_change_n_per_tick = self.max_change_n_per_tick.max(change);
+        self.max_desired_n = self.max_desired_n.max(force.desired_n.norm());
+        self.max_sent_n = self.max_sent_n.max(sent);
+        if touching {
+            let n = self.contact_ticks as f64;
+            self.mean_sent_in_contact_n = (self.mean_sent_in_contact_n * n + sent) / (n + 1.0);
+            self.contact_ticks += 1;
+        }
+        self.final_n = force.sent_n.into();
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HeadlessReport {
+    pub device: String,
+    pub organs: Vec<String>,
+    pub ticks: u64,
+    pub simulated_s: f64,
+    pub force: ForceSummary,
+    /// Wall-clock compute time of each tick.
+    pub compute: TickTimes,
+    /// Ticks whose compute exceeded the 1 ms period.
+    pub overruns: u64,
+    pub faulted_ticks: u64,
+    /// (tick, fault) each time a fault started.
+    pub faults: Vec<(u64, String)>,
+}
+
+impl HeadlessReport {
+    pub(super) fn new(
+        haptic: &mut HapticLoop,
+        ticks: u64,
+        force: ForceSummary,
+        compute: &Histogram,
+    ) -> Self {
+        let period = Duration::from_secs_f64(TICK_S);
+        let overruns = compute.count_above(period);
+        let log = haptic.world().resource::<FaultLog>();
+        Self {
+            device: haptic.device_name(),
+            faulted_ticks: log.faulted_ticks,
+            faults: log.log.iter().map(|(t, f)| (*t, f.to_string())).collect(),
+            organs: haptic.organ_names(),
+            ticks,
+            simulated_s: ticks as f64 * TICK_S,
+            force,
+            compute: TickTimes::of(compute),
+            overruns,
+        }
+    }
+}
+
+impl fmt::Display for HeadlessReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "device: {}", self.device)?;
+        writeln!(f, "organs: {}", self.organs.join(", "))?;
+        writeln!(
+            f,
+            "ticks: {} ({:.3} s simulated), {} in contact",
+            self.ticks, self.simulated_s, self.force.contact_ticks
+        )?;
+        writeln!(
+            f,
+            "force sent: max {:.3} N, mean in contact {:.3} N, largest change {:.4} N/tick \
+             (physics asked up to {:.3} N)",
+            self.force.max_sent_n,
+            self.force.mean_sent_in_contact_n,
+            self.force.max_change_n_per_tick,
+            self.force.max_desired_n
+        )?;
+        writeln!(
+            f,
+            "tick compute: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; {} overruns of 1 ms",
+            self.compute.p50_us, self.compute.p99_us, self.compute.max_us, self.overruns
+        )?;
+        write!(f, "faults: {} ticks faulted", self.faulted_ticks)?;
+        for (tick, fault) in &self.faults {
+            write!(f, "\n  tick {tick}: {fault}")?;
+        }
+        Ok(())
+    }
+}

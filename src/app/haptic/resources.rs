@@ -1,0 +1,57 @@
+//! The haptic world's resources: the device, the tool, the clock, the force on its way to the
+//! device, and the fault log.
+
+use bevy::prelude::*;
+use nalgebra::Vector3;
+
+use crate::contact::Probe;
+use crate::haptics::{DeviceSample, Fault, HapticDevice, SafetyFilter};
+
+#[derive(Resource)]
+pub struct Device(pub Box<dyn HapticDevice>);
+
+/// The tool as the last good device sample left it.
+#[derive(Resource, Default)]
+pub struct Tool {
+    pub probe: Probe,
+    /// None until the device has reported a finite position.
+    pub sample: Option<DeviceSample>,
+}
+
+/// The tick being run, set by the runner before each run of the schedule.
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct TickClock {
+    pub tick: u64,
+    pub time_s: f64,
+    /// Ticks in a row that missed their deadline.
+    pub overruns_in_a_row: u32,
+}
+
+/// The force (N) on its way to the device: what the physics asks for, what is sent.
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct DeviceForce {
+    pub desired_n: Vector3<f64>,
+    pub sent_n: Vector3<f64>,
+}
+
+#[derive(Resource)]
+pub struct Safety(pub SafetyFilter);
+
+/// Faults: those of this tick (read by the safety filter), those found after it (a failed
+/// write, carried to the next tick), and a log of every change of fault.
+#[derive(Resource, Default)]
+pub struct FaultLog {
+    pub this_tick: Vec<Fault>,
+    pub next_tick: Vec<Fault>,
+    /// (tick, fault) each time a fault starts or changes kind.
+    pub log: Vec<(u64, Fault)>,
+    /// Ticks that had at least one fault.
+    pub faulted_ticks: u64,
+}
+
+/// Every tick's desired and sent force, kept when asked for (tests, `--json` traces).
+#[derive(Resource, Default)]
+pub struct ForceTrace {
+    pub desired_n: Vec<Vector3<f64>>,
+    pub sent_n: Vec<Vector3<f64>>,
+}

@@ -1,0 +1,143 @@
+//! The haptic world and its schedule, and the simulated-clock run behind `--headless`.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use bevy::prelude::*;
+
+use super::components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
+use super::report::{ForceSummary, HeadlessReport};
+use super::resources::{Device, DeviceForce, FaultLog, ForceTrace, Safety, TickClock, Tool};
+use super::snapshot::{HapticSnapshot, OrganSnapshot, SnapshotPublisher};
+use crate::contact::{ContactError, ContactSurface, Probe};
+use crate::haptics::{HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S};
+use crate::pgd::{Deformation, Vademecum};
+
+/// What the haptic world is made of.
+#[derive(Clone)]
+pub struct HapticScene {
+    /// Organ names and vademecums, in the scene's order.
+    pub organs: Vec<(String, Arc<Vademecum>)>,
+    pub probe: Probe,
+    pub safety: SafetySettings,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error(transparent)]
+    Contact(#[from] ContactError),
+}
+
+/// A haptic `World` of organ entities and the schedule that ticks it.
+pub struct HapticLoop {
+    world: World,
+    schedule: Schedule,
+}
+
+impl HapticLoop {
+    pub fn new(scene: &HapticScene, device: Box<dyn HapticDevice>) -> Result<Self, SceneError> {
+        let mut world = World::new();
+        for (index, (name, vademecum)) in scene.organs.iter().enumerate() {
+            world.spawn((
+                OrganBody {
+                    name: name.clone(),
+                    surface: Arc::new(ContactSurface::new(vademecum)?),
+                    vademecum: vademecum.clone(),
+                },
+                OrganIndex(index),
+                ToolTouch::default(),
+                OrganDeformation(Deformation::new(vademecum, 1)),
+            ));
+        }
+        let max_force_n = device.limits().max_force_n;
+        world.insert_resource(Device(device));
+        world.insert_resource(Tool {
+            probe: scene.probe,
+            sample: None,
+        });
+        world.insert_resource(TickClock::default());
+        world.insert_resource(DeviceForce::default());
+        world.insert_resource(FaultLog::default());
+        world.insert_resource(Safety(SafetyFilter::new(scene.safety, max_force_n)));
+        Ok(Self {
+            world,
+            schedule: super::haptic_schedule(),
+        })
+    }
+
+    /// Keeps every tick's forces in a [`ForceTrace`].
+    pub fn keep_trace(&mut self) {
+        self.world.insert_resource(ForceTrace::default());
+    }
+
+    /// Starts publishing a snapshot every tick; the returned end reads the latest.
+    pub fn publish(&mut self) -> triple_buffer::Output<HapticSnapshot> {
+        let organs = self
+            .world
+            .query::<&OrganDeformation>()
+            .iter(&self.world)
+            .count();
+        let template = HapticSnapshot {
+            organs: vec![OrganSnapshot::default(); organs],
+            ..HapticSnapshot::default()
+        };
+        let (input, output) = triple_buffer::triple_buffer(&template);
+        self.world.insert_resource(SnapshotPublisher(input));
+        output
+    }
+
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    pub fn world_mut(&mut self) -> &mut World {
+        &mut self.world
+    }
+
+    /// Runs one tick at `clock`; returns its compute time.
+    pub fn tick(&mut self, clock: TickClock) -> Duration {
+        let started = Instant::now();
+        *self.world.resource_mut::<TickClock>() = clock;
+        self.schedule.run(&mut self.world);
+        started.elapsed()
+    }
+
+    /// Runs `ticks` ticks on a simulated clock (tick k at k ms), as fast as they compute:
+    /// deterministic, whatever the machine is doing. Overruns are counted, not fed to the
+    /// safety filter, so that a slow machine does not change the forces.
+    pub fn run_simulated(&mut self, ticks: u64) -> HeadlessReport {
+        let mut compute = Histogram::default();
+        let mut forces = ForceSummary::default();
+        for tick in 0..ticks {
+            let time = self.tick(TickClock {
+                tick,
+                time_s: tick as f64 * TICK_S,
+                overruns_in_a_row: 0,
+            });
+            compute.record(time);
+            let force = *self.world.resource::<DeviceForce>();
+            let touching = self
+                .world
+                .query::<&ToolTouch>()
+                .iter(&self.world)
+                .any(|t| t.0.is_some());
+            forces.record(&force, touching);
+        }
+        HeadlessReport::new(self, ticks, forces, &compute)
+    }
+
+    pub(super) fn device_name(&self) -> String {
+        self.world.resource::<Device>().0.name().to_owned()
+    }
+
+    pub(super) fn organ_names(&mut self) -> Vec<String> {
+        let mut organs: Vec<(usize, String)> = self
+            .world
+            .query::<(&OrganIndex, &OrganBody)>()
+            .iter(&self.world)
+            .map(|(i, b)| (i.0, b.name.clone()))
+            .collect();
+        organs.sort();
+        organs.into_iter().map(|o| o.1).collect()
+    }
+}

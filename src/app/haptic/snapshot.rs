@@ -1,0 +1,33 @@
+//! What the render side sees of the haptic world: the latest complete tick, through a
+//! triple buffer (wait-free on both sides: the haptic thread never blocks on a frame, and a
+//! frame never sees half a tick).
+
+use bevy::prelude::*;
+use nalgebra::Vector3;
+
+use crate::contact::ToolContact;
+use crate::pgd::Deformation;
+
+#[derive(Clone, Debug, Default)]
+pub struct OrganSnapshot {
+    pub deformation: Deformation,
+    pub contact: Option<ToolContact>,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct HapticSnapshot {
+    pub tick: u64,
+    pub time_s: f64,
+    /// The tool tip (m), once the device has reported one.
+    pub tip_m: Option<Vector3<f64>>,
+    /// The force sent to the device (N).
+    pub force_n: Vector3<f64>,
+    /// Whether the force is faded or held after a fault.
+    pub faulted: bool,
+    /// In the scene's organ order.
+    pub organs: Vec<OrganSnapshot>,
+}
+
+/// The haptic thread's end of the triple buffer.
+#[derive(Resource)]
+pub struct SnapshotPublisher(pub triple_buffer::Input<HapticSnapshot>);

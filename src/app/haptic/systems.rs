@@ -1,0 +1,147 @@
+//! The systems of a haptic tick, one stage each, in [`super::HapticSet`] order.
+
+use bevy::prelude::*;
+use nalgebra::Vector3;
+
+use super::components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
+use super::resources::{Device, DeviceForce, FaultLog, ForceTrace, Safety, TickClock, Tool};
+use super::snapshot::SnapshotPublisher;
+use crate::contact::press;
+use crate::haptics::Fault;
+
+/// Reads the device into [`Tool`]. A non-finite sample or a device error is a fault and the
+/// tool keeps its last good position; so is a streak of overrun ticks.
+pub fn read_device(
+    clock: Res<TickClock>,
+    safety: Res<Safety>,
+    mut device: ResMut<Device>,
+    mut tool: ResMut<Tool>,
+    mut faults: ResMut<FaultLog>,
+) {
+    let faults = &mut *faults;
+    faults.this_tick.clear();
+    faults.this_tick.append(&mut faults.next_tick);
+    match device.0.read(clock.time_s) {
+        Ok(sample) if sample.is_finite() => tool.sample = Some(sample),
+        Ok(_) => faults.this_tick.push(Fault::NonFiniteDevice),
+        Err(e) => faults.this_tick.push(Fault::Device(e.to_string())),
+    }
+    if clock.overruns_in_a_row >= safety.0.settings().overrun_streak {
+        faults
+            .this_tick
+            .push(Fault::Overruns(clock.overruns_in_a_row));
+    }
+}
+
+/// Presses the tool into every organ it touches and sets the organ's tool load.
+pub fn tool_contact(
+    tool: Res<Tool>,
+    mut organs: Query<(&OrganBody, &mut ToolTouch, &mut OrganDeformation)>,
+) {
+    for (body, mut touch, mut deformation) in &mut organs {
+        let load = &mut deformation.0.loads[OrganDeformation::TOOL];
+        touch.0 = match &tool.sample {
+            Some(sample) => press(
+                &body.vademecum,
+                &body.surface,
+                &tool.probe,
+                &sample.tip_m,
+                load,
+            ),
+            None => {
+                load.release();
+                None
+            }
+        };
+    }
+}
+
+/// Sums every organ's loads into its modal coefficients.
+pub fn evaluate_modes(mut organs: Query<(&OrganBody, &mut OrganDeformation)>) {
+    for (body, mut deformation) in &mut organs {
+        deformation.0.evaluate(&body.vademecum);
+    }
+}
+
+/// The force on the tool: the opposite of what it applies to the organs.
+pub fn compute_force(touches: Query<&ToolTouch>, mut force: ResMut<DeviceForce>) {
+    force.desired_n = -touches
+        .iter()
+        .filter_map(|t| t.0.map(|c| c.force_n))
+        .sum::<Vector3<f64>>();
+}
+
+/// Clamps, rate-limits and, on a fault, fades the force; logs each fault as it starts (a fault
+/// of the same kind as the last logged one is counted, not logged again).
+pub fn apply_safety(
+    clock: Res<TickClock>,
+    mut safety: ResMut<Safety>,
+    mut force: ResMut<DeviceForce>,
+    mut faults: ResMut<FaultLog>,
+) {
+    let faults = &mut *faults;
+    if !force.desired_n.iter().all(|c| c.is_finite()) {
+        faults.this_tick.push(Fault::NonFiniteForce);
+    }
+    force.sent_n = safety.0.filter(&force.desired_n, &faults.this_tick);
+    if faults.this_tick.is_empty() {
+        return;
+    }
+    faults.faulted_ticks += 1;
+    for fault in &faults.this_tick {
+        let known = faults
+            .log
+            .last()
+            .is_some_and(|(_, last)| std::mem::discriminant(last) == std::mem::discriminant(fault));
+        if !known {
+            warn!("haptic tick {}: {fault}; fading the force", clock.tick);
+            faults.log.push((clock.tick, fault.clone()));
+        }
+    }
+}
+
+/// Sends the force; a failed write is a fault of the next tick.
+pub fn write_device(
+    force: Res<DeviceForce>,
+    mut device: ResMut<Device>,
+    mut faults: ResMut<FaultLog>,
+) {
+    if let Err(e) = device.0.write_force(&force.sent_n) {
+        faults.next_tick.push(Fault::Device(e.to_string()));
+    }
+}
+
+/// Keeps the tick's forces when a trace was asked for.
+pub fn trace_force(force: Res<DeviceForce>, trace: Option<ResMut<ForceTrace>>) {
+    if let Some(mut trace) = trace {
+        trace.desired_n.push(force.desired_n);
+        trace.sent_n.push(force.sent_n);
+    }
+}
+
+/// Hands the render side the tick's state, when one is listening; never waits.
+#[allow(clippy::too_many_arguments)]
+pub fn publish_snapshot(
+    clock: Res<TickClock>,
+    tool: Res<Tool>,
+    force: Res<DeviceForce>,
+    safety: Res<Safety>,
+    organs: Query<(&OrganIndex, &ToolTouch, &OrganDeformation)>,
+    publisher: Option<ResMut<SnapshotPublisher>>,
+) {
+    let Some(mut publisher) = publisher else {
+        return;
+    };
+    let snapshot = publisher.0.input_buffer_mut();
+    snapshot.tick = clock.tick;
+    snapshot.time_s = clock.time_s;
+    snapshot.tip_m = tool.sample.map(|s| s.tip_m);
+    snapshot.force_n = force.sent_n;
+    snapshot.faulted = safety.0.is_faulted();
+    for (index, touch, deformation) in &organs {
+        let organ = &mut snapshot.organs[index.0];
+        organ.contact = touch.0;
+        organ.deformation.clone_from(&deformation.0);
+    }
+    publisher.0.publish();
+}

@@ -1,0 +1,99 @@
+//! The haptic loop on a thread of its own, paced by absolute deadlines: render frames can
+//! neither bunch its ticks nor delay them.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+
+use super::report::TickTimes;
+use super::resources::TickClock;
+use super::runner::HapticLoop;
+use crate::haptics::{Histogram, Metronome, TICK_S, TimerMode};
+
+/// How well the thread kept time.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RealTimeReport {
+    pub timer: TimerMode,
+    pub ticks: u64,
+    /// Deadlines passed by more than a period, skipped rather than run late in a burst.
+    pub skipped: u64,
+    /// How late each tick started after its deadline.
+    pub lateness: TickTimes,
+    /// How far each interval between tick starts was from 1 ms.
+    pub period_error: TickTimes,
+    pub compute: TickTimes,
+}
+
+pub struct HapticThread {
+    stop: Arc<AtomicBool>,
+    handle: JoinHandle<RealTimeReport>,
+}
+
+impl HapticThread {
+    /// Starts ticking `haptic` every millisecond of real time.
+    pub fn spawn(haptic: HapticLoop, timer: TimerMode) -> std::io::Result<Self> {
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = stop.clone();
+        let handle = std::thread::Builder::new()
+            .name("haptic 1 kHz".into())
+            .spawn(move || run(haptic, timer, &flag))?;
+        Ok(Self { stop, handle })
+    }
+
+    /// Stops the loop after its current tick and says how it kept time.
+    pub fn stop(self) -> RealTimeReport {
+        self.stop.store(true, Ordering::Relaxed);
+        self.handle
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    }
+}
+
+fn run(mut haptic: HapticLoop, timer: TimerMode, stop: &AtomicBool) -> RealTimeReport {
+    let period = Duration::from_secs_f64(TICK_S);
+    let mut metronome = Metronome::new(period, timer);
+    let (mut lateness, mut period_error, mut compute) = (
+        Histogram::default(),
+        Histogram::default(),
+        Histogram::default(),
+    );
+    let (mut ticks, mut skipped, mut in_a_row) = (0, 0, 0);
+    let mut last_start: Option<Instant> = None;
+    while !stop.load(Ordering::Relaxed) {
+        let beat = metronome.wait();
+        let started = Instant::now();
+        if let Some(last) = last_start {
+            period_error.record(abs_diff(started - last, period));
+        }
+        last_start = Some(started);
+        lateness.record(beat.lateness);
+        skipped += beat.skipped;
+        let time = haptic.tick(TickClock {
+            tick: beat.tick,
+            time_s: beat.tick as f64 * TICK_S,
+            overruns_in_a_row: in_a_row,
+        });
+        compute.record(time);
+        in_a_row = if beat.skipped > 0 || time > period {
+            in_a_row + 1
+        } else {
+            0
+        };
+        ticks += 1;
+    }
+    RealTimeReport {
+        timer,
+        ticks,
+        skipped,
+        lateness: TickTimes::of(&lateness),
+        period_error: TickTimes::of(&period_error),
+        compute: TickTimes::of(&compute),
+    }
+}
+
+fn abs_diff(a: Duration, b: Duration) -> Duration {
+    a.max(b) - a.min(b)
+}

@@ -1,0 +1,85 @@
+//! The rigid probe and the load it puts on an organ.
+//!
+//! The tool tip is a sphere. Its contact point `s` is the closest point of the organ's rest
+//! surface to the sphere's centre: the surface under a frictionless tip moves with it, so the
+//! point that touches the tip is the one below its centre. The surface there must move by the
+//! tip's penetration along the normal; the load that does so is the vademecum's 3 × 3
+//! compliance at `s`, inverted (for a KSV vademecum, the secant over its load steps).
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use super::{ContactSurface, SurfaceHit};
+use crate::pgd::{BuildSettings, PatchLoad, Vademecum};
+
+/// A rigid probe with a spherical tip.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Probe {
+    pub tip_radius_m: f64,
+}
+
+impl Default for Probe {
+    /// The tip the vademecums' tool patch is built for by default.
+    fn default() -> Self {
+        Self {
+            tip_radius_m: BuildSettings::default().tool_tip_radius_m,
+        }
+    }
+}
+
+/// The tool pressing into an organ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ToolContact {
+    pub hit: SurfaceHit,
+    /// How far the tip reaches below the rest surface, along the normal (m); clamped to the
+    /// vademecum's valid range.
+    pub depth_m: f64,
+    /// The displacement imposed on the surface under the tool (m).
+    pub indentation_m: Vector3<f64>,
+    /// The force on the organ (N); the device renders its opposite.
+    pub force_n: Vector3<f64>,
+}
+
+/// Presses `probe`, its tip centred at `tip_m`, into the organ of `vademecum`: sets `load` to the
+/// force that makes the surface follow the tip (its buffer reused, nothing allocated once
+/// grown) and returns the contact, or releases `load` when the tip does not touch.
+pub fn press(
+    vademecum: &Vademecum,
+    surface: &ContactSurface,
+    probe: &Probe,
+    tip_m: &Vector3<f64>,
+    load: &mut PatchLoad,
+) -> Option<ToolContact> {
+    let Some(contact) = touch(vademecum, surface, probe, tip_m) else {
+        load.release();
+        return None;
+    };
+    vademecum.shares_into(&contact.hit.at, &mut load.shares);
+    let force_n = vademecum.patch_force_for_indentation(&load.shares, &contact.indentation_m);
+    load.force_n = force_n;
+    Some(ToolContact { force_n, ..contact })
+}
+
+/// Where and how deep the tip presses, before the force is known.
+fn touch(
+    vademecum: &Vademecum,
+    surface: &ContactSurface,
+    probe: &Probe,
+    tip_m: &Vector3<f64>,
+) -> Option<ToolContact> {
+    let hit = surface.closest(tip_m)?;
+    let depth_m = probe.tip_radius_m - (tip_m - hit.point_m).dot(&hit.normal);
+    if depth_m <= 0.0 {
+        return None;
+    }
+    let depth_m = match vademecum.steps.len() {
+        1 => depth_m,
+        _ => depth_m.min(vademecum.valid_indentation_m()),
+    };
+    Some(ToolContact {
+        hit,
+        depth_m,
+        indentation_m: -hit.normal * depth_m,
+        force_n: Vector3::zeros(),
+    })
+}

@@ -1,0 +1,26 @@
+//! The haptic device side, free of Bevy: the device trait and its backends, the trajectory
+//! files they replay and record, the safety filter between the physics and the motors, and the
+//! clock that paces the 1 kHz loop.
+
+mod device;
+mod recorder;
+mod safety;
+mod scripted;
+mod spec;
+mod sweep;
+mod timing;
+mod trajectory;
+mod virtual_device;
+
+pub use device::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
+pub use recorder::Recorder;
+pub use safety::{Fault, SafetyFilter, SafetySettings};
+pub use scripted::Scripted;
+pub use spec::DeviceSpec;
+pub use sweep::{PressMotion, PressTarget, press_and_slide};
+pub use timing::{Histogram, Metronome, TimerMode};
+pub use trajectory::{Trajectory, TrajectoryError, TrajectoryRow};
+pub use virtual_device::{VirtualDevice, VirtualHandle};
+
+/// The haptic rate: one tick a millisecond.
+pub const TICK_S: f64 = 1e-3;

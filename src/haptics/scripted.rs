@@ -1,0 +1,49 @@
+//! The scripted device: replays a trajectory deterministically, for tests, demos and
+//! benchmarks. The forces it is sent are kept, so a run can be compared with another.
+
+use nalgebra::Vector3;
+
+use super::{DeviceError, DeviceLimits, DeviceSample, HapticDevice, Trajectory};
+
+pub struct Scripted {
+    name: String,
+    trajectory: Trajectory,
+    limits: DeviceLimits,
+}
+
+impl Scripted {
+    pub fn new(name: impl Into<String>, trajectory: Trajectory) -> Self {
+        Self {
+            name: name.into(),
+            trajectory,
+            limits: DeviceLimits::default(),
+        }
+    }
+
+    pub fn with_limits(mut self, limits: DeviceLimits) -> Self {
+        self.limits = limits;
+        self
+    }
+
+    pub fn duration_s(&self) -> f64 {
+        self.trajectory.duration_s()
+    }
+}
+
+impl HapticDevice for Scripted {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn limits(&self) -> DeviceLimits {
+        self.limits
+    }
+
+    fn read(&mut self, time_s: f64) -> Result<DeviceSample, DeviceError> {
+        Ok(self.trajectory.sample(time_s))
+    }
+
+    fn write_force(&mut self, _force_n: &Vector3<f64>) -> Result<(), DeviceError> {
+        Ok(())
+    }
+}

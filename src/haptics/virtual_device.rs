@@ -1,0 +1,96 @@
+//! The virtual device: a tool driven by mouse and keyboard from the trainer window, for
+//! trainees without hardware. The window writes the tool's target and reads the force the
+//! device would render through a [`VirtualHandle`]; both sides only load and store atomics,
+//! so neither ever waits for the other.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+
+use nalgebra::Vector3;
+
+use super::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
+
+/// Three f64 in atomics: each component is consistent, the triple may mix two writes for one
+/// tick, which a tool moved by hand cannot tell.
+#[derive(Default)]
+struct AtomicVector([AtomicU64; 3]);
+
+impl AtomicVector {
+    fn store(&self, v: &Vector3<f64>) {
+        for (slot, c) in self.0.iter().zip(v.iter()) {
+            slot.store(c.to_bits(), Ordering::Relaxed);
+        }
+    }
+
+    fn load(&self) -> Vector3<f64> {
+        Vector3::from_fn(|i, _| f64::from_bits(self.0[i].load(Ordering::Relaxed)))
+    }
+}
+
+/// The window's side of the virtual device.
+#[derive(Default)]
+pub struct VirtualHandle {
+    tip_m: AtomicVector,
+    force_n: AtomicVector,
+    buttons: AtomicU32,
+}
+
+impl VirtualHandle {
+    /// Moves the tool tip to `tip_m` (m, scene frame).
+    pub fn set_tip(&self, tip_m: &Vector3<f64>) {
+        self.tip_m.store(tip_m);
+    }
+
+    pub fn tip_m(&self) -> Vector3<f64> {
+        self.tip_m.load()
+    }
+
+    pub fn set_buttons(&self, buttons: u32) {
+        self.buttons.store(buttons, Ordering::Relaxed);
+    }
+
+    /// The force (N) the device would render now: shown on screen in place of a motor.
+    pub fn force_n(&self) -> Vector3<f64> {
+        self.force_n.load()
+    }
+}
+
+pub struct VirtualDevice {
+    handle: Arc<VirtualHandle>,
+    limits: DeviceLimits,
+}
+
+impl VirtualDevice {
+    /// A virtual device with its tip at `tip_m`, and the handle the window drives it with.
+    pub fn new(tip_m: &Vector3<f64>) -> (Self, Arc<VirtualHandle>) {
+        let handle = Arc::new(VirtualHandle::default());
+        handle.set_tip(tip_m);
+        let device = Self {
+            handle: handle.clone(),
+            limits: DeviceLimits::default(),
+        };
+        (device, handle)
+    }
+}
+
+impl HapticDevice for VirtualDevice {
+    fn name(&self) -> &str {
+        "virtual (mouse and keyboard)"
+    }
+
+    fn limits(&self) -> DeviceLimits {
+        self.limits
+    }
+
+    fn read(&mut self, _time_s: f64) -> Result<DeviceSample, DeviceError> {
+        Ok(DeviceSample {
+            buttons: self.handle.buttons.load(Ordering::Relaxed),
+            ..DeviceSample::at(self.handle.tip_m())
+        })
+    }
+
+    fn write_force(&mut self, force_n: &Vector3<f64>) -> Result<(), DeviceError> {
+        self.handle.force_n.store(force_n);
+        Ok(())
+    }
+}

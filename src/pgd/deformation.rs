@@ -1,0 +1,74 @@
+//! The deformation state of one organ online: the loads on it and the modal coefficients they
+//! sum to. Several loads superpose through the vademecum; the whole field is only formed
+//! where someone needs it (the renderer), the coefficients every haptic tick.
+
+use nalgebra::Vector3;
+
+use super::Vademecum;
+
+/// A force on a tool-sized patch of the accessible surface.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PatchLoad {
+    /// Load positions and their shares of the force (summing to one).
+    pub shares: Vec<(usize, f64)>,
+    pub force_n: Vector3<f64>,
+}
+
+impl PatchLoad {
+    pub fn is_active(&self) -> bool {
+        self.force_n != Vector3::zeros() && !self.shares.is_empty()
+    }
+
+    /// Removes the load, keeping its buffer.
+    pub fn release(&mut self) {
+        self.shares.clear();
+        self.force_n = Vector3::zeros();
+    }
+}
+
+/// The loads on an organ and, per load step, the modal coefficients of their sum.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Deformation {
+    pub loads: Vec<PatchLoad>,
+    /// `coefficients[step][mode]`.
+    pub coefficients: Vec<Vec<f64>>,
+}
+
+impl Deformation {
+    /// An unloaded organ with `load_slots` loads (released) ready to be set.
+    pub fn new(vademecum: &Vademecum, load_slots: usize) -> Self {
+        Self {
+            loads: vec![PatchLoad::default(); load_slots],
+            coefficients: (0..vademecum.steps.len())
+                .map(|k| vec![0.0; vademecum.modes(k)])
+                .collect(),
+        }
+    }
+
+    /// Recomputes the modal coefficients from the loads: O(modes × patch) per load.
+    pub fn evaluate(&mut self, vademecum: &Vademecum) {
+        for (step, coefficients) in self.coefficients.iter_mut().enumerate() {
+            coefficients.fill(0.0);
+            for load in self.loads.iter().filter(|l| l.is_active()) {
+                vademecum.add_coefficients(step, &load.shares, &load.force_n, coefficients);
+            }
+        }
+    }
+
+    /// The whole displacement field (m, `3 × nodes`) into `u`: the modes with the current
+    /// coefficients plus each load's near-field correction.
+    pub fn field_into(&self, vademecum: &Vademecum, u: &mut [f64]) {
+        u.fill(0.0);
+        for (step, coefficients) in self.coefficients.iter().enumerate() {
+            vademecum.add_modes(step, coefficients, u);
+            for load in self.loads.iter().filter(|l| l.is_active()) {
+                vademecum.add_corrections(step, &load.shares, &load.force_n, u);
+            }
+        }
+    }
+
+    /// The sum of the forces (N) applied to the organ.
+    pub fn total_force_n(&self) -> Vector3<f64> {
+        self.loads.iter().map(|l| l.force_n).sum()
+    }
+}

@@ -1,0 +1,8 @@
+//! The real-time core, as headless Bevy haptic worlds: forces against full FEM, smooth sliding,
+//! deterministic replay, faults and the clamp; and the device files and timing pieces.
+
+mod common;
+mod devices;
+mod faults;
+mod press;
+mod replay;
