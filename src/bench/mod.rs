@@ -2,4 +2,5 @@
 //! baseline measured in the same run. Run them with `pgd bench …`.
 
 pub mod fem;
+pub mod haptics;
 pub mod vademecum;

@@ -214,6 +214,22 @@ impl BuildArgs {
 
 #[derive(Subcommand)]
 enum BenchTarget {
+    /// The haptic loop on the four-organ scene: tick compute time over a scripted sweep (all
+    /// organs, then each), the same press by full FEM, and real-time punctuality per timer.
+    Haptics {
+        /// Sweeps run per figure; the median is reported.
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Seconds of real-time ticking per timer.
+        #[arg(long, default_value_t = 5.0)]
+        realtime_seconds: f64,
+        /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
+        #[arg(long, default_value = "vademecums")]
+        vademecums: PathBuf,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Assembly, factorization and solve on a liver-sized mesh (~4,300 nodes, ~21,000 tets).
     Fem {
         /// Print the report as JSON instead of a table.
@@ -316,6 +332,29 @@ fn main() -> ExitCode {
                     ExitCode::SUCCESS
                 }
                 Err(e) => fail("pgd bench vademecum", &e.to_string()),
+            }
+        }
+        Command::Bench {
+            what:
+                BenchTarget::Haptics {
+                    repeats,
+                    realtime_seconds,
+                    vademecums,
+                    json,
+                },
+        } => {
+            let scene =
+                match pgd_surgery::app::scene::default_scene(&vademecums, cli::OnStale::Rebuild) {
+                    Ok(scene) => scene,
+                    Err(e) => return fail("pgd bench haptics", &e),
+                };
+            match bench::haptics::run(&scene, repeats, realtime_seconds) {
+                Ok(report) if json => print_json(&report),
+                Ok(report) => {
+                    print!("{report}");
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail("pgd bench haptics", &e.to_string()),
             }
         }
         Command::Bench {

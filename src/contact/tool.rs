@@ -10,7 +10,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::{ContactSurface, SurfaceHit};
-use crate::pgd::{BuildSettings, PatchLoad, Vademecum};
+use crate::pgd::{BuildSettings, Patch, PatchLoad, Vademecum};
 
 /// A rigid probe with a spherical tip.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -41,21 +41,24 @@ pub struct ToolContact {
 }
 
 /// Presses `probe`, its tip centred at `tip_m`, into the organ of `vademecum`: sets `load` to the
-/// force that makes the surface follow the tip (its buffer reused, nothing allocated once
-/// grown) and returns the contact, or releases `load` when the tip does not touch.
+/// force that makes the surface follow the tip and returns the contact, or releases `load`
+/// when the tip does not touch. `patch` is scratch space kept between ticks: nothing is
+/// allocated once it and `load` have grown.
 pub fn press(
     vademecum: &Vademecum,
     surface: &ContactSurface,
     probe: &Probe,
     tip_m: &Vector3<f64>,
+    patch: &mut Patch,
     load: &mut PatchLoad,
 ) -> Option<ToolContact> {
     let Some(contact) = touch(vademecum, surface, probe, tip_m) else {
         load.release();
         return None;
     };
-    vademecum.shares_into(&contact.hit.at, &mut load.shares);
-    let force_n = vademecum.patch_force_for_indentation(&load.shares, &contact.indentation_m);
+    vademecum.patch_into(&contact.hit.at, patch);
+    let force_n = vademecum.patch_force_for_indentation(patch, &contact.indentation_m);
+    load.shares.clone_from(&patch.shares);
     load.force_n = force_n;
     Some(ToolContact { force_n, ..contact })
 }

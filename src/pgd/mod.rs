@@ -26,7 +26,7 @@ pub use local::LocalPart;
 pub use responses::{Responses, SecantReport, SecantSettings};
 pub use separated::SeparatedField;
 pub use stiffness::RestStiffness;
-pub use vademecum::{Header, Step, SurfacePoint, Vademecum};
+pub use vademecum::{Header, Patch, Step, SurfacePoint, Vademecum};
 pub use validate::{Sample, Statistics, ValidationReport, ValidationSettings, validate};
 
 use crate::mesh::TetMesh;

@@ -53,6 +53,42 @@ pub struct SurfacePoint {
     pub barycentric: [f64; 3],
 }
 
+/// The tool's contact patch on one vademecum's surface: positions with their shares of the
+/// load (summing to one), and the patch slot of every position, so that the pairs of a patch
+/// compliance are found by one lookup each. Reused from tick to tick, it allocates nothing
+/// once grown.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Patch {
+    pub shares: Vec<(usize, f64)>,
+    slot_of: Vec<u32>,
+}
+
+const NO_SLOT: u32 = u32::MAX;
+
+impl Patch {
+    fn slot(&self, position: usize) -> Option<usize> {
+        match self.slot_of[position] {
+            NO_SLOT => None,
+            slot => Some(slot as usize),
+        }
+    }
+
+    /// Replaces the shares, keeping the slot table in step (sized for `positions`).
+    fn set(&mut self, positions: usize, shares: impl Iterator<Item = (usize, f64)>) {
+        if self.slot_of.len() != positions {
+            self.slot_of = vec![NO_SLOT; positions];
+        }
+        for &(m, _) in &self.shares {
+            self.slot_of[m] = NO_SLOT;
+        }
+        self.shares.clear();
+        self.shares.extend(shares);
+        for (slot, &(m, _)) in self.shares.iter().enumerate() {
+            self.slot_of[m] = slot as u32;
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Vademecum {
     pub header: Header,
@@ -121,47 +157,40 @@ impl Vademecum {
             .sum()
     }
 
-    /// The tool's contact patch centred at `at`: positions and their shares of the load
-    /// (summing to one), the same kernel as the full FEM load. A patch narrower than the mesh
-    /// (no node inside it) falls back to the triangle's corners.
-    pub fn shares(&self, at: &SurfacePoint) -> Vec<(usize, f64)> {
-        let mut shares = Vec::new();
-        self.shares_into(at, &mut shares);
-        shares
+    /// The tool's contact patch centred at `at`, the same kernel as the full FEM load. A patch
+    /// narrower than the mesh (no node inside it) falls back to the triangle's corners.
+    pub fn patch(&self, at: &SurfacePoint) -> Patch {
+        let mut patch = Patch::default();
+        self.patch_into(at, &mut patch);
+        patch
     }
 
-    /// [`Self::shares`] into a buffer the caller keeps: a haptic tick allocates nothing once
-    /// the buffer has grown to the largest patch.
-    pub fn shares_into(&self, at: &SurfacePoint, shares: &mut Vec<(usize, f64)>) {
-        shares.clear();
+    /// [`Self::patch`] into a patch the caller keeps. The candidates are one corner's
+    /// neighbours: they reach `2 r + longest edge` from it, and every position of the patch
+    /// lies within `r + longest edge` of each corner.
+    pub fn patch_into(&self, at: &SurfacePoint, patch: &mut Patch) {
         let centre = self.point(at);
         let radius_m = self.header.settings.tool_tip_radius_m;
         let local = &self.steps[0].local;
         let corners = self.triangles[at.triangle];
-        for &corner in &corners {
-            for e in local.neighbours_of(corner as usize) {
-                let m = local.neighbours[e] as usize;
-                if shares.iter().any(|&(j, _)| j == m) {
-                    continue;
-                }
-                let p = Vector3::from(self.position_coords_m[m].map(f64::from));
-                let w = patch_weight(
-                    self.position_areas_m2[m] as f64,
-                    (p - centre).norm(),
-                    radius_m,
-                );
-                if w > 0.0 {
-                    shares.push((m, w));
-                }
-            }
+        let weights = local.neighbours_of(corners[0] as usize).filter_map(|e| {
+            let m = local.neighbours[e] as usize;
+            let p = Vector3::from(self.position_coords_m[m].map(f64::from));
+            let w = patch_weight(
+                self.position_areas_m2[m] as f64,
+                (p - centre).norm(),
+                radius_m,
+            );
+            (w > 0.0).then_some((m, w))
+        });
+        patch.set(self.positions.len(), weights);
+        let total: f64 = patch.shares.iter().map(|s| s.1).sum();
+        if total > 0.0 {
+            patch.shares.iter_mut().for_each(|s| s.1 /= total);
+        } else {
+            let corners = (0..3).map(|k| (corners[k] as usize, at.barycentric[k]));
+            patch.set(self.positions.len(), corners);
         }
-        let total: f64 = shares.iter().map(|s| s.1).sum();
-        if total <= 0.0 {
-            shares.clear();
-            shares.extend((0..3).map(|k| (corners[k] as usize, at.barycentric[k])));
-            return;
-        }
-        shares.iter_mut().for_each(|s| s.1 /= total);
     }
 
     /// Weight of load step `step` for a nodal load whose linear response is `level_m` deep:
@@ -196,49 +225,51 @@ impl Vademecum {
         l * self.step_weight(step, level)
     }
 
-    /// The 3 × 3 compliance (m/N) of load step `step` for the patch `shares`: the
-    /// patch-averaged displacement under the tool per unit force, `Σ_ij β_i β_j C_ij`.
-    pub fn step_compliance(&self, step: usize, shares: &[(usize, f64)]) -> Matrix3<f64> {
-        self.weighted_compliance(step, shares, |_, l| l)
+    /// The 3 × 3 compliance (m/N) of load step `step` for `patch`: the patch-averaged
+    /// displacement under the tool per unit force, `Σ_ij β_i β_j C_ij`.
+    pub fn step_compliance(&self, step: usize, patch: &Patch) -> Matrix3<f64> {
+        self.weighted_compliance(step, patch, |_, l| l)
     }
 
-    /// `Σ_ij β_i γ_j C_ij`: the displacement averaged with `observed` under loads whose shares
-    /// are `loaded(j, β_j)`, over the same patch.
+    /// `Σ_ij β_i γ_j C_ij`: the displacement averaged with the patch's shares `β` under loads
+    /// whose shares are `γ_j = loaded(j, β_j)`. Each position's row of blocks is scanned
+    /// once and its patch members picked by the slot table.
     fn weighted_compliance(
         &self,
         step: usize,
-        observed: &[(usize, f64)],
+        patch: &Patch,
         loaded: impl Fn(usize, f64) -> f64,
     ) -> Matrix3<f64> {
         let local = &self.steps[step].local;
-        let mut c = Matrix3::zeros();
-        for &(i, li) in observed {
+        let mut c = [0.0f64; 9];
+        for &(i, li) in &patch.shares {
             for e in local.neighbours_of(i) {
                 let j = local.neighbours[e] as usize;
-                if let Some(&(_, lj)) = observed.iter().find(|(v, _)| *v == j) {
+                if let Some(slot) = patch.slot(j) {
+                    let w = li * loaded(j, patch.shares[slot].1);
                     let block = &local.compliance[9 * e..9 * e + 9];
-                    c += Matrix3::from_row_iterator(block.iter().map(|&v| v as f64))
-                        * (li * loaded(j, lj));
+                    for (ck, &bk) in c.iter_mut().zip(block) {
+                        *ck += w * bk as f64;
+                    }
                 }
             }
         }
-        c
+        Matrix3::from_row_slice(&c)
     }
 
-    /// The compliance for a force `force_n` on the patch `shares` (load steps blended).
-    pub fn compliance(&self, shares: &[(usize, f64)], force_n: &Vector3<f64>) -> Matrix3<f64> {
+    /// The compliance for a force `force_n` on `patch` (load steps blended).
+    pub fn compliance(&self, patch: &Patch, force_n: &Vector3<f64>) -> Matrix3<f64> {
         if self.steps.len() == 1 {
-            return self.step_compliance(0, shares);
+            return self.step_compliance(0, patch);
         }
         (0..self.steps.len())
-            .map(|k| self.weighted_compliance(k, shares, |j, l| self.step_share(k, j, l, force_n)))
+            .map(|k| self.weighted_compliance(k, patch, |j, l| self.step_share(k, j, l, force_n)))
             .sum()
     }
 
     /// Displacement (m) of the surface under the tool for a force (N) at `at`.
     pub fn tool_displacement(&self, at: &SurfacePoint, force_n: &Vector3<f64>) -> Vector3<f64> {
-        let shares = self.shares(at);
-        self.compliance(&shares, force_n) * force_n
+        self.compliance(&self.patch(at), force_n) * force_n
     }
 
     /// The force (N) that pushes the surface at `at` by `indentation_m`: the force the trainee
@@ -248,24 +279,24 @@ impl Vademecum {
         at: &SurfacePoint,
         indentation_m: &Vector3<f64>,
     ) -> Vector3<f64> {
-        self.patch_force_for_indentation(&self.shares(at), indentation_m)
+        self.patch_force_for_indentation(&self.patch(at), indentation_m)
     }
 
     /// [`Self::force_for_indentation`] on a patch already found: a secant iteration over the
     /// load steps, one 3 × 3 solve when linear. Zero if the patch's compliance is singular.
     pub fn patch_force_for_indentation(
         &self,
-        shares: &[(usize, f64)],
+        patch: &Patch,
         indentation_m: &Vector3<f64>,
     ) -> Vector3<f64> {
         let solve = |c: Matrix3<f64>| {
             c.try_inverse()
                 .map_or_else(Vector3::zeros, |inverse| inverse * indentation_m)
         };
-        let mut force = solve(self.step_compliance(0, shares));
+        let mut force = solve(self.step_compliance(0, patch));
         if self.steps.len() > 1 {
             for _ in 0..SECANT_ITERATIONS {
-                force = solve(self.compliance(shares, &force));
+                force = solve(self.compliance(patch, &force));
             }
         }
         force
@@ -274,7 +305,7 @@ impl Vademecum {
     /// The displacement field (m, all dofs) for a force (N) at `at`.
     pub fn field(&self, at: &SurfacePoint, force_n: &Vector3<f64>) -> Vec<f64> {
         let mut u = vec![0.0; self.dof_count()];
-        self.add_patch_field(&self.shares(at), force_n, &mut u);
+        self.add_patch_field(&self.patch(at).shares, force_n, &mut u);
         u
     }
 

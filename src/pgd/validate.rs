@@ -172,7 +172,7 @@ fn sample(
     let indentation_m = low + (high - low) * rng.f64();
     // The linear compliance along the direction sets the force for the wanted indentation.
     let stiffness =
-        direction.dot(&(vademecum.step_compliance(0, &vademecum.shares(at)) * direction));
+        direction.dot(&(vademecum.step_compliance(0, &vademecum.patch(at)) * direction));
     let force = direction * (indentation_m / stiffness);
 
     let shares = kernel.shares(point)?;

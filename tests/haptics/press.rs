@@ -55,7 +55,7 @@ fn a_scripted_press_matches_full_fem() {
         .query::<&ToolTouch>()
         .single(world)
         .unwrap()
-        .0
+        .contact
         .expect("the tool presses the liver");
     assert!(
         (contact.depth_m - motion.depth_m).abs() < 2e-4,

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use bevy::prelude::*;
 
 use crate::contact::{ContactSurface, ToolContact};
-use crate::pgd::{Deformation, Vademecum};
+use crate::pgd::{Deformation, Patch, Vademecum};
 
 /// An organ's mechanical model (the vademecum, which carries the regions it was built with in
 /// its header) and collision model (its accessible surface).
@@ -21,9 +21,13 @@ pub struct OrganBody {
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OrganIndex(pub usize);
 
-/// The tool's contact with the organ this tick, if it touches.
+/// The tool's contact with the organ this tick, if it touches, and the patch under it
+/// (scratch space kept from tick to tick).
 #[derive(Component, Clone, Debug, Default)]
-pub struct ToolTouch(pub Option<ToolContact>);
+pub struct ToolTouch {
+    pub contact: Option<ToolContact>,
+    pub patch: Patch,
+}
 
 /// The loads on the organ and their modal coefficients. Load slot [`Self::TOOL`] is the tool's.
 #[derive(Component, Clone, Debug)]

@@ -120,7 +120,7 @@ impl HapticLoop {
                 .world
                 .query::<&ToolTouch>()
                 .iter(&self.world)
-                .any(|t| t.0.is_some());
+                .any(|t| t.contact.is_some());
             forces.record(&force, touching);
         }
         HeadlessReport::new(self, ticks, forces, &compute)

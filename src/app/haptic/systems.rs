@@ -40,12 +40,14 @@ pub fn tool_contact(
 ) {
     for (body, mut touch, mut deformation) in &mut organs {
         let load = &mut deformation.0.loads[OrganDeformation::TOOL];
-        touch.0 = match &tool.sample {
+        let touch = &mut *touch;
+        touch.contact = match &tool.sample {
             Some(sample) => press(
                 &body.vademecum,
                 &body.surface,
                 &tool.probe,
                 &sample.tip_m,
+                &mut touch.patch,
                 load,
             ),
             None => {
@@ -67,7 +69,7 @@ pub fn evaluate_modes(mut organs: Query<(&OrganBody, &mut OrganDeformation)>) {
 pub fn compute_force(touches: Query<&ToolTouch>, mut force: ResMut<DeviceForce>) {
     force.desired_n = -touches
         .iter()
-        .filter_map(|t| t.0.map(|c| c.force_n))
+        .filter_map(|t| t.contact.map(|c| c.force_n))
         .sum::<Vector3<f64>>();
 }
 
@@ -140,7 +142,7 @@ pub fn publish_snapshot(
     snapshot.faulted = safety.0.is_faulted();
     for (index, touch, deformation) in &organs {
         let organ = &mut snapshot.organs[index.0];
-        organ.contact = touch.0;
+        organ.contact = touch.contact;
         organ.deformation.clone_from(&deformation.0);
     }
     publisher.0.publish();

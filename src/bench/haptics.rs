@@ -1,0 +1,235 @@
+//! The haptic loop benchmark: tick compute time over a scripted sweep of the four-organ scene
+//! (simulated clock), per organ pressed, and against the same contact solved by full FEM;
+//! then the real-time loop's punctuality with each timer while the render side's CPU work
+//! (every organ's whole displacement field, 60 times a second) runs beside it.
+
+use std::fmt;
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+
+use super::fem::median_ms;
+use crate::app::haptic::{HapticLoop, HapticScene, HapticThread, RealTimeReport, TickTimes};
+use crate::app::scene::press_targets;
+use crate::fem::{FemError, Law, Loads, NewtonSettings};
+use crate::haptics::{
+    HapticDevice, PressMotion, PressTarget, Scripted, TICK_S, TimerMode, press_and_slide,
+};
+use crate::mesh::Surface;
+use crate::mesh::organs::{self, Organ, OrganSettings};
+use crate::pgd;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SweepFigures {
+    /// Which organs the script presses.
+    pub pressed: String,
+    pub ticks: u64,
+    pub contact_ticks: u64,
+    /// Medians over the repeats of each run's quantiles (µs).
+    pub compute_p50_us: f64,
+    pub compute_p99_us: f64,
+    pub compute_max_us: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct FemContact {
+    pub organ: &'static str,
+    pub nodes: usize,
+    /// One Newton solve (assembly, factorization, solve) of the liver press (ms, median).
+    pub newton_ms: f64,
+    /// `newton_ms` over the four-organ sweep's tick p50.
+    pub ratio_to_tick_p50: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct HapticBenchReport {
+    pub organs: Vec<String>,
+    pub repeats: usize,
+    pub sweeps: Vec<SweepFigures>,
+    pub fem_contact: FemContact,
+    /// Real-time runs while the render side's CPU work runs.
+    pub realtime: Vec<RealTimeReport>,
+    pub realtime_seconds: f64,
+}
+
+/// Runs the benchmark on `scene` (the four organs), `repeats` times per sweep and
+/// `realtime_seconds` per timer.
+pub fn run(
+    scene: &HapticScene,
+    repeats: usize,
+    realtime_seconds: f64,
+) -> Result<HapticBenchReport, FemError> {
+    let targets = press_targets(scene);
+    let mut sweeps = vec![sweep(scene, "all", &targets, repeats)];
+    for ((name, _), target) in scene.organs.iter().zip(&targets) {
+        sweeps.push(sweep(scene, name, std::slice::from_ref(target), repeats));
+    }
+    let fem_contact = fem_contact(&targets[0], repeats, sweeps[0].compute_p50_us)?;
+    let realtime = [TimerMode::Sleep, TimerMode::default()]
+        .into_iter()
+        .map(|timer| realtime(scene, &targets, timer, realtime_seconds))
+        .collect();
+    Ok(HapticBenchReport {
+        organs: scene.organs.iter().map(|o| o.0.clone()).collect(),
+        repeats,
+        sweeps,
+        fem_contact,
+        realtime,
+        realtime_seconds,
+    })
+}
+
+fn device(targets: &[PressTarget]) -> Box<dyn HapticDevice> {
+    let trajectory = press_and_slide(targets, &PressMotion::default());
+    Box::new(Scripted::new("benchmark sweep", trajectory))
+}
+
+fn sweep(
+    scene: &HapticScene,
+    pressed: &str,
+    targets: &[PressTarget],
+    repeats: usize,
+) -> SweepFigures {
+    let ticks = (press_and_slide(targets, &PressMotion::default()).duration_s() / TICK_S) as u64;
+    let runs: Vec<_> = (0..repeats.max(1))
+        .map(|_| {
+            let mut haptic = HapticLoop::new(scene, device(targets)).expect("scene was built");
+            haptic.run_simulated(ticks)
+        })
+        .collect();
+    let median = |f: &dyn Fn(&TickTimes) -> f64| {
+        let mut v: Vec<f64> = runs.iter().map(|r| f(&r.compute)).collect();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    SweepFigures {
+        pressed: pressed.to_owned(),
+        ticks,
+        contact_ticks: runs[0].force.contact_ticks,
+        compute_p50_us: median(&|t| t.p50_us),
+        compute_p99_us: median(&|t| t.p99_us),
+        compute_max_us: median(&|t| t.max_us),
+    }
+}
+
+/// The liver press of the sweep, solved by full FEM: the force the tick found, applied as the
+/// same patch load, one Newton solve on the liver mesh.
+fn fem_contact(
+    target: &PressTarget,
+    repeats: usize,
+    tick_p50_us: f64,
+) -> Result<FemContact, FemError> {
+    let mesh = organs::generate(Organ::Liver, &OrganSettings::default())?;
+    let nodes = mesh.node_count();
+    let model = pgd::organ::clamped_model(mesh, pgd::organ::material(Organ::Liver, Law::Linear))?;
+    let surface = Surface::extract(model.mesh());
+    let mut loads = Loads::new(nodes);
+    let force_n = target.normal * -0.25;
+    loads.add_point_load(
+        model.mesh(),
+        &surface,
+        nalgebra::Point3::from(target.point_m),
+        force_n.into(),
+        PressMotion::default().tip_radius_m,
+    )?;
+    let mut failure = None;
+    let newton_ms = median_ms(repeats.max(1), &mut || {
+        if let Err(e) = model.solve_static(&loads, &NewtonSettings::default()) {
+            failure = Some(e);
+        }
+    });
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    Ok(FemContact {
+        organ: "liver",
+        nodes,
+        newton_ms,
+        ratio_to_tick_p50: newton_ms * 1e3 / tick_p50_us,
+    })
+}
+
+/// The real-time loop for `seconds` with `timer`, while this thread does what a renderer does
+/// on the CPU each 60 Hz frame: read the latest snapshot and form every organ's whole field.
+fn realtime(
+    scene: &HapticScene,
+    targets: &[PressTarget],
+    timer: TimerMode,
+    seconds: f64,
+) -> RealTimeReport {
+    let mut haptic = HapticLoop::new(scene, device(targets)).expect("scene was built");
+    let mut snapshots = haptic.publish();
+    let thread = HapticThread::spawn(haptic, timer).expect("a thread can be spawned");
+    let mut fields: Vec<Vec<f64>> = scene
+        .organs
+        .iter()
+        .map(|(_, v)| vec![0.0; v.dof_count()])
+        .collect();
+    let frame = Duration::from_secs_f64(1.0 / 60.0);
+    let end = Instant::now() + Duration::from_secs_f64(seconds);
+    while Instant::now() < end {
+        let started = Instant::now();
+        let snapshot = snapshots.read();
+        for ((organ, (_, vademecum)), u) in
+            snapshot.organs.iter().zip(&scene.organs).zip(&mut fields)
+        {
+            organ.deformation.field_into(vademecum, u);
+        }
+        std::hint::black_box(&fields);
+        std::thread::sleep(frame.saturating_sub(started.elapsed()));
+    }
+    thread.stop()
+}
+
+impl fmt::Display for HapticBenchReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "haptic loop: {} (medians of {} runs)",
+            self.organs.join(", "),
+            self.repeats
+        )?;
+        writeln!(
+            f,
+            "{:<14} {:>7} {:>8} {:>9} {:>9} {:>9}",
+            "pressed", "ticks", "contact", "p50 µs", "p99 µs", "max µs"
+        )?;
+        for s in &self.sweeps {
+            writeln!(
+                f,
+                "{:<14} {:>7} {:>8} {:>9.1} {:>9.1} {:>9.1}",
+                s.pressed,
+                s.ticks,
+                s.contact_ticks,
+                s.compute_p50_us,
+                s.compute_p99_us,
+                s.compute_max_us
+            )?;
+        }
+        let c = &self.fem_contact;
+        writeln!(
+            f,
+            "full FEM, the same liver press ({} nodes, one Newton solve): {:.1} ms = {:.0}x the tick p50",
+            c.nodes, c.newton_ms, c.ratio_to_tick_p50
+        )?;
+        writeln!(
+            f,
+            "real time, {:.0} s each, render-side CPU work beside it:",
+            self.realtime_seconds
+        )?;
+        for r in &self.realtime {
+            writeln!(
+                f,
+                "  {:?}: lateness p50 {:.1} / p99 {:.1} / max {:.1} µs; period error p99 {:.1} µs; {} skipped of {}",
+                r.timer,
+                r.lateness.p50_us,
+                r.lateness.p99_us,
+                r.lateness.max_us,
+                r.period_error.p99_us,
+                r.skipped,
+                r.ticks
+            )?;
+        }
+        Ok(())
+    }
+}
