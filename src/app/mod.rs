@@ -1,41 +1,11 @@
-//! The Bevy layer: plugins and systems that wrap the numerical core for the trainer window.
+//! The Bevy layer over the numerical core: the haptic world and its 1 kHz thread
+//! ([`haptic`]), the default scene ([`scene`]), a session of the trainer, headless or not
+//! ([`session`]), and the trainer window ([`window`]).
 
 pub mod haptic;
-pub mod headless;
-mod pressed_slab;
 pub mod scene;
-mod view;
-
-use bevy::prelude::*;
-
-pub use pressed_slab::PressedSlab;
-
-/// Shows a solved default scene in a window until the user closes it.
-pub struct TrainerPlugin {
-    pub scene: PressedSlab,
-}
-
-impl Plugin for TrainerPlugin {
-    fn build(&self, app: &mut App) {
-        app.insert_resource(self.scene.clone())
-            .insert_resource(ClearColor(Color::srgb(0.05, 0.06, 0.08)))
-            .add_systems(Startup, view::spawn_scene);
-    }
-}
-
-/// Opens the trainer window.
-pub fn run_window(scene: PressedSlab) -> AppExit {
-    App::new()
-        .add_plugins(DefaultPlugins.set(WindowPlugin {
-            primary_window: Some(Window {
-                title: "PGD surgery trainer".into(),
-                ..default()
-            }),
-            ..default()
-        }))
-        .add_plugins(TrainerPlugin { scene })
-        .run()
-}
+pub mod session;
+pub mod window;
 
 /// Why a window cannot be opened here, if that is known before trying.
 pub fn missing_display() -> Option<&'static str> {

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Parser;
-use pgd_surgery::app::{self, PressedSlab, headless};
+use pgd_surgery::app::{self, session};
 use pgd_surgery::cli::OnStale;
 use pgd_surgery::haptics::{DeviceSpec, TimerMode};
 
@@ -28,7 +28,7 @@ struct Cli {
     /// Headless: ticks to run (default: the script's length plus 100 ms).
     #[arg(long)]
     ticks: Option<u64>,
-    /// Headless: print the summary as JSON.
+    /// Print the summary (headless) or the haptic timing report (window) as JSON.
     #[arg(long)]
     json: bool,
     /// Headless: tick on the real clock (1 kHz on a thread of its own) instead of a simulated
@@ -41,6 +41,10 @@ struct Cli {
     /// The largest force (N) sent to the device (also capped by the device's own limit).
     #[arg(long, default_value_t = 3.3)]
     max_force_n: f64,
+    /// Close the window after this many seconds and report how the haptic loop kept time
+    /// while the renderer ran.
+    #[arg(long)]
+    exit_after_s: Option<f64>,
     /// Where the organs' vademecums are kept.
     #[arg(long, default_value = "vademecums")]
     vademecums: PathBuf,
@@ -74,37 +78,31 @@ fn main() -> ExitCode {
     } else {
         OnStale::Rebuild
     };
-    if cli.headless {
-        let options = headless::Options {
-            vademecums: cli.vademecums,
-            on_stale,
-            device: cli.device,
-            record: cli.record,
-            ticks: cli.ticks,
-            realtime: cli.realtime.then_some(cli.timer),
-            max_force_n: cli.max_force_n,
-        };
-        return match headless::run(&options) {
-            Ok(report) => {
-                report.print(cli.json);
-                ExitCode::SUCCESS
-            }
-            Err(e) => {
-                eprintln!("trainer: {e}");
-                ExitCode::FAILURE
-            }
-        };
-    }
-    let scene = match PressedSlab::solve() {
-        Ok(scene) => scene,
-        Err(e) => {
-            eprintln!("trainer: the default scene could not be solved: {e}");
-            return ExitCode::FAILURE;
-        }
+    let realtime = match cli.headless {
+        true => cli.realtime.then_some(cli.timer),
+        false => Some(cli.timer),
     };
-    println!("{}", scene.summary());
-    match app::run_window(scene) {
-        bevy::app::AppExit::Success => ExitCode::SUCCESS,
-        bevy::app::AppExit::Error(code) => ExitCode::from(code.get()),
+    let options = session::Options {
+        vademecums: cli.vademecums.clone(),
+        on_stale,
+        device: cli.device.clone(),
+        record: cli.record.clone(),
+        ticks: cli.ticks,
+        realtime,
+        max_force_n: cli.max_force_n,
+    };
+    let result = match cli.headless {
+        true => session::run_headless(&options),
+        false => session::open_window(&options, cli.exit_after_s),
+    };
+    match result {
+        Ok(report) => {
+            report.print(cli.json);
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("trainer: {e}");
+            ExitCode::FAILURE
+        }
     }
 }

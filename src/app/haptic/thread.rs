@@ -17,6 +17,8 @@ use crate::haptics::{Histogram, Metronome, TICK_S, TimerMode};
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RealTimeReport {
     pub timer: TimerMode,
+    /// The haptic thread's scheduling: real-time, or why it could not be.
+    pub scheduling: String,
     pub ticks: u64,
     /// Deadlines passed by more than a period, skipped rather than run late in a burst.
     pub skipped: u64,
@@ -53,6 +55,15 @@ impl HapticThread {
 }
 
 fn run(mut haptic: HapticLoop, timer: TimerMode, stop: &AtomicBool) -> RealTimeReport {
+    let scheduling = match raise_priority() {
+        Ok(()) => "real-time (FIFO)".to_owned(),
+        Err(e) => {
+            bevy::log::warn!(
+                "haptic thread: could not get real-time scheduling ({e}); ticks may be late when the machine is busy"
+            );
+            format!("normal (real-time refused: {e})")
+        }
+    };
     let period = Duration::from_secs_f64(TICK_S);
     let mut metronome = Metronome::new(period, timer);
     let (mut lateness, mut period_error, mut compute) = (
@@ -86,12 +97,38 @@ fn run(mut haptic: HapticLoop, timer: TimerMode, stop: &AtomicBool) -> RealTimeR
     }
     RealTimeReport {
         timer,
+        scheduling,
         ticks,
         skipped,
         lateness: TickTimes::of(&lateness),
         period_error: TickTimes::of(&period_error),
         compute: TickTimes::of(&compute),
     }
+}
+
+/// Real-time (FIFO) scheduling above every normal thread, the renderer's included, so that a
+/// busy machine delays ticks rather than the haptic thread's turn; needs the right to (root or
+/// `CAP_SYS_NICE`, or an rtprio limit), and the loop runs without it if refused.
+#[cfg(unix)]
+fn raise_priority() -> Result<(), String> {
+    use thread_priority::unix::{
+        RealtimeThreadSchedulePolicy, ThreadSchedulePolicy, set_thread_priority_and_policy,
+        thread_native_id,
+    };
+    use thread_priority::{ThreadPriority, ThreadPriorityValue};
+    let priority = ThreadPriorityValue::try_from(70u8).map_err(|e| e.to_string())?;
+    set_thread_priority_and_policy(
+        thread_native_id(),
+        ThreadPriority::Crossplatform(priority),
+        ThreadSchedulePolicy::Realtime(RealtimeThreadSchedulePolicy::Fifo),
+    )
+    .map_err(|e| format!("{e:?}"))
+}
+
+#[cfg(not(unix))]
+fn raise_priority() -> Result<(), String> {
+    thread_priority::set_current_thread_priority(thread_priority::ThreadPriority::Max)
+        .map_err(|e| format!("{e:?}"))
 }
 
 fn abs_diff(a: Duration, b: Duration) -> Duration {

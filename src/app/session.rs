@@ -1,0 +1,163 @@
+//! A trainer session: the default scene, the device the options name, and the haptic loop —
+//! headless on a simulated clock (deterministic) or the real one, or behind the window — and
+//! what it reports.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use serde::Serialize;
+
+use bevy::app::AppExit;
+use nalgebra::Vector3;
+
+use super::haptic::{HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport};
+use super::scene::{default_scene, press_targets};
+use super::window::WindowScene;
+use crate::cli::OnStale;
+use crate::haptics::{
+    DeviceSpec, HapticDevice, PressMotion, Recorder, Scripted, TICK_S, TimerMode, Trajectory,
+    VirtualDevice, press_and_slide,
+};
+
+pub struct Options {
+    pub vademecums: PathBuf,
+    pub on_stale: OnStale,
+    pub device: Option<DeviceSpec>,
+    pub record: Option<PathBuf>,
+    pub ticks: Option<u64>,
+    /// Headless: tick on the real clock with this timer instead of a simulated one. The
+    /// window always ticks on the real clock, with this timer or the default.
+    pub realtime: Option<TimerMode>,
+    pub max_force_n: f64,
+}
+
+/// What a headless run reports.
+#[derive(Serialize)]
+#[serde(untagged)]
+pub enum Report {
+    Simulated(HeadlessReport),
+    RealTime(RealTimeReport),
+}
+
+impl Report {
+    pub fn print(&self, json: bool) {
+        if json {
+            match serde_json::to_string_pretty(self) {
+                Ok(text) => println!("{text}"),
+                Err(e) => eprintln!("trainer: could not write the JSON summary: {e}"),
+            }
+            return;
+        }
+        match self {
+            Report::Simulated(report) => println!("{report}"),
+            Report::RealTime(report) => println!(
+                "real-time haptic loop ({:?}, {} scheduling): {} ticks, {} deadlines skipped\n\
+                 tick lateness: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs\n\
+                 period error: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs\n\
+                 tick compute: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs",
+                report.timer,
+                report.scheduling,
+                report.ticks,
+                report.skipped,
+                report.lateness.p50_us,
+                report.lateness.p99_us,
+                report.lateness.max_us,
+                report.period_error.p50_us,
+                report.period_error.p99_us,
+                report.period_error.max_us,
+                report.compute.p50_us,
+                report.compute.p99_us,
+                report.compute.max_us,
+            ),
+        }
+    }
+}
+
+/// Runs the haptic loop without a window: on a simulated clock unless `options.realtime`.
+pub fn run_headless(options: &Options) -> Result<Report, String> {
+    let scene = scene(options)?;
+    let trajectory = match &options.device {
+        None => press_and_slide(&press_targets(&scene), &PressMotion::default()),
+        Some(DeviceSpec::Scripted(path)) => Trajectory::load(path).map_err(|e| e.to_string())?,
+        Some(DeviceSpec::Virtual) => {
+            return Err("the virtual device needs the window: drop --headless".into());
+        }
+    };
+    let ticks = options
+        .ticks
+        .unwrap_or_else(|| ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64);
+    let device = recorded(scripted(&options.device, trajectory), &options.record);
+    let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
+    Ok(match options.realtime {
+        None => Report::Simulated(haptic.run_simulated(ticks)),
+        Some(timer) => Report::RealTime(run_realtime(haptic, timer, ticks)?),
+    })
+}
+
+/// Opens the trainer window over the real-time haptic loop, driven by the mouse unless a
+/// scripted device is named; reports how the loop kept time while the renderer ran.
+pub fn open_window(options: &Options, exit_after_s: Option<f64>) -> Result<Report, String> {
+    let scene = scene(options)?;
+    let (device, virtual_device) = match &options.device {
+        Some(DeviceSpec::Scripted(path)) => {
+            let trajectory = Trajectory::load(path).map_err(|e| e.to_string())?;
+            (scripted(&options.device, trajectory), None)
+        }
+        None | Some(DeviceSpec::Virtual) => {
+            let start = press_targets(&scene)
+                .first()
+                .map_or_else(Vector3::zeros, |t| t.point_m + t.normal * 0.03);
+            let (device, handle) = VirtualDevice::new(&start);
+            (Box::new(device) as Box<dyn HapticDevice>, Some(handle))
+        }
+    };
+    let device = recorded(device, &options.record);
+    let device_name = device.name().to_owned();
+    let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
+    let snapshots = haptic.publish();
+    let timer = options.realtime.unwrap_or_default();
+    let haptic = HapticThread::spawn(haptic, timer).map_err(|e| e.to_string())?;
+    let exit = super::window::run(WindowScene {
+        scene,
+        snapshots,
+        virtual_device,
+        device_name,
+        exit_after_s,
+    });
+    let report = haptic.stop();
+    match exit {
+        AppExit::Success => Ok(Report::RealTime(report)),
+        AppExit::Error(code) => Err(format!("the window closed with error code {code}")),
+    }
+}
+
+fn scene(options: &Options) -> Result<HapticScene, String> {
+    let mut scene = default_scene(&options.vademecums, options.on_stale)?;
+    scene.safety.max_force_n = options.max_force_n;
+    Ok(scene)
+}
+
+fn scripted(spec: &Option<DeviceSpec>, trajectory: Trajectory) -> Box<dyn HapticDevice> {
+    let name = match spec {
+        Some(DeviceSpec::Scripted(path)) => format!("scripted ({})", path.display()),
+        _ => "scripted (built-in press and slide on each organ)".into(),
+    };
+    Box::new(Scripted::new(name, trajectory))
+}
+
+fn recorded(device: Box<dyn HapticDevice>, record: &Option<PathBuf>) -> Box<dyn HapticDevice> {
+    match record {
+        Some(path) => Box::new(Recorder::new(device, path)),
+        None => device,
+    }
+}
+
+fn run_realtime(
+    haptic: HapticLoop,
+    timer: TimerMode,
+    ticks: u64,
+) -> Result<RealTimeReport, String> {
+    let thread = HapticThread::spawn(haptic, timer).map_err(|e| e.to_string())?;
+    std::thread::sleep(Duration::from_secs_f64(ticks as f64 * TICK_S));
+    Ok(thread.stop())
+}

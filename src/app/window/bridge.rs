@@ -1,0 +1,52 @@
+//! The link to the haptic thread: the latest snapshot, read once per frame without waiting.
+
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use bevy::prelude::*;
+
+use super::{FrameSet, WindowScene};
+use crate::app::haptic::{HapticScene, HapticSnapshot};
+use crate::haptics::VirtualHandle;
+
+/// What the window holds of the haptic side.
+#[derive(Resource)]
+pub struct HapticLink {
+    pub scene: HapticScene,
+    pub virtual_device: Option<Arc<VirtualHandle>>,
+    pub device_name: String,
+    snapshots: Mutex<triple_buffer::Output<HapticSnapshot>>,
+    exit_after: Option<Duration>,
+}
+
+/// The haptic state this frame draws.
+#[derive(Resource, Default)]
+pub struct Snapshot(pub HapticSnapshot);
+
+pub(super) fn setup(app: &mut App, window: WindowScene) {
+    app.insert_resource(HapticLink {
+        scene: window.scene,
+        virtual_device: window.virtual_device,
+        device_name: window.device_name,
+        snapshots: Mutex::new(window.snapshots),
+        exit_after: window.exit_after_s.map(Duration::from_secs_f64),
+    })
+    .init_resource::<Snapshot>()
+    .add_systems(Update, (receive, exit_when_due).in_set(FrameSet::Receive));
+}
+
+/// Copies the latest complete tick (the triple buffer's reader never blocks the writer; the
+/// mutex is only ever taken by this system).
+fn receive(link: Res<HapticLink>, mut snapshot: ResMut<Snapshot>) {
+    if let Ok(mut output) = link.snapshots.lock() {
+        snapshot.0.clone_from(output.read());
+    }
+}
+
+/// Closes the window once the wall-clock time asked for has passed (virtual time would lag
+/// behind on a slow renderer: it caps each frame's step).
+fn exit_when_due(link: Res<HapticLink>, time: Res<Time<Real>>, mut exit: MessageWriter<AppExit>) {
+    if link.exit_after.is_some_and(|after| time.elapsed() >= after) {
+        exit.write(AppExit::Success);
+    }
+}

@@ -1,0 +1,91 @@
+//! What the trainee reads: the force the device renders against its limit, the haptic rate,
+//! the frame time, faults, and how to drive the virtual tool.
+
+use bevy::prelude::*;
+
+use super::FrameSet;
+use super::bridge::{HapticLink, Snapshot};
+
+#[derive(Component)]
+struct Hud;
+
+pub(super) fn setup(app: &mut App) {
+    app.add_systems(Startup, spawn_hud)
+        .add_systems(Update, update_hud.in_set(FrameSet::Draw));
+}
+
+fn spawn_hud(mut commands: Commands) {
+    commands.spawn((
+        Hud,
+        Text::new(""),
+        TextFont {
+            font_size: FontSize::Px(15.0),
+            ..default()
+        },
+        Node {
+            position_type: PositionType::Absolute,
+            top: px(10),
+            left: px(10),
+            ..default()
+        },
+    ));
+}
+
+/// The haptic rate measured from the snapshots' tick counter against wall-clock time (not the
+/// virtual time, which caps a slow frame's step), smoothed over about a second.
+#[derive(Default)]
+struct Rate {
+    last_tick: u64,
+    hz: f64,
+}
+
+fn update_hud(
+    link: Res<HapticLink>,
+    snapshot: Res<Snapshot>,
+    time: Res<Time<Real>>,
+    mut rate: Local<Rate>,
+    mut hud: Query<&mut Text, With<Hud>>,
+) {
+    let Ok(mut text) = hud.single_mut() else {
+        return;
+    };
+    let dt = time.delta_secs_f64();
+    let ticks = snapshot.0.tick.saturating_sub(rate.last_tick);
+    let first = rate.last_tick == 0;
+    rate.last_tick = snapshot.0.tick;
+    if dt > 0.0 && !first {
+        let k = dt.min(1.0);
+        rate.hz = rate.hz * (1.0 - k) + k * ticks as f64 / dt;
+    }
+    let limit_n = link.scene.safety.max_force_n;
+    let force_n = snapshot.0.force_n.norm();
+    let filled = ((force_n / limit_n).clamp(0.0, 1.0) * 20.0).round() as usize;
+    let gauge = format!("[{}{}]", "#".repeat(filled), "-".repeat(20 - filled));
+    let touching: Vec<&str> = snapshot
+        .0
+        .organs
+        .iter()
+        .zip(&link.scene.organs)
+        .filter(|(o, _)| o.contact.is_some())
+        .map(|(_, (name, _))| name.as_str())
+        .collect();
+    let status = if snapshot.0.faulted {
+        "FAULT: force faded to zero (see the log)".to_owned()
+    } else if touching.is_empty() {
+        "no contact".to_owned()
+    } else {
+        format!("touching {}", touching.join(", "))
+    };
+    let help = if link.virtual_device.is_some() {
+        "\nmouse: move the tool | wheel or W/S: push in / pull out"
+    } else {
+        ""
+    };
+    text.0 = format!(
+        "device: {}\nforce {force_n:.3} N {gauge} limit {limit_n:.1} N\n{status}\n\
+         haptic {:.0} Hz | frame {:.1} ms{help}",
+        link.device_name,
+        rate.hz,
+        dt * 1e3
+    );
+}

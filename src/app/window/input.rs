@@ -1,0 +1,62 @@
+//! The virtual device, driven from the window: the tool tip follows the cursor on the plane
+//! facing the camera through the tip, and the wheel (or W/S, ↑/↓) pushes it in and out along
+//! the view.
+
+use bevy::input::mouse::{MouseScrollUnit, MouseWheel};
+use bevy::prelude::*;
+
+use super::bridge::HapticLink;
+use super::{FrameSet, from_bevy, to_bevy};
+
+/// How far one wheel notch moves the tip along the view (m).
+const WHEEL_STEP_M: f32 = 0.002;
+/// How fast W/S move the tip along the view (m/s).
+const KEY_SPEED_M_PER_S: f32 = 0.02;
+/// Pixels of a touchpad scroll per wheel notch.
+const PIXELS_PER_NOTCH: f32 = 20.0;
+
+pub(super) fn setup(app: &mut App) {
+    app.add_systems(Update, drive_virtual_device.in_set(FrameSet::Input));
+}
+
+fn drive_virtual_device(
+    link: Res<HapticLink>,
+    windows: Query<&Window>,
+    cameras: Query<(&Camera, &GlobalTransform)>,
+    mut wheel: MessageReader<MouseWheel>,
+    keys: Res<ButtonInput<KeyCode>>,
+    time: Res<Time>,
+) {
+    let Some(handle) = &link.virtual_device else {
+        return;
+    };
+    let (Ok(window), Ok((camera, eye))) = (windows.single(), cameras.single()) else {
+        return;
+    };
+    let forward = eye.forward();
+    let mut tip = to_bevy(&handle.tip_m());
+    if let Some(cursor) = window.cursor_position()
+        && let Ok(ray) = camera.viewport_to_world(eye, cursor)
+        && let Some(distance) = ray.intersect_plane(tip, InfinitePlane3d::new(*forward))
+    {
+        tip = ray.get_point(distance);
+    }
+    let notches: f32 = wheel
+        .read()
+        .map(|w| match w.unit {
+            MouseScrollUnit::Line => w.y,
+            MouseScrollUnit::Pixel => w.y / PIXELS_PER_NOTCH,
+        })
+        .sum();
+    let pressed = |a: KeyCode, b: KeyCode| keys.pressed(a) || keys.pressed(b);
+    let keyed = match (
+        pressed(KeyCode::KeyW, KeyCode::ArrowUp),
+        pressed(KeyCode::KeyS, KeyCode::ArrowDown),
+    ) {
+        (true, false) => 1.0,
+        (false, true) => -1.0,
+        _ => 0.0,
+    };
+    let push = notches * WHEEL_STEP_M + keyed * KEY_SPEED_M_PER_S * time.delta_secs();
+    handle.set_tip(&from_bevy(tip + *forward * push));
+}

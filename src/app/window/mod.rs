@@ -1,0 +1,69 @@
+//! The trainer window: the organs deforming under the tool from the haptic thread's latest
+//! snapshot, the tool and the force it renders, a HUD, and the mouse driving the virtual
+//! device. The haptic loop runs apart; this side only reads its snapshots.
+
+mod bridge;
+mod hud;
+mod input;
+mod organs;
+mod tool;
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+
+pub use bridge::{HapticLink, Snapshot};
+
+use super::haptic::{HapticScene, HapticSnapshot};
+use crate::haptics::VirtualHandle;
+
+/// Everything the window needs from the haptic side.
+pub struct WindowScene {
+    pub scene: HapticScene,
+    pub snapshots: triple_buffer::Output<HapticSnapshot>,
+    /// The virtual device's handle when the mouse drives the tool.
+    pub virtual_device: Option<Arc<VirtualHandle>>,
+    pub device_name: String,
+    /// Close the window after this many seconds (for measurements under Xvfb).
+    pub exit_after_s: Option<f64>,
+}
+
+/// The haptic side's f64 vectors as Bevy's (the Bevy end of the seam; parry's is `crate::seam`).
+fn to_bevy(v: &nalgebra::Vector3<f64>) -> Vec3 {
+    Vec3::from_array([v.x as f32, v.y as f32, v.z as f32])
+}
+
+fn from_bevy(v: Vec3) -> nalgebra::Vector3<f64> {
+    nalgebra::Vector3::new(v.x as f64, v.y as f64, v.z as f64)
+}
+
+/// The stages of a frame, in order.
+#[derive(SystemSet, Clone, Debug, PartialEq, Eq, Hash)]
+enum FrameSet {
+    Input,
+    Receive,
+    Draw,
+}
+
+/// Opens the trainer window and returns when it closes.
+pub fn run(window: WindowScene) -> AppExit {
+    let mut app = App::new();
+    app.add_plugins(DefaultPlugins.set(WindowPlugin {
+        primary_window: Some(Window {
+            title: "PGD surgery trainer".into(),
+            ..default()
+        }),
+        ..default()
+    }))
+    .insert_resource(ClearColor(Color::srgb(0.05, 0.06, 0.08)))
+    .configure_sets(
+        Update,
+        (FrameSet::Input, FrameSet::Receive, FrameSet::Draw).chain(),
+    );
+    bridge::setup(&mut app, window);
+    organs::setup(&mut app);
+    tool::setup(&mut app);
+    input::setup(&mut app);
+    hud::setup(&mut app);
+    app.run()
+}

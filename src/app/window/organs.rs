@@ -1,0 +1,149 @@
+//! The organs as the trainee sees them: each organ's accessible surface, moved every frame by
+//! the displacement field of the latest snapshot, with nodal normals recomputed on the
+//! deformed surface so that shading follows the deformation.
+
+use std::sync::Arc;
+
+use bevy::asset::RenderAssetUsages;
+use bevy::mesh::{Indices, PrimitiveTopology};
+use bevy::prelude::*;
+
+use super::FrameSet;
+use super::bridge::{HapticLink, Snapshot};
+use crate::mesh::vertex_normals;
+use crate::pgd::Vademecum;
+
+/// An organ's visual model, mapped to its vademecum through the load positions (surface
+/// vertex `k` is volume node `positions[k]`).
+#[derive(Component)]
+struct OrganView {
+    index: usize,
+    vademecum: Arc<Vademecum>,
+    triangles: Vec<[usize; 3]>,
+    /// Scratch: the whole displacement field (m).
+    field: Vec<f64>,
+}
+
+pub(super) fn setup(app: &mut App) {
+    app.add_systems(Startup, (spawn_organs, spawn_camera_and_light))
+        .add_systems(Update, deform.in_set(FrameSet::Draw));
+}
+
+/// Wet-tissue colours: liver red-brown, gallbladder green, pancreas pale yellow-pink,
+/// duodenum pink.
+fn colour(name: &str) -> Color {
+    match name {
+        "liver" => Color::srgb(0.48, 0.14, 0.11),
+        "gallbladder" => Color::srgb(0.24, 0.42, 0.16),
+        "pancreas" => Color::srgb(0.85, 0.68, 0.52),
+        _ => Color::srgb(0.80, 0.45, 0.45),
+    }
+}
+
+fn spawn_organs(
+    mut commands: Commands,
+    link: Res<HapticLink>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    for (index, (name, vademecum)) in link.scene.organs.iter().enumerate() {
+        let triangles: Vec<[usize; 3]> = vademecum
+            .triangles
+            .iter()
+            .map(|t| t.map(|m| m as usize))
+            .collect();
+        let mesh = surface_mesh(&triangles, &vademecum.position_coords_m);
+        commands.spawn((
+            Name::new(name.clone()),
+            Mesh3d(meshes.add(mesh)),
+            MeshMaterial3d(materials.add(StandardMaterial {
+                base_color: colour(name),
+                perceptual_roughness: 0.35,
+                reflectance: 0.5,
+                double_sided: true,
+                cull_mode: None,
+                ..default()
+            })),
+            OrganView {
+                index,
+                field: vec![0.0; vademecum.dof_count()],
+                vademecum: vademecum.clone(),
+                triangles,
+            },
+        ));
+    }
+}
+
+/// The centre of the scene's organs (m).
+pub(super) fn scene_centre(link: &HapticLink) -> Vec3 {
+    let points = link
+        .scene
+        .organs
+        .iter()
+        .flat_map(|(_, v)| v.position_coords_m.iter());
+    let (sum, count) = points.fold((Vec3::ZERO, 0), |(s, n), p| (s + Vec3::from(*p), n + 1));
+    sum / count.max(1) as f32
+}
+
+/// The surgeon's view of a supine patient: from above (anterior, +y), head (+z) up the screen.
+fn spawn_camera_and_light(mut commands: Commands, link: Res<HapticLink>) {
+    let centre = scene_centre(&link);
+    commands.spawn((
+        Camera3d::default(),
+        Transform::from_translation(centre + Vec3::new(0.0, 0.32, -0.10))
+            .looking_at(centre, Vec3::Z),
+    ));
+    commands.spawn((
+        DirectionalLight {
+            illuminance: 9_000.0,
+            shadow_maps_enabled: true,
+            ..default()
+        },
+        Transform::from_translation(centre + Vec3::new(0.1, 0.5, -0.2)).looking_at(centre, Vec3::Z),
+    ));
+}
+
+fn deform(
+    snapshot: Res<Snapshot>,
+    mut views: Query<(&mut OrganView, &Mesh3d)>,
+    mut meshes: ResMut<Assets<Mesh>>,
+) {
+    for (mut view, mesh) in &mut views {
+        let Some(organ) = snapshot.0.organs.get(view.index) else {
+            continue;
+        };
+        let view = &mut *view;
+        organ
+            .deformation
+            .field_into(&view.vademecum, &mut view.field);
+        let positions: Vec<[f32; 3]> = view
+            .vademecum
+            .positions
+            .iter()
+            .zip(&view.vademecum.position_coords_m)
+            .map(|(&node, rest)| {
+                let u = &view.field[3 * node as usize..3 * node as usize + 3];
+                [0, 1, 2].map(|c| rest[c] + u[c] as f32)
+            })
+            .collect();
+        if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
+            mesh.insert_attribute(
+                Mesh::ATTRIBUTE_NORMAL,
+                vertex_normals(&view.triangles, &positions),
+            );
+            mesh.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions);
+        }
+    }
+}
+
+/// A render mesh of a surface with area-weighted normals of the given positions.
+fn surface_mesh(triangles: &[[usize; 3]], positions: &[[f32; 3]]) -> Mesh {
+    let indices: Vec<u32> = triangles.iter().flatten().map(|&i| i as u32).collect();
+    Mesh::new(
+        PrimitiveTopology::TriangleList,
+        RenderAssetUsages::default(),
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions.to_vec())
+    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vertex_normals(triangles, positions))
+    .with_inserted_indices(Indices::U32(indices))
+}

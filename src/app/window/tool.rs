@@ -1,0 +1,71 @@
+//! The tool as the trainee sees it: a sphere at the tip the device reports, and an arrow of
+//! the force the device renders.
+
+use bevy::prelude::*;
+
+use super::bridge::{HapticLink, Snapshot};
+use super::{FrameSet, to_bevy};
+
+#[derive(Component)]
+struct ToolTip;
+
+/// Arrow length per newton (m/N): 0.3 N, a firm press on the liver, draws 6 cm.
+const ARROW_M_PER_N: f32 = 0.2;
+
+pub(super) fn setup(app: &mut App) {
+    app.add_systems(Startup, spawn_tool)
+        .add_systems(Update, (follow_device, draw_force).in_set(FrameSet::Draw));
+}
+
+fn spawn_tool(
+    mut commands: Commands,
+    link: Res<HapticLink>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    commands.spawn((
+        ToolTip,
+        Mesh3d(meshes.add(Sphere::new(link.scene.probe.tip_radius_m as f32))),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            base_color: Color::srgb(0.75, 0.77, 0.80),
+            metallic: 0.9,
+            perceptual_roughness: 0.25,
+            ..default()
+        })),
+        Transform::default(),
+        Visibility::Hidden,
+    ));
+}
+
+fn follow_device(
+    snapshot: Res<Snapshot>,
+    mut tip: Query<(&mut Transform, &mut Visibility), With<ToolTip>>,
+) {
+    let Ok((mut transform, mut visibility)) = tip.single_mut() else {
+        return;
+    };
+    match snapshot.0.tip_m {
+        Some(p) => {
+            transform.translation = to_bevy(&p);
+            *visibility = Visibility::Visible;
+        }
+        None => *visibility = Visibility::Hidden,
+    }
+}
+
+fn draw_force(snapshot: Res<Snapshot>, mut gizmos: Gizmos) {
+    let (Some(tip), force) = (snapshot.0.tip_m, snapshot.0.force_n) else {
+        return;
+    };
+    if force.norm() < 1e-4 {
+        return;
+    }
+    let start = to_bevy(&tip);
+    let arrow = to_bevy(&force) * ARROW_M_PER_N;
+    let colour = if snapshot.0.faulted {
+        Color::srgb(1.0, 0.2, 0.2)
+    } else {
+        Color::srgb(1.0, 0.85, 0.2)
+    };
+    gizmos.arrow(start, start + arrow, colour);
+}
