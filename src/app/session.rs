@@ -10,7 +10,9 @@ use serde::Serialize;
 use bevy::app::AppExit;
 use nalgebra::Vector3;
 
-use super::haptic::{HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport};
+use super::haptic::{
+    HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport, Scheduling,
+};
 use super::scene::{default_scene, press_targets};
 use super::window::WindowScene;
 use crate::cli::OnStale;
@@ -116,7 +118,8 @@ pub fn open_window(options: &Options, exit_after_s: Option<f64>) -> Result<Repor
     let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
     let snapshots = haptic.publish();
     let timer = options.realtime.unwrap_or_default();
-    let haptic = HapticThread::spawn(haptic, timer).map_err(|e| e.to_string())?;
+    let haptic =
+        HapticThread::spawn(haptic, timer, Scheduling::RealTime).map_err(|e| e.to_string())?;
     let exit = super::window::run(WindowScene {
         scene,
         snapshots,
@@ -157,7 +160,8 @@ fn run_realtime(
     timer: TimerMode,
     ticks: u64,
 ) -> Result<RealTimeReport, String> {
-    let thread = HapticThread::spawn(haptic, timer).map_err(|e| e.to_string())?;
+    let thread =
+        HapticThread::spawn(haptic, timer, Scheduling::RealTime).map_err(|e| e.to_string())?;
     std::thread::sleep(Duration::from_secs_f64(ticks as f64 * TICK_S));
     Ok(thread.stop())
 }

@@ -9,7 +9,9 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 
 use super::fem::median_ms;
-use crate::app::haptic::{HapticLoop, HapticScene, HapticThread, RealTimeReport, TickTimes};
+use crate::app::haptic::{
+    HapticLoop, HapticScene, HapticThread, RealTimeReport, Scheduling, TickTimes,
+};
 use crate::app::scene::press_targets;
 use crate::fem::{FemError, Law, Loads, NewtonSettings};
 use crate::haptics::{
@@ -65,10 +67,14 @@ pub fn run(
         sweeps.push(sweep(scene, name, std::slice::from_ref(target), repeats));
     }
     let fem_contact = fem_contact(&targets[0], repeats, sweeps[0].compute_p50_us)?;
-    let realtime = [TimerMode::Sleep, TimerMode::default()]
-        .into_iter()
-        .map(|timer| realtime(scene, &targets, timer, realtime_seconds))
-        .collect();
+    let realtime = [
+        (TimerMode::Sleep, Scheduling::Normal),
+        (TimerMode::Sleep, Scheduling::RealTime),
+        (TimerMode::default(), Scheduling::RealTime),
+    ]
+    .into_iter()
+    .map(|(timer, scheduling)| realtime(scene, &targets, timer, scheduling, realtime_seconds))
+    .collect();
     Ok(HapticBenchReport {
         organs: scene.organs.iter().map(|o| o.0.clone()).collect(),
         repeats,
@@ -155,11 +161,12 @@ fn realtime(
     scene: &HapticScene,
     targets: &[PressTarget],
     timer: TimerMode,
+    scheduling: Scheduling,
     seconds: f64,
 ) -> RealTimeReport {
     let mut haptic = HapticLoop::new(scene, device(targets)).expect("scene was built");
     let mut snapshots = haptic.publish();
-    let thread = HapticThread::spawn(haptic, timer).expect("a thread can be spawned");
+    let thread = HapticThread::spawn(haptic, timer, scheduling).expect("a thread can be spawned");
     let mut fields: Vec<Vec<f64>> = scene
         .organs
         .iter()
@@ -220,8 +227,9 @@ impl fmt::Display for HapticBenchReport {
         for r in &self.realtime {
             writeln!(
                 f,
-                "  {:?}: lateness p50 {:.1} / p99 {:.1} / max {:.1} µs; period error p99 {:.1} µs; {} skipped of {}",
+                "  {:?}, {}: lateness p50 {:.1} / p99 {:.1} / max {:.1} µs; period error p99 {:.1} µs; {} skipped of {}",
                 r.timer,
+                r.scheduling,
                 r.lateness.p50_us,
                 r.lateness.p99_us,
                 r.lateness.max_us,

@@ -228,7 +228,40 @@ impl Vademecum {
     /// The 3 × 3 compliance (m/N) of load step `step` for `patch`: the patch-averaged
     /// displacement under the tool per unit force, `Σ_ij β_i β_j C_ij`.
     pub fn step_compliance(&self, step: usize, patch: &Patch) -> Matrix3<f64> {
-        self.weighted_compliance(step, patch, |_, l| l)
+        match step {
+            0 => self.linear_compliance(patch),
+            _ => self.weighted_compliance(step, patch, |_, l| l),
+        }
+    }
+
+    /// The linear step's patch compliance by reciprocity (Maxwell–Betti, `C_ji = C_ijᵀ`): each
+    /// pair once, from the row of its lower index, which halves the scan of the general sum.
+    /// The haptic tick's hot spot on fine organs (65 positions under the gallbladder's tip).
+    fn linear_compliance(&self, patch: &Patch) -> Matrix3<f64> {
+        let local = &self.steps[0].local;
+        let mut c = [0.0f64; 9];
+        for &(i, li) in &patch.shares {
+            let row = local.neighbours_of(i);
+            let own = &local.compliance[9 * row.start..9 * row.start + 9];
+            for (ck, &bk) in c.iter_mut().zip(own) {
+                *ck += li * li * bk as f64;
+            }
+            let others = &local.neighbours[row.start + 1..row.end];
+            let higher = row.start + 1 + others.partition_point(|&j| (j as usize) < i);
+            for e in higher..row.end {
+                let Some(slot) = patch.slot(local.neighbours[e] as usize) else {
+                    continue;
+                };
+                let w = li * patch.shares[slot].1;
+                let b = &local.compliance[9 * e..9 * e + 9];
+                for r in 0..3 {
+                    for k in 0..3 {
+                        c[3 * r + k] += w * (b[3 * r + k] as f64 + b[3 * k + r] as f64);
+                    }
+                }
+            }
+        }
+        Matrix3::from_row_slice(&c)
     }
 
     /// `Σ_ij β_i γ_j C_ij`: the displacement averaged with the patch's shares `β` under loads

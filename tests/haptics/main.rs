@@ -6,3 +6,4 @@ mod devices;
 mod faults;
 mod press;
 mod replay;
+mod superposition;

@@ -19,7 +19,7 @@ pub use report::{ForceSummary, HeadlessReport, TickTimes};
 pub use resources::{Device, DeviceForce, FaultLog, ForceTrace, TickClock, Tool};
 pub use runner::{HapticLoop, HapticScene, SceneError};
 pub use snapshot::{HapticSnapshot, OrganSnapshot};
-pub use thread::{HapticThread, RealTimeReport};
+pub use thread::{HapticThread, RealTimeReport, Scheduling};
 
 /// The schedule run once per haptic tick.
 #[derive(ScheduleLabel, Clone, Debug, PartialEq, Eq, Hash)]

@@ -29,6 +29,15 @@ pub struct RealTimeReport {
     pub compute: TickTimes,
 }
 
+/// How the haptic thread asks the OS to schedule it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Scheduling {
+    /// Like any other thread: the baseline.
+    Normal,
+    /// Real-time (FIFO), above every normal thread, when the OS grants it.
+    RealTime,
+}
+
 pub struct HapticThread {
     stop: Arc<AtomicBool>,
     handle: JoinHandle<RealTimeReport>,
@@ -36,12 +45,16 @@ pub struct HapticThread {
 
 impl HapticThread {
     /// Starts ticking `haptic` every millisecond of real time.
-    pub fn spawn(haptic: HapticLoop, timer: TimerMode) -> std::io::Result<Self> {
+    pub fn spawn(
+        haptic: HapticLoop,
+        timer: TimerMode,
+        scheduling: Scheduling,
+    ) -> std::io::Result<Self> {
         let stop = Arc::new(AtomicBool::new(false));
         let flag = stop.clone();
         let handle = std::thread::Builder::new()
             .name("haptic 1 kHz".into())
-            .spawn(move || run(haptic, timer, &flag))?;
+            .spawn(move || run(haptic, timer, scheduling, &flag))?;
         Ok(Self { stop, handle })
     }
 
@@ -54,15 +67,24 @@ impl HapticThread {
     }
 }
 
-fn run(mut haptic: HapticLoop, timer: TimerMode, stop: &AtomicBool) -> RealTimeReport {
-    let scheduling = match raise_priority() {
-        Ok(()) => "real-time (FIFO)".to_owned(),
-        Err(e) => {
-            bevy::log::warn!(
-                "haptic thread: could not get real-time scheduling ({e}); ticks may be late when the machine is busy"
-            );
-            format!("normal (real-time refused: {e})")
-        }
+fn run(
+    mut haptic: HapticLoop,
+    timer: TimerMode,
+    scheduling: Scheduling,
+    stop: &AtomicBool,
+) -> RealTimeReport {
+    let scheduling = match scheduling {
+        Scheduling::Normal => "normal".to_owned(),
+        Scheduling::RealTime => match raise_priority() {
+            Ok(()) => "real-time (FIFO)".to_owned(),
+            Err(e) => {
+                bevy::log::warn!(
+                    "haptic thread: could not get real-time scheduling ({e}); ticks may be \
+                     late when the machine is busy"
+                );
+                format!("normal (real-time refused: {e})")
+            }
+        },
     };
     let period = Duration::from_secs_f64(TICK_S);
     let mut metronome = Metronome::new(period, timer);
