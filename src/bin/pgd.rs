@@ -402,16 +402,7 @@ fn validate_vademecum(
 /// Writes the build's convergence curves beside the vademecum (to stderr, so `--json` output
 /// stays parseable).
 fn write_convergence(vademecum: &Path, header: &pgd::Header) -> Result<(), String> {
-    let steps: Vec<cli::StepCurve> = header
-        .indentation_levels_m
-        .iter()
-        .zip(&header.convergence)
-        .map(|(&indentation_m, curve)| cli::StepCurve {
-            indentation_m,
-            curve,
-        })
-        .collect();
-    let [csv, png] = cli::write_convergence(vademecum, &steps)?;
+    let [csv, png] = cli::write_of_header(vademecum, header)?;
     eprintln!(
         "convergence curves: {} and {}",
         csv.display(),

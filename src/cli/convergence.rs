@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
-use crate::pgd::ErrorCurve;
+use crate::pgd::{ErrorCurve, Header};
 
 /// The plot's font, shipped with the crate so that plots need nothing from the system.
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
@@ -19,6 +19,20 @@ const SIZE: (u32, u32) = (1400, 560);
 pub struct StepCurve<'a> {
     pub indentation_m: f64,
     pub curve: &'a ErrorCurve,
+}
+
+/// Writes the curves a vademecum's header keeps, per load step, beside it; returns the paths.
+pub fn write_of_header(vademecum: &Path, header: &Header) -> Result<[PathBuf; 2], String> {
+    let steps: Vec<StepCurve> = header
+        .indentation_levels_m
+        .iter()
+        .zip(&header.convergence)
+        .map(|(&indentation_m, curve)| StepCurve {
+            indentation_m,
+            curve,
+        })
+        .collect();
+    write(vademecum, &steps)
 }
 
 /// Writes `<stem>.convergence.csv` and `<stem>.convergence.png` beside `vademecum`; returns

@@ -6,7 +6,7 @@ mod progress;
 mod source;
 mod vademecums;
 
-pub use convergence::{StepCurve, write as write_convergence};
+pub use convergence::{StepCurve, write as write_convergence, write_of_header};
 pub use progress::Bar;
 pub use source::{MeshSource, load_source};
 pub use vademecums::{OnStale, build_command, ensure_vademecum, vademecum_path};

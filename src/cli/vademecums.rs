@@ -70,7 +70,13 @@ pub fn ensure_vademecum(
         .map_err(|e| format!("{}: {e}", organ.name()))?;
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     pgd::save(&file, &vademecum).map_err(|e| e.to_string())?;
-    eprintln!("wrote {}", file.display());
+    let [csv, png] = super::write_of_header(&file, &vademecum.header)?;
+    eprintln!(
+        "wrote {} (convergence curves: {} and {})",
+        file.display(),
+        csv.display(),
+        png.display()
+    );
     Ok(vademecum)
 }
 
