@@ -5,4 +5,4 @@ mod surface;
 mod tool;
 
 pub use surface::{ContactError, ContactSurface, SurfaceHit};
-pub use tool::{Probe, ToolContact, press};
+pub use tool::{Probe, Target, ToolContact, press};

@@ -4,7 +4,7 @@
 
 use nalgebra::Vector3;
 
-use super::Vademecum;
+use super::{SurfacePoint, Vademecum};
 
 /// A force on a tool-sized patch of the accessible surface.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -65,6 +65,39 @@ impl Deformation {
                 vademecum.add_corrections(step, &load.shares, &load.force_n, u);
             }
         }
+    }
+
+    /// Displacement (m) of the surface point `at` under every load but the one in slot `skip`:
+    /// how far other loads have already moved the surface a tool is about to touch.
+    pub fn displacement_without(
+        &self,
+        vademecum: &Vademecum,
+        at: &SurfacePoint,
+        skip: usize,
+    ) -> Vector3<f64> {
+        let mut u = Vector3::zeros();
+        let others = self
+            .loads
+            .iter()
+            .enumerate()
+            .filter(|&(slot, load)| slot != skip && load.is_active());
+        for (_, load) in others {
+            for (corner, weight) in vademecum.triangles[at.triangle].iter().zip(at.barycentric) {
+                let node = vademecum.positions[*corner as usize] as usize;
+                let mut at_node = Vector3::zeros();
+                for step in 0..vademecum.steps.len() {
+                    vademecum.add_node_displacement(
+                        step,
+                        &load.shares,
+                        &load.force_n,
+                        node,
+                        &mut at_node,
+                    );
+                }
+                u += at_node * weight;
+            }
+        }
+        u
     }
 
     /// The sum of the forces (N) applied to the organ.

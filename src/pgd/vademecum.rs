@@ -415,6 +415,52 @@ impl Vademecum {
         }
     }
 
+    /// Adds to `u` the displacement (m) of volume node `node` under a force on `shares` in
+    /// load step `step`: the modes at that node and, where the node is in a loaded position's
+    /// near field, its correction (the lists are sorted: a binary search each). Allocates
+    /// nothing: what contact needs of a surface moved by other loads.
+    pub fn add_node_displacement(
+        &self,
+        step: usize,
+        shares: &[(usize, f64)],
+        force_n: &Vector3<f64>,
+        node: usize,
+        u: &mut Vector3<f64>,
+    ) {
+        let step_data = &self.steps[step];
+        let (dofs, params) = (self.dof_count(), self.parameter_count());
+        let modes = step_data
+            .spatial
+            .chunks_exact(dofs)
+            .zip(step_data.parametric.chunks_exact(params));
+        for (x, y) in modes {
+            let c: f64 = shares
+                .iter()
+                .map(|&(i, l)| {
+                    self.step_share(step, i, l, force_n)
+                        * (0..3)
+                            .map(|d| y[3 * i + d] as f64 * force_n[d])
+                            .sum::<f64>()
+                })
+                .sum();
+            *u += Vector3::from_fn(|k, _| c * x[3 * node + k] as f64);
+        }
+        let local = &step_data.local;
+        for &(i, l) in shares {
+            let range = local.corrections_of(i);
+            let nodes = &local.correction_nodes[range.clone()];
+            if let Ok(k) = nodes.binary_search(&(node as u32)) {
+                let r = &local.correction[9 * (range.start + k)..9 * (range.start + k) + 9];
+                let l = self.step_share(step, i, l, force_n);
+                *u += Vector3::from_fn(|c, _| {
+                    l * (0..3)
+                        .map(|d| r[3 * d + c] as f64 * force_n[d])
+                        .sum::<f64>()
+                });
+            }
+        }
+    }
+
     fn add_step_field(
         &self,
         k: usize,

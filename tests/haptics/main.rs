@@ -2,6 +2,7 @@
 //! deterministic replay, faults and the clamp; and the device files and timing pieces.
 
 mod common;
+mod deformed;
 mod devices;
 mod faults;
 mod press;

@@ -6,8 +6,9 @@ use nalgebra::Vector3;
 use super::components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
 use super::resources::{Device, DeviceForce, FaultLog, ForceTrace, Safety, TickClock, Tool};
 use super::snapshot::SnapshotPublisher;
-use crate::contact::press;
+use crate::contact::{Target, press};
 use crate::haptics::Fault;
+use crate::pgd::SurfacePoint;
 
 /// Reads the device into [`Tool`]. A non-finite sample or a device error is a fault and the
 /// tool keeps its last good position; so is a streak of overrun ticks.
@@ -33,28 +34,37 @@ pub fn read_device(
     }
 }
 
-/// Presses the tool into every organ it touches and sets the organ's tool load.
+/// Presses the tool into every organ it touches, on the surface as the organ's other loads have
+/// moved it, and sets the organ's tool load.
 pub fn tool_contact(
     tool: Res<Tool>,
     mut organs: Query<(&OrganBody, &mut ToolTouch, &mut OrganDeformation)>,
 ) {
     for (body, mut touch, mut deformation) in &mut organs {
-        let load = &mut deformation.0.loads[OrganDeformation::TOOL];
-        let touch = &mut *touch;
-        touch.contact = match &tool.sample {
-            Some(sample) => press(
-                &body.vademecum,
-                &body.surface,
-                &tool.probe,
-                &sample.tip_m,
-                &mut touch.patch,
-                load,
-            ),
-            None => {
-                load.release();
-                None
-            }
+        let Some(sample) = &tool.sample else {
+            deformation.0.loads[OrganDeformation::TOOL].release();
+            touch.contact = None;
+            continue;
         };
+        let deformation = &mut deformation.0;
+        // Split the borrow: other loads are read while the tool's slot is written.
+        let mut tool_load = std::mem::take(&mut deformation.loads[OrganDeformation::TOOL]);
+        let target = Target {
+            vademecum: &body.vademecum,
+            surface: &body.surface,
+            moved_by_others: |at: &SurfacePoint| {
+                deformation.displacement_without(&body.vademecum, at, OrganDeformation::TOOL)
+            },
+        };
+        let touch = &mut *touch;
+        touch.contact = press(
+            &target,
+            &tool.probe,
+            &sample.tip_m,
+            &mut touch.patch,
+            &mut tool_load,
+        );
+        deformation.loads[OrganDeformation::TOOL] = tool_load;
     }
 }
 
