@@ -7,6 +7,7 @@
 //! exactly at `s`, not for an interpolation of patches centred on nodes. The load matrix `F`
 //! (dofs × parameters) is never formed: it is applied, and transposed, node by node.
 
+use faer::{ColRef, MatRef};
 use rayon::prelude::*;
 
 use super::responses::Responses;
@@ -95,15 +96,13 @@ impl LoadOperator for SecantLoads<'_> {
         self.responses.count()
     }
 
+    /// `Ũ s` is a dense product over every response (the whole `Ũ`, hundreds of MB, streamed
+    /// once): faer's GEMV, on all cores.
     fn apply(&self, s: &[f64], out: &mut [f64]) {
-        let mut u = vec![0.0; self.responses.rows];
-        for (p, &sp) in s.iter().enumerate() {
-            if sp != 0.0 {
-                u.iter_mut()
-                    .zip(self.responses.column(p))
-                    .for_each(|(a, b)| *a += sp * b);
-            }
-        }
+        let responses = self.responses;
+        let u_all = MatRef::from_column_major_slice(&responses.columns, responses.rows, s.len());
+        let u = u_all * ColRef::from_slice(s);
+        let u: Vec<f64> = u.iter().copied().collect();
         let mut ku = vec![0.0; u.len()];
         self.stiffness.mul(&u, &mut ku);
         for (v, &d) in ku.iter().zip(&self.stiffness.model.dofs().free_dofs) {

@@ -18,7 +18,7 @@ pub use components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
 pub use report::{ForceSummary, HeadlessReport, TickTimes};
 pub use resources::{Device, DeviceForce, FaultLog, ForceTrace, TickClock, Tool};
 pub use runner::{HapticLoop, HapticScene, SceneError};
-pub use snapshot::{HapticSnapshot, OrganSnapshot};
+pub use snapshot::{HapticSnapshot, LoopTiming, OrganSnapshot};
 pub use thread::{HapticThread, RealTimeReport, Scheduling};
 
 /// The schedule run once per haptic tick.

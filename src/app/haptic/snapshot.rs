@@ -26,6 +26,16 @@ pub struct HapticSnapshot {
     pub faulted: bool,
     /// In the scene's organ order.
     pub organs: Vec<OrganSnapshot>,
+    /// How the real-time loop has kept time so far (refreshed once a second).
+    pub timing: LoopTiming,
+}
+
+/// The real-time loop's timing so far, for the HUD (µs).
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct LoopTiming {
+    pub compute_p99_us: f64,
+    pub lateness_p99_us: f64,
+    pub skipped: u64,
 }
 
 /// The haptic thread's end of the triple buffer.

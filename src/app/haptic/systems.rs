@@ -5,7 +5,7 @@ use nalgebra::Vector3;
 
 use super::components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
 use super::resources::{Device, DeviceForce, FaultLog, ForceTrace, Safety, TickClock, Tool};
-use super::snapshot::SnapshotPublisher;
+use super::snapshot::{LoopTiming, SnapshotPublisher};
 use crate::contact::{Target, press};
 use crate::haptics::Fault;
 use crate::pgd::SurfacePoint;
@@ -139,6 +139,7 @@ pub fn publish_snapshot(
     force: Res<DeviceForce>,
     safety: Res<Safety>,
     organs: Query<(&OrganIndex, &ToolTouch, &OrganDeformation)>,
+    timing: Option<Res<LoopTiming>>,
     publisher: Option<ResMut<SnapshotPublisher>>,
 ) {
     let Some(mut publisher) = publisher else {
@@ -150,6 +151,7 @@ pub fn publish_snapshot(
     snapshot.tip_m = tool.sample.map(|s| s.tip_m);
     snapshot.force_n = force.sent_n;
     snapshot.faulted = safety.0.is_faulted();
+    snapshot.timing = timing.map_or_else(LoopTiming::default, |t| *t);
     for (index, touch, deformation) in &organs {
         let organ = &mut snapshot.organs[index.0];
         organ.contact = touch.contact;

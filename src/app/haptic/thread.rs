@@ -11,6 +11,7 @@ use serde::Serialize;
 use super::report::TickTimes;
 use super::resources::TickClock;
 use super::runner::HapticLoop;
+use super::snapshot::LoopTiming;
 use crate::haptics::{Histogram, Metronome, TICK_S, TimerMode};
 
 /// How well the thread kept time.
@@ -67,6 +68,10 @@ impl HapticThread {
     }
 }
 
+/// How often the loop hands its timing to the snapshots: quantiles scan the histogram (tens of
+/// µs), so once a second.
+const TIMING_EVERY_TICKS: u64 = 1000;
+
 fn run(
     mut haptic: HapticLoop,
     timer: TimerMode,
@@ -110,6 +115,13 @@ fn run(
             overruns_in_a_row: in_a_row,
         });
         compute.record(time);
+        if beat.tick.is_multiple_of(TIMING_EVERY_TICKS) {
+            haptic.world_mut().insert_resource(LoopTiming {
+                compute_p99_us: TickTimes::of(&compute).p99_us,
+                lateness_p99_us: TickTimes::of(&lateness).p99_us,
+                skipped,
+            });
+        }
         in_a_row = if beat.skipped > 0 || time > period {
             in_a_row + 1
         } else {

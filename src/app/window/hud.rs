@@ -81,11 +81,15 @@ fn update_hud(
     } else {
         ""
     };
+    let timing = &snapshot.0.timing;
     text.0 = format!(
         "device: {}\nforce {force_n:.3} N {gauge} limit {limit_n:.1} N\n{status}\n\
-         haptic {:.0} Hz | frame {:.1} ms{help}",
+         haptic {:.0} Hz | tick p99 {:.0} us, late p99 {:.0} us, {} skipped | frame {:.1} ms{help}",
         link.device_name,
         rate.hz,
+        timing.compute_p99_us,
+        timing.lateness_p99_us,
+        timing.skipped,
         dt * 1e3
     );
 }
