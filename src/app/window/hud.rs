@@ -77,7 +77,8 @@ fn update_hud(
         format!("touching {}", touching.join(", "))
     };
     let help = if link.virtual_device.is_some() {
-        "\nmouse: move the tool | wheel or W/S: push in / pull out"
+        "\nmouse: move the tool | wheel or W/S: push in / pull out\n\
+         right-drag: orbit | middle-drag: pan | Ctrl+wheel or +/-: zoom"
     } else {
         ""
     };

@@ -1,6 +1,7 @@
 //! The virtual device, driven from the window: the tool tip follows the cursor on the plane
 //! facing the camera through the tip, and the wheel (or W/S, ↑/↓) pushes it in and out along
-//! the view.
+//! the view. Ctrl + wheel is the camera's zoom; a held right or middle button, its orbit or
+//! pan, during which the tool stays where it is.
 
 use bevy::input::mouse::{MouseScrollUnit, MouseWheel};
 use bevy::prelude::*;
@@ -25,6 +26,7 @@ fn drive_virtual_device(
     cameras: Query<(&Camera, &GlobalTransform)>,
     mut wheel: MessageReader<MouseWheel>,
     keys: Res<ButtonInput<KeyCode>>,
+    buttons: Res<ButtonInput<MouseButton>>,
     time: Res<Time>,
 ) {
     let Some(handle) = &link.virtual_device else {
@@ -35,14 +37,19 @@ fn drive_virtual_device(
     };
     let forward = eye.forward();
     let mut tip = to_bevy(&handle.tip_m());
-    if let Some(cursor) = window.cursor_position()
+    let steering_camera =
+        buttons.pressed(MouseButton::Right) || buttons.pressed(MouseButton::Middle);
+    if !steering_camera
+        && let Some(cursor) = window.cursor_position()
         && let Ok(ray) = camera.viewport_to_world(eye, cursor)
         && let Some(distance) = ray.intersect_plane(tip, InfinitePlane3d::new(*forward))
     {
         tip = ray.get_point(distance);
     }
+    let ctrl = keys.pressed(KeyCode::ControlLeft) || keys.pressed(KeyCode::ControlRight);
     let notches: f32 = wheel
         .read()
+        .filter(|_| !ctrl)
         .map(|w| match w.unit {
             MouseScrollUnit::Line => w.y,
             MouseScrollUnit::Pixel => w.y / PIXELS_PER_NOTCH,

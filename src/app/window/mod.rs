@@ -3,6 +3,7 @@
 //! device. The haptic loop runs apart; this side only reads its snapshots.
 
 mod bridge;
+mod camera;
 mod hud;
 mod input;
 mod organs;
@@ -62,6 +63,7 @@ pub fn run(window: WindowScene) -> AppExit {
     );
     bridge::setup(&mut app, window);
     organs::setup(&mut app);
+    camera::setup(&mut app);
     tool::setup(&mut app);
     input::setup(&mut app);
     hud::setup(&mut app);

@@ -29,7 +29,7 @@ pub(super) fn setup(app: &mut App) {
         .add_systems(Update, deform.in_set(FrameSet::Draw));
 }
 
-/// Wet-tissue colours: liver red-brown, gallbladder green, pancreas pale yellow-pink,
+/// Wet-tissue colours (the vertex colours tint them where the tool presses): liver red-brown, gallbladder green, pancreas pale yellow-pink,
 /// duodenum pink.
 fn colour(name: &str) -> Color {
     match name {
@@ -88,11 +88,8 @@ pub(super) fn scene_centre(link: &HapticLink) -> Vec3 {
 /// The surgeon's view of a supine patient: from above (anterior, +y), head (+z) up the screen.
 fn spawn_camera_and_light(mut commands: Commands, link: Res<HapticLink>) {
     let centre = scene_centre(&link);
-    commands.spawn((
-        Camera3d::default(),
-        Transform::from_translation(centre + Vec3::new(0.0, 0.32, -0.10))
-            .looking_at(centre, Vec3::Z),
-    ));
+    let orbit = super::camera::Orbit::looking_at(centre, Vec3::new(0.0, 0.32, -0.10));
+    commands.spawn((Camera3d::default(), orbit.transform(), orbit));
     commands.spawn((
         DirectionalLight {
             illuminance: 9_000.0,
@@ -126,14 +123,30 @@ fn deform(
                 [0, 1, 2].map(|c| rest[c] + u[c] as f32)
             })
             .collect();
+        let colours = contact_tint(positions.len(), &organ.deformation.loads[0].shares);
         if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
             mesh.insert_attribute(
                 Mesh::ATTRIBUTE_NORMAL,
                 vertex_normals(&view.triangles, &positions),
             );
             mesh.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions);
+            mesh.insert_attribute(Mesh::ATTRIBUTE_COLOR, colours);
         }
     }
+}
+
+/// Vertex colours that light up the tool's contact patch (by each position's share of the
+/// load) and leave the rest of the organ its material's colour.
+fn contact_tint(vertices: usize, shares: &[(usize, f64)]) -> Vec<[f32; 4]> {
+    let mut colours = vec![[1.0; 4]; vertices];
+    let largest = shares.iter().map(|s| s.1).fold(0.0, f64::max);
+    if largest > 0.0 {
+        for &(m, share) in shares {
+            let t = (0.7 * share / largest) as f32;
+            colours[m] = [1.0 + t, 1.0 + 0.8 * t, 1.0 + 0.3 * t, 1.0];
+        }
+    }
+    colours
 }
 
 /// A render mesh of a surface with area-weighted normals of the given positions.
@@ -145,5 +158,6 @@ fn surface_mesh(triangles: &[[usize; 3]], positions: &[[f32; 3]]) -> Mesh {
     )
     .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions.to_vec())
     .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vertex_normals(triangles, positions))
+    .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, contact_tint(positions.len(), &[]))
     .with_inserted_indices(Indices::U32(indices))
 }
