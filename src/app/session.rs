@@ -14,7 +14,7 @@ use super::haptic::{
     HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport, Scheduling,
 };
 use super::scene::{default_scene, press_targets};
-use super::window::WindowScene;
+use super::window::{ScreenshotPlan, WindowScene};
 use crate::cli::OnStale;
 use crate::haptics::{
     DeviceSpec, HapticDevice, PressMotion, Recorder, Scripted, TICK_S, TimerMode, Trajectory,
@@ -98,7 +98,11 @@ pub fn run_headless(options: &Options) -> Result<Report, String> {
 
 /// Opens the trainer window over the real-time haptic loop, driven by the mouse unless a
 /// scripted device is named; reports how the loop kept time while the renderer ran.
-pub fn open_window(options: &Options, exit_after_s: Option<f64>) -> Result<Report, String> {
+pub fn open_window(
+    options: &Options,
+    exit_after_s: Option<f64>,
+    screenshot: Option<ScreenshotPlan>,
+) -> Result<Report, String> {
     let scene = scene(options)?;
     let (device, virtual_device) = match &options.device {
         Some(DeviceSpec::Scripted(path)) => {
@@ -126,6 +130,7 @@ pub fn open_window(options: &Options, exit_after_s: Option<f64>) -> Result<Repor
         virtual_device,
         device_name,
         exit_after_s,
+        screenshot,
     });
     let report = haptic.stop();
     match exit {

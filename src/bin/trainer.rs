@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Parser;
+use pgd_surgery::app::window::ScreenshotPlan;
 use pgd_surgery::app::{self, session};
 use pgd_surgery::cli::OnStale;
 use pgd_surgery::haptics::{DeviceSpec, TimerMode};
@@ -45,6 +46,12 @@ struct Cli {
     /// while the renderer ran.
     #[arg(long)]
     exit_after_s: Option<f64>,
+    /// Save the window to this PNG after `--frames` frames, then close it.
+    #[arg(long)]
+    screenshot: Option<PathBuf>,
+    /// Frames to draw before the screenshot.
+    #[arg(long, default_value_t = 30)]
+    frames: u32,
     /// Where the organs' vademecums are kept.
     #[arg(long, default_value = "vademecums")]
     vademecums: PathBuf,
@@ -93,7 +100,13 @@ fn main() -> ExitCode {
     };
     let result = match cli.headless {
         true => session::run_headless(&options),
-        false => session::open_window(&options, cli.exit_after_s),
+        false => {
+            let screenshot = cli.screenshot.clone().map(|path| ScreenshotPlan {
+                path,
+                after_frames: cli.frames.max(1),
+            });
+            session::open_window(&options, cli.exit_after_s, screenshot)
+        }
     };
     match result {
         Ok(report) => {

@@ -7,6 +7,7 @@ mod camera;
 mod hud;
 mod input;
 mod organs;
+mod screenshot;
 mod tool;
 
 use std::sync::Arc;
@@ -14,6 +15,7 @@ use std::sync::Arc;
 use bevy::prelude::*;
 
 pub use bridge::{HapticLink, Snapshot};
+pub use screenshot::ScreenshotPlan;
 
 use super::haptic::{HapticScene, HapticSnapshot};
 use crate::haptics::VirtualHandle;
@@ -27,6 +29,8 @@ pub struct WindowScene {
     pub device_name: String,
     /// Close the window after this many seconds (for measurements under Xvfb).
     pub exit_after_s: Option<f64>,
+    /// Save the window to a PNG after some frames, then close it.
+    pub screenshot: Option<ScreenshotPlan>,
 }
 
 /// The haptic side's f64 vectors as Bevy's (the Bevy end of the seam; parry's is `crate::seam`).
@@ -61,6 +65,7 @@ pub fn run(window: WindowScene) -> AppExit {
         Update,
         (FrameSet::Input, FrameSet::Receive, FrameSet::Draw).chain(),
     );
+    screenshot::setup(&mut app, window.screenshot.clone());
     bridge::setup(&mut app, window);
     organs::setup(&mut app);
     camera::setup(&mut app);
