@@ -13,13 +13,14 @@ use crate::app::haptic::{
     HapticLoop, HapticScene, HapticThread, RealTimeReport, Scheduling, TickTimes,
 };
 use crate::app::scene::press_targets;
+use crate::contact::ContactSurface;
 use crate::fem::{FemError, Law, Loads, NewtonSettings};
 use crate::haptics::{
     HapticDevice, PressMotion, PressTarget, Scripted, TICK_S, TimerMode, press_and_slide,
 };
-use crate::mesh::Surface;
 use crate::mesh::organs::{self, Organ, OrganSettings};
-use crate::pgd;
+use crate::mesh::{Surface, vertex_normals};
+use crate::pgd::{self, Deformation, PatchLoad};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct SweepFigures {
@@ -49,6 +50,9 @@ pub struct HapticBenchReport {
     pub repeats: usize,
     pub sweeps: Vec<SweepFigures>,
     pub fem_contact: FemContact,
+    /// The render side's CPU work per frame: every organ's deformed surface and its normals,
+    /// each organ pressed by a tool (ms, median).
+    pub render_cpu_ms: f64,
     /// Real-time runs while the render side's CPU work runs.
     pub realtime: Vec<RealTimeReport>,
     pub realtime_seconds: f64,
@@ -67,6 +71,7 @@ pub fn run(
         sweeps.push(sweep(scene, name, std::slice::from_ref(target), repeats));
     }
     let fem_contact = fem_contact(&targets[0], repeats, sweeps[0].compute_p50_us)?;
+    let render_cpu_ms = render_cpu(scene, &targets, repeats);
     let realtime = [
         (TimerMode::Sleep, Scheduling::Normal),
         (TimerMode::Sleep, Scheduling::RealTime),
@@ -80,6 +85,7 @@ pub fn run(
         repeats,
         sweeps,
         fem_contact,
+        render_cpu_ms,
         realtime,
         realtime_seconds,
     })
@@ -155,6 +161,45 @@ fn fem_contact(
     })
 }
 
+/// What the window does on the CPU per frame, timed: each organ deformed by a 0.2 N press at
+/// its target, its surface formed and its normals recomputed.
+fn render_cpu(scene: &HapticScene, targets: &[PressTarget], repeats: usize) -> f64 {
+    let mut organs: Vec<_> = scene
+        .organs
+        .iter()
+        .zip(targets)
+        .map(|((_, vademecum), target)| {
+            let surface = ContactSurface::new(vademecum).expect("scene was built");
+            let mut deformation = Deformation::new(vademecum, 1);
+            if let Some(hit) = surface.closest(&target.point_m) {
+                deformation.loads[0] = PatchLoad {
+                    shares: vademecum.patch(&hit.at).shares,
+                    force_n: -target.normal * 0.2,
+                };
+            }
+            deformation.evaluate(vademecum);
+            let triangles: Vec<[usize; 3]> = vademecum
+                .triangles
+                .iter()
+                .map(|t| t.map(|m| m as usize))
+                .collect();
+            (
+                vademecum,
+                deformation,
+                triangles,
+                vec![0.0; vademecum.dof_count()],
+            )
+        })
+        .collect();
+    let mut positions = Vec::new();
+    median_ms(repeats.max(1) * 4, &mut || {
+        for (vademecum, deformation, triangles, field) in &mut organs {
+            deformation.deformed_surface(vademecum, field, &mut positions);
+            std::hint::black_box(vertex_normals(triangles, &positions));
+        }
+    })
+}
+
 /// The real-time loop for `seconds` with `timer`, while this thread does what a renderer does
 /// on the CPU each 60 Hz frame: read the latest snapshot and form every organ's whole field.
 fn realtime(
@@ -172,6 +217,7 @@ fn realtime(
         .iter()
         .map(|(_, v)| vec![0.0; v.dof_count()])
         .collect();
+    let mut positions = Vec::new();
     let frame = Duration::from_secs_f64(1.0 / 60.0);
     let end = Instant::now() + Duration::from_secs_f64(seconds);
     while Instant::now() < end {
@@ -180,9 +226,11 @@ fn realtime(
         for ((organ, (_, vademecum)), u) in
             snapshot.organs.iter().zip(&scene.organs).zip(&mut fields)
         {
-            organ.deformation.field_into(vademecum, u);
+            organ
+                .deformation
+                .deformed_surface(vademecum, u, &mut positions);
         }
-        std::hint::black_box(&fields);
+        std::hint::black_box(&positions);
         std::thread::sleep(frame.saturating_sub(started.elapsed()));
     }
     thread.stop()
@@ -213,6 +261,11 @@ impl fmt::Display for HapticBenchReport {
                 s.compute_max_us
             )?;
         }
+        writeln!(
+            f,
+            "render side on the CPU, per frame (four organs pressed: surfaces and normals): {:.2} ms",
+            self.render_cpu_ms
+        )?;
         let c = &self.fem_contact;
         writeln!(
             f,

@@ -67,6 +67,29 @@ impl Deformation {
         }
     }
 
+    /// The accessible surface's vertices, deformed, into `positions` (f32, ready to draw):
+    /// the visual model mapped from the mechanical one through the load positions' nodes.
+    /// `field` is scratch space for the whole displacement field (`3 × nodes`).
+    pub fn deformed_surface(
+        &self,
+        vademecum: &Vademecum,
+        field: &mut [f64],
+        positions: &mut Vec<[f32; 3]>,
+    ) {
+        self.field_into(vademecum, field);
+        positions.clear();
+        positions.extend(
+            vademecum
+                .positions
+                .iter()
+                .zip(&vademecum.position_coords_m)
+                .map(|(&node, rest)| {
+                    let u = &field[3 * node as usize..3 * node as usize + 3];
+                    [0, 1, 2].map(|c| rest[c] + u[c] as f32)
+                }),
+        );
+    }
+
     /// Displacement (m) of the surface point `at` under every load but the one in slot `skip`:
     /// how far other loads have already moved the surface a tool is about to touch.
     pub fn displacement_without(

@@ -110,19 +110,10 @@ fn deform(
             continue;
         };
         let view = &mut *view;
+        let mut positions = Vec::with_capacity(view.vademecum.positions.len());
         organ
             .deformation
-            .field_into(&view.vademecum, &mut view.field);
-        let positions: Vec<[f32; 3]> = view
-            .vademecum
-            .positions
-            .iter()
-            .zip(&view.vademecum.position_coords_m)
-            .map(|(&node, rest)| {
-                let u = &view.field[3 * node as usize..3 * node as usize + 3];
-                [0, 1, 2].map(|c| rest[c] + u[c] as f32)
-            })
-            .collect();
+            .deformed_surface(&view.vademecum, &mut view.field, &mut positions);
         let colours = contact_tint(positions.len(), &organ.deformation.loads[0].shares);
         if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
             mesh.insert_attribute(
