@@ -24,10 +24,6 @@ impl Scripted {
         self.limits = limits;
         self
     }
-
-    pub fn duration_s(&self) -> f64 {
-        self.trajectory.duration_s()
-    }
 }
 
 impl HapticDevice for Scripted {

@@ -66,4 +66,6 @@ fn drive_virtual_device(
     };
     let push = notches * WHEEL_STEP_M + keyed * KEY_SPEED_M_PER_S * time.delta_secs();
     handle.set_tip(&from_bevy(tip + *forward * push));
+    // The left button is the device's first button (a stylus button on hardware).
+    handle.set_buttons(u32::from(buttons.pressed(MouseButton::Left)));
 }
