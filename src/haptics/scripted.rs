@@ -1,5 +1,6 @@
 //! The scripted device: replays a trajectory deterministically, for tests, demos and
-//! benchmarks. The forces it is sent are kept, so a run can be compared with another.
+//! benchmarks. It has no motors: the forces it is sent are the haptic world's to keep (its
+//! force trace), so that two runs can be compared.
 
 use nalgebra::Vector3;
 
