@@ -163,7 +163,9 @@ impl<'a> FieldError<'a> {
                         }
                     }
                 }
-                self.weights[p] * sum
+                // |r|² minus its near part cancels to rounding when the near field covers
+                // the whole organ: never below zero.
+                self.weights[p] * sum.max(0.0)
             })
             .sum()
     }

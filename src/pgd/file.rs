@@ -64,6 +64,10 @@ pub enum VademecumError {
         expected: String,
         found: String,
     },
+    #[error(
+        "{file}: not written: its header would not read back the same ({why}); nothing was saved"
+    )]
+    Unwritable { file: PathBuf, why: String },
 }
 
 /// Writes `vademecum` to `path` atomically.
@@ -72,6 +76,10 @@ pub fn save(path: &Path, vademecum: &Vademecum) -> Result<(), VademecumError> {
         file: path.to_path_buf(),
         source,
     };
+    check_round_trip(&vademecum.header).map_err(|why| VademecumError::Unwritable {
+        file: path.to_path_buf(),
+        why,
+    })?;
     let bytes = encode(vademecum);
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(io)?;
@@ -82,6 +90,18 @@ pub fn save(path: &Path, vademecum: &Vademecum) -> Result<(), VademecumError> {
 }
 
 /// The bytes of the file `save` writes.
+/// A header with a non-finite number would be written as JSON `null` and never load again: the
+/// header must read back equal to itself before anything is written.
+fn check_round_trip(header: &Header) -> Result<(), String> {
+    let json = serde_json::to_vec(header).map_err(|e| e.to_string())?;
+    let back: Header = serde_json::from_slice(&json).map_err(|e| e.to_string())?;
+    if &back == header {
+        Ok(())
+    } else {
+        Err("a number in it is not finite".into())
+    }
+}
+
 pub fn encode(vademecum: &Vademecum) -> Vec<u8> {
     let header = serde_json::to_vec_pretty(&vademecum.header).expect("plain data serializes");
     let payload = payload(vademecum);

@@ -64,3 +64,19 @@ fn truncated_corrupted_foreign_and_old_files_are_refused() {
     let missing = load(&temp("missing.vdm")).unwrap_err();
     assert!(matches!(missing, VademecumError::Io { .. }), "{missing}");
 }
+
+/// A header holding a non-finite number would be written as JSON `null` and never load again:
+/// it is refused before anything is written, and an older good file in its place is kept.
+#[test]
+fn a_vademecum_that_would_not_load_back_is_not_written() {
+    let model = block_model(block_mesh([4, 3, 2]));
+    let mut vademecum = build_block(&model, 2);
+    let path = temp("unwritable.vdm");
+    save(&path, &vademecum).unwrap();
+    let before = std::fs::read(&path).unwrap();
+    vademecum.header.build_seconds = f64::NAN;
+    let err = save(&path, &vademecum).unwrap_err();
+    assert!(matches!(err, VademecumError::Unwritable { .. }), "{err}");
+    assert!(err.to_string().contains("unwritable.vdm"), "{err}");
+    assert_eq!(std::fs::read(&path).unwrap(), before);
+}
