@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use super::fem::median_ms;
 use crate::app::haptic::{
-    HapticLoop, HapticScene, HapticThread, RealTimeReport, Scheduling, TickTimes,
+    HapticLoop, HapticScene, HapticThread, OrganDeformation, RealTimeReport, Scheduling, TickTimes,
 };
 use crate::app::scene::press_targets;
 use crate::contact::ContactSurface;
@@ -172,7 +172,7 @@ fn render_cpu(scene: &HapticScene, targets: &[PressTarget], repeats: usize) -> f
             let surface = ContactSurface::new(vademecum).expect("scene was built");
             let mut deformation = Deformation::new(vademecum, 1);
             if let Some(hit) = surface.closest(&target.point_m) {
-                deformation.loads[0] = PatchLoad {
+                deformation.loads[OrganDeformation::TOOL] = PatchLoad {
                     shares: vademecum.patch(&hit.at).shares,
                     force_n: -target.normal * 0.2,
                 };

@@ -325,14 +325,11 @@ fn main() -> ExitCode {
                 );
             };
             let laws: Vec<Law> = laws.into_iter().map(LawArg::law).collect();
-            match bench::vademecum::run(organ, &laws, repeats) {
-                Ok(report) if json => print_json(&report),
-                Ok(report) => {
-                    print!("{report}");
-                    ExitCode::SUCCESS
-                }
-                Err(e) => fail("pgd bench vademecum", &e.to_string()),
-            }
+            print_report(
+                "pgd bench vademecum",
+                bench::vademecum::run(organ, &laws, repeats),
+                json,
+            )
         }
         Command::Bench {
             what:
@@ -348,14 +345,11 @@ fn main() -> ExitCode {
                     Ok(scene) => scene,
                     Err(e) => return fail("pgd bench haptics", &e),
                 };
-            match bench::haptics::run(&scene, repeats, realtime_seconds) {
-                Ok(report) if json => print_json(&report),
-                Ok(report) => {
-                    print!("{report}");
-                    ExitCode::SUCCESS
-                }
-                Err(e) => fail("pgd bench haptics", &e.to_string()),
-            }
+            print_report(
+                "pgd bench haptics",
+                bench::haptics::run(&scene, repeats, realtime_seconds),
+                json,
+            )
         }
         Command::Bench {
             what:
@@ -366,14 +360,7 @@ fn main() -> ExitCode {
                 },
         } => {
             let cells = cells.map_or(bench::fem::LIVER_SIZED_CELLS, |c| [c[0], c[1], c[2]]);
-            match bench::fem::run(cells, repeats) {
-                Ok(report) if json => print_json(&report),
-                Ok(report) => {
-                    print!("{report}");
-                    ExitCode::SUCCESS
-                }
-                Err(e) => fail("pgd bench fem", &e.to_string()),
-            }
+            print_report("pgd bench fem", bench::fem::run(cells, repeats), json)
         }
     }
 }
@@ -553,6 +540,22 @@ fn report_mesh(source: &str, mesh: &TetMesh, out: Option<&Path>, json: bool) -> 
         ExitCode::FAILURE
     } else {
         ExitCode::SUCCESS
+    }
+}
+
+/// A benchmark's report as JSON or as its table, or its error.
+fn print_report<R, E>(command: &str, result: Result<R, E>, json: bool) -> ExitCode
+where
+    R: serde::Serialize + std::fmt::Display,
+    E: std::fmt::Display,
+{
+    match result {
+        Ok(report) if json => print_json(&report),
+        Ok(report) => {
+            print!("{report}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => fail(command, &e.to_string()),
     }
 }
 

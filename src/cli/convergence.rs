@@ -15,6 +15,9 @@ const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 const SIZE: (u32, u32) = (1400, 560);
 
+/// Which of a step's curves a plotted series shows.
+type CurveValues = fn(&ErrorCurve) -> &[f64];
+
 /// One load step's curve and the indentation it stands for.
 pub struct StepCurve<'a> {
     pub indentation_m: f64,
@@ -127,24 +130,25 @@ fn all_steps(
         .x_desc("modes (all load steps)")
         .y_desc("relative error")
         .draw()?;
-    let points = steps
-        .iter()
-        .flat_map(|s| s.curve.separated.iter().copied())
-        .enumerate()
-        .map(|(n, e)| (n + 1, e.max(floor)));
-    chart
-        .draw_series(LineSeries::new(points, BLUE.stroke_width(2)))?
-        .label("PGD separated part (energy norm)")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE.stroke_width(2)));
-    let field = steps
-        .iter()
-        .flat_map(|s| s.curve.field.iter().copied())
-        .enumerate()
-        .map(|(n, e)| (n + 1, e.max(floor)));
-    chart
-        .draw_series(LineSeries::new(field, RED.stroke_width(2)))?
-        .label("whole vademecum, modes + exact near field (L2)")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
+    let series: [(CurveValues, RGBColor, &str); 2] = [
+        (|c| &c.separated, BLUE, "PGD separated part (energy norm)"),
+        (
+            |c| &c.field,
+            RED,
+            "whole vademecum, modes + exact near field (L2)",
+        ),
+    ];
+    for (values, colour, label) in series {
+        let points = steps
+            .iter()
+            .flat_map(|s| values(s.curve).iter().copied())
+            .enumerate()
+            .map(|(n, e)| (n + 1, e.max(floor)));
+        chart
+            .draw_series(LineSeries::new(points, colour.stroke_width(2)))?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
+    }
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))

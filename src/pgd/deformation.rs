@@ -7,11 +7,27 @@ use nalgebra::Vector3;
 use super::{SurfacePoint, Vademecum};
 
 /// A force on a tool-sized patch of the accessible surface.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 pub struct PatchLoad {
     /// Load positions and their shares of the force (summing to one).
     pub shares: Vec<(usize, f64)>,
     pub force_n: Vector3<f64>,
+}
+
+/// `clone_from` reuses the buffers: the haptic tick copies loads into its snapshot every
+/// millisecond, and a derived `Clone` would allocate each time.
+impl Clone for PatchLoad {
+    fn clone(&self) -> Self {
+        Self {
+            shares: self.shares.clone(),
+            force_n: self.force_n,
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.shares.clone_from(&source.shares);
+        self.force_n = source.force_n;
+    }
 }
 
 impl PatchLoad {
@@ -27,11 +43,26 @@ impl PatchLoad {
 }
 
 /// The loads on an organ and, per load step, the modal coefficients of their sum.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 pub struct Deformation {
     pub loads: Vec<PatchLoad>,
     /// `coefficients[step][mode]`.
     pub coefficients: Vec<Vec<f64>>,
+}
+
+/// `clone_from` reuses the buffers, as for [`PatchLoad`].
+impl Clone for Deformation {
+    fn clone(&self) -> Self {
+        Self {
+            loads: self.loads.clone(),
+            coefficients: self.coefficients.clone(),
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.loads.clone_from(&source.loads);
+        self.coefficients.clone_from(&source.coefficients);
+    }
 }
 
 impl Deformation {

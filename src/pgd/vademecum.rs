@@ -366,16 +366,28 @@ impl Vademecum {
         let params = self.parameter_count();
         let modes = self.steps[step].parametric.chunks_exact(params);
         for (c, y) in coefficients.iter_mut().zip(modes) {
-            *c += shares
-                .iter()
-                .map(|&(i, l)| {
-                    self.step_share(step, i, l, force_n)
-                        * (0..3)
-                            .map(|d| y[3 * i + d] as f64 * force_n[d])
-                            .sum::<f64>()
-                })
-                .sum::<f64>();
+            *c += self.mode_coefficient(step, y, shares, force_n);
         }
+    }
+
+    /// One mode's coefficient for a force on `shares`: `Σ_i γ_i Y_i · F`, with `y` the mode's
+    /// parametric part.
+    fn mode_coefficient(
+        &self,
+        step: usize,
+        y: &[f32],
+        shares: &[(usize, f64)],
+        force_n: &Vector3<f64>,
+    ) -> f64 {
+        shares
+            .iter()
+            .map(|&(i, l)| {
+                self.step_share(step, i, l, force_n)
+                    * (0..3)
+                        .map(|d| y[3 * i + d] as f64 * force_n[d])
+                        .sum::<f64>()
+            })
+            .sum()
     }
 
     /// Adds `Σ_k c_k X^k` of load step `step` to `u`.
@@ -406,10 +418,9 @@ impl Vademecum {
             }
             for e in local.corrections_of(i) {
                 let node = local.correction_nodes[e] as usize;
-                let r = &local.correction[9 * e..9 * e + 9];
+                let value = correction_value(&local.correction[9 * e..9 * e + 9], force_n);
                 for c in 0..3 {
-                    let value: f64 = (0..3).map(|d| r[3 * d + c] as f64 * force_n[d]).sum();
-                    u[3 * node + c] += l * value;
+                    u[3 * node + c] += l * value[c];
                 }
             }
         }
@@ -434,15 +445,7 @@ impl Vademecum {
             .chunks_exact(dofs)
             .zip(step_data.parametric.chunks_exact(params));
         for (x, y) in modes {
-            let c: f64 = shares
-                .iter()
-                .map(|&(i, l)| {
-                    self.step_share(step, i, l, force_n)
-                        * (0..3)
-                            .map(|d| y[3 * i + d] as f64 * force_n[d])
-                            .sum::<f64>()
-                })
-                .sum();
+            let c = self.mode_coefficient(step, y, shares, force_n);
             *u += Vector3::from_fn(|k, _| c * x[3 * node + k] as f64);
         }
         let local = &step_data.local;
@@ -450,13 +453,9 @@ impl Vademecum {
             let range = local.corrections_of(i);
             let nodes = &local.correction_nodes[range.clone()];
             if let Ok(k) = nodes.binary_search(&(node as u32)) {
-                let r = &local.correction[9 * (range.start + k)..9 * (range.start + k) + 9];
+                let e = range.start + k;
                 let l = self.step_share(step, i, l, force_n);
-                *u += Vector3::from_fn(|c, _| {
-                    l * (0..3)
-                        .map(|d| r[3 * d + c] as f64 * force_n[d])
-                        .sum::<f64>()
-                });
+                *u += correction_value(&local.correction[9 * e..9 * e + 9], force_n) * l;
             }
         }
     }
@@ -473,6 +472,12 @@ impl Vademecum {
         self.add_modes(k, &coefficients, u);
         self.add_corrections(k, shares, force_n, u);
     }
+}
+
+/// A near-field correction entry (`[d * 3 + c]`: component `c` under a unit load along `d`)
+/// applied to a force: the node's residual displacement (m).
+fn correction_value(entry: &[f32], force_n: &Vector3<f64>) -> Vector3<f64> {
+    Vector3::from_fn(|c, _| (0..3).map(|d| entry[3 * d + c] as f64 * force_n[d]).sum())
 }
 
 /// Secant iterations of [`Vademecum::force_for_indentation`] over load steps.

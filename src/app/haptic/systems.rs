@@ -132,7 +132,6 @@ pub fn trace_force(force: Res<DeviceForce>, trace: Option<ResMut<ForceTrace>>) {
 }
 
 /// Hands the render side the tick's state, when one is listening; never waits.
-#[allow(clippy::too_many_arguments)]
 pub fn publish_snapshot(
     clock: Res<TickClock>,
     tool: Res<Tool>,

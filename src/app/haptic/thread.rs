@@ -104,7 +104,7 @@ fn run(
         let beat = metronome.wait();
         let started = Instant::now();
         if let Some(last) = last_start {
-            period_error.record(abs_diff(started - last, period));
+            period_error.record((started - last).abs_diff(period));
         }
         last_start = Some(started);
         lateness.record(beat.lateness);
@@ -163,8 +163,4 @@ fn raise_priority() -> Result<(), String> {
 fn raise_priority() -> Result<(), String> {
     thread_priority::set_current_thread_priority(thread_priority::ThreadPriority::Max)
         .map_err(|e| format!("{e:?}"))
-}
-
-fn abs_diff(a: Duration, b: Duration) -> Duration {
-    a.max(b) - a.min(b)
 }

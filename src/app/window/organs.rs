@@ -10,6 +10,7 @@ use bevy::prelude::*;
 
 use super::FrameSet;
 use super::bridge::{HapticLink, Snapshot};
+use crate::app::haptic::OrganDeformation;
 use crate::mesh::vertex_normals;
 use crate::pgd::Vademecum;
 
@@ -114,7 +115,10 @@ fn deform(
         organ
             .deformation
             .deformed_surface(&view.vademecum, &mut view.field, &mut positions);
-        let colours = contact_tint(positions.len(), &organ.deformation.loads[0].shares);
+        let colours = contact_tint(
+            positions.len(),
+            &organ.deformation.loads[OrganDeformation::TOOL].shares,
+        );
         if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
             mesh.insert_attribute(
                 Mesh::ATTRIBUTE_NORMAL,
