@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # Installs the system packages the trainer needs on Debian/Ubuntu: the X11 and Vulkan runtime
-# libraries its window loads, and Mesa's Vulkan drivers (software rendering where there is no
-# GPU driver). Building needs nothing beyond the Rust toolchain and a C compiler.
+# libraries its window loads, Mesa's Vulkan drivers (software rendering where there is no GPU
+# driver), and Xvfb, the virtual X server the window tests draw into. Building needs nothing
+# beyond the Rust toolchain and a C compiler.
 set -euo pipefail
 packages=(
   pkg-config
   libx11-6 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0
   libvulkan1 mesa-vulkan-drivers
+  xvfb
 )
 missing=()
 for p in "${packages[@]}"; do

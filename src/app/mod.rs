@@ -7,11 +7,33 @@ pub mod scene;
 pub mod session;
 pub mod window;
 
-/// Why a window cannot be opened here, if that is known before trying.
-pub fn missing_display() -> Option<&'static str> {
-    if cfg!(target_os = "linux") && std::env::var_os("DISPLAY").is_none_or(|d| d.is_empty()) {
-        Some("no X display is available (DISPLAY is not set)")
-    } else {
-        None
+/// Why a window cannot be opened here, if that is known before trying: no `DISPLAY`, or a
+/// local X display whose server does not answer (winit would panic on either).
+pub fn missing_display() -> Option<String> {
+    if !cfg!(target_os = "linux") {
+        return None;
     }
+    let display = std::env::var("DISPLAY").unwrap_or_default();
+    if display.is_empty() {
+        return Some("no X display is available (DISPLAY is not set)".into());
+    }
+    let socket = local_x_socket(&display)?;
+    match std::os::unix::net::UnixStream::connect(&socket) {
+        Ok(_) => None,
+        Err(e) => Some(format!(
+            "no X server answers on DISPLAY={display} ({}: {e})",
+            socket.display()
+        )),
+    }
+}
+
+/// The socket of a local display (`:N`, `:N.S`, `unix:N`); `None` for a remote one.
+fn local_x_socket(display: &str) -> Option<std::path::PathBuf> {
+    let number = display
+        .strip_prefix(':')
+        .or_else(|| display.strip_prefix("unix:"))?
+        .split('.')
+        .next()?;
+    number.parse::<u32>().ok()?;
+    Some(format!("/tmp/.X11-unix/X{number}").into())
 }

@@ -7,12 +7,12 @@ use std::sync::Arc;
 use nalgebra::Vector3;
 
 use super::haptic::HapticScene;
-use crate::cli::{OnStale, ensure_vademecum};
+use crate::cli::{OnStale, VademecumSpec, ensure_vademecum};
 use crate::contact::Probe;
 use crate::fem::Law;
 use crate::haptics::{PressTarget, SafetySettings};
-use crate::mesh::organs::Organ;
-use crate::pgd::Vademecum;
+use crate::mesh::organs::{Organ, OrganSettings};
+use crate::pgd::{BuildSettings, Vademecum};
 
 pub const SCENE_ORGANS: [Organ; 4] = [
     Organ::Liver,
@@ -21,19 +21,56 @@ pub const SCENE_ORGANS: [Organ; 4] = [
     Organ::Duodenum,
 ];
 
-/// The default scene, its vademecums loaded (rebuilt first if missing or stale, unless
-/// `on_stale` refuses).
-pub fn default_scene(dir: &Path, on_stale: OnStale) -> Result<HapticScene, String> {
+/// How finely the scene's organs are meshed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Detail {
+    /// The papers' meshes and the default 6 mm tool (vademecums build in about 3 minutes).
+    #[default]
+    Full,
+    /// A quarter of the nodes and a 12 mm tool, whose patch must span the coarser edges: the
+    /// vademecums build in seconds, for a quick look on a slow machine and for tests.
+    Coarse,
+}
+
+impl Detail {
+    /// The vademecum of `organ` at this detail, kept under `dir`.
+    pub fn vademecum(self, dir: &Path, organ: Organ) -> VademecumSpec {
+        let full = VademecumSpec::default_in(dir, organ, Law::Linear);
+        match self {
+            Detail::Full => full,
+            Detail::Coarse => VademecumSpec {
+                mesh: OrganSettings {
+                    resolution: 0.25,
+                    ..full.mesh
+                },
+                build: BuildSettings {
+                    tool_tip_radius_m: 0.012,
+                    local_radius_m: 0.025,
+                    ..full.build
+                },
+                file: dir.join(format!("{}.coarse.vdm", organ.name())),
+                ..full
+            },
+        }
+    }
+}
+
+/// The default scene at `detail`, its vademecums loaded from `dir` (rebuilt first if missing
+/// or stale, unless `on_stale` refuses); the tool is the one they were built for.
+pub fn default_scene(dir: &Path, detail: Detail, on_stale: OnStale) -> Result<HapticScene, String> {
     let organs = SCENE_ORGANS
         .iter()
         .map(|&organ| {
-            let vademecum = ensure_vademecum(dir, organ, Law::Linear, on_stale)?;
+            let vademecum = ensure_vademecum(&detail.vademecum(dir, organ), on_stale)?;
             Ok((organ.name().to_owned(), Arc::new(vademecum)))
         })
         .collect::<Result<Vec<_>, String>>()?;
+    let probe = Probe {
+        tip_radius_m: detail.vademecum(dir, Organ::Liver).build.tool_tip_radius_m,
+    };
     Ok(HapticScene {
         organs,
-        probe: Probe::default(),
+        probe,
         safety: SafetySettings::default(),
     })
 }

@@ -13,7 +13,7 @@ use nalgebra::Vector3;
 use super::haptic::{
     HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport, Scheduling,
 };
-use super::scene::{default_scene, press_targets};
+use super::scene::{Detail, default_scene, press_targets};
 use super::window::{ScreenshotPlan, WindowScene};
 use crate::cli::OnStale;
 use crate::haptics::{
@@ -23,6 +23,7 @@ use crate::haptics::{
 
 pub struct Options {
     pub vademecums: PathBuf,
+    pub detail: Detail,
     pub on_stale: OnStale,
     pub device: Option<DeviceSpec>,
     pub record: Option<PathBuf>,
@@ -79,7 +80,13 @@ impl Report {
 pub fn run_headless(options: &Options) -> Result<Report, String> {
     let scene = scene(options)?;
     let trajectory = match &options.device {
-        None => press_and_slide(&press_targets(&scene), &PressMotion::default()),
+        None => {
+            let motion = PressMotion {
+                tip_radius_m: scene.probe.tip_radius_m,
+                ..PressMotion::default()
+            };
+            press_and_slide(&press_targets(&scene), &motion)
+        }
         Some(DeviceSpec::Scripted(path)) => Trajectory::load(path).map_err(|e| e.to_string())?,
         Some(DeviceSpec::Virtual) => {
             return Err("the virtual device needs the window: drop --headless".into());
@@ -140,7 +147,7 @@ pub fn open_window(
 }
 
 fn scene(options: &Options) -> Result<HapticScene, String> {
-    let mut scene = default_scene(&options.vademecums, options.on_stale)?;
+    let mut scene = default_scene(&options.vademecums, options.detail, options.on_stale)?;
     scene.safety.max_force_n = options.max_force_n;
     Ok(scene)
 }

@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
+use pgd_surgery::app::scene::Detail;
 use pgd_surgery::fem::{Law, Material, TISSUE_DENSITY_KG_M3};
 use pgd_surgery::mesh::io::{ImportOptions, write_vtu};
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, region};
@@ -340,11 +341,14 @@ fn main() -> ExitCode {
                     json,
                 },
         } => {
-            let scene =
-                match pgd_surgery::app::scene::default_scene(&vademecums, cli::OnStale::Rebuild) {
-                    Ok(scene) => scene,
-                    Err(e) => return fail("pgd bench haptics", &e),
-                };
+            let scene = match pgd_surgery::app::scene::default_scene(
+                &vademecums,
+                Detail::Full,
+                cli::OnStale::Rebuild,
+            ) {
+                Ok(scene) => scene,
+                Err(e) => return fail("pgd bench haptics", &e),
+            };
             print_report(
                 "pgd bench haptics",
                 bench::haptics::run(&scene, repeats, realtime_seconds),

@@ -9,4 +9,4 @@ mod vademecums;
 pub use convergence::{StepCurve, write as write_convergence, write_of_header};
 pub use progress::Bar;
 pub use source::{MeshSource, load_source};
-pub use vademecums::{OnStale, build_command, ensure_vademecum, vademecum_path};
+pub use vademecums::{OnStale, VademecumSpec, ensure_vademecum};

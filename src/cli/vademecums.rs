@@ -19,41 +19,67 @@ pub enum OnStale {
     Refuse,
 }
 
-/// Where the vademecum of a generated organ lives, under `dir`.
-pub fn vademecum_path(dir: &Path, organ: Organ) -> PathBuf {
-    dir.join(format!("{}.vdm", organ.name()))
+/// What the trainer wants of one organ's vademecum: the generated organ at a mesh
+/// resolution, its material under a law, built with these settings, kept in `file`.
+#[derive(Clone, Debug)]
+pub struct VademecumSpec {
+    pub organ: Organ,
+    pub law: Law,
+    pub mesh: OrganSettings,
+    pub build: BuildSettings,
+    pub file: PathBuf,
 }
 
-/// The command a user runs to build what [`ensure_vademecum`] wants.
-pub fn build_command(organ: Organ, law: Law, file: &Path) -> String {
-    let law = match law {
-        Law::Linear => "linear",
-        Law::KirchhoffSaintVenant => "ksv",
-    };
-    format!(
-        "cargo run --release --bin pgd -- build {} --law {law} --out {}",
-        organ.name(),
-        file.display()
-    )
+impl VademecumSpec {
+    /// The organ's default vademecum (the papers' mesh, default settings) under `dir`.
+    pub fn default_in(dir: &Path, organ: Organ, law: Law) -> Self {
+        Self {
+            organ,
+            law,
+            mesh: OrganSettings::default(),
+            build: BuildSettings::default(),
+            file: dir.join(format!("{}.vdm", organ.name())),
+        }
+    }
+
+    /// The command a user runs to build it (options left at their defaults are left out).
+    pub fn build_command(&self) -> String {
+        let law = match self.law {
+            Law::Linear => "linear",
+            Law::KirchhoffSaintVenant => "ksv",
+        };
+        let mut command = format!(
+            "cargo run --release --bin pgd -- build {} --law {law}",
+            self.organ.name()
+        );
+        let (mesh, build) = (OrganSettings::default(), BuildSettings::default());
+        if self.mesh.resolution != mesh.resolution {
+            command += &format!(" --resolution {}", self.mesh.resolution);
+        }
+        if self.mesh.seed != mesh.seed {
+            command += &format!(" --seed {}", self.mesh.seed);
+        }
+        if self.build.tool_tip_radius_m != build.tool_tip_radius_m {
+            command += &format!(" --tool-radius-mm {}", self.build.tool_tip_radius_m * 1e3);
+        }
+        if self.build.local_radius_m != build.local_radius_m {
+            command += &format!(" --local-radius-mm {}", self.build.local_radius_m * 1e3);
+        }
+        command + &format!(" --out {}", self.file.display())
+    }
 }
 
-/// The vademecum of `organ` (default mesh, its material under `law`) from `dir`, checked for
-/// its mesh and material; a missing or stale one is rebuilt or refused per `on_stale`.
-pub fn ensure_vademecum(
-    dir: &Path,
-    organ: Organ,
-    law: Law,
-    on_stale: OnStale,
-) -> Result<Vademecum, String> {
-    let file = vademecum_path(dir, organ);
-    let mesh = organs::generate(organ, &OrganSettings::default())
-        .map_err(|e| format!("{}: {e}", organ.name()))?;
-    let material = pgd::organ::material(organ, law);
-    let why = match checked(&file, &mesh, &material) {
+/// The vademecum `spec` asks for, checked for its mesh, material and settings; a missing or
+/// stale one is rebuilt or refused per `on_stale`.
+pub fn ensure_vademecum(spec: &VademecumSpec, on_stale: OnStale) -> Result<Vademecum, String> {
+    let organ = spec.organ;
+    let mesh = organs::generate(organ, &spec.mesh).map_err(|e| format!("{}: {e}", organ.name()))?;
+    let material = pgd::organ::material(organ, spec.law);
+    let why = match checked(spec, &mesh, &material) {
         Ok(vademecum) => return Ok(vademecum),
         Err(why) => why,
     };
-    let command = build_command(organ, law, &file);
+    let command = spec.build_command();
     if on_stale == OnStale::Refuse {
         return Err(format!("{why}\nbuild it with:\n  {command}"));
     }
@@ -66,11 +92,11 @@ pub fn ensure_vademecum(
         clamped_region: region::CLAMPED.into(),
         accessible_region: region::ACCESSIBLE.into(),
     };
-    let (vademecum, _) = pgd::build(&organ_model, &BuildSettings::default(), &Bar::default())
+    let (vademecum, _) = pgd::build(&organ_model, &spec.build, &Bar::default())
         .map_err(|e| format!("{}: {e}", organ.name()))?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    pgd::save(&file, &vademecum).map_err(|e| e.to_string())?;
-    let [csv, png] = super::write_of_header(&file, &vademecum.header)?;
+    let file = &spec.file;
+    pgd::save(file, &vademecum).map_err(|e| e.to_string())?;
+    let [csv, png] = super::write_of_header(file, &vademecum.header)?;
     eprintln!(
         "wrote {} (convergence curves: {} and {})",
         file.display(),
@@ -80,14 +106,17 @@ pub fn ensure_vademecum(
     Ok(vademecum)
 }
 
-/// Loads `file` and refuses it unless it was built for `mesh` and `material`.
+/// Loads the spec's file and refuses it unless it was built for `mesh`, `material` and the
+/// spec's settings.
 fn checked(
-    file: &Path,
+    spec: &VademecumSpec,
     mesh: &crate::mesh::TetMesh,
     material: &Material,
 ) -> Result<Vademecum, VademecumError> {
+    let file = &spec.file;
     let vademecum = pgd::load(file)?;
     vademecum.check_mesh(file, mesh)?;
     vademecum.check_material(file, material)?;
+    vademecum.check_settings(file, &spec.build)?;
     Ok(vademecum)
 }

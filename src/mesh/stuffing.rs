@@ -10,7 +10,7 @@
 //! The method is pure Rust and permissively licensed; it needs only the sign of the implicit
 //! function, so any continuous function that is negative inside works, not just true distances.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 use nalgebra::{Point3, Vector3};
 
@@ -180,6 +180,11 @@ fn edge_key(a: usize, b: usize) -> (usize, usize) {
     (a.min(b), a.max(b))
 }
 
+/// Cut points by lattice edge, ordered: [`warp`] walks them and keeps the first of equally near
+/// ones, so a hash map's per-process order would make the mesh differ from run to run (and
+/// every vademecum built on it look stale).
+type Cuts = BTreeMap<(usize, usize), Point3<f64>>;
+
 /// Where each lattice edge with one end inside and one outside crosses the surface, found by
 /// bisection on the implicit function.
 fn cut_points(
@@ -187,8 +192,8 @@ fn cut_points(
     tets: &[[usize; 4]],
     points: &[Point3<f64>],
     values: &[f64],
-) -> HashMap<(usize, usize), Point3<f64>> {
-    let mut cuts = HashMap::new();
+) -> Cuts {
+    let mut cuts = Cuts::new();
     for tet in tets {
         for [i, j] in TET_EDGES {
             let key = edge_key(tet[i], tet[j]);
@@ -220,13 +225,8 @@ fn bisect(solid: &Implicit, mut a: Point3<f64>, value_a: f64, mut b: Point3<f64>
 
 /// Moves each lattice vertex that lies closer than the warp threshold to a cut point on one of
 /// its edges onto the nearest such cut point, and marks it as on the surface.
-fn warp(
-    cuts: &HashMap<(usize, usize), Point3<f64>>,
-    lattice: &Lattice,
-    points: &mut [Point3<f64>],
-    values: &mut [f64],
-) {
-    let mut nearest: HashMap<usize, (f64, Point3<f64>)> = HashMap::new();
+fn warp(cuts: &Cuts, lattice: &Lattice, points: &mut [Point3<f64>], values: &mut [f64]) {
+    let mut nearest: BTreeMap<usize, (f64, Point3<f64>)> = BTreeMap::new();
     for (&(a, b), &cut) in cuts {
         let length = (points[b] - points[a]).norm();
         let alpha = lattice.alpha(a, b);
@@ -250,7 +250,7 @@ fn warp(
 struct Pieces {
     points: Vec<Point3<f64>>,
     sides: Vec<Side>,
-    cuts: HashMap<(usize, usize), Point3<f64>>,
+    cuts: Cuts,
     /// Cut points turned into mesh vertices, by lattice edge.
     cut_vertex: HashMap<(usize, usize), usize>,
     tets: Vec<[usize; 4]>,

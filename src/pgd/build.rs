@@ -55,6 +55,23 @@ impl Default for BuildSettings {
     }
 }
 
+impl BuildSettings {
+    /// The settings a user chooses, in a line (for messages).
+    pub fn summary(&self) -> String {
+        format!(
+            "tool tip {:.1} mm, local radius {:.1} mm, target error {}, at most {} modes, load steps {:?} mm",
+            self.tool_tip_radius_m * 1e3,
+            self.local_radius_m * 1e3,
+            self.target_error,
+            self.pgd.max_modes,
+            self.load_steps_m
+                .iter()
+                .map(|m| m * 1e3)
+                .collect::<Vec<_>>()
+        )
+    }
+}
+
 /// KSV load steps: three, as in paper 000, up to the deepest indentation over which the KSV
 /// law stays stable under a 6 mm tool on the organs here: beyond about 1.5 mm the elements
 /// under the tool lose stability in compression (measured in docs/pgd.md).

@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
+use super::BuildSettings;
 use super::local::LocalPart;
 use super::vademecum::{Header, Step, Vademecum};
 use crate::fem::Material;
@@ -60,6 +61,14 @@ pub enum VademecumError {
         "{file}: built for another material ({found}, wanted {expected}); rebuild it with `pgd build`"
     )]
     OtherMaterial {
+        file: PathBuf,
+        expected: String,
+        found: String,
+    },
+    #[error(
+        "{file}: built with other settings ({found}, wanted {expected}); rebuild it with `pgd build`"
+    )]
+    OtherSettings {
         file: PathBuf,
         expected: String,
         found: String,
@@ -169,6 +178,23 @@ impl Vademecum {
                 file: file.to_path_buf(),
                 expected: format!("{material:?}"),
                 found: format!("{:?}", self.header.material),
+            });
+        }
+        Ok(())
+    }
+
+    /// Refuses a vademecum built with other settings than `settings` (a tool tip of another
+    /// radius would feel another stiffness).
+    pub fn check_settings(
+        &self,
+        file: &Path,
+        settings: &BuildSettings,
+    ) -> Result<(), VademecumError> {
+        if self.header.settings != *settings {
+            return Err(VademecumError::OtherSettings {
+                file: file.to_path_buf(),
+                expected: settings.summary(),
+                found: self.header.settings.summary(),
             });
         }
         Ok(())

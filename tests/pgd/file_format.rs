@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use pgd_surgery::pgd::{FORMAT_VERSION, VademecumError, load, save};
+use pgd_surgery::pgd::{BuildSettings, FORMAT_VERSION, VademecumError, load, save};
 
 use crate::common::{block_mesh, block_model, build_block};
 
@@ -26,6 +26,16 @@ fn a_saved_vademecum_loads_back_identical_and_fits_its_mesh_only() {
     let err = back.check_mesh(&path, &other).unwrap_err();
     assert!(matches!(err, VademecumError::OtherMesh { .. }), "{err}");
     assert!(err.to_string().contains("roundtrip.vdm") && err.to_string().contains("pgd build"));
+    // Built for a 6 mm tool: a trainer with a 12 mm one must not take it.
+    back.check_settings(&path, &vademecum.header.settings)
+        .unwrap();
+    let wider_tool = BuildSettings {
+        tool_tip_radius_m: 2.0 * vademecum.header.settings.tool_tip_radius_m,
+        ..vademecum.header.settings.clone()
+    };
+    let err = back.check_settings(&path, &wider_tool).unwrap_err();
+    assert!(matches!(err, VademecumError::OtherSettings { .. }), "{err}");
+    assert!(err.to_string().contains("tool tip"), "{err}");
 }
 
 #[test]

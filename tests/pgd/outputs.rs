@@ -1,7 +1,7 @@
 //! What the offline tools hand to users: the convergence table and plot, and the trainer's
 //! refusal of a vademecum that does not fit its organ.
 
-use pgd_surgery::cli::{self, OnStale, StepCurve};
+use pgd_surgery::cli::{self, OnStale, StepCurve, VademecumSpec};
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::organs::Organ;
 use pgd_surgery::pgd::save;
@@ -41,20 +41,15 @@ fn the_convergence_curves_are_written_as_csv_and_png() {
 #[test]
 fn the_trainer_refuses_a_stale_or_missing_vademecum_with_the_command_to_run() {
     let dir = temp_dir("stale");
-    let missing =
-        cli::ensure_vademecum(&dir, Organ::Liver, Law::Linear, OnStale::Refuse).unwrap_err();
+    let spec = VademecumSpec::default_in(&dir, Organ::Liver, Law::Linear);
+    let missing = cli::ensure_vademecum(&spec, OnStale::Refuse).unwrap_err();
     assert!(
         missing.contains("liver.vdm") && missing.contains("pgd -- build liver"),
         "{missing}"
     );
     let model = block_model(block_mesh([4, 3, 2]));
-    save(
-        &cli::vademecum_path(&dir, Organ::Liver),
-        &build_block(&model, 2),
-    )
-    .unwrap();
-    let stale =
-        cli::ensure_vademecum(&dir, Organ::Liver, Law::Linear, OnStale::Refuse).unwrap_err();
+    save(&spec.file, &build_block(&model, 2)).unwrap();
+    let stale = cli::ensure_vademecum(&spec, OnStale::Refuse).unwrap_err();
     assert!(
         stale.contains("another mesh") && stale.contains("pgd -- build liver"),
         "{stale}"

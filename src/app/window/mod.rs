@@ -6,8 +6,10 @@ mod bridge;
 mod camera;
 mod hud;
 mod input;
+mod legend;
 mod organs;
 mod screenshot;
+pub mod tissue;
 mod tool;
 
 use std::sync::Arc;
@@ -15,6 +17,7 @@ use std::sync::Arc;
 use bevy::prelude::*;
 
 pub use bridge::{HapticLink, Snapshot};
+pub use legend::{Legend, OrganLegend, ToolLegend};
 pub use screenshot::ScreenshotPlan;
 
 use super::haptic::{HapticScene, HapticSnapshot};

@@ -8,8 +8,8 @@ use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
 
-use super::FrameSet;
 use super::bridge::{HapticLink, Snapshot};
+use super::{FrameSet, tissue};
 use crate::app::haptic::OrganDeformation;
 use crate::mesh::vertex_normals;
 use crate::pgd::Vademecum;
@@ -17,10 +17,10 @@ use crate::pgd::Vademecum;
 /// An organ's visual model, mapped to its vademecum through the load positions (surface
 /// vertex `k` is volume node `positions[k]`).
 #[derive(Component)]
-struct OrganView {
+pub(super) struct OrganView {
     index: usize,
     vademecum: Arc<Vademecum>,
-    triangles: Vec<[usize; 3]>,
+    pub(super) triangles: Vec<[usize; 3]>,
     /// Scratch: the whole displacement field (m).
     field: Vec<f64>,
 }
@@ -30,24 +30,15 @@ pub(super) fn setup(app: &mut App) {
         .add_systems(Update, deform.in_set(FrameSet::Draw));
 }
 
-/// Wet-tissue colours (the vertex colours tint them where the tool presses): liver red-brown, gallbladder green, pancreas pale yellow-pink,
-/// duodenum pink.
-fn colour(name: &str) -> Color {
-    match name {
-        "liver" => Color::srgb(0.48, 0.14, 0.11),
-        "gallbladder" => Color::srgb(0.24, 0.42, 0.16),
-        "pancreas" => Color::srgb(0.85, 0.68, 0.52),
-        _ => Color::srgb(0.80, 0.45, 0.45),
-    }
-}
-
 fn spawn_organs(
     mut commands: Commands,
     link: Res<HapticLink>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
+    mut images: ResMut<Assets<Image>>,
 ) {
     for (index, (name, vademecum)) in link.scene.organs.iter().enumerate() {
+        let (colour, roughness) = tissue::images(&tissue::tissue(name));
         let triangles: Vec<[usize; 3]> = vademecum
             .triangles
             .iter()
@@ -58,9 +49,14 @@ fn spawn_organs(
             Name::new(name.clone()),
             Mesh3d(meshes.add(mesh)),
             MeshMaterial3d(materials.add(StandardMaterial {
-                base_color: colour(name),
-                perceptual_roughness: 0.35,
+                base_color_texture: Some(images.add(colour)),
+                metallic_roughness_texture: Some(images.add(roughness)),
+                metallic: 0.0,
+                perceptual_roughness: 1.0,
                 reflectance: 0.5,
+                // Wet tissue: a thin glossy film over the rougher parenchyma.
+                clearcoat: 0.5,
+                clearcoat_perceptual_roughness: 0.2,
                 double_sided: true,
                 cull_mode: None,
                 ..default()
@@ -131,7 +127,7 @@ fn deform(
 }
 
 /// Vertex colours that light up the tool's contact patch (by each position's share of the
-/// load) and leave the rest of the organ its material's colour.
+/// load) and leave the rest of the organ its tissue's colour.
 fn contact_tint(vertices: usize, shares: &[(usize, f64)]) -> Vec<[f32; 4]> {
     let mut colours = vec![[1.0; 4]; vertices];
     let largest = shares.iter().map(|s| s.1).fold(0.0, f64::max);
@@ -144,7 +140,8 @@ fn contact_tint(vertices: usize, shares: &[(usize, f64)]) -> Vec<[f32; 4]> {
     colours
 }
 
-/// A render mesh of a surface with area-weighted normals of the given positions.
+/// A render mesh of a surface with area-weighted normals of the given positions and texture
+/// coordinates fixed at them.
 fn surface_mesh(triangles: &[[usize; 3]], positions: &[[f32; 3]]) -> Mesh {
     let indices: Vec<u32> = triangles.iter().flatten().map(|&i| i as u32).collect();
     Mesh::new(
@@ -153,6 +150,7 @@ fn surface_mesh(triangles: &[[usize; 3]], positions: &[[f32; 3]]) -> Mesh {
     )
     .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions.to_vec())
     .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vertex_normals(triangles, positions))
+    .with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, tissue::planar_uvs(positions))
     .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, contact_tint(positions.len(), &[]))
     .with_inserted_indices(Indices::U32(indices))
 }

@@ -6,8 +6,9 @@ use bevy::prelude::*;
 use super::bridge::{HapticLink, Snapshot};
 use super::{FrameSet, to_bevy};
 
+/// The sphere drawn at the tool tip.
 #[derive(Component)]
-struct ToolTip;
+pub(super) struct ToolTip;
 
 /// Arrow length per newton (m/N): 0.3 N, a firm press on the liver, draws 6 cm.
 const ARROW_M_PER_N: f32 = 0.2;
