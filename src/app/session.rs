@@ -14,7 +14,7 @@ use super::haptic::{
     HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport, Scheduling,
 };
 use super::scene::{Detail, default_scene, press_targets};
-use super::window::{ScreenshotPlan, WindowScene};
+use super::window::{FrameReport, ScreenshotPlan, WindowScene};
 use crate::cli::OnStale;
 use crate::haptics::{
     DeviceSpec, HapticDevice, PressMotion, Recorder, Scripted, TICK_S, TimerMode, Trajectory,
@@ -40,6 +40,10 @@ pub struct Options {
 pub enum Report {
     Simulated(HeadlessReport),
     RealTime(RealTimeReport),
+    Window {
+        haptic: RealTimeReport,
+        frames: Option<FrameReport>,
+    },
 }
 
 impl Report {
@@ -53,27 +57,41 @@ impl Report {
         }
         match self {
             Report::Simulated(report) => println!("{report}"),
-            Report::RealTime(report) => println!(
-                "real-time haptic loop ({:?}, {} scheduling): {} ticks, {} deadlines skipped\n\
+            Report::RealTime(report) => print_realtime(report),
+            Report::Window { haptic, frames } => {
+                print_realtime(haptic);
+                match frames {
+                    Some(f) => println!(
+                        "window: {} frames after warm-up, frame time p50 {:.1} ms ({:.1} fps), p95 {:.1} ms",
+                        f.frames, f.frame_ms_p50, f.fps_p50, f.frame_ms_p95
+                    ),
+                    None => println!("window: closed before drawing past its warm-up"),
+                }
+            }
+        }
+    }
+}
+
+fn print_realtime(report: &RealTimeReport) {
+    println!(
+        "real-time haptic loop ({:?}, {} scheduling): {} ticks, {} deadlines skipped\n\
                  tick lateness: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs\n\
                  period error: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs\n\
                  tick compute: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs",
-                report.timer,
-                report.scheduling,
-                report.ticks,
-                report.skipped,
-                report.lateness.p50_us,
-                report.lateness.p99_us,
-                report.lateness.max_us,
-                report.period_error.p50_us,
-                report.period_error.p99_us,
-                report.period_error.max_us,
-                report.compute.p50_us,
-                report.compute.p99_us,
-                report.compute.max_us,
-            ),
-        }
-    }
+        report.timer,
+        report.scheduling,
+        report.ticks,
+        report.skipped,
+        report.lateness.p50_us,
+        report.lateness.p99_us,
+        report.lateness.max_us,
+        report.period_error.p50_us,
+        report.period_error.p99_us,
+        report.period_error.max_us,
+        report.compute.p50_us,
+        report.compute.p99_us,
+        report.compute.max_us,
+    );
 }
 
 /// Runs the haptic loop without a window: on a simulated clock unless `options.realtime`.
@@ -131,7 +149,7 @@ pub fn open_window(
     let timer = options.realtime.unwrap_or_default();
     let haptic =
         HapticThread::spawn(haptic, timer, Scheduling::RealTime).map_err(|e| e.to_string())?;
-    let exit = super::window::run(WindowScene {
+    let (exit, frames) = super::window::run(WindowScene {
         scene,
         snapshots,
         virtual_device,
@@ -141,7 +159,10 @@ pub fn open_window(
     });
     let report = haptic.stop();
     match exit {
-        AppExit::Success => Ok(Report::RealTime(report)),
+        AppExit::Success => Ok(Report::Window {
+            haptic: report,
+            frames,
+        }),
         AppExit::Error(code) => Err(format!("the window closed with error code {code}")),
     }
 }

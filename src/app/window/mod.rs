@@ -4,6 +4,7 @@
 
 mod bridge;
 mod camera;
+mod frames;
 mod hud;
 mod input;
 mod legend;
@@ -17,6 +18,7 @@ use std::sync::Arc;
 use bevy::prelude::*;
 
 pub use bridge::{HapticLink, Snapshot};
+pub use frames::FrameReport;
 pub use legend::{Legend, OrganLegend, ToolLegend};
 pub use screenshot::ScreenshotPlan;
 
@@ -53,8 +55,9 @@ enum FrameSet {
     Draw,
 }
 
-/// Opens the trainer window and returns when it closes.
-pub fn run(window: WindowScene) -> AppExit {
+/// Opens the trainer window and returns, when it closes, how it closed and how fast it drew.
+pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
+    let log = frames::FrameLog::default();
     let mut app = App::new();
     app.add_plugins(DefaultPlugins.set(WindowPlugin {
         primary_window: Some(Window {
@@ -75,5 +78,7 @@ pub fn run(window: WindowScene) -> AppExit {
     tool::setup(&mut app);
     input::setup(&mut app);
     hud::setup(&mut app);
-    app.run()
+    frames::setup(&mut app, log.clone());
+    let exit = app.run();
+    (exit, log.report())
 }
