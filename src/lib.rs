@@ -13,4 +13,5 @@ pub mod fem;
 pub mod haptics;
 pub mod mesh;
 pub mod pgd;
+pub mod scenario;
 pub mod seam;

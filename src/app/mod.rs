@@ -2,6 +2,7 @@
 //! ([`haptic`]), the default scene ([`scene`]), a session of the trainer, headless or not
 //! ([`session`]), and the trainer window ([`window`]).
 
+pub mod exercise;
 pub mod haptic;
 pub mod scene;
 pub mod session;

@@ -14,12 +14,7 @@ use crate::haptics::{PressTarget, SafetySettings};
 use crate::mesh::organs::{Organ, OrganSettings};
 use crate::pgd::{BuildSettings, Vademecum};
 
-pub const SCENE_ORGANS: [Organ; 4] = [
-    Organ::Liver,
-    Organ::Gallbladder,
-    Organ::Pancreas,
-    Organ::Duodenum,
-];
+pub const SCENE_ORGANS: [Organ; 4] = Organ::ABDOMEN;
 
 /// How finely the scene's organs are meshed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -58,18 +53,40 @@ impl Detail {
 /// The default scene at `detail`, its vademecums loaded from `dir` (rebuilt first if missing
 /// or stale, unless `on_stale` refuses); the tool is the one they were built for.
 pub fn default_scene(dir: &Path, detail: Detail, on_stale: OnStale) -> Result<HapticScene, String> {
-    let organs = SCENE_ORGANS
+    scene_of(&SCENE_ORGANS, None, dir, detail, on_stale)
+}
+
+/// A scene of `organs` felt through a tool tip of `tip_radius_m` (the detail's own when
+/// `None`; coarse organs always take the coarse tool, which their edges need).
+pub fn scene_of(
+    organs: &[Organ],
+    tip_radius_m: Option<f64>,
+    dir: &Path,
+    detail: Detail,
+    on_stale: OnStale,
+) -> Result<HapticScene, String> {
+    let spec = |organ: Organ| {
+        let mut spec = detail.vademecum(dir, organ);
+        if let Some(tip) = tip_radius_m.filter(|_| detail == Detail::Full)
+            && tip != spec.build.tool_tip_radius_m
+        {
+            spec.build.tool_tip_radius_m = tip;
+            spec.file = dir.join(format!("{}.tip{}mm.vdm", organ.name(), tip * 1e3));
+        }
+        spec
+    };
+    let loaded = organs
         .iter()
         .map(|&organ| {
-            let vademecum = ensure_vademecum(&detail.vademecum(dir, organ), on_stale)?;
+            let vademecum = ensure_vademecum(&spec(organ), on_stale)?;
             Ok((organ.name().to_owned(), Arc::new(vademecum)))
         })
         .collect::<Result<Vec<_>, String>>()?;
     let probe = Probe {
-        tip_radius_m: detail.vademecum(dir, Organ::Liver).build.tool_tip_radius_m,
+        tip_radius_m: spec(Organ::Liver).build.tool_tip_radius_m,
     };
     Ok(HapticScene {
-        organs,
+        organs: loaded,
         probe,
         safety: SafetySettings::default(),
     })

@@ -10,6 +10,7 @@ use serde::Serialize;
 use bevy::app::AppExit;
 use nalgebra::Vector3;
 
+use super::exercise::{Outcome, run_simulated, scenario_scene};
 use super::haptic::{
     HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport, Scheduling,
 };
@@ -20,6 +21,7 @@ use crate::haptics::{
     DeviceSpec, HapticDevice, PressMotion, Recorder, Scripted, TICK_S, TimerMode, Trajectory,
     VirtualDevice, press_and_slide,
 };
+use crate::scenario::Scenario;
 
 pub struct Options {
     pub vademecums: PathBuf,
@@ -165,6 +167,31 @@ pub fn open_window(
         }),
         AppExit::Error(code) => Err(format!("the window closed with error code {code}")),
     }
+}
+
+/// Runs a scenario's exercise on the scripted device `options` names, on a simulated clock,
+/// until its tasks have ended or the script has (plus 100 ms).
+pub fn run_scenario_headless(options: &Options, scenario: Scenario) -> Result<Outcome, String> {
+    let mut scene = scenario_scene(
+        &scenario,
+        &options.vademecums,
+        options.detail,
+        options.on_stale,
+    )?;
+    scene.safety.max_force_n = scene.safety.max_force_n.min(options.max_force_n);
+    let trajectory = match &options.device {
+        Some(DeviceSpec::Scripted(path)) => Trajectory::load(path).map_err(|e| e.to_string())?,
+        _ => {
+            return Err(
+                "a headless exercise needs a scripted device: --device scripted:FILE".into(),
+            );
+        }
+    };
+    let ticks = options
+        .ticks
+        .unwrap_or_else(|| ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64);
+    let device = recorded(scripted(&options.device, trajectory), &options.record);
+    run_simulated(scenario, &scene, device, ticks)
 }
 
 fn scene(options: &Options) -> Result<HapticScene, String> {

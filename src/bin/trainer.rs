@@ -1,14 +1,15 @@
 //! `trainer`: the surgical trainee's application.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clap::Parser;
+use clap::{Parser, Subcommand};
 use pgd_surgery::app::scene::Detail;
 use pgd_surgery::app::window::ScreenshotPlan;
 use pgd_surgery::app::{self, session};
-use pgd_surgery::cli::OnStale;
+use pgd_surgery::cli::{self, OnStale};
 use pgd_surgery::haptics::{DeviceSpec, TimerMode};
+use pgd_surgery::scenario;
 
 #[derive(Parser)]
 #[command(
@@ -17,52 +18,73 @@ use pgd_surgery::haptics::{DeviceSpec, TimerMode};
     about = "Real-time surgery trainer: organs deform under a haptic tool through PGD vademecums"
 )]
 struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
     /// Run the haptic loop without a window and print a summary.
-    #[arg(long)]
+    #[arg(long, global = true)]
     headless: bool,
     /// The haptic device: `scripted:FILE` replays a trajectory CSV (time_s,x_m,y_m,z_m,buttons);
     /// `virtual` is the mouse. Headless default: a built-in press-and-slide on every organ.
-    #[arg(long)]
+    #[arg(long, global = true)]
     device: Option<DeviceSpec>,
     /// Record what the device reports to this trajectory file (replayable with scripted:FILE).
-    #[arg(long)]
+    #[arg(long, global = true)]
     record: Option<PathBuf>,
     /// Headless: ticks to run (default: the script's length plus 100 ms).
-    #[arg(long)]
+    #[arg(long, global = true)]
     ticks: Option<u64>,
     /// Print the summary (headless) or the haptic timing report (window) as JSON.
-    #[arg(long)]
+    #[arg(long, global = true)]
     json: bool,
     /// Headless: tick on the real clock (1 kHz on a thread of its own) instead of a simulated
     /// one, and report how well it kept time.
-    #[arg(long)]
+    #[arg(long, global = true)]
     realtime: bool,
     /// Real-time pacing: `hybrid` sleeps then spins to the deadline, `sleep` only sleeps.
-    #[arg(long, default_value = "hybrid", value_parser = parse_timer)]
+    #[arg(long, global = true, default_value = "hybrid", value_parser = parse_timer)]
     timer: TimerMode,
     /// The largest force (N) sent to the device (also capped by the device's own limit).
-    #[arg(long, default_value_t = 3.3)]
+    #[arg(long, global = true, default_value_t = 3.3)]
     max_force_n: f64,
     /// Close the window after this many seconds and report how the haptic loop kept time
     /// while the renderer ran.
-    #[arg(long)]
+    #[arg(long, global = true)]
     exit_after_s: Option<f64>,
     /// Save the window to this PNG after `--frames` frames, then close it.
-    #[arg(long)]
+    #[arg(long, global = true)]
     screenshot: Option<PathBuf>,
     /// Frames to draw before the screenshot.
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, global = true, default_value_t = 30)]
     frames: u32,
     /// Where the organs' vademecums are kept.
-    #[arg(long, default_value = "vademecums")]
+    #[arg(long, global = true, default_value = "vademecums")]
     vademecums: PathBuf,
     /// Coarse organs (a quarter of the nodes, a 12 mm tool): their vademecums build in
     /// seconds. For a quick look on a slow machine, and for tests.
-    #[arg(long)]
+    #[arg(long, global = true)]
     coarse: bool,
     /// Fail (with the command to run) instead of rebuilding a missing or stale vademecum.
-    #[arg(long)]
+    #[arg(long, global = true)]
     no_rebuild: bool,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run the exercise a scenario file describes and score it (in the window, or with
+    /// --headless on a scripted device).
+    Run {
+        /// The scenario, e.g. scenarios/liver-steady-press.scenario.ron.
+        file: PathBuf,
+        /// Where the session report goes (JSON, a summary, a force plot).
+        #[arg(long, default_value = "reports")]
+        report_dir: PathBuf,
+    },
+    /// Check scenario files without running them; every problem is printed with its file,
+    /// line, column and field.
+    Validate {
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+    },
 }
 
 fn parse_timer(s: &str) -> Result<TimerMode, String> {
@@ -75,6 +97,9 @@ fn parse_timer(s: &str) -> Result<TimerMode, String> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(Command::Validate { files }) = &cli.command {
+        return validate(files);
+    }
     if !cli.headless
         && let Some(why) = app::missing_display()
     {
@@ -107,9 +132,15 @@ fn main() -> ExitCode {
         realtime,
         max_force_n: cli.max_force_n,
     };
-    let result = match cli.headless {
-        true => session::run_headless(&options),
-        false => {
+    let result = match (&cli.command, cli.headless) {
+        (Some(Command::Run { file, report_dir }), true) => {
+            return run_scenario(&options, file, report_dir, cli.json);
+        }
+        (Some(Command::Run { .. }), false) => {
+            Err("exercises run headless for now: add --headless and --device scripted:FILE".into())
+        }
+        (_, true) => session::run_headless(&options),
+        (_, false) => {
             let screenshot = cli.screenshot.clone().map(|path| ScreenshotPlan {
                 path,
                 after_frames: cli.frames.max(1),
@@ -124,6 +155,79 @@ fn main() -> ExitCode {
         }
         Err(e) => {
             eprintln!("trainer: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// `trainer validate`: every file checked, every problem printed; fails if any file has one.
+fn validate(files: &[PathBuf]) -> ExitCode {
+    let mut failed = false;
+    for file in files {
+        match scenario::load(file) {
+            Ok(s) => println!(
+                "{}: ok ({}, {} tasks)",
+                file.display(),
+                s.title,
+                s.tasks.len()
+            ),
+            Err(e) => {
+                eprintln!("{e}");
+                failed = true;
+            }
+        }
+    }
+    if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// `trainer run FILE --headless`: the exercise on a scripted device, its score printed and
+/// its report written.
+fn run_scenario(
+    options: &session::Options,
+    file: &Path,
+    report_dir: &Path,
+    json: bool,
+) -> ExitCode {
+    let scenario = match scenario::load(file) {
+        Ok(scenario) => scenario,
+        Err(e) => {
+            eprintln!("{e}");
+            return ExitCode::from(2);
+        }
+    };
+    let outcome = match session::run_scenario_headless(options, scenario) {
+        Ok(outcome) => outcome,
+        Err(e) => {
+            eprintln!("trainer: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let name = file
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or("session");
+    let stem = name.trim_end_matches(".ron").trim_end_matches(".scenario");
+    let written = cli::write_report(report_dir, stem, &outcome.card, &outcome.force_trace);
+    if json {
+        match serde_json::to_string_pretty(&outcome.card) {
+            Ok(text) => println!("{text}"),
+            Err(e) => eprintln!("trainer: could not write the JSON scorecard: {e}"),
+        }
+    } else {
+        print!("{}", cli::summary(&outcome.card));
+    }
+    match written {
+        Ok(paths) => {
+            let paths: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+            eprintln!("report: {}", paths.join(", "));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("trainer: the report was not written: {e}");
             ExitCode::FAILURE
         }
     }

@@ -8,10 +8,8 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
+use super::plot::{Area, PlotResult, save_png};
 use crate::pgd::{ErrorCurve, Header};
-
-/// The plot's font, shipped with the crate so that plots need nothing from the system.
-const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 const SIZE: (u32, u32) = (1400, 560);
 
@@ -76,15 +74,9 @@ pub fn table(steps: &[StepCurve]) -> String {
     out
 }
 
-fn plot(path: &Path, steps: &[StepCurve]) -> Result<(), Box<dyn std::error::Error>> {
-    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
-        .map_err(|_| "the embedded font could not be read")?;
-    let (width, height) = SIZE;
-    let mut pixels = vec![0u8; (width * height * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
-        root.fill(&WHITE)?;
-        let (left, right) = root.split_horizontally(width / 2);
+fn plot(path: &Path, steps: &[StepCurve]) -> PlotResult {
+    save_png(path, SIZE, |root| {
+        let (left, right) = root.split_horizontally(SIZE.0 / 2);
         let lowest = steps
             .iter()
             .flat_map(|s| {
@@ -99,25 +91,12 @@ fn plot(path: &Path, steps: &[StepCurve]) -> Result<(), Box<dyn std::error::Erro
             .fold(1.0, f64::min);
         let floor = 10f64.powf(lowest.log10().floor());
         all_steps(&left, steps, floor)?;
-        per_step(&right, steps, floor)?;
-        root.present()?;
-    }
-    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
-    let mut encoder = png::Encoder::new(file, width, height);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
-    encoder.write_header()?.write_image_data(&pixels)?;
-    Ok(())
+        per_step(&right, steps, floor)
+    })
 }
 
-type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
-
 /// Figure 13: the energy error of the separated part against all modes so far.
-fn all_steps(
-    area: &Area,
-    steps: &[StepCurve],
-    floor: f64,
-) -> Result<(), Box<dyn std::error::Error>> {
+fn all_steps(area: &Area, steps: &[StepCurve], floor: f64) -> PlotResult {
     let total: usize = steps.iter().map(|s| s.curve.separated.len()).sum();
     let mut chart = ChartBuilder::on(area)
         .caption("Error against total number of modes", ("sans-serif", 24))
@@ -158,11 +137,7 @@ fn all_steps(
 }
 
 /// Figure 14: per load step, the PGD's error and the optimal rank-n error.
-fn per_step(
-    area: &Area,
-    steps: &[StepCurve],
-    floor: f64,
-) -> Result<(), Box<dyn std::error::Error>> {
+fn per_step(area: &Area, steps: &[StepCurve], floor: f64) -> PlotResult {
     let longest = steps
         .iter()
         .map(|s| s.curve.separated.len())

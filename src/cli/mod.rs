@@ -2,11 +2,14 @@
 //! the binaries so they stay thin, and out of the numerical core so it stays quiet.
 
 mod convergence;
+mod plot;
 mod progress;
+mod report;
 mod source;
 mod vademecums;
 
 pub use convergence::{StepCurve, write as write_convergence, write_of_header};
 pub use progress::Bar;
+pub use report::{summary, write_report};
 pub use source::{MeshSource, load_source};
 pub use vademecums::{OnStale, VademecumSpec, ensure_vademecum};

@@ -4,6 +4,7 @@
 //! The render side only ever reads the latest [`HapticSnapshot`].
 
 mod components;
+mod exercise;
 mod report;
 mod resources;
 mod runner;
@@ -15,6 +16,7 @@ use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
 
 pub use components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
+pub use exercise::ExerciseRun;
 pub use report::{ForceSummary, HeadlessReport, TickTimes};
 pub use resources::{Device, DeviceForce, FaultLog, ForceTrace, TickClock, Tool};
 pub use runner::{HapticLoop, HapticScene, SceneError};
@@ -36,6 +38,8 @@ pub enum HapticSet {
     ComputeForce,
     Safety,
     WriteDevice,
+    /// The scenario's tasks take the tick's sample.
+    Score,
     Publish,
 }
 
@@ -53,6 +57,7 @@ pub fn haptic_schedule() -> Schedule {
             HapticSet::ComputeForce,
             HapticSet::Safety,
             HapticSet::WriteDevice,
+            HapticSet::Score,
             HapticSet::Publish,
         )
             .chain(),
@@ -64,6 +69,7 @@ pub fn haptic_schedule() -> Schedule {
         systems::compute_force.in_set(HapticSet::ComputeForce),
         systems::apply_safety.in_set(HapticSet::Safety),
         systems::write_device.in_set(HapticSet::WriteDevice),
+        exercise::score_tick.in_set(HapticSet::Score),
         (systems::trace_force, systems::publish_snapshot).in_set(HapticSet::Publish),
     ));
     schedule

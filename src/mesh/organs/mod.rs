@@ -50,6 +50,14 @@ impl Organ {
         Organ::Cornea,
     ];
 
+    /// The organs of the abdominal scene, which share one frame (the cornea stands alone).
+    pub const ABDOMEN: [Organ; 4] = [
+        Organ::Liver,
+        Organ::Gallbladder,
+        Organ::Pancreas,
+        Organ::Duodenum,
+    ];
+
     pub fn name(self) -> &'static str {
         match self {
             Organ::Liver => "liver",

@@ -1,0 +1,69 @@
+//! A session that runs a scenario: its scene (organs, tool, device limit), its exercise inside
+//! the haptic world, and the scorecard when every task has ended or the device's script has.
+
+use std::path::Path;
+
+use super::haptic::{ExerciseRun, HapticLoop, HapticScene, TickClock};
+use super::scene::{Detail, scene_of};
+use crate::cli::OnStale;
+use crate::haptics::{HapticDevice, TICK_S};
+use crate::mesh::organs::Organ;
+use crate::scenario::{Exercise, Scenario, Scorecard, score};
+
+/// The scene a scenario asks for, its vademecums from `dir`.
+pub fn scenario_scene(
+    scenario: &Scenario,
+    dir: &Path,
+    detail: Detail,
+    on_stale: OnStale,
+) -> Result<HapticScene, String> {
+    let organs: Vec<Organ> = scenario
+        .organs
+        .iter()
+        .map(|name| Organ::from_name(name).ok_or_else(|| format!("there is no organ `{name}`")))
+        .collect::<Result<_, _>>()?;
+    let tip = scenario.tool.tip_radius_m();
+    let mut scene = scene_of(&organs, Some(tip), dir, detail, on_stale)?;
+    scene.safety.max_force_n = scenario.device.max_force_n.0;
+    Ok(scene)
+}
+
+/// What a session of a scenario leaves: the scorecard and the force against time (100 Hz).
+pub struct Outcome {
+    pub card: Scorecard,
+    pub force_trace: Vec<(f64, f64)>,
+}
+
+/// Runs `scenario` on a simulated clock with `device` until every task has ended or
+/// `max_ticks` have run (the script's end), then scores it.
+pub fn run_simulated(
+    scenario: Scenario,
+    scene: &HapticScene,
+    device: Box<dyn HapticDevice>,
+    max_ticks: u64,
+) -> Result<Outcome, String> {
+    let mut haptic = HapticLoop::new(scene, device).map_err(|e| e.to_string())?;
+    haptic
+        .world_mut()
+        .insert_resource(ExerciseRun(Exercise::new(scenario)));
+    for tick in 0..max_ticks {
+        haptic.tick(TickClock {
+            tick,
+            time_s: tick as f64 * TICK_S,
+            overruns_in_a_row: 0,
+        });
+        if haptic.world().resource::<ExerciseRun>().0.finished() {
+            break;
+        }
+    }
+    let exercise = haptic
+        .world_mut()
+        .remove_resource::<ExerciseRun>()
+        .expect("inserted above")
+        .0;
+    let (scenario, tasks, force_trace) = exercise.finish();
+    Ok(Outcome {
+        card: score(&scenario, tasks),
+        force_trace,
+    })
+}

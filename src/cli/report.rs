@@ -1,0 +1,125 @@
+//! A training session's report on disk: the scorecard as JSON, a summary a trainee reads, and
+//! a plot of the force against time with each task's limits drawn over its span.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use plotters::prelude::*;
+
+use super::plot::{PlotResult, save_png};
+use crate::scenario::Scorecard;
+
+const SIZE: (u32, u32) = (1200, 500);
+
+/// Writes `<stem>.json`, `<stem>.txt` and `<stem>.png` in `dir`; returns their paths.
+pub fn write_report(
+    dir: &Path,
+    stem: &str,
+    card: &Scorecard,
+    force_trace: &[(f64, f64)],
+) -> Result<[PathBuf; 3], String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let [json, text, png] = ["json", "txt", "png"].map(|ext| dir.join(format!("{stem}.{ext}")));
+    let body = serde_json::to_string_pretty(card).map_err(|e| e.to_string())?;
+    std::fs::write(&json, body).map_err(|e| format!("{}: {e}", json.display()))?;
+    std::fs::write(&text, summary(card)).map_err(|e| format!("{}: {e}", text.display()))?;
+    plot(&png, card, force_trace).map_err(|e| format!("{}: {e}", png.display()))?;
+    Ok([json, text, png])
+}
+
+/// The scorecard in words: the verdict, each task's metrics and score, what went wrong.
+pub fn summary(card: &Scorecard) -> String {
+    let mut out = String::new();
+    let verdict = if card.passed { "PASSED" } else { "FAILED" };
+    let _ = writeln!(
+        out,
+        "{}: {verdict} with {:.0} / 100 (pass mark {:.0})",
+        card.title, card.score, card.pass_mark
+    );
+    for (k, task) in card.tasks.iter().enumerate() {
+        let m = &task.metrics;
+        let _ = writeln!(
+            out,
+            "task {}: {} — {}\n  {} in {:.1} s of {:.0} s; contact {:.1} s, peak {:.2} N, mean {:.2} N, {:.1} s above {:.2} N; {} errors; score {:.0}",
+            k + 1,
+            m.kind,
+            m.description,
+            if m.completed { "done" } else { "not done" },
+            m.time_s,
+            m.time_limit_s,
+            m.contact_s,
+            m.peak_force_n,
+            m.mean_force_n,
+            m.time_over_limit_s,
+            m.force_limit_n,
+            m.errors.len(),
+            task.score
+        );
+        if m.targets > 0 {
+            let path = m.path_ratio.map_or(String::new(), |r| {
+                format!(", path {r:.2}× the straight line")
+            });
+            let _ = writeln!(
+                out,
+                "  targets reached: {} of {}{path}",
+                m.targets_reached, m.targets
+            );
+        }
+    }
+    if !card.feedback.is_empty() {
+        let _ = writeln!(out, "what to work on:");
+        for line in &card.feedback {
+            let _ = writeln!(out, "  - {line}");
+        }
+    }
+    out
+}
+
+fn plot(path: &Path, card: &Scorecard, trace: &[(f64, f64)]) -> PlotResult {
+    save_png(path, SIZE, |root| {
+        let end_s = trace.last().map_or(1.0, |p| p.0).max(1e-3);
+        let limits = card.tasks.iter().map(|t| t.metrics.force_limit_n);
+        let top_n = trace.iter().map(|p| p.1).chain(limits).fold(0.1, f64::max) * 1.15;
+        let mut chart = ChartBuilder::on(root)
+            .caption(
+                format!("{}: force against time", card.title),
+                ("sans-serif", 22),
+            )
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
+            .build_cartesian_2d(0.0..end_s, 0.0..top_n)?;
+        chart
+            .configure_mesh()
+            .x_desc("time (s)")
+            .y_desc("force (N)")
+            .draw()?;
+        chart
+            .draw_series(LineSeries::new(trace.iter().copied(), BLUE.stroke_width(2)))?
+            .label("force sent to the device")
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE.stroke_width(2)));
+        for task in &card.tasks {
+            let m = &task.metrics;
+            let span = (m.started_s, m.started_s + m.time_s.max(1e-3));
+            let mut bounds = vec![m.force_limit_n];
+            bounds.extend(m.band_min_n);
+            for level in bounds {
+                chart.draw_series(LineSeries::new(
+                    [(span.0, level), (span.1, level)],
+                    RED.stroke_width(2),
+                ))?;
+            }
+            chart.draw_series([Text::new(
+                m.kind.clone(),
+                (span.0, m.force_limit_n),
+                ("sans-serif", 14),
+            )])?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()?;
+        Ok(())
+    })
+}

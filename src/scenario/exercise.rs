@@ -1,0 +1,339 @@
+//! A scenario's tasks as they run: fed one [`Sample`] per haptic tick, each task measures what
+//! its kind is scored on and ends when done or out of time; then the next starts.
+
+use nalgebra::Vector3;
+use serde::Serialize;
+
+use super::format::{Scenario, Spot, Task};
+
+/// What the haptic loop knows of one tick, for scoring.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    pub time_s: f64,
+    pub tip_m: Option<Vector3<f64>>,
+    /// The force sent to the device (N).
+    pub force_n: f64,
+    /// The organs the tool touches: bit `k` for the scenario's `organs[k]`.
+    pub touching: u64,
+}
+
+impl Sample {
+    pub fn touches(&self, organ: usize) -> bool {
+        organ < 64 && self.touching & (1 << organ) != 0
+    }
+}
+
+/// Force recorded for the plot every this many ticks (100 Hz at 1 kHz).
+const PLOT_EVERY: u64 = 10;
+/// Above a limit until the force falls below this share of it: one press is one error.
+const HYSTERESIS: f64 = 0.9;
+
+/// What a task measured.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct TaskMetrics {
+    pub kind: String,
+    pub description: String,
+    pub started_s: f64,
+    pub time_limit_s: f64,
+    pub completed: bool,
+    /// Time spent on the task (to completion, or the whole limit).
+    pub time_s: f64,
+    pub contact_s: f64,
+    pub peak_force_n: f64,
+    /// Mean force while in contact.
+    pub mean_force_n: f64,
+    /// The force limit the task sets (the band's top for force control).
+    pub force_limit_n: f64,
+    /// Force control: the band's bottom.
+    pub band_min_n: Option<f64>,
+    pub time_over_limit_s: f64,
+    /// Force control: time in contact with the organ within the band.
+    pub within_band_s: f64,
+    /// Safe navigation: targets reached, of how many.
+    pub targets_reached: usize,
+    pub targets: usize,
+    /// Safe navigation: the tip's path against the straight lines between targets (1 = straight).
+    pub path_ratio: Option<f64>,
+    /// Each error, with the time it was made.
+    pub errors: Vec<String>,
+}
+
+/// One task's running state.
+struct Running {
+    metrics: TaskMetrics,
+    force_sum: f64,
+    /// Force control: since when the force has been in the band on the organ.
+    in_band_since: Option<f64>,
+    over_limit: bool,
+    /// Safe navigation: the forbidden zone the tip is in, if any.
+    inside_zone: Option<usize>,
+    path_m: f64,
+    first_tip: Option<Vector3<f64>>,
+    last_tip: Option<Vector3<f64>>,
+}
+
+/// The tasks of a scenario, run one after another.
+pub struct Exercise {
+    scenario: Scenario,
+    current: usize,
+    running: Option<Running>,
+    done: Vec<TaskMetrics>,
+    last_time_s: Option<f64>,
+    ticks: u64,
+    /// (time s, force N) at 100 Hz, for the report's plot.
+    pub force_trace: Vec<(f64, f64)>,
+}
+
+impl Exercise {
+    pub fn new(scenario: Scenario) -> Self {
+        Self {
+            scenario,
+            current: 0,
+            running: None,
+            done: Vec::new(),
+            last_time_s: None,
+            ticks: 0,
+            force_trace: Vec::new(),
+        }
+    }
+
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+
+    /// Whether every task has ended.
+    pub fn finished(&self) -> bool {
+        self.current >= self.scenario.tasks.len()
+    }
+
+    /// The task under way, if any: its index and kind.
+    pub fn current_task(&self) -> Option<(usize, &Task)> {
+        self.scenario
+            .tasks
+            .get(self.current)
+            .map(|t| (self.current, t))
+    }
+
+    /// Takes one tick's sample.
+    pub fn step(&mut self, sample: &Sample) {
+        let dt = self
+            .last_time_s
+            .map_or(0.0, |last| (sample.time_s - last).max(0.0));
+        self.last_time_s = Some(sample.time_s);
+        if self.ticks.is_multiple_of(PLOT_EVERY) {
+            self.force_trace.push((sample.time_s, sample.force_n));
+        }
+        self.ticks += 1;
+        let Some(task) = self.scenario.tasks.get(self.current) else {
+            return;
+        };
+        let running = self
+            .running
+            .get_or_insert_with(|| Running::start(task, sample.time_s));
+        running.step(task, &self.scenario.organs, sample, dt);
+        let elapsed = sample.time_s - running.metrics.started_s;
+        if running.metrics.completed || elapsed >= task.time_limit_s() {
+            self.end_task(sample.time_s);
+        }
+    }
+
+    fn end_task(&mut self, time_s: f64) {
+        if let Some(mut running) = self.running.take() {
+            running.metrics.time_s = time_s - running.metrics.started_s;
+            running.metrics.mean_force_n = if running.metrics.contact_s > 0.0 {
+                running.force_sum / running.metrics.contact_s
+            } else {
+                0.0
+            };
+            self.done.push(running.metrics);
+        }
+        self.current += 1;
+    }
+
+    /// Ends the exercise (unfinished tasks are not completed) and returns every task's metrics.
+    pub fn finish(mut self) -> (Scenario, Vec<TaskMetrics>, Vec<(f64, f64)>) {
+        let now = self.last_time_s.unwrap_or(0.0);
+        while !self.finished() {
+            if self.running.is_none() {
+                let task = &self.scenario.tasks[self.current];
+                self.running = Some(Running::start(task, now));
+            }
+            self.end_task(now);
+        }
+        (self.scenario, self.done, self.force_trace)
+    }
+}
+
+impl Running {
+    fn start(task: &Task, time_s: f64) -> Self {
+        let (description, force_limit_n, targets, band_min_n) = match task {
+            Task::ForceControl {
+                organ,
+                min_force_n,
+                max_force_n,
+                hold_s,
+                ..
+            } => (
+                format!(
+                    "hold {:.2}–{:.2} N on the {organ} for {} s",
+                    min_force_n.0, max_force_n.0, hold_s.0
+                ),
+                max_force_n.0,
+                0,
+                Some(min_force_n.0),
+            ),
+            Task::SafeNavigation {
+                targets,
+                forbidden,
+                max_force_n,
+                ..
+            } => (
+                format!(
+                    "reach {} in order, avoiding {}, under {:.2} N",
+                    names(targets),
+                    names(forbidden),
+                    max_force_n.0
+                ),
+                max_force_n.0,
+                targets.len(),
+                None,
+            ),
+        };
+        Self {
+            metrics: TaskMetrics {
+                kind: task.kind().into(),
+                description,
+                started_s: time_s,
+                time_limit_s: task.time_limit_s(),
+                force_limit_n,
+                band_min_n,
+                targets,
+                ..TaskMetrics::default()
+            },
+            force_sum: 0.0,
+            in_band_since: None,
+            over_limit: false,
+            inside_zone: None,
+            path_m: 0.0,
+            first_tip: None,
+            last_tip: None,
+        }
+    }
+
+    fn step(&mut self, task: &Task, organs: &[String], sample: &Sample, dt: f64) {
+        let m = &mut self.metrics;
+        let force = sample.force_n;
+        m.peak_force_n = m.peak_force_n.max(force);
+        if sample.touching != 0 {
+            m.contact_s += dt;
+            self.force_sum += force * dt;
+        }
+        if force > m.force_limit_n {
+            m.time_over_limit_s += dt;
+            if !self.over_limit {
+                let error = format!(
+                    "{:.2} s: pressed harder than {:.2} N",
+                    sample.time_s, m.force_limit_n
+                );
+                m.errors.push(error);
+            }
+            self.over_limit = true;
+        } else if force < HYSTERESIS * m.force_limit_n {
+            self.over_limit = false;
+        }
+        match task {
+            Task::ForceControl {
+                organ,
+                min_force_n,
+                max_force_n,
+                hold_s,
+                ..
+            } => {
+                let on_organ = organs
+                    .iter()
+                    .position(|o| o == organ)
+                    .is_some_and(|k| sample.touches(k));
+                let in_band = on_organ && (min_force_n.0..=max_force_n.0).contains(&force);
+                if in_band {
+                    self.metrics.within_band_s += dt;
+                    let since = *self.in_band_since.get_or_insert(sample.time_s);
+                    self.metrics.completed = sample.time_s - since >= hold_s.0;
+                } else {
+                    self.in_band_since = None;
+                }
+            }
+            Task::SafeNavigation {
+                targets, forbidden, ..
+            } => self.navigate(targets, forbidden, sample),
+        }
+    }
+
+    fn navigate(&mut self, targets: &[Spot], forbidden: &[Spot], sample: &Sample) {
+        let Some(tip) = sample.tip_m else {
+            return;
+        };
+        if let Some(last) = self.last_tip {
+            self.path_m += (tip - last).norm();
+        }
+        self.last_tip = Some(tip);
+        let first = *self.first_tip.get_or_insert(tip);
+        let m = &mut self.metrics;
+        if let Some(target) = targets.get(m.targets_reached)
+            && target.contains(&tip)
+        {
+            m.targets_reached += 1;
+            if m.targets_reached == targets.len() {
+                m.completed = true;
+                m.path_ratio = Some(self.path_m / straight_length_m(first, targets).max(1e-6));
+            }
+        }
+        match self.inside_zone {
+            Some(k) => {
+                let zone = &forbidden[k];
+                if (tip - zone.centre_m()).norm() > zone.radius_mm.metres() / HYSTERESIS {
+                    self.inside_zone = None;
+                }
+            }
+            None => {
+                if let Some(k) = forbidden.iter().position(|z| z.contains(&tip)) {
+                    self.inside_zone = Some(k);
+                    m.errors.push(format!(
+                        "{:.2} s: entered the forbidden {}",
+                        sample.time_s,
+                        spot_name(&forbidden[k], k)
+                    ));
+                }
+            }
+        }
+    }
+}
+
+/// The straight path from `start` through the targets, in order (m).
+fn straight_length_m(start: Vector3<f64>, targets: &[Spot]) -> f64 {
+    let mut length = 0.0;
+    let mut from = start;
+    for target in targets {
+        length += (target.centre_m() - from).norm();
+        from = target.centre_m();
+    }
+    length
+}
+
+fn spot_name(spot: &Spot, k: usize) -> String {
+    match spot.name.is_empty() {
+        true => format!("zone {}", k + 1),
+        false => spot.name.clone(),
+    }
+}
+
+fn names(spots: &[Spot]) -> String {
+    match spots.len() {
+        0 => "nothing".into(),
+        _ => spots
+            .iter()
+            .enumerate()
+            .map(|(k, s)| spot_name(s, k))
+            .collect::<Vec<_>>()
+            .join(", "),
+    }
+}

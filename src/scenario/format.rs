@@ -1,0 +1,198 @@
+//! The scenario file, `scenarios/<name>.scenario.ron`, as types: every field an educator may
+//! write, its unit in its name, its default where it may be left out. Unknown fields are
+//! refused (a misspelt field would otherwise be silently ignored). `docs/scenarios.md` is the
+//! reference page for this file.
+
+use serde::Deserialize;
+
+use super::units::{Millimetres, Newtons, Seconds};
+
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    pub title: String,
+    /// What the trainee reads before starting.
+    pub briefing: String,
+    #[serde(default)]
+    pub difficulty: Difficulty,
+    /// The organs in the scene, by name: liver, gallbladder, pancreas, duodenum.
+    pub organs: Vec<String>,
+    #[serde(default)]
+    pub tool: Tool,
+    #[serde(default)]
+    pub device: Device,
+    /// Done in order: each task starts when the one before is done or out of time.
+    pub tasks: Vec<Task>,
+    #[serde(default)]
+    pub rubric: Rubric,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+pub enum Difficulty {
+    #[default]
+    Beginner,
+    Intermediate,
+    Advanced,
+}
+
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Tool {
+    /// A round-tipped probe.
+    Probe { tip_radius_mm: Millimetres },
+}
+
+impl Default for Tool {
+    fn default() -> Self {
+        Tool::Probe {
+            tip_radius_mm: Millimetres(6.0),
+        }
+    }
+}
+
+impl Tool {
+    pub fn tip_radius_m(&self) -> f64 {
+        match self {
+            Tool::Probe { tip_radius_mm } => tip_radius_mm.metres(),
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Device {
+    /// The largest force sent to the device (also capped by the device's own limit).
+    #[serde(default = "default_device_force")]
+    pub max_force_n: Newtons,
+}
+
+fn default_device_force() -> Newtons {
+    Newtons(3.3)
+}
+
+impl Default for Device {
+    fn default() -> Self {
+        Self {
+            max_force_n: default_device_force(),
+        }
+    }
+}
+
+/// A point in the scene's frame (millimetres; x to the patient's left, y anterior, z to the
+/// head), with a radius around it.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Spot {
+    /// What the trainee is told it is.
+    #[serde(default)]
+    pub name: String,
+    pub at_mm: (f64, f64, f64),
+    pub radius_mm: Millimetres,
+}
+
+impl Spot {
+    pub fn centre_m(&self) -> nalgebra::Vector3<f64> {
+        nalgebra::Vector3::new(self.at_mm.0, self.at_mm.1, self.at_mm.2) * 1e-3
+    }
+
+    /// Whether the tool tip at `tip_m` is within the spot.
+    pub fn contains(&self, tip_m: &nalgebra::Vector3<f64>) -> bool {
+        (tip_m - self.centre_m()).norm() <= self.radius_mm.metres()
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Task {
+    /// Press the organ and hold the force within a band for a while.
+    ForceControl {
+        organ: String,
+        min_force_n: Newtons,
+        max_force_n: Newtons,
+        hold_s: Seconds,
+        time_limit_s: Seconds,
+    },
+    /// Reach the targets in order, without entering a forbidden zone or pressing harder
+    /// than the limit.
+    SafeNavigation {
+        targets: Vec<Spot>,
+        #[serde(default)]
+        forbidden: Vec<Spot>,
+        max_force_n: Newtons,
+        time_limit_s: Seconds,
+    },
+}
+
+impl Task {
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Task::ForceControl { .. } => "force control",
+            Task::SafeNavigation { .. } => "safe navigation",
+        }
+    }
+
+    pub fn time_limit_s(&self) -> f64 {
+        match self {
+            Task::ForceControl { time_limit_s, .. } | Task::SafeNavigation { time_limit_s, .. } => {
+                time_limit_s.0
+            }
+        }
+    }
+}
+
+/// How a task's score (0–100) is made from its metrics, and what passes.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Rubric {
+    /// Weight of finishing the task at all.
+    #[serde(default = "default_completion")]
+    pub completion: f64,
+    /// Weight of speed: the share of the time limit left.
+    #[serde(default = "default_speed")]
+    pub speed: f64,
+    /// Weight of force control: the share of the time in contact spent within the task's
+    /// force limits.
+    #[serde(default = "default_force")]
+    pub force: f64,
+    /// Points lost per error (a forbidden zone entered, a press over the limit).
+    #[serde(default = "default_error_penalty")]
+    pub error_penalty: f64,
+    /// The session passes with this overall score (0–100) or more...
+    #[serde(default = "default_pass_mark")]
+    pub pass_mark: f64,
+    /// ...and, if set, only with every task finished.
+    #[serde(default = "default_true")]
+    pub all_tasks_required: bool,
+}
+
+fn default_completion() -> f64 {
+    0.4
+}
+fn default_speed() -> f64 {
+    0.2
+}
+fn default_force() -> f64 {
+    0.4
+}
+fn default_error_penalty() -> f64 {
+    10.0
+}
+fn default_pass_mark() -> f64 {
+    70.0
+}
+fn default_true() -> bool {
+    true
+}
+
+impl Default for Rubric {
+    fn default() -> Self {
+        Self {
+            completion: default_completion(),
+            speed: default_speed(),
+            force: default_force(),
+            error_penalty: default_error_penalty(),
+            pass_mark: default_pass_mark(),
+            all_tasks_required: true,
+        }
+    }
+}

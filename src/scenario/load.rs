@@ -1,0 +1,268 @@
+//! Reading a scenario file: RON syntax, field names and units while deserializing (ron knows
+//! the line and column, serde_path_to_error the field path), then what only the whole
+//! scenario can tell (an organ a task names but the scene lacks, a force band upside down),
+//! located in the text by the field it is about. Every error names the file, the line and
+//! column, the field path, the problem and a hint.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use super::format::{Scenario, Task};
+use crate::mesh::organs::Organ;
+
+/// Where every reference of the scenario format is explained.
+const REFERENCE: &str = "docs/scenarios.md";
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScenarioError {
+    pub file: PathBuf,
+    /// 1-based, as editors count.
+    pub line: usize,
+    pub column: usize,
+    /// The field path, e.g. `tasks[1].max_force_n` (empty for the file as a whole).
+    pub field: String,
+    pub message: String,
+    pub hint: String,
+}
+
+impl fmt::Display for ScenarioError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}:{}: ", self.file.display(), self.line, self.column)?;
+        if !self.field.is_empty() {
+            write!(f, "{}: ", self.field)?;
+        }
+        write!(f, "{}\n  hint: {}", self.message, self.hint)
+    }
+}
+
+impl std::error::Error for ScenarioError {}
+
+/// Reads and checks the scenario in `file`.
+pub fn load(file: &Path) -> Result<Scenario, ScenarioError> {
+    let text = std::fs::read_to_string(file).map_err(|e| ScenarioError {
+        file: file.to_owned(),
+        line: 1,
+        column: 1,
+        field: String::new(),
+        message: format!("cannot read it: {e}"),
+        hint: "check the path; shipped scenarios are in scenarios/".into(),
+    })?;
+    parse(file, &text)
+}
+
+/// Parses and checks scenario text; `file` names it in errors.
+pub fn parse(file: &Path, text: &str) -> Result<Scenario, ScenarioError> {
+    let syntax = |e: ron::error::SpannedError, field: String| {
+        let hint = hint_for(&e.code);
+        ScenarioError {
+            file: file.to_owned(),
+            line: e.span.start.line,
+            column: e.span.start.col,
+            field,
+            message: e.code.to_string(),
+            hint,
+        }
+    };
+    let mut de = ron::Deserializer::from_str(text).map_err(|e| syntax(e, String::new()))?;
+    let scenario: Scenario = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        // serde_path_to_error writes `?` for a step it cannot name and `.` for the root.
+        let field = e.path().to_string().replace('?', "");
+        let field = field.trim_matches('.').to_owned();
+        syntax(de.span_error(e.into_inner()), field)
+    })?;
+    de.end()
+        .map_err(|e| syntax(de.span_error(e), String::new()))?;
+    let problems = check(&scenario);
+    match problems.into_iter().next() {
+        None => Ok(scenario),
+        Some(problem) => Err(problem.locate(file, text)),
+    }
+}
+
+fn hint_for(code: &ron::Error) -> String {
+    use ron::Error as E;
+    match code {
+        E::NoSuchStructField { expected, .. } => {
+            format!("the fields here are: {}", expected.join(", "))
+        }
+        E::MissingStructField { field, .. } => format!("add `{field}: …` ({REFERENCE})"),
+        E::NoSuchEnumVariant { expected, .. } => {
+            format!("one of: {}", expected.join(", "))
+        }
+        E::Message(_) => format!("units and ranges are listed in {REFERENCE}"),
+        _ => format!(
+            "RON syntax: `Name(field: value, …)`, lists in `[…]`, text in \"…\" ({REFERENCE})"
+        ),
+    }
+}
+
+/// A problem found after parsing: the field path, and what to look for in the text to put
+/// the cursor on it (each key or quoted value in turn, from the start of the file).
+struct Problem {
+    field: String,
+    anchors: Vec<String>,
+    message: String,
+    hint: String,
+}
+
+impl Problem {
+    fn locate(self, file: &Path, text: &str) -> ScenarioError {
+        let mut at = 0;
+        for anchor in &self.anchors {
+            if let Some(found) = text[at..].find(anchor.as_str()) {
+                at += found;
+            }
+        }
+        let line = text[..at].matches('\n').count() + 1;
+        let column = at - text[..at].rfind('\n').map_or(0, |n| n + 1) + 1;
+        ScenarioError {
+            file: file.to_owned(),
+            line,
+            column,
+            field: self.field,
+            message: self.message,
+            hint: self.hint,
+        }
+    }
+}
+
+/// What is wrong with a scenario as a whole, in file order.
+fn check(scenario: &Scenario) -> Vec<Problem> {
+    let mut problems = Vec::new();
+    let known: Vec<&str> = Organ::ABDOMEN.iter().map(|o| o.name()).collect();
+    if scenario.organs.is_empty() {
+        problems.push(Problem {
+            field: "organs".into(),
+            anchors: vec!["organs".into()],
+            message: "the scene has no organs".into(),
+            hint: format!("name at least one of: {}", known.join(", ")),
+        });
+    }
+    for (k, organ) in scenario.organs.iter().enumerate() {
+        let anchors = vec!["organs".into(), format!("\"{organ}\"")];
+        if !known.contains(&organ.as_str()) {
+            problems.push(Problem {
+                field: format!("organs[{k}]"),
+                anchors,
+                message: format!("there is no organ `{organ}`"),
+                hint: format!("the organs are: {}", known.join(", ")),
+            });
+        } else if scenario.organs[..k].contains(organ) {
+            problems.push(Problem {
+                field: format!("organs[{k}]"),
+                anchors,
+                message: format!("`{organ}` is named twice"),
+                hint: "name each organ once".into(),
+            });
+        }
+    }
+    if scenario.tasks.is_empty() {
+        problems.push(Problem {
+            field: "tasks".into(),
+            anchors: vec!["tasks".into()],
+            message: "the scenario has no tasks".into(),
+            hint: format!("add a ForceControl(…) or SafeNavigation(…) task ({REFERENCE})"),
+        });
+    }
+    for (k, task) in scenario.tasks.iter().enumerate() {
+        check_task(scenario, k, task, &mut problems);
+    }
+    check_rubric(scenario, &mut problems);
+    problems
+}
+
+fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Problem>) {
+    let field = |name: &str| format!("tasks[{k}].{name}");
+    let anchors = |name: &str| vec!["tasks".to_owned(), name.to_owned()];
+    let device_limit = scenario.device.max_force_n.0;
+    match task {
+        Task::ForceControl {
+            organ,
+            min_force_n,
+            max_force_n,
+            hold_s,
+            time_limit_s,
+        } => {
+            if !scenario.organs.contains(organ) {
+                problems.push(Problem {
+                    field: field("organ"),
+                    anchors: vec!["tasks".into(), format!("\"{organ}\"")],
+                    message: format!("`{organ}` is not in this scenario's organs"),
+                    hint: format!("the scene has: {}", scenario.organs.join(", ")),
+                });
+            }
+            if min_force_n.0 >= max_force_n.0 {
+                problems.push(Problem {
+                    field: field("min_force_n"),
+                    anchors: anchors("min_force_n"),
+                    message: format!(
+                        "the band is empty: {} N is not below max_force_n {} N",
+                        min_force_n.0, max_force_n.0
+                    ),
+                    hint: "min_force_n must be below max_force_n".into(),
+                });
+            }
+            if max_force_n.0 > device_limit {
+                problems.push(Problem {
+                    field: field("max_force_n"),
+                    anchors: anchors("max_force_n"),
+                    message: format!(
+                        "{} N is above the device's limit of {device_limit} N: the band cannot be reached",
+                        max_force_n.0
+                    ),
+                    hint: "lower it, or raise device.max_force_n".into(),
+                });
+            }
+            if hold_s.0 >= time_limit_s.0 {
+                problems.push(Problem {
+                    field: field("hold_s"),
+                    anchors: anchors("hold_s"),
+                    message: format!(
+                        "holding {} s cannot fit in the time limit of {} s",
+                        hold_s.0, time_limit_s.0
+                    ),
+                    hint: "make time_limit_s longer than hold_s".into(),
+                });
+            }
+        }
+        Task::SafeNavigation { targets, .. } => {
+            if targets.is_empty() {
+                problems.push(Problem {
+                    field: field("targets"),
+                    anchors: anchors("targets"),
+                    message: "there are no targets to reach".into(),
+                    hint: "add Spot(name: …, at_mm: (x, y, z), radius_mm: …) targets".into(),
+                });
+            }
+        }
+    }
+}
+
+fn check_rubric(scenario: &Scenario, problems: &mut Vec<Problem>) {
+    let rubric = &scenario.rubric;
+    let weights = [rubric.completion, rubric.speed, rubric.force];
+    if weights.iter().any(|w| !(w.is_finite() && *w >= 0.0)) || weights.iter().sum::<f64>() <= 0.0 {
+        problems.push(Problem {
+            field: "rubric".into(),
+            anchors: vec!["rubric".into()],
+            message: format!("the weights {weights:?} are not usable"),
+            hint: "completion, speed and force are weights of 0 or more, not all 0".into(),
+        });
+    }
+    if !(0.0..=100.0).contains(&rubric.pass_mark) {
+        problems.push(Problem {
+            field: "rubric.pass_mark".into(),
+            anchors: vec!["rubric".into(), "pass_mark".into()],
+            message: format!("{} is not a score", rubric.pass_mark),
+            hint: "scores run from 0 to 100".into(),
+        });
+    }
+    if !(rubric.error_penalty.is_finite() && rubric.error_penalty >= 0.0) {
+        problems.push(Problem {
+            field: "rubric.error_penalty".into(),
+            anchors: vec!["rubric".into(), "error_penalty".into()],
+            message: format!("{} is not a penalty", rubric.error_penalty),
+            hint: "points lost per error, 0 or more".into(),
+        });
+    }
+}

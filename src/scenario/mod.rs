@@ -1,0 +1,16 @@
+//! Training exercises: the scenario file educators write (`format`, `units`), reading it with
+//! errors that point at the line and field (`load`), its tasks as they run, fed by the haptic
+//! loop one tick at a time (`exercise`), and the rubric's score (`score`). No Bevy here: the
+//! app layer runs an [`Exercise`] inside the haptic schedule.
+
+mod exercise;
+mod format;
+mod load;
+mod score;
+mod units;
+
+pub use exercise::{Exercise, Sample, TaskMetrics};
+pub use format::{Device, Difficulty, Rubric, Scenario, Spot, Task, Tool};
+pub use load::{ScenarioError, load, parse};
+pub use score::{Scorecard, TaskScore, score};
+pub use units::{Millimetres, Newtons, Seconds};

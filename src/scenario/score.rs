@@ -1,0 +1,109 @@
+//! The rubric applied to what the tasks measured: a score per task, an overall score 0–100,
+//! pass or fail, and in words what went wrong.
+
+use serde::Serialize;
+
+use super::exercise::TaskMetrics;
+use super::format::{Rubric, Scenario};
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TaskScore {
+    pub metrics: TaskMetrics,
+    /// 0–100.
+    pub score: f64,
+}
+
+/// A session's result.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Scorecard {
+    pub title: String,
+    pub tasks: Vec<TaskScore>,
+    /// The mean of the task scores, 0–100.
+    pub score: f64,
+    pub pass_mark: f64,
+    pub passed: bool,
+    /// What went wrong, in words, for the debrief.
+    pub feedback: Vec<String>,
+}
+
+/// Scores `tasks` (in the scenario's order) by the scenario's rubric.
+pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
+    let rubric = &scenario.rubric;
+    let tasks: Vec<TaskScore> = tasks
+        .into_iter()
+        .map(|metrics| TaskScore {
+            score: task_score(rubric, &metrics),
+            metrics,
+        })
+        .collect();
+    let score = tasks.iter().map(|t| t.score).sum::<f64>() / tasks.len().max(1) as f64;
+    let all_done = tasks.iter().all(|t| t.metrics.completed);
+    let passed = score >= rubric.pass_mark && (all_done || !rubric.all_tasks_required);
+    let mut feedback: Vec<String> = tasks.iter().flat_map(task_feedback).collect();
+    if score < rubric.pass_mark {
+        feedback.push(format!(
+            "the score {score:.0} is below the pass mark {:.0}",
+            rubric.pass_mark
+        ));
+    }
+    Scorecard {
+        title: scenario.title.clone(),
+        tasks,
+        score,
+        pass_mark: rubric.pass_mark,
+        passed,
+        feedback,
+    }
+}
+
+/// Completion, speed and force control weighted by the rubric, less the error penalties.
+fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
+    let completion = f64::from(u8::from(m.completed));
+    let speed = match m.completed {
+        true => (1.0 - m.time_s / m.time_limit_s).clamp(0.0, 1.0),
+        false => 0.0,
+    };
+    let force = force_control(m);
+    let weights = rubric.completion + rubric.speed + rubric.force;
+    let weighted = (rubric.completion * completion + rubric.speed * speed + rubric.force * force)
+        / weights.max(f64::MIN_POSITIVE);
+    (100.0 * weighted - rubric.error_penalty * m.errors.len() as f64).clamp(0.0, 100.0)
+}
+
+/// The share of the time in contact spent as the task wants: within the band (force control),
+/// under the limit (safe navigation; full marks if the tool never touched).
+fn force_control(m: &TaskMetrics) -> f64 {
+    if m.contact_s <= 0.0 {
+        return match m.kind.as_str() {
+            "force control" => 0.0,
+            _ => 1.0,
+        };
+    }
+    match m.kind.as_str() {
+        "force control" => (m.within_band_s / m.contact_s).clamp(0.0, 1.0),
+        _ => (1.0 - m.time_over_limit_s / m.contact_s).clamp(0.0, 1.0),
+    }
+}
+
+fn task_feedback(task: &TaskScore) -> Vec<String> {
+    let m = &task.metrics;
+    let mut lines = Vec::new();
+    if !m.completed {
+        let what = match m.targets {
+            0 => String::new(),
+            n => format!(" ({} of {n} targets reached)", m.targets_reached),
+        };
+        lines.push(format!(
+            "{}: not finished in {:.0} s{what}",
+            m.kind, m.time_limit_s
+        ));
+    }
+    if m.time_over_limit_s > 0.0 {
+        lines.push(format!(
+            "{}: {:.1} s above {:.2} N (peak {:.2} N)",
+            m.kind, m.time_over_limit_s, m.force_limit_n, m.peak_force_n
+        ));
+    }
+    lines.extend(m.errors.iter().map(|e| format!("{}: {e}", m.kind)));
+    lines
+}

@@ -1,0 +1,71 @@
+//! Quantities in the units a scenario names, each refused out of its sensible range with a
+//! hint, while the file is read (so the error carries the line, column and field path).
+
+use serde::Deserialize;
+
+/// A length in millimetres, more than 0.5 mm and at most half a metre.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct Millimetres(pub f64);
+
+impl Millimetres {
+    pub fn metres(self) -> f64 {
+        self.0 * 1e-3
+    }
+}
+
+impl TryFrom<f64> for Millimetres {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if !v.is_finite() => Err(format!("{v} is not a length")),
+            v if v < 0.5 => Err(format!(
+                "{v} mm is too small: lengths here are in millimetres (a 6 mm tip is `6.0`, not `0.006`)"
+            )),
+            v if v > 500.0 => Err(format!(
+                "{v} mm is larger than the abdomen: lengths here are in millimetres"
+            )),
+            v => Ok(Self(v)),
+        }
+    }
+}
+
+/// A force in newtons, from 0 to 20 N.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct Newtons(pub f64);
+
+impl TryFrom<f64> for Newtons {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if !v.is_finite() || v < 0.0 => {
+                Err(format!("{v} is not a force (newtons, 0 or more)"))
+            }
+            v if v > 20.0 => Err(format!(
+                "{v} N is more than any haptic device gives: forces here are in newtons (a firm press on the liver is about 0.3 N)"
+            )),
+            v => Ok(Self(v)),
+        }
+    }
+}
+
+/// A duration in seconds, more than 0 and at most an hour.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct Seconds(pub f64);
+
+impl TryFrom<f64> for Seconds {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if !v.is_finite() || v <= 0.0 => {
+                Err(format!("{v} is not a duration (seconds, more than 0)"))
+            }
+            v if v > 3600.0 => Err(format!(
+                "{v} s is more than an hour: durations here are in seconds"
+            )),
+            v => Ok(Self(v)),
+        }
+    }
+}

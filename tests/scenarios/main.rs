@@ -1,0 +1,253 @@
+//! Scenarios: every shipped file validates; each has a competent and a careless scripted run
+//! (`tests/scenarios/<name>.competent.csv`, `.careless.csv`, written for the coarse organs and
+//! their 12 mm tool) — the competent one passes, the careless one fails, and the score orders
+//! them; broken files each give their expected error at the right line and field; and the
+//! `trainer` binary validates, runs and reports.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+use pgd_surgery::app::exercise::{Outcome, run_simulated, scenario_scene};
+use pgd_surgery::app::scene::{Detail, default_scene};
+use pgd_surgery::cli::{OnStale, write_report};
+use pgd_surgery::haptics::{Scripted, TICK_S, Trajectory};
+use pgd_surgery::scenario::{load, parse};
+
+const TRAINER: &str = env!("CARGO_BIN_EXE_trainer");
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The coarse vademecums of the four organs, built once for all tests here.
+fn vademecums() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenario-vademecums");
+        default_scene(&dir, Detail::Coarse, OnStale::Rebuild).unwrap();
+        dir
+    })
+}
+
+/// Runs a shipped scenario on the coarse organs with one of its scripts.
+fn run(name: &str, script: &str) -> Outcome {
+    let scenario = load(&root().join(format!("scenarios/{name}.scenario.ron"))).unwrap();
+    let scene = scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Refuse).unwrap();
+    let path = root().join(format!("tests/scenarios/{name}.{script}.csv"));
+    let trajectory = Trajectory::load(&path).unwrap();
+    let ticks = ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64;
+    let device = Box::new(Scripted::new("test", trajectory));
+    run_simulated(scenario, &scene, device, ticks).unwrap()
+}
+
+const SHIPPED: [&str; 5] = [
+    "liver-steady-press",
+    "gallbladder-gentle-press",
+    "pancreas-tour",
+    "duodenum-navigation",
+    "abdomen-tour",
+];
+
+#[test]
+fn every_shipped_scenario_validates() {
+    let mut found = 0;
+    for entry in std::fs::read_dir(root().join("scenarios")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.to_string_lossy().ends_with(".scenario.ron") {
+            load(&path).unwrap_or_else(|e| panic!("{e}"));
+            found += 1;
+        }
+    }
+    assert!(found >= SHIPPED.len(), "{found} scenarios");
+}
+
+/// A scoring that cannot tell a competent run from a careless one is broken.
+#[test]
+fn competent_runs_pass_careless_runs_fail_and_the_score_orders_them() {
+    for name in SHIPPED {
+        let competent = run(name, "competent").card;
+        let careless = run(name, "careless").card;
+        assert!(
+            competent.passed,
+            "{name}: the competent run failed: {competent:#?}"
+        );
+        assert!(
+            !careless.passed,
+            "{name}: the careless run passed: {careless:#?}"
+        );
+        assert!(
+            competent.score > careless.score + 20.0,
+            "{name}: {} vs {}",
+            competent.score,
+            careless.score
+        );
+        assert!(
+            !careless.feedback.is_empty(),
+            "{name}: a failure must say why"
+        );
+    }
+}
+
+/// The careless liver press is scored on what it did: pressed too hard, more than once, and
+/// never held the band; the competent one held it and finished early.
+#[test]
+fn metrics_say_what_went_wrong() {
+    let competent = &run("liver-steady-press", "competent").card.tasks[0].metrics;
+    assert!(competent.completed);
+    assert!(competent.time_s < 5.0, "{}", competent.time_s);
+    assert!(competent.errors.is_empty(), "{:?}", competent.errors);
+    assert!((0.15..=0.35).contains(&competent.mean_force_n));
+    let careless = &run("liver-steady-press", "careless").card.tasks[0].metrics;
+    assert!(!careless.completed);
+    assert!(careless.peak_force_n > 0.35);
+    assert!(careless.time_over_limit_s > 1.0);
+    assert!(careless.errors.len() >= 2, "{:?}", careless.errors);
+    let vessels = &run("pancreas-tour", "careless").card.tasks[0].metrics;
+    assert!(
+        vessels.errors.iter().any(|e| e.contains("splenic vessels")),
+        "{:?}",
+        vessels.errors
+    );
+}
+
+#[test]
+fn the_report_is_written_as_json_text_and_plot() {
+    let outcome = run("abdomen-tour", "competent");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenario-report");
+    let [json, text, png] =
+        write_report(&dir, "tour", &outcome.card, &outcome.force_trace).unwrap();
+    let value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    assert_eq!(value["passed"], true);
+    assert_eq!(value["tasks"].as_array().unwrap().len(), 2);
+    let summary = std::fs::read_to_string(text).unwrap();
+    assert!(
+        summary.contains("PASSED") && summary.contains("safe navigation"),
+        "{summary}"
+    );
+    assert_eq!(&std::fs::read(png).unwrap()[..8], b"\x89PNG\r\n\x1a\n");
+}
+
+/// Each broken file gives its error at the line and field it is about, with a hint.
+#[test]
+fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
+    let cases = [
+        (
+            "unknown-field",
+            8,
+            "rubrik",
+            "Unexpected field named `rubrik`",
+        ),
+        (
+            "metres-for-millimetres",
+            5,
+            "tip_radius_mm",
+            "in millimetres",
+        ),
+        ("missing-tasks", 5, "", "missing field named `tasks`"),
+        ("unknown-organ", 4, "organs[1]", "no organ `spleen`"),
+        (
+            "organ-not-in-scene",
+            6,
+            "tasks[0].organ",
+            "`pancreas` is not in this scenario",
+        ),
+        (
+            "band-upside-down",
+            8,
+            "tasks[0].min_force_n",
+            "the band is empty",
+        ),
+        ("syntax", 6, "tasks[0]", "Expected comma"),
+        (
+            "unknown-task",
+            6,
+            "tasks[0]",
+            "Unexpected variant named `Palpate`",
+        ),
+        (
+            "too-much-force",
+            8,
+            "max_force_n",
+            "forces here are in newtons",
+        ),
+        ("bad-pass-mark", 8, "rubric.pass_mark", "not a score"),
+    ];
+    for (name, line, field, message) in cases {
+        let file = root().join(format!("tests/scenarios/broken/{name}.scenario.ron"));
+        let error = load(&file).unwrap_err();
+        let shown = error.to_string();
+        assert_eq!(error.line, line, "{shown}");
+        assert!(
+            error.field.contains(field),
+            "{name}: field `{}`",
+            error.field
+        );
+        assert!(error.message.contains(message), "{shown}");
+        assert!(!error.hint.is_empty(), "{shown}");
+        assert!(
+            shown.starts_with(&format!("{}:{line}:", file.display())),
+            "{shown}"
+        );
+    }
+}
+
+#[test]
+fn a_missing_file_is_named() {
+    let error = load(Path::new("scenarios/nowhere.scenario.ron")).unwrap_err();
+    assert!(
+        error.to_string().contains("nowhere.scenario.ron"),
+        "{error}"
+    );
+    assert!(parse(Path::new("inline"), "").is_err());
+}
+
+#[test]
+fn the_trainer_validates_runs_and_reports() {
+    let broken = root().join("tests/scenarios/broken/unknown-organ.scenario.ron");
+    let output = Command::new(TRAINER)
+        .arg("validate")
+        .arg(&broken)
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("unknown-organ.scenario.ron:4:") && stderr.contains("spleen"),
+        "{stderr}"
+    );
+
+    let report_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenario-cli-report");
+    let output = Command::new(TRAINER)
+        .args([
+            "run",
+            "scenarios/liver-steady-press.scenario.ron",
+            "--headless",
+            "--coarse",
+            "--no-rebuild",
+            "--json",
+        ])
+        .arg("--device")
+        .arg(format!(
+            "scripted:{}",
+            root()
+                .join("tests/scenarios/liver-steady-press.careless.csv")
+                .display()
+        ))
+        .arg("--vademecums")
+        .arg(vademecums())
+        .arg("--report-dir")
+        .arg(&report_dir)
+        .current_dir(root())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    let card: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(card["passed"], false);
+    assert!(
+        report_dir.join("liver-steady-press.png").exists(),
+        "{stderr}"
+    );
+}
