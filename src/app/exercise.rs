@@ -43,9 +43,7 @@ pub fn run_simulated(
     max_ticks: u64,
 ) -> Result<Outcome, String> {
     let mut haptic = HapticLoop::new(scene, device).map_err(|e| e.to_string())?;
-    haptic
-        .world_mut()
-        .insert_resource(ExerciseRun(Exercise::new(scenario)));
+    start(&mut haptic, scenario);
     for tick in 0..max_ticks {
         haptic.tick(TickClock {
             tick,
@@ -56,13 +54,21 @@ pub fn run_simulated(
             break;
         }
     }
-    let exercise = haptic
+    Ok(end(&mut haptic).expect("started above"))
+}
+
+/// Puts `scenario`'s exercise into the haptic world: from the next tick on, it is scored.
+pub fn start(haptic: &mut HapticLoop, scenario: Scenario) {
+    haptic
         .world_mut()
-        .remove_resource::<ExerciseRun>()
-        .expect("inserted above")
-        .0;
+        .insert_resource(ExerciseRun(Exercise::new(scenario)));
+}
+
+/// Takes the exercise out of the haptic world, ends it and scores it; `None` if none ran.
+pub fn end(haptic: &mut HapticLoop) -> Option<Outcome> {
+    let exercise = haptic.world_mut().remove_resource::<ExerciseRun>()?.0;
     let (scenario, tasks, force_trace) = exercise.finish();
-    Ok(Outcome {
+    Some(Outcome {
         card: score(&scenario, tasks),
         force_trace,
     })

@@ -10,7 +10,7 @@ use serde::Serialize;
 use bevy::app::AppExit;
 use nalgebra::Vector3;
 
-use super::exercise::{Outcome, run_simulated, scenario_scene};
+use super::exercise::{Outcome, end, run_simulated, scenario_scene, start};
 use super::haptic::{
     HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport, Scheduling,
 };
@@ -129,8 +129,12 @@ pub fn open_window(
     options: &Options,
     exit_after_s: Option<f64>,
     screenshot: Option<ScreenshotPlan>,
-) -> Result<Report, String> {
-    let scene = scene(options)?;
+    scenario: Option<Scenario>,
+) -> Result<(Report, Option<Outcome>), String> {
+    let scene = match &scenario {
+        Some(scenario) => scenario_scene_capped(options, scenario)?,
+        None => scene(options)?,
+    };
     let (device, virtual_device) = match &options.device {
         Some(DeviceSpec::Scripted(path)) => {
             let trajectory = Trajectory::load(path).map_err(|e| e.to_string())?;
@@ -147,6 +151,9 @@ pub fn open_window(
     let device = recorded(device, &options.record);
     let device_name = device.name().to_owned();
     let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
+    if let Some(scenario) = scenario {
+        start(&mut haptic, scenario);
+    }
     let snapshots = haptic.publish();
     let timer = options.realtime.unwrap_or_default();
     let haptic =
@@ -159,12 +166,16 @@ pub fn open_window(
         exit_after_s,
         screenshot,
     });
-    let report = haptic.stop();
+    let (report, mut haptic) = haptic.stop();
+    let outcome = end(&mut haptic);
     match exit {
-        AppExit::Success => Ok(Report::Window {
-            haptic: report,
-            frames,
-        }),
+        AppExit::Success => Ok((
+            Report::Window {
+                haptic: report,
+                frames,
+            },
+            outcome,
+        )),
         AppExit::Error(code) => Err(format!("the window closed with error code {code}")),
     }
 }
@@ -192,6 +203,18 @@ pub fn run_scenario_headless(options: &Options, scenario: Scenario) -> Result<Ou
         .unwrap_or_else(|| ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64);
     let device = recorded(scripted(&options.device, trajectory), &options.record);
     run_simulated(scenario, &scene, device, ticks)
+}
+
+/// The scenario's scene, its force limit capped by the command line's.
+fn scenario_scene_capped(options: &Options, scenario: &Scenario) -> Result<HapticScene, String> {
+    let mut scene = scenario_scene(
+        scenario,
+        &options.vademecums,
+        options.detail,
+        options.on_stale,
+    )?;
+    scene.safety.max_force_n = scene.safety.max_force_n.min(options.max_force_n);
+    Ok(scene)
 }
 
 fn scene(options: &Options) -> Result<HapticScene, String> {
@@ -223,5 +246,5 @@ fn run_realtime(
     let thread =
         HapticThread::spawn(haptic, timer, Scheduling::RealTime).map_err(|e| e.to_string())?;
     std::thread::sleep(Duration::from_secs_f64(ticks as f64 * TICK_S));
-    Ok(thread.stop())
+    Ok(thread.stop().0)
 }

@@ -233,7 +233,7 @@ fn realtime(
         std::hint::black_box(&positions);
         std::thread::sleep(frame.saturating_sub(started.elapsed()));
     }
-    thread.stop()
+    thread.stop().0
 }
 
 impl fmt::Display for HapticBenchReport {

@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use pgd_surgery::app::exercise::Outcome;
 use pgd_surgery::app::scene::Detail;
 use pgd_surgery::app::window::ScreenshotPlan;
 use pgd_surgery::app::{self, session};
@@ -132,25 +133,49 @@ fn main() -> ExitCode {
         realtime,
         max_force_n: cli.max_force_n,
     };
-    let result = match (&cli.command, cli.headless) {
-        (Some(Command::Run { file, report_dir }), true) => {
-            return run_scenario(&options, file, report_dir, cli.json);
-        }
-        (Some(Command::Run { .. }), false) => {
-            Err("exercises run headless for now: add --headless and --device scripted:FILE".into())
-        }
-        (_, true) => session::run_headless(&options),
-        (_, false) => {
-            let screenshot = cli.screenshot.clone().map(|path| ScreenshotPlan {
-                path,
-                after_frames: cli.frames.max(1),
-            });
-            session::open_window(&options, cli.exit_after_s, screenshot)
-        }
+    let exercise = match &cli.command {
+        Some(Command::Run { file, report_dir }) => match scenario::load(file) {
+            Ok(scenario) => Some((scenario, file.as_path(), report_dir.as_path())),
+            Err(e) => {
+                eprintln!("{e}");
+                return ExitCode::from(2);
+            }
+        },
+        _ => None,
     };
+    if cli.headless {
+        return match exercise {
+            Some((scenario, file, report_dir)) => {
+                let outcome = session::run_scenario_headless(&options, scenario);
+                debrief(outcome, file, report_dir, cli.json)
+            }
+            None => finish(session::run_headless(&options), cli.json),
+        };
+    }
+    let screenshot = cli.screenshot.clone().map(|path| ScreenshotPlan {
+        path,
+        after_frames: cli.frames.max(1),
+    });
+    let (scenario, file, report_dir) = match exercise {
+        Some((scenario, file, report_dir)) => (Some(scenario), Some(file), report_dir),
+        None => (None, None, Path::new("reports")),
+    };
+    match session::open_window(&options, cli.exit_after_s, screenshot, scenario) {
+        Ok((report, outcome)) => {
+            report.print(cli.json && outcome.is_none());
+            match (outcome, file) {
+                (Some(outcome), Some(file)) => debrief(Ok(outcome), file, report_dir, cli.json),
+                _ => ExitCode::SUCCESS,
+            }
+        }
+        Err(e) => finish(Err(e), cli.json),
+    }
+}
+
+fn finish(result: Result<session::Report, String>, json: bool) -> ExitCode {
     match result {
         Ok(report) => {
-            report.print(cli.json);
+            report.print(json);
             ExitCode::SUCCESS
         }
         Err(e) => {
@@ -184,22 +209,14 @@ fn validate(files: &[PathBuf]) -> ExitCode {
     }
 }
 
-/// `trainer run FILE --headless`: the exercise on a scripted device, its score printed and
-/// its report written.
-fn run_scenario(
-    options: &session::Options,
+/// The end of an exercise: its score printed (JSON with `json`) and its report written.
+fn debrief(
+    outcome: Result<Outcome, String>,
     file: &Path,
     report_dir: &Path,
     json: bool,
 ) -> ExitCode {
-    let scenario = match scenario::load(file) {
-        Ok(scenario) => scenario,
-        Err(e) => {
-            eprintln!("{e}");
-            return ExitCode::from(2);
-        }
-    };
-    let outcome = match session::run_scenario_headless(options, scenario) {
+    let outcome = match outcome {
         Ok(outcome) => outcome,
         Err(e) => {
             eprintln!("trainer: {e}");

@@ -41,7 +41,7 @@ pub enum Scheduling {
 
 pub struct HapticThread {
     stop: Arc<AtomicBool>,
-    handle: JoinHandle<RealTimeReport>,
+    handle: JoinHandle<(RealTimeReport, HapticLoop)>,
 }
 
 impl HapticThread {
@@ -59,8 +59,9 @@ impl HapticThread {
         Ok(Self { stop, handle })
     }
 
-    /// Stops the loop after its current tick and says how it kept time.
-    pub fn stop(self) -> RealTimeReport {
+    /// Stops the loop after its current tick; says how it kept time, and hands the loop back
+    /// (its world holds what the session measured).
+    pub fn stop(self) -> (RealTimeReport, HapticLoop) {
         self.stop.store(true, Ordering::Relaxed);
         self.handle
             .join()
@@ -77,7 +78,7 @@ fn run(
     timer: TimerMode,
     scheduling: Scheduling,
     stop: &AtomicBool,
-) -> RealTimeReport {
+) -> (RealTimeReport, HapticLoop) {
     let scheduling = match scheduling {
         Scheduling::Normal => "normal".to_owned(),
         Scheduling::RealTime => match raise_priority() {
@@ -129,7 +130,7 @@ fn run(
         };
         ticks += 1;
     }
-    RealTimeReport {
+    let report = RealTimeReport {
         timer,
         scheduling,
         ticks,
@@ -137,7 +138,8 @@ fn run(
         lateness: TickTimes::of(&lateness),
         period_error: TickTimes::of(&period_error),
         compute: TickTimes::of(&compute),
-    }
+    };
+    (report, haptic)
 }
 
 /// Real-time (FIFO) scheduling above every normal thread, the renderer's included, so that a
