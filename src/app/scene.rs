@@ -28,6 +28,14 @@ pub enum Detail {
 }
 
 impl Detail {
+    /// The tool tip radius (m) the vademecums at this detail are built for.
+    pub fn tip_radius_m(self) -> f64 {
+        match self {
+            Detail::Full => BuildSettings::default().tool_tip_radius_m,
+            Detail::Coarse => 0.012,
+        }
+    }
+
     /// The vademecum of `organ` at this detail, kept under `dir`.
     pub fn vademecum(self, dir: &Path, organ: Organ) -> VademecumSpec {
         let full = VademecumSpec::default_in(dir, organ, Law::Linear);
@@ -39,7 +47,7 @@ impl Detail {
                     ..full.mesh
                 },
                 build: BuildSettings {
-                    tool_tip_radius_m: 0.012,
+                    tool_tip_radius_m: self.tip_radius_m(),
                     local_radius_m: 0.025,
                     ..full.build
                 },
@@ -65,11 +73,13 @@ pub fn scene_of(
     detail: Detail,
     on_stale: OnStale,
 ) -> Result<HapticScene, String> {
+    let tip = match (detail, tip_radius_m) {
+        (Detail::Full, Some(tip)) => tip,
+        _ => detail.tip_radius_m(),
+    };
     let spec = |organ: Organ| {
         let mut spec = detail.vademecum(dir, organ);
-        if let Some(tip) = tip_radius_m.filter(|_| detail == Detail::Full)
-            && tip != spec.build.tool_tip_radius_m
-        {
+        if tip != spec.build.tool_tip_radius_m {
             spec.build.tool_tip_radius_m = tip;
             spec.file = dir.join(format!("{}.tip{}mm.vdm", organ.name(), tip * 1e3));
         }
@@ -82,12 +92,9 @@ pub fn scene_of(
             Ok((organ.name().to_owned(), Arc::new(vademecum)))
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let probe = Probe {
-        tip_radius_m: spec(Organ::Liver).build.tool_tip_radius_m,
-    };
     Ok(HapticScene {
         organs: loaded,
-        probe,
+        probe: Probe { tip_radius_m: tip },
         safety: SafetySettings::default(),
     })
 }

@@ -112,9 +112,7 @@ pub fn run_headless(options: &Options) -> Result<Report, String> {
             return Err("the virtual device needs the window: drop --headless".into());
         }
     };
-    let ticks = options
-        .ticks
-        .unwrap_or_else(|| ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64);
+    let ticks = ticks_for(options, &trajectory);
     let device = recorded(scripted(&options.device, trajectory), &options.record);
     let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
     Ok(match options.realtime {
@@ -183,13 +181,7 @@ pub fn open_window(
 /// Runs a scenario's exercise on the scripted device `options` names, on a simulated clock,
 /// until its tasks have ended or the script has (plus 100 ms).
 pub fn run_scenario_headless(options: &Options, scenario: Scenario) -> Result<Outcome, String> {
-    let mut scene = scenario_scene(
-        &scenario,
-        &options.vademecums,
-        options.detail,
-        options.on_stale,
-    )?;
-    scene.safety.max_force_n = scene.safety.max_force_n.min(options.max_force_n);
+    let scene = scenario_scene_capped(options, &scenario)?;
     let trajectory = match &options.device {
         Some(DeviceSpec::Scripted(path)) => Trajectory::load(path).map_err(|e| e.to_string())?,
         _ => {
@@ -198,11 +190,16 @@ pub fn run_scenario_headless(options: &Options, scenario: Scenario) -> Result<Ou
             );
         }
     };
-    let ticks = options
-        .ticks
-        .unwrap_or_else(|| ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64);
+    let ticks = ticks_for(options, &trajectory);
     let device = recorded(scripted(&options.device, trajectory), &options.record);
     run_simulated(scenario, &scene, device, ticks)
+}
+
+/// The ticks `--ticks` asks for, or the script's length plus 100 ms.
+fn ticks_for(options: &Options, trajectory: &Trajectory) -> u64 {
+    options
+        .ticks
+        .unwrap_or_else(|| ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64)
 }
 
 /// The scenario's scene, its force limit capped by the command line's.

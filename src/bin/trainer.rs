@@ -156,18 +156,18 @@ fn main() -> ExitCode {
         path,
         after_frames: cli.frames.max(1),
     });
-    let (scenario, file, report_dir) = match exercise {
-        Some((scenario, file, report_dir)) => (Some(scenario), Some(file), report_dir),
-        None => (None, None, Path::new("reports")),
-    };
+    let (scenario, debrief_to) = exercise.map(|(s, file, dir)| (s, (file, dir))).unzip();
     match session::open_window(&options, cli.exit_after_s, screenshot, scenario) {
-        Ok((report, outcome)) => {
-            report.print(cli.json && outcome.is_none());
-            match (outcome, file) {
-                (Some(outcome), Some(file)) => debrief(Ok(outcome), file, report_dir, cli.json),
-                _ => ExitCode::SUCCESS,
+        Ok((report, outcome)) => match (outcome, debrief_to) {
+            (Some(outcome), Some((file, dir))) => {
+                // With --json, stdout carries the scorecard alone.
+                if !cli.json {
+                    report.print(false);
+                }
+                debrief(Ok(outcome), file, dir, cli.json)
             }
-        }
+            _ => finish(Ok(report), cli.json),
+        },
         Err(e) => finish(Err(e), cli.json),
     }
 }

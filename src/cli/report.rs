@@ -110,7 +110,7 @@ fn plot(path: &Path, card: &Scorecard, trace: &[(f64, f64)]) -> PlotResult {
                 ))?;
             }
             chart.draw_series([Text::new(
-                m.kind.clone(),
+                m.kind.to_string(),
                 (span.0, m.force_limit_n),
                 ("sans-serif", 14),
             )])?;

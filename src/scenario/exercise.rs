@@ -4,7 +4,7 @@
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use super::format::{Scenario, Spot, Task};
+use super::format::{Scenario, Spot, Task, TaskKind};
 
 /// What the haptic loop knows of one tick, for scoring.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,7 +31,7 @@ const HYSTERESIS: f64 = 0.9;
 /// What a task measured.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct TaskMetrics {
-    pub kind: String,
+    pub kind: TaskKind,
     pub description: String,
     pub started_s: f64,
     pub time_limit_s: f64,
@@ -62,6 +62,8 @@ pub struct TaskMetrics {
 struct Running {
     metrics: TaskMetrics,
     force_sum: f64,
+    /// Force control: the organ's index in the scenario's organs.
+    organ: Option<usize>,
     /// Force control: since when the force has been in the band on the organ.
     in_band_since: Option<f64>,
     over_limit: bool,
@@ -80,12 +82,15 @@ pub struct Exercise {
     done: Vec<TaskMetrics>,
     last_time_s: Option<f64>,
     ticks: u64,
-    /// (time s, force N) at 100 Hz, for the report's plot.
+    /// (time s, force N) at 100 Hz while a task runs, for the report's plot; sized for every
+    /// task's time limit up front, so the real-time thread does not reallocate it.
     pub force_trace: Vec<(f64, f64)>,
 }
 
 impl Exercise {
     pub fn new(scenario: Scenario) -> Self {
+        let total_s: f64 = scenario.tasks.iter().map(Task::time_limit_s).sum();
+        let samples = (total_s / (PLOT_EVERY as f64 * crate::haptics::TICK_S)).ceil() as usize;
         Self {
             scenario,
             current: 0,
@@ -93,25 +98,13 @@ impl Exercise {
             done: Vec::new(),
             last_time_s: None,
             ticks: 0,
-            force_trace: Vec::new(),
+            force_trace: Vec::with_capacity(samples + 1),
         }
-    }
-
-    pub fn scenario(&self) -> &Scenario {
-        &self.scenario
     }
 
     /// Whether every task has ended.
     pub fn finished(&self) -> bool {
         self.current >= self.scenario.tasks.len()
-    }
-
-    /// The task under way, if any: its index and kind.
-    pub fn current_task(&self) -> Option<(usize, &Task)> {
-        self.scenario
-            .tasks
-            .get(self.current)
-            .map(|t| (self.current, t))
     }
 
     /// Takes one tick's sample.
@@ -120,17 +113,18 @@ impl Exercise {
             .last_time_s
             .map_or(0.0, |last| (sample.time_s - last).max(0.0));
         self.last_time_s = Some(sample.time_s);
+        let Some(task) = self.scenario.tasks.get(self.current) else {
+            return;
+        };
         if self.ticks.is_multiple_of(PLOT_EVERY) {
             self.force_trace.push((sample.time_s, sample.force_n));
         }
         self.ticks += 1;
-        let Some(task) = self.scenario.tasks.get(self.current) else {
-            return;
-        };
+        let organs = &self.scenario.organs;
         let running = self
             .running
-            .get_or_insert_with(|| Running::start(task, sample.time_s));
-        running.step(task, &self.scenario.organs, sample, dt);
+            .get_or_insert_with(|| Running::start(task, organs, sample.time_s));
+        running.step(task, sample, dt);
         let elapsed = sample.time_s - running.metrics.started_s;
         if running.metrics.completed || elapsed >= task.time_limit_s() {
             self.end_task(sample.time_s);
@@ -156,7 +150,7 @@ impl Exercise {
         while !self.finished() {
             if self.running.is_none() {
                 let task = &self.scenario.tasks[self.current];
-                self.running = Some(Running::start(task, now));
+                self.running = Some(Running::start(task, &self.scenario.organs, now));
             }
             self.end_task(now);
         }
@@ -165,7 +159,7 @@ impl Exercise {
 }
 
 impl Running {
-    fn start(task: &Task, time_s: f64) -> Self {
+    fn start(task: &Task, organs: &[String], time_s: f64) -> Self {
         let (description, force_limit_n, targets, band_min_n) = match task {
             Task::ForceControl {
                 organ,
@@ -201,7 +195,7 @@ impl Running {
         };
         Self {
             metrics: TaskMetrics {
-                kind: task.kind().into(),
+                kind: task.kind(),
                 description,
                 started_s: time_s,
                 time_limit_s: task.time_limit_s(),
@@ -211,6 +205,10 @@ impl Running {
                 ..TaskMetrics::default()
             },
             force_sum: 0.0,
+            organ: match task {
+                Task::ForceControl { organ, .. } => organs.iter().position(|o| o == organ),
+                Task::SafeNavigation { .. } => None,
+            },
             in_band_since: None,
             over_limit: false,
             inside_zone: None,
@@ -220,7 +218,7 @@ impl Running {
         }
     }
 
-    fn step(&mut self, task: &Task, organs: &[String], sample: &Sample, dt: f64) {
+    fn step(&mut self, task: &Task, sample: &Sample, dt: f64) {
         let m = &mut self.metrics;
         let force = sample.force_n;
         m.peak_force_n = m.peak_force_n.max(force);
@@ -243,16 +241,12 @@ impl Running {
         }
         match task {
             Task::ForceControl {
-                organ,
                 min_force_n,
                 max_force_n,
                 hold_s,
                 ..
             } => {
-                let on_organ = organs
-                    .iter()
-                    .position(|o| o == organ)
-                    .is_some_and(|k| sample.touches(k));
+                let on_organ = self.organ.is_some_and(|k| sample.touches(k));
                 let in_band = on_organ && (min_force_n.0..=max_force_n.0).contains(&force);
                 if in_band {
                     self.metrics.within_band_s += dt;

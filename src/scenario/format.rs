@@ -123,11 +123,30 @@ pub enum Task {
     },
 }
 
+/// What kind a task is, for its metrics and its score.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub enum TaskKind {
+    #[default]
+    #[serde(rename = "force control")]
+    ForceControl,
+    #[serde(rename = "safe navigation")]
+    SafeNavigation,
+}
+
+impl std::fmt::Display for TaskKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            TaskKind::ForceControl => "force control",
+            TaskKind::SafeNavigation => "safe navigation",
+        })
+    }
+}
+
 impl Task {
-    pub fn kind(&self) -> &'static str {
+    pub fn kind(&self) -> TaskKind {
         match self {
-            Task::ForceControl { .. } => "force control",
-            Task::SafeNavigation { .. } => "safe navigation",
+            Task::ForceControl { .. } => TaskKind::ForceControl,
+            Task::SafeNavigation { .. } => TaskKind::SafeNavigation,
         }
     }
 

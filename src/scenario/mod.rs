@@ -10,7 +10,7 @@ mod score;
 mod units;
 
 pub use exercise::{Exercise, Sample, TaskMetrics};
-pub use format::{Device, Difficulty, Rubric, Scenario, Spot, Task, Tool};
+pub use format::{Device, Difficulty, Rubric, Scenario, Spot, Task, TaskKind, Tool};
 pub use load::{ScenarioError, load, parse};
 pub use score::{Scorecard, TaskScore, score};
 pub use units::{Millimetres, Newtons, Seconds};

@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::exercise::TaskMetrics;
-use super::format::{Rubric, Scenario};
+use super::format::{Rubric, Scenario, TaskKind};
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TaskScore {
@@ -74,14 +74,14 @@ fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
 /// under the limit (safe navigation; full marks if the tool never touched).
 fn force_control(m: &TaskMetrics) -> f64 {
     if m.contact_s <= 0.0 {
-        return match m.kind.as_str() {
-            "force control" => 0.0,
-            _ => 1.0,
+        return match m.kind {
+            TaskKind::ForceControl => 0.0,
+            TaskKind::SafeNavigation => 1.0,
         };
     }
-    match m.kind.as_str() {
-        "force control" => (m.within_band_s / m.contact_s).clamp(0.0, 1.0),
-        _ => (1.0 - m.time_over_limit_s / m.contact_s).clamp(0.0, 1.0),
+    match m.kind {
+        TaskKind::ForceControl => (m.within_band_s / m.contact_s).clamp(0.0, 1.0),
+        TaskKind::SafeNavigation => (1.0 - m.time_over_limit_s / m.contact_s).clamp(0.0, 1.0),
     }
 }
 

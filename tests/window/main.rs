@@ -133,10 +133,7 @@ fn rest_and_press() -> &'static (Shot, Shot) {
     static SHOTS: OnceLock<(Shot, Shot)> = OnceLock::new();
     SHOTS.get_or_init(|| {
         let (point, normal) = liver_target();
-        let radius_m = Detail::Coarse
-            .vademecum(vademecums(), pgd_surgery::mesh::organs::Organ::Liver)
-            .build
-            .tool_tip_radius_m;
+        let radius_m = Detail::Coarse.tip_radius_m();
         let rest = screenshot("rest", held_at(point + Vector3::new(0.3, 0.0, 0.0)));
         let above = point + normal * 0.05;
         let pressed = point + normal * (radius_m - PRESS_DEPTH_M);
