@@ -1,6 +1,7 @@
 //! The default training scene: the four abdominal organs in their anatomical places (the
 //! generator builds them in one frame), each with its vademecum from `vademecums/`.
 
+use std::collections::BTreeSet;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -8,10 +9,11 @@ use nalgebra::Vector3;
 
 use super::haptic::HapticScene;
 use crate::cli::{OnStale, VademecumSpec, ensure_vademecum};
-use crate::contact::Probe;
+use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, Probe};
 use crate::fem::Law;
 use crate::haptics::{PressTarget, SafetySettings};
-use crate::mesh::organs::{Organ, OrganSettings};
+use crate::mesh::TetMesh;
+use crate::mesh::organs::{Organ, OrganSettings, region};
 use crate::pgd::{BuildSettings, Vademecum};
 
 pub const SCENE_ORGANS: [Organ; 4] = Organ::ABDOMEN;
@@ -88,15 +90,57 @@ pub fn scene_of(
     let loaded = organs
         .iter()
         .map(|&organ| {
-            let vademecum = ensure_vademecum(&spec(organ), on_stale)?;
-            Ok((organ.name().to_owned(), Arc::new(vademecum)))
+            let (vademecum, mesh) = ensure_vademecum(&spec(organ), on_stale)?;
+            Ok((organ, Arc::new(vademecum), mesh))
         })
         .collect::<Result<Vec<_>, String>>()?;
+    let attachments: Vec<AttachmentSpec> = loaded
+        .iter()
+        .flat_map(|(organ, vademecum, mesh)| attachments_of(*organ, vademecum, mesh))
+        .collect();
+    let organs: Vec<(String, Arc<Vademecum>)> = loaded
+        .into_iter()
+        .map(|(organ, vademecum, _)| (organ.name().to_owned(), vademecum))
+        .collect();
+    let coupling = Coupling::new(&organs, &attachments, &CouplingSettings::default())
+        .map_err(|e| e.to_string())?;
     Ok(HapticScene {
-        organs: loaded,
+        organs,
         probe: Probe { tip_radius_m: tip },
         safety: SafetySettings::default(),
+        coupling: (!coupling.is_empty()).then(|| Arc::new(coupling)),
     })
+}
+
+/// The attachments `organ` carries: each `attached_<other>` node set of its mesh, as the free
+/// load positions it covers (an organ clamped at its attachment hangs from it and carries
+/// nothing there).
+fn attachments_of(organ: Organ, vademecum: &Vademecum, mesh: &TetMesh) -> Vec<AttachmentSpec> {
+    let sets = &mesh.regions().node_sets;
+    let clamped: BTreeSet<usize> = sets
+        .get(region::CLAMPED)
+        .into_iter()
+        .flatten()
+        .copied()
+        .collect();
+    sets.iter()
+        .filter_map(|(name, nodes)| {
+            let carried = name.strip_prefix(region::ATTACHED_PREFIX)?;
+            let nodes: BTreeSet<usize> = nodes
+                .iter()
+                .filter(|n| !clamped.contains(n))
+                .copied()
+                .collect();
+            let interface = (0..vademecum.positions.len())
+                .filter(|&m| nodes.contains(&(vademecum.positions[m] as usize)))
+                .collect();
+            Some(AttachmentSpec {
+                carrier: organ.name().to_owned(),
+                carried: carried.to_owned(),
+                interface,
+            })
+        })
+        .collect()
 }
 
 /// Per organ, the accessible point that faces the surgeon most (the largest anterior

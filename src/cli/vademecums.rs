@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::fem::{Law, Material};
+use crate::mesh::TetMesh;
 use crate::mesh::organs::{self, Organ, OrganSettings, region};
 use crate::pgd::{self, BuildSettings, OrganModel, Vademecum, VademecumError};
 
@@ -70,13 +71,17 @@ impl VademecumSpec {
 }
 
 /// The vademecum `spec` asks for, checked for its mesh, material and settings; a missing or
-/// stale one is rebuilt or refused per `on_stale`.
-pub fn ensure_vademecum(spec: &VademecumSpec, on_stale: OnStale) -> Result<Vademecum, String> {
+/// stale one is rebuilt or refused per `on_stale`. The organ's mesh comes with it: its regions
+/// (attachments) are not in the vademecum.
+pub fn ensure_vademecum(
+    spec: &VademecumSpec,
+    on_stale: OnStale,
+) -> Result<(Vademecum, TetMesh), String> {
     let organ = spec.organ;
     let mesh = organs::generate(organ, &spec.mesh).map_err(|e| format!("{}: {e}", organ.name()))?;
     let material = pgd::organ::material(organ, spec.law);
     let why = match checked(spec, &mesh, &material) {
-        Ok(vademecum) => return Ok(vademecum),
+        Ok(vademecum) => return Ok((vademecum, mesh)),
         Err(why) => why,
     };
     let command = spec.build_command();
@@ -84,8 +89,8 @@ pub fn ensure_vademecum(spec: &VademecumSpec, on_stale: OnStale) -> Result<Vadem
         return Err(format!("{why}\nbuild it with:\n  {command}"));
     }
     eprintln!("{why}\nbuilding it now (the same as `{command}`):");
-    let model =
-        pgd::organ::clamped_model(mesh, material).map_err(|e| format!("{}: {e}", organ.name()))?;
+    let model = pgd::organ::clamped_model(mesh.clone(), material)
+        .map_err(|e| format!("{}: {e}", organ.name()))?;
     let organ_model = OrganModel {
         source: organ.name().into(),
         model: &model,
@@ -103,14 +108,14 @@ pub fn ensure_vademecum(spec: &VademecumSpec, on_stale: OnStale) -> Result<Vadem
         csv.display(),
         png.display()
     );
-    Ok(vademecum)
+    Ok((vademecum, mesh))
 }
 
 /// Loads the spec's file and refuses it unless it was built for `mesh`, `material` and the
 /// spec's settings.
 fn checked(
     spec: &VademecumSpec,
-    mesh: &crate::mesh::TetMesh,
+    mesh: &TetMesh,
     material: &Material,
 ) -> Result<Vademecum, VademecumError> {
     let file = &spec.file;

@@ -1,8 +1,26 @@
-//! Contact between the tool and the organs, on the organs' accessible surfaces. Plain Rust, no
-//! Bevy: the haptic schedule calls it every tick.
+//! Contact, plain Rust, no Bevy: the haptic schedule calls it every tick.
+//!
+//! - the tool against the organs' accessible surfaces ([`press`]);
+//! - organ against organ ([`Coupling`]): the master organ's distance field for every
+//!   deformation ([`DistanceField`]), probed by the other organs' pointshells
+//!   ([`Pointshell`]) with a relaxed penalty ([`ContactPair`]), and attached organs carried by
+//!   the organ they hang from ([`Attachment`]).
 
+mod attachment;
+mod coupling;
+mod distance;
+mod modal_rows;
+mod normal_compliance;
+mod penalty;
+mod pointshell;
 mod surface;
 mod tool;
 
+pub use attachment::Attachment;
+pub use coupling::{AttachmentSpec, Coupling, CouplingSettings};
+pub use distance::{DistanceField, DistanceSample, DistanceSettings, LatticeCache};
+pub use modal_rows::ModalRows;
+pub use penalty::{ContactPair, OrganPose, PairOutput, PairReport, PenaltySettings};
+pub use pointshell::Pointshell;
 pub use surface::{ContactError, ContactSurface, SurfaceHit};
 pub use tool::{Probe, Target, ToolContact, press};

@@ -42,12 +42,36 @@ impl PatchLoad {
     }
 }
 
+/// A small rigid motion: `u(p) = t + ω × (p − c)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RigidCarry {
+    pub translation_m: Vector3<f64>,
+    /// Small-angle rotation vector (rad).
+    pub rotation_rad: Vector3<f64>,
+    pub centre_m: Vector3<f64>,
+}
+
+impl RigidCarry {
+    /// The displacement (m) it gives the point `p`.
+    pub fn at(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        self.translation_m + self.rotation_rad.cross(&(p - self.centre_m))
+    }
+}
+
 /// The loads on an organ and, per load step, the modal coefficients of their sum.
 #[derive(Debug, Default, PartialEq)]
 pub struct Deformation {
     pub loads: Vec<PatchLoad>,
-    /// `coefficients[step][mode]`.
+    /// `coefficients[step][mode]`: the loads' and the coupling's together.
     pub coefficients: Vec<Vec<f64>>,
+    /// The coefficients of the loads other organs put on this one (organ contact, an
+    /// attached organ's pull), set by the contact stage each tick; modes only, as contact
+    /// loads are spread too wide for the near-field corrections to matter.
+    pub coupling: Vec<Vec<f64>>,
+    /// The total force (N) of those loads.
+    pub coupling_force_n: Vector3<f64>,
+    /// How the organ it is attached to carries it along.
+    pub carry: RigidCarry,
 }
 
 /// `clone_from` reuses the buffers, as for [`PatchLoad`].
@@ -56,30 +80,41 @@ impl Clone for Deformation {
         Self {
             loads: self.loads.clone(),
             coefficients: self.coefficients.clone(),
+            coupling: self.coupling.clone(),
+            coupling_force_n: self.coupling_force_n,
+            carry: self.carry,
         }
     }
 
     fn clone_from(&mut self, source: &Self) {
         self.loads.clone_from(&source.loads);
         self.coefficients.clone_from(&source.coefficients);
+        self.coupling.clone_from(&source.coupling);
+        self.coupling_force_n = source.coupling_force_n;
+        self.carry = source.carry;
     }
 }
 
 impl Deformation {
     /// An unloaded organ with `load_slots` loads (released) ready to be set.
     pub fn new(vademecum: &Vademecum, load_slots: usize) -> Self {
+        let zeros: Vec<Vec<f64>> = (0..vademecum.steps.len())
+            .map(|k| vec![0.0; vademecum.modes(k)])
+            .collect();
         Self {
             loads: vec![PatchLoad::default(); load_slots],
-            coefficients: (0..vademecum.steps.len())
-                .map(|k| vec![0.0; vademecum.modes(k)])
-                .collect(),
+            coefficients: zeros.clone(),
+            coupling: zeros,
+            coupling_force_n: Vector3::zeros(),
+            carry: RigidCarry::default(),
         }
     }
 
-    /// Recomputes the modal coefficients from the loads: O(modes × patch) per load.
+    /// Recomputes the modal coefficients from the loads and the coupling: O(modes × patch)
+    /// per load.
     pub fn evaluate(&mut self, vademecum: &Vademecum) {
         for (step, coefficients) in self.coefficients.iter_mut().enumerate() {
-            coefficients.fill(0.0);
+            coefficients.copy_from_slice(&self.coupling[step]);
             for load in self.loads.iter().filter(|l| l.is_active()) {
                 vademecum.add_coefficients(step, &load.shares, &load.force_n, coefficients);
             }
@@ -116,20 +151,32 @@ impl Deformation {
                 .zip(&vademecum.position_coords_m)
                 .map(|(&node, rest)| {
                     let u = &field[3 * node as usize..3 * node as usize + 3];
-                    [0, 1, 2].map(|c| rest[c] + u[c] as f32)
+                    let carried = self.carry.at(&Vector3::from(rest.map(f64::from)));
+                    [0, 1, 2].map(|c| rest[c] + (u[c] + carried[c]) as f32)
                 }),
         );
     }
 
-    /// Displacement (m) of the surface point `at` under every load but the one in slot `skip`:
-    /// how far other loads have already moved the surface a tool is about to touch.
+    /// Displacement (m) of the surface point `at` under every load but the one in slot `skip`,
+    /// the coupling's and the carry included: how far other loads have already moved the
+    /// surface a tool is about to touch.
     pub fn displacement_without(
         &self,
         vademecum: &Vademecum,
         at: &SurfacePoint,
         skip: usize,
     ) -> Vector3<f64> {
-        let mut u = Vector3::zeros();
+        let mut u = self.carry.at(&vademecum.point(at));
+        for (corner, weight) in vademecum.triangles[at.triangle].iter().zip(at.barycentric) {
+            let node = vademecum.positions[*corner as usize] as usize;
+            for (step, coupling) in self.coupling.iter().enumerate() {
+                for (mode, &c) in coupling.iter().enumerate() {
+                    if c != 0.0 {
+                        u += vademecum.mode_at_node(step, mode, node) * (c * weight);
+                    }
+                }
+            }
+        }
         let others = self
             .loads
             .iter()
@@ -154,8 +201,8 @@ impl Deformation {
         u
     }
 
-    /// The sum of the forces (N) applied to the organ.
+    /// The sum of the forces (N) applied to the organ, the coupling's included.
     pub fn total_force_n(&self) -> Vector3<f64> {
-        self.loads.iter().map(|l| l.force_n).sum()
+        self.loads.iter().map(|l| l.force_n).sum::<Vector3<f64>>() + self.coupling_force_n
     }
 }

@@ -17,7 +17,7 @@ mod vademecum;
 mod validate;
 
 pub use build::{BuildReport, BuildSettings, DEFAULT_LOAD_STEPS_M, OrganModel, StepReport, build};
-pub use deformation::{Deformation, PatchLoad};
+pub use deformation::{Deformation, PatchLoad, RigidCarry};
 pub use enrichment::{ModeReport, PgdSettings, enrich};
 pub use error_curve::{EnergyError, ErrorCurve, optimal_errors};
 pub use file::{FORMAT_VERSION, VademecumError, decode, encode, load, read_header, save};

@@ -120,6 +120,24 @@ impl Vademecum {
         self.steps[step].parametric.len() / self.parameter_count()
     }
 
+    /// Spatial mode `mode` of load step `step` at volume node `node` (m/N).
+    pub fn mode_at_node(&self, step: usize, mode: usize, node: usize) -> Vector3<f64> {
+        let x = &self.steps[step].spatial[mode * self.dof_count() + 3 * node..];
+        Vector3::new(x[0], x[1], x[2]).map(f64::from)
+    }
+
+    /// Parametric mode `mode` of load step `step` at load position `position`: the mode's
+    /// coefficient per newton along each axis there.
+    pub fn load_mode_at(&self, step: usize, mode: usize, position: usize) -> Vector3<f64> {
+        let y = &self.steps[step].parametric[mode * self.parameter_count() + 3 * position..];
+        Vector3::new(y[0], y[1], y[2]).map(f64::from)
+    }
+
+    /// The modes of every load step together: the length of a concatenated coefficient list.
+    pub fn total_modes(&self) -> usize {
+        (0..self.steps.len()).map(|s| self.modes(s)).sum()
+    }
+
     /// The deepest indentation (m) the load steps cover: beyond it a nonlinear vademecum is
     /// extrapolated, and the trainer must keep the tool shallower.
     pub fn valid_indentation_m(&self) -> f64 {

@@ -52,6 +52,7 @@ pub fn liver() -> &'static Liver {
 
 pub fn scene(safety: SafetySettings) -> HapticScene {
     HapticScene {
+        coupling: None,
         organs: vec![("liver".into(), liver().vademecum.clone())],
         probe: Probe {
             tip_radius_m: TIP_RADIUS_M,

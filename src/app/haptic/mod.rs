@@ -18,7 +18,7 @@ use bevy::prelude::*;
 pub use components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
 pub use exercise::ExerciseRun;
 pub use report::{ForceSummary, HeadlessReport, TickTimes};
-pub use resources::{Device, DeviceForce, FaultLog, ForceTrace, TickClock, Tool};
+pub use resources::{Device, DeviceForce, FaultLog, ForceTrace, OrganCoupling, TickClock, Tool};
 pub use runner::{HapticLoop, HapticScene, SceneError};
 pub use snapshot::{HapticSnapshot, LoopTiming, OrganSnapshot};
 pub use thread::{HapticThread, RealTimeReport, Scheduling};
@@ -33,7 +33,7 @@ pub enum HapticSet {
     ReadDevice,
     ToolContact,
     EvaluateModes,
-    /// Organ/organ contact slots in here.
+    /// Organ against organ, and attachments.
     OrganContact,
     ComputeForce,
     Safety,
@@ -66,6 +66,7 @@ pub fn haptic_schedule() -> Schedule {
         systems::read_device.in_set(HapticSet::ReadDevice),
         systems::tool_contact.in_set(HapticSet::ToolContact),
         systems::evaluate_modes.in_set(HapticSet::EvaluateModes),
+        systems::organ_contact.in_set(HapticSet::OrganContact),
         systems::compute_force.in_set(HapticSet::ComputeForce),
         systems::apply_safety.in_set(HapticSet::Safety),
         systems::write_device.in_set(HapticSet::WriteDevice),

@@ -2,6 +2,8 @@
 //! device, and the fault log.
 
 use bevy::prelude::*;
+
+use crate::contact::Coupling;
 use nalgebra::Vector3;
 
 use crate::contact::Probe;
@@ -55,3 +57,7 @@ pub struct ForceTrace {
     pub desired_n: Vec<Vector3<f64>>,
     pub sent_n: Vec<Vector3<f64>>,
 }
+
+/// The organs' contact and attachments, with their state from tick to tick.
+#[derive(Resource, Clone)]
+pub struct OrganCoupling(pub Coupling);

@@ -7,9 +7,11 @@ use bevy::prelude::*;
 
 use super::components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
 use super::report::{ForceSummary, HeadlessReport};
-use super::resources::{Device, DeviceForce, FaultLog, ForceTrace, Safety, TickClock, Tool};
+use super::resources::{
+    Device, DeviceForce, FaultLog, ForceTrace, OrganCoupling, Safety, TickClock, Tool,
+};
 use super::snapshot::{HapticSnapshot, OrganSnapshot, SnapshotPublisher};
-use crate::contact::{ContactError, ContactSurface, Probe};
+use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
 use crate::haptics::{HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S};
 use crate::pgd::{Deformation, Vademecum};
 
@@ -20,6 +22,8 @@ pub struct HapticScene {
     pub organs: Vec<(String, Arc<Vademecum>)>,
     pub probe: Probe,
     pub safety: SafetySettings,
+    /// Organ/organ contact and attachments (set up, at rest); `None` leaves the organs apart.
+    pub coupling: Option<Arc<Coupling>>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -59,6 +63,9 @@ impl HapticLoop {
         world.insert_resource(DeviceForce::default());
         world.insert_resource(FaultLog::default());
         world.insert_resource(Safety(SafetyFilter::new(scene.safety, max_force_n)));
+        if let Some(coupling) = &scene.coupling {
+            world.insert_resource(OrganCoupling(Coupling::clone(coupling)));
+        }
         Ok(Self {
             world,
             schedule: super::haptic_schedule(),

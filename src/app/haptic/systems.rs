@@ -4,7 +4,9 @@ use bevy::prelude::*;
 use nalgebra::Vector3;
 
 use super::components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
-use super::resources::{Device, DeviceForce, FaultLog, ForceTrace, Safety, TickClock, Tool};
+use super::resources::{
+    Device, DeviceForce, FaultLog, ForceTrace, OrganCoupling, Safety, TickClock, Tool,
+};
 use super::snapshot::{LoopTiming, SnapshotPublisher};
 use crate::contact::{Target, press};
 use crate::haptics::Fault;
@@ -72,6 +74,26 @@ pub fn tool_contact(
 pub fn evaluate_modes(mut organs: Query<(&OrganBody, &mut OrganDeformation)>) {
     for (body, mut deformation) in &mut organs {
         deformation.0.evaluate(&body.vademecum);
+    }
+}
+
+/// Organ against organ: hands every organ's coefficients to the coupling, ticks its pairs and
+/// attachments, and gives each organ its coupling loads and carry (felt through the tool from
+/// the next tick on, as the surface under it moves).
+pub fn organ_contact(
+    coupling: Option<ResMut<OrganCoupling>>,
+    mut organs: Query<(&OrganIndex, &mut OrganDeformation)>,
+) {
+    let Some(mut coupling) = coupling else {
+        return;
+    };
+    let coupling = &mut coupling.0;
+    for (index, deformation) in &organs {
+        coupling.read(index.0, &deformation.0);
+    }
+    coupling.tick();
+    for (index, mut deformation) in &mut organs {
+        coupling.write(index.0, &mut deformation.0);
     }
 }
 

@@ -1,0 +1,193 @@
+//! Everything that ties a scene's organs together in one tick: the master's contact with each
+//! pointshell organ and the attachments. The caller hands in each organ's modal
+//! coefficients and loads, calls [`Coupling::tick`], and writes each organ's coupling back
+//! into its [`Deformation`]. Nothing is allocated once set up.
+
+use std::ops::Range;
+use std::sync::Arc;
+
+use nalgebra::Vector3;
+
+use super::modal_rows::{concatenate, step_ranges};
+use super::penalty::{OrganPose, PairOutput, PenaltySettings};
+use super::{
+    Attachment, ContactError, ContactPair, ContactSurface, DistanceField, DistanceSettings,
+    Pointshell,
+};
+use crate::pgd::{Deformation, RigidCarry, Vademecum};
+
+/// Which organ is the master, and how the coupling is set up.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CouplingSettings {
+    /// The organ carrying the distance field (paper 000: the gallbladder).
+    pub master: String,
+    pub distance: DistanceSettings,
+    pub penalty: PenaltySettings,
+}
+
+impl Default for CouplingSettings {
+    fn default() -> Self {
+        Self {
+            master: "gallbladder".into(),
+            distance: DistanceSettings::default(),
+            penalty: PenaltySettings::default(),
+        }
+    }
+}
+
+/// An attachment by organ names and the carrier's interface positions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AttachmentSpec {
+    pub carrier: String,
+    pub carried: String,
+    pub interface: Vec<usize>,
+}
+
+#[derive(Clone)]
+struct CoupledOrgan {
+    steps: Vec<Range<usize>>,
+    alpha: Vec<f32>,
+    coupling: Vec<f64>,
+    coupling_force_n: Vector3<f64>,
+    carry: RigidCarry,
+}
+
+#[derive(Clone)]
+pub struct Coupling {
+    pub pairs: Vec<ContactPair>,
+    pub attachments: Vec<Attachment>,
+    organs: Vec<CoupledOrgan>,
+}
+
+impl Coupling {
+    /// Sets up the coupling of `organs` (names and vademecums, the scene's order): the master's
+    /// distance field, a pair with every organ not attached to it whose boundary comes within
+    /// the field's lattice, and the attachments. No master in the scene: no contact pairs.
+    pub fn new(
+        organs: &[(String, Arc<Vademecum>)],
+        attachments: &[AttachmentSpec],
+        settings: &CouplingSettings,
+    ) -> Result<Self, ContactError> {
+        let index = |name: &str| organs.iter().position(|(n, _)| n == name);
+        let attachments: Vec<Attachment> = attachments
+            .iter()
+            .filter_map(|a| {
+                let (carrier, carried) = (index(&a.carrier)?, index(&a.carried)?);
+                Attachment::new(carrier, carried, &organs[carrier].1, &a.interface)
+            })
+            .collect();
+        let attached = |x: usize, y: usize| {
+            attachments
+                .iter()
+                .any(|a| (a.carrier, a.carried) == (x, y) || (a.carrier, a.carried) == (y, x))
+        };
+        let mut pairs = Vec::new();
+        if let Some(master) = index(&settings.master) {
+            let master_vademecum = &organs[master].1;
+            let surface = ContactSurface::new(master_vademecum)?;
+            let field = Arc::new(DistanceField::build(
+                master_vademecum,
+                &surface,
+                &settings.distance,
+            ));
+            for (shell, (_, shell_vademecum)) in organs.iter().enumerate() {
+                if shell == master || attached(master, shell) {
+                    continue;
+                }
+                let nodes =
+                    Pointshell::boundary(shell_vademecum, master_vademecum, &surface, &field);
+                if nodes.is_empty() {
+                    continue;
+                }
+                pairs.push(ContactPair::new(
+                    (master, master_vademecum.clone()),
+                    (shell, shell_vademecum.clone()),
+                    field.clone(),
+                    nodes,
+                    &settings.penalty,
+                ));
+            }
+        }
+        let organs = organs
+            .iter()
+            .map(|(_, v)| CoupledOrgan {
+                steps: step_ranges(v),
+                alpha: Vec::with_capacity(v.total_modes()),
+                coupling: vec![0.0; v.total_modes()],
+                coupling_force_n: Vector3::zeros(),
+                carry: RigidCarry::default(),
+            })
+            .collect();
+        Ok(Self {
+            pairs,
+            attachments,
+            organs,
+        })
+    }
+
+    /// Whether it couples anything at all.
+    pub fn is_empty(&self) -> bool {
+        self.pairs.is_empty() && self.attachments.is_empty()
+    }
+
+    /// Takes organ `index`'s state for this tick: its coefficients (the coupling of the last
+    /// tick included).
+    pub fn read(&mut self, index: usize, deformation: &Deformation) {
+        let organ = &mut self.organs[index];
+        concatenate(&deformation.coefficients, &mut organ.alpha);
+    }
+
+    /// One tick of every attachment and pair.
+    pub fn tick(&mut self) {
+        for organ in &mut self.organs {
+            organ.coupling.fill(0.0);
+            organ.coupling_force_n = Vector3::zeros();
+            organ.carry = RigidCarry::default();
+        }
+        for a in &self.attachments {
+            self.organs[a.carried].carry = a.carry(&self.organs[a.carrier].alpha);
+        }
+        for pair in &mut self.pairs {
+            let (master, shell) = two_mut(&mut self.organs, pair.master, pair.shell);
+            pair.tick(
+                OrganPose {
+                    alpha: &master.alpha,
+                    carry: &master.carry,
+                },
+                OrganPose {
+                    alpha: &shell.alpha,
+                    carry: &shell.carry,
+                },
+                PairOutput {
+                    master: &mut master.coupling,
+                    shell: &mut shell.coupling,
+                },
+            );
+            let force = pair.report().force_on_shell_n;
+            shell.coupling_force_n += force;
+            master.coupling_force_n -= force;
+        }
+    }
+
+    /// Hands organ `index` its coupling of this tick.
+    pub fn write(&self, index: usize, deformation: &mut Deformation) {
+        let organ = &self.organs[index];
+        for (step, range) in organ.steps.iter().enumerate() {
+            deformation.coupling[step].copy_from_slice(&organ.coupling[range.clone()]);
+        }
+        deformation.coupling_force_n = organ.coupling_force_n;
+        deformation.carry = organ.carry;
+    }
+}
+
+/// Two distinct elements of a slice, both mutable.
+fn two_mut<T>(items: &mut [T], a: usize, b: usize) -> (&mut T, &mut T) {
+    assert_ne!(a, b, "an organ is not coupled to itself");
+    if a < b {
+        let (low, high) = items.split_at_mut(b);
+        (&mut low[a], &mut high[0])
+    } else {
+        let (low, high) = items.split_at_mut(a);
+        (&mut high[0], &mut low[b])
+    }
+}

@@ -1,0 +1,304 @@
+//! The master organ's signed distance field for every deformation its vademecum can take, in
+//! separated form: `d(x, α) = d₀(x) + Σ_k α_k D^k(x)`, sampled on a lattice around it.
+//!
+//! `α` are the master's modal coefficients (all load steps, one after another), the same the
+//! haptic tick already sums for the organ. Each distance mode is the first-order change of the
+//! distance when the surface moves by that mode: `D^k(x) = -∇d₀(x) · X^k(π(x))`, where `π(x)`
+//! is the closest point of the rest surface. A lattice node is then one dot product over the
+//! modes, evaluated at most once per tick ([`LatticeCache`]).
+//!
+//! What it leaves out, by design: the vademecum's near-field corrections (the dimple under a
+//! tool, within `local_radius_m` of it) and second-order terms (the surface's curvature times
+//! its tangential motion). `tests/contact` measures the result against the exact distance to
+//! the deformed surface.
+
+use nalgebra::Vector3;
+use rayon::prelude::*;
+
+use super::ContactSurface;
+use crate::pgd::Vademecum;
+
+/// How the lattice is laid out.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DistanceSettings {
+    /// Lattice spacing (m): one cell is the depth the contact test tolerates.
+    pub spacing_m: f64,
+    /// How far the lattice reaches beyond the master's bounding box (m): pointshell nodes
+    /// farther than this at rest never meet the master.
+    pub margin_m: f64,
+}
+
+impl Default for DistanceSettings {
+    fn default() -> Self {
+        Self {
+            spacing_m: 2e-3,
+            margin_m: 12e-3,
+        }
+    }
+}
+
+/// Per lattice node: the rest distance, its unit gradient, then one value per mode.
+const HEAD: usize = 4;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct DistanceField {
+    origin_m: Vector3<f64>,
+    spacing_m: f64,
+    dims: [usize; 3],
+    modes: usize,
+    /// `HEAD + modes` values per lattice node, x fastest.
+    values: Vec<f32>,
+    /// Per mode, the largest `|D^k|` over the lattice: bounds how far the field can move.
+    mode_bounds: Vec<f32>,
+}
+
+/// The lattice values of the current tick, each computed on first use.
+#[derive(Clone, Debug, Default)]
+pub struct LatticeCache {
+    tick: u32,
+    stamps: Vec<u32>,
+    values: Vec<f32>,
+}
+
+impl LatticeCache {
+    /// Forgets the last tick's values (O(1): stamps, not clearing).
+    pub fn next_tick(&mut self, field: &DistanceField) {
+        if self.stamps.len() != field.node_count() {
+            self.stamps = vec![0; field.node_count()];
+            self.values = vec![0.0; field.node_count()];
+        }
+        self.tick = self.tick.wrapping_add(1);
+        if self.tick == 0 {
+            self.stamps.fill(0);
+            self.tick = 1;
+        }
+    }
+}
+
+/// The distance and outward direction at a point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DistanceSample {
+    /// Signed distance to the deformed master (m), negative inside.
+    pub distance_m: f64,
+    /// Unit direction out of the master (the rest field's gradient, interpolated).
+    pub normal: Vector3<f64>,
+}
+
+impl DistanceField {
+    /// Samples the master at rest (`surface`, the accessible surface of `vademecum`) and its
+    /// modes on a lattice. Work: one closest-point query per node, in parallel.
+    pub fn build(
+        vademecum: &Vademecum,
+        surface: &ContactSurface,
+        settings: &DistanceSettings,
+    ) -> Self {
+        let (min, max) = bounds(vademecum);
+        let margin = Vector3::repeat(settings.margin_m);
+        let origin_m = min - margin;
+        let extent = max - min + 2.0 * margin;
+        let dims = [0, 1, 2].map(|c| (extent[c] / settings.spacing_m).ceil() as usize + 1);
+        let modes = vademecum.total_modes();
+        let mut field = Self {
+            origin_m,
+            spacing_m: settings.spacing_m,
+            dims,
+            modes,
+            values: Vec::new(),
+            mode_bounds: vec![0.0; modes],
+        };
+        let stride = field.stride();
+        let mut values = vec![0.0f32; field.node_count() * stride];
+        values
+            .par_chunks_mut(stride)
+            .enumerate()
+            .for_each(|(node, out)| field.fill_node(vademecum, surface, node, out));
+        for node in values.chunks_exact(stride) {
+            for (bound, &v) in field.mode_bounds.iter_mut().zip(&node[HEAD..]) {
+                *bound = bound.max(v.abs());
+            }
+        }
+        field.values = values;
+        field
+    }
+
+    /// Fills one lattice node: the rest distance and gradient from the closest surface point,
+    /// and each mode's displacement there projected on the gradient.
+    fn fill_node(
+        &self,
+        vademecum: &Vademecum,
+        surface: &ContactSurface,
+        node: usize,
+        out: &mut [f32],
+    ) {
+        let x = self.node_point(node);
+        let Some(hit) = surface.closest(&x) else {
+            out[0] = f32::MAX;
+            return;
+        };
+        let offset = x - hit.point_m;
+        let outside = offset.dot(&hit.normal) >= 0.0;
+        let sign = if outside { 1.0 } else { -1.0 };
+        let gradient = offset
+            .try_normalize(1e-9)
+            .map_or(hit.normal, |direction| direction * sign);
+        out[0] = (sign * offset.norm()) as f32;
+        out[1..HEAD].copy_from_slice(&gradient.map(|c| c as f32).as_slice()[..3]);
+        let corners = vademecum.triangles[hit.at.triangle];
+        let mut k = HEAD;
+        for step in 0..vademecum.steps.len() {
+            for mode in 0..vademecum.modes(step) {
+                let moved: Vector3<f64> = corners
+                    .iter()
+                    .zip(hit.at.barycentric)
+                    .map(|(&m, l)| {
+                        let node = vademecum.positions[m as usize] as usize;
+                        vademecum.mode_at_node(step, mode, node) * l
+                    })
+                    .sum();
+                out[k] = -gradient.dot(&moved) as f32;
+                k += 1;
+            }
+        }
+    }
+
+    pub fn node_count(&self) -> usize {
+        self.dims.iter().product()
+    }
+
+    pub fn modes(&self) -> usize {
+        self.modes
+    }
+
+    pub fn spacing_m(&self) -> f64 {
+        self.spacing_m
+    }
+
+    /// How far the lattice's farthest point lies from `centre_m` (m).
+    pub fn farthest_from_m(&self, centre_m: &Vector3<f64>) -> f64 {
+        let extent = Vector3::from(self.dims.map(|n| (n - 1) as f64)) * self.spacing_m;
+        let far = (self.origin_m - centre_m)
+            .abs()
+            .sup(&(self.origin_m + extent - centre_m).abs());
+        far.norm()
+    }
+
+    fn stride(&self) -> usize {
+        HEAD + self.modes
+    }
+
+    fn node_point(&self, node: usize) -> Vector3<f64> {
+        let [nx, ny, _] = self.dims;
+        let ijk = [node % nx, (node / nx) % ny, node / (nx * ny)];
+        self.origin_m + Vector3::from(ijk.map(|i| i as f64)) * self.spacing_m
+    }
+
+    /// The rest distance and direction at a point, or `None` outside the lattice.
+    pub fn at_rest(&self, x: &Vector3<f64>) -> Option<DistanceSample> {
+        self.interpolate(x, |node| self.values[node * self.stride()])
+    }
+
+    /// `Σ_k |α_k| max|D^k|`: no lattice value moves farther than this from its rest value.
+    pub fn movement_bound_m(&self, alpha: &[f32]) -> f32 {
+        alpha
+            .iter()
+            .zip(&self.mode_bounds)
+            .map(|(a, b)| a.abs() * b)
+            .sum()
+    }
+
+    /// The deformed distance at `x` for modal coefficients `alpha` (all load steps
+    /// concatenated); `None` outside the lattice, where no contact is possible.
+    pub fn sample(
+        &self,
+        x: &Vector3<f64>,
+        alpha: &[f32],
+        cache: &mut LatticeCache,
+    ) -> Option<DistanceSample> {
+        self.interpolate(x, |node| self.node_value(node, alpha, cache))
+    }
+
+    /// Trilinear interpolation of the node values `value` and of the rest gradient. The
+    /// gradient comes from the rest field, so the direction of a penalty varies smoothly
+    /// from cell to cell.
+    fn interpolate(
+        &self,
+        x: &Vector3<f64>,
+        mut value: impl FnMut(usize) -> f32,
+    ) -> Option<DistanceSample> {
+        let (base, weights) = self.cell(x)?;
+        let mut distance_m = 0.0;
+        let mut gradient = Vector3::zeros();
+        for (node, w) in self.corners(base).zip(weights) {
+            distance_m += w * value(node) as f64;
+            let head = &self.values[node * self.stride()..node * self.stride() + HEAD];
+            gradient += Vector3::new(head[1], head[2], head[3]).map(f64::from) * w;
+        }
+        Some(DistanceSample {
+            distance_m,
+            normal: gradient.try_normalize(1e-9)?,
+        })
+    }
+
+    /// One lattice node's deformed distance: `d₀ + D · α`, once per tick.
+    fn node_value(&self, node: usize, alpha: &[f32], cache: &mut LatticeCache) -> f32 {
+        if cache.stamps[node] == cache.tick {
+            return cache.values[node];
+        }
+        let values = &self.values[node * self.stride()..(node + 1) * self.stride()];
+        let value = values[0]
+            + values[HEAD..]
+                .iter()
+                .zip(alpha)
+                .map(|(d, a)| d * a)
+                .sum::<f32>();
+        cache.stamps[node] = cache.tick;
+        cache.values[node] = value;
+        value
+    }
+
+    /// The lattice cell holding `x` (its lowest node) and the trilinear weights of its eight
+    /// corners, in [`Self::corners`] order.
+    fn cell(&self, x: &Vector3<f64>) -> Option<(usize, [f64; 8])> {
+        let local = (x - self.origin_m) / self.spacing_m;
+        let mut base = [0usize; 3];
+        let mut t = [0.0; 3];
+        for c in 0..3 {
+            let cells = (self.dims[c] - 1) as f64;
+            if !(0.0..=cells).contains(&local[c]) {
+                return None;
+            }
+            let i = (local[c].floor() as usize).min(self.dims[c] - 2);
+            base[c] = i;
+            t[c] = local[c] - i as f64;
+        }
+        let [nx, ny, _] = self.dims;
+        let weights = std::array::from_fn(|corner| {
+            (0..3)
+                .map(|c| match (corner >> c) & 1 {
+                    0 => 1.0 - t[c],
+                    _ => t[c],
+                })
+                .product()
+        });
+        Some((base[0] + nx * (base[1] + ny * base[2]), weights))
+    }
+
+    fn corners(&self, base: usize) -> impl Iterator<Item = usize> {
+        let [nx, ny, _] = self.dims;
+        (0..8).map(move |corner| {
+            base + (corner & 1) + nx * ((corner >> 1) & 1) + nx * ny * ((corner >> 2) & 1)
+        })
+    }
+}
+
+/// The bounding box of the master's accessible surface at rest.
+fn bounds(vademecum: &Vademecum) -> (Vector3<f64>, Vector3<f64>) {
+    let mut min = Vector3::repeat(f64::INFINITY);
+    let mut max = Vector3::repeat(f64::NEG_INFINITY);
+    for p in &vademecum.position_coords_m {
+        let p = Vector3::from(p.map(f64::from));
+        min = min.inf(&p);
+        max = max.sup(&p);
+    }
+    (min, max)
+}

@@ -1,0 +1,123 @@
+//! The coarse abdominal scene (all four organs, coupled), built once per test run, and a
+//! scripted push run through the haptic schedule with what each tick left recorded.
+
+use std::path::Path;
+use std::sync::OnceLock;
+
+use nalgebra::Vector3;
+use pgd_surgery::app::haptic::{
+    HapticLoop, HapticScene, OrganCoupling, OrganDeformation, OrganIndex, TickClock,
+};
+use pgd_surgery::app::scene::{Detail, default_scene};
+use pgd_surgery::cli::OnStale;
+use pgd_surgery::contact::PairReport;
+use pgd_surgery::haptics::{PressTarget, Scripted, TICK_S, Trajectory, TrajectoryRow};
+use pgd_surgery::pgd::{Deformation, Vademecum};
+
+pub fn scene() -> &'static HapticScene {
+    static SCENE: OnceLock<HapticScene> = OnceLock::new();
+    SCENE.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("contact-vademecums");
+        default_scene(&dir, Detail::Coarse, OnStale::Rebuild).unwrap()
+    })
+}
+
+pub fn organ(name: &str) -> (usize, &'static Vademecum) {
+    let index = scene().organs.iter().position(|(n, _)| n == name).unwrap();
+    (index, &scene().organs[index].1)
+}
+
+/// The accessible point of `name` whose normal is closest to `direction`.
+pub fn facing(name: &str, direction: Vector3<f64>) -> PressTarget {
+    let (_, vademecum) = organ(name);
+    let normals = vademecum.rest_normals();
+    let best = (0..normals.len())
+        .max_by(|&a, &b| {
+            normals[a]
+                .dot(&direction)
+                .total_cmp(&normals[b].dot(&direction))
+        })
+        .unwrap();
+    PressTarget {
+        point_m: Vector3::from(vademecum.position_coords_m[best].map(f64::from)),
+        normal: normals[best],
+    }
+}
+
+/// The tool comes from 5 mm off `target` and pushes `depth_m` into it along its normal over
+/// `push_s`, then holds for `hold_s`.
+pub fn push(target: &PressTarget, depth_m: f64, push_s: f64, hold_s: f64) -> Trajectory {
+    let radius_m = scene().probe.tip_radius_m;
+    let centre = |depth: f64| target.point_m + target.normal * (radius_m - depth);
+    let row = |time_s: f64, p: Vector3<f64>| TrajectoryRow {
+        time_s,
+        x_m: p.x,
+        y_m: p.y,
+        z_m: p.z,
+        buttons: 0,
+        qx: 0.0,
+        qy: 0.0,
+        qz: 0.0,
+        qw: 1.0,
+    };
+    Trajectory {
+        rows: vec![
+            row(0.0, centre(-0.005)),
+            row(push_s, centre(depth_m)),
+            row(push_s + hold_s, centre(depth_m)),
+        ],
+    }
+}
+
+/// What one tick left: each pair's report and each organ's deformation.
+pub struct Tick {
+    pub pairs: Vec<(usize, usize, PairReport)>,
+    pub organs: Vec<Deformation>,
+}
+
+/// Runs `trajectory` through the coupled scene's haptic schedule, tick by tick.
+pub fn run(trajectory: Trajectory, ticks: u64) -> (HapticLoop, Vec<Tick>) {
+    let device = Box::new(Scripted::new("push", trajectory));
+    let mut haptic = HapticLoop::new(scene(), device).unwrap();
+    let mut record = Vec::new();
+    for tick in 0..ticks {
+        haptic.tick(TickClock {
+            tick,
+            time_s: tick as f64 * TICK_S,
+            overruns_in_a_row: 0,
+        });
+        record.push(observe(&mut haptic));
+    }
+    (haptic, record)
+}
+
+fn observe(haptic: &mut HapticLoop) -> Tick {
+    let world = haptic.world_mut();
+    let pairs = world
+        .resource::<OrganCoupling>()
+        .0
+        .pairs
+        .iter()
+        .map(|p| (p.master, p.shell, *p.report()))
+        .collect();
+    let mut organs: Vec<(usize, Deformation)> = world
+        .query::<(&OrganIndex, &OrganDeformation)>()
+        .iter(world)
+        .map(|(i, d)| (i.0, d.0.clone()))
+        .collect();
+    organs.sort_by_key(|o| o.0);
+    Tick {
+        pairs,
+        organs: organs.into_iter().map(|o| o.1).collect(),
+    }
+}
+
+/// The largest nodal displacement (m) of an organ's field.
+pub fn largest_displacement_m(vademecum: &Vademecum, deformation: &Deformation) -> f64 {
+    let mut field = vec![0.0; vademecum.dof_count()];
+    deformation.field_into(vademecum, &mut field);
+    field
+        .chunks_exact(3)
+        .map(|u| Vector3::new(u[0], u[1], u[2]).norm())
+        .fold(0.0, f64::max)
+}

@@ -1,0 +1,293 @@
+//! Organ against organ (issue 8) on the coarse abdominal scene: the gallbladder pressed into
+//! the liver through the whole haptic schedule, the distance field against the exact distance
+//! to the deformed gallbladder, and the attachments.
+
+mod common;
+
+use common::*;
+use nalgebra::{Point3, Vector3};
+use pgd_surgery::app::haptic::{DeviceForce, HapticLoop, HapticScene};
+use pgd_surgery::contact::LatticeCache;
+use pgd_surgery::haptics::Scripted;
+use pgd_surgery::seam::{from_parry, to_parry};
+
+/// 12 mm up into the gallbladder's underside over 2 s, held for half a second.
+const PUSH_S: f64 = 2.0;
+const TICKS: u64 = 2500;
+
+fn pushed() -> &'static Vec<Tick> {
+    static RECORD: std::sync::OnceLock<Vec<Tick>> = std::sync::OnceLock::new();
+    RECORD.get_or_init(|| {
+        let target = facing("gallbladder", -Vector3::z());
+        run(push(&target, 0.012, PUSH_S, 0.5), TICKS).1
+    })
+}
+
+fn liver_pair(tick: &Tick) -> &pgd_surgery::contact::PairReport {
+    let (g, l) = (organ("gallbladder").0, organ("liver").0);
+    &tick.pairs.iter().find(|p| (p.0, p.1) == (g, l)).unwrap().2
+}
+
+#[test]
+fn pressing_the_gallbladder_into_the_liver_deforms_the_liver_and_stays_shallow() {
+    let record = pushed();
+    let last = record.last().unwrap();
+    let report = liver_pair(last);
+    let (l, liver) = organ("liver");
+    let moved_m = largest_displacement_m(liver, &last.organs[l]);
+    eprintln!("{report:?}; liver moved {:.3} mm", moved_m * 1e3);
+    assert!(report.nodes_in_contact > 0, "{report:?}");
+    assert!(report.force_on_shell_n.norm() > 1e-3, "{report:?}");
+    // The liver is displaced by the contact alone (the tool never touches it).
+    assert!(last.organs[l].loads.iter().all(|load| !load.is_active()));
+    assert!(moved_m > 0.05e-3, "liver moved {moved_m} m");
+    let spacing = scene().coupling.as_ref().unwrap().pairs[0]
+        .field()
+        .spacing_m();
+    let deepest = record
+        .iter()
+        .map(|t| liver_pair(t).deepest_m)
+        .fold(0.0, f64::max);
+    eprintln!(
+        "deepest {:.3} mm, lattice cell {:.1} mm",
+        deepest * 1e3,
+        spacing * 1e3
+    );
+    assert!(deepest < spacing, "a liver node {deepest} m deep");
+}
+
+#[test]
+fn contact_forces_on_the_two_organs_are_equal_and_opposite() {
+    let (g, l, p) = (
+        organ("gallbladder").0,
+        organ("liver").0,
+        organ("pancreas").0,
+    );
+    for tick in pushed() {
+        let on_shells: Vector3<f64> = tick.pairs.iter().map(|p| p.2.force_on_shell_n).sum();
+        let on_master = tick.organs[g].coupling_force_n;
+        assert!((on_master + on_shells).norm() <= 1e-12 * on_shells.norm().max(1e-9));
+        let shells = tick.organs[l].coupling_force_n + tick.organs[p].coupling_force_n;
+        assert!((shells - on_shells).norm() <= 1e-15);
+    }
+}
+
+#[test]
+#[ignore = "not met yet: the contact force zig-zags (steps up to 2 % of its peak, hundreds of reversals)"]
+fn a_slow_push_changes_the_contact_force_smoothly_without_flicker() {
+    let record = pushed();
+    let totals: Vec<f64> = record
+        .iter()
+        .map(|t| liver_pair(t).force_on_shell_n.norm())
+        .collect();
+    let peak = totals.iter().copied().fold(0.0, f64::max);
+    let largest_step = totals
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(0.0, f64::max);
+    let sign_changes = totals
+        .windows(3)
+        .filter(|w| (w[1] - w[0]) * (w[2] - w[1]) < -1e-16 * peak * peak)
+        .count();
+    eprintln!(
+        "peak {peak:.5} N, largest step {largest_step:.2e} N ({:.2} % of peak), reversals {sign_changes}",
+        100.0 * largest_step / peak
+    );
+    // The push ramps the overlap over 2000 ticks: a smooth response changes by about
+    // 1/2000 of the peak per tick; allow ten times that, and no oscillation.
+    assert!(
+        largest_step <= 0.005 * peak,
+        "a step of {largest_step} N against a peak of {peak} N"
+    );
+}
+
+/// The exact signed distance (m) to a closed-enough triangle surface: the closest point's
+/// distance, negative behind its triangle.
+fn exact_distance(mesh: &parry3d::shape::TriMesh, x: &Vector3<f64>) -> f64 {
+    use parry3d::query::PointQueryWithLocation;
+    let (projection, (triangle, _)) =
+        mesh.project_local_point_and_get_location(to_parry(&Point3::from(*x)), false);
+    let t = mesh.triangle(triangle);
+    let normal = from_parry(t.b - t.a)
+        .coords
+        .cross(&from_parry(t.c - t.a).coords);
+    let offset = x - from_parry(projection.point).coords;
+    offset.norm() * offset.dot(&normal).signum()
+}
+
+/// The gallbladder's accessible surface at the end of the push: deformed by its whole field
+/// (`modes_only == false`) or by its modes alone, carried by the duodenum either way.
+fn deformed_gallbladder(modes_only: bool) -> Vec<[f32; 3]> {
+    let last = pushed().last().unwrap();
+    let (g, gallbladder) = organ("gallbladder");
+    let deformation = &last.organs[g];
+    let mut field = vec![0.0; gallbladder.dof_count()];
+    let mut positions = Vec::new();
+    deformation.deformed_surface(gallbladder, &mut field, &mut positions);
+    if modes_only {
+        field.fill(0.0);
+        for (step, coefficients) in deformation.coefficients.iter().enumerate() {
+            gallbladder.add_modes(step, coefficients, &mut field);
+        }
+        for (m, p) in positions.iter_mut().enumerate() {
+            let node = gallbladder.positions[m] as usize;
+            let rest = Vector3::from(gallbladder.position_coords_m[m].map(f64::from));
+            let moved = rest
+                + Vector3::from_column_slice(&field[3 * node..3 * node + 3])
+                + deformation.carry.at(&rest);
+            *p = [0, 1, 2].map(|c| moved[c] as f32);
+        }
+    }
+    positions
+}
+
+/// p95 of the distance field's error (m) against the exact distance to `positions`, at points
+/// 1.5 mm inside to 3 mm outside every surface vertex: beyond the tool's near field and
+/// within it.
+fn distance_errors(positions: &[[f32; 3]]) -> (f64, f64) {
+    let last = pushed().last().unwrap();
+    let (g, gallbladder) = organ("gallbladder");
+    let deformation = &last.organs[g];
+    let mesh = pgd_surgery::seam::trimesh(positions, &gallbladder.triangles).unwrap();
+    let coupling = scene().coupling.as_ref().unwrap();
+    let distance = coupling.pairs[0].field();
+    let alpha: Vec<f32> = deformation
+        .coefficients
+        .iter()
+        .flatten()
+        .map(|&c| c as f32)
+        .collect();
+    let mut cache = LatticeCache::default();
+    cache.next_tick(distance);
+    let normals = gallbladder.rest_normals();
+    let tool = last.organs[g].loads[0].shares.first().map(|s| s.0).unwrap();
+    let tool_at = Vector3::from(gallbladder.position_coords_m[tool].map(f64::from));
+    let (mut near, mut far) = (Vec::new(), Vec::new());
+    for (m, p) in positions.iter().enumerate() {
+        let rest = Vector3::from(gallbladder.position_coords_m[m].map(f64::from));
+        for offset_mm in [-1.5, -0.5, 0.5, 1.5, 3.0] {
+            let x = Vector3::from(p.map(f64::from)) + normals[m] * offset_mm * 1e-3;
+            let q = x - deformation.carry.at(&x);
+            let Some(sample) = distance.sample(&q, &alpha, &mut cache) else {
+                continue;
+            };
+            let error = (sample.distance_m - exact_distance(&mesh, &x)).abs();
+            match (rest - tool_at).norm() > 0.025 {
+                true => far.push(error),
+                false => near.push(error),
+            }
+        }
+    }
+    let p95 = |e: &mut Vec<f64>| {
+        e.sort_by(f64::total_cmp);
+        e[e.len() * 95 / 100]
+    };
+    let (near95, far95) = (p95(&mut near), p95(&mut far));
+    eprintln!(
+        "distance error p95: {:.3} mm beyond the near field ({} points), {:.3} mm within it ({} points)",
+        far95 * 1e3,
+        far.len(),
+        near95 * 1e3,
+        near.len()
+    );
+    (far95, near95)
+}
+
+/// What the field claims: the first-order distance to the surface its modes move. The push
+/// moves the gallbladder about 12 mm; the error should stay within a quarter of a lattice cell.
+#[test]
+#[ignore = "not met yet: first-order in a 12 mm motion, p95 1.0 mm far from the tool, 0.5 mm near it"]
+fn the_distance_field_agrees_with_the_exact_distance_to_the_modally_deformed_gallbladder() {
+    let (far, near) = distance_errors(&deformed_gallbladder(true));
+    assert!(
+        far.max(near) < 0.5e-3,
+        "p95 {far} m far from the tool, {near} m near it"
+    );
+}
+
+#[test]
+#[ignore = "not met yet: the field leaves out the near-field corrections, which carry most of the coarse gallbladder's response (p95 1.9 mm far from the tool, 7.5 mm near it)"]
+fn the_distance_field_agrees_with_the_exact_distance_to_the_deformed_gallbladder() {
+    let (far, near) = distance_errors(&deformed_gallbladder(false));
+    assert!(
+        far.max(near) < 0.5e-3,
+        "p95 {far} m far from the tool, {near} m near it"
+    );
+}
+
+#[test]
+fn an_attached_organ_moves_with_the_organ_it_hangs_from() {
+    let coupling = scene().coupling.as_ref().unwrap();
+    let (d, duodenum) = organ("duodenum");
+    let (g, _) = organ("gallbladder");
+    let attachment = coupling
+        .attachments
+        .iter()
+        .find(|a| (a.carrier, a.carried) == (d, g))
+        .unwrap();
+    let interface = attachment.interface();
+    let centre: Vector3<f64> = interface
+        .iter()
+        .map(|&m| Vector3::from(duodenum.position_coords_m[m].map(f64::from)))
+        .sum::<Vector3<f64>>()
+        / interface.len() as f64;
+    let normals = duodenum.rest_normals();
+    // Pressed 3 cm from the interface, whose motion is then mostly the duodenum's bending.
+    let nearest = (0..duodenum.positions.len())
+        .filter(|&m| normals[m].y > 0.5)
+        .min_by(|&a, &b| {
+            let dist = |m: usize| {
+                ((Vector3::from(duodenum.position_coords_m[m].map(f64::from)) - centre).norm()
+                    - 0.03)
+                    .abs()
+            };
+            dist(a).total_cmp(&dist(b))
+        })
+        .unwrap();
+    let target = pgd_surgery::haptics::PressTarget {
+        point_m: Vector3::from(duodenum.position_coords_m[nearest].map(f64::from)),
+        normal: normals[nearest],
+    };
+    let (_, record) = run(push(&target, 0.008, 1.0, 0.2), 1300);
+    let last = record.last().unwrap();
+    let mut field = vec![0.0; duodenum.dof_count()];
+    last.organs[d].field_into(duodenum, &mut field);
+    let carry = last.organs[g].carry;
+    let (mut moved, mut mismatch) = (0.0, 0.0);
+    for &m in interface {
+        let node = duodenum.positions[m] as usize;
+        let u = Vector3::new(field[3 * node], field[3 * node + 1], field[3 * node + 2]);
+        let x = Vector3::from(duodenum.position_coords_m[m].map(f64::from));
+        moved += u.norm_squared();
+        mismatch += (u - carry.at(&x)).norm_squared();
+    }
+    let n = interface.len() as f64;
+    let (moved, mismatch) = ((moved / n).sqrt(), (mismatch / n).sqrt());
+    eprintln!(
+        "interface moved {:.3} mm rms, the carried gallbladder differs by {:.3} mm rms; carry {:.3?} mm",
+        moved * 1e3,
+        mismatch * 1e3,
+        (carry.translation_m * 1e3).as_slice()
+    );
+    assert!(moved > 0.5e-3);
+    assert!(mismatch < 0.25 * moved);
+}
+
+#[test]
+#[ignore = "not met yet: with three global modes the gallbladder's response to the contact reaction does not stiffen the press"]
+fn the_trainee_feels_the_liver_behind_the_gallbladder() {
+    let target = facing("gallbladder", -Vector3::z());
+    let felt = |scene: &HapticScene| {
+        let device = Box::new(Scripted::new("push", push(&target, 0.012, PUSH_S, 0.5)));
+        let mut haptic = HapticLoop::new(scene, device).unwrap();
+        haptic.run_simulated(TICKS);
+        haptic.world().resource::<DeviceForce>().desired_n.norm()
+    };
+    let apart = HapticScene {
+        coupling: None,
+        ..scene().clone()
+    };
+    let (coupled, alone) = (felt(scene()), felt(&apart));
+    eprintln!("felt {coupled:.4} N with the liver behind, {alone:.4} N without");
+    assert!(coupled > alone * 1.02);
+}
