@@ -199,11 +199,7 @@ impl DistanceField {
 
     /// `Σ_k |α_k| max|D^k|`: no lattice value moves farther than this from its rest value.
     pub fn movement_bound_m(&self, alpha: &[f32]) -> f32 {
-        alpha
-            .iter()
-            .zip(&self.mode_bounds)
-            .map(|(a, b)| a.abs() * b)
-            .sum()
+        super::modal_rows::movement_bound(alpha, &self.mode_bounds)
     }
 
     /// The deformed distance at `x` for modal coefficients `alpha` (all load steps

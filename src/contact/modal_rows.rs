@@ -130,3 +130,9 @@ pub fn concatenate(coefficients: &[Vec<f64>], out: &mut Vec<f32>) {
     out.clear();
     out.extend(coefficients.iter().flatten().map(|&c| c as f32));
 }
+
+/// `Σ_k |α_k| b_k`: how far modes with per-mode bounds `bounds` can move anything, for
+/// coefficients `alpha`.
+pub fn movement_bound(alpha: &[f32], bounds: &[f32]) -> f32 {
+    alpha.iter().zip(bounds).map(|(a, b)| a.abs() * b).sum()
+}

@@ -88,11 +88,7 @@ impl Pointshell {
 
     /// `Σ_k |α_k| max|X^k|`: no node moves farther than this (m).
     pub fn movement_bound_m(&self, alpha: &[f32]) -> f32 {
-        alpha
-            .iter()
-            .zip(&self.mode_bounds)
-            .map(|(a, b)| a.abs() * b)
-            .sum()
+        super::modal_rows::movement_bound(alpha, &self.mode_bounds)
     }
 }
 
