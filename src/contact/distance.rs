@@ -165,10 +165,6 @@ impl DistanceField {
         self.dims.iter().product()
     }
 
-    pub fn modes(&self) -> usize {
-        self.modes
-    }
-
     pub fn spacing_m(&self) -> f64 {
         self.spacing_m
     }

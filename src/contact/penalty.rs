@@ -80,14 +80,12 @@ pub struct ContactPair {
     shell_vademecum: Arc<Vademecum>,
     master_steps: Vec<Range<usize>>,
     shell_steps: Vec<Range<usize>>,
-    /// Penalty per area (N/m³), and per node (N/m).
-    stiffness_n_per_m3: f64,
+    /// Penalty per node (N/m): per area (N/m³) times its area.
     stiffness_n_per_m: Vec<f64>,
-    /// Per node: the normal force (N, ≥ 0), its direction, this tick's gradient `d + f/k` (m)
-    /// and descent direction (N).
+    /// Per node: the normal force (N, ≥ 0), its direction, and this tick's descent direction
+    /// `−k (d + f/k)` (N).
     force_n: Vec<f64>,
     normal: Vec<Vector3<f64>>,
-    gradient_m: Vec<f64>,
     descent_n: Vec<f64>,
     /// `A` times the descent direction (m).
     response_m: Vec<f64>,
@@ -130,12 +128,10 @@ impl ContactPair {
             field,
             master_vademecum,
             shell_vademecum,
-            stiffness_n_per_m3,
             stiffness_n_per_m: areas.iter().map(|a| a * stiffness_n_per_m3).collect(),
             nodes,
             force_n: vec![0.0; count],
             normal: vec![Vector3::zeros(); count],
-            gradient_m: vec![0.0; count],
             descent_n: vec![0.0; count],
             response_m: vec![0.0; count],
             active: Vec::with_capacity(count),
@@ -145,25 +141,12 @@ impl ContactPair {
         }
     }
 
-    pub fn stiffness_n_per_m3(&self) -> f64 {
-        self.stiffness_n_per_m3
-    }
-
     pub fn field(&self) -> &DistanceField {
         &self.field
     }
 
-    pub fn pointshell(&self) -> &Pointshell {
-        &self.nodes
-    }
-
     pub fn report(&self) -> &PairReport {
         &self.report
-    }
-
-    /// Whether pointshell node `i` pushes on the master.
-    pub fn in_contact(&self, i: usize) -> bool {
-        self.force_n[i] > 0.0
     }
 
     /// One tick: measures every node that can touch (or still pushes), takes the descent step,
@@ -213,7 +196,6 @@ impl ContactPair {
         let gradient = sample.distance_m + self.force_n[i] / k;
         if self.force_n[i] > 0.0 || gradient < 0.0 {
             self.normal[i] = sample.normal;
-            self.gradient_m[i] = gradient;
             self.descent_n[i] = -k * gradient;
             self.active.push(i as u32);
         }
