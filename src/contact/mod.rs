@@ -3,7 +3,7 @@
 //! - the tool against the organs' accessible surfaces ([`press`]);
 //! - organ against organ ([`Coupling`]): the master organ's distance field for every
 //!   deformation ([`DistanceField`]), probed by the other organs' pointshells
-//!   ([`Pointshell`]) with a relaxed penalty ([`ContactPair`]), and attached organs carried by
+//!   ([`Pointshell`]) with a penalty solved each tick ([`ContactPair`]), and attached organs carried by
 //!   the organ they hang from ([`Attachment`]).
 
 mod attachment;
@@ -13,6 +13,7 @@ mod modal_rows;
 mod normal_compliance;
 mod penalty;
 mod pointshell;
+mod projected_cg;
 mod surface;
 mod tool;
 
@@ -20,7 +21,8 @@ pub use attachment::Attachment;
 pub use coupling::{AttachmentSpec, Coupling, CouplingSettings};
 pub use distance::{DistanceField, DistanceSample, DistanceSettings, LatticeCache};
 pub use modal_rows::ModalRows;
-pub use penalty::{ContactPair, OrganPose, PairOutput, PairReport, PenaltySettings};
+pub use penalty::{ContactPair, LoopGain, OrganPose, PairOutput, PairReport, PenaltySettings};
 pub use pointshell::Pointshell;
+pub use projected_cg::Convergence;
 pub use surface::{ContactError, ContactSurface, SurfaceHit};
 pub use tool::{Probe, Target, ToolContact, press};

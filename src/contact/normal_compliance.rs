@@ -1,8 +1,9 @@
 //! The normal compliance `A` of a contact pair: how the nodes' normal forces change their
 //! distances to the master, through both organs' modal compliance (the shell node pushed out,
 //! the master pushed back). Rows are projected on the rest normals once, so applying it over
-//! a set of nodes costs `2 · nodes · (shell modes + master modes)` products: once per tick for
-//! the contact's line search, and a power iteration for the loop gain `λ_max(KA)` at set-up.
+//! a set of nodes costs `4 · nodes · (shell modes + master modes)` products: a few times per
+//! tick in the contact's force solve, and a power iteration for the loop gain `λ_max(KA)` at
+//! set-up.
 
 use super::modal_rows::ModalRows;
 use super::pointshell::Pointshell;
@@ -10,15 +11,59 @@ use crate::pgd::Vademecum;
 
 #[derive(Clone, Debug, Default)]
 pub struct NormalCompliance {
-    /// Per node: the shell's displacement and load modes along the normal, then the master's.
-    shell_displacement: Vec<f32>,
-    shell_load: Vec<f32>,
-    master_displacement: Vec<f32>,
-    master_load: Vec<f32>,
-    shell_modes: usize,
-    master_modes: usize,
-    shell_c: Vec<f32>,
-    master_c: Vec<f32>,
+    shell: OrganRows,
+    master: OrganRows,
+}
+
+/// One organ's part of `A`, per node along its normal: how far the organ's modes move the
+/// node's distance (`displacement`, per unit coefficient) and the coefficients of a unit
+/// normal force there (`load`), with the signs that make a push apart positive.
+///
+/// `A_ij = displacement_i · load_j` is the organ's compliance between the nodes, symmetric
+/// by Maxwell–Betti; its separated form is only nearly so, and conjugate gradients need a
+/// symmetric `A`, so its symmetric part is applied: `½ (displacement_i · load_j +
+/// load_i · displacement_j)`, one more pass over the same rows.
+#[derive(Clone, Debug, Default)]
+struct OrganRows {
+    modes: usize,
+    displacement: Vec<f32>,
+    load: Vec<f32>,
+    /// `Σ_j load_j v_j` and `Σ_j displacement_j v_j` for the forces `v` being applied.
+    by_load: Vec<f32>,
+    by_displacement: Vec<f32>,
+}
+
+impl OrganRows {
+    fn new(modes: usize, displacement: Vec<f32>, load: Vec<f32>) -> Self {
+        Self {
+            modes,
+            displacement,
+            load,
+            by_load: vec![0.0; modes],
+            by_displacement: vec![0.0; modes],
+        }
+    }
+
+    fn rows(&self, i: usize) -> (&[f32], &[f32]) {
+        let range = i * self.modes..(i + 1) * self.modes;
+        (&self.displacement[range.clone()], &self.load[range])
+    }
+
+    fn gather(&mut self, set: &[u32], v: &[f64]) {
+        self.by_load.fill(0.0);
+        self.by_displacement.fill(0.0);
+        for &i in set {
+            let (i, f) = (i as usize, v[i as usize] as f32);
+            let range = i * self.modes..(i + 1) * self.modes;
+            axpy(f, &self.load[range.clone()], &mut self.by_load);
+            axpy(f, &self.displacement[range], &mut self.by_displacement);
+        }
+    }
+
+    fn answer(&self, i: usize) -> f32 {
+        let (displacement, load) = self.rows(i);
+        0.5 * (dot(displacement, &self.by_load) + dot(load, &self.by_displacement))
+    }
 }
 
 impl NormalCompliance {
@@ -35,43 +80,30 @@ impl NormalCompliance {
                 .flat_map(|i| rows.along(i, nodes.rest_normal[i].map(|c| c as f32)))
                 .collect()
         };
+        // The master is pushed against the normal: both its rows change sign, `A` does not.
+        let negate = |rows: Vec<f32>| rows.into_iter().map(|v| -v).collect();
         Self {
-            shell_displacement: project(&nodes.displacement),
-            shell_load: project(&nodes.load),
-            master_displacement: project(&master_rows),
-            master_load: project(&nodes.master_load),
-            shell_modes: shell.total_modes(),
-            master_modes: master.total_modes(),
-            shell_c: vec![0.0; shell.total_modes()],
-            master_c: vec![0.0; master.total_modes()],
+            shell: OrganRows::new(
+                shell.total_modes(),
+                project(&nodes.displacement),
+                project(&nodes.load),
+            ),
+            master: OrganRows::new(
+                master.total_modes(),
+                negate(project(&master_rows)),
+                negate(project(&nodes.master_load)),
+            ),
         }
     }
 
     /// `out[i] = (A v)[i]` for every node `i` of `set` (m), from normal forces `v` (N) on
     /// those nodes; other entries of `out` are left alone.
     pub fn apply(&mut self, set: &[u32], v: &[f64], out: &mut [f64]) {
-        let (ms, mm) = (self.shell_modes, self.master_modes);
-        self.shell_c.fill(0.0);
-        self.master_c.fill(0.0);
-        for &i in set {
-            let (i, f) = (i as usize, v[i as usize] as f32);
-            axpy(f, &self.shell_load[i * ms..(i + 1) * ms], &mut self.shell_c);
-            axpy(
-                -f,
-                &self.master_load[i * mm..(i + 1) * mm],
-                &mut self.master_c,
-            );
-        }
+        self.shell.gather(set, v);
+        self.master.gather(set, v);
         for &i in set {
             let i = i as usize;
-            let moved = dot(
-                &self.shell_displacement[i * ms..(i + 1) * ms],
-                &self.shell_c,
-            ) - dot(
-                &self.master_displacement[i * mm..(i + 1) * mm],
-                &self.master_c,
-            );
-            out[i] = moved as f64;
+            out[i] = (self.shell.answer(i) + self.master.answer(i)) as f64;
         }
     }
 

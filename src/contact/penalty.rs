@@ -12,13 +12,14 @@
 //! both organs' compliance ([`NormalCompliance`]), `K` holds the penalties. The equilibrium
 //! the penalty asks for (`f = max(0, −k d)`, with `d` the distance the forces leave) is the
 //! minimum of the convex energy `E(f) = ½ fᵀ A f + Σ f²/2k + d₀ᵀ f` over `f ≥ 0`, whose
-//! gradient `d + f/k` each tick already measures. So each tick takes one projected
-//! steepest-descent step on `E`, preconditioned by `K`, with an exact line search (one product
-//! with `A` over the nodes involved), warm-started from the last tick's forces:
+//! gradient `d + f/k` each tick already measures. So each tick minimizes `E` by conjugate
+//! gradients with bounds ([`ProjectedCg`]), warm-started from the last tick's forces, with the
+//! distances the tick measured and `A` for how the forces move them:
 //! - the energy falls every tick whatever `k`: no divergence, no overshoot, no chatter;
-//! - a node pushes only while `f > 0`, and lets go as fast as the line search allows when it
-//!   comes out, with no force left pulling or pushing at a distance;
-//! - the force on a node is continuous in its depth, zero at `d = 0`.
+//! - a node pushes only while `f > 0`, and lets go when it comes out, with no force left
+//!   pulling or pushing at a distance;
+//! - the force on a node is continuous in its depth, zero at `d = 0`, and with the minimum
+//!   reached every tick, it follows a slow push smoothly (`tests/contact`).
 //!
 //! **The penalty `k`** (per area) is set once, so that every pointshell node pushing at once
 //! would have loop gain `G` ([`PenaltySettings::loop_gain`]): the stiffest contact the pair
@@ -33,20 +34,25 @@ use nalgebra::Vector3;
 use super::modal_rows::step_ranges;
 use super::normal_compliance::NormalCompliance;
 use super::pointshell::Pointshell;
+use super::projected_cg::{Convergence, ProjectedCg};
 use super::{DistanceField, LatticeCache};
 use crate::pgd::{RigidCarry, Vademecum};
 
-/// The loop gain `G` of the penalty: see the module's documentation.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The loop gain `G` of the penalty (see the module's documentation) and how far each tick
+/// solves for the forces.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PenaltySettings {
-    pub loop_gain: f64,
+    pub loop_gain: LoopGain,
+    pub convergence: Convergence,
 }
 
-impl Default for PenaltySettings {
-    /// 100: with the whole pointshell pressed, an overlap is cut to 1 %; a contact patch of a
-    /// tenth of it settles in about 20 ms.
+/// `G`: 1000 cuts an overlap the whole pointshell is pushed into to 0.1 % of itself.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoopGain(pub f64);
+
+impl Default for LoopGain {
     fn default() -> Self {
-        Self { loop_gain: 1000.0 }
+        Self(1000.0)
     }
 }
 
@@ -68,6 +74,8 @@ pub struct PairReport {
     pub deepest_m: f64,
     /// Total force on the pointshell organ (N); the master takes its opposite.
     pub force_on_shell_n: Vector3<f64>,
+    /// Products with the normal compliance the force solve took.
+    pub products: usize,
 }
 
 #[derive(Clone)]
@@ -82,16 +90,16 @@ pub struct ContactPair {
     shell_steps: Vec<Range<usize>>,
     /// Penalty per node (N/m): per area (N/m³) times its area.
     stiffness_n_per_m: Vec<f64>,
-    /// Per node: the normal force (N, ≥ 0), its direction, and this tick's descent direction
-    /// `−k (d + f/k)` (N).
+    /// Per node: the normal force (N, ≥ 0), its direction, and the energy's gradient
+    /// `d + f/k` (m).
     force_n: Vec<f64>,
     normal: Vec<Vector3<f64>>,
-    descent_n: Vec<f64>,
-    /// `A` times the descent direction (m).
-    response_m: Vec<f64>,
+    gradient_m: Vec<f64>,
     /// Nodes that push or are pushed into, this tick.
     active: Vec<u32>,
     compliance: NormalCompliance,
+    solver: ProjectedCg,
+    convergence: Convergence,
     cache: LatticeCache,
     report: PairReport,
 }
@@ -116,7 +124,7 @@ impl ContactPair {
         let areas: Vec<f64> = nodes.area_m2.iter().map(|&a| a as f64).collect();
         let per_stiffness = compliance.loop_gain(&all, &areas);
         let stiffness_n_per_m3 = match per_stiffness > 0.0 {
-            true => settings.loop_gain / per_stiffness,
+            true => settings.loop_gain.0 / per_stiffness,
             false => 0.0,
         };
         let count = nodes.len();
@@ -132,10 +140,11 @@ impl ContactPair {
             nodes,
             force_n: vec![0.0; count],
             normal: vec![Vector3::zeros(); count],
-            descent_n: vec![0.0; count],
-            response_m: vec![0.0; count],
+            gradient_m: vec![0.0; count],
             active: Vec::with_capacity(count),
             compliance,
+            solver: ProjectedCg::new(count),
+            convergence: settings.convergence,
             cache: LatticeCache::default(),
             report: PairReport::default(),
         }
@@ -149,15 +158,18 @@ impl ContactPair {
         &self.report
     }
 
-    /// One tick: measures every node that can touch (or still pushes), takes the descent step,
+    /// One tick: measures every node that can touch (or still pushes), solves for the forces,
     /// and adds both organs' contact coefficients to `out`. Nodes farther at rest than
-    /// everything can move are skipped with one comparison.
+    /// everything can move are skipped with one comparison: the lattice values move by at
+    /// most the field's bound, and the point itself by the shell's bound and both carries,
+    /// across an interpolated distance whose slope is at most `√3` (trilinear, per axis at
+    /// most 1).
     pub fn tick(&mut self, master: OrganPose, shell: OrganPose, out: PairOutput) {
         self.cache.next_tick(&self.field);
-        let reach = self.field.movement_bound_m(master.alpha)
-            + self.nodes.movement_bound_m(shell.alpha)
+        let point_moves = self.nodes.movement_bound_m(shell.alpha)
             + carry_bound_m(master.carry, &self.field)
             + carry_bound_m(shell.carry, &self.field);
+        let reach = self.field.movement_bound_m(master.alpha) + 3f32.sqrt() * point_moves;
         let mut report = PairReport::default();
         self.active.clear();
         for i in 0..self.nodes.len() {
@@ -168,7 +180,15 @@ impl ContactPair {
             let depth_m = self.measure(i, master, shell);
             report.deepest_m = report.deepest_m.max(depth_m);
         }
-        self.descend();
+        let compliance = &mut self.compliance;
+        report.products = self.solver.solve(
+            &self.active,
+            &self.stiffness_n_per_m,
+            &mut |set: &[u32], v: &[f64], out: &mut [f64]| compliance.apply(set, v, out),
+            &mut self.force_n,
+            &mut self.gradient_m,
+            &self.convergence,
+        );
         for &i in &self.active {
             let i = i as usize;
             if self.force_n[i] > 0.0 {
@@ -196,34 +216,10 @@ impl ContactPair {
         let gradient = sample.distance_m + self.force_n[i] / k;
         if self.force_n[i] > 0.0 || gradient < 0.0 {
             self.normal[i] = sample.normal;
-            self.descent_n[i] = -k * gradient;
+            self.gradient_m[i] = gradient;
             self.active.push(i as u32);
         }
         (-sample.distance_m).max(0.0)
-    }
-
-    /// The projected steepest-descent step with exact line search over the active nodes.
-    fn descend(&mut self) {
-        if self.active.is_empty() {
-            return;
-        }
-        self.compliance
-            .apply(&self.active, &self.descent_n, &mut self.response_m);
-        let (mut slope, mut curvature) = (0.0, 0.0);
-        for &i in &self.active {
-            let i = i as usize;
-            let (s, k) = (self.descent_n[i], self.stiffness_n_per_m[i]);
-            slope += s * s / k;
-            curvature += s * self.response_m[i] + s * s / k;
-        }
-        let step = match curvature > 0.0 {
-            true => (slope / curvature).min(1.0),
-            false => 0.0,
-        };
-        for &i in &self.active {
-            let i = i as usize;
-            self.force_n[i] = (self.force_n[i] + step * self.descent_n[i]).max(0.0);
-        }
     }
 
     /// Node `i`'s force on the shell organ and its reaction on the master, as coefficients.

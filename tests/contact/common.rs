@@ -38,10 +38,33 @@ pub fn facing(name: &str, direction: Vector3<f64>) -> PressTarget {
                 .total_cmp(&normals[b].dot(&direction))
         })
         .unwrap();
+    target(vademecum, best)
+}
+
+fn target(vademecum: &Vademecum, m: usize) -> PressTarget {
     PressTarget {
-        point_m: Vector3::from(vademecum.position_coords_m[best].map(f64::from)),
-        normal: normals[best],
+        point_m: Vector3::from(vademecum.position_coords_m[m].map(f64::from)),
+        normal: vademecum.rest_normals()[m],
     }
+}
+
+/// An accessible point of `name` facing `direction` (normal within about 35° of it), as far as
+/// can be from `clear_of`'s surface, so that a tool pressing there touches `name` alone.
+pub fn facing_clear_of(name: &str, direction: Vector3<f64>, clear_of: &str) -> PressTarget {
+    let (_, vademecum) = organ(name);
+    let (_, other) = organ(clear_of);
+    let at = |v: &Vademecum, m: usize| Vector3::from(v.position_coords_m[m].map(f64::from));
+    let clearance = |m: usize| {
+        (0..other.positions.len())
+            .map(|o| (at(vademecum, m) - at(other, o)).norm())
+            .fold(f64::INFINITY, f64::min)
+    };
+    let normals = vademecum.rest_normals();
+    let best = (0..normals.len())
+        .filter(|&m| normals[m].dot(&direction) > 0.8)
+        .max_by(|&a, &b| clearance(a).total_cmp(&clearance(b)))
+        .unwrap();
+    target(vademecum, best)
 }
 
 /// The tool comes from 5 mm off `target` and pushes `depth_m` into it along its normal over

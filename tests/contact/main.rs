@@ -72,29 +72,50 @@ fn contact_forces_on_the_two_organs_are_equal_and_opposite() {
     }
 }
 
-#[test]
-#[ignore = "not met yet: the contact force zig-zags (steps up to 2 % of its peak, hundreds of reversals)"]
-fn a_slow_push_changes_the_contact_force_smoothly_without_flicker() {
-    let record = pushed();
-    let totals: Vec<f64> = record
+/// The liver pair's total contact force per tick, and its peak.
+fn contact_force_series() -> (Vec<f64>, f64) {
+    let totals: Vec<f64> = pushed()
         .iter()
         .map(|t| liver_pair(t).force_on_shell_n.norm())
         .collect();
     let peak = totals.iter().copied().fold(0.0, f64::max);
+    (totals, peak)
+}
+
+/// Once the gallbladder touches the liver during the push, contact holds on every tick, and
+/// the force rises without zig-zagging: a force that turns back more than a handful of times
+/// over the 1,700 ticks of contact is chattering (one steepest-descent step per tick turned
+/// back 280 times).
+#[test]
+fn a_slow_push_keeps_contact_without_flicker_or_zig_zag() {
+    let (totals, peak) = contact_force_series();
+    let first = totals.iter().position(|&f| f > 0.0).expect("contact begins");
+    let off = totals[first..].iter().filter(|&&f| f == 0.0).count();
+    let reversals = totals[first..]
+        .windows(3)
+        .filter(|w| (w[1] - w[0]) * (w[2] - w[1]) < -1e-12 * peak * peak)
+        .count();
+    eprintln!(
+        "contact from tick {first}: {off} ticks without, {reversals} reversals of the force"
+    );
+    assert_eq!(off, 0, "contact flickered off on {off} ticks");
+    assert!(reversals <= 10, "the force turned back {reversals} times");
+}
+
+#[test]
+#[ignore = "not met yet: the tool's load on the duodenum, which this push grazes, jumps when its contact patch changes (tick 782), and the carry passes the jump on: a step of 3.6 % of the peak"]
+fn a_slow_push_changes_the_contact_force_smoothly() {
+    let (totals, peak) = contact_force_series();
     let largest_step = totals
         .windows(2)
         .map(|w| (w[1] - w[0]).abs())
         .fold(0.0, f64::max);
-    let sign_changes = totals
-        .windows(3)
-        .filter(|w| (w[1] - w[0]) * (w[2] - w[1]) < -1e-16 * peak * peak)
-        .count();
     eprintln!(
-        "peak {peak:.5} N, largest step {largest_step:.2e} N ({:.2} % of peak), reversals {sign_changes}",
+        "peak {peak:.5} N, largest step {largest_step:.2e} N ({:.2} % of peak)",
         100.0 * largest_step / peak
     );
     // The push ramps the overlap over 2000 ticks: a smooth response changes by about
-    // 1/2000 of the peak per tick; allow ten times that, and no oscillation.
+    // 1/2000 of the peak per tick; allow ten times that.
     assert!(
         largest_step <= 0.005 * peak,
         "a step of {largest_step} N against a peak of {peak} N"
@@ -290,4 +311,23 @@ fn the_trainee_feels_the_liver_behind_the_gallbladder() {
     let (coupled, alone) = (felt(scene()), felt(&apart));
     eprintln!("felt {coupled:.4} N with the liver behind, {alone:.4} N without");
     assert!(coupled > alone * 1.02);
+}
+
+/// The push of the other tests also grazes the duodenum. Pressed where the tool touches the
+/// gallbladder alone, the contact and the tool fight: the contact pushes the gallbladder back
+/// onto the tool, and the tool, finding it nearer, pushes harder on the next tick.
+#[test]
+#[ignore = "not met yet: pressed where the tool touches the gallbladder alone, liver nodes sink up to 12 mm after about 1.2 s"]
+fn pressed_where_the_tool_touches_the_gallbladder_alone_the_liver_stays_out() {
+    let target = facing_clear_of("gallbladder", -Vector3::z(), "duodenum");
+    let (_, record) = run(push(&target, 0.012, PUSH_S, 0.5), TICKS);
+    let deepest = record
+        .iter()
+        .map(|t| liver_pair(t).deepest_m)
+        .fold(0.0, f64::max);
+    let spacing = scene().coupling.as_ref().unwrap().pairs[0]
+        .field()
+        .spacing_m();
+    eprintln!("deepest {:.3} mm", deepest * 1e3);
+    assert!(deepest < spacing, "a liver node {deepest} m deep");
 }
