@@ -215,6 +215,23 @@ impl BuildArgs {
 
 #[derive(Subcommand)]
 enum BenchTarget {
+    /// The organ-contact stage: one pair's tick with the organs apart and with the master
+    /// pressed until at least 400 pointshell nodes push, against parry's brute-force check of
+    /// every node against the deformed master surface.
+    Contact {
+        /// Ticks timed per case.
+        #[arg(long, default_value_t = 2000)]
+        ticks: usize,
+        /// The coarse scene (quarter-node organs, built in seconds) instead of the full one.
+        #[arg(long)]
+        coarse: bool,
+        /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
+        #[arg(long, default_value = "vademecums")]
+        vademecums: PathBuf,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// The haptic loop on the four-organ scene: tick compute time over a scripted sweep (all
     /// organs, then each), the same press by full FEM, and real-time punctuality per timer.
     Haptics {
@@ -329,6 +346,30 @@ fn main() -> ExitCode {
             print_report(
                 "pgd bench vademecum",
                 bench::vademecum::run(organ, &laws, repeats),
+                json,
+            )
+        }
+        Command::Bench {
+            what:
+                BenchTarget::Contact {
+                    ticks,
+                    coarse,
+                    vademecums,
+                    json,
+                },
+        } => {
+            let detail = if coarse { Detail::Coarse } else { Detail::Full };
+            let scene = match pgd_surgery::app::scene::default_scene(
+                &vademecums,
+                detail,
+                cli::OnStale::Rebuild,
+            ) {
+                Ok(scene) => scene,
+                Err(e) => return fail("pgd bench contact", &e),
+            };
+            print_report(
+                "pgd bench contact",
+                bench::contact::run(&scene, ticks),
                 json,
             )
         }

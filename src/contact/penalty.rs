@@ -150,6 +150,10 @@ impl ContactPair {
         }
     }
 
+    pub fn pointshell(&self) -> &Pointshell {
+        &self.nodes
+    }
+
     pub fn field(&self) -> &DistanceField {
         &self.field
     }

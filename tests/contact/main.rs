@@ -89,15 +89,16 @@ fn contact_force_series() -> (Vec<f64>, f64) {
 #[test]
 fn a_slow_push_keeps_contact_without_flicker_or_zig_zag() {
     let (totals, peak) = contact_force_series();
-    let first = totals.iter().position(|&f| f > 0.0).expect("contact begins");
+    let first = totals
+        .iter()
+        .position(|&f| f > 0.0)
+        .expect("contact begins");
     let off = totals[first..].iter().filter(|&&f| f == 0.0).count();
     let reversals = totals[first..]
         .windows(3)
         .filter(|w| (w[1] - w[0]) * (w[2] - w[1]) < -1e-12 * peak * peak)
         .count();
-    eprintln!(
-        "contact from tick {first}: {off} ticks without, {reversals} reversals of the force"
-    );
+    eprintln!("contact from tick {first}: {off} ticks without, {reversals} reversals of the force");
     assert_eq!(off, 0, "contact flickered off on {off} ticks");
     assert!(reversals <= 10, "the force turned back {reversals} times");
 }

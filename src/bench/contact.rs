@@ -1,0 +1,267 @@
+//! The organ-contact stage benchmark: one pair's tick (the master's distance field probed by a
+//! pointshell, the force solve, the loads on both organs) with the organs apart and with the
+//! master pressed into the shell organ until at least 400 nodes push, against the brute-force
+//! check of every pointshell node against the exact deformed master surface (parry3d), timed
+//! in the same run.
+
+use std::fmt;
+use std::time::{Duration, Instant};
+
+use nalgebra::{Point3, Vector3};
+use parry3d::query::PointQuery;
+use serde::Serialize;
+
+use crate::app::haptic::HapticScene;
+use crate::contact::{ContactPair, OrganPose, PairOutput};
+use crate::pgd::{RigidCarry, Vademecum};
+use crate::seam::{to_parry, trimesh};
+
+/// Nodes in contact the pressed case asks for (the figure).
+const PRESSED_NODES: usize = 400;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct StageFigures {
+    pub case: &'static str,
+    /// How far the master is carried into the shell organ (m).
+    pub pressed_m: f64,
+    pub nodes_in_contact: usize,
+    pub nodes_evaluated: usize,
+    /// The contact stage per tick (µs).
+    pub stage_p50_us: f64,
+    pub stage_p99_us: f64,
+    /// Every pointshell node against the exact deformed master surface: the surface's BVH
+    /// rebuilt, then one closest-point query per node (µs per tick).
+    pub brute_force_p50_us: f64,
+    /// `brute_force_p50_us / stage_p50_us`.
+    pub speedup: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ContactBenchReport {
+    pub master: String,
+    pub shell: String,
+    pub pointshell_nodes: usize,
+    pub lattice_nodes: usize,
+    pub ticks: usize,
+    pub cases: Vec<StageFigures>,
+}
+
+/// Times the scene's master against its largest pointshell over `ticks` ticks per case.
+pub fn run(scene: &HapticScene, ticks: usize) -> Result<ContactBenchReport, String> {
+    let coupling = scene
+        .coupling
+        .as_ref()
+        .ok_or("the scene has no organ contact")?;
+    let pair = coupling
+        .pairs
+        .iter()
+        .max_by_key(|p| p.pointshell().len())
+        .ok_or("the scene's master meets no other organ")?;
+    let master = &scene.organs[pair.master];
+    let shell = &scene.organs[pair.shell];
+    let apart = time_case(pair, master, shell, 0.0, ticks);
+    let pressed =
+        press_depth(pair, master, shell).map(|depth| time_case(pair, master, shell, depth, ticks));
+    Ok(ContactBenchReport {
+        master: master.0.clone(),
+        shell: shell.0.clone(),
+        pointshell_nodes: pair.pointshell().len(),
+        lattice_nodes: pair.field().node_count(),
+        ticks,
+        cases: std::iter::once(apart).chain(pressed).collect(),
+    })
+}
+
+/// The master carried `depth_m` into the shell organ, along the mean direction from it to the
+/// pointshell's nodes.
+fn carry_into(pair: &ContactPair, depth_m: f64) -> RigidCarry {
+    let normals = &pair.pointshell().rest_normal;
+    let direction = normals.iter().sum::<Vector3<f64>>().normalize();
+    RigidCarry {
+        translation_m: direction * depth_m,
+        ..RigidCarry::default()
+    }
+}
+
+/// The smallest depth (1 mm steps, up to 30 mm) at which at least 400 nodes push, or, where
+/// the pointshell never gets there, the depth with the most nodes pushing; `None` when none
+/// ever does.
+fn press_depth(
+    pair: &ContactPair,
+    master: &(String, std::sync::Arc<Vademecum>),
+    shell: &(String, std::sync::Arc<Vademecum>),
+) -> Option<f64> {
+    let mut most = (0, None);
+    for depth in (1..=30).map(|mm| mm as f64 * 1e-3) {
+        let mut run = Run::new(pair, master, shell, carry_into(pair, depth));
+        (0..20).for_each(|_| run.tick());
+        let in_contact = run.pair.report().nodes_in_contact;
+        if in_contact >= PRESSED_NODES {
+            return Some(depth);
+        }
+        if in_contact > most.0 {
+            most = (in_contact, Some(depth));
+        }
+    }
+    most.1
+}
+
+/// A pair ticking on its own, the contact's coefficients fed back as each organ's only ones.
+struct Run {
+    pair: ContactPair,
+    carry: RigidCarry,
+    still: RigidCarry,
+    coefficients: [Vec<f64>; 2],
+    alpha: [Vec<f32>; 2],
+}
+
+impl Run {
+    fn new(
+        pair: &ContactPair,
+        master: &(String, std::sync::Arc<Vademecum>),
+        shell: &(String, std::sync::Arc<Vademecum>),
+        carry: RigidCarry,
+    ) -> Self {
+        let modes = [master.1.total_modes(), shell.1.total_modes()];
+        Self {
+            pair: pair.clone(),
+            carry,
+            still: RigidCarry::default(),
+            coefficients: modes.map(|m| vec![0.0; m]),
+            alpha: modes.map(|m| vec![0.0; m]),
+        }
+    }
+
+    fn tick(&mut self) {
+        for (alpha, c) in self.alpha.iter_mut().zip(&self.coefficients) {
+            alpha.iter_mut().zip(c).for_each(|(a, &c)| *a = c as f32);
+        }
+        let [master_c, shell_c] = &mut self.coefficients;
+        master_c.fill(0.0);
+        shell_c.fill(0.0);
+        self.pair.tick(
+            OrganPose {
+                alpha: &self.alpha[0],
+                carry: &self.carry,
+            },
+            OrganPose {
+                alpha: &self.alpha[1],
+                carry: &self.still,
+            },
+            PairOutput {
+                master: master_c,
+                shell: shell_c,
+            },
+        );
+    }
+}
+
+fn time_case(
+    pair: &ContactPair,
+    master: &(String, std::sync::Arc<Vademecum>),
+    shell: &(String, std::sync::Arc<Vademecum>),
+    depth_m: f64,
+    ticks: usize,
+) -> StageFigures {
+    let mut run = Run::new(pair, master, shell, carry_into(pair, depth_m));
+    (0..50).for_each(|_| run.tick());
+    let mut times: Vec<Duration> = (0..ticks)
+        .map(|_| {
+            let start = Instant::now();
+            run.tick();
+            start.elapsed()
+        })
+        .collect();
+    times.sort();
+    let brute = brute_force_us(pair, &master.1, &run.carry, ticks.min(200));
+    let p50 = micros(times[times.len() / 2]);
+    let report = run.pair.report();
+    StageFigures {
+        case: if depth_m == 0.0 { "apart" } else { "pressed" },
+        pressed_m: depth_m,
+        nodes_in_contact: report.nodes_in_contact,
+        nodes_evaluated: report.nodes_evaluated,
+        stage_p50_us: p50,
+        stage_p99_us: micros(times[times.len() * 99 / 100]),
+        brute_force_p50_us: brute,
+        speedup: brute / p50,
+    }
+}
+
+/// The median over `ticks` of the brute-force check (µs).
+fn brute_force_us(pair: &ContactPair, master: &Vademecum, carry: &RigidCarry, ticks: usize) -> f64 {
+    let positions: Vec<[f32; 3]> = master
+        .position_coords_m
+        .iter()
+        .map(|p| {
+            let moved = Vector3::from(p.map(f64::from));
+            let moved = moved + carry.at(&moved);
+            [0, 1, 2].map(|c| moved[c] as f32)
+        })
+        .collect();
+    let nodes = &pair.pointshell().rest_m;
+    let mut times: Vec<Duration> = (0..ticks.max(1))
+        .map(|_| {
+            let start = Instant::now();
+            let mesh = trimesh(&positions, &master.triangles).expect("the master's surface");
+            let inside = nodes
+                .iter()
+                .filter(|p| {
+                    let p = Point3::from(p.map(f64::from));
+                    mesh.project_local_point(to_parry(&p), false).is_inside
+                })
+                .count();
+            std::hint::black_box(inside);
+            start.elapsed()
+        })
+        .collect();
+    times.sort();
+    micros(times[times.len() / 2])
+}
+
+fn micros(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e6
+}
+
+impl fmt::Display for ContactBenchReport {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        writeln!(
+            f,
+            "Organ contact: {} (distance field, {} lattice nodes) against {} ({} pointshell nodes), {} ticks per case",
+            self.master, self.lattice_nodes, self.shell, self.pointshell_nodes, self.ticks
+        )?;
+        writeln!(
+            f,
+            "{:<8} {:>8} {:>9} {:>9} {:>10} {:>10} {:>12} {:>8}",
+            "case",
+            "depth mm",
+            "in contact",
+            "evaluated",
+            "p50 µs",
+            "p99 µs",
+            "parry p50 µs",
+            "speedup"
+        )?;
+        for c in &self.cases {
+            writeln!(
+                f,
+                "{:<8} {:>8.1} {:>9} {:>9} {:>10.1} {:>10.1} {:>12.1} {:>7.1}×",
+                c.case,
+                c.pressed_m * 1e3,
+                c.nodes_in_contact,
+                c.nodes_evaluated,
+                c.stage_p50_us,
+                c.stage_p99_us,
+                c.brute_force_p50_us,
+                c.speedup
+            )?;
+        }
+        if self.cases.len() == 1 {
+            writeln!(
+                f,
+                "(no depth up to 30 mm puts {PRESSED_NODES} nodes in contact)"
+            )?;
+        }
+        Ok(())
+    }
+}
