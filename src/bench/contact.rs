@@ -5,6 +5,7 @@
 //! in the same run.
 
 use std::fmt;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use nalgebra::{Point3, Vector3};
@@ -19,6 +20,9 @@ use crate::seam::{to_parry, trimesh};
 /// Nodes in contact the pressed case asks for (the figure).
 const PRESSED_NODES: usize = 400;
 
+/// A scene's organ: its name and vademecum.
+type Organ = (String, Arc<Vademecum>);
+
 #[derive(Clone, Debug, Serialize)]
 pub struct StageFigures {
     pub case: &'static str,
@@ -26,6 +30,8 @@ pub struct StageFigures {
     pub pressed_m: f64,
     pub nodes_in_contact: usize,
     pub nodes_evaluated: usize,
+    /// Products with the normal compliance the force solve took, median per tick.
+    pub solve_products: usize,
     /// The contact stage per tick (µs).
     pub stage_p50_us: f64,
     pub stage_p99_us: f64,
@@ -86,11 +92,7 @@ fn carry_into(pair: &ContactPair, depth_m: f64) -> RigidCarry {
 /// The smallest depth (1 mm steps, up to 30 mm) at which at least 400 nodes push, or, where
 /// the pointshell never gets there, the depth with the most nodes pushing; `None` when none
 /// ever does.
-fn press_depth(
-    pair: &ContactPair,
-    master: &(String, std::sync::Arc<Vademecum>),
-    shell: &(String, std::sync::Arc<Vademecum>),
-) -> Option<f64> {
+fn press_depth(pair: &ContactPair, master: &Organ, shell: &Organ) -> Option<f64> {
     let mut most = (0, None);
     for depth in (1..=30).map(|mm| mm as f64 * 1e-3) {
         let mut run = Run::new(pair, master, shell, carry_into(pair, depth));
@@ -116,12 +118,7 @@ struct Run {
 }
 
 impl Run {
-    fn new(
-        pair: &ContactPair,
-        master: &(String, std::sync::Arc<Vademecum>),
-        shell: &(String, std::sync::Arc<Vademecum>),
-        carry: RigidCarry,
-    ) -> Self {
+    fn new(pair: &ContactPair, master: &Organ, shell: &Organ, carry: RigidCarry) -> Self {
         let modes = [master.1.total_modes(), shell.1.total_modes()];
         Self {
             pair: pair.clone(),
@@ -158,21 +155,25 @@ impl Run {
 
 fn time_case(
     pair: &ContactPair,
-    master: &(String, std::sync::Arc<Vademecum>),
-    shell: &(String, std::sync::Arc<Vademecum>),
+    master: &Organ,
+    shell: &Organ,
     depth_m: f64,
     ticks: usize,
 ) -> StageFigures {
     let mut run = Run::new(pair, master, shell, carry_into(pair, depth_m));
     (0..50).for_each(|_| run.tick());
+    let mut products = Vec::with_capacity(ticks);
     let mut times: Vec<Duration> = (0..ticks)
         .map(|_| {
             let start = Instant::now();
             run.tick();
-            start.elapsed()
+            let elapsed = start.elapsed();
+            products.push(run.pair.report().products);
+            elapsed
         })
         .collect();
     times.sort();
+    products.sort();
     let brute = brute_force_us(pair, &master.1, &run.carry, ticks.min(200));
     let p50 = micros(times[times.len() / 2]);
     let report = run.pair.report();
@@ -181,6 +182,7 @@ fn time_case(
         pressed_m: depth_m,
         nodes_in_contact: report.nodes_in_contact,
         nodes_evaluated: report.nodes_evaluated,
+        solve_products: products[products.len() / 2],
         stage_p50_us: p50,
         stage_p99_us: micros(times[times.len() * 99 / 100]),
         brute_force_p50_us: brute,
@@ -232,11 +234,12 @@ impl fmt::Display for ContactBenchReport {
         )?;
         writeln!(
             f,
-            "{:<8} {:>8} {:>9} {:>9} {:>10} {:>10} {:>12} {:>8}",
+            "{:<8} {:>8} {:>9} {:>9} {:>8} {:>10} {:>10} {:>12} {:>8}",
             "case",
             "depth mm",
             "in contact",
             "evaluated",
+            "products",
             "p50 µs",
             "p99 µs",
             "parry p50 µs",
@@ -245,11 +248,12 @@ impl fmt::Display for ContactBenchReport {
         for c in &self.cases {
             writeln!(
                 f,
-                "{:<8} {:>8.1} {:>9} {:>9} {:>10.1} {:>10.1} {:>12.1} {:>7.1}×",
+                "{:<8} {:>8.1} {:>9} {:>9} {:>8} {:>10.1} {:>10.1} {:>12.1} {:>7.1}×",
                 c.case,
                 c.pressed_m * 1e3,
                 c.nodes_in_contact,
                 c.nodes_evaluated,
+                c.solve_products,
                 c.stage_p50_us,
                 c.stage_p99_us,
                 c.brute_force_p50_us,

@@ -21,7 +21,7 @@ pub use attachment::Attachment;
 pub use coupling::{AttachmentSpec, Coupling, CouplingSettings};
 pub use distance::{DistanceField, DistanceSample, DistanceSettings, LatticeCache};
 pub use modal_rows::ModalRows;
-pub use penalty::{ContactPair, LoopGain, OrganPose, PairOutput, PairReport, PenaltySettings};
+pub use penalty::{ContactPair, OrganPose, PairOutput, PairReport, PenaltySettings};
 pub use pointshell::Pointshell;
 pub use projected_cg::Convergence;
 pub use surface::{ContactError, ContactSurface, SurfaceHit};

@@ -40,19 +40,19 @@ use crate::pgd::{RigidCarry, Vademecum};
 
 /// The loop gain `G` of the penalty (see the module's documentation) and how far each tick
 /// solves for the forces.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PenaltySettings {
-    pub loop_gain: LoopGain,
+    pub loop_gain: f64,
     pub convergence: Convergence,
 }
 
-/// `G`: 1000 cuts an overlap the whole pointshell is pushed into to 0.1 % of itself.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LoopGain(pub f64);
-
-impl Default for LoopGain {
+impl Default for PenaltySettings {
+    /// `G` = 1000 cuts an overlap the whole pointshell is pushed into to 0.1 % of itself.
     fn default() -> Self {
-        Self(1000.0)
+        Self {
+            loop_gain: 1000.0,
+            convergence: Convergence::default(),
+        }
     }
 }
 
@@ -124,7 +124,7 @@ impl ContactPair {
         let areas: Vec<f64> = nodes.area_m2.iter().map(|&a| a as f64).collect();
         let per_stiffness = compliance.loop_gain(&all, &areas);
         let stiffness_n_per_m3 = match per_stiffness > 0.0 {
-            true => settings.loop_gain.0 / per_stiffness,
+            true => settings.loop_gain / per_stiffness,
             false => 0.0,
         };
         let count = nodes.len();

@@ -16,8 +16,6 @@ pub struct ProjectedCg {
     direction_n: Vec<f64>,
     /// `(A + K⁻¹)` times the direction (m).
     product_m: Vec<f64>,
-    /// `A` alone times the direction (m), before the penalty term is added.
-    compliance_m: Vec<f64>,
     /// Whether a node takes part in the current conjugate sequence.
     free: Vec<bool>,
 }
@@ -46,7 +44,6 @@ impl ProjectedCg {
         Self {
             direction_n: vec![0.0; count],
             product_m: vec![0.0; count],
-            compliance_m: vec![0.0; count],
             free: vec![false; count],
         }
     }
@@ -120,10 +117,10 @@ impl ProjectedCg {
         stiffness_n_per_m: &[f64],
         compliance: &mut impl FnMut(&[u32], &[f64], &mut [f64]),
     ) {
-        compliance(set, &self.direction_n, &mut self.compliance_m);
+        compliance(set, &self.direction_n, &mut self.product_m);
         for &i in set {
             let i = i as usize;
-            self.product_m[i] = self.compliance_m[i] + self.direction_n[i] / stiffness_n_per_m[i];
+            self.product_m[i] += self.direction_n[i] / stiffness_n_per_m[i];
         }
     }
 
