@@ -3,12 +3,14 @@
 
 use std::path::Path;
 
+use nalgebra::Vector3;
+
 use super::haptic::{ExerciseRun, HapticLoop, HapticScene, TickClock};
-use super::scene::{Detail, scene_of};
+use super::scene::{Detail, SceneOrgan, scene_of};
 use crate::cli::OnStale;
 use crate::haptics::{HapticDevice, TICK_S};
 use crate::mesh::organs::Organ;
-use crate::scenario::{Exercise, Scenario, Scorecard, score};
+use crate::scenario::{Exercise, Nodule, NoduleSite, Scenario, Scorecard, score};
 
 /// The scene a scenario asks for, its vademecums from `dir`.
 pub fn scenario_scene(
@@ -17,11 +19,21 @@ pub fn scenario_scene(
     detail: Detail,
     on_stale: OnStale,
 ) -> Result<HapticScene, String> {
-    let organs: Vec<Organ> = scenario
+    let organs: Vec<SceneOrgan> = scenario
         .organs
         .iter()
-        .map(|name| Organ::from_name(name).ok_or_else(|| format!("there is no organ `{name}`")))
-        .collect::<Result<_, _>>()?;
+        .map(|name| {
+            let organ =
+                Organ::from_name(name).ok_or_else(|| format!("there is no organ `{name}`"))?;
+            let inclusions = scenario
+                .nodules
+                .iter()
+                .filter(|nodule| &nodule.organ == name)
+                .map(Nodule::inclusion)
+                .collect();
+            Ok(SceneOrgan { organ, inclusions })
+        })
+        .collect::<Result<_, String>>()?;
     let tip = scenario.tool.tip_radius_m();
     let mut scene = scene_of(&organs, Some(tip), dir, detail, on_stale)?;
     scene.safety.max_force_n = scenario.device.max_force_n.0;
@@ -43,7 +55,7 @@ pub fn run_simulated(
     max_ticks: u64,
 ) -> Result<Outcome, String> {
     let mut haptic = HapticLoop::new(scene, device).map_err(|e| e.to_string())?;
-    start(&mut haptic, scenario);
+    start(&mut haptic, scene, scenario);
     for tick in 0..max_ticks {
         haptic.tick(TickClock {
             tick,
@@ -57,11 +69,36 @@ pub fn run_simulated(
     Ok(end(&mut haptic).expect("started above"))
 }
 
-/// Puts `scenario`'s exercise into the haptic world: from the next tick on, it is scored.
-pub fn start(haptic: &mut HapticLoop, scenario: Scenario) {
+/// Puts `scenario`'s exercise, on `scene`, into the haptic world: from the next tick on, it
+/// is scored.
+pub fn start(haptic: &mut HapticLoop, scene: &HapticScene, scenario: Scenario) {
+    let sites = scenario
+        .nodules
+        .iter()
+        .map(|nodule| nodule_site(scene, nodule))
+        .collect();
     haptic
         .world_mut()
-        .insert_resource(ExerciseRun(Exercise::new(scenario)));
+        .insert_resource(ExerciseRun(Exercise::new(scenario, sites)));
+}
+
+/// Where `nodule` lies under its organ's surface: the outward normal at the accessible point
+/// nearest its centre (straight up when the organ is not in the scene, which validation
+/// refuses).
+fn nodule_site(scene: &HapticScene, nodule: &Nodule) -> NoduleSite {
+    let centre_m = nodule.centre_m();
+    let vademecum = scene.organs.iter().find(|(name, _)| name == &nodule.organ);
+    let outward = vademecum
+        .and_then(|(_, vademecum)| {
+            let distance = |k: usize| {
+                (Vector3::from(vademecum.position_coords_m[k].map(f64::from)) - centre_m).norm()
+            };
+            let nearest = (0..vademecum.positions.len())
+                .min_by(|&a, &b| distance(a).total_cmp(&distance(b)))?;
+            Some(vademecum.rest_normals()[nearest])
+        })
+        .unwrap_or_else(Vector3::z);
+    NoduleSite { centre_m, outward }
 }
 
 /// Takes the exercise out of the haptic world, ends it and scores it; `None` if none ran.

@@ -10,7 +10,7 @@ use nalgebra::Vector3;
 use super::haptic::HapticScene;
 use crate::cli::{OnStale, VademecumSpec, ensure_vademecum};
 use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, Probe};
-use crate::fem::Law;
+use crate::fem::{Inclusion, Law};
 use crate::haptics::{PressTarget, SafetySettings};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::{Organ, OrganSettings, region};
@@ -63,13 +63,30 @@ impl Detail {
 /// The default scene at `detail`, its vademecums loaded from `dir` (rebuilt first if missing
 /// or stale, unless `on_stale` refuses); the tool is the one they were built for.
 pub fn default_scene(dir: &Path, detail: Detail, on_stale: OnStale) -> Result<HapticScene, String> {
-    scene_of(&SCENE_ORGANS, None, dir, detail, on_stale)
+    let organs = SCENE_ORGANS.map(SceneOrgan::from);
+    scene_of(&organs, None, dir, detail, on_stale)
+}
+
+/// An organ of a scene, with any stiffer or softer regions in its tissue.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneOrgan {
+    pub organ: Organ,
+    pub inclusions: Vec<Inclusion>,
+}
+
+impl From<Organ> for SceneOrgan {
+    fn from(organ: Organ) -> Self {
+        Self {
+            organ,
+            inclusions: Vec::new(),
+        }
+    }
 }
 
 /// A scene of `organs` felt through a tool tip of `tip_radius_m` (the detail's own when
 /// `None`; coarse organs always take the coarse tool, which their edges need).
 pub fn scene_of(
-    organs: &[Organ],
+    organs: &[SceneOrgan],
     tip_radius_m: Option<f64>,
     dir: &Path,
     detail: Detail,
@@ -79,19 +96,24 @@ pub fn scene_of(
         (Detail::Full, Some(tip)) => tip,
         _ => detail.tip_radius_m(),
     };
-    let spec = |organ: Organ| {
-        let mut spec = detail.vademecum(dir, organ);
+    let spec = |organ: &SceneOrgan| {
+        let mut spec = detail.vademecum(dir, organ.organ);
         if tip != spec.build.tool_tip_radius_m {
             spec.build.tool_tip_radius_m = tip;
-            spec.file = dir.join(format!("{}.tip{}mm.vdm", organ.name(), tip * 1e3));
+            spec.file = dir.join(format!("{}.tip{}mm.vdm", organ.organ.name(), tip * 1e3));
+        }
+        if !organ.inclusions.is_empty() {
+            spec.inclusions = organ.inclusions.clone();
+            let tag = format!("inclusions-{}.vdm", inclusions_tag(&organ.inclusions));
+            spec.file = spec.file.with_extension(tag);
         }
         spec
     };
     let loaded = organs
         .iter()
-        .map(|&organ| {
+        .map(|organ| {
             let (vademecum, mesh) = ensure_vademecum(&spec(organ), on_stale)?;
-            Ok((organ, Arc::new(vademecum), mesh))
+            Ok((organ.organ, Arc::new(vademecum), mesh))
         })
         .collect::<Result<Vec<_>, String>>()?;
     let attachments: Vec<AttachmentSpec> = loaded
@@ -110,6 +132,12 @@ pub fn scene_of(
         safety: SafetySettings::default(),
         coupling: (!coupling.is_empty()).then(|| Arc::new(coupling)),
     })
+}
+
+/// A short tag that tells one set of inclusions from another in a file name.
+fn inclusions_tag(inclusions: &[Inclusion]) -> String {
+    let hash = blake3::hash(format!("{inclusions:?}").as_bytes());
+    hash.to_hex()[..8].to_owned()
 }
 
 /// The attachments `organ` carries: each `attached_<other>` node set of its mesh, as the free

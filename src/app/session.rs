@@ -150,7 +150,7 @@ pub fn open_window(
     let device_name = device.name().to_owned();
     let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
     if let Some(scenario) = scenario {
-        start(&mut haptic, scenario);
+        start(&mut haptic, &scene, scenario);
     }
     let snapshots = haptic.publish();
     let timer = options.realtime.unwrap_or_default();

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 use pgd_surgery::app::scene::Detail;
-use pgd_surgery::fem::{Law, Material, TISSUE_DENSITY_KG_M3};
+use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
 use pgd_surgery::mesh::io::{ImportOptions, write_vtu};
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, region};
 use pgd_surgery::mesh::{QualityReport, TetMesh};
@@ -157,6 +157,11 @@ struct MaterialArgs {
     /// Poisson's ratio.
     #[arg(long, default_value_t = pgd::organ::POISSON)]
     poisson: f64,
+    /// A stiffer (or softer) sphere in the tissue, such as a tumour to find by palpation:
+    /// its centre and radius in millimetres and its Young's modulus over the organ's, as
+    /// `X,Y,Z,RADIUS,RATIO` (e.g. `10,-5,30,7,6`). Repeat for several.
+    #[arg(long, value_name = "X,Y,Z,RADIUS,RATIO", value_parser = cli::parse_inclusion)]
+    inclusion: Vec<Inclusion>,
 }
 
 impl MaterialArgs {
@@ -426,6 +431,7 @@ fn validate_vademecum(
         .check_mesh(file, &tet_mesh)
         .map_err(|e| e.to_string())?;
     let model = pgd::organ::clamped_model(tet_mesh, vademecum.header.material)
+        .and_then(|model| model.with_inclusions(&vademecum.header.inclusions))
         .map_err(|e| format!("{}: {e}", mesh.source))?;
     pgd::validate(&model, &vademecum, settings, &cli::Bar::default())
         .map_err(|e| format!("{}: {e}", mesh.source))
@@ -470,8 +476,10 @@ fn build_vademecum(
     out: &Path,
 ) -> Result<BuildReport, String> {
     let (organ, tet_mesh) = mesh.load()?;
+    let inclusions = &material.inclusion;
     let material = material.material(organ)?;
     let model = pgd::organ::clamped_model(tet_mesh, material)
+        .and_then(|model| model.with_inclusions(inclusions))
         .map_err(|e| format!("{}: {e}", mesh.source))?;
     let organ_model = OrganModel {
         source: mesh.source.clone(),

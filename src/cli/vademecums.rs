@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::fem::{Law, Material};
+use crate::fem::{Inclusion, Law, Material};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::{self, Organ, OrganSettings, region};
 use crate::pgd::{self, BuildSettings, OrganModel, Vademecum, VademecumError};
@@ -27,6 +27,8 @@ pub struct VademecumSpec {
     pub organ: Organ,
     pub law: Law,
     pub mesh: OrganSettings,
+    /// Stiffer or softer regions in the organ's tissue (none by default).
+    pub inclusions: Vec<Inclusion>,
     pub build: BuildSettings,
     pub file: PathBuf,
 }
@@ -38,6 +40,7 @@ impl VademecumSpec {
             organ,
             law,
             mesh: OrganSettings::default(),
+            inclusions: Vec::new(),
             build: BuildSettings::default(),
             file: dir.join(format!("{}.vdm", organ.name())),
         }
@@ -66,6 +69,9 @@ impl VademecumSpec {
         if self.build.local_radius_m != build.local_radius_m {
             command += &format!(" --local-radius-mm {}", self.build.local_radius_m * 1e3);
         }
+        for inclusion in &self.inclusions {
+            command += &format!(" --inclusion {}", inclusion_arg(inclusion));
+        }
         command + &format!(" --out {}", self.file.display())
     }
 }
@@ -90,6 +96,7 @@ pub fn ensure_vademecum(
     }
     eprintln!("{why}\nbuilding it now (the same as `{command}`):");
     let model = pgd::organ::clamped_model(mesh.clone(), material)
+        .and_then(|model| model.with_inclusions(&spec.inclusions))
         .map_err(|e| format!("{}: {e}", organ.name()))?;
     let organ_model = OrganModel {
         source: organ.name().into(),
@@ -121,7 +128,36 @@ fn checked(
     let file = &spec.file;
     let vademecum = pgd::load(file)?;
     vademecum.check_mesh(file, mesh)?;
-    vademecum.check_material(file, material)?;
+    vademecum.check_material(file, material, &spec.inclusions)?;
     vademecum.check_settings(file, &spec.build)?;
     Ok(vademecum)
+}
+
+/// An inclusion as `pgd build --inclusion` takes it: `X,Y,Z,RADIUS,RATIO`, lengths in mm.
+fn inclusion_arg(inclusion: &Inclusion) -> String {
+    let [x, y, z] = inclusion.centre_m.map(|c| c * 1e3);
+    let radius_mm = inclusion.radius_m * 1e3;
+    format!("{x},{y},{z},{radius_mm},{}", inclusion.stiffness_ratio)
+}
+
+/// Reads `X,Y,Z,RADIUS,RATIO` (lengths in mm) as `pgd build --inclusion` takes it.
+pub fn parse_inclusion(text: &str) -> Result<Inclusion, String> {
+    let numbers: Vec<f64> = text
+        .split(',')
+        .map(|part| part.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("`{text}`: {e}; expected X,Y,Z,RADIUS,RATIO (millimetres, ratio)"))?;
+    let [x, y, z, radius_mm, stiffness_ratio] = numbers[..] else {
+        return Err(format!(
+            "`{text}`: {} numbers; expected five: X,Y,Z,RADIUS,RATIO (millimetres, ratio)",
+            numbers.len()
+        ));
+    };
+    let inclusion = Inclusion {
+        centre_m: [x, y, z].map(|c| c * 1e-3),
+        radius_m: radius_mm * 1e-3,
+        stiffness_ratio,
+    };
+    inclusion.validate().map_err(|e| format!("`{text}`: {e}"))?;
+    Ok(inclusion)
 }

@@ -5,6 +5,7 @@
 mod dofs;
 mod element;
 mod error;
+mod inclusion;
 mod linear_solver;
 mod loads;
 mod mass;
@@ -16,6 +17,7 @@ mod pattern;
 pub use dofs::{Dirichlet, DofMap, PRESCRIBED};
 pub use element::{ElementMatrix, ElementVector, TetGeometry};
 pub use error::FemError;
+pub use inclusion::Inclusion;
 pub use linear_solver::{DirectSolver, Factorization};
 pub use loads::{Loads, PatchKernel, patch_weight};
 pub use mass::{consistent_mass, lumped_mass};

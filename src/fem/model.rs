@@ -4,6 +4,7 @@
 use nalgebra::{SMatrix, SymmetricEigen, Vector3};
 
 use super::element::{ElementVector, TetGeometry};
+use super::inclusion::{Inclusion, modulus_scale};
 use super::pattern::FreePattern;
 use super::{Dirichlet, DofMap, FemError, Law, Material, consistent_mass, lumped_mass};
 use crate::mesh::TetMesh;
@@ -16,6 +17,10 @@ pub struct FemModel {
     mesh: TetMesh,
     geometry: Vec<TetGeometry>,
     material: Material,
+    /// Stiffer or softer regions of the tissue, and the factor on Young's modulus they give
+    /// each element (1 for all when there are none).
+    inclusions: Vec<Inclusion>,
+    modulus_scale: Vec<f64>,
     dirichlet: Dirichlet,
     dofs: DofMap,
     pattern: FreePattern,
@@ -38,6 +43,8 @@ impl FemModel {
         let dofs = DofMap::new(&dirichlet);
         let pattern = FreePattern::new(&mesh, &dofs);
         Ok(Self {
+            modulus_scale: vec![1.0; mesh.tet_count()],
+            inclusions: Vec::new(),
             mesh,
             geometry,
             material,
@@ -51,8 +58,27 @@ impl FemModel {
         &self.mesh
     }
 
+    /// The model with `inclusions` in its tissue (replacing any it had).
+    pub fn with_inclusions(mut self, inclusions: &[Inclusion]) -> Result<Self, FemError> {
+        self.modulus_scale = modulus_scale(&self.mesh, inclusions)?;
+        self.inclusions = inclusions.to_vec();
+        Ok(self)
+    }
+
     pub fn material(&self) -> &Material {
         &self.material
+    }
+
+    pub fn inclusions(&self) -> &[Inclusion] {
+        &self.inclusions
+    }
+
+    /// The element's Lamé constants (λ, μ) in pascals: the material's, scaled by any inclusion
+    /// the element lies in (both scale with Young's modulus at a fixed Poisson's ratio).
+    fn lame(&self, element: usize) -> (f64, f64) {
+        let (lambda, mu) = self.material.lame();
+        let scale = self.modulus_scale[element];
+        (scale * lambda, scale * mu)
     }
 
     pub fn dirichlet(&self) -> &Dirichlet {
@@ -73,9 +99,9 @@ impl FemModel {
 
     /// Internal force (N) on every dof for the full displacement `u_m`.
     pub fn internal_force(&self, u_m: &[f64]) -> Vec<f64> {
-        let (lambda, mu) = self.material.lame();
         let mut force = vec![0.0; u_m.len()];
-        for (tet, geo) in self.mesh.tets().iter().zip(&self.geometry) {
+        for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
+            let (lambda, mu) = self.lame(t);
             let ue = gather(tet, u_m);
             let fe = geo.force(self.material.law, lambda, mu, &ue);
             scatter_vector(tet, &fe, &mut force);
@@ -89,8 +115,8 @@ impl FemModel {
         if self.material.law == Law::Linear {
             return;
         }
-        let (lambda, mu) = self.material.lame();
-        for (tet, geo) in self.mesh.tets().iter().zip(&self.geometry) {
+        for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
+            let (lambda, mu) = self.lame(t);
             let ue = gather(tet, u_m);
             let fe = geo.nonlinear_force(self.material.law, lambda, mu, &ue);
             scatter_vector(tet, &fe, out);
@@ -100,10 +126,10 @@ impl FemModel {
     /// Internal force on every dof, and the tangent stiffness over free dofs as values of
     /// [`Self::pattern`], both at the full displacement `u_m`.
     pub fn force_and_tangent(&self, u_m: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let (lambda, mu) = self.material.lame();
         let mut force = vec![0.0; u_m.len()];
         let mut values = self.pattern.zero_values();
         for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
+            let (lambda, mu) = self.lame(t);
             let ue = gather(tet, u_m);
             let (fe, ke) = geo.force_and_tangent(self.material.law, lambda, mu, &ue);
             scatter_vector(tet, &fe, &mut force);

@@ -201,6 +201,7 @@ pub fn build(
         node_count: mesh.node_count(),
         tet_count: mesh.tet_count(),
         material: *model.material(),
+        inclusions: model.inclusions().to_vec(),
         clamped_region: organ.clamped_region.clone(),
         accessible_region: organ.accessible_region.clone(),
         load_directions: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],

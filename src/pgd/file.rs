@@ -13,7 +13,7 @@ use thiserror::Error;
 use super::BuildSettings;
 use super::local::LocalPart;
 use super::vademecum::{Header, Step, Vademecum};
-use crate::fem::Material;
+use crate::fem::{Inclusion, Material};
 use crate::mesh::TetMesh;
 
 /// Bumped on any change of layout or meaning; older files are refused, not misread.
@@ -171,13 +171,20 @@ impl Vademecum {
         Ok(())
     }
 
-    /// Refuses a vademecum built for another material law or constants than `material`.
-    pub fn check_material(&self, file: &Path, material: &Material) -> Result<(), VademecumError> {
-        if self.header.material != *material {
+    /// Refuses a vademecum built for another material law or constants than `material`, or
+    /// with other inclusions in the tissue.
+    pub fn check_material(
+        &self,
+        file: &Path,
+        material: &Material,
+        inclusions: &[Inclusion],
+    ) -> Result<(), VademecumError> {
+        let header = &self.header;
+        if header.material != *material || header.inclusions != inclusions {
             return Err(VademecumError::OtherMaterial {
                 file: file.to_path_buf(),
-                expected: format!("{material:?}"),
-                found: format!("{:?}", self.header.material),
+                expected: tissue(material, inclusions),
+                found: tissue(&header.material, &header.inclusions),
             });
         }
         Ok(())
@@ -434,4 +441,12 @@ fn validate(path: &Path, v: &Vademecum) -> Result<(), VademecumError> {
         }
     }
     Ok(())
+}
+
+/// A material and its inclusions, for a message.
+fn tissue(material: &Material, inclusions: &[Inclusion]) -> String {
+    match inclusions {
+        [] => format!("{material:?}"),
+        _ => format!("{material:?} with inclusions {inclusions:?}"),
+    }
 }

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::BuildSettings;
 use super::error_curve::ErrorCurve;
 use super::local::LocalPart;
-use crate::fem::{Material, patch_weight};
+use crate::fem::{Inclusion, Material, patch_weight};
 
 /// What the vademecum was built from and how: enough to refuse a stale file and to say how it
 /// was made.
@@ -21,6 +21,9 @@ pub struct Header {
     pub node_count: usize,
     pub tet_count: usize,
     pub material: Material,
+    /// Stiffer or softer regions of the tissue (none in files written before they existed).
+    #[serde(default)]
+    pub inclusions: Vec<Inclusion>,
     /// The node set held fixed.
     pub clamped_region: String,
     /// The face set the tool may load.

@@ -15,11 +15,30 @@ pub struct Sample {
     pub force_n: f64,
     /// The organs the tool touches: bit `k` for the scenario's `organs[k]`.
     pub touching: u64,
+    /// Whether the device's first button is held (the mark in palpation).
+    pub button: bool,
 }
 
 impl Sample {
     pub fn touches(&self, organ: usize) -> bool {
         organ < 64 && self.touching & (1 << organ) != 0
+    }
+}
+
+/// Where a nodule of the scenario lies: its centre, and the outward normal of the organ's
+/// surface nearest to it, along which a mark right above it lies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoduleSite {
+    pub centre_m: Vector3<f64>,
+    pub outward: Vector3<f64>,
+}
+
+impl NoduleSite {
+    /// How far (m) `point_m` is from the nodule across the surface: its distance from the
+    /// line through the centre along the outward normal, so that depth does not count.
+    pub fn lateral_distance_m(&self, point_m: &Vector3<f64>) -> f64 {
+        let offset = point_m - self.centre_m;
+        (offset - self.outward * offset.dot(&self.outward)).norm()
     }
 }
 
@@ -54,6 +73,10 @@ pub struct TaskMetrics {
     pub targets: usize,
     /// Safe navigation: the tip's path against the straight lines between targets (1 = straight).
     pub path_ratio: Option<f64>,
+    /// Palpation: how far across the surface the mark was from the nodule (mm), if made...
+    pub localization_error_mm: Option<f64>,
+    /// ...and how near counts as found (mm).
+    pub found_within_mm: Option<f64>,
     /// Each error, with the time it was made.
     pub errors: Vec<String>,
 }
@@ -72,11 +95,16 @@ struct Running {
     path_m: f64,
     first_tip: Option<Vector3<f64>>,
     last_tip: Option<Vector3<f64>>,
+    /// Palpation: the organ's nodules, and whether the button was held on the last tick.
+    nodules: Vec<NoduleSite>,
+    button_held: bool,
 }
 
 /// The tasks of a scenario, run one after another.
 pub struct Exercise {
     scenario: Scenario,
+    /// Per nodule of the scenario, where it lies.
+    sites: Vec<NoduleSite>,
     current: usize,
     running: Option<Running>,
     done: Vec<TaskMetrics>,
@@ -88,11 +116,13 @@ pub struct Exercise {
 }
 
 impl Exercise {
-    pub fn new(scenario: Scenario) -> Self {
+    /// The exercise of `scenario`, whose nodules lie at `sites` (one per nodule, in order).
+    pub fn new(scenario: Scenario, sites: Vec<NoduleSite>) -> Self {
         let total_s: f64 = scenario.tasks.iter().map(Task::time_limit_s).sum();
         let samples = (total_s / (PLOT_EVERY as f64 * crate::haptics::TICK_S)).ceil() as usize;
         Self {
             scenario,
+            sites,
             current: 0,
             running: None,
             done: Vec::new(),
@@ -120,13 +150,13 @@ impl Exercise {
             self.force_trace.push((sample.time_s, sample.force_n));
         }
         self.ticks += 1;
-        let organs = &self.scenario.organs;
+        let (scenario, sites) = (&self.scenario, &self.sites);
         let running = self
             .running
-            .get_or_insert_with(|| Running::start(task, organs, sample.time_s));
+            .get_or_insert_with(|| Running::start(task, scenario, sites, sample.time_s));
         running.step(task, sample, dt);
         let elapsed = sample.time_s - running.metrics.started_s;
-        if running.metrics.completed || elapsed >= task.time_limit_s() {
+        if running.over() || elapsed >= task.time_limit_s() {
             self.end_task(sample.time_s);
         }
     }
@@ -150,7 +180,7 @@ impl Exercise {
         while !self.finished() {
             if self.running.is_none() {
                 let task = &self.scenario.tasks[self.current];
-                self.running = Some(Running::start(task, &self.scenario.organs, now));
+                self.running = Some(Running::start(task, &self.scenario, &self.sites, now));
             }
             self.end_task(now);
         }
@@ -159,7 +189,8 @@ impl Exercise {
 }
 
 impl Running {
-    fn start(task: &Task, organs: &[String], time_s: f64) -> Self {
+    fn start(task: &Task, scenario: &Scenario, sites: &[NoduleSite], time_s: f64) -> Self {
+        let organs = &scenario.organs;
         let (description, force_limit_n, targets, band_min_n) = match task {
             Task::ForceControl {
                 organ,
@@ -192,6 +223,17 @@ impl Running {
                 targets.len(),
                 None,
             ),
+            Task::Palpation {
+                organ, max_force_n, ..
+            } => (
+                format!(
+                    "find the nodule in the {organ} by feel and mark it, under {:.2} N",
+                    max_force_n.0
+                ),
+                max_force_n.0,
+                0,
+                None,
+            ),
         };
         Self {
             metrics: TaskMetrics {
@@ -202,13 +244,32 @@ impl Running {
                 force_limit_n,
                 band_min_n,
                 targets,
+                found_within_mm: match task {
+                    Task::Palpation {
+                        found_within_mm, ..
+                    } => Some(found_within_mm.0),
+                    _ => None,
+                },
                 ..TaskMetrics::default()
             },
             force_sum: 0.0,
             organ: match task {
-                Task::ForceControl { organ, .. } => organs.iter().position(|o| o == organ),
+                Task::ForceControl { organ, .. } | Task::Palpation { organ, .. } => {
+                    organs.iter().position(|o| o == organ)
+                }
                 Task::SafeNavigation { .. } => None,
             },
+            nodules: match task {
+                Task::Palpation { organ, .. } => scenario
+                    .nodules
+                    .iter()
+                    .zip(sites)
+                    .filter(|(nodule, _)| &nodule.organ == organ)
+                    .map(|(_, site)| *site)
+                    .collect(),
+                _ => Vec::new(),
+            },
+            button_held: false,
             in_band_since: None,
             over_limit: false,
             inside_zone: None,
@@ -259,7 +320,37 @@ impl Running {
             Task::SafeNavigation {
                 targets, forbidden, ..
             } => self.navigate(targets, forbidden, sample),
+            Task::Palpation {
+                found_within_mm, ..
+            } => self.palpate(found_within_mm.metres(), sample),
         }
+    }
+
+    /// A press of the button while on the organ is the mark: the task ends with it, found if
+    /// the mark is near enough a nodule. A press off the organ marks nothing.
+    fn palpate(&mut self, found_within_m: f64, sample: &Sample) {
+        let pressed = sample.button && !self.button_held;
+        self.button_held = sample.button;
+        let on_organ = self.organ.is_some_and(|k| sample.touches(k));
+        let (true, true, Some(tip)) = (pressed, on_organ, sample.tip_m) else {
+            return;
+        };
+        let Some(error_m) = self
+            .nodules
+            .iter()
+            .map(|site| site.lateral_distance_m(&tip))
+            .min_by(f64::total_cmp)
+        else {
+            return;
+        };
+        let m = &mut self.metrics;
+        m.localization_error_mm = Some(error_m * 1e3);
+        m.completed = error_m <= found_within_m;
+    }
+
+    /// Whether the task is over before its time: done, or (palpation) marked, right or wrong.
+    fn over(&self) -> bool {
+        self.metrics.completed || self.metrics.localization_error_mm.is_some()
     }
 
     fn navigate(&mut self, targets: &[Spot], forbidden: &[Spot], sample: &Sample) {

@@ -5,7 +5,7 @@
 
 use serde::Deserialize;
 
-use super::units::{Millimetres, Newtons, Seconds};
+use super::units::{Millimetres, Newtons, Ratio, Seconds};
 
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -21,6 +21,10 @@ pub struct Scenario {
     pub tool: Tool,
     #[serde(default)]
     pub device: Device,
+    /// Stiffer lumps hidden in the organs' tissue, such as tumours, for palpation. The
+    /// organ's vademecum is built with them (the first run of the scenario builds it).
+    #[serde(default)]
+    pub nodules: Vec<Nodule>,
     /// Done in order: each task starts when the one before is done or out of time.
     pub tasks: Vec<Task>,
     #[serde(default)]
@@ -101,6 +105,33 @@ impl Spot {
     }
 }
 
+/// A sphere of stiffer tissue inside an organ.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Nodule {
+    pub organ: String,
+    /// Its centre, in the scene's frame (mm).
+    pub at_mm: (f64, f64, f64),
+    pub radius_mm: Millimetres,
+    /// Its Young's modulus over the organ's (tumours are several times stiffer).
+    pub stiffness_ratio: Ratio,
+}
+
+impl Nodule {
+    pub fn centre_m(&self) -> nalgebra::Vector3<f64> {
+        nalgebra::Vector3::new(self.at_mm.0, self.at_mm.1, self.at_mm.2) * 1e-3
+    }
+
+    /// The nodule as the finite-element model takes it.
+    pub fn inclusion(&self) -> crate::fem::Inclusion {
+        crate::fem::Inclusion {
+            centre_m: self.centre_m().into(),
+            radius_m: self.radius_mm.metres(),
+            stiffness_ratio: self.stiffness_ratio.0,
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Task {
@@ -121,6 +152,15 @@ pub enum Task {
         max_force_n: Newtons,
         time_limit_s: Seconds,
     },
+    /// Find the organ's hidden nodule by feel and mark it with the device's button (one
+    /// mark: the task ends with it). Found when the mark is within `found_within_mm` of the
+    /// nodule, measured across the surface (depth does not count).
+    Palpation {
+        organ: String,
+        found_within_mm: Millimetres,
+        max_force_n: Newtons,
+        time_limit_s: Seconds,
+    },
 }
 
 /// What kind a task is, for its metrics and its score.
@@ -131,6 +171,8 @@ pub enum TaskKind {
     ForceControl,
     #[serde(rename = "safe navigation")]
     SafeNavigation,
+    #[serde(rename = "palpation")]
+    Palpation,
 }
 
 impl std::fmt::Display for TaskKind {
@@ -138,6 +180,7 @@ impl std::fmt::Display for TaskKind {
         f.write_str(match self {
             TaskKind::ForceControl => "force control",
             TaskKind::SafeNavigation => "safe navigation",
+            TaskKind::Palpation => "palpation",
         })
     }
 }
@@ -147,14 +190,15 @@ impl Task {
         match self {
             Task::ForceControl { .. } => TaskKind::ForceControl,
             Task::SafeNavigation { .. } => TaskKind::SafeNavigation,
+            Task::Palpation { .. } => TaskKind::Palpation,
         }
     }
 
     pub fn time_limit_s(&self) -> f64 {
         match self {
-            Task::ForceControl { time_limit_s, .. } | Task::SafeNavigation { time_limit_s, .. } => {
-                time_limit_s.0
-            }
+            Task::ForceControl { time_limit_s, .. }
+            | Task::SafeNavigation { time_limit_s, .. }
+            | Task::Palpation { time_limit_s, .. } => time_limit_s.0,
         }
     }
 }
@@ -173,6 +217,10 @@ pub struct Rubric {
     /// force limits.
     #[serde(default = "default_force")]
     pub force: f64,
+    /// Weight of accuracy, in palpation only: 1 for a mark on the nodule, falling to 0 at
+    /// twice `found_within_mm` from it.
+    #[serde(default = "default_accuracy")]
+    pub accuracy: f64,
     /// Points lost per error (a forbidden zone entered, a press over the limit).
     #[serde(default = "default_error_penalty")]
     pub error_penalty: f64,
@@ -193,6 +241,9 @@ fn default_speed() -> f64 {
 fn default_force() -> f64 {
     0.4
 }
+fn default_accuracy() -> f64 {
+    0.4
+}
 fn default_error_penalty() -> f64 {
     10.0
 }
@@ -209,6 +260,7 @@ impl Default for Rubric {
             completion: default_completion(),
             speed: default_speed(),
             force: default_force(),
+            accuracy: default_accuracy(),
             error_penalty: default_error_penalty(),
             pass_mark: default_pass_mark(),
             all_tasks_required: true,

@@ -156,12 +156,18 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
             });
         }
     }
+    for (k, nodule) in scenario.nodules.iter().enumerate() {
+        let field = format!("nodules[{k}].organ");
+        problems.extend(not_in_scene(scenario, &nodule.organ, field, "nodules"));
+    }
     if scenario.tasks.is_empty() {
         problems.push(Problem {
             field: "tasks".into(),
             anchors: vec!["tasks".into()],
             message: "the scenario has no tasks".into(),
-            hint: format!("add a ForceControl(…) or SafeNavigation(…) task ({REFERENCE})"),
+            hint: format!(
+                "add a ForceControl(…), SafeNavigation(…) or Palpation(…) task ({REFERENCE})"
+            ),
         });
     }
     for (k, task) in scenario.tasks.iter().enumerate() {
@@ -183,14 +189,7 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
             hold_s,
             time_limit_s,
         } => {
-            if !scenario.organs.contains(organ) {
-                problems.push(Problem {
-                    field: field("organ"),
-                    anchors: vec!["tasks".into(), format!("\"{organ}\"")],
-                    message: format!("`{organ}` is not in this scenario's organs"),
-                    hint: format!("the scene has: {}", scenario.organs.join(", ")),
-                });
-            }
+            problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
             if min_force_n.0 >= max_force_n.0 {
                 problems.push(Problem {
                     field: field("min_force_n"),
@@ -225,6 +224,19 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
                 });
             }
         }
+        Task::Palpation { organ, .. } => {
+            problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
+            if !scenario.nodules.iter().any(|n| &n.organ == organ) {
+                problems.push(Problem {
+                    field: field("organ"),
+                    anchors: vec!["tasks".into(), "Palpation".into(), format!("\"{organ}\"")],
+                    message: format!("the {organ} has no nodule to find"),
+                    hint: format!(
+                        "add `nodules: [Nodule(organ: \"{organ}\", at_mm: (x, y, z), radius_mm: …, stiffness_ratio: …)]` ({REFERENCE})"
+                    ),
+                });
+            }
+        }
         Task::SafeNavigation { targets, .. } => {
             if targets.is_empty() {
                 problems.push(Problem {
@@ -238,15 +250,31 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
     }
 }
 
+/// A problem if `organ`, named at `field` in the `section` of the file, is not in the scene.
+fn not_in_scene(scenario: &Scenario, organ: &str, field: String, section: &str) -> Option<Problem> {
+    (!scenario.organs.iter().any(|o| o == organ)).then(|| Problem {
+        field,
+        anchors: vec![section.into(), format!("\"{organ}\"")],
+        message: format!("`{organ}` is not in this scenario's organs"),
+        hint: format!("the scene has: {}", scenario.organs.join(", ")),
+    })
+}
+
 fn check_rubric(scenario: &Scenario, problems: &mut Vec<Problem>) {
     let rubric = &scenario.rubric;
-    let weights = [rubric.completion, rubric.speed, rubric.force];
+    let weights = [
+        rubric.completion,
+        rubric.speed,
+        rubric.force,
+        rubric.accuracy,
+    ];
     if weights.iter().any(|w| !(w.is_finite() && *w >= 0.0)) || weights.iter().sum::<f64>() <= 0.0 {
         problems.push(Problem {
             field: "rubric".into(),
             anchors: vec!["rubric".into()],
             message: format!("the weights {weights:?} are not usable"),
-            hint: "completion, speed and force are weights of 0 or more, not all 0".into(),
+            hint: "completion, speed, force and accuracy are weights of 0 or more, not all 0"
+                .into(),
         });
     }
     if !(0.0..=100.0).contains(&rubric.pass_mark) {

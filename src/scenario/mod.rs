@@ -9,8 +9,8 @@ mod load;
 mod score;
 mod units;
 
-pub use exercise::{Exercise, Sample, TaskMetrics};
-pub use format::{Device, Difficulty, Rubric, Scenario, Spot, Task, TaskKind, Tool};
+pub use exercise::{Exercise, NoduleSite, Sample, TaskMetrics};
+pub use format::{Device, Difficulty, Nodule, Rubric, Scenario, Spot, Task, TaskKind, Tool};
 pub use load::{ScenarioError, load, parse};
 pub use score::{Scorecard, TaskScore, score};
-pub use units::{Millimetres, Newtons, Seconds};
+pub use units::{Millimetres, Newtons, Ratio, Seconds};

@@ -56,39 +56,58 @@ pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
     }
 }
 
-/// Completion, speed and force control weighted by the rubric, less the error penalties.
+/// Completion, speed, force control and (palpation) accuracy weighted by the rubric, less the
+/// error penalties.
 fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
     let completion = f64::from(u8::from(m.completed));
     let speed = match m.completed {
         true => (1.0 - m.time_s / m.time_limit_s).clamp(0.0, 1.0),
         false => 0.0,
     };
-    let force = force_control(m);
-    let weights = rubric.completion + rubric.speed + rubric.force;
-    let weighted = (rubric.completion * completion + rubric.speed * speed + rubric.force * force)
-        / weights.max(f64::MIN_POSITIVE);
+    let mut terms = vec![
+        (rubric.completion, completion),
+        (rubric.speed, speed),
+        (rubric.force, force_control(m)),
+    ];
+    if m.kind == TaskKind::Palpation {
+        terms.push((rubric.accuracy, accuracy(m)));
+    }
+    let weights: f64 = terms.iter().map(|(w, _)| w).sum();
+    let weighted = terms.iter().map(|(w, v)| w * v).sum::<f64>() / weights.max(f64::MIN_POSITIVE);
     (100.0 * weighted - rubric.error_penalty * m.errors.len() as f64).clamp(0.0, 100.0)
 }
 
+/// Palpation: 1 for a mark on the nodule, falling linearly to 0 at twice the distance that
+/// counts as found; 0 without a mark.
+fn accuracy(m: &TaskMetrics) -> f64 {
+    match (m.localization_error_mm, m.found_within_mm) {
+        (Some(error), Some(within)) => (1.0 - error / (2.0 * within)).clamp(0.0, 1.0),
+        _ => 0.0,
+    }
+}
+
 /// The share of the time in contact spent as the task wants: within the band (force control),
-/// under the limit (safe navigation; full marks if the tool never touched).
+/// under the limit (safe navigation and palpation; full marks if the tool never touched in
+/// safe navigation, none in palpation, where touching is the task).
 fn force_control(m: &TaskMetrics) -> f64 {
     if m.contact_s <= 0.0 {
         return match m.kind {
-            TaskKind::ForceControl => 0.0,
+            TaskKind::ForceControl | TaskKind::Palpation => 0.0,
             TaskKind::SafeNavigation => 1.0,
         };
     }
     match m.kind {
         TaskKind::ForceControl => (m.within_band_s / m.contact_s).clamp(0.0, 1.0),
-        TaskKind::SafeNavigation => (1.0 - m.time_over_limit_s / m.contact_s).clamp(0.0, 1.0),
+        TaskKind::SafeNavigation | TaskKind::Palpation => {
+            (1.0 - m.time_over_limit_s / m.contact_s).clamp(0.0, 1.0)
+        }
     }
 }
 
 fn task_feedback(task: &TaskScore) -> Vec<String> {
     let m = &task.metrics;
     let mut lines = Vec::new();
-    if !m.completed {
+    if !m.completed && m.localization_error_mm.is_none() {
         let what = match m.targets {
             0 => String::new(),
             n => format!(" ({} of {n} targets reached)", m.targets_reached),
@@ -96,6 +115,14 @@ fn task_feedback(task: &TaskScore) -> Vec<String> {
         lines.push(format!(
             "{}: not finished in {:.0} s{what}",
             m.kind, m.time_limit_s
+        ));
+    }
+    if let (Some(error), Some(within)) = (m.localization_error_mm, m.found_within_mm)
+        && error > within
+    {
+        lines.push(format!(
+            "{}: marked {error:.0} mm from the nodule; within {within:.0} mm counts as found",
+            m.kind
         ));
     }
     if m.time_over_limit_s > 0.0 {

@@ -69,3 +69,23 @@ impl TryFrom<f64> for Seconds {
         }
     }
 }
+
+/// A stiffness ratio of a nodule to its organ: more than 1 (stiffer) and at most 50.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct Ratio(pub f64);
+
+impl TryFrom<f64> for Ratio {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if !v.is_finite() || v <= 1.0 => Err(format!(
+                "{v} is not the ratio of a stiffer nodule: it must be more than 1 (a tumour is typically 3 to 10 times stiffer)"
+            )),
+            v if v > 50.0 => Err(format!(
+                "{v} is stiffer than any tissue over its organ: at most 50 (a tumour is typically 3 to 10 times stiffer)"
+            )),
+            v => Ok(Self(v)),
+        }
+    }
+}

@@ -4,6 +4,7 @@
 mod bad_input;
 mod beams;
 mod cantilever;
+mod inclusion;
 mod ksv;
 mod loads_and_mass;
 mod patch;

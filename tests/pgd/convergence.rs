@@ -5,7 +5,7 @@ use pgd_surgery::pgd::{Silent, ValidationSettings, build, validate};
 
 use crate::common::{block_mesh, block_model, build_block, organ, settings};
 
-fn off_node_loads() -> ValidationSettings {
+pub fn off_node_loads() -> ValidationSettings {
     ValidationSettings {
         samples: 12,
         near_radius_m: 0.015,

@@ -3,5 +3,6 @@
 mod common;
 mod convergence;
 mod file_format;
+mod inclusion;
 mod nonlinear;
 mod outputs;

@@ -31,5 +31,6 @@ pub fn score_tick(
         tip_m: tool.sample.map(|s| s.tip_m),
         force_n: force.sent_n.norm(),
         touching,
+        button: tool.sample.is_some_and(|s| s.buttons & 1 != 0),
     });
 }
