@@ -65,6 +65,12 @@ pub fn summary(card: &Scorecard) -> String {
                 m.targets_reached, m.targets
             );
         }
+        if let (Some(error), Some(within)) = (m.localization_error_mm, m.found_within_mm) {
+            let _ = writeln!(
+                out,
+                "  mark: {error:.1} mm from the nodule across the surface (found within {within:.0} mm)"
+            );
+        }
     }
     if !card.feedback.is_empty() {
         let _ = writeln!(out, "what to work on:");

@@ -12,7 +12,7 @@ use pgd_surgery::app::exercise::{Outcome, run_simulated, scenario_scene};
 use pgd_surgery::app::scene::{Detail, default_scene};
 use pgd_surgery::cli::{OnStale, write_report};
 use pgd_surgery::haptics::{Scripted, TICK_S, Trajectory};
-use pgd_surgery::scenario::{load, parse};
+use pgd_surgery::scenario::{Scenario, load, parse};
 
 const TRAINER: &str = env!("CARGO_BIN_EXE_trainer");
 
@@ -20,12 +20,17 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The coarse vademecums of the four organs, built once for all tests here.
+/// The coarse vademecums of the four organs, and of the organs with nodules the shipped
+/// scenarios ask for, built once for all tests here.
 fn vademecums() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenario-vademecums");
         default_scene(&dir, Detail::Coarse, OnStale::Rebuild).unwrap();
+        for name in SHIPPED {
+            let scenario = load(&root().join(format!("scenarios/{name}.scenario.ron"))).unwrap();
+            scenario_scene(&scenario, &dir, Detail::Coarse, OnStale::Rebuild).unwrap();
+        }
         dir
     })
 }
@@ -33,6 +38,17 @@ fn vademecums() -> &'static Path {
 /// Runs a shipped scenario on the coarse organs with one of its scripts.
 fn run(name: &str, script: &str) -> Outcome {
     let scenario = load(&root().join(format!("scenarios/{name}.scenario.ron"))).unwrap();
+    run_scenario(scenario, name, script)
+}
+
+/// [`run`] with the organs' tissue plain: no nodules.
+fn run_without_nodules(name: &str, script: &str) -> Outcome {
+    let mut scenario = load(&root().join(format!("scenarios/{name}.scenario.ron"))).unwrap();
+    scenario.nodules.clear();
+    run_scenario(scenario, name, script)
+}
+
+fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     let scene = scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Refuse).unwrap();
     let path = root().join(format!("tests/scenarios/{name}.{script}.csv"));
     let trajectory = Trajectory::load(&path).unwrap();
@@ -41,8 +57,9 @@ fn run(name: &str, script: &str) -> Outcome {
     run_simulated(scenario, &scene, device, ticks).unwrap()
 }
 
-const SHIPPED: [&str; 5] = [
+const SHIPPED: [&str; 6] = [
     "liver-steady-press",
+    "pancreas-palpation",
     "gallbladder-gentle-press",
     "pancreas-tour",
     "duodenum-navigation",
@@ -173,6 +190,18 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "forces here are in newtons",
         ),
         ("bad-pass-mark", 8, "rubric.pass_mark", "not a score"),
+        (
+            "palpation-without-nodule",
+            6,
+            "tasks[0].organ",
+            "the pancreas has no nodule to find",
+        ),
+        (
+            "softer-nodule",
+            7,
+            "nodules[0].stiffness_ratio",
+            "must be more than 1",
+        ),
     ];
     for (name, line, field, message) in cases {
         let file = root().join(format!("tests/scenarios/broken/{name}.scenario.ron"));
@@ -249,5 +278,37 @@ fn the_trainer_validates_runs_and_reports() {
     assert!(
         report_dir.join("liver-steady-press.png").exists(),
         "{stderr}"
+    );
+}
+
+/// Palpation is scored on where the mark was: the competent mark lies over the nodule, the
+/// careless one on plain tissue after a press over the limit. The nodule is in the tissue the
+/// trainee feels: the same press over it pushes back harder than on a pancreas without it.
+#[test]
+fn palpation_scores_the_mark_and_the_nodule_is_felt() {
+    let competent = run("pancreas-palpation", "competent");
+    let metrics = &competent.card.tasks[0].metrics;
+    let error_mm = metrics.localization_error_mm.expect("marked");
+    assert!(metrics.completed && error_mm < 10.0, "{metrics:#?}");
+    let careless = &run("pancreas-palpation", "careless").card.tasks[0].metrics;
+    assert!(!careless.completed, "{careless:#?}");
+    assert!(careless.localization_error_mm.expect("marked") > 20.0);
+    assert!(careless.peak_force_n > 0.6 && !careless.errors.is_empty());
+
+    let plain = run_without_nodules("pancreas-palpation", "competent");
+    let pressing_over_nodule = |trace: &[(f64, f64)]| {
+        trace
+            .iter()
+            .filter(|(t, _)| (7.6..8.5).contains(t))
+            .map(|(_, f)| *f)
+            .fold(0.0, f64::max)
+    };
+    let (with, without) = (
+        pressing_over_nodule(&competent.force_trace),
+        pressing_over_nodule(&plain.force_trace),
+    );
+    assert!(
+        with > 1.2 * without,
+        "over the nodule {with:.3} N, plain pancreas {without:.3} N"
     );
 }
