@@ -2,10 +2,11 @@
 //! the haptic world, and the scorecard when every task has ended or the device's script has.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use nalgebra::Vector3;
 
-use super::haptic::{ExerciseRun, HapticLoop, HapticScene, TickClock};
+use super::haptic::{ExerciseLink, ExerciseRun, HapticLoop, HapticScene, TickClock};
 use super::scene::{Detail, SceneOrgan, scene_of};
 use crate::cli::OnStale;
 use crate::haptics::{HapticDevice, TICK_S};
@@ -41,6 +42,7 @@ pub fn scenario_scene(
 }
 
 /// What a session of a scenario leaves: the scorecard and the force against time (100 Hz).
+#[derive(Clone, Debug)]
 pub struct Outcome {
     pub card: Scorecard,
     pub force_trace: Vec<(f64, f64)>,
@@ -55,31 +57,36 @@ pub fn run_simulated(
     max_ticks: u64,
 ) -> Result<Outcome, String> {
     let mut haptic = HapticLoop::new(scene, device).map_err(|e| e.to_string())?;
-    start(&mut haptic, scene, scenario);
+    prepare(&mut haptic, scene, scenario).start();
     for tick in 0..max_ticks {
         haptic.tick(TickClock {
             tick,
             time_s: tick as f64 * TICK_S,
             overruns_in_a_row: 0,
         });
-        if haptic.world().resource::<ExerciseRun>().0.finished() {
+        if haptic.world().resource::<ExerciseRun>().exercise.is_none() {
             break;
         }
     }
     Ok(end(&mut haptic).expect("started above"))
 }
 
-/// Puts `scenario`'s exercise, on `scene`, into the haptic world: from the next tick on, it
-/// is scored.
-pub fn start(haptic: &mut HapticLoop, scene: &HapticScene, scenario: Scenario) {
+/// Puts `scenario`'s exercise, on `scene`, into the haptic world; it is scored from the tick
+/// after the link returned is started.
+pub fn prepare(
+    haptic: &mut HapticLoop,
+    scene: &HapticScene,
+    scenario: Scenario,
+) -> Arc<ExerciseLink> {
     let sites = scenario
         .nodules
         .iter()
         .map(|nodule| nodule_site(scene, nodule))
         .collect();
-    haptic
-        .world_mut()
-        .insert_resource(ExerciseRun(Exercise::new(scenario, sites)));
+    let link = Arc::new(ExerciseLink::default());
+    let run = ExerciseRun::new(Exercise::new(scenario, sites), link.clone());
+    haptic.world_mut().insert_resource(run);
+    link
 }
 
 /// Where `nodule` lies under its organ's surface: the outward normal at the accessible point
@@ -101,12 +108,19 @@ fn nodule_site(scene: &HapticScene, nodule: &Nodule) -> NoduleSite {
     NoduleSite { centre_m, outward }
 }
 
-/// Takes the exercise out of the haptic world, ends it and scores it; `None` if none ran.
+/// Takes the exercise out of the haptic world (or from the link, if it ended and nobody took
+/// it), ends it and scores it; `None` if none ran or it was taken already.
 pub fn end(haptic: &mut HapticLoop) -> Option<Outcome> {
-    let exercise = haptic.world_mut().remove_resource::<ExerciseRun>()?.0;
+    let run = haptic.world_mut().remove_resource::<ExerciseRun>()?;
+    let exercise = run.exercise.or_else(|| run.link.take_ended())?;
+    Some(outcome_of(exercise))
+}
+
+/// Ends `exercise` (unfinished tasks are not completed) and scores it.
+pub fn outcome_of(exercise: Exercise) -> Outcome {
     let (scenario, tasks, force_trace) = exercise.finish();
-    Some(Outcome {
+    Outcome {
         card: score(&scenario, tasks),
         force_trace,
-    })
+    }
 }

@@ -10,12 +10,12 @@ use serde::Serialize;
 use bevy::app::AppExit;
 use nalgebra::Vector3;
 
-use super::exercise::{Outcome, end, run_simulated, scenario_scene, start};
+use super::exercise::{Outcome, end, prepare, run_simulated, scenario_scene};
 use super::haptic::{
     HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport, Scheduling,
 };
 use super::scene::{Detail, default_scene, press_targets};
-use super::window::{FrameReport, ScreenshotPlan, WindowScene};
+use super::window::{FrameReport, Lesson, ScreenshotPlan, WindowScene};
 use crate::cli::OnStale;
 use crate::haptics::{
     DeviceSpec, HapticDevice, PressMotion, Recorder, Scripted, TICK_S, TimerMode, Trajectory,
@@ -149,8 +149,13 @@ pub fn open_window(
     let device = recorded(device, &options.record);
     let device_name = device.name().to_owned();
     let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
-    if let Some(scenario) = scenario {
-        start(&mut haptic, &scene, scenario);
+    let lesson = scenario.map(|scenario| Lesson {
+        link: prepare(&mut haptic, &scene, scenario.clone()),
+        scenario,
+    });
+    let link = lesson.as_ref().map(|lesson| lesson.link.clone());
+    if let (Some(link), Some(DeviceSpec::Scripted(_))) = (&link, &options.device) {
+        link.start();
     }
     let snapshots = haptic.publish();
     let timer = options.realtime.unwrap_or_default();
@@ -163,9 +168,12 @@ pub fn open_window(
         device_name,
         exit_after_s,
         screenshot,
+        lesson,
     });
     let (report, mut haptic) = haptic.stop();
-    let outcome = end(&mut haptic);
+    // An exercise never begun (the window closed on the briefing) has nothing to score.
+    let begun = link.is_some_and(|link| link.started());
+    let outcome = begun.then(|| end(&mut haptic)).flatten();
     match exit {
         AppExit::Success => Ok((
             Report::Window {

@@ -67,7 +67,17 @@ struct Cli {
     /// Fail (with the command to run) instead of rebuilding a missing or stale vademecum.
     #[arg(long, global = true)]
     no_rebuild: bool,
+    /// The window without an exercise: the organs and the tool only (by default the window
+    /// runs the built-in scenario, scenarios/liver-steady-press.scenario.ron).
+    #[arg(long)]
+    free_play: bool,
 }
+
+/// The window's default exercise, built into the binary so that it runs from any directory;
+/// the same file ships in `scenarios/` for educators to copy.
+const DEFAULT_SCENARIO_FILE: &str = "scenarios/liver-steady-press.scenario.ron";
+const DEFAULT_SCENARIO: &str = include_str!("../../scenarios/liver-steady-press.scenario.ron");
+const DEFAULT_REPORT_DIR: &str = "reports";
 
 #[derive(Subcommand)]
 enum Command {
@@ -141,7 +151,18 @@ fn main() -> ExitCode {
                 return ExitCode::from(2);
             }
         },
-        _ => None,
+        _ if cli.headless || cli.free_play => None,
+        _ => match scenario::parse(Path::new(DEFAULT_SCENARIO_FILE), DEFAULT_SCENARIO) {
+            Ok(scenario) => Some((
+                scenario,
+                Path::new(DEFAULT_SCENARIO_FILE),
+                Path::new(DEFAULT_REPORT_DIR),
+            )),
+            Err(e) => {
+                eprintln!("trainer: the built-in scenario does not read: {e}");
+                return ExitCode::FAILURE;
+            }
+        },
     };
     if cli.headless {
         return match exercise {
@@ -166,7 +187,14 @@ fn main() -> ExitCode {
                 }
                 debrief(Ok(outcome), file, dir, cli.json)
             }
-            _ => finish(Ok(report), cli.json),
+            (None, Some((file, _))) => {
+                eprintln!(
+                    "trainer: the exercise of {} was not begun (Space on the briefing begins it): nothing scored, no report",
+                    file.display()
+                );
+                finish(Ok(report), cli.json)
+            }
+            (_, None) => finish(Ok(report), cli.json),
         },
         Err(e) => finish(Err(e), cli.json),
     }

@@ -40,7 +40,7 @@ pub fn summary(card: &Scorecard) -> String {
         let m = &task.metrics;
         let _ = writeln!(
             out,
-            "task {}: {} — {}\n  {} in {:.1} s of {:.0} s; contact {:.1} s, peak {:.2} N, mean {:.2} N, {:.1} s above {:.2} N; {} errors; score {:.0}",
+            "task {}: {}: {}\n  {} in {:.1} s of {:.0} s; contact {:.1} s, peak {:.2} N, mean {:.2} N, {:.1} s above {:.2} N; {} errors; score {:.0}",
             k + 1,
             m.kind,
             m.description,

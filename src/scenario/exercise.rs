@@ -4,7 +4,7 @@
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use super::format::{Scenario, Spot, Task, TaskKind};
+use super::format::{Scenario, Spot, Task, TaskKind, spot_name};
 
 /// What the haptic loop knows of one tick, for scoring.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,6 +39,21 @@ impl NoduleSite {
     pub fn lateral_distance_m(&self, point_m: &Vector3<f64>) -> f64 {
         let offset = point_m - self.centre_m;
         (offset - self.outward * offset.dot(&self.outward)).norm()
+    }
+}
+
+/// Where an exercise stands, for the trainee's display.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Progress {
+    /// The task under way (0-based); `tasks` once all have ended.
+    pub task: usize,
+    pub tasks: usize,
+    pub task_elapsed_s: f64,
+}
+
+impl Progress {
+    pub fn finished(&self) -> bool {
+        self.task >= self.tasks
     }
 }
 
@@ -82,6 +97,7 @@ pub struct TaskMetrics {
 }
 
 /// One task's running state.
+#[derive(Clone)]
 struct Running {
     metrics: TaskMetrics,
     force_sum: f64,
@@ -101,6 +117,7 @@ struct Running {
 }
 
 /// The tasks of a scenario, run one after another.
+#[derive(Clone)]
 pub struct Exercise {
     scenario: Scenario,
     /// Per nodule of the scenario, where it lies.
@@ -129,6 +146,18 @@ impl Exercise {
             last_time_s: None,
             ticks: 0,
             force_trace: Vec::with_capacity(samples + 1),
+        }
+    }
+
+    /// Where the exercise stands: the task under way and how long it has run.
+    pub fn progress(&self) -> Progress {
+        Progress {
+            task: self.current,
+            tasks: self.scenario.tasks.len(),
+            task_elapsed_s: match (&self.running, self.last_time_s) {
+                (Some(running), Some(now)) => now - running.metrics.started_s,
+                _ => 0.0,
+            },
         }
     }
 
@@ -191,54 +220,23 @@ impl Exercise {
 impl Running {
     fn start(task: &Task, scenario: &Scenario, sites: &[NoduleSite], time_s: f64) -> Self {
         let organs = &scenario.organs;
-        let (description, force_limit_n, targets, band_min_n) = match task {
+        let (force_limit_n, targets, band_min_n) = match task {
             Task::ForceControl {
-                organ,
                 min_force_n,
                 max_force_n,
-                hold_s,
                 ..
-            } => (
-                format!(
-                    "hold {:.2}–{:.2} N on the {organ} for {} s",
-                    min_force_n.0, max_force_n.0, hold_s.0
-                ),
-                max_force_n.0,
-                0,
-                Some(min_force_n.0),
-            ),
+            } => (max_force_n.0, 0, Some(min_force_n.0)),
             Task::SafeNavigation {
                 targets,
-                forbidden,
                 max_force_n,
                 ..
-            } => (
-                format!(
-                    "reach {} in order, avoiding {}, under {:.2} N",
-                    names(targets),
-                    names(forbidden),
-                    max_force_n.0
-                ),
-                max_force_n.0,
-                targets.len(),
-                None,
-            ),
-            Task::Palpation {
-                organ, max_force_n, ..
-            } => (
-                format!(
-                    "find the nodule in the {organ} by feel and mark it, under {:.2} N",
-                    max_force_n.0
-                ),
-                max_force_n.0,
-                0,
-                None,
-            ),
+            } => (max_force_n.0, targets.len(), None),
+            Task::Palpation { max_force_n, .. } => (max_force_n.0, 0, None),
         };
         Self {
             metrics: TaskMetrics {
                 kind: task.kind(),
-                description,
+                description: task.description(),
                 started_s: time_s,
                 time_limit_s: task.time_limit_s(),
                 force_limit_n,
@@ -402,23 +400,4 @@ fn straight_length_m(start: Vector3<f64>, targets: &[Spot]) -> f64 {
         from = target.centre_m();
     }
     length
-}
-
-fn spot_name(spot: &Spot, k: usize) -> String {
-    match spot.name.is_empty() {
-        true => format!("zone {}", k + 1),
-        false => spot.name.clone(),
-    }
-}
-
-fn names(spots: &[Spot]) -> String {
-    match spots.len() {
-        0 => "nothing".into(),
-        _ => spots
-            .iter()
-            .enumerate()
-            .map(|(k, s)| spot_name(s, k))
-            .collect::<Vec<_>>()
-            .join(", "),
-    }
 }

@@ -194,6 +194,39 @@ impl Task {
         }
     }
 
+    /// What the task asks, in words, for the trainee.
+    pub fn description(&self) -> String {
+        match self {
+            Task::ForceControl {
+                organ,
+                min_force_n,
+                max_force_n,
+                hold_s,
+                ..
+            } => format!(
+                "hold {:.2} to {:.2} N on the {organ} for {} s",
+                min_force_n.0, max_force_n.0, hold_s.0
+            ),
+            Task::SafeNavigation {
+                targets,
+                forbidden,
+                max_force_n,
+                ..
+            } => format!(
+                "reach {} in order, avoiding {}, under {:.2} N",
+                names(targets),
+                names(forbidden),
+                max_force_n.0
+            ),
+            Task::Palpation {
+                organ, max_force_n, ..
+            } => format!(
+                "find the nodule in the {organ} by feel and mark it, under {:.2} N",
+                max_force_n.0
+            ),
+        }
+    }
+
     pub fn time_limit_s(&self) -> f64 {
         match self {
             Task::ForceControl { time_limit_s, .. }
@@ -265,5 +298,24 @@ impl Default for Rubric {
             pass_mark: default_pass_mark(),
             all_tasks_required: true,
         }
+    }
+}
+
+pub(super) fn spot_name(spot: &Spot, k: usize) -> String {
+    match spot.name.is_empty() {
+        true => format!("zone {}", k + 1),
+        false => spot.name.clone(),
+    }
+}
+
+fn names(spots: &[Spot]) -> String {
+    match spots.len() {
+        0 => "nothing".into(),
+        _ => spots
+            .iter()
+            .enumerate()
+            .map(|(k, s)| spot_name(s, k))
+            .collect::<Vec<_>>()
+            .join(", "),
     }
 }

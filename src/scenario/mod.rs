@@ -9,7 +9,7 @@ mod load;
 mod score;
 mod units;
 
-pub use exercise::{Exercise, NoduleSite, Sample, TaskMetrics};
+pub use exercise::{Exercise, NoduleSite, Progress, Sample, TaskMetrics};
 pub use format::{Device, Difficulty, Nodule, Rubric, Scenario, Spot, Task, TaskKind, Tool};
 pub use load::{ScenarioError, load, parse};
 pub use score::{Scorecard, TaskScore, score};

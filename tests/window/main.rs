@@ -73,7 +73,13 @@ fn screenshot(name: &str, rows: Vec<TrajectoryRow>) -> Shot {
     Trajectory { rows }.save(&script).unwrap();
     let png = dir.join(format!("{name}.png"));
     let output = Command::new(TRAINER)
-        .args(["--coarse", "--no-rebuild", "--frames", FRAMES])
+        .args([
+            "--coarse",
+            "--no-rebuild",
+            "--free-play",
+            "--frames",
+            FRAMES,
+        ])
         .arg("--vademecums")
         .arg(vademecums())
         .arg("--device")

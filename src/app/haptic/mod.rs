@@ -16,7 +16,7 @@ use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
 
 pub use components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
-pub use exercise::ExerciseRun;
+pub use exercise::{ExerciseLink, ExerciseRun};
 pub use report::{ForceSummary, HeadlessReport, TickTimes};
 pub use resources::{Device, DeviceForce, FaultLog, ForceTrace, OrganCoupling, TickClock, Tool};
 pub use runner::{HapticLoop, HapticScene, SceneError};
@@ -71,7 +71,11 @@ pub fn haptic_schedule() -> Schedule {
         systems::apply_safety.in_set(HapticSet::Safety),
         systems::write_device.in_set(HapticSet::WriteDevice),
         exercise::score_tick.in_set(HapticSet::Score),
-        (systems::trace_force, systems::publish_snapshot).in_set(HapticSet::Publish),
+        (
+            systems::trace_force,
+            (exercise::publish_progress, systems::publish_snapshot).chain(),
+        )
+            .in_set(HapticSet::Publish),
     ));
     schedule
 }

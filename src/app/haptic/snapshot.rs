@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 
 use crate::contact::ToolContact;
 use crate::pgd::Deformation;
+use crate::scenario::Progress;
 
 #[derive(Clone, Debug, Default)]
 pub struct OrganSnapshot {
@@ -28,6 +29,8 @@ pub struct HapticSnapshot {
     pub organs: Vec<OrganSnapshot>,
     /// How the real-time loop has kept time so far (refreshed once a second).
     pub timing: LoopTiming,
+    /// Where the scenario's exercise stands, once started.
+    pub exercise: Option<Progress>,
 }
 
 /// The real-time loop's timing so far, for the HUD (µs).

@@ -5,6 +5,7 @@ use bevy::prelude::*;
 
 use super::FrameSet;
 use super::bridge::{HapticLink, Snapshot};
+use super::lesson::Lesson;
 
 #[derive(Component)]
 struct Hud;
@@ -43,6 +44,7 @@ fn update_hud(
     link: Res<HapticLink>,
     snapshot: Res<Snapshot>,
     time: Res<Time<Real>>,
+    lesson: Option<Res<Lesson>>,
     mut rate: Local<Rate>,
     mut hud: Query<&mut Text, With<Hud>>,
 ) {
@@ -82,9 +84,10 @@ fn update_hud(
     } else {
         ""
     };
+    let task = lesson.map_or_else(String::new, |lesson| task_line(&lesson, &snapshot));
     let timing = &snapshot.0.timing;
     text.0 = format!(
-        "device: {}\nforce {force_n:.3} N {gauge} limit {limit_n:.1} N\n{status}\n\
+        "{task}device: {}\nforce {force_n:.3} N {gauge} limit {limit_n:.1} N\n{status}\n\
          haptic {:.0} Hz | tick p99 {:.0} us, late p99 {:.0} us, {} skipped | frame {:.1} ms{help}",
         link.device_name,
         rate.hz,
@@ -93,4 +96,23 @@ fn update_hud(
         timing.skipped,
         dt * 1e3
     );
+}
+
+/// The task under way and its clock, above the rest of the HUD (nothing before the exercise
+/// begins or after it ends).
+fn task_line(lesson: &Lesson, snapshot: &Snapshot) -> String {
+    let Some(progress) = snapshot.0.exercise.filter(|p| !p.finished()) else {
+        return String::new();
+    };
+    let Some(task) = lesson.scenario.tasks.get(progress.task) else {
+        return String::new();
+    };
+    format!(
+        "task {} of {}: {}\n{:.1} s of {:.0} s\n\n",
+        progress.task + 1,
+        progress.tasks,
+        task.description(),
+        progress.task_elapsed_s,
+        task.time_limit_s()
+    )
 }

@@ -8,6 +8,7 @@ mod frames;
 mod hud;
 mod input;
 mod legend;
+mod lesson;
 mod organs;
 mod screenshot;
 pub mod tissue;
@@ -20,6 +21,7 @@ use bevy::prelude::*;
 pub use bridge::{HapticLink, Snapshot};
 pub use frames::FrameReport;
 pub use legend::{Legend, OrganLegend, ToolLegend};
+pub use lesson::{Lesson, Stage, briefing_text};
 pub use screenshot::ScreenshotPlan;
 
 use super::haptic::{HapticScene, HapticSnapshot};
@@ -36,6 +38,8 @@ pub struct WindowScene {
     pub exit_after_s: Option<f64>,
     /// Save the window to a PNG after some frames, then close it.
     pub screenshot: Option<ScreenshotPlan>,
+    /// The scenario to brief, run and debrief; free play without one.
+    pub lesson: Option<Lesson>,
 }
 
 /// The haptic side's f64 vectors as Bevy's (the Bevy end of the seam; parry's is `crate::seam`).
@@ -72,6 +76,7 @@ pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
         (FrameSet::Input, FrameSet::Receive, FrameSet::Draw).chain(),
     );
     screenshot::setup(&mut app, window.screenshot.clone());
+    lesson::setup(&mut app, window.lesson.clone());
     bridge::setup(&mut app, window);
     organs::setup(&mut app);
     camera::setup(&mut app);

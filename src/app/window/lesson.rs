@@ -1,0 +1,275 @@
+//! A scenario in the window, in stages: the briefing (what to do, Space to begin), the
+//! exercise (scored in the haptic thread; the HUD shows the task and its clock), and the
+//! debrief (the score and what went wrong; Esc closes the window and writes the report).
+//! Without a scenario the window stays in free play; with a scripted device the exercise
+//! begins at once.
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+
+use super::FrameSet;
+use super::bridge::Snapshot;
+use crate::app::exercise::outcome_of;
+use crate::app::haptic::ExerciseLink;
+use crate::cli;
+use crate::scenario::{Difficulty, Scenario};
+
+/// Where the trainee is.
+#[derive(States, Default, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Stage {
+    /// No scenario: the organs and the tool only.
+    #[default]
+    FreePlay,
+    Briefing,
+    Exercise,
+    Debrief,
+}
+
+/// The scenario the window runs, and its link to the exercise in the haptic thread.
+#[derive(Resource, Clone)]
+pub struct Lesson {
+    pub scenario: Scenario,
+    pub link: Arc<ExerciseLink>,
+}
+
+pub(super) fn setup(app: &mut App, lesson: Option<Lesson>) {
+    app.init_state::<Stage>()
+        .add_systems(OnEnter(Stage::Briefing), show_briefing)
+        .add_systems(OnEnter(Stage::Debrief), show_debrief)
+        .add_systems(
+            Update,
+            (
+                begin_on_space.run_if(in_state(Stage::Briefing)),
+                debrief_when_done.run_if(in_state(Stage::Exercise)),
+                close_on_escape.run_if(in_state(Stage::Debrief)),
+            )
+                .in_set(FrameSet::Input),
+        );
+    if let Some(lesson) = lesson {
+        // An exercise begun already (a scripted device has no one to press Space) skips the
+        // briefing.
+        let first = match lesson.link.started() {
+            true => Stage::Exercise,
+            false => Stage::Briefing,
+        };
+        app.insert_resource(lesson)
+            .add_systems(Startup, move |mut next: ResMut<NextState<Stage>>| {
+                next.set(first)
+            });
+    }
+}
+
+/// A panel of text in the middle of the window, gone when the stage ends.
+fn spawn_panel(commands: &mut Commands, stage: Stage, text: String) {
+    commands
+        .spawn((
+            DespawnOnExit(stage),
+            Node {
+                position_type: PositionType::Absolute,
+                width: percent(100),
+                height: percent(100),
+                align_items: AlignItems::Center,
+                justify_content: JustifyContent::Center,
+                ..default()
+            },
+        ))
+        .with_children(|parent| {
+            parent
+                .spawn((
+                    Node {
+                        max_width: px(720),
+                        padding: UiRect::all(px(24)),
+                        ..default()
+                    },
+                    BackgroundColor(Color::srgba(0.02, 0.03, 0.05, 0.88)),
+                ))
+                .with_child((
+                    Text::new(text),
+                    TextFont {
+                        font_size: FontSize::Px(17.0),
+                        ..default()
+                    },
+                ));
+        });
+}
+
+fn show_briefing(mut commands: Commands, lesson: Res<Lesson>) {
+    spawn_panel(
+        &mut commands,
+        Stage::Briefing,
+        briefing_text(&lesson.scenario),
+    );
+}
+
+/// The briefing: title, difficulty, what to do, the tasks in order, how to begin.
+pub fn briefing_text(scenario: &Scenario) -> String {
+    let difficulty = match scenario.difficulty {
+        Difficulty::Beginner => "beginner",
+        Difficulty::Intermediate => "intermediate",
+        Difficulty::Advanced => "advanced",
+    };
+    let tasks: Vec<String> = scenario
+        .tasks
+        .iter()
+        .enumerate()
+        .map(|(k, task)| {
+            format!(
+                "  {}. {} ({:.0} s)",
+                k + 1,
+                task.description(),
+                task.time_limit_s()
+            )
+        })
+        .collect();
+    format!(
+        "{} ({difficulty})\n\n{}\n\n{}\n\nPress Space to begin.",
+        scenario.title,
+        scenario.briefing,
+        tasks.join("\n")
+    )
+}
+
+fn begin_on_space(
+    keys: Res<ButtonInput<KeyCode>>,
+    lesson: Res<Lesson>,
+    mut next: ResMut<NextState<Stage>>,
+) {
+    if keys.just_pressed(KeyCode::Space) {
+        lesson.link.start();
+        next.set(Stage::Exercise);
+    }
+}
+
+fn debrief_when_done(snapshot: Res<Snapshot>, mut next: ResMut<NextState<Stage>>) {
+    if snapshot.0.exercise.is_some_and(|p| p.finished()) {
+        next.set(Stage::Debrief);
+    }
+}
+
+/// Scores a copy of the ended exercise for the screen; the session scores the exercise itself
+/// for the report when the window closes.
+fn show_debrief(mut commands: Commands, lesson: Res<Lesson>) {
+    let text = match lesson.link.ended_copy() {
+        Some(exercise) => cli::summary(&outcome_of(exercise).card),
+        None => "The exercise has ended.".to_owned(),
+    };
+    let text = format!("{text}\nPress Esc to close; the report is written then.");
+    spawn_panel(&mut commands, Stage::Debrief, text);
+}
+
+fn close_on_escape(keys: Res<ButtonInput<KeyCode>>, mut exit: MessageWriter<AppExit>) {
+    if keys.just_pressed(KeyCode::Escape) {
+        exit.write(AppExit::Success);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use bevy::state::app::StatesPlugin;
+
+    use super::*;
+    use crate::scenario::{Exercise, Progress, Sample, parse};
+
+    const SCENARIO: &str = r#"Scenario(
+        title: "Quick press",
+        briefing: "Press the liver.",
+        organs: ["liver"],
+        tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3,
+                             hold_s: 0.005, time_limit_s: 0.01)],
+    )"#;
+
+    fn app() -> (App, Arc<ExerciseLink>) {
+        let scenario = parse(Path::new("quick.scenario.ron"), SCENARIO).unwrap();
+        let link = Arc::new(ExerciseLink::default());
+        let mut app = App::new();
+        app.add_plugins((MinimalPlugins, StatesPlugin))
+            .init_resource::<ButtonInput<KeyCode>>()
+            .init_resource::<Snapshot>()
+            .add_message::<AppExit>();
+        let lesson = Lesson {
+            scenario,
+            link: link.clone(),
+        };
+        setup(&mut app, Some(lesson));
+        (app, link)
+    }
+
+    fn stage(app: &App) -> Stage {
+        *app.world().resource::<State<Stage>>().get()
+    }
+
+    fn panel_text(app: &mut App) -> String {
+        let mut texts = app.world_mut().query::<&Text>();
+        texts
+            .iter(app.world())
+            .map(|t| t.0.clone())
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+
+    /// The exercise ended without the trainee touching the organ: a failed force control.
+    fn ended_exercise(scenario: &Scenario) -> Exercise {
+        let mut exercise = Exercise::new(scenario.clone(), Vec::new());
+        for tick in 0..20 {
+            exercise.step(&Sample {
+                time_s: tick as f64 * 1e-3,
+                tip_m: None,
+                force_n: 0.0,
+                touching: 0,
+                button: false,
+            });
+        }
+        assert!(exercise.finished());
+        exercise
+    }
+
+    #[test]
+    fn briefing_then_exercise_on_space_then_debrief_with_the_score() {
+        let (mut app, link) = app();
+        app.update();
+        app.update();
+        assert_eq!(stage(&app), Stage::Briefing);
+        assert!(panel_text(&mut app).contains("Press the liver."));
+        assert!(
+            !link.started(),
+            "the exercise began before the trainee was ready"
+        );
+
+        app.world_mut()
+            .resource_mut::<ButtonInput<KeyCode>>()
+            .press(KeyCode::Space);
+        app.update();
+        app.world_mut()
+            .resource_mut::<ButtonInput<KeyCode>>()
+            .release_all();
+        app.update();
+        assert_eq!(stage(&app), Stage::Exercise);
+        assert!(link.started());
+        assert!(!panel_text(&mut app).contains("Press the liver."));
+
+        let scenario = app.world().resource::<Lesson>().scenario.clone();
+        let mut ended = Some(ended_exercise(&scenario));
+        link.hand_over(&mut ended);
+        assert!(ended.is_none());
+        app.world_mut().resource_mut::<Snapshot>().0.exercise = Some(Progress {
+            task: 1,
+            tasks: 1,
+            task_elapsed_s: 0.0,
+        });
+        app.update();
+        app.update();
+        assert_eq!(stage(&app), Stage::Debrief);
+        let debrief = panel_text(&mut app);
+        assert!(
+            debrief.contains("FAILED") && debrief.contains("Esc"),
+            "{debrief}"
+        );
+        assert!(
+            link.take_ended().is_some(),
+            "the debrief must leave the exercise for the report"
+        );
+    }
+}
