@@ -1,11 +1,12 @@
 //! The vademecum against full FEM at loads it was not built on, and the PGD against the
 //! best separated sum of as many terms (Eckart–Young).
 
-use pgd_surgery::pgd::{Silent, ValidationSettings, build, validate};
+use pgd_surgery::fem::FemModel;
+use pgd_surgery::pgd::{Silent, Vademecum, ValidationSettings, build, validate};
 
 use crate::common::{block_mesh, block_model, build_block, organ, settings};
 
-pub fn off_node_loads() -> ValidationSettings {
+fn off_node_loads() -> ValidationSettings {
     ValidationSettings {
         samples: 12,
         near_radius_m: 0.015,
@@ -16,16 +17,19 @@ pub fn off_node_loads() -> ValidationSettings {
 
 /// By linearity the local compliances make the felt force exact for a tool patch centred
 /// anywhere, up to the f32 storage: stated tolerance 1e-4.
-#[test]
-fn the_felt_force_matches_full_fem_off_the_nodes() {
-    let model = block_model(block_mesh([6, 4, 3]));
-    let vademecum = build_block(&model, 8);
-    let report = validate(&model, &vademecum, &off_node_loads(), &Silent).unwrap();
+pub fn assert_felt_force_exact(model: &FemModel, vademecum: &Vademecum) {
+    let report = validate(model, vademecum, &off_node_loads(), &Silent).unwrap();
     assert!(
         report.force_error.max < 1e-4,
         "felt-force error {:?}",
         report.force_error
     );
+}
+
+#[test]
+fn the_felt_force_matches_full_fem_off_the_nodes() {
+    let model = block_model(block_mesh([6, 4, 3]));
+    assert_felt_force_exact(&model, &build_block(&model, 8));
 }
 
 /// More modes, smaller field error; with the near-field correction the field near the tool is
