@@ -113,8 +113,8 @@ fn task_feedback(task: &TaskScore) -> Vec<String> {
             n => format!(" ({} of {n} targets reached)", m.targets_reached),
         };
         lines.push(format!(
-            "{}: not finished in {:.0} s{what}",
-            m.kind, m.time_limit_s
+            "{}: not finished after {:.1} s of {:.0} s{what}",
+            m.kind, m.time_s, m.time_limit_s
         ));
     }
     if let (Some(error), Some(within)) = (m.localization_error_mm, m.found_within_mm)
