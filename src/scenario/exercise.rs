@@ -57,6 +57,25 @@ impl Progress {
     }
 }
 
+/// The scenario's nodules and where each lies.
+#[derive(Clone, Copy)]
+struct Nodules<'a> {
+    scenario: &'a Scenario,
+    sites: &'a [NoduleSite],
+}
+
+impl<'a> Nodules<'a> {
+    /// Where the nodules in `organ` lie.
+    fn of(self, organ: &'a str) -> impl Iterator<Item = NoduleSite> + 'a {
+        self.scenario
+            .nodules
+            .iter()
+            .zip(self.sites)
+            .filter(move |(nodule, _)| nodule.organ == organ)
+            .map(|(_, site)| *site)
+    }
+}
+
 /// Force recorded for the plot every this many ticks (100 Hz at 1 kHz).
 const PLOT_EVERY: u64 = 10;
 /// Above a limit until the force falls below this share of it: one press is one error.
@@ -111,8 +130,7 @@ struct Running {
     path_m: f64,
     first_tip: Option<Vector3<f64>>,
     last_tip: Option<Vector3<f64>>,
-    /// Palpation: the organ's nodules, and whether the button was held on the last tick.
-    nodules: Vec<NoduleSite>,
+    /// Palpation: whether the button was held on the last tick.
     button_held: bool,
 }
 
@@ -182,8 +200,8 @@ impl Exercise {
         let (scenario, sites) = (&self.scenario, &self.sites);
         let running = self
             .running
-            .get_or_insert_with(|| Running::start(task, scenario, sites, sample.time_s));
-        running.step(task, sample, dt);
+            .get_or_insert_with(|| Running::start(task, &scenario.organs, sample.time_s));
+        running.step(task, sample, dt, Nodules { scenario, sites });
         let elapsed = sample.time_s - running.metrics.started_s;
         if running.over() || elapsed >= task.time_limit_s() {
             self.end_task(sample.time_s);
@@ -209,7 +227,7 @@ impl Exercise {
         while !self.finished() {
             if self.running.is_none() {
                 let task = &self.scenario.tasks[self.current];
-                self.running = Some(Running::start(task, &self.scenario, &self.sites, now));
+                self.running = Some(Running::start(task, &self.scenario.organs, now));
             }
             self.end_task(now);
         }
@@ -218,8 +236,7 @@ impl Exercise {
 }
 
 impl Running {
-    fn start(task: &Task, scenario: &Scenario, sites: &[NoduleSite], time_s: f64) -> Self {
-        let organs = &scenario.organs;
+    fn start(task: &Task, organs: &[String], time_s: f64) -> Self {
         let (force_limit_n, targets, band_min_n) = match task {
             Task::ForceControl {
                 min_force_n,
@@ -257,16 +274,6 @@ impl Running {
                 }
                 Task::SafeNavigation { .. } => None,
             },
-            nodules: match task {
-                Task::Palpation { organ, .. } => scenario
-                    .nodules
-                    .iter()
-                    .zip(sites)
-                    .filter(|(nodule, _)| &nodule.organ == organ)
-                    .map(|(_, site)| *site)
-                    .collect(),
-                _ => Vec::new(),
-            },
             button_held: false,
             in_band_since: None,
             over_limit: false,
@@ -277,7 +284,7 @@ impl Running {
         }
     }
 
-    fn step(&mut self, task: &Task, sample: &Sample, dt: f64) {
+    fn step(&mut self, task: &Task, sample: &Sample, dt: f64, nodules: Nodules) {
         let m = &mut self.metrics;
         let force = sample.force_n;
         m.peak_force_n = m.peak_force_n.max(force);
@@ -319,23 +326,28 @@ impl Running {
                 targets, forbidden, ..
             } => self.navigate(targets, forbidden, sample),
             Task::Palpation {
-                found_within_mm, ..
-            } => self.palpate(found_within_mm.metres(), sample),
+                organ,
+                found_within_mm,
+                ..
+            } => self.palpate(nodules.of(organ), found_within_mm.metres(), sample),
         }
     }
 
     /// A press of the button while on the organ is the mark: the task ends with it, found if
     /// the mark is near enough a nodule. A press off the organ marks nothing.
-    fn palpate(&mut self, found_within_m: f64, sample: &Sample) {
+    fn palpate(
+        &mut self,
+        nodules: impl Iterator<Item = NoduleSite>,
+        found_within_m: f64,
+        sample: &Sample,
+    ) {
         let pressed = sample.button && !self.button_held;
         self.button_held = sample.button;
         let on_organ = self.organ.is_some_and(|k| sample.touches(k));
         let (true, true, Some(tip)) = (pressed, on_organ, sample.tip_m) else {
             return;
         };
-        let Some(error_m) = self
-            .nodules
-            .iter()
+        let Some(error_m) = nodules
             .map(|site| site.lateral_distance_m(&tip))
             .min_by(f64::total_cmp)
         else {

@@ -94,9 +94,14 @@ pub struct Spot {
     pub radius_mm: Millimetres,
 }
 
+/// A point written in millimetres, in metres.
+fn metres(at_mm: (f64, f64, f64)) -> nalgebra::Vector3<f64> {
+    nalgebra::Vector3::new(at_mm.0, at_mm.1, at_mm.2) * 1e-3
+}
+
 impl Spot {
     pub fn centre_m(&self) -> nalgebra::Vector3<f64> {
-        nalgebra::Vector3::new(self.at_mm.0, self.at_mm.1, self.at_mm.2) * 1e-3
+        metres(self.at_mm)
     }
 
     /// Whether the tool tip at `tip_m` is within the spot.
@@ -119,7 +124,7 @@ pub struct Nodule {
 
 impl Nodule {
     pub fn centre_m(&self) -> nalgebra::Vector3<f64> {
-        nalgebra::Vector3::new(self.at_mm.0, self.at_mm.1, self.at_mm.2) * 1e-3
+        metres(self.at_mm)
     }
 
     /// The nodule as the finite-element model takes it.

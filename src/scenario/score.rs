@@ -64,14 +64,17 @@ fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
         true => (1.0 - m.time_s / m.time_limit_s).clamp(0.0, 1.0),
         false => 0.0,
     };
-    let mut terms = vec![
+    // Accuracy weighs only where there is a mark to be accurate about.
+    let accuracy_weight = match m.kind {
+        TaskKind::Palpation => rubric.accuracy,
+        TaskKind::ForceControl | TaskKind::SafeNavigation => 0.0,
+    };
+    let terms = [
         (rubric.completion, completion),
         (rubric.speed, speed),
         (rubric.force, force_control(m)),
+        (accuracy_weight, accuracy(m)),
     ];
-    if m.kind == TaskKind::Palpation {
-        terms.push((rubric.accuracy, accuracy(m)));
-    }
     let weights: f64 = terms.iter().map(|(w, _)| w).sum();
     let weighted = terms.iter().map(|(w, v)| w * v).sum::<f64>() / weights.max(f64::MIN_POSITIVE);
     (100.0 * weighted - rubric.error_penalty * m.errors.len() as f64).clamp(0.0, 100.0)

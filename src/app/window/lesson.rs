@@ -17,7 +17,7 @@ use crate::scenario::{Difficulty, Scenario};
 
 /// Where the trainee is.
 #[derive(States, Default, Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Stage {
+enum Stage {
     /// No scenario: the organs and the tool only.
     #[default]
     FreePlay,
@@ -103,7 +103,7 @@ fn show_briefing(mut commands: Commands, lesson: Res<Lesson>) {
 }
 
 /// The briefing: title, difficulty, what to do, the tasks in order, how to begin.
-pub fn briefing_text(scenario: &Scenario) -> String {
+fn briefing_text(scenario: &Scenario) -> String {
     let difficulty = match scenario.difficulty {
         Difficulty::Beginner => "beginner",
         Difficulty::Intermediate => "intermediate",

@@ -21,7 +21,7 @@ use bevy::prelude::*;
 pub use bridge::{HapticLink, Snapshot};
 pub use frames::FrameReport;
 pub use legend::{Legend, OrganLegend, ToolLegend};
-pub use lesson::{Lesson, Stage, briefing_text};
+pub use lesson::Lesson;
 pub use screenshot::ScreenshotPlan;
 
 use super::haptic::{HapticScene, HapticSnapshot};
