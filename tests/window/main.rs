@@ -251,6 +251,11 @@ fn each_organ_shows_its_colour_where_it_is() {
 #[test]
 fn pressing_changes_the_picture_where_the_tool_presses() {
     let (rest, press) = rest_and_press();
+    assert_eq!(
+        (rest.width, rest.rgb.len()),
+        (press.width, press.rgb.len()),
+        "the two screenshots differ in size"
+    );
     let tool = press.legend.tool.as_ref().expect("the tool is drawn");
     let centre = tool.centre_px;
     let ring: Vec<[f32; 2]> = (0..48)

@@ -1,8 +1,7 @@
 //! A private X server (Xvfb) for one run of the trainer, stopped when dropped.
 
-use std::path::Path;
+use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
 
 pub struct Xvfb {
     child: Child,
@@ -10,38 +9,42 @@ pub struct Xvfb {
 }
 
 impl Xvfb {
-    /// Starts Xvfb on the first free display from :90 and waits until it accepts clients.
+    /// Starts Xvfb on a display it finds free itself (`-displayfd`: it writes the number to
+    /// its standard output once it accepts clients, and clears stale locks of dead servers).
     pub fn start() -> Self {
-        let number = (90..200)
-            .find(|n| !Path::new(&format!("/tmp/.X{n}-lock")).exists())
-            .expect("a free X display number");
-        let display = format!(":{number}");
-        let child = Command::new("Xvfb")
-            .args([&display, "-screen", "0", "1280x800x24", "-nolisten", "tcp"])
-            .stdout(Stdio::null())
+        let mut child = Command::new("Xvfb")
+            .args(["-displayfd", "1", "-screen", "0", "1280x800x24"])
+            .args(["-nolisten", "tcp"])
+            .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()
             .unwrap_or_else(|e| {
                 panic!("cannot start Xvfb ({e}): install it with scripts/setup-debian.sh")
             });
-        let server = Self { child, display };
-        let socket = format!("/tmp/.X11-unix/X{number}");
-        let started = Instant::now();
-        while std::os::unix::net::UnixStream::connect(&socket).is_err() {
-            assert!(
-                started.elapsed() < Duration::from_secs(20),
-                "Xvfb {} did not start",
-                server.display
-            );
-            std::thread::sleep(Duration::from_millis(50));
+        let mut line = String::new();
+        let stdout = child.stdout.take().expect("Xvfb's standard output");
+        BufReader::new(stdout).read_line(&mut line).unwrap();
+        let number: u32 = line
+            .trim()
+            .parse()
+            .unwrap_or_else(|_| panic!("Xvfb did not start (it wrote {line:?})"));
+        Self {
+            child,
+            display: format!(":{number}"),
         }
-        server
     }
 }
 
 impl Drop for Xvfb {
+    /// Asks the server to end, so that it removes its lock and socket, then waits for it.
     fn drop(&mut self) {
-        let _ = self.child.kill();
+        let asked = Command::new("kill")
+            .args(["-TERM", &self.child.id().to_string()])
+            .status()
+            .is_ok_and(|s| s.success());
+        if !asked {
+            let _ = self.child.kill();
+        }
         let _ = self.child.wait();
     }
 }

@@ -1,14 +1,18 @@
 //! `--screenshot FILE`: saves the window after a number of frames, with its legend (what is
 //! where, `FILE` with a `.json` extension), then closes it; a failed save closes it with an
-//! error rather than a silent success. A capture in which the organs are not drawn yet (their
-//! shaders still compiling) is retried a few frames later.
+//! error rather than a silent success. Shaders compile asynchronously, and until a pipeline is
+//! ready Bevy silently skips what it draws (an organ, or the tone mapping of the whole frame):
+//! the capture waits until no pipeline has been waiting for a few frames, and one in which the
+//! organs are still not drawn is retried a few frames later.
 
 use std::path::{Path, PathBuf};
 
 use bevy::ecs::system::SystemParam;
 use bevy::mesh::VertexAttributeValues;
 use bevy::prelude::*;
+use bevy::render::render_resource::PipelineCache;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy::render::{ExtractSchedule, MainWorld, RenderApp};
 use bevy::window::PrimaryWindow;
 
 use super::legend::{DrawnSurface, Legend, legend};
@@ -34,7 +38,29 @@ pub(super) fn setup(app: &mut App, plan: Option<ScreenshotPlan>) {
     if let Some(plan) = plan {
         app.insert_resource(plan)
             .init_resource::<Progress>()
+            .init_resource::<PipelinesReady>()
             .add_systems(Update, take_screenshot.after(FrameSet::Draw));
+        if let Some(render) = app.get_sub_app_mut(RenderApp) {
+            render.add_systems(ExtractSchedule, count_ready_frames);
+        }
+    }
+}
+
+/// Consecutive frames at whose extraction no render pipeline was waiting to compile.
+#[derive(Resource, Default)]
+struct PipelinesReady(u32);
+
+/// Frames with every pipeline compiled before a capture: a pipeline asked for late in a frame
+/// (after the extraction that counts) shows up as waiting in the next.
+const READY_FRAMES: u32 = 3;
+/// Frames past the planned one to wait for pipelines before capturing what there is anyway
+/// (the drawn check below still applies).
+const MAX_COMPILE_FRAMES: u32 = 300;
+
+fn count_ready_frames(mut main_world: ResMut<MainWorld>, pipelines: Res<PipelineCache>) {
+    let idle = pipelines.waiting_pipelines().next().is_none();
+    if let Some(mut ready) = main_world.get_resource_mut::<PipelinesReady>() {
+        ready.0 = if idle { ready.0 + 1 } else { 0 };
     }
 }
 
@@ -70,10 +96,13 @@ fn take_screenshot(
     mut progress: ResMut<Progress>,
     frame: Frame,
     clear: Res<ClearColor>,
+    ready: Res<PipelinesReady>,
     mut exit: MessageWriter<AppExit>,
 ) {
     progress.frames += 1;
-    if progress.waiting || progress.frames < plan.after_frames + progress.retries * RETRY_FRAMES {
+    let due = plan.after_frames + progress.retries * RETRY_FRAMES;
+    let compiled = ready.0 >= READY_FRAMES || progress.frames >= due + MAX_COMPILE_FRAMES;
+    if progress.waiting || progress.frames < due || !compiled {
         return;
     }
     let legend = match frame_legend(&frame) {
@@ -116,7 +145,12 @@ fn take_screenshot(
                 .and_then(|()| write_legend(&plan.legend_path(), &legend));
             match saved {
                 Ok(()) => {
-                    info!("screenshot saved to {}", plan.path.display());
+                    info!(
+                        "screenshot saved to {} (frame {}, {} retries)",
+                        plan.path.display(),
+                        progress.frames,
+                        progress.retries
+                    );
                     exit.write(AppExit::Success);
                 }
                 Err(e) => {
@@ -129,13 +163,16 @@ fn take_screenshot(
 }
 
 /// Whether the organs are drawn where the legend puts them: nine in ten of those pixels differ
-/// from the background (vacuously so if none is in sight).
+/// from the background and from black (vacuously so if none is in sight). A frame whose
+/// pipelines are not all compiled may reach the window black, with nothing drawn at all.
 fn drawn(width: u32, rgb: &[u8], legend: &Legend, background: [u8; 4]) -> bool {
     let pixels: Vec<[f32; 2]> = legend
         .organs
         .iter()
         .flat_map(|o| o.visible_px.iter().copied())
         .collect();
+    let unlike =
+        |p: &[u8], other: [u8; 3]| (0..3).map(|c| p[c].abs_diff(other[c]) as u32).sum::<u32>() > 24;
     let differs = pixels
         .iter()
         .filter(|px| {
@@ -143,10 +180,7 @@ fn drawn(width: u32, rgb: &[u8], legend: &Legend, background: [u8; 4]) -> bool {
             let at = (y * width as usize + x) * 3;
             x < width as usize
                 && rgb.get(at..at + 3).is_some_and(|p| {
-                    (0..3)
-                        .map(|c| p[c].abs_diff(background[c]) as u32)
-                        .sum::<u32>()
-                        > 24
+                    unlike(p, [background[0], background[1], background[2]]) && unlike(p, [0; 3])
                 })
         })
         .count();
@@ -205,4 +239,32 @@ fn frame_legend(frame: &Frame) -> Result<Legend, String> {
 fn write_legend(path: &Path, legend: &Legend) -> Result<(), String> {
     let text = serde_json::to_string_pretty(legend).map_err(|e| e.to_string())?;
     std::fs::write(path, text).map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::app::window::OrganLegend;
+
+    /// A 4×1 image whose organ is said to be in sight at its two middle pixels.
+    fn organ_at_middle() -> Legend {
+        Legend {
+            organs: vec![OrganLegend {
+                name: "liver".into(),
+                visible_px: vec![[1.0, 0.0], [2.0, 0.0]],
+            }],
+            tool: None,
+        }
+    }
+
+    #[test]
+    fn a_frame_is_drawn_only_where_the_organ_shows_neither_background_nor_black() {
+        let background = [13, 15, 20, 255];
+        let liver = [150, 70, 60];
+        let frame = |middle: [u8; 3]| [[13, 15, 20], middle, middle, [13, 15, 20]].concat();
+        let legend = organ_at_middle();
+        assert!(drawn(4, &frame(liver), &legend, background));
+        assert!(!drawn(4, &frame([13, 15, 20]), &legend, background));
+        assert!(!drawn(4, &frame([0, 0, 0]), &legend, background));
+    }
 }
