@@ -9,9 +9,12 @@ use nalgebra::Vector3;
 use super::haptic::{ExerciseLink, ExerciseRun, HapticLoop, HapticScene, TickClock};
 use super::scene::{Detail, SceneOrgan, scene_of};
 use crate::cli::OnStale;
+use crate::contact::ContactSurface;
 use crate::haptics::{HapticDevice, TICK_S};
 use crate::mesh::organs::Organ;
-use crate::scenario::{Exercise, Nodule, NoduleSite, Scenario, Scorecard, score};
+use crate::scenario::{
+    self, Exercise, Nodule, NoduleSite, RegionSite, Scenario, Scorecard, Sites, Task, score,
+};
 
 /// The scene a scenario asks for, its vademecums from `dir`.
 pub fn scenario_scene(
@@ -78,11 +81,18 @@ pub fn prepare(
     scene: &HapticScene,
     scenario: Scenario,
 ) -> Arc<ExerciseLink> {
-    let sites = scenario
-        .nodules
-        .iter()
-        .map(|nodule| nodule_site(scene, nodule))
-        .collect();
+    let sites = Sites {
+        nodules: scenario
+            .nodules
+            .iter()
+            .map(|nodule| nodule_site(scene, nodule))
+            .collect(),
+        regions: scenario
+            .tasks
+            .iter()
+            .map(|task| region_site(scene, task))
+            .collect(),
+    };
     let link = Arc::new(ExerciseLink::default());
     let run = ExerciseRun::new(Exercise::new(scenario, sites), link.clone());
     haptic.world_mut().insert_resource(run);
@@ -106,6 +116,29 @@ fn nodule_site(scene: &HapticScene, nodule: &Nodule) -> NoduleSite {
         })
         .unwrap_or_else(Vector3::z);
     NoduleSite { centre_m, outward }
+}
+
+/// Where a retraction `task` watches its organ: the accessible surface point nearest the
+/// scenario's point (`None` for other tasks, or an organ not in the scene, which validation
+/// refuses).
+fn region_site(scene: &HapticScene, task: &Task) -> Option<RegionSite> {
+    let Task::Retraction {
+        organ,
+        at_mm,
+        towards,
+        ..
+    } = task
+    else {
+        return None;
+    };
+    let index = scene.organs.iter().position(|(name, _)| name == organ)?;
+    let surface = ContactSurface::new(&scene.organs[index].1).ok()?;
+    let (x, y, z) = *towards;
+    Some(RegionSite {
+        organ: index,
+        at: surface.closest(&scenario::metres(*at_mm))?.at,
+        towards: Vector3::new(x, y, z).try_normalize(0.0)?,
+    })
 }
 
 /// Takes the exercise out of the haptic world (or from the link, if it ended and nobody took

@@ -71,6 +71,15 @@ pub fn summary(card: &Scorecard) -> String {
                 "  mark: {error:.1} mm from the nodule across the surface (found within {within:.0} mm)"
             );
         }
+        if let (Some(moved), Some(target), Some(limit)) =
+            (m.moved_mm, m.move_target_mm, m.surrounding_limit_n)
+        {
+            let _ = writeln!(
+                out,
+                "  region moved up to {moved:.1} mm (of {target:.0}), held {:.1} s; organs around: peak {:.2} N, {:.1} s above {limit:.2} N",
+                m.longest_hold_s, m.surrounding_peak_n, m.surrounding_over_limit_s
+            );
+        }
     }
     if !card.feedback.is_empty() {
         let _ = writeln!(out, "what to work on:");

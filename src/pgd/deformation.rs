@@ -201,6 +201,12 @@ impl Deformation {
         u
     }
 
+    /// Displacement (m) of the surface point `at` under every load, the coupling's and the
+    /// carry included.
+    pub fn displacement(&self, vademecum: &Vademecum, at: &SurfacePoint) -> Vector3<f64> {
+        self.displacement_without(vademecum, at, usize::MAX)
+    }
+
     /// The sum of the forces (N) applied to the organ, the coupling's included.
     pub fn total_force_n(&self) -> Vector3<f64> {
         self.loads.iter().map(|l| l.force_n).sum::<Vector3<f64>>() + self.coupling_force_n

@@ -1,13 +1,16 @@
 //! A scenario's tasks as they run: fed one [`Sample`] per haptic tick, each task measures what
 //! its kind is scored on and ends when done or out of time; then the next starts.
 
+use std::mem::take;
+
 use nalgebra::Vector3;
 use serde::Serialize;
 
 use super::format::{Scenario, Spot, Task, TaskKind, spot_name};
+use crate::pgd::SurfacePoint;
 
 /// What the haptic loop knows of one tick, for scoring.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Sample {
     pub time_s: f64,
     pub tip_m: Option<Vector3<f64>>,
@@ -17,6 +20,12 @@ pub struct Sample {
     pub touching: u64,
     /// Whether the device's first button is held (the mark in palpation).
     pub button: bool,
+    /// Retraction: how far (m) the watched region ([`Exercise::watched_region`]) has moved
+    /// along its direction; 0 when nothing is watched.
+    pub region_moved_m: f64,
+    /// Retraction: the force (N) on the organs other than the watched region's, from the tool
+    /// and from the organs they touch.
+    pub surrounding_force_n: f64,
 }
 
 impl Sample {
@@ -40,6 +49,24 @@ impl NoduleSite {
         let offset = point_m - self.centre_m;
         (offset - self.outward * offset.dot(&self.outward)).norm()
     }
+}
+
+/// Where a retraction task's region lies: the surface point of its organ (the scene's
+/// `organ`-th) nearest the scenario's point, and the unit direction it is to move in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RegionSite {
+    pub organ: usize,
+    pub at: SurfacePoint,
+    pub towards: Vector3<f64>,
+}
+
+/// Where the scenario's points lie on the scene's organs, found when the exercise is set up.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Sites {
+    /// One per nodule of the scenario, in order.
+    pub nodules: Vec<NoduleSite>,
+    /// One per task, in order: the region a retraction task watches.
+    pub regions: Vec<Option<RegionSite>>,
 }
 
 /// Where an exercise stands, for the trainee's display.
@@ -102,6 +129,10 @@ pub struct TaskMetrics {
     pub time_over_limit_s: f64,
     /// Force control: time in contact with the organ within the band.
     pub within_band_s: f64,
+    /// Force control and retraction: how long the task asks to hold, and the longest hold
+    /// without a break.
+    pub hold_s: Option<f64>,
+    pub longest_hold_s: f64,
     /// Safe navigation: targets reached, of how many.
     pub targets_reached: usize,
     pub targets: usize,
@@ -111,6 +142,13 @@ pub struct TaskMetrics {
     pub localization_error_mm: Option<f64>,
     /// ...and how near counts as found (mm).
     pub found_within_mm: Option<f64>,
+    /// Retraction: the farthest the region moved along its direction (mm), of how far...
+    pub moved_mm: Option<f64>,
+    pub move_target_mm: Option<f64>,
+    /// ...and the load on the organs around: its limit, its peak and the time above it.
+    pub surrounding_limit_n: Option<f64>,
+    pub surrounding_peak_n: f64,
+    pub surrounding_over_limit_s: f64,
     /// Each error, with the time it was made.
     pub errors: Vec<String>,
 }
@@ -120,11 +158,14 @@ pub struct TaskMetrics {
 struct Running {
     metrics: TaskMetrics,
     force_sum: f64,
-    /// Force control: the organ's index in the scenario's organs.
+    /// Force control and palpation: the organ's index in the scenario's organs.
     organ: Option<usize>,
-    /// Force control: since when the force has been in the band on the organ.
-    in_band_since: Option<f64>,
-    over_limit: bool,
+    /// Force control and retraction: since when what the task asks has held (the force in
+    /// the band on the organ, the region moved far enough).
+    held_since: Option<f64>,
+    over_limit: LimitWatch,
+    /// Retraction: the load on the organs around.
+    over_surrounding: LimitWatch,
     /// Safe navigation: the forbidden zone the tip is in, if any.
     inside_zone: Option<usize>,
     path_m: f64,
@@ -138,8 +179,10 @@ struct Running {
 #[derive(Clone)]
 pub struct Exercise {
     scenario: Scenario,
-    /// Per nodule of the scenario, where it lies.
-    sites: Vec<NoduleSite>,
+    sites: Sites,
+    /// Each task's description, made up front and moved into its metrics when it starts, so
+    /// that the real-time thread formats nothing then.
+    descriptions: Vec<String>,
     current: usize,
     running: Option<Running>,
     done: Vec<TaskMetrics>,
@@ -151,11 +194,12 @@ pub struct Exercise {
 }
 
 impl Exercise {
-    /// The exercise of `scenario`, whose nodules lie at `sites` (one per nodule, in order).
-    pub fn new(scenario: Scenario, sites: Vec<NoduleSite>) -> Self {
+    /// The exercise of `scenario`, whose nodules and regions lie at `sites`.
+    pub fn new(scenario: Scenario, sites: Sites) -> Self {
         let total_s: f64 = scenario.tasks.iter().map(Task::time_limit_s).sum();
         let samples = (total_s / (PLOT_EVERY as f64 * crate::haptics::TICK_S)).ceil() as usize;
         Self {
+            descriptions: scenario.tasks.iter().map(Task::description).collect(),
             scenario,
             sites,
             current: 0,
@@ -179,6 +223,11 @@ impl Exercise {
         }
     }
 
+    /// The region the task under way watches (retraction), for the sample to measure.
+    pub fn watched_region(&self) -> Option<&RegionSite> {
+        self.sites.regions.get(self.current)?.as_ref()
+    }
+
     /// Whether every task has ended.
     pub fn finished(&self) -> bool {
         self.current >= self.scenario.tasks.len()
@@ -198,10 +247,15 @@ impl Exercise {
         }
         self.ticks += 1;
         let (scenario, sites) = (&self.scenario, &self.sites);
-        let running = self
-            .running
-            .get_or_insert_with(|| Running::start(task, &scenario.organs, sample.time_s));
-        running.step(task, sample, dt, Nodules { scenario, sites });
+        let description = &mut self.descriptions[self.current];
+        let running = self.running.get_or_insert_with(|| {
+            Running::start(task, take(description), &scenario.organs, sample.time_s)
+        });
+        let nodules = Nodules {
+            scenario,
+            sites: &sites.nodules,
+        };
+        running.step(task, sample, dt, nodules);
         let elapsed = sample.time_s - running.metrics.started_s;
         if running.over() || elapsed >= task.time_limit_s() {
             self.end_task(sample.time_s);
@@ -227,7 +281,13 @@ impl Exercise {
         while !self.finished() {
             if self.running.is_none() {
                 let task = &self.scenario.tasks[self.current];
-                self.running = Some(Running::start(task, &self.scenario.organs, now));
+                let description = take(&mut self.descriptions[self.current]);
+                self.running = Some(Running::start(
+                    task,
+                    description,
+                    &self.scenario.organs,
+                    now,
+                ));
             }
             self.end_task(now);
         }
@@ -236,7 +296,8 @@ impl Exercise {
 }
 
 impl Running {
-    fn start(task: &Task, organs: &[String], time_s: f64) -> Self {
+    /// The task starting at `time_s`, told to the trainee as `description`.
+    fn start(task: &Task, description: String, organs: &[String], time_s: f64) -> Self {
         let (force_limit_n, targets, band_min_n) = match task {
             Task::ForceControl {
                 min_force_n,
@@ -248,12 +309,26 @@ impl Running {
                 max_force_n,
                 ..
             } => (max_force_n.0, targets.len(), None),
-            Task::Palpation { max_force_n, .. } => (max_force_n.0, 0, None),
+            Task::Palpation { max_force_n, .. } | Task::Retraction { max_force_n, .. } => {
+                (max_force_n.0, 0, None)
+            }
+        };
+        let hold_s = match task {
+            Task::ForceControl { hold_s, .. } | Task::Retraction { hold_s, .. } => Some(hold_s.0),
+            Task::SafeNavigation { .. } | Task::Palpation { .. } => None,
+        };
+        let (move_target_mm, surrounding_limit_n) = match task {
+            Task::Retraction {
+                move_mm,
+                max_surrounding_force_n,
+                ..
+            } => (Some(move_mm.0), Some(max_surrounding_force_n.0)),
+            _ => (None, None),
         };
         Self {
             metrics: TaskMetrics {
                 kind: task.kind(),
-                description: task.description(),
+                description,
                 started_s: time_s,
                 time_limit_s: task.time_limit_s(),
                 force_limit_n,
@@ -265,18 +340,22 @@ impl Running {
                     } => Some(found_within_mm.0),
                     _ => None,
                 },
+                move_target_mm,
+                surrounding_limit_n,
+                hold_s,
                 ..TaskMetrics::default()
             },
             force_sum: 0.0,
             organ: match task {
-                Task::ForceControl { organ, .. } | Task::Palpation { organ, .. } => {
-                    organs.iter().position(|o| o == organ)
-                }
+                Task::ForceControl { organ, .. }
+                | Task::Palpation { organ, .. }
+                | Task::Retraction { organ, .. } => organs.iter().position(|o| o == organ),
                 Task::SafeNavigation { .. } => None,
             },
             button_held: false,
-            in_band_since: None,
-            over_limit: false,
+            held_since: None,
+            over_limit: LimitWatch::default(),
+            over_surrounding: LimitWatch::default(),
             inside_zone: None,
             path_m: 0.0,
             first_tip: None,
@@ -292,18 +371,15 @@ impl Running {
             m.contact_s += dt;
             self.force_sum += force * dt;
         }
-        if force > m.force_limit_n {
-            m.time_over_limit_s += dt;
-            if !self.over_limit {
-                let error = format!(
-                    "{:.2} s: pressed harder than {:.2} N",
-                    sample.time_s, m.force_limit_n
-                );
-                m.errors.push(error);
-            }
-            self.over_limit = true;
-        } else if force < HYSTERESIS * m.force_limit_n {
-            self.over_limit = false;
+        if self
+            .over_limit
+            .crossed(force, m.force_limit_n, dt, &mut m.time_over_limit_s)
+        {
+            let error = format!(
+                "{:.2} s: pressed harder than {:.2} N",
+                sample.time_s, m.force_limit_n
+            );
+            m.errors.push(error);
         }
         match task {
             Task::ForceControl {
@@ -316,11 +392,8 @@ impl Running {
                 let in_band = on_organ && (min_force_n.0..=max_force_n.0).contains(&force);
                 if in_band {
                     self.metrics.within_band_s += dt;
-                    let since = *self.in_band_since.get_or_insert(sample.time_s);
-                    self.metrics.completed = sample.time_s - since >= hold_s.0;
-                } else {
-                    self.in_band_since = None;
                 }
+                self.hold(in_band, hold_s.0, sample.time_s);
             }
             Task::SafeNavigation {
                 targets, forbidden, ..
@@ -330,6 +403,47 @@ impl Running {
                 found_within_mm,
                 ..
             } => self.palpate(nodules.of(organ), found_within_mm.metres(), sample),
+            Task::Retraction {
+                move_mm,
+                hold_s,
+                max_surrounding_force_n,
+                ..
+            } => {
+                self.load_around(max_surrounding_force_n.0, sample, dt);
+                let m = &mut self.metrics;
+                let moved_mm = sample.region_moved_m * 1e3;
+                m.moved_mm = Some(m.moved_mm.map_or(moved_mm, |most| most.max(moved_mm)));
+                self.hold(moved_mm >= move_mm.0, hold_s.0, sample.time_s);
+            }
+        }
+    }
+
+    /// Completes the task once `holding` has been true for `hold_s` without a break.
+    fn hold(&mut self, holding: bool, hold_s: f64, time_s: f64) {
+        if holding {
+            let since = *self.held_since.get_or_insert(time_s);
+            let m = &mut self.metrics;
+            m.longest_hold_s = m.longest_hold_s.max(time_s - since);
+            m.completed = m.longest_hold_s >= hold_s;
+        } else {
+            self.held_since = None;
+        }
+    }
+
+    /// Retraction: the load on the organs around, against its limit.
+    fn load_around(&mut self, limit_n: f64, sample: &Sample, dt: f64) {
+        let m = &mut self.metrics;
+        let force = sample.surrounding_force_n;
+        m.surrounding_peak_n = m.surrounding_peak_n.max(force);
+        if self
+            .over_surrounding
+            .crossed(force, limit_n, dt, &mut m.surrounding_over_limit_s)
+        {
+            let error = format!(
+                "{:.2} s: loaded the organs around harder than {limit_n:.2} N",
+                sample.time_s
+            );
+            m.errors.push(error);
         }
     }
 
@@ -399,6 +513,30 @@ impl Running {
                     ));
                 }
             }
+        }
+    }
+}
+
+/// One force limit as a task watches it: the time spent above it, and a press above it seen
+/// once (it ends when the force falls below [`HYSTERESIS`] of the limit).
+#[derive(Clone, Copy, Default)]
+struct LimitWatch {
+    over: bool,
+}
+
+impl LimitWatch {
+    /// Adds `dt` to `time_over` while `force` is above `limit`; true on the tick it goes over.
+    fn crossed(&mut self, force: f64, limit: f64, dt: f64, time_over: &mut f64) -> bool {
+        if force > limit {
+            *time_over += dt;
+            let crossed = !self.over;
+            self.over = true;
+            crossed
+        } else {
+            if force < HYSTERESIS * limit {
+                self.over = false;
+            }
+            false
         }
     }
 }

@@ -95,7 +95,7 @@ pub struct Spot {
 }
 
 /// A point written in millimetres, in metres.
-fn metres(at_mm: (f64, f64, f64)) -> nalgebra::Vector3<f64> {
+pub fn metres(at_mm: (f64, f64, f64)) -> nalgebra::Vector3<f64> {
     nalgebra::Vector3::new(at_mm.0, at_mm.1, at_mm.2) * 1e-3
 }
 
@@ -166,6 +166,24 @@ pub enum Task {
         max_force_n: Newtons,
         time_limit_s: Seconds,
     },
+    /// Move the organ with the tool to expose what lies behind it: push its `region` (the
+    /// surface nearest `at_mm`) at least `move_mm` along `towards` and keep it there for
+    /// `hold_s`, without pressing harder than `max_force_n`, and without loading the
+    /// surrounding organs (through the retracted organ or by touching them) beyond
+    /// `max_surrounding_force_n`.
+    Retraction {
+        organ: String,
+        /// What the trainee is told the region is (e.g. "the fundus").
+        region: String,
+        at_mm: (f64, f64, f64),
+        /// The direction to move the region in (any length; the scene's frame).
+        towards: (f64, f64, f64),
+        move_mm: Millimetres,
+        hold_s: Seconds,
+        max_force_n: Newtons,
+        max_surrounding_force_n: Newtons,
+        time_limit_s: Seconds,
+    },
 }
 
 /// What kind a task is, for its metrics and its score.
@@ -178,6 +196,8 @@ pub enum TaskKind {
     SafeNavigation,
     #[serde(rename = "palpation")]
     Palpation,
+    #[serde(rename = "retraction")]
+    Retraction,
 }
 
 impl std::fmt::Display for TaskKind {
@@ -186,6 +206,7 @@ impl std::fmt::Display for TaskKind {
             TaskKind::ForceControl => "force control",
             TaskKind::SafeNavigation => "safe navigation",
             TaskKind::Palpation => "palpation",
+            TaskKind::Retraction => "retraction",
         })
     }
 }
@@ -196,6 +217,7 @@ impl Task {
             Task::ForceControl { .. } => TaskKind::ForceControl,
             Task::SafeNavigation { .. } => TaskKind::SafeNavigation,
             Task::Palpation { .. } => TaskKind::Palpation,
+            Task::Retraction { .. } => TaskKind::Retraction,
         }
     }
 
@@ -229,6 +251,19 @@ impl Task {
                 "find the nodule in the {organ} by feel and mark it, under {:.2} N",
                 max_force_n.0
             ),
+            Task::Retraction {
+                organ,
+                region,
+                move_mm,
+                hold_s,
+                max_force_n,
+                max_surrounding_force_n,
+                ..
+            } => format!(
+                "move {region} of the {organ} {:.0} mm and hold it {} s, under {:.2} N, \
+                 loading the organs around under {:.2} N",
+                move_mm.0, hold_s.0, max_force_n.0, max_surrounding_force_n.0
+            ),
         }
     }
 
@@ -236,7 +271,8 @@ impl Task {
         match self {
             Task::ForceControl { time_limit_s, .. }
             | Task::SafeNavigation { time_limit_s, .. }
-            | Task::Palpation { time_limit_s, .. } => time_limit_s.0,
+            | Task::Palpation { time_limit_s, .. }
+            | Task::Retraction { time_limit_s, .. } => time_limit_s.0,
         }
     }
 }

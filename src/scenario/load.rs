@@ -166,7 +166,7 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
             anchors: vec!["tasks".into()],
             message: "the scenario has no tasks".into(),
             hint: format!(
-                "add a ForceControl(…), SafeNavigation(…) or Palpation(…) task ({REFERENCE})"
+                "add a ForceControl(…), SafeNavigation(…), Palpation(…) or Retraction(…) task ({REFERENCE})"
             ),
         });
     }
@@ -212,17 +212,26 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
                     hint: "lower it, or raise device.max_force_n".into(),
                 });
             }
-            if hold_s.0 >= time_limit_s.0 {
+            problems.extend(hold_fits(hold_s.0, time_limit_s.0, field("hold_s")));
+        }
+        Task::Retraction {
+            organ,
+            towards,
+            hold_s,
+            time_limit_s,
+            ..
+        } => {
+            problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
+            let (x, y, z) = *towards;
+            if !(x * x + y * y + z * z).is_normal() {
                 problems.push(Problem {
-                    field: field("hold_s"),
-                    anchors: anchors("hold_s"),
-                    message: format!(
-                        "holding {} s cannot fit in the time limit of {} s",
-                        hold_s.0, time_limit_s.0
-                    ),
-                    hint: "make time_limit_s longer than hold_s".into(),
+                    field: field("towards"),
+                    anchors: anchors("towards"),
+                    message: "the direction to move the region in has no length".into(),
+                    hint: "give a direction such as (0.0, 0.0, 1.0) (towards the head)".into(),
                 });
             }
+            problems.extend(hold_fits(hold_s.0, time_limit_s.0, field("hold_s")));
         }
         Task::Palpation { organ, .. } => {
             problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
@@ -248,6 +257,16 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
             }
         }
     }
+}
+
+/// A problem if holding for `hold_s` (at `field`) cannot fit in the task's time limit.
+fn hold_fits(hold_s: f64, time_limit_s: f64, field: String) -> Option<Problem> {
+    (hold_s >= time_limit_s).then(|| Problem {
+        field,
+        anchors: vec!["tasks".into(), "hold_s".into()],
+        message: format!("holding {hold_s} s cannot fit in the time limit of {time_limit_s} s"),
+        hint: "make time_limit_s longer than hold_s".into(),
+    })
 }
 
 /// A problem if `organ`, named at `field` in the `section` of the file, is not in the scene.

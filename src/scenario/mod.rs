@@ -9,8 +9,10 @@ mod load;
 mod score;
 mod units;
 
-pub use exercise::{Exercise, NoduleSite, Progress, Sample, TaskMetrics};
-pub use format::{Device, Difficulty, Nodule, Rubric, Scenario, Spot, Task, TaskKind, Tool};
+pub use exercise::{Exercise, NoduleSite, Progress, RegionSite, Sample, Sites, TaskMetrics};
+pub use format::{
+    Device, Difficulty, Nodule, Rubric, Scenario, Spot, Task, TaskKind, Tool, metres,
+};
 pub use load::{ScenarioError, load, parse};
 pub use score::{Scorecard, TaskScore, score};
 pub use units::{Millimetres, Newtons, Ratio, Seconds};

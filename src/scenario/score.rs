@@ -67,7 +67,7 @@ fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
     // Accuracy weighs only where there is a mark to be accurate about.
     let accuracy_weight = match m.kind {
         TaskKind::Palpation => rubric.accuracy,
-        TaskKind::ForceControl | TaskKind::SafeNavigation => 0.0,
+        TaskKind::ForceControl | TaskKind::SafeNavigation | TaskKind::Retraction => 0.0,
     };
     let terms = [
         (rubric.completion, completion),
@@ -90,30 +90,37 @@ fn accuracy(m: &TaskMetrics) -> f64 {
 }
 
 /// The share of the time in contact spent as the task wants: within the band (force control),
-/// under the limit (safe navigation and palpation; full marks if the tool never touched in
-/// safe navigation, none in palpation, where touching is the task).
+/// under the limit (safe navigation and palpation; retraction, under the limits on the tool
+/// and on the organs around; full marks if the tool never touched in safe navigation, none in
+/// the others, where touching is the task).
 fn force_control(m: &TaskMetrics) -> f64 {
     if m.contact_s <= 0.0 {
         return match m.kind {
-            TaskKind::ForceControl | TaskKind::Palpation => 0.0,
+            TaskKind::ForceControl | TaskKind::Palpation | TaskKind::Retraction => 0.0,
             TaskKind::SafeNavigation => 1.0,
         };
     }
-    match m.kind {
-        TaskKind::ForceControl => (m.within_band_s / m.contact_s).clamp(0.0, 1.0),
-        TaskKind::SafeNavigation | TaskKind::Palpation => {
-            (1.0 - m.time_over_limit_s / m.contact_s).clamp(0.0, 1.0)
-        }
-    }
+    let over_s = match m.kind {
+        TaskKind::ForceControl => m.contact_s - m.within_band_s,
+        TaskKind::SafeNavigation | TaskKind::Palpation => m.time_over_limit_s,
+        TaskKind::Retraction => m.time_over_limit_s + m.surrounding_over_limit_s,
+    };
+    (1.0 - over_s / m.contact_s).clamp(0.0, 1.0)
 }
 
 fn task_feedback(task: &TaskScore) -> Vec<String> {
     let m = &task.metrics;
     let mut lines = Vec::new();
     if !m.completed && m.localization_error_mm.is_none() {
-        let what = match m.targets {
-            0 => String::new(),
-            n => format!(" ({} of {n} targets reached)", m.targets_reached),
+        let what = match (m.targets, m.moved_mm, m.move_target_mm) {
+            (0, Some(moved), Some(target)) if moved < target => {
+                format!(" (moved at most {moved:.0} of {target:.0} mm)")
+            }
+            (0, _, _) => match m.hold_s {
+                Some(hold) => format!(" (held {:.1} s of {hold:.1} s)", m.longest_hold_s),
+                None => String::new(),
+            },
+            (n, _, _) => format!(" ({} of {n} targets reached)", m.targets_reached),
         };
         lines.push(format!(
             "{}: not finished after {:.1} s of {:.0} s{what}",
@@ -132,6 +139,14 @@ fn task_feedback(task: &TaskScore) -> Vec<String> {
         lines.push(format!(
             "{}: {:.1} s above {:.2} N (peak {:.2} N)",
             m.kind, m.time_over_limit_s, m.force_limit_n, m.peak_force_n
+        ));
+    }
+    if let Some(limit) = m.surrounding_limit_n
+        && m.surrounding_over_limit_s > 0.0
+    {
+        lines.push(format!(
+            "{}: {:.1} s loading the organs around above {limit:.2} N (peak {:.2} N)",
+            m.kind, m.surrounding_over_limit_s, m.surrounding_peak_n
         ));
     }
     lines.extend(m.errors.iter().map(|e| format!("{}: {e}", m.kind)));

@@ -4,7 +4,7 @@ use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{OrganDeformation, ToolTouch};
 use pgd_surgery::contact::ContactSurface;
 use pgd_surgery::haptics::{DeviceSample, SafetySettings, Trajectory, TrajectoryRow};
-use pgd_surgery::pgd::PatchLoad;
+use pgd_surgery::pgd::{Deformation, PatchLoad, SurfacePoint, Vademecum};
 
 use crate::common::{TIP_RADIUS_M, haptic, liver, run, scripted, target};
 
@@ -38,16 +38,7 @@ fn the_tool_touches_the_surface_other_loads_have_moved() {
         shares: vademecum.patch(&hit.at).shares,
         force_n: -target.normal * 0.3,
     };
-    // The surface point's displacement, from the whole field at its triangle's corners.
-    let field = vademecum.field(&hit.at, &held.force_n);
-    let moved: Vector3<f64> = vademecum.triangles[hit.at.triangle]
-        .iter()
-        .zip(hit.at.barycentric)
-        .map(|(&m, l)| {
-            let n = vademecum.positions[m as usize] as usize;
-            Vector3::new(field[3 * n], field[3 * n + 1], field[3 * n + 2]) * l
-        })
-        .sum();
+    let moved = whole_field_at(vademecum, &hit.at, &vademecum.field(&hit.at, &held.force_n));
     let sunk_m = -moved.dot(&target.normal);
     assert!(
         sunk_m > 4e-3,
@@ -73,4 +64,47 @@ fn the_tool_touches_the_surface_other_loads_have_moved() {
         "{seen_moved:?}"
     );
     assert!((depth - 2e-3).abs() < 1e-4, "depth {depth} m");
+}
+
+/// A surface point's displacement from the whole field (`3 × nodes`) at its triangle's corners.
+fn whole_field_at(vademecum: &Vademecum, at: &SurfacePoint, field: &[f64]) -> Vector3<f64> {
+    vademecum.triangles[at.triangle]
+        .iter()
+        .zip(at.barycentric)
+        .map(|(&m, l)| {
+            let n = vademecum.positions[m as usize] as usize;
+            Vector3::new(field[3 * n], field[3 * n + 1], field[3 * n + 2]) * l
+        })
+        .sum()
+}
+
+/// What a retraction task watches, a surface point's displacement under the organ's loads
+/// (evaluated at that point only, every tick), is the whole field's there: at the loaded point
+/// and at one 3 cm away (relative tolerance 1e-6).
+#[test]
+fn a_surface_point_moves_as_the_whole_field_says() {
+    let vademecum = &liver().vademecum;
+    let surface = ContactSurface::new(vademecum).unwrap();
+    let target = target();
+    let hit = surface.closest(&target.point_m).unwrap();
+    let held = PatchLoad {
+        shares: vademecum.patch(&hit.at).shares,
+        force_n: -target.normal * 0.3 + Vector3::new(0.1, 0.0, 0.05),
+    };
+    let mut deformation = Deformation::new(vademecum, 1);
+    deformation.loads[0] = held.clone();
+    deformation.evaluate(vademecum);
+    let field = vademecum.field(&hit.at, &held.force_n);
+    let away = surface
+        .closest(&(target.point_m + Vector3::new(0.03, 0.0, 0.0)))
+        .unwrap();
+    for at in [hit.at, away.at] {
+        let expected = whole_field_at(vademecum, &at, &field);
+        let watched = deformation.displacement(vademecum, &at);
+        assert!(expected.norm() > 1e-4, "{expected:?}");
+        assert!(
+            (watched - expected).norm() < 1e-6 * expected.norm(),
+            "{watched:?} against {expected:?}"
+        );
+    }
 }

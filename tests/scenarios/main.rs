@@ -57,13 +57,14 @@ fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     run_simulated(scenario, &scene, device, ticks).unwrap()
 }
 
-const SHIPPED: [&str; 6] = [
+const SHIPPED: [&str; 7] = [
     "liver-steady-press",
     "pancreas-palpation",
     "gallbladder-gentle-press",
     "pancreas-tour",
     "duodenum-navigation",
     "abdomen-tour",
+    "gallbladder-retraction",
 ];
 
 #[test]
@@ -202,6 +203,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "nodules[0].stiffness_ratio",
             "must be more than 1",
         ),
+        (
+            "retraction-without-direction",
+            10,
+            "tasks[0].towards",
+            "has no length",
+        ),
     ];
     for (name, line, field, message) in cases {
         let file = root().join(format!("tests/scenarios/broken/{name}.scenario.ron"));
@@ -311,4 +318,28 @@ fn palpation_scores_the_mark_and_the_nodule_is_felt() {
         with > 1.2 * without,
         "over the nodule {with:.3} N, plain pancreas {without:.3} N"
     );
+}
+
+/// Retraction is scored on what the region did and what the organs around carried: the
+/// competent push moved the fundus past the mark and held it while the liver carried almost
+/// nothing; the careless run pressed the liver itself (an error for the organs around, with
+/// its time above the limit) and lost the fundus off the probe after jabbing it too far.
+#[test]
+fn retraction_measures_the_region_and_the_organs_around() {
+    let competent = &run("gallbladder-retraction", "competent").card.tasks[0].metrics;
+    let (target_mm, limit_n) = (competent.move_target_mm.unwrap(), 0.05);
+    assert!(competent.completed, "{competent:#?}");
+    assert!(competent.moved_mm.unwrap() >= target_mm);
+    assert!(competent.longest_hold_s >= competent.hold_s.unwrap());
+    assert!(competent.surrounding_peak_n < limit_n, "{competent:#?}");
+    assert_eq!(competent.surrounding_limit_n, Some(limit_n));
+    let careless = &run("gallbladder-retraction", "careless").card.tasks[0].metrics;
+    assert!(!careless.completed, "{careless:#?}");
+    assert!(careless.surrounding_peak_n > limit_n && careless.surrounding_over_limit_s > 1.0);
+    assert!(
+        careless.errors.iter().any(|e| e.contains("organs around")),
+        "{:?}",
+        careless.errors
+    );
+    assert!(careless.longest_hold_s < careless.hold_s.unwrap());
 }

@@ -11,10 +11,18 @@ use std::sync::{Arc, Mutex};
 
 use bevy::prelude::*;
 
-use super::components::{OrganIndex, ToolTouch};
+use super::components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
 use super::resources::{DeviceForce, TickClock, Tool};
 use super::snapshot::SnapshotPublisher;
-use crate::scenario::{Exercise, Progress, Sample};
+use crate::scenario::{Exercise, Progress, RegionSite, Sample};
+
+/// What scoring reads of an organ entity.
+type Organ = (
+    &'static OrganIndex,
+    &'static ToolTouch,
+    &'static OrganBody,
+    &'static OrganDeformation,
+);
 
 /// Between the haptic thread and whoever started the exercise: whether it has begun, and the
 /// exercise once it has ended.
@@ -90,7 +98,7 @@ pub fn score_tick(
     clock: Res<TickClock>,
     tool: Res<Tool>,
     force: Res<DeviceForce>,
-    organs: Query<(&OrganIndex, &ToolTouch)>,
+    organs: Query<Organ>,
     run: Option<ResMut<ExerciseRun>>,
 ) {
     let Some(mut run) = run else {
@@ -104,19 +112,43 @@ pub fn score_tick(
     };
     let touching = organs
         .iter()
-        .filter(|(index, touch)| touch.contact.is_some() && index.0 < 64)
-        .fold(0, |bits, (index, _)| bits | 1 << index.0);
+        .filter(|(index, touch, ..)| touch.contact.is_some() && index.0 < 64)
+        .fold(0, |bits, (index, ..)| bits | 1 << index.0);
+    let (region_moved_m, surrounding_force_n) = exercise
+        .watched_region()
+        .map_or((0.0, 0.0), |region| watch(region, &organs));
     exercise.step(&Sample {
         time_s: clock.time_s,
         tip_m: tool.sample.map(|s| s.tip_m),
         force_n: force.sent_n.norm(),
         touching,
         button: tool.sample.is_some_and(|s| s.buttons & 1 != 0),
+        region_moved_m,
+        surrounding_force_n,
     });
     if exercise.finished() {
         let run = &mut *run;
         run.link.hand_over(&mut run.exercise);
     }
+}
+
+/// How far the region has moved along its direction (m), and the force on every other organ
+/// (N): the tool's on it, and what the organs it touches or hangs from put on it.
+fn watch(region: &RegionSite, organs: &Query<Organ>) -> (f64, f64) {
+    let mut moved_m = 0.0;
+    let mut surrounding_n = 0.0;
+    for (index, _, body, deformation) in organs {
+        let deformation = &deformation.0;
+        if index.0 == region.organ {
+            moved_m = deformation
+                .displacement(&body.vademecum, &region.at)
+                .dot(&region.towards);
+        } else {
+            let tool = deformation.loads[OrganDeformation::TOOL].force_n;
+            surrounding_n += tool.norm() + deformation.coupling_force_n.norm();
+        }
+    }
+    (moved_m, surrounding_n)
 }
 
 /// Where the exercise stands, into the snapshot about to be published.

@@ -171,7 +171,7 @@ mod tests {
     use bevy::state::app::StatesPlugin;
 
     use super::*;
-    use crate::scenario::{Exercise, Progress, Sample, parse};
+    use crate::scenario::{Exercise, Progress, Sample, Sites, parse};
 
     const SCENARIO: &str = r#"Scenario(
         title: "Quick press",
@@ -212,14 +212,11 @@ mod tests {
 
     /// The exercise ended without the trainee touching the organ: a failed force control.
     fn ended_exercise(scenario: &Scenario) -> Exercise {
-        let mut exercise = Exercise::new(scenario.clone(), Vec::new());
+        let mut exercise = Exercise::new(scenario.clone(), Sites::default());
         for tick in 0..20 {
             exercise.step(&Sample {
                 time_s: tick as f64 * 1e-3,
-                tip_m: None,
-                force_n: 0.0,
-                touching: 0,
-                button: false,
+                ..Sample::default()
             });
         }
         assert!(exercise.finished());
