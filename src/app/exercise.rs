@@ -60,7 +60,8 @@ pub fn run_simulated(
     max_ticks: u64,
 ) -> Result<Outcome, String> {
     let mut haptic = HapticLoop::new(scene, device).map_err(|e| e.to_string())?;
-    prepare(&mut haptic, scene, scenario).start();
+    let sites = sites_on(scene, &scenario);
+    prepare(&mut haptic, Exercise::new(scenario, sites)).start();
     for tick in 0..max_ticks {
         haptic.tick(TickClock {
             tick,
@@ -74,14 +75,18 @@ pub fn run_simulated(
     Ok(end(&mut haptic).expect("started above"))
 }
 
-/// Puts `scenario`'s exercise, on `scene`, into the haptic world; it is scored from the tick
-/// after the link returned is started.
-pub fn prepare(
-    haptic: &mut HapticLoop,
-    scene: &HapticScene,
-    scenario: Scenario,
-) -> Arc<ExerciseLink> {
-    let sites = Sites {
+/// Puts `exercise` into the haptic world; it is scored from the tick after the link returned
+/// is started.
+pub fn prepare(haptic: &mut HapticLoop, exercise: Exercise) -> Arc<ExerciseLink> {
+    let link = Arc::new(ExerciseLink::default());
+    let run = ExerciseRun::new(exercise, link.clone());
+    haptic.world_mut().insert_resource(run);
+    link
+}
+
+/// Where `scenario`'s nodules and watched regions lie on `scene`'s organs.
+pub fn sites_on(scene: &HapticScene, scenario: &Scenario) -> Sites {
+    Sites {
         nodules: scenario
             .nodules
             .iter()
@@ -92,11 +97,7 @@ pub fn prepare(
             .iter()
             .map(|task| region_site(scene, task))
             .collect(),
-    };
-    let link = Arc::new(ExerciseLink::default());
-    let run = ExerciseRun::new(Exercise::new(scenario, sites), link.clone());
-    haptic.world_mut().insert_resource(run);
-    link
+    }
 }
 
 /// Where `nodule` lies under its organ's surface: the outward normal at the accessible point

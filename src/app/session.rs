@@ -10,7 +10,7 @@ use serde::Serialize;
 use bevy::app::AppExit;
 use nalgebra::Vector3;
 
-use super::exercise::{Outcome, end, prepare, run_simulated, scenario_scene};
+use super::exercise::{Outcome, end, outcome_of, prepare, run_simulated, scenario_scene, sites_on};
 use super::haptic::{
     HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport, Scheduling,
 };
@@ -21,7 +21,7 @@ use crate::haptics::{
     DeviceSpec, HapticDevice, PressMotion, Recorder, Scripted, TICK_S, TimerMode, Trajectory,
     VirtualDevice, press_and_slide,
 };
-use crate::scenario::Scenario;
+use crate::scenario::{Exercise, Scenario};
 
 pub struct Options {
     pub vademecums: PathBuf,
@@ -122,13 +122,14 @@ pub fn run_headless(options: &Options) -> Result<Report, String> {
 }
 
 /// Opens the trainer window over the real-time haptic loop, driven by the mouse unless a
-/// scripted device is named; reports how the loop kept time while the renderer ran.
+/// scripted device is named; reports how the loop kept time while the renderer ran, and each
+/// attempt at the scenario's exercise that was begun, in order.
 pub fn open_window(
     options: &Options,
     exit_after_s: Option<f64>,
     screenshot: Option<ScreenshotPlan>,
     scenario: Option<Scenario>,
-) -> Result<(Report, Option<Outcome>), String> {
+) -> Result<(Report, Vec<Outcome>), String> {
     let scene = match &scenario {
         Some(scenario) => scenario_scene_capped(options, scenario)?,
         None => scene(options)?,
@@ -149,9 +150,14 @@ pub fn open_window(
     let device = recorded(device, &options.record);
     let device_name = device.name().to_owned();
     let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
-    let lesson = scenario.map(|scenario| Lesson {
-        link: prepare(&mut haptic, &scene, scenario.clone()),
-        scenario,
+    let lesson = scenario.map(|scenario| {
+        let sites = sites_on(&scene, &scenario);
+        let exercise = Exercise::new(scenario.clone(), sites.clone());
+        Lesson {
+            link: prepare(&mut haptic, exercise),
+            scenario,
+            sites,
+        }
     });
     let link = lesson.as_ref().map(|lesson| lesson.link.clone());
     if let (Some(link), Some(DeviceSpec::Scripted(_))) = (&link, &options.device) {
@@ -171,16 +177,21 @@ pub fn open_window(
         lesson,
     });
     let (report, mut haptic) = haptic.stop();
-    // An exercise never begun (the window closed on the briefing) has nothing to score.
-    let begun = link.is_some_and(|link| link.started());
-    let outcome = begun.then(|| end(&mut haptic)).flatten();
+    let mut attempts: Vec<Outcome> = link
+        .as_ref()
+        .map(|link| link.take_earlier().into_iter().map(outcome_of).collect())
+        .unwrap_or_default();
+    // An attempt never begun (the window closed on the briefing) has nothing to score.
+    if link.is_some_and(|link| link.started()) {
+        attempts.extend(end(&mut haptic));
+    }
     match exit {
         AppExit::Success => Ok((
             Report::Window {
                 haptic: report,
                 frames,
             },
-            outcome,
+            attempts,
         )),
         AppExit::Error(code) => Err(format!("the window closed with error code {code}")),
     }

@@ -168,7 +168,7 @@ fn main() -> ExitCode {
         return match exercise {
             Some((scenario, file, report_dir)) => {
                 let outcome = session::run_scenario_headless(&options, scenario);
-                debrief(outcome, file, report_dir, cli.json)
+                debrief(outcome, file, None, report_dir, cli.json)
             }
             None => finish(session::run_headless(&options), cli.json),
         };
@@ -179,22 +179,34 @@ fn main() -> ExitCode {
     });
     let (scenario, debrief_to) = exercise.map(|(s, file, dir)| (s, (file, dir))).unzip();
     match session::open_window(&options, cli.exit_after_s, screenshot, scenario) {
-        Ok((report, outcome)) => match (outcome, debrief_to) {
-            (Some(outcome), Some((file, dir))) => {
-                // With --json, stdout carries the scorecard alone.
+        Ok((report, attempts)) => match debrief_to {
+            Some((file, dir)) if !attempts.is_empty() => {
+                // With --json, stdout carries the scorecards alone.
                 if !cli.json {
                     report.print(false);
                 }
-                debrief(Ok(outcome), file, dir, cli.json)
+                let count = attempts.len();
+                let codes: Vec<ExitCode> = attempts
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, outcome)| {
+                        let attempt = (count > 1).then_some(k + 1);
+                        debrief(Ok(outcome), file, attempt, dir, cli.json)
+                    })
+                    .collect();
+                codes
+                    .into_iter()
+                    .find(|code| *code != ExitCode::SUCCESS)
+                    .unwrap_or(ExitCode::SUCCESS)
             }
-            (None, Some((file, _))) => {
+            Some((file, _)) => {
                 eprintln!(
                     "trainer: the exercise of {} was not begun (Space on the briefing begins it): nothing scored, no report",
                     file.display()
                 );
                 finish(Ok(report), cli.json)
             }
-            (_, None) => finish(Ok(report), cli.json),
+            None => finish(Ok(report), cli.json),
         },
         Err(e) => finish(Err(e), cli.json),
     }
@@ -237,10 +249,12 @@ fn validate(files: &[PathBuf]) -> ExitCode {
     }
 }
 
-/// The end of an exercise: its score printed (JSON with `json`) and its report written.
+/// The end of an exercise: its score printed (JSON with `json`) and its report written, named
+/// after the scenario's file (and the attempt, when the trainee retried).
 fn debrief(
     outcome: Result<Outcome, String>,
     file: &Path,
+    attempt: Option<usize>,
     report_dir: &Path,
     json: bool,
 ) -> ExitCode {
@@ -256,7 +270,11 @@ fn debrief(
         .and_then(|n| n.to_str())
         .unwrap_or("session");
     let stem = name.trim_end_matches(".ron").trim_end_matches(".scenario");
-    let written = cli::write_report(report_dir, stem, &outcome.card, &outcome.force_trace);
+    let stem = match attempt {
+        Some(k) => format!("{stem}.attempt-{k}"),
+        None => stem.to_owned(),
+    };
+    let written = cli::write_report(report_dir, &stem, &outcome.card, &outcome.force_trace);
     if json {
         match serde_json::to_string_pretty(&outcome.card) {
             Ok(text) => println!("{text}"),

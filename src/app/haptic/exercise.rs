@@ -6,6 +6,7 @@
 //! when it has ended, to score it and show the debrief; both go through an [`ExerciseLink`],
 //! which the haptic thread touches without ever waiting or allocating.
 
+use std::mem::take;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
@@ -24,12 +25,17 @@ type Organ = (
     &'static OrganDeformation,
 );
 
-/// Between the haptic thread and whoever started the exercise: whether it has begun, and the
-/// exercise once it has ended.
+/// Between the haptic thread and whoever started the exercise: whether it has begun, the
+/// exercise once it has ended, and a fresh one for another attempt.
 #[derive(Default)]
 pub struct ExerciseLink {
     started: AtomicBool,
     ended: Mutex<Option<Exercise>>,
+    /// The next attempt's exercise, until the haptic thread takes it.
+    next: Mutex<Option<Exercise>>,
+    /// The attempts ended before the one under way (the other side's; the haptic thread
+    /// never touches it).
+    earlier: Mutex<Vec<Exercise>>,
 }
 
 impl ExerciseLink {
@@ -57,6 +63,40 @@ impl ExerciseLink {
     pub(crate) fn hand_over(&self, exercise: &mut Option<Exercise>) {
         if let Ok(mut ended) = self.ended.try_lock() {
             *ended = exercise.take();
+        }
+    }
+
+    /// Sets up another attempt with `fresh`, to be scored once started again; the ended
+    /// attempt is kept with the earlier ones. Refused (false, nothing changed) until the
+    /// haptic thread has handed the ended attempt over.
+    pub fn retry(&self, fresh: Exercise) -> bool {
+        let Some(ended) = self.take_ended() else {
+            return false;
+        };
+        if let Ok(mut earlier) = self.earlier.lock() {
+            earlier.push(ended);
+        }
+        if let Ok(mut next) = self.next.lock() {
+            *next = Some(fresh);
+        }
+        self.started.store(false, Ordering::Release);
+        true
+    }
+
+    /// The attempts ended before the last, in order (once: after that, none).
+    pub fn take_earlier(&self) -> Vec<Exercise> {
+        self.earlier
+            .lock()
+            .map(|mut e| take(&mut *e))
+            .unwrap_or_default()
+    }
+
+    /// The next attempt's exercise into `exercise`, if there is one, without waiting.
+    fn take_next(&self, exercise: &mut Option<Exercise>) {
+        if let Ok(mut next) = self.next.try_lock()
+            && next.is_some()
+        {
+            *exercise = next.take();
         }
     }
 }
@@ -104,6 +144,10 @@ pub fn score_tick(
     let Some(mut run) = run else {
         return;
     };
+    if run.exercise.is_none() {
+        let run = &mut *run;
+        run.link.take_next(&mut run.exercise);
+    }
     if !run.link.started() {
         return;
     }
@@ -158,5 +202,41 @@ pub fn publish_progress(
 ) {
     if let Some(mut publisher) = publisher {
         publisher.0.input_buffer_mut().exercise = run.and_then(|run| run.progress());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::scenario::{Sites, parse};
+
+    fn exercise() -> Exercise {
+        let text = r#"Scenario(title: "t", briefing: "b", organs: ["liver"],
+            tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3,
+                                 hold_s: 1.0, time_limit_s: 2.0)])"#;
+        let scenario = parse(Path::new("t.scenario.ron"), text).unwrap();
+        Exercise::new(scenario, Sites::default())
+    }
+
+    /// Another attempt waits for the ended one to be handed over (so that the two are never
+    /// mixed up), keeps it, stops scoring until started again, and reaches the haptic side
+    /// once.
+    #[test]
+    fn a_retry_takes_turns_with_the_haptic_thread() {
+        let link = ExerciseLink::default();
+        link.start();
+        assert!(!link.retry(exercise()), "nothing has ended yet");
+        let mut under_way = Some(exercise());
+        link.hand_over(&mut under_way);
+        assert!(link.retry(exercise()));
+        assert!(!link.started());
+        link.take_next(&mut under_way);
+        assert!(under_way.is_some());
+        let mut again = None;
+        link.take_next(&mut again);
+        assert!(again.is_none(), "the next attempt is handed over once");
+        assert_eq!(link.take_earlier().len(), 1);
     }
 }

@@ -1,6 +1,7 @@
 //! A scenario in the window, in stages: the briefing (what to do, Space to begin), the
 //! exercise (scored in the haptic thread; the HUD shows the task and its clock), and the
-//! debrief (the score and what went wrong; Esc closes the window and writes the report).
+//! debrief (the score and what went wrong; R tries again from the briefing, Esc closes the
+//! window and writes a report per attempt).
 //! Without a scenario the window stays in free play; with a scripted device the exercise
 //! begins at once.
 
@@ -13,7 +14,7 @@ use super::bridge::Snapshot;
 use crate::app::exercise::outcome_of;
 use crate::app::haptic::ExerciseLink;
 use crate::cli;
-use crate::scenario::{Difficulty, Scenario};
+use crate::scenario::{Difficulty, Exercise, Scenario, Sites};
 
 /// Where the trainee is.
 #[derive(States, Default, Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -30,6 +31,8 @@ enum Stage {
 #[derive(Resource, Clone)]
 pub struct Lesson {
     pub scenario: Scenario,
+    /// Where its nodules and regions lie, for a fresh exercise at each attempt.
+    pub sites: Sites,
     pub link: Arc<ExerciseLink>,
 }
 
@@ -42,7 +45,7 @@ pub(super) fn setup(app: &mut App, lesson: Option<Lesson>) {
             (
                 begin_on_space.run_if(in_state(Stage::Briefing)),
                 debrief_when_done.run_if(in_state(Stage::Exercise)),
-                close_on_escape.run_if(in_state(Stage::Debrief)),
+                (retry_on_r, close_on_escape).run_if(in_state(Stage::Debrief)),
             )
                 .in_set(FrameSet::Input),
         );
@@ -154,8 +157,24 @@ fn show_debrief(mut commands: Commands, lesson: Res<Lesson>) {
         Some(exercise) => cli::summary(&outcome_of(exercise).card),
         None => "The exercise has ended.".to_owned(),
     };
-    let text = format!("{text}\nPress Esc to close; the report is written then.");
+    let text =
+        format!("{text}\nPress R to try again, or Esc to close; the reports are written then.");
     spawn_panel(&mut commands, Stage::Debrief, text);
+}
+
+/// Another attempt at the same exercise: back to the briefing, scored from Space as before.
+/// The ended attempt is kept for its report.
+fn retry_on_r(
+    keys: Res<ButtonInput<KeyCode>>,
+    lesson: Res<Lesson>,
+    mut next: ResMut<NextState<Stage>>,
+) {
+    if keys.just_pressed(KeyCode::KeyR) {
+        let fresh = Exercise::new(lesson.scenario.clone(), lesson.sites.clone());
+        if lesson.link.retry(fresh) {
+            next.set(Stage::Briefing);
+        }
+    }
 }
 
 fn close_on_escape(keys: Res<ButtonInput<KeyCode>>, mut exit: MessageWriter<AppExit>) {
@@ -171,7 +190,7 @@ mod tests {
     use bevy::state::app::StatesPlugin;
 
     use super::*;
-    use crate::scenario::{Exercise, Progress, Sample, Sites, parse};
+    use crate::scenario::{Progress, Sample, parse};
 
     const SCENARIO: &str = r#"Scenario(
         title: "Quick press",
@@ -191,6 +210,7 @@ mod tests {
             .add_message::<AppExit>();
         let lesson = Lesson {
             scenario,
+            sites: Sites::default(),
             link: link.clone(),
         };
         setup(&mut app, Some(lesson));
@@ -223,6 +243,33 @@ mod tests {
         exercise
     }
 
+    /// Presses `key` for one frame, then lets it go for another.
+    fn tap(app: &mut App, key: KeyCode) {
+        app.world_mut()
+            .resource_mut::<ButtonInput<KeyCode>>()
+            .press(key);
+        app.update();
+        let mut keys = app.world_mut().resource_mut::<ButtonInput<KeyCode>>();
+        keys.release_all();
+        keys.clear();
+        app.update();
+    }
+
+    /// The haptic side ends the exercise, unscored, and says so in its snapshot.
+    fn end_exercise(app: &mut App, link: &ExerciseLink) {
+        let scenario = app.world().resource::<Lesson>().scenario.clone();
+        let mut ended = Some(ended_exercise(&scenario));
+        link.hand_over(&mut ended);
+        assert!(ended.is_none());
+        app.world_mut().resource_mut::<Snapshot>().0.exercise = Some(Progress {
+            task: 1,
+            tasks: 1,
+            task_elapsed_s: 0.0,
+        });
+        app.update();
+        app.update();
+    }
+
     #[test]
     fn briefing_then_exercise_on_space_then_debrief_with_the_score() {
         let (mut app, link) = app();
@@ -235,29 +282,12 @@ mod tests {
             "the exercise began before the trainee was ready"
         );
 
-        app.world_mut()
-            .resource_mut::<ButtonInput<KeyCode>>()
-            .press(KeyCode::Space);
-        app.update();
-        app.world_mut()
-            .resource_mut::<ButtonInput<KeyCode>>()
-            .release_all();
-        app.update();
+        tap(&mut app, KeyCode::Space);
         assert_eq!(stage(&app), Stage::Exercise);
         assert!(link.started());
         assert!(!panel_text(&mut app).contains("Press the liver."));
 
-        let scenario = app.world().resource::<Lesson>().scenario.clone();
-        let mut ended = Some(ended_exercise(&scenario));
-        link.hand_over(&mut ended);
-        assert!(ended.is_none());
-        app.world_mut().resource_mut::<Snapshot>().0.exercise = Some(Progress {
-            task: 1,
-            tasks: 1,
-            task_elapsed_s: 0.0,
-        });
-        app.update();
-        app.update();
+        end_exercise(&mut app, &link);
         assert_eq!(stage(&app), Stage::Debrief);
         let debrief = panel_text(&mut app);
         assert!(
@@ -268,5 +298,28 @@ mod tests {
             link.take_ended().is_some(),
             "the debrief must leave the exercise for the report"
         );
+    }
+
+    /// R on the debrief goes back to the briefing for another attempt: the exercise is not
+    /// scored until Space again, and the ended attempt is kept for its report.
+    #[test]
+    fn r_on_the_debrief_tries_again() {
+        let (mut app, link) = app();
+        app.update();
+        tap(&mut app, KeyCode::Space);
+        end_exercise(&mut app, &link);
+        assert_eq!(stage(&app), Stage::Debrief);
+        assert!(panel_text(&mut app).contains("R to try again"));
+
+        tap(&mut app, KeyCode::KeyR);
+        assert_eq!(stage(&app), Stage::Briefing);
+        assert!(panel_text(&mut app).contains("Press the liver."));
+        assert!(!link.started());
+        app.world_mut().resource_mut::<Snapshot>().0.exercise = None;
+        tap(&mut app, KeyCode::Space);
+        assert_eq!(stage(&app), Stage::Exercise);
+        assert!(link.started());
+        assert_eq!(link.take_earlier().len(), 1, "the first attempt is kept");
+        assert!(link.take_ended().is_none());
     }
 }
