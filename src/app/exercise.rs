@@ -79,8 +79,10 @@ pub fn run_simulated(
 /// is started.
 pub fn prepare(haptic: &mut HapticLoop, exercise: Exercise) -> Arc<ExerciseLink> {
     let link = Arc::new(ExerciseLink::default());
-    let run = ExerciseRun::new(exercise, link.clone());
-    haptic.world_mut().insert_resource(run);
+    link.offer(exercise);
+    haptic
+        .world_mut()
+        .insert_resource(ExerciseRun::new(link.clone()));
     link
 }
 
@@ -146,8 +148,7 @@ fn region_site(scene: &HapticScene, task: &Task) -> Option<RegionSite> {
 /// it), ends it and scores it; `None` if none ran or it was taken already.
 pub fn end(haptic: &mut HapticLoop) -> Option<Outcome> {
     let run = haptic.world_mut().remove_resource::<ExerciseRun>()?;
-    let exercise = run.exercise.or_else(|| run.link.take_ended())?;
-    Some(outcome_of(exercise))
+    run.into_exercise().map(outcome_of)
 }
 
 /// Ends `exercise` (unfinished tasks are not completed) and scores it.

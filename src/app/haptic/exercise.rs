@@ -76,11 +76,17 @@ impl ExerciseLink {
         if let Ok(mut earlier) = self.earlier.lock() {
             earlier.push(ended);
         }
-        if let Ok(mut next) = self.next.lock() {
-            *next = Some(fresh);
-        }
         self.started.store(false, Ordering::Release);
+        self.offer(fresh);
         true
+    }
+
+    /// The exercise the haptic thread takes when started (replacing one offered before and
+    /// not yet taken, such as the exercise of a scenario edited on the briefing).
+    pub fn offer(&self, exercise: Exercise) {
+        if let Ok(mut next) = self.next.lock() {
+            *next = Some(exercise);
+        }
     }
 
     /// The attempts ended before the last, in order (once: after that, none).
@@ -101,21 +107,45 @@ impl ExerciseLink {
     }
 }
 
-/// The exercise under way, when the session runs a scenario (`None` once handed over).
+/// The exercise under way, when the session runs a scenario: taken from the link when it is
+/// started (so that, until then, the other side may replace it and drop the old one: the
+/// haptic thread drops no exercise), handed back to it when it has ended.
 #[derive(Resource)]
 pub struct ExerciseRun {
     pub exercise: Option<Exercise>,
     pub link: Arc<ExerciseLink>,
+    /// The attempt taken last has ended and been handed over.
+    ended: bool,
     tasks: usize,
 }
 
 impl ExerciseRun {
-    pub fn new(exercise: Exercise, link: Arc<ExerciseLink>) -> Self {
+    /// A run of the exercises `link` is offered.
+    pub fn new(link: Arc<ExerciseLink>) -> Self {
         Self {
-            tasks: exercise.progress().tasks,
-            exercise: Some(exercise),
+            exercise: None,
             link,
+            ended: false,
+            tasks: 0,
         }
+    }
+
+    /// Takes the offered exercise, if there is one.
+    fn take_next(&mut self) {
+        self.link.take_next(&mut self.exercise);
+        if let Some(exercise) = &self.exercise {
+            self.tasks = exercise.progress().tasks;
+            self.ended = false;
+        }
+    }
+
+    /// The attempt under way or ended last, wherever it is: here, handed over, or (started
+    /// but not yet ticked) still offered.
+    pub fn into_exercise(mut self) -> Option<Exercise> {
+        if self.exercise.is_none() && self.link.started() && !self.ended {
+            self.take_next();
+        }
+        self.exercise.or_else(|| self.link.take_ended())
     }
 
     /// Where the exercise stands; `None` before it has started.
@@ -123,14 +153,14 @@ impl ExerciseRun {
         if !self.link.started() {
             return None;
         }
-        Some(match &self.exercise {
-            Some(exercise) => exercise.progress(),
-            None => Progress {
+        match &self.exercise {
+            Some(exercise) => Some(exercise.progress()),
+            None => self.ended.then_some(Progress {
                 task: self.tasks,
                 tasks: self.tasks,
                 task_elapsed_s: 0.0,
-            },
-        })
+            }),
+        }
     }
 }
 
@@ -144,12 +174,11 @@ pub fn score_tick(
     let Some(mut run) = run else {
         return;
     };
-    if run.exercise.is_none() {
-        let run = &mut *run;
-        run.link.take_next(&mut run.exercise);
-    }
     if !run.link.started() {
         return;
+    }
+    if run.exercise.is_none() && !run.ended {
+        run.take_next();
     }
     let Some(exercise) = run.exercise.as_mut() else {
         return;
@@ -173,6 +202,7 @@ pub fn score_tick(
     if exercise.finished() {
         let run = &mut *run;
         run.link.hand_over(&mut run.exercise);
+        run.ended = run.exercise.is_none();
     }
 }
 
