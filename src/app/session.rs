@@ -123,15 +123,16 @@ pub fn run_headless(options: &Options) -> Result<Report, String> {
 
 /// Opens the trainer window over the real-time haptic loop, driven by the mouse unless a
 /// scripted device is named; reports how the loop kept time while the renderer ran, and each
-/// attempt at the scenario's exercise that was begun, in order.
+/// attempt at the scenario's exercise that was begun, in order. The scenario's file, if it has
+/// one, is watched: an edit reloads it (see the window's `reload`).
 pub fn open_window(
     options: &Options,
     exit_after_s: Option<f64>,
     screenshot: Option<ScreenshotPlan>,
-    scenario: Option<Scenario>,
+    scenario: Option<(Scenario, Option<PathBuf>)>,
 ) -> Result<(Report, Vec<Outcome>), String> {
     let scene = match &scenario {
-        Some(scenario) => scenario_scene_capped(options, scenario)?,
+        Some((scenario, _)) => scenario_scene_capped(options, scenario)?,
         None => scene(options)?,
     };
     let (device, virtual_device) = match &options.device {
@@ -150,13 +151,13 @@ pub fn open_window(
     let device = recorded(device, &options.record);
     let device_name = device.name().to_owned();
     let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
-    let lesson = scenario.map(|scenario| {
-        let sites = sites_on(&scene, &scenario);
-        let exercise = Exercise::new(scenario.clone(), sites.clone());
+    let lesson = scenario.map(|(scenario, file)| {
+        let exercise = Exercise::new(scenario.clone(), sites_on(&scene, &scenario));
         Lesson {
             link: prepare(&mut haptic, exercise),
             scenario,
-            sites,
+            file,
+            scene: scene.clone(),
         }
     });
     let link = lesson.as_ref().map(|lesson| lesson.link.clone());

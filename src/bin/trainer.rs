@@ -177,7 +177,11 @@ fn main() -> ExitCode {
         path,
         after_frames: cli.frames.max(1),
     });
-    let (scenario, debrief_to) = exercise.map(|(s, file, dir)| (s, (file, dir))).unzip();
+    // A scenario file named on the command line is watched for edits; the built-in one is not.
+    let watched = matches!(cli.command, Some(Command::Run { .. }));
+    let (scenario, debrief_to) = exercise
+        .map(|(s, file, dir)| ((s, watched.then(|| file.to_owned())), (file, dir)))
+        .unzip();
     match session::open_window(&options, cli.exit_after_s, screenshot, scenario) {
         Ok((report, attempts)) => match debrief_to {
             Some((file, dir)) if !attempts.is_empty() => {

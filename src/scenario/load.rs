@@ -37,16 +37,23 @@ impl fmt::Display for ScenarioError {
 
 impl std::error::Error for ScenarioError {}
 
+impl ScenarioError {
+    /// `file` could not be read as text, for the reason `why`.
+    pub fn unreadable(file: &Path, why: impl fmt::Display) -> Self {
+        Self {
+            file: file.to_owned(),
+            line: 1,
+            column: 1,
+            field: String::new(),
+            message: format!("cannot read it: {why}"),
+            hint: "check the path; shipped scenarios are in scenarios/".into(),
+        }
+    }
+}
+
 /// Reads and checks the scenario in `file`.
 pub fn load(file: &Path) -> Result<Scenario, ScenarioError> {
-    let text = std::fs::read_to_string(file).map_err(|e| ScenarioError {
-        file: file.to_owned(),
-        line: 1,
-        column: 1,
-        field: String::new(),
-        message: format!("cannot read it: {e}"),
-        hint: "check the path; shipped scenarios are in scenarios/".into(),
-    })?;
+    let text = std::fs::read_to_string(file).map_err(|e| ScenarioError::unreadable(file, e))?;
     parse(file, &text)
 }
 

@@ -5,20 +5,21 @@
 //! Without a scenario the window stays in free play; with a scripted device the exercise
 //! begins at once.
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use bevy::prelude::*;
 
 use super::FrameSet;
 use super::bridge::Snapshot;
-use crate::app::exercise::outcome_of;
-use crate::app::haptic::ExerciseLink;
+use crate::app::exercise::{outcome_of, sites_on};
+use crate::app::haptic::{ExerciseLink, HapticScene};
 use crate::cli;
-use crate::scenario::{Difficulty, Exercise, Scenario, Sites};
+use crate::scenario::{Difficulty, Exercise, Scenario};
 
 /// Where the trainee is.
 #[derive(States, Default, Debug, Clone, Copy, PartialEq, Eq, Hash)]
-enum Stage {
+pub(super) enum Stage {
     /// No scenario: the organs and the tool only.
     #[default]
     FreePlay,
@@ -31,9 +32,18 @@ enum Stage {
 #[derive(Resource, Clone)]
 pub struct Lesson {
     pub scenario: Scenario,
-    /// Where its nodules and regions lie, for a fresh exercise at each attempt.
-    pub sites: Sites,
+    /// The file it was read from, watched for edits (none for the built-in scenario).
+    pub file: Option<PathBuf>,
+    /// The scene it runs on, to find its nodules and regions for each fresh exercise.
+    pub scene: HapticScene,
     pub link: Arc<ExerciseLink>,
+}
+
+impl Lesson {
+    /// A fresh exercise of the scenario, for another attempt.
+    pub(super) fn fresh_exercise(&self) -> Exercise {
+        Exercise::new(self.scenario.clone(), sites_on(&self.scene, &self.scenario))
+    }
 }
 
 pub(super) fn setup(app: &mut App, lesson: Option<Lesson>) {
@@ -169,11 +179,8 @@ fn retry_on_r(
     lesson: Res<Lesson>,
     mut next: ResMut<NextState<Stage>>,
 ) {
-    if keys.just_pressed(KeyCode::KeyR) {
-        let fresh = Exercise::new(lesson.scenario.clone(), lesson.sites.clone());
-        if lesson.link.retry(fresh) {
-            next.set(Stage::Briefing);
-        }
+    if keys.just_pressed(KeyCode::KeyR) && lesson.link.retry(lesson.fresh_exercise()) {
+        next.set(Stage::Briefing);
     }
 }
 
@@ -190,7 +197,9 @@ mod tests {
     use bevy::state::app::StatesPlugin;
 
     use super::*;
-    use crate::scenario::{Progress, Sample, parse};
+    use crate::contact::Probe;
+    use crate::haptics::SafetySettings;
+    use crate::scenario::{Progress, Sample, Sites, parse};
 
     const SCENARIO: &str = r#"Scenario(
         title: "Quick press",
@@ -210,7 +219,15 @@ mod tests {
             .add_message::<AppExit>();
         let lesson = Lesson {
             scenario,
-            sites: Sites::default(),
+            file: None,
+            scene: HapticScene {
+                organs: Vec::new(),
+                probe: Probe {
+                    tip_radius_m: 0.006,
+                },
+                safety: SafetySettings::default(),
+                coupling: None,
+            },
             link: link.clone(),
         };
         setup(&mut app, Some(lesson));

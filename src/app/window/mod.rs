@@ -10,6 +10,7 @@ mod input;
 mod legend;
 mod lesson;
 mod organs;
+mod reload;
 mod screenshot;
 pub mod tissue;
 mod tool;
@@ -63,19 +64,25 @@ enum FrameSet {
 pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
     let log = frames::FrameLog::default();
     let mut app = App::new();
-    app.add_plugins(DefaultPlugins.set(WindowPlugin {
-        primary_window: Some(Window {
-            title: "PGD surgery trainer".into(),
-            ..default()
-        }),
-        ..default()
-    }))
+    let scenario_file = window.lesson.as_ref().and_then(|l| l.file.as_deref());
+    app.add_plugins(
+        DefaultPlugins
+            .set(WindowPlugin {
+                primary_window: Some(Window {
+                    title: "PGD surgery trainer".into(),
+                    ..default()
+                }),
+                ..default()
+            })
+            .set(reload::asset_plugin(scenario_file)),
+    )
     .insert_resource(ClearColor(Color::srgb(0.05, 0.06, 0.08)))
     .configure_sets(
         Update,
         (FrameSet::Input, FrameSet::Receive, FrameSet::Draw).chain(),
     );
     screenshot::setup(&mut app, window.screenshot.clone());
+    reload::setup(&mut app, window.lesson.as_ref());
     lesson::setup(&mut app, window.lesson.clone());
     bridge::setup(&mut app, window);
     organs::setup(&mut app);
