@@ -41,6 +41,7 @@ pub fn scenario_scene(
     let tip = scenario.tool.tip_radius_m();
     let mut scene = scene_of(&organs, Some(tip), dir, detail, on_stale)?;
     scene.safety.max_force_n = scenario.device.max_force_n.0;
+    scene.workspace.scale = scenario.device.workspace_scale.0;
     Ok(scene)
 }
 

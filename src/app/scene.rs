@@ -11,7 +11,7 @@ use super::haptic::HapticScene;
 use crate::cli::{OnStale, VademecumSpec, ensure_vademecum};
 use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, Probe};
 use crate::fem::{Inclusion, Law};
-use crate::haptics::{PressTarget, SafetySettings};
+use crate::haptics::{PressTarget, SafetySettings, Workspace};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::{Organ, OrganSettings, region};
 use crate::pgd::{BuildSettings, Vademecum};
@@ -129,6 +129,7 @@ pub fn scene_of(
     Ok(HapticScene {
         organs,
         probe: Probe { tip_radius_m: tip },
+        workspace: Workspace::default(),
         safety: SafetySettings::default(),
         coupling: (!coupling.is_empty()).then(|| Arc::new(coupling)),
     })

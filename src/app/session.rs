@@ -144,7 +144,7 @@ pub fn open_window(
             let start = press_targets(&scene)
                 .first()
                 .map_or_else(Vector3::zeros, |t| t.point_m + t.normal * 0.03);
-            let (device, handle) = VirtualDevice::new(&start);
+            let (device, handle) = VirtualDevice::new(&scene.workspace.to_device(&start));
             (Box::new(device) as Box<dyn HapticDevice>, Some(handle))
         }
     };

@@ -1,6 +1,6 @@
 //! The haptic device side, free of Bevy: the device trait and its backends, the trajectory
-//! files they replay and record, the safety filter between the physics and the motors, and the
-//! clock that paces the 1 kHz loop.
+//! files they replay and record, the map from the device's workspace to the scene, the safety
+//! filter between the physics and the motors, and the clock that paces the 1 kHz loop.
 
 mod device;
 mod recorder;
@@ -11,6 +11,7 @@ mod sweep;
 mod timing;
 mod trajectory;
 mod virtual_device;
+mod workspace;
 
 pub use device::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
 pub use recorder::Recorder;
@@ -21,6 +22,7 @@ pub use sweep::{PressMotion, PressTarget, press_and_slide};
 pub use timing::{Histogram, Metronome, TimerMode};
 pub use trajectory::{Trajectory, TrajectoryError, TrajectoryRow};
 pub use virtual_device::{VirtualDevice, VirtualHandle};
+pub use workspace::Workspace;
 
 /// The haptic rate: one tick a millisecond.
 pub const TICK_S: f64 = 1e-3;

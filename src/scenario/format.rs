@@ -5,7 +5,7 @@
 
 use serde::Deserialize;
 
-use super::units::{Millimetres, Newtons, Ratio, Seconds};
+use super::units::{Millimetres, Newtons, Ratio, Scale, Seconds};
 
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -68,6 +68,14 @@ pub struct Device {
     /// The largest force sent to the device (also capped by the device's own limit).
     #[serde(default = "default_device_force")]
     pub max_force_n: Newtons,
+    /// The tool moves this many times as far as the device's handle (the felt stiffness
+    /// scales with it: forces are not scaled).
+    #[serde(default = "default_workspace_scale")]
+    pub workspace_scale: Scale,
+}
+
+fn default_workspace_scale() -> Scale {
+    Scale(1.0)
 }
 
 fn default_device_force() -> Newtons {
@@ -78,6 +86,7 @@ impl Default for Device {
     fn default() -> Self {
         Self {
             max_force_n: default_device_force(),
+            workspace_scale: default_workspace_scale(),
         }
     }
 }

@@ -15,4 +15,4 @@ pub use format::{
 };
 pub use load::{ScenarioError, load, parse};
 pub use score::{Scorecard, TaskScore, score};
-pub use units::{Millimetres, Newtons, Ratio, Seconds};
+pub use units::{Millimetres, Newtons, Ratio, Scale, Seconds};

@@ -70,6 +70,23 @@ impl TryFrom<f64> for Seconds {
     }
 }
 
+/// How many times the device's motion is scaled in the scene: from 0.1 (fine work) to 10.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct Scale(pub f64);
+
+impl TryFrom<f64> for Scale {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (0.1..=10.0).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v} is not a workspace scale: from 0.1 to 10 (1 moves the tool as far as the hand)"
+            )),
+        }
+    }
+}
+
 /// A stiffness ratio of a nodule to its organ: more than 1 (stiffer) and at most 50.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(try_from = "f64")]

@@ -9,7 +9,8 @@ use pgd_surgery::app::scene::press_targets;
 use pgd_surgery::contact::Probe;
 use pgd_surgery::fem::{FemModel, Law};
 use pgd_surgery::haptics::{
-    HapticDevice, PressMotion, PressTarget, SafetySettings, Scripted, Trajectory, press_and_slide,
+    HapticDevice, PressMotion, PressTarget, SafetySettings, Scripted, Trajectory, Workspace,
+    press_and_slide,
 };
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate, region};
 use pgd_surgery::pgd::{BuildSettings, OrganModel, Silent, Vademecum, build, organ};
@@ -57,6 +58,7 @@ pub fn scene(safety: SafetySettings) -> HapticScene {
         probe: Probe {
             tip_radius_m: TIP_RADIUS_M,
         },
+        workspace: Workspace::default(),
         safety,
     }
 }

@@ -8,3 +8,4 @@ mod faults;
 mod press;
 mod replay;
 mod superposition;
+mod workspace;

@@ -209,6 +209,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "tasks[0].towards",
             "has no length",
         ),
+        (
+            "workspace-scale-zero",
+            5,
+            "workspace_scale",
+            "not a workspace scale",
+        ),
     ];
     for (name, line, field, message) in cases {
         let file = root().join(format!("tests/scenarios/broken/{name}.scenario.ron"));

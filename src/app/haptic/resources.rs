@@ -7,7 +7,7 @@ use crate::contact::Coupling;
 use nalgebra::Vector3;
 
 use crate::contact::Probe;
-use crate::haptics::{DeviceSample, Fault, HapticDevice, SafetyFilter};
+use crate::haptics::{DeviceSample, Fault, HapticDevice, SafetyFilter, Workspace};
 
 #[derive(Resource)]
 pub struct Device(pub Box<dyn HapticDevice>);
@@ -16,7 +16,9 @@ pub struct Device(pub Box<dyn HapticDevice>);
 #[derive(Resource, Default)]
 pub struct Tool {
     pub probe: Probe,
-    /// None until the device has reported a finite position.
+    /// How the device's motion maps onto the scene.
+    pub workspace: Workspace,
+    /// In the scene's frame; none until the device has reported a finite position.
     pub sample: Option<DeviceSample>,
 }
 

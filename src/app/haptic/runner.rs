@@ -12,7 +12,7 @@ use super::resources::{
 };
 use super::snapshot::{HapticSnapshot, OrganSnapshot, SnapshotPublisher};
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
-use crate::haptics::{HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S};
+use crate::haptics::{HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S, Workspace};
 use crate::pgd::{Deformation, Vademecum};
 
 /// What the haptic world is made of.
@@ -21,6 +21,7 @@ pub struct HapticScene {
     /// Organ names and vademecums, in the scene's order.
     pub organs: Vec<(String, Arc<Vademecum>)>,
     pub probe: Probe,
+    pub workspace: Workspace,
     pub safety: SafetySettings,
     /// Organ/organ contact and attachments (set up, at rest); `None` leaves the organs apart.
     pub coupling: Option<Arc<Coupling>>,
@@ -57,6 +58,7 @@ impl HapticLoop {
         world.insert_resource(Device(device));
         world.insert_resource(Tool {
             probe: scene.probe,
+            workspace: scene.workspace,
             sample: None,
         });
         world.insert_resource(TickClock::default());

@@ -12,7 +12,7 @@ use crate::contact::{Target, press};
 use crate::haptics::Fault;
 use crate::pgd::SurfacePoint;
 
-/// Reads the device into [`Tool`]. A non-finite sample or a device error is a fault and the
+/// Reads the device into [`Tool`], mapped onto the scene. A non-finite sample or a device error is a fault and the
 /// tool keeps its last good position; so is a streak of overrun ticks.
 pub fn read_device(
     clock: Res<TickClock>,
@@ -25,7 +25,7 @@ pub fn read_device(
     faults.this_tick.clear();
     faults.this_tick.append(&mut faults.next_tick);
     match device.0.read(clock.time_s) {
-        Ok(sample) if sample.is_finite() => tool.sample = Some(sample),
+        Ok(sample) if sample.is_finite() => tool.sample = Some(tool.workspace.to_scene(sample)),
         Ok(_) => faults.this_tick.push(Fault::NonFiniteDevice),
         Err(e) => faults.this_tick.push(Fault::Device(e.to_string())),
     }

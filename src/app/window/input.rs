@@ -36,7 +36,9 @@ fn drive_virtual_device(
         return;
     };
     let forward = eye.forward();
-    let mut tip = to_bevy(&handle.tip_m());
+    // The cursor places the tool in the scene; the device's handle is in its own workspace.
+    let workspace = link.scene.workspace;
+    let mut tip = to_bevy(&workspace.to_scene_m(&handle.tip_m()));
     let steering_camera =
         buttons.pressed(MouseButton::Right) || buttons.pressed(MouseButton::Middle);
     if !steering_camera
@@ -65,7 +67,7 @@ fn drive_virtual_device(
         _ => 0.0,
     };
     let push = notches * WHEEL_STEP_M + keyed * KEY_SPEED_M_PER_S * time.delta_secs();
-    handle.set_tip(&from_bevy(tip + *forward * push));
+    handle.set_tip(&workspace.to_device(&from_bevy(tip + *forward * push)));
     // The left button is the device's first button (a stylus button on hardware).
     handle.set_buttons(u32::from(buttons.pressed(MouseButton::Left)));
 }

@@ -197,8 +197,6 @@ mod tests {
     use bevy::state::app::StatesPlugin;
 
     use super::*;
-    use crate::contact::Probe;
-    use crate::haptics::SafetySettings;
     use crate::scenario::{Progress, Sample, Sites, parse};
 
     const SCENARIO: &str = r#"Scenario(
@@ -220,14 +218,7 @@ mod tests {
         let lesson = Lesson {
             scenario,
             file: None,
-            scene: HapticScene {
-                organs: Vec::new(),
-                probe: Probe {
-                    tip_radius_m: 0.006,
-                },
-                safety: SafetySettings::default(),
-                coupling: None,
-            },
+            scene: super::super::scene_without_organs(),
             link: link.clone(),
         };
         setup(&mut app, Some(lesson));

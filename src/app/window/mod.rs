@@ -94,3 +94,17 @@ pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
     let exit = app.run();
     (exit, log.report())
 }
+
+/// A scene without organs, for the window's stages in a headless app.
+#[cfg(test)]
+fn scene_without_organs() -> HapticScene {
+    HapticScene {
+        organs: Vec::new(),
+        probe: crate::contact::Probe {
+            tip_radius_m: 0.006,
+        },
+        workspace: crate::haptics::Workspace::default(),
+        safety: crate::haptics::SafetySettings::default(),
+        coupling: None,
+    }
+}

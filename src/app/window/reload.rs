@@ -177,10 +177,8 @@ mod tests {
     use bevy::state::app::StatesPlugin;
 
     use super::*;
-    use crate::app::haptic::{ExerciseLink, ExerciseRun, HapticScene};
+    use crate::app::haptic::{ExerciseLink, ExerciseRun};
     use crate::app::window::bridge::Snapshot;
-    use crate::contact::Probe;
-    use crate::haptics::SafetySettings;
     use crate::scenario::load;
 
     fn scenario_text(briefing: &str, organ: &str, max_force_n: f64) -> String {
@@ -197,14 +195,7 @@ mod tests {
         let lesson = Lesson {
             scenario: load(file).unwrap(),
             file: Some(file.to_owned()),
-            scene: HapticScene {
-                organs: Vec::new(),
-                probe: Probe {
-                    tip_radius_m: 0.006,
-                },
-                safety: SafetySettings::default(),
-                coupling: None,
-            },
+            scene: super::super::scene_without_organs(),
             link: link.clone(),
         };
         let mut app = App::new();
