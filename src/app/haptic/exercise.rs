@@ -130,7 +130,8 @@ impl ExerciseRun {
         }
     }
 
-    /// Takes the offered exercise, if there is one.
+    /// Takes the offered exercise, if there is one (none is offered between an attempt's end
+    /// and the next retry).
     fn take_next(&mut self) {
         self.link.take_next(&mut self.exercise);
         if let Some(exercise) = &self.exercise {
@@ -142,7 +143,7 @@ impl ExerciseRun {
     /// The attempt under way or ended last, wherever it is: here, handed over, or (started
     /// but not yet ticked) still offered.
     pub fn into_exercise(mut self) -> Option<Exercise> {
-        if self.exercise.is_none() && self.link.started() && !self.ended {
+        if self.exercise.is_none() && self.link.started() {
             self.take_next();
         }
         self.exercise.or_else(|| self.link.take_ended())
@@ -177,7 +178,7 @@ pub fn score_tick(
     if !run.link.started() {
         return;
     }
-    if run.exercise.is_none() && !run.ended {
+    if run.exercise.is_none() {
         run.take_next();
     }
     let Some(exercise) = run.exercise.as_mut() else {
@@ -239,34 +240,70 @@ pub fn publish_progress(
 mod tests {
     use std::path::Path;
 
+    use bevy::ecs::system::RunSystemOnce;
+
     use super::*;
     use crate::scenario::{Sites, parse};
 
+    /// An exercise whose one task ends after 5 ms.
     fn exercise() -> Exercise {
         let text = r#"Scenario(title: "t", briefing: "b", organs: ["liver"],
             tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3,
-                                 hold_s: 1.0, time_limit_s: 2.0)])"#;
+                                 hold_s: 0.001, time_limit_s: 0.005)])"#;
         let scenario = parse(Path::new("t.scenario.ron"), text).unwrap();
         Exercise::new(scenario, Sites::default())
     }
 
-    /// Another attempt waits for the ended one to be handed over (so that the two are never
-    /// mixed up), keeps it, stops scoring until started again, and reaches the haptic side
-    /// once.
+    /// A haptic world with no organs, scoring what `link` offers.
+    fn world(link: &Arc<ExerciseLink>) -> World {
+        let mut world = World::new();
+        world.insert_resource(TickClock::default());
+        world.insert_resource(Tool::default());
+        world.insert_resource(DeviceForce::default());
+        world.insert_resource(ExerciseRun::new(link.clone()));
+        world
+    }
+
+    /// Ticks the world's scoring `ticks` times, 1 ms apart, from `tick`.
+    fn score(world: &mut World, from: u64, ticks: u64) {
+        for tick in from..from + ticks {
+            world.resource_mut::<TickClock>().time_s = tick as f64 * 1e-3;
+            world.run_system_once(score_tick).unwrap();
+        }
+    }
+
+    fn progress(world: &World) -> Option<Progress> {
+        world.resource::<ExerciseRun>().progress()
+    }
+
+    /// Nothing is scored before the start; the attempt runs and is handed over; another
+    /// attempt waits for that hand-over (so that the two are never mixed up), is not scored
+    /// until started again, then runs from its first task; the first is kept for its report.
     #[test]
-    fn a_retry_takes_turns_with_the_haptic_thread() {
-        let link = ExerciseLink::default();
-        link.start();
+    fn attempts_take_turns_between_the_window_and_the_haptic_thread() {
+        let link = Arc::new(ExerciseLink::default());
+        let mut world = world(&link);
+        link.offer(exercise());
+        score(&mut world, 0, 3);
+        assert_eq!(progress(&world), None, "scored before the start");
         assert!(!link.retry(exercise()), "nothing has ended yet");
-        let mut under_way = Some(exercise());
-        link.hand_over(&mut under_way);
+
+        link.start();
+        score(&mut world, 3, 2);
+        assert_eq!(progress(&world).map(|p| p.task), Some(0));
+        score(&mut world, 5, 10);
+        assert!(progress(&world).is_some_and(|p| p.finished()));
+        assert!(link.ended_copy().is_some(), "handed over");
+
         assert!(link.retry(exercise()));
-        assert!(!link.started());
-        link.take_next(&mut under_way);
-        assert!(under_way.is_some());
-        let mut again = None;
-        link.take_next(&mut again);
-        assert!(again.is_none(), "the next attempt is handed over once");
+        score(&mut world, 15, 3);
+        assert_eq!(progress(&world), None, "scored before the second start");
+        link.start();
+        score(&mut world, 18, 1);
+        assert_eq!(progress(&world).map(|p| p.task), Some(0));
+        score(&mut world, 19, 10);
+        assert!(progress(&world).is_some_and(|p| p.finished()));
         assert_eq!(link.take_earlier().len(), 1);
+        assert!(link.take_ended().is_some());
     }
 }
