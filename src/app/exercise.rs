@@ -35,7 +35,16 @@ pub fn scenario_scene(
                 .filter(|nodule| &nodule.organ == name)
                 .map(Nodule::inclusion)
                 .collect();
-            Ok(SceneOrgan { organ, inclusions })
+            let young_pa = scenario
+                .tissues
+                .iter()
+                .find(|tissue| &tissue.organ == name)
+                .map(|tissue| tissue.young_pa.0);
+            Ok(SceneOrgan {
+                organ,
+                young_pa,
+                inclusions,
+            })
         })
         .collect::<Result<_, String>>()?;
     let tip = scenario.tool.tip_radius_m();

@@ -71,6 +71,8 @@ pub fn default_scene(dir: &Path, detail: Detail, on_stale: OnStale) -> Result<Ha
 #[derive(Clone, Debug, PartialEq)]
 pub struct SceneOrgan {
     pub organ: Organ,
+    /// Young's modulus (Pa) of its tissue when not the organ's own.
+    pub young_pa: Option<f64>,
     pub inclusions: Vec<Inclusion>,
 }
 
@@ -78,6 +80,7 @@ impl From<Organ> for SceneOrgan {
     fn from(organ: Organ) -> Self {
         Self {
             organ,
+            young_pa: None,
             inclusions: Vec::new(),
         }
     }
@@ -101,6 +104,10 @@ pub fn scene_of(
         if tip != spec.build.tool_tip_radius_m {
             spec.build.tool_tip_radius_m = tip;
             spec.file = dir.join(format!("{}.tip{}mm.vdm", organ.organ.name(), tip * 1e3));
+        }
+        if let Some(young_pa) = organ.young_pa {
+            spec.young_pa = Some(young_pa);
+            spec.file = spec.file.with_extension(format!("young-{young_pa}pa.vdm"));
         }
         if !organ.inclusions.is_empty() {
             spec.inclusions = organ.inclusions.clone();

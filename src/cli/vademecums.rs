@@ -27,6 +27,8 @@ pub struct VademecumSpec {
     pub organ: Organ,
     pub law: Law,
     pub mesh: OrganSettings,
+    /// The tissue's Young's modulus (Pa) when not the organ's own.
+    pub young_pa: Option<f64>,
     /// Stiffer or softer regions in the organ's tissue (none by default).
     pub inclusions: Vec<Inclusion>,
     pub build: BuildSettings,
@@ -40,6 +42,7 @@ impl VademecumSpec {
             organ,
             law,
             mesh: OrganSettings::default(),
+            young_pa: None,
             inclusions: Vec::new(),
             build: BuildSettings::default(),
             file: dir.join(format!("{}.vdm", organ.name())),
@@ -69,6 +72,9 @@ impl VademecumSpec {
         if self.build.local_radius_m != build.local_radius_m {
             command += &format!(" --local-radius-mm {}", self.build.local_radius_m * 1e3);
         }
+        if let Some(young_pa) = self.young_pa {
+            command += &format!(" --young-pa {young_pa}");
+        }
         for inclusion in &self.inclusions {
             command += &format!(" --inclusion {}", inclusion_arg(inclusion));
         }
@@ -85,7 +91,10 @@ pub fn ensure_vademecum(
 ) -> Result<(Vademecum, TetMesh), String> {
     let organ = spec.organ;
     let mesh = organs::generate(organ, &spec.mesh).map_err(|e| format!("{}: {e}", organ.name()))?;
-    let material = pgd::organ::material(organ, spec.law);
+    let mut material = pgd::organ::material(organ, spec.law);
+    if let Some(young_pa) = spec.young_pa {
+        material.young_pa = young_pa;
+    }
     let why = match checked(spec, &mesh, &material) {
         Ok(vademecum) => return Ok((vademecum, mesh)),
         Err(why) => why,

@@ -5,7 +5,7 @@
 
 use serde::Deserialize;
 
-use super::units::{Millimetres, Newtons, Ratio, Scale, Seconds};
+use super::units::{Millimetres, Newtons, Pascals, Ratio, Scale, Seconds};
 
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -21,6 +21,10 @@ pub struct Scenario {
     pub tool: Tool,
     #[serde(default)]
     pub device: Device,
+    /// Organs whose tissue is stiffer or softer than the organ's own (a fibrotic liver). The
+    /// organ's vademecum is built for it (the first run of the scenario builds it).
+    #[serde(default)]
+    pub tissues: Vec<Tissue>,
     /// Stiffer lumps hidden in the organs' tissue, such as tumours, for palpation. The
     /// organ's vademecum is built with them (the first run of the scenario builds it).
     #[serde(default)]
@@ -117,6 +121,14 @@ impl Spot {
     pub fn contains(&self, tip_m: &nalgebra::Vector3<f64>) -> bool {
         (tip_m - self.centre_m()).norm() <= self.radius_mm.metres()
     }
+}
+
+/// An organ's tissue, when not its own default.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Tissue {
+    pub organ: String,
+    pub young_pa: Pascals,
 }
 
 /// A sphere of stiffer tissue inside an organ.

@@ -167,6 +167,26 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
         let field = format!("nodules[{k}].organ");
         problems.extend(not_in_scene(scenario, &nodule.organ, field, "nodules"));
     }
+    for (k, tissue) in scenario.tissues.iter().enumerate() {
+        let field = format!("tissues[{k}].organ");
+        problems.extend(not_in_scene(
+            scenario,
+            &tissue.organ,
+            field.clone(),
+            "tissues",
+        ));
+        if scenario.tissues[..k]
+            .iter()
+            .any(|t| t.organ == tissue.organ)
+        {
+            problems.push(Problem {
+                field,
+                anchors: vec!["tissues".into(), format!("\"{}\"", tissue.organ)],
+                message: format!("the {} is given a tissue twice", tissue.organ),
+                hint: "give each organ one Tissue(…)".into(),
+            });
+        }
+    }
     if scenario.tasks.is_empty() {
         problems.push(Problem {
             field: "tasks".into(),

@@ -70,6 +70,23 @@ impl TryFrom<f64> for Seconds {
     }
 }
 
+/// A Young's modulus of soft tissue, from 100 Pa to 1 MPa.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct Pascals(pub f64);
+
+impl TryFrom<f64> for Pascals {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (100.0..=1e6).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v} Pa is not the stiffness of soft tissue: from 100 Pa to 1 MPa (liver about 1.6 kPa; kilopascals must be written in pascals)"
+            )),
+        }
+    }
+}
+
 /// How many times the device's motion is scaled in the scene: from 0.1 (fine work) to 10.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(try_from = "f64")]

@@ -12,6 +12,7 @@ use pgd_surgery::app::exercise::{Outcome, run_simulated, scenario_scene};
 use pgd_surgery::app::scene::{Detail, default_scene};
 use pgd_surgery::cli::{OnStale, write_report};
 use pgd_surgery::haptics::{Scripted, TICK_S, Trajectory};
+use pgd_surgery::mesh::organs::Organ;
 use pgd_surgery::scenario::{Scenario, load, parse};
 
 const TRAINER: &str = env!("CARGO_BIN_EXE_trainer");
@@ -215,6 +216,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "workspace_scale",
             "not a workspace scale",
         ),
+        (
+            "tissue-not-in-scene",
+            5,
+            "tissues[0].organ",
+            "`pancreas` is not in this scenario",
+        ),
     ];
     for (name, line, field, message) in cases {
         let file = root().join(format!("tests/scenarios/broken/{name}.scenario.ron"));
@@ -348,4 +355,49 @@ fn retraction_measures_the_region_and_the_organs_around() {
         careless.errors
     );
     assert!(careless.longest_hold_s < careless.hold_s.unwrap());
+}
+
+/// A scenario's `tissues` build the organ's vademecum for that tissue: the liver given twice
+/// its Young's modulus pushes back twice as hard on the same scripted press (linear
+/// elasticity at a fixed indentation: force ∝ E; tolerance 0.2 %, for the f32 storage and the
+/// build's convergence tolerance; 2.000 measured), with no other organ in the scene to add
+/// contact.
+#[test]
+fn a_stiffer_tissue_pushes_back_harder_in_proportion() {
+    let text = |tissues: &str| {
+        format!(
+            r#"Scenario(title: "Press", briefing: "Press.", organs: ["liver"], {tissues}
+                tasks: [ForceControl(organ: "liver", min_force_n: 0.15, max_force_n: 0.35,
+                                     hold_s: 30.0, time_limit_s: 40.0)])"#
+        )
+    };
+    let file = Path::new("stiff-liver.scenario.ron");
+    let young_pa = 2.0 * pgd_surgery::pgd::organ::young_pa(Organ::Liver);
+    let stiff = parse(
+        file,
+        &text(&format!(
+            "tissues: [Tissue(organ: \"liver\", young_pa: {young_pa})],"
+        )),
+    )
+    .unwrap();
+    let plain = parse(file, &text("")).unwrap();
+    let holding = |scenario: Scenario| {
+        let dir = vademecums();
+        scenario_scene(&scenario, dir, Detail::Coarse, OnStale::Rebuild).unwrap();
+        let trace = run_scenario(scenario, "liver-steady-press", "competent").force_trace;
+        let held: Vec<f64> = trace
+            .iter()
+            .filter(|(t, _)| (2.0..4.0).contains(t))
+            .map(|(_, f)| *f)
+            .collect();
+        held.iter().sum::<f64>() / held.len() as f64
+    };
+    let (stiff_n, plain_n) = (holding(stiff), holding(plain));
+    let ratio = stiff_n / plain_n;
+    eprintln!("held {stiff_n:.4} N on the stiff liver, {plain_n:.4} N on the plain one");
+    assert!(plain_n > 0.1, "{plain_n} N");
+    assert!(
+        (ratio - 2.0).abs() < 0.004,
+        "{stiff_n} N against {plain_n} N: ratio {ratio}"
+    );
 }
