@@ -239,21 +239,21 @@ impl Exercise {
             .last_time_s
             .map_or(0.0, |last| (sample.time_s - last).max(0.0));
         self.last_time_s = Some(sample.time_s);
-        let Some(task) = self.scenario.tasks.get(self.current) else {
+        if self.finished() {
             return;
-        };
+        }
         if self.ticks.is_multiple_of(PLOT_EVERY) {
             self.force_trace.push((sample.time_s, sample.force_n));
         }
         self.ticks += 1;
-        let (scenario, sites) = (&self.scenario, &self.sites);
-        let description = &mut self.descriptions[self.current];
+        let task = &self.scenario.tasks[self.current];
         let running = self.running.get_or_insert_with(|| {
-            Running::start(task, take(description), &scenario.organs, sample.time_s)
+            let description = take(&mut self.descriptions[self.current]);
+            Running::start(task, description, &self.scenario.organs, sample.time_s)
         });
         let nodules = Nodules {
-            scenario,
-            sites: &sites.nodules,
+            scenario: &self.scenario,
+            sites: &self.sites.nodules,
         };
         running.step(task, sample, dt, nodules);
         let elapsed = sample.time_s - running.metrics.started_s;
@@ -279,16 +279,11 @@ impl Exercise {
     pub fn finish(mut self) -> (Scenario, Vec<TaskMetrics>, Vec<(f64, f64)>) {
         let now = self.last_time_s.unwrap_or(0.0);
         while !self.finished() {
-            if self.running.is_none() {
-                let task = &self.scenario.tasks[self.current];
+            let task = &self.scenario.tasks[self.current];
+            self.running.get_or_insert_with(|| {
                 let description = take(&mut self.descriptions[self.current]);
-                self.running = Some(Running::start(
-                    task,
-                    description,
-                    &self.scenario.organs,
-                    now,
-                ));
-            }
+                Running::start(task, description, &self.scenario.organs, now)
+            });
             self.end_task(now);
         }
         (self.scenario, self.done, self.force_trace)
@@ -347,10 +342,11 @@ impl Running {
             },
             force_sum: 0.0,
             organ: match task {
-                Task::ForceControl { organ, .. }
-                | Task::Palpation { organ, .. }
-                | Task::Retraction { organ, .. } => organs.iter().position(|o| o == organ),
-                Task::SafeNavigation { .. } => None,
+                Task::ForceControl { organ, .. } | Task::Palpation { organ, .. } => {
+                    organs.iter().position(|o| o == organ)
+                }
+                // Retraction watches its organ through its region site.
+                Task::SafeNavigation { .. } | Task::Retraction { .. } => None,
             },
             button_held: false,
             held_since: None,
