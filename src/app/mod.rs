@@ -8,6 +8,14 @@ pub mod scene;
 pub mod session;
 pub mod window;
 
+/// The trainer's built-in scenario (its shipped file and its text): the window's default
+/// exercise, built into the binary so that it runs from any directory; the same file ships in
+/// `scenarios/` for educators to copy.
+pub const DEFAULT_SCENARIO: (&str, &str) = (
+    "scenarios/liver-steady-press.scenario.ron",
+    include_str!("../../scenarios/liver-steady-press.scenario.ron"),
+);
+
 /// Why a window cannot be opened here, if that is known before trying: no `DISPLAY`, or a
 /// local X display whose server does not answer (winit would panic on either).
 pub fn missing_display() -> Option<String> {

@@ -10,12 +10,15 @@ use serde::Serialize;
 use bevy::app::AppExit;
 use nalgebra::Vector3;
 
-use super::exercise::{Outcome, end, outcome_of, prepare, run_simulated, scenario_scene, sites_on};
+use super::exercise::{Outcome, outcome_of, prepare, run_simulated, scenario_scene, sites_on};
+use super::haptic::ExerciseRun;
 use super::haptic::{
     HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport, Scheduling,
 };
 use super::scene::{Detail, default_scene, press_targets};
-use super::window::{FrameReport, Lesson, ScreenshotPlan, WindowScene};
+use super::window::{
+    FrameReport, Lesson, Lessons, MenuPlan, Opening, SceneSource, ScreenshotPlan, WindowScene,
+};
 use crate::cli::OnStale;
 use crate::haptics::{
     DeviceSpec, HapticDevice, PressMotion, Recorder, Scripted, TICK_S, TimerMode, Trajectory,
@@ -23,6 +26,7 @@ use crate::haptics::{
 };
 use crate::scenario::{Exercise, Scenario};
 
+#[derive(Clone)]
 pub struct Options {
     pub vademecums: PathBuf,
     pub detail: Detail,
@@ -121,18 +125,32 @@ pub fn run_headless(options: &Options) -> Result<Report, String> {
     })
 }
 
+/// A scenario for the window: the lesson it opens with, and the scenarios its menu offers.
+pub struct WindowLesson {
+    pub scenario: Scenario,
+    /// The file it was read from (the built-in one's shipped name): its reports are named
+    /// after it.
+    pub file: PathBuf,
+    pub opening: Opening,
+    /// The folder whose scenarios the menu offers, watched for edits.
+    pub folder: Option<PathBuf>,
+}
+
+/// Each attempt at an exercise begun in the window, in order, with its scenario's file.
+pub type Attempts = Vec<(PathBuf, Outcome)>;
+
 /// Opens the trainer window over the real-time haptic loop, driven by the mouse unless a
 /// scripted device is named; reports how the loop kept time while the renderer ran, and each
-/// attempt at the scenario's exercise that was begun, in order. The scenario's file, if it has
-/// one, is watched: an edit reloads it (see the window's `reload`).
+/// attempt at an exercise that was begun, in order. The scenarios folder is watched: an edit
+/// of the lesson's file reloads it (see the window's `reload`).
 pub fn open_window(
     options: &Options,
     exit_after_s: Option<f64>,
     screenshot: Option<ScreenshotPlan>,
-    scenario: Option<(Scenario, Option<PathBuf>)>,
-) -> Result<(Report, Vec<Outcome>), String> {
-    let scene = match &scenario {
-        Some((scenario, _)) => scenario_scene_capped(options, scenario)?,
+    lesson: Option<WindowLesson>,
+) -> Result<(Report, Attempts), String> {
+    let scene = match &lesson {
+        Some(lesson) => scenario_scene_capped(options, &lesson.scenario)?,
         None => scene(options)?,
     };
     let (device, virtual_device) = match &options.device {
@@ -151,23 +169,41 @@ pub fn open_window(
     let device = recorded(device, &options.record);
     let device_name = device.name().to_owned();
     let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
-    let lesson = scenario.map(|(scenario, file)| {
-        let exercise = Exercise::new(scenario.clone(), sites_on(&scene, &scenario));
-        Lesson {
-            link: prepare(&mut haptic, exercise),
+    let (lesson, folder) = match lesson {
+        Some(WindowLesson {
             scenario,
             file,
-            scene: scene.clone(),
+            opening,
+            folder,
+        }) => {
+            let exercise = Exercise::new(scenario.clone(), sites_on(&scene, &scenario));
+            let lesson = Lesson {
+                link: prepare(&mut haptic, exercise),
+                scenario,
+                file,
+                scene: scene.clone(),
+            };
+            if let Some(DeviceSpec::Scripted(_)) = &options.device {
+                lesson.link.start();
+            }
+            (Some((lesson, opening)), folder)
         }
-    });
-    let link = lesson.as_ref().map(|lesson| lesson.link.clone());
-    if let (Some(link), Some(DeviceSpec::Scripted(_))) = (&link, &options.device) {
-        link.start();
-    }
+        None => (None, None),
+    };
     let snapshots = haptic.publish();
     let timer = options.realtime.unwrap_or_default();
     let haptic =
         HapticThread::spawn(haptic, timer, Scheduling::RealTime).map_err(|e| e.to_string())?;
+    let menu = lesson.is_some().then(|| MenuPlan {
+        folder,
+        built_in: (
+            PathBuf::from(super::DEFAULT_SCENARIO.0),
+            super::DEFAULT_SCENARIO.1,
+        ),
+        scenes: scene_source(options),
+        swap: haptic.swap(),
+    });
+    let lessons = Lessons::default();
     let (exit, frames) = super::window::run(WindowScene {
         scene,
         snapshots,
@@ -176,16 +212,11 @@ pub fn open_window(
         exit_after_s,
         screenshot,
         lesson,
+        lessons: lessons.clone(),
+        menu,
     });
     let (report, mut haptic) = haptic.stop();
-    let mut attempts: Vec<Outcome> = link
-        .as_ref()
-        .map(|link| link.take_earlier().into_iter().map(outcome_of).collect())
-        .unwrap_or_default();
-    // An attempt never begun (the window closed on the briefing) has nothing to score.
-    if link.is_some_and(|link| link.started()) {
-        attempts.extend(end(&mut haptic));
-    }
+    let attempts = attempts(&lessons, &mut haptic);
     match exit {
         AppExit::Success => Ok((
             Report::Window {
@@ -196,6 +227,39 @@ pub fn open_window(
         )),
         AppExit::Error(code) => Err(format!("the window closed with error code {code}")),
     }
+}
+
+/// How the window's menu builds the scene of the scenario chosen.
+fn scene_source(options: &Options) -> SceneSource {
+    let options = options.clone();
+    std::sync::Arc::new(move |scenario: &Scenario| scenario_scene_capped(&options, scenario))
+}
+
+/// Every attempt begun under the window's lessons, in order, scored: the ended ones from each
+/// lesson's link, and the one under way in `haptic` (the current lesson's).
+fn attempts(lessons: &Lessons, haptic: &mut HapticLoop) -> Attempts {
+    let running = haptic
+        .world()
+        .get_resource::<ExerciseRun>()
+        .map(|run| run.link.clone());
+    let mut attempts = Attempts::new();
+    for (file, link) in lessons.take() {
+        let mut ended = link.take_earlier();
+        if running
+            .as_ref()
+            .is_some_and(|r| std::sync::Arc::ptr_eq(r, &link))
+        {
+            // An attempt never begun (the window closed on the briefing) has nothing to score.
+            if link.started() {
+                let run = haptic.world_mut().remove_resource::<ExerciseRun>();
+                ended.extend(run.and_then(ExerciseRun::into_exercise));
+            }
+        } else {
+            ended.extend(link.take_ended());
+        }
+        attempts.extend(ended.into_iter().map(|e| (file.clone(), outcome_of(e))));
+    }
+    attempts
 }
 
 /// Runs a scenario's exercise on the scripted device `options` names, on a simulated clock,

@@ -6,8 +6,9 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use pgd_surgery::app::exercise::Outcome;
 use pgd_surgery::app::scene::Detail;
-use pgd_surgery::app::window::ScreenshotPlan;
-use pgd_surgery::app::{self, session};
+use pgd_surgery::app::session::WindowLesson;
+use pgd_surgery::app::window::{Opening, ScreenshotPlan};
+use pgd_surgery::app::{self, DEFAULT_SCENARIO, session};
 use pgd_surgery::cli::{self, OnStale};
 use pgd_surgery::haptics::{DeviceSpec, TimerMode};
 use pgd_surgery::scenario;
@@ -68,15 +69,12 @@ struct Cli {
     #[arg(long, global = true)]
     no_rebuild: bool,
     /// The window without an exercise: the organs and the tool only (by default the window
-    /// runs the built-in scenario, scenarios/liver-steady-press.scenario.ron).
+    /// opens the menu of scenarios/, the built-in scenarios/liver-steady-press.scenario.ron
+    /// chosen).
     #[arg(long)]
     free_play: bool,
 }
 
-/// The window's default exercise, built into the binary so that it runs from any directory;
-/// the same file ships in `scenarios/` for educators to copy.
-const DEFAULT_SCENARIO_FILE: &str = "scenarios/liver-steady-press.scenario.ron";
-const DEFAULT_SCENARIO: &str = include_str!("../../scenarios/liver-steady-press.scenario.ron");
 const DEFAULT_REPORT_DIR: &str = "reports";
 
 #[derive(Subcommand)]
@@ -152,10 +150,10 @@ fn main() -> ExitCode {
             }
         },
         _ if cli.headless || cli.free_play => None,
-        _ => match scenario::parse(Path::new(DEFAULT_SCENARIO_FILE), DEFAULT_SCENARIO) {
+        _ => match scenario::parse(Path::new(DEFAULT_SCENARIO.0), DEFAULT_SCENARIO.1) {
             Ok(scenario) => Some((
                 scenario,
-                Path::new(DEFAULT_SCENARIO_FILE),
+                Path::new(DEFAULT_SCENARIO.0),
                 Path::new(DEFAULT_REPORT_DIR),
             )),
             Err(e) => {
@@ -177,25 +175,31 @@ fn main() -> ExitCode {
         path,
         after_frames: cli.frames.max(1),
     });
-    // A scenario file named on the command line is watched for edits; the built-in one is not.
-    let watched = matches!(cli.command, Some(Command::Run { .. }));
-    let (scenario, debrief_to) = exercise
-        .map(|(s, file, dir)| ((s, watched.then(|| file.to_owned())), (file, dir)))
-        .unzip();
-    match session::open_window(&options, cli.exit_after_s, screenshot, scenario) {
-        Ok((report, attempts)) => match debrief_to {
-            Some((file, dir)) if !attempts.is_empty() => {
+    // `trainer run FILE` opens FILE's briefing, its menu offering FILE's folder; the plain
+    // trainer opens the menu of `scenarios/`, the built-in scenario chosen.
+    let run_file = matches!(cli.command, Some(Command::Run { .. }));
+    let report_dir = exercise.as_ref().map(|(_, _, dir)| dir.to_path_buf());
+    let lesson = exercise.map(|(scenario, file, _)| WindowLesson {
+        scenario,
+        file: file.to_owned(),
+        opening: match run_file {
+            true => Opening::Lesson,
+            false => Opening::Menu,
+        },
+        folder: Some(file.parent().unwrap_or(Path::new(".")).to_owned())
+            .filter(|folder| folder.is_dir()),
+    });
+    match session::open_window(&options, cli.exit_after_s, screenshot, lesson) {
+        Ok((report, attempts)) => match report_dir {
+            Some(dir) if !attempts.is_empty() => {
                 // With --json, stdout carries the scorecards alone.
                 if !cli.json {
                     report.print(false);
                 }
-                let count = attempts.len();
-                let codes: Vec<ExitCode> = attempts
+                let codes: Vec<ExitCode> = numbered(attempts)
                     .into_iter()
-                    .enumerate()
-                    .map(|(k, outcome)| {
-                        let attempt = (count > 1).then_some(k + 1);
-                        debrief(Ok(outcome), file, attempt, dir, cli.json)
+                    .map(|(file, attempt, outcome)| {
+                        debrief(Ok(outcome), &file, attempt, &dir, cli.json)
                     })
                     .collect();
                 codes
@@ -203,10 +207,9 @@ fn main() -> ExitCode {
                     .find(|code| *code != ExitCode::SUCCESS)
                     .unwrap_or(ExitCode::SUCCESS)
             }
-            Some((file, _)) => {
+            Some(_) => {
                 eprintln!(
-                    "trainer: the exercise of {} was not begun (Space on the briefing begins it): nothing scored, no report",
-                    file.display()
+                    "trainer: no exercise was begun (Space on a briefing begins it): nothing scored, no report"
                 );
                 finish(Ok(report), cli.json)
             }
@@ -214,6 +217,22 @@ fn main() -> ExitCode {
         },
         Err(e) => finish(Err(e), cli.json),
     }
+}
+
+/// Each attempt with its number among its scenario's attempts, when there were several.
+fn numbered(attempts: session::Attempts) -> Vec<(PathBuf, Option<usize>, Outcome)> {
+    let count = |file: &PathBuf| attempts.iter().filter(|(f, _)| f == file).count();
+    let counts: Vec<usize> = attempts.iter().map(|(file, _)| count(file)).collect();
+    let mut seen: Vec<PathBuf> = Vec::new();
+    attempts
+        .into_iter()
+        .zip(counts)
+        .map(|((file, outcome), count)| {
+            seen.push(file.clone());
+            let k = seen.iter().filter(|f| **f == file).count();
+            (file, (count > 1).then_some(k), outcome)
+        })
+        .collect()
 }
 
 fn finish(result: Result<session::Report, String>, json: bool) -> ExitCode {

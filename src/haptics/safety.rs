@@ -95,6 +95,13 @@ impl SafetyFilter {
         &self.settings
     }
 
+    /// New settings (another scene's), keeping the force being sent and any fault: the force
+    /// then moves from what the hand feels now at the allowed rate, as it would within a scene.
+    pub fn retune(&mut self, settings: SafetySettings, device_max_force_n: f64) {
+        self.max_force_n = settings.max_force_n.min(device_max_force_n);
+        self.settings = settings;
+    }
+
     /// The limit actually applied (N): the smaller of the settings' and the device's.
     pub fn max_force_n(&self) -> f64 {
         self.max_force_n

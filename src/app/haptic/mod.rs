@@ -21,7 +21,7 @@ pub use report::{ForceSummary, HeadlessReport, TickTimes};
 pub use resources::{Device, DeviceForce, FaultLog, ForceTrace, OrganCoupling, TickClock, Tool};
 pub use runner::{HapticLoop, HapticScene, SceneError};
 pub use snapshot::{HapticSnapshot, LoopTiming, OrganSnapshot};
-pub use thread::{HapticThread, RealTimeReport, Scheduling};
+pub use thread::{HapticThread, RealTimeReport, SceneSwap, Scheduling};
 
 /// The schedule run once per haptic tick.
 #[derive(ScheduleLabel, Clone, Debug, PartialEq, Eq, Hash)]

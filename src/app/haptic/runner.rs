@@ -33,6 +33,10 @@ pub enum SceneError {
     Contact(#[from] ContactError),
 }
 
+/// The safety settings of a loop that has no device yet.
+#[derive(Resource, Clone, Copy)]
+struct Parked(SafetySettings);
+
 /// A haptic `World` of organ entities and the schedule that ticks it.
 pub struct HapticLoop {
     world: World,
@@ -41,6 +45,20 @@ pub struct HapticLoop {
 
 impl HapticLoop {
     pub fn new(scene: &HapticScene, device: Box<dyn HapticDevice>) -> Result<Self, SceneError> {
+        let mut haptic = Self::parked(scene)?;
+        haptic.world.remove_resource::<Parked>();
+        let max_force_n = device.limits().max_force_n;
+        haptic.world.insert_resource(Device(device));
+        haptic
+            .world
+            .insert_resource(Safety(SafetyFilter::new(scene.safety, max_force_n)));
+        Ok(haptic)
+    }
+
+    /// A world for `scene` without a device, to be built away from the haptic thread (its
+    /// contact surfaces take milliseconds) and then take over a running loop's device with
+    /// [`HapticLoop::take_device`]. Ticked without one, it would panic.
+    pub fn parked(scene: &HapticScene) -> Result<Self, SceneError> {
         let mut world = World::new();
         for (index, (name, vademecum)) in scene.organs.iter().enumerate() {
             world.spawn((
@@ -54,8 +72,6 @@ impl HapticLoop {
                 OrganDeformation(Deformation::new(vademecum, 1)),
             ));
         }
-        let max_force_n = device.limits().max_force_n;
-        world.insert_resource(Device(device));
         world.insert_resource(Tool {
             probe: scene.probe,
             workspace: scene.workspace,
@@ -64,7 +80,7 @@ impl HapticLoop {
         world.insert_resource(TickClock::default());
         world.insert_resource(DeviceForce::default());
         world.insert_resource(FaultLog::default());
-        world.insert_resource(Safety(SafetyFilter::new(scene.safety, max_force_n)));
+        world.insert_resource(Parked(scene.safety));
         if let Some(coupling) = &scene.coupling {
             world.insert_resource(OrganCoupling(Coupling::clone(coupling)));
         }
@@ -74,20 +90,48 @@ impl HapticLoop {
         })
     }
 
+    /// Takes `running`'s device and its safety filter (retuned to this scene's settings), so
+    /// that the force the hand feels carries over the change of scene at the allowed rate.
+    /// Does nothing if this loop has a device already or `running` has none.
+    pub fn take_device(&mut self, running: &mut HapticLoop) {
+        let Some(Parked(settings)) = self.world.get_resource::<Parked>().copied() else {
+            return;
+        };
+        let (Some(device), Some(mut safety)) = (
+            running.world.remove_resource::<Device>(),
+            running.world.remove_resource::<Safety>(),
+        ) else {
+            return;
+        };
+        safety.0.retune(settings, device.0.limits().max_force_n);
+        self.world.remove_resource::<Parked>();
+        self.world.insert_resource(device);
+        self.world.insert_resource(safety);
+    }
+
     /// Keeps every tick's forces in a [`ForceTrace`].
     pub fn keep_trace(&mut self) {
         self.world.insert_resource(ForceTrace::default());
     }
 
-    /// Starts publishing a snapshot every tick; the returned end reads the latest.
+    /// Starts publishing a snapshot every tick; the returned end reads the latest, and until
+    /// the first tick, the organs at rest.
     pub fn publish(&mut self) -> triple_buffer::Output<HapticSnapshot> {
-        let organs = self
+        let mut organs: Vec<(usize, OrganSnapshot)> = self
             .world
-            .query::<&OrganDeformation>()
+            .query::<(&OrganIndex, &OrganDeformation)>()
             .iter(&self.world)
-            .count();
+            .map(|(index, deformation)| {
+                let organ = OrganSnapshot {
+                    deformation: deformation.0.clone(),
+                    contact: None,
+                };
+                (index.0, organ)
+            })
+            .collect();
+        organs.sort_by_key(|(index, _)| *index);
         let template = HapticSnapshot {
-            organs: vec![OrganSnapshot::default(); organs],
+            organs: organs.into_iter().map(|(_, organ)| organ).collect(),
             ..HapticSnapshot::default()
         };
         let (input, output) = triple_buffer::triple_buffer(&template);

@@ -1,8 +1,8 @@
 //! The haptic loop on a thread of its own, paced by absolute deadlines: render frames can
 //! neither bunch its ticks nor delay them.
 
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -41,7 +41,48 @@ pub enum Scheduling {
 
 pub struct HapticThread {
     stop: Arc<AtomicBool>,
+    swap: SceneSwap,
     handle: JoinHandle<(RealTimeReport, HapticLoop)>,
+}
+
+/// Another scene for the running thread: a parked loop (see [`HapticLoop::parked`]) offered
+/// here is taken at the start of the next tick, with the running loop's device; the loop it
+/// replaces is kept here, to be dropped away from the haptic thread.
+#[derive(Clone, Default)]
+pub struct SceneSwap(Arc<Mutex<Swap>>);
+
+#[derive(Default)]
+struct Swap {
+    incoming: Option<HapticLoop>,
+    retired: Option<HapticLoop>,
+}
+
+impl SceneSwap {
+    /// Offers `next` to the haptic thread (replacing one offered and not yet taken).
+    pub fn offer(&self, next: HapticLoop) {
+        let retired = self.0.lock().ok().and_then(|mut swap| {
+            swap.incoming = Some(next);
+            swap.retired.take()
+        });
+        // Dropped here, outside the lock, on the caller's thread.
+        drop(retired);
+    }
+
+    /// Whether a loop offered has not been taken yet.
+    pub fn pending(&self) -> bool {
+        self.0.lock().is_ok_and(|swap| swap.incoming.is_some())
+    }
+
+    /// On the haptic thread: runs the offered loop from now on, if there is one and the lock
+    /// is free (never waits).
+    fn take(&self, running: &mut HapticLoop) {
+        if let Ok(mut swap) = self.0.try_lock()
+            && let Some(mut next) = swap.incoming.take()
+        {
+            next.take_device(running);
+            swap.retired = Some(std::mem::replace(running, next));
+        }
+    }
 }
 
 impl HapticThread {
@@ -52,11 +93,17 @@ impl HapticThread {
         scheduling: Scheduling,
     ) -> std::io::Result<Self> {
         let stop = Arc::new(AtomicBool::new(false));
-        let flag = stop.clone();
+        let swap = SceneSwap::default();
+        let (flag, swapped) = (stop.clone(), swap.clone());
         let handle = std::thread::Builder::new()
             .name("haptic 1 kHz".into())
-            .spawn(move || run(haptic, timer, scheduling, &flag))?;
-        Ok(Self { stop, handle })
+            .spawn(move || run(haptic, timer, scheduling, &flag, &swapped))?;
+        Ok(Self { stop, swap, handle })
+    }
+
+    /// Where to offer the thread another scene.
+    pub fn swap(&self) -> SceneSwap {
+        self.swap.clone()
     }
 
     /// Stops the loop after its current tick; says how it kept time, and hands the loop back
@@ -78,6 +125,7 @@ fn run(
     timer: TimerMode,
     scheduling: Scheduling,
     stop: &AtomicBool,
+    swap: &SceneSwap,
 ) -> (RealTimeReport, HapticLoop) {
     let scheduling = match scheduling {
         Scheduling::Normal => "normal".to_owned(),
@@ -110,6 +158,7 @@ fn run(
         last_start = Some(started);
         lateness.record(beat.lateness);
         skipped += beat.skipped;
+        swap.take(&mut haptic);
         let time = haptic.tick(TickClock {
             tick: beat.tick,
             time_s: beat.tick as f64 * TICK_S,
@@ -165,4 +214,50 @@ fn raise_priority() -> Result<(), String> {
 fn raise_priority() -> Result<(), String> {
     thread_priority::set_current_thread_priority(thread_priority::ThreadPriority::Max)
         .map_err(|e| format!("{e:?}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::app::haptic::HapticScene;
+    use crate::app::haptic::resources::{Device, Safety};
+    use crate::contact::Probe;
+    use crate::haptics::{
+        DeviceSample, SafetySettings, Scripted, Trajectory, TrajectoryRow, Workspace,
+    };
+    use nalgebra::Vector3;
+
+    fn scene(max_force_n: f64) -> HapticScene {
+        HapticScene {
+            organs: Vec::new(),
+            probe: Probe {
+                tip_radius_m: 0.006,
+            },
+            workspace: Workspace::default(),
+            safety: SafetySettings {
+                max_force_n,
+                ..SafetySettings::default()
+            },
+            coupling: None,
+        }
+    }
+
+    /// The offered world runs from the next tick with the running one's device, under its own
+    /// force limit; the world it replaced is kept for the other side to drop, without a device.
+    #[test]
+    fn a_swapped_scene_takes_over_the_device() {
+        let rows = vec![TrajectoryRow::new(0.0, &DeviceSample::at(Vector3::zeros()))];
+        let device = Box::new(Scripted::new("the hand", Trajectory { rows }));
+        let mut running = HapticLoop::new(&scene(3.3), device).unwrap();
+        let swap = SceneSwap::default();
+        swap.offer(HapticLoop::parked(&scene(1.0)).unwrap());
+        assert!(swap.pending());
+        swap.take(&mut running);
+        assert!(!swap.pending());
+        assert_eq!(running.device_name(), "the hand");
+        assert_eq!(running.world().resource::<Safety>().0.max_force_n(), 1.0);
+        running.tick(TickClock::default());
+        let retired = swap.0.lock().unwrap().retired.take().unwrap();
+        assert!(!retired.world().contains_resource::<Device>());
+    }
 }

@@ -19,6 +19,34 @@ pub struct HapticLink {
     exit_after: Option<Duration>,
 }
 
+impl HapticLink {
+    /// Another scene, whose snapshots come from `snapshots` (the haptic thread takes its world
+    /// from the scene swap).
+    pub(super) fn change_scene(
+        &mut self,
+        scene: HapticScene,
+        snapshots: triple_buffer::Output<HapticSnapshot>,
+    ) {
+        self.scene = scene;
+        self.snapshots = Mutex::new(snapshots);
+    }
+
+    /// A link without a device, for the window's stages in a headless app.
+    #[cfg(test)]
+    pub(super) fn headless(
+        scene: HapticScene,
+        snapshots: triple_buffer::Output<HapticSnapshot>,
+    ) -> Self {
+        Self {
+            scene,
+            virtual_device: None,
+            device_name: String::new(),
+            snapshots: Mutex::new(snapshots),
+            exit_after: None,
+        }
+    }
+}
+
 /// The haptic state this frame draws.
 #[derive(Resource, Default)]
 pub struct Snapshot(pub HapticSnapshot);

@@ -1,12 +1,12 @@
 //! A scenario in the window, in stages: the briefing (what to do, Space to begin), the
 //! exercise (scored in the haptic thread; the HUD shows the task and its clock), and the
-//! debrief (the score and what went wrong; R tries again from the briefing, Esc closes the
-//! window and writes a report per attempt).
+//! debrief (the score and what went wrong; R tries again from the briefing, M goes to the
+//! menu of scenarios, Esc closes the window and writes a report per attempt).
 //! Without a scenario the window stays in free play; with a scripted device the exercise
 //! begins at once.
 
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use bevy::prelude::*;
 
@@ -15,7 +15,7 @@ use super::bridge::Snapshot;
 use crate::app::exercise::{outcome_of, sites_on};
 use crate::app::haptic::{ExerciseLink, HapticScene};
 use crate::cli;
-use crate::scenario::{Difficulty, Exercise, Scenario};
+use crate::scenario::{Exercise, Scenario};
 
 /// Where the trainee is.
 #[derive(States, Default, Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -23,6 +23,10 @@ pub(super) enum Stage {
     /// No scenario: the organs and the tool only.
     #[default]
     FreePlay,
+    /// Choosing a scenario.
+    Menu,
+    /// The chosen scenario's scene being read (or built) away from the window.
+    Loading,
     Briefing,
     Exercise,
     Debrief,
@@ -32,8 +36,9 @@ pub(super) enum Stage {
 #[derive(Resource, Clone)]
 pub struct Lesson {
     pub scenario: Scenario,
-    /// The file it was read from, watched for edits (none for the built-in scenario).
-    pub file: Option<PathBuf>,
+    /// The file it was read from (the built-in scenario's shipped name): its reports are
+    /// named after it, and an edit of it reloads it.
+    pub file: PathBuf,
     /// The scene it runs on, to find its nodules and regions for each fresh exercise.
     pub scene: HapticScene,
     pub link: Arc<ExerciseLink>,
@@ -46,7 +51,40 @@ impl Lesson {
     }
 }
 
-pub(super) fn setup(app: &mut App, lesson: Option<Lesson>) {
+/// Every lesson the window has run, in order, with its scenario's file: the attempts at each
+/// are collected from its link when the window closes.
+#[derive(Resource, Clone, Default)]
+pub struct Lessons(Arc<Mutex<Vec<LessonRun>>>);
+
+/// A lesson's scenario file and its link to the exercise.
+pub type LessonRun = (PathBuf, Arc<ExerciseLink>);
+
+impl Lessons {
+    pub fn add(&self, lesson: &Lesson) {
+        if let Ok(mut lessons) = self.0.lock() {
+            lessons.push((lesson.file.clone(), lesson.link.clone()));
+        }
+    }
+
+    /// The lessons run, once (after that, none).
+    pub fn take(&self) -> Vec<LessonRun> {
+        self.0
+            .lock()
+            .map(|mut l| std::mem::take(&mut *l))
+            .unwrap_or_default()
+    }
+}
+
+/// Where the window opens a lesson.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Opening {
+    /// On the menu of scenarios, the lesson's own chosen.
+    Menu,
+    /// On the lesson's briefing (or its exercise, if begun already).
+    Lesson,
+}
+
+pub(super) fn setup(app: &mut App, lesson: Option<(Lesson, Opening)>, lessons: Lessons) {
     app.init_state::<Stage>()
         .add_systems(OnEnter(Stage::Briefing), show_briefing)
         .add_systems(OnEnter(Stage::Debrief), show_debrief)
@@ -55,26 +93,41 @@ pub(super) fn setup(app: &mut App, lesson: Option<Lesson>) {
             (
                 begin_on_space.run_if(in_state(Stage::Briefing)),
                 debrief_when_done.run_if(in_state(Stage::Exercise)),
-                (retry_on_r, close_on_escape).run_if(in_state(Stage::Debrief)),
+                retry_on_r.run_if(in_state(Stage::Debrief)),
+                close_on_escape.run_if(in_state(Stage::Debrief).or_else(in_state(Stage::Menu))),
+                menu_on_m.run_if(in_state(Stage::Briefing).or_else(in_state(Stage::Debrief))),
             )
                 .in_set(FrameSet::Input),
         );
-    if let Some(lesson) = lesson {
+    if let Some((lesson, opening)) = lesson {
         // An exercise begun already (a scripted device has no one to press Space) skips the
         // briefing.
-        let first = match lesson.link.started() {
-            true => Stage::Exercise,
-            false => Stage::Briefing,
+        let first = match (lesson.link.started(), opening) {
+            (true, _) => Stage::Exercise,
+            (false, Opening::Menu) => Stage::Menu,
+            (false, Opening::Lesson) => Stage::Briefing,
         };
+        lessons.add(&lesson);
         app.insert_resource(lesson)
+            .insert_resource(lessons)
             .add_systems(Startup, move |mut next: ResMut<NextState<Stage>>| {
                 next.set(first)
             });
     }
 }
 
-/// A panel of text in the middle of the window, gone when the stage ends.
-fn spawn_panel(commands: &mut Commands, stage: Stage, text: String) {
+/// A panel of text in the middle of the window, gone when the stage ends; returns the text's
+/// entity.
+pub(super) fn spawn_panel(commands: &mut Commands, stage: Stage, text: String) -> Entity {
+    let text = commands
+        .spawn((
+            Text::new(text),
+            TextFont {
+                font_size: FontSize::Px(17.0),
+                ..default()
+            },
+        ))
+        .id();
     commands
         .spawn((
             DespawnOnExit(stage),
@@ -97,14 +150,9 @@ fn spawn_panel(commands: &mut Commands, stage: Stage, text: String) {
                     },
                     BackgroundColor(Color::srgba(0.02, 0.03, 0.05, 0.88)),
                 ))
-                .with_child((
-                    Text::new(text),
-                    TextFont {
-                        font_size: FontSize::Px(17.0),
-                        ..default()
-                    },
-                ));
+                .add_child(text);
         });
+    text
 }
 
 fn show_briefing(mut commands: Commands, lesson: Res<Lesson>) {
@@ -117,11 +165,7 @@ fn show_briefing(mut commands: Commands, lesson: Res<Lesson>) {
 
 /// The briefing: title, difficulty, what to do, the tasks in order, how to begin.
 fn briefing_text(scenario: &Scenario) -> String {
-    let difficulty = match scenario.difficulty {
-        Difficulty::Beginner => "beginner",
-        Difficulty::Intermediate => "intermediate",
-        Difficulty::Advanced => "advanced",
-    };
+    let difficulty = scenario.difficulty.name();
     let tasks: Vec<String> = scenario
         .tasks
         .iter()
@@ -136,7 +180,7 @@ fn briefing_text(scenario: &Scenario) -> String {
         })
         .collect();
     format!(
-        "{} ({difficulty})\n\n{}\n\n{}\n\nPress Space to begin.",
+        "{} ({difficulty})\n\n{}\n\n{}\n\nPress Space to begin (M: the menu of scenarios).",
         scenario.title,
         scenario.briefing,
         tasks.join("\n")
@@ -167,8 +211,10 @@ fn show_debrief(mut commands: Commands, lesson: Res<Lesson>) {
         Some(exercise) => cli::summary(&outcome_of(exercise).card),
         None => "The exercise has ended.".to_owned(),
     };
-    let text =
-        format!("{text}\nPress R to try again, or Esc to close; the reports are written then.");
+    let text = format!(
+        "{text}\nPress R to try again, M for the menu of scenarios, or Esc to close; the reports \
+         are written then."
+    );
     spawn_panel(&mut commands, Stage::Debrief, text);
 }
 
@@ -181,6 +227,20 @@ fn retry_on_r(
 ) {
     if keys.just_pressed(KeyCode::KeyR) && lesson.link.retry(lesson.fresh_exercise()) {
         next.set(Stage::Briefing);
+    }
+}
+
+/// To the menu, once the haptic thread has handed over an ended attempt (as for a retry).
+fn menu_on_m(
+    keys: Res<ButtonInput<KeyCode>>,
+    lesson: Res<Lesson>,
+    stage: Res<State<Stage>>,
+    mut next: ResMut<NextState<Stage>>,
+) {
+    if keys.just_pressed(KeyCode::KeyM)
+        && (*stage.get() == Stage::Briefing || lesson.link.ended_copy().is_some())
+    {
+        next.set(Stage::Menu);
     }
 }
 
@@ -217,11 +277,15 @@ mod tests {
             .add_message::<AppExit>();
         let lesson = Lesson {
             scenario,
-            file: None,
+            file: PathBuf::from("quick.scenario.ron"),
             scene: super::super::scene_without_organs(),
             link: link.clone(),
         };
-        setup(&mut app, Some(lesson));
+        setup(
+            &mut app,
+            Some((lesson, Opening::Lesson)),
+            Lessons::default(),
+        );
         (app, link)
     }
 

@@ -9,6 +9,7 @@ mod hud;
 mod input;
 mod legend;
 mod lesson;
+mod menu;
 mod organs;
 mod reload;
 mod screenshot;
@@ -22,7 +23,8 @@ use bevy::prelude::*;
 pub use bridge::{HapticLink, Snapshot};
 pub use frames::FrameReport;
 pub use legend::{Legend, OrganLegend, ToolLegend};
-pub use lesson::Lesson;
+pub use lesson::{Lesson, Lessons, Opening};
+pub use menu::{MenuPlan, SceneSource};
 pub use screenshot::ScreenshotPlan;
 
 use super::haptic::{HapticScene, HapticSnapshot};
@@ -39,8 +41,13 @@ pub struct WindowScene {
     pub exit_after_s: Option<f64>,
     /// Save the window to a PNG after some frames, then close it.
     pub screenshot: Option<ScreenshotPlan>,
-    /// The scenario to brief, run and debrief; free play without one.
-    pub lesson: Option<Lesson>,
+    /// The scenario to brief, run and debrief, and where the window opens it; free play
+    /// without one.
+    pub lesson: Option<(Lesson, Opening)>,
+    /// Every lesson run, for their reports when the window closes.
+    pub lessons: Lessons,
+    /// The menu of scenarios (none in free play).
+    pub menu: Option<MenuPlan>,
 }
 
 /// The haptic side's f64 vectors as Bevy's (the Bevy end of the seam; parry's is `crate::seam`).
@@ -57,14 +64,46 @@ fn from_bevy(v: Vec3) -> nalgebra::Vector3<f64> {
 enum FrameSet {
     Input,
     Receive,
+    /// The scene's entities despawned and spawned again after a change of scene.
+    Respawn,
     Draw,
+}
+
+/// The haptic scene has changed (another scenario was chosen): what is drawn of it is
+/// despawned and spawned again from the [`HapticLink`]'s scene.
+#[derive(Message, Clone, Copy, Debug)]
+struct SceneChanged;
+
+/// An entity drawn from the haptic scene (organs, tool, camera and light), replaced when it
+/// changes.
+#[derive(Component)]
+struct SceneView;
+
+fn despawn_scene_views(mut commands: Commands, views: Query<Entity, With<SceneView>>) {
+    for view in &views {
+        commands.entity(view).despawn();
+    }
+}
+
+/// Runs `spawn` at start-up and again on every change of scene.
+fn spawn_with_scene<M>(
+    app: &mut App,
+    spawn: impl IntoScheduleConfigs<bevy::ecs::system::ScheduleSystem, M> + Clone,
+) {
+    app.add_systems(Startup, spawn.clone()).add_systems(
+        Update,
+        spawn
+            .run_if(on_message::<SceneChanged>)
+            .in_set(FrameSet::Respawn),
+    );
 }
 
 /// Opens the trainer window and returns, when it closes, how it closed and how fast it drew.
 pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
     let log = frames::FrameLog::default();
     let mut app = App::new();
-    let scenario_file = window.lesson.as_ref().and_then(|l| l.file.as_deref());
+    // The scenarios folder is watched: an edit of the lesson's file reloads it.
+    let folder = window.menu.as_ref().and_then(|m| m.folder.clone());
     app.add_plugins(
         DefaultPlugins
             .set(WindowPlugin {
@@ -74,16 +113,30 @@ pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
                 }),
                 ..default()
             })
-            .set(reload::asset_plugin(scenario_file)),
+            .set(reload::asset_plugin(folder.as_deref())),
     )
     .insert_resource(ClearColor(Color::srgb(0.05, 0.06, 0.08)))
     .configure_sets(
         Update,
-        (FrameSet::Input, FrameSet::Receive, FrameSet::Draw).chain(),
+        (
+            FrameSet::Input,
+            FrameSet::Receive,
+            FrameSet::Respawn,
+            FrameSet::Draw,
+        )
+            .chain(),
+    )
+    .add_message::<SceneChanged>()
+    .add_systems(
+        Update,
+        despawn_scene_views
+            .run_if(on_message::<SceneChanged>)
+            .in_set(FrameSet::Receive),
     );
     screenshot::setup(&mut app, window.screenshot.clone());
-    reload::setup(&mut app, window.lesson.as_ref());
-    lesson::setup(&mut app, window.lesson.clone());
+    reload::setup(&mut app, folder.as_deref());
+    lesson::setup(&mut app, window.lesson.clone(), window.lessons.clone());
+    menu::setup(&mut app, window.menu.clone());
     bridge::setup(&mut app, window);
     organs::setup(&mut app);
     camera::setup(&mut app);

@@ -9,7 +9,7 @@ use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
 
 use super::bridge::{HapticLink, Snapshot};
-use super::{FrameSet, tissue};
+use super::{FrameSet, SceneView, tissue};
 use crate::app::haptic::OrganDeformation;
 use crate::mesh::vertex_normals;
 use crate::pgd::Vademecum;
@@ -26,8 +26,8 @@ pub(super) struct OrganView {
 }
 
 pub(super) fn setup(app: &mut App) {
-    app.add_systems(Startup, (spawn_organs, spawn_camera_and_light))
-        .add_systems(Update, deform.in_set(FrameSet::Draw));
+    super::spawn_with_scene(app, (spawn_organs, spawn_camera_and_light));
+    app.add_systems(Update, deform.in_set(FrameSet::Draw));
 }
 
 fn spawn_organs(
@@ -46,6 +46,7 @@ fn spawn_organs(
             .collect();
         let mesh = surface_mesh(&triangles, &vademecum.position_coords_m);
         commands.spawn((
+            SceneView,
             Name::new(name.clone()),
             Mesh3d(meshes.add(mesh)),
             MeshMaterial3d(materials.add(StandardMaterial {
@@ -86,8 +87,9 @@ pub(super) fn scene_centre(link: &HapticLink) -> Vec3 {
 fn spawn_camera_and_light(mut commands: Commands, link: Res<HapticLink>) {
     let centre = scene_centre(&link);
     let orbit = super::camera::Orbit::looking_at(centre, Vec3::new(0.0, 0.32, -0.10));
-    commands.spawn((Camera3d::default(), orbit.transform(), orbit));
+    commands.spawn((SceneView, Camera3d::default(), orbit.transform(), orbit));
     commands.spawn((
+        SceneView,
         DirectionalLight {
             illuminance: 9_000.0,
             shadow_maps_enabled: true,

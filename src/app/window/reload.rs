@@ -52,10 +52,10 @@ impl AssetLoader for ScenarioLoader {
     }
 }
 
-/// The asset server for a lesson from `file`: reading from its folder and watching it. Without
-/// a file, nothing is watched.
-pub(super) fn asset_plugin(file: Option<&Path>) -> AssetPlugin {
-    let folder = file.map(|f| absolute_folder(f).to_string_lossy().into_owned());
+/// The asset server for the scenarios in `folder`: reading from it and watching it. Without a
+/// folder, nothing is watched.
+pub(super) fn asset_plugin(folder: Option<&Path>) -> AssetPlugin {
+    let folder = folder.map(|f| absolute(f).to_string_lossy().into_owned());
     AssetPlugin {
         watch_for_changes_override: Some(folder.is_some()),
         file_path: folder.unwrap_or_else(|| AssetPlugin::default().file_path),
@@ -64,40 +64,65 @@ pub(super) fn asset_plugin(file: Option<&Path>) -> AssetPlugin {
     }
 }
 
-fn absolute_folder(file: &Path) -> PathBuf {
-    let folder = file.parent().unwrap_or(Path::new("."));
-    std::path::absolute(folder).unwrap_or_else(|_| folder.to_owned())
+fn absolute(path: &Path) -> PathBuf {
+    std::path::absolute(path).unwrap_or_else(|_| path.to_owned())
 }
 
-/// The scenario file the lesson came from, as loaded.
+/// The lesson's scenario file as loaded from the watched folder.
 #[derive(Resource)]
 struct Watched {
+    folder: PathBuf,
     file: PathBuf,
-    handle: Handle<ScenarioAsset>,
+    handle: Option<Handle<ScenarioAsset>>,
 }
 
 /// The last word about the file (reloaded, refused), shown at the bottom of the window.
 #[derive(Component)]
 struct Notice;
 
-/// Watches the lesson's file, if it has one (the asset plugin must come from
-/// [`asset_plugin`] with the same file).
-pub(super) fn setup(app: &mut App, lesson: Option<&Lesson>) {
-    let Some(file) = lesson.and_then(|l| l.file.clone()) else {
+/// Watches the scenarios in `folder`, if there is one (the asset plugin must come from
+/// [`asset_plugin`] with the same folder): the lesson's file, whichever it is.
+pub(super) fn setup(app: &mut App, folder: Option<&Path>) {
+    let Some(folder) = folder.map(absolute) else {
         return;
     };
-    let name = file.file_name().map(PathBuf::from).unwrap_or_default();
     app.init_asset::<ScenarioAsset>()
         .register_asset_loader(ScenarioLoader {
-            dir: absolute_folder(&file),
-        });
-    let handle = app.world().resource::<AssetServer>().load(name);
-    app.insert_resource(Watched { file, handle })
+            dir: folder.clone(),
+        })
+        .insert_resource(Watched {
+            folder,
+            file: PathBuf::new(),
+            handle: None,
+        })
         .add_systems(Startup, spawn_notice)
         .add_systems(
             Update,
-            (apply_edits, report_failures).in_set(FrameSet::Input),
+            (
+                follow_lesson.run_if(resource_exists_and_changed::<Lesson>),
+                apply_edits,
+                report_failures,
+            )
+                .chain()
+                .in_set(FrameSet::Input),
         );
+}
+
+/// Watches the lesson's file when it lies in the watched folder (the built-in scenario run
+/// away from its folder does not).
+fn follow_lesson(lesson: Res<Lesson>, assets: Res<AssetServer>, mut watched: ResMut<Watched>) {
+    if watched.file == lesson.file {
+        return;
+    }
+    watched.file = lesson.file.clone();
+    let in_folder = lesson
+        .file
+        .parent()
+        .is_some_and(|parent| absolute(parent) == watched.folder);
+    watched.handle = match (in_folder, lesson.file.file_name()) {
+        (true, Some(name)) => Some(assets.load(PathBuf::from(name))),
+        _ => None,
+    };
 }
 
 fn spawn_notice(mut commands: Commands) {
@@ -132,7 +157,8 @@ fn apply_edits(
         let AssetEvent::Modified { id } = event else {
             continue;
         };
-        let Some(edited) = scenarios.get(*id).filter(|_| *id == watched.handle.id()) else {
+        let ours = watched.handle.as_ref().is_some_and(|h| h.id() == *id);
+        let Some(edited) = scenarios.get(*id).filter(|_| ours) else {
             continue;
         };
         let file = watched.file.display();
@@ -155,7 +181,7 @@ fn apply_edits(
 }
 
 /// Whether two scenarios run on the same haptic scene.
-fn same_scene(a: &Scenario, b: &Scenario) -> bool {
+pub(super) fn same_scene(a: &Scenario, b: &Scenario) -> bool {
     a.organs == b.organs
         && a.tissues == b.tissues
         && a.nodules == b.nodules
@@ -198,17 +224,19 @@ mod tests {
         let link = Arc::new(ExerciseLink::default());
         let lesson = Lesson {
             scenario: load(file).unwrap(),
-            file: Some(file.to_owned()),
+            file: file.to_owned(),
             scene: super::super::scene_without_organs(),
             link: link.clone(),
         };
         let mut app = App::new();
-        app.add_plugins((MinimalPlugins, StatesPlugin, asset_plugin(Some(file))))
+        let folder = file.parent();
+        app.add_plugins((MinimalPlugins, StatesPlugin, asset_plugin(folder)))
             .init_resource::<ButtonInput<KeyCode>>()
             .init_resource::<Snapshot>()
             .add_message::<AppExit>();
-        setup(&mut app, Some(&lesson));
-        super::super::lesson::setup(&mut app, Some(lesson));
+        setup(&mut app, folder);
+        let opening = super::super::lesson::Opening::Lesson;
+        super::super::lesson::setup(&mut app, Some((lesson, opening)), Default::default());
         (app, link)
     }
 

@@ -4,7 +4,7 @@
 use bevy::prelude::*;
 
 use super::bridge::{HapticLink, Snapshot};
-use super::{FrameSet, to_bevy};
+use super::{FrameSet, SceneView, to_bevy};
 
 /// The sphere drawn at the tool tip.
 #[derive(Component)]
@@ -14,8 +14,8 @@ pub(super) struct ToolTip;
 const ARROW_M_PER_N: f32 = 0.2;
 
 pub(super) fn setup(app: &mut App) {
-    app.add_systems(Startup, spawn_tool)
-        .add_systems(Update, (follow_device, draw_force).in_set(FrameSet::Draw));
+    super::spawn_with_scene(app, spawn_tool);
+    app.add_systems(Update, (follow_device, draw_force).in_set(FrameSet::Draw));
 }
 
 fn spawn_tool(
@@ -25,6 +25,7 @@ fn spawn_tool(
     mut materials: ResMut<Assets<StandardMaterial>>,
 ) {
     commands.spawn((
+        SceneView,
         ToolTip,
         Mesh3d(meshes.add(Sphere::new(link.scene.probe.tip_radius_m as f32))),
         MeshMaterial3d(materials.add(StandardMaterial {

@@ -1,0 +1,486 @@
+//! The menu of scenarios: every `*.scenario.ron` in the scenarios folder (and the built-in
+//! one, when the folder lacks it), each with its title, difficulty and organs; a file that
+//! does not validate is listed with its error and cannot be chosen. The chosen scenario's
+//! scene is read away from the window (its vademecums loaded, or built when missing), handed
+//! to the haptic thread, and the window redrawn on it; then its briefing opens.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+
+use bevy::prelude::*;
+
+use super::bridge::{HapticLink, Snapshot};
+use super::lesson::{Lesson, Lessons, Stage, spawn_panel};
+use super::{FrameSet, SceneChanged};
+use crate::app::exercise::{prepare, sites_on};
+use crate::app::haptic::{ExerciseLink, HapticLoop, HapticScene, HapticSnapshot, SceneSwap};
+use crate::scenario::{self, Exercise, Scenario};
+
+/// Builds a scenario's scene: its organs' vademecums read, or built when missing or stale.
+pub type SceneSource = Arc<dyn Fn(&Scenario) -> Result<HapticScene, String> + Send + Sync>;
+
+/// What the menu offers and how it changes the scene.
+#[derive(Resource, Clone)]
+pub struct MenuPlan {
+    /// The folder whose scenarios are offered (none: the built-in one only).
+    pub folder: Option<PathBuf>,
+    /// The built-in scenario's file name and text.
+    pub built_in: (PathBuf, &'static str),
+    pub scenes: SceneSource,
+    /// Where the haptic thread takes the chosen scenario's world.
+    pub swap: SceneSwap,
+}
+
+/// A scenario on offer: read and checked, or why not.
+struct Entry {
+    file: PathBuf,
+    scenario: Result<Scenario, String>,
+}
+
+/// The menu on screen: its entries, the one highlighted, and why the last choice failed.
+#[derive(Resource, Default)]
+struct Menu {
+    entries: Vec<Entry>,
+    selected: usize,
+    problem: Option<String>,
+}
+
+/// The menu's text.
+#[derive(Component)]
+struct MenuText;
+
+/// The chosen scenario on its way: a thread reading its scene and building its haptic world.
+#[derive(Resource)]
+struct Loading {
+    title: String,
+    task: Mutex<Option<JoinHandle<Result<Prepared, String>>>>,
+}
+
+/// A lesson ready to run: its haptic world (parked, with its exercise offered) and the end of
+/// the world's snapshots that the window reads.
+struct Prepared {
+    lesson: Lesson,
+    haptic: HapticLoop,
+    snapshots: triple_buffer::Output<HapticSnapshot>,
+}
+
+pub(super) fn setup(app: &mut App, plan: Option<MenuPlan>) {
+    let Some(plan) = plan else {
+        return;
+    };
+    app.insert_resource(plan)
+        .init_resource::<Menu>()
+        .add_systems(OnEnter(Stage::Menu), show_menu)
+        .add_systems(OnEnter(Stage::Loading), show_loading)
+        .add_systems(
+            Update,
+            (
+                (move_selection, choose_on_enter)
+                    .chain()
+                    .run_if(in_state(Stage::Menu)),
+                finish_loading.run_if(in_state(Stage::Loading)),
+            )
+                .in_set(FrameSet::Input),
+        );
+}
+
+/// The scenarios on offer, read afresh (an educator may have edited or added one).
+fn entries(plan: &MenuPlan) -> Vec<Entry> {
+    let mut files: Vec<PathBuf> = plan
+        .folder
+        .as_deref()
+        .and_then(|folder| std::fs::read_dir(folder).ok())
+        .into_iter()
+        .flatten()
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| path.to_string_lossy().ends_with(".scenario.ron"))
+        .collect();
+    files.sort();
+    let mut entries: Vec<Entry> = files
+        .into_iter()
+        .map(|file| Entry {
+            scenario: scenario::load(&file).map_err(|e| e.to_string()),
+            file,
+        })
+        .collect();
+    let (built_in, text) = &plan.built_in;
+    if !entries
+        .iter()
+        .any(|e| e.file.file_name() == built_in.file_name())
+    {
+        let scenario = scenario::parse(built_in, text).map_err(|e| e.to_string());
+        entries.insert(
+            0,
+            Entry {
+                file: built_in.clone(),
+                scenario,
+            },
+        );
+    }
+    entries
+}
+
+fn show_menu(
+    mut commands: Commands,
+    plan: Res<MenuPlan>,
+    lesson: Res<Lesson>,
+    mut menu: ResMut<Menu>,
+) {
+    menu.entries = entries(&plan);
+    let current = lesson.file.file_name();
+    menu.selected = menu
+        .entries
+        .iter()
+        .position(|e| e.file.file_name() == current)
+        .unwrap_or(0);
+    let text = spawn_panel(&mut commands, Stage::Menu, menu_text(&menu));
+    commands.entity(text).insert(MenuText);
+}
+
+fn menu_text(menu: &Menu) -> String {
+    let lines: Vec<String> = menu
+        .entries
+        .iter()
+        .enumerate()
+        .map(|(k, entry)| {
+            let mark = if k == menu.selected { ">" } else { " " };
+            let name = file_name(&entry.file);
+            match &entry.scenario {
+                Ok(s) => format!(
+                    "{mark} {}  ({}; {})\n      {name}",
+                    s.title,
+                    s.difficulty.name(),
+                    s.organs.join(", ")
+                ),
+                Err(e) => {
+                    let first = e.lines().next().unwrap_or_default();
+                    format!("{mark} {name}: cannot be run\n      {first}")
+                }
+            }
+        })
+        .collect();
+    let problem = match &menu.problem {
+        Some(problem) => format!("\n\nThe last choice could not be loaded:\n{problem}"),
+        None => String::new(),
+    };
+    format!(
+        "Choose a scenario: Up and Down, then Enter (Esc closes the trainer).\n\n{}{problem}",
+        lines.join("\n")
+    )
+}
+
+fn file_name(file: &Path) -> String {
+    file.file_name().map_or_else(
+        || file.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    )
+}
+
+fn move_selection(
+    keys: Res<ButtonInput<KeyCode>>,
+    mut menu: ResMut<Menu>,
+    mut text: Single<&mut Text, With<MenuText>>,
+) {
+    let count = menu.entries.len().max(1);
+    let step = if keys.just_pressed(KeyCode::ArrowDown) {
+        1
+    } else if keys.just_pressed(KeyCode::ArrowUp) {
+        count - 1
+    } else {
+        return;
+    };
+    menu.selected = (menu.selected + step) % count;
+    text.0 = menu_text(&menu);
+}
+
+/// Enter on a scenario that reads: its scene is loaded on a thread of its own.
+fn choose_on_enter(
+    mut commands: Commands,
+    keys: Res<ButtonInput<KeyCode>>,
+    menu: Res<Menu>,
+    plan: Res<MenuPlan>,
+    lesson: Res<Lesson>,
+    mut next: ResMut<NextState<Stage>>,
+) {
+    if !keys.just_pressed(KeyCode::Enter) {
+        return;
+    }
+    let Some(Entry {
+        file,
+        scenario: Ok(scenario),
+    }) = menu.entries.get(menu.selected)
+    else {
+        return;
+    };
+    // The same scene needs no vademecum read again.
+    let scene = super::reload::same_scene(&lesson.scenario, scenario).then(|| lesson.scene.clone());
+    let (file, scenario, scenes) = (file.clone(), scenario.clone(), plan.scenes.clone());
+    let title = scenario.title.clone();
+    let task = std::thread::Builder::new()
+        .name("scenario loader".into())
+        .spawn(move || prepared(file, scenario, scene, &scenes));
+    match task {
+        Ok(task) => {
+            commands.insert_resource(Loading {
+                title,
+                task: Mutex::new(Some(task)),
+            });
+            next.set(Stage::Loading);
+        }
+        Err(e) => bevy::log::error!("could not start loading the scenario: {e}"),
+    }
+}
+
+/// The lesson of `scenario` on `scene` (built from `scenes` when not given), with its parked
+/// haptic world.
+fn prepared(
+    file: PathBuf,
+    scenario: Scenario,
+    scene: Option<HapticScene>,
+    scenes: &SceneSource,
+) -> Result<Prepared, String> {
+    let scene = match scene {
+        Some(scene) => scene,
+        None => scenes(&scenario)?,
+    };
+    let mut haptic = HapticLoop::parked(&scene).map_err(|e| format!("{}: {e}", file.display()))?;
+    let exercise = Exercise::new(scenario.clone(), sites_on(&scene, &scenario));
+    let link: Arc<ExerciseLink> = prepare(&mut haptic, exercise);
+    let snapshots = haptic.publish();
+    Ok(Prepared {
+        lesson: Lesson {
+            scenario,
+            file,
+            scene,
+            link,
+        },
+        haptic,
+        snapshots,
+    })
+}
+
+fn show_loading(mut commands: Commands, loading: Res<Loading>) {
+    spawn_panel(
+        &mut commands,
+        Stage::Loading,
+        format!(
+            "Loading {}: reading its organs' vademecums (one that is missing is built first; \
+             its progress shows in the terminal).",
+            loading.title
+        ),
+    );
+}
+
+/// When the chosen scene is ready: the haptic thread is handed its world, the window redraws
+/// on it, and the briefing opens; if it failed, back to the menu with the reason.
+#[allow(clippy::too_many_arguments)]
+fn finish_loading(
+    mut commands: Commands,
+    loading: Res<Loading>,
+    plan: Res<MenuPlan>,
+    lessons: Res<Lessons>,
+    mut link: ResMut<HapticLink>,
+    mut snapshot: ResMut<Snapshot>,
+    mut menu: ResMut<Menu>,
+    mut changed: MessageWriter<SceneChanged>,
+    mut next: ResMut<NextState<Stage>>,
+) {
+    let Ok(mut task) = loading.task.lock() else {
+        return;
+    };
+    if !task.as_ref().is_some_and(JoinHandle::is_finished) {
+        return;
+    }
+    let result = task.take().map(|t| {
+        t.join()
+            .unwrap_or_else(|_| Err("the loader panicked".into()))
+    });
+    commands.remove_resource::<Loading>();
+    match result {
+        Some(Ok(prepared)) => {
+            plan.swap.offer(prepared.haptic);
+            link.change_scene(prepared.lesson.scene.clone(), prepared.snapshots);
+            *snapshot = Snapshot::default();
+            lessons.add(&prepared.lesson);
+            commands.insert_resource(prepared.lesson);
+            menu.problem = None;
+            changed.write(SceneChanged);
+            next.set(Stage::Briefing);
+        }
+        Some(Err(problem)) => {
+            menu.problem = Some(problem);
+            next.set(Stage::Menu);
+        }
+        None => next.set(Stage::Menu),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::time::{Duration, Instant};
+
+    use bevy::state::app::StatesPlugin;
+
+    use super::super::lesson::{self, Opening};
+    use super::super::scene_without_organs;
+    use super::*;
+
+    fn scenario_text(title: &str, organ: &str) -> String {
+        format!(
+            r#"Scenario(title: "{title}", briefing: "Brief of {title}.", organs: ["{organ}"],
+                tasks: [ForceControl(organ: "{organ}", min_force_n: 0.1, max_force_n: 0.3,
+                                     hold_s: 1.0, time_limit_s: 5.0)])"#
+        )
+    }
+
+    struct Fixture {
+        app: App,
+        folder: PathBuf,
+        /// How many scenes the menu has had built.
+        built: Arc<AtomicUsize>,
+        swap: SceneSwap,
+        lessons: Lessons,
+    }
+
+    /// A headless window on the first of three scenarios in a folder (the third broken),
+    /// opening on the menu; scenes are built without organs.
+    fn fixture() -> Fixture {
+        let folder = std::env::temp_dir().join(format!("pgd-menu-{}", std::process::id()));
+        std::fs::create_dir_all(&folder).unwrap();
+        let write = |name: &str, text: &str| std::fs::write(folder.join(name), text).unwrap();
+        write("a.scenario.ron", &scenario_text("Liver press", "liver"));
+        write(
+            "b.scenario.ron",
+            &scenario_text("Pancreas press", "pancreas"),
+        );
+        write("c.scenario.ron", "Scenario(title: 3)");
+        let file = folder.join("a.scenario.ron");
+        let scene = scene_without_organs();
+        let lesson = Lesson {
+            scenario: scenario::load(&file).unwrap(),
+            file,
+            scene: scene.clone(),
+            link: Arc::new(ExerciseLink::default()),
+        };
+        let built = Arc::new(AtomicUsize::new(0));
+        let counter = built.clone();
+        let swap = SceneSwap::default();
+        let plan = MenuPlan {
+            folder: Some(folder.clone()),
+            built_in: (PathBuf::from("scenarios/built-in.scenario.ron"), "unused"),
+            scenes: Arc::new(move |_: &Scenario| {
+                counter.fetch_add(1, Ordering::SeqCst);
+                Ok(scene_without_organs())
+            }),
+            swap: swap.clone(),
+        };
+        let lessons = Lessons::default();
+        let mut app = App::new();
+        let snapshots = HapticLoop::parked(&scene).unwrap().publish();
+        app.add_plugins((MinimalPlugins, StatesPlugin))
+            .init_resource::<ButtonInput<KeyCode>>()
+            .init_resource::<Snapshot>()
+            .insert_resource(HapticLink::headless(scene, snapshots))
+            .add_message::<AppExit>()
+            .add_message::<SceneChanged>();
+        lesson::setup(&mut app, Some((lesson, Opening::Menu)), lessons.clone());
+        setup(&mut app, Some(plan));
+        Fixture {
+            app,
+            folder,
+            built,
+            swap,
+            lessons,
+        }
+    }
+
+    fn stage(app: &App) -> Stage {
+        *app.world().resource::<State<Stage>>().get()
+    }
+
+    fn texts(app: &mut App) -> String {
+        let mut texts = app.world_mut().query::<&Text>();
+        let all: Vec<String> = texts.iter(app.world()).map(|t| t.0.clone()).collect();
+        all.join("\n")
+    }
+
+    fn tap(app: &mut App, key: KeyCode) {
+        app.world_mut()
+            .resource_mut::<ButtonInput<KeyCode>>()
+            .press(key);
+        app.update();
+        let mut keys = app.world_mut().resource_mut::<ButtonInput<KeyCode>>();
+        keys.release_all();
+        keys.clear();
+        app.update();
+    }
+
+    /// Updates until the chosen scenario's briefing opens (the loader is a thread), at most 20 s.
+    fn until_briefing(app: &mut App) {
+        let start = Instant::now();
+        while stage(app) != Stage::Briefing {
+            assert!(start.elapsed() < Duration::from_secs(20), "never loaded");
+            std::thread::sleep(Duration::from_millis(5));
+            app.update();
+        }
+        app.update();
+    }
+
+    /// The menu lists the folder's scenarios (a broken one with its error, not choosable);
+    /// choosing another builds its scene, hands the haptic thread its world and opens its
+    /// briefing; back on the menu, choosing the same scene again builds nothing.
+    #[test]
+    fn the_menu_changes_the_scenario_and_its_scene() {
+        let Fixture {
+            mut app,
+            folder,
+            built,
+            swap,
+            lessons,
+        } = fixture();
+        app.update();
+        app.update();
+        assert_eq!(stage(&app), Stage::Menu);
+        let menu = texts(&mut app);
+        assert!(menu.contains("> Liver press"), "{menu}");
+        assert!(menu.contains("  Pancreas press"), "{menu}");
+        assert!(menu.contains("c.scenario.ron: cannot be run"), "{menu}");
+        assert!(
+            menu.contains("built-in.scenario.ron"),
+            "the built-in scenario is offered when the folder lacks it: {menu}"
+        );
+
+        tap(&mut app, KeyCode::ArrowDown);
+        assert!(texts(&mut app).contains("> Pancreas press"));
+        tap(&mut app, KeyCode::Enter);
+        until_briefing(&mut app);
+        assert!(texts(&mut app).contains("Brief of Pancreas press."));
+        assert_eq!(built.load(Ordering::SeqCst), 1);
+        assert!(
+            swap.pending(),
+            "the haptic thread was not offered the new world"
+        );
+        let lesson = app.world().resource::<Lesson>();
+        assert_eq!(lesson.scenario.organs, ["pancreas"]);
+        assert_eq!(lessons.take().len(), 2);
+
+        tap(&mut app, KeyCode::KeyM);
+        assert_eq!(stage(&app), Stage::Menu);
+        assert!(texts(&mut app).contains("> Pancreas press"));
+        tap(&mut app, KeyCode::ArrowDown);
+        tap(&mut app, KeyCode::Enter);
+        assert_eq!(stage(&app), Stage::Menu, "a broken scenario was chosen");
+        tap(&mut app, KeyCode::ArrowUp);
+        tap(&mut app, KeyCode::Enter);
+        until_briefing(&mut app);
+        assert!(texts(&mut app).contains("Brief of Pancreas press."));
+        assert_eq!(
+            built.load(Ordering::SeqCst),
+            1,
+            "the same scene was built again"
+        );
+        std::fs::remove_dir_all(&folder).unwrap();
+    }
+}
