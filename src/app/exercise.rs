@@ -8,12 +8,13 @@ use nalgebra::Vector3;
 
 use super::haptic::{ExerciseLink, ExerciseRun, HapticLoop, HapticScene, TickClock};
 use super::scene::{Detail, SceneOrgan, scene_of};
-use crate::cli::OnStale;
+use crate::cli::{OnStale, OrganSource};
 use crate::contact::ContactSurface;
 use crate::haptics::{HapticDevice, TICK_S};
 use crate::mesh::organs::Organ;
 use crate::scenario::{
-    self, Exercise, Nodule, NoduleSite, RegionSite, Scenario, Scorecard, Sites, Task, score,
+    self, Exercise, Nodule, NoduleSite, OrganEntry, RegionSite, Scenario, Scorecard, Sites, Task,
+    score,
 };
 
 /// The scene a scenario asks for, its vademecums from `dir`.
@@ -26,32 +27,37 @@ pub fn scenario_scene(
     let organs: Vec<SceneOrgan> = scenario
         .organs
         .iter()
-        .map(|name| {
-            let organ =
-                Organ::from_name(name).ok_or_else(|| format!("there is no organ `{name}`"))?;
-            let inclusions = scenario
-                .nodules
-                .iter()
-                .filter(|nodule| &nodule.organ == name)
-                .map(Nodule::inclusion)
-                .collect();
-            let young_pa = scenario
-                .tissues
-                .iter()
-                .find(|tissue| &tissue.organ == name)
-                .map(|tissue| tissue.young_pa.0);
-            Ok(SceneOrgan {
-                organ,
-                young_pa,
-                inclusions,
-            })
-        })
+        .map(|entry| scene_organ(scenario, entry))
         .collect::<Result<_, String>>()?;
     let tip = scenario.tool.tip_radius_m();
     let mut scene = scene_of(&organs, Some(tip), dir, detail, on_stale)?;
     scene.safety.max_force_n = scenario.device.max_force_n.0;
     scene.workspace.scale = scenario.device.workspace_scale.0;
     Ok(scene)
+}
+
+/// The scene's organ a scenario's entry describes, with its nodules in its tissue.
+fn scene_organ(scenario: &Scenario, entry: &OrganEntry) -> Result<SceneOrgan, String> {
+    let name = &entry.name;
+    let source = match &entry.mesh {
+        Some(path) => OrganSource::File(path.clone()),
+        None => OrganSource::Generated(
+            Organ::from_name(name).ok_or_else(|| format!("there is no organ `{name}`"))?,
+        ),
+    };
+    Ok(SceneOrgan {
+        name: name.clone(),
+        source,
+        young_pa: entry.young_pa.map(|e| e.0),
+        poisson: entry.poisson_ratio.map(|nu| nu.0),
+        max_modes: entry.max_modes.map(|n| n.0),
+        inclusions: scenario
+            .nodules
+            .iter()
+            .filter(|nodule| &nodule.organ == name)
+            .map(Nodule::inclusion)
+            .collect(),
+    })
 }
 
 /// What a session of a scenario leaves: the scorecard and the force against time (100 Hz).

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use nalgebra::Vector3;
 
 use super::haptic::HapticScene;
-use crate::cli::{OnStale, VademecumSpec, ensure_vademecum};
+use crate::cli::{OnStale, OrganSource, VademecumSpec, ensure_vademecum};
 use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, Probe};
 use crate::fem::{Inclusion, Law};
 use crate::haptics::{PressTarget, SafetySettings, Workspace};
@@ -40,7 +40,12 @@ impl Detail {
 
     /// The vademecum of `organ` at this detail, kept under `dir`.
     pub fn vademecum(self, dir: &Path, organ: Organ) -> VademecumSpec {
-        let full = VademecumSpec::default_in(dir, organ, Law::Linear);
+        self.applied(VademecumSpec::default_in(dir, organ, Law::Linear))
+    }
+
+    /// `full`, the vademecum at full detail, at this detail (a generated organ's mesh
+    /// coarsened; the coarse tool and near field for any).
+    fn applied(self, full: VademecumSpec) -> VademecumSpec {
         match self {
             Detail::Full => full,
             Detail::Coarse => VademecumSpec {
@@ -53,7 +58,7 @@ impl Detail {
                     local_radius_m: 0.025,
                     ..full.build
                 },
-                file: dir.join(format!("{}.coarse.vdm", organ.name())),
+                file: full.file.with_extension("coarse.vdm"),
                 ..full
             },
         }
@@ -67,22 +72,73 @@ pub fn default_scene(dir: &Path, detail: Detail, on_stale: OnStale) -> Result<Ha
     scene_of(&organs, None, dir, detail, on_stale)
 }
 
-/// An organ of a scene, with any stiffer or softer regions in its tissue.
+/// An organ of a scene: its mesh, its tissue (with any stiffer or softer regions in it) and
+/// its vademecum's settings where not the defaults.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SceneOrgan {
-    pub organ: Organ,
+    pub name: String,
+    pub source: OrganSource,
     /// Young's modulus (Pa) of its tissue when not the organ's own.
     pub young_pa: Option<f64>,
+    /// Poisson's ratio of its tissue when not the organs' own.
+    pub poisson: Option<f64>,
+    /// The vademecum's cap on modes when not the builder's.
+    pub max_modes: Option<usize>,
     pub inclusions: Vec<Inclusion>,
 }
 
 impl From<Organ> for SceneOrgan {
     fn from(organ: Organ) -> Self {
         Self {
-            organ,
+            name: organ.name().to_owned(),
+            source: OrganSource::Generated(organ),
             young_pa: None,
+            poisson: None,
+            max_modes: None,
             inclusions: Vec::new(),
         }
+    }
+}
+
+impl SceneOrgan {
+    /// Its vademecum at `detail` for a tool tip of `tip_m`, kept under `dir` in a file named
+    /// after what differs from the defaults.
+    fn vademecum(&self, dir: &Path, detail: Detail, tip_m: f64) -> VademecumSpec {
+        let (base, file) = match &self.source {
+            OrganSource::Generated(organ) => (*organ, format!("{}.vdm", self.name)),
+            OrganSource::File(path) => {
+                let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+                (Organ::Liver, format!("{}.mesh-{stem}.vdm", self.name))
+            }
+        };
+        let mut spec = detail.applied(VademecumSpec {
+            name: self.name.clone(),
+            source: self.source.clone(),
+            file: dir.join(file),
+            ..VademecumSpec::default_in(dir, base, Law::Linear)
+        });
+        let mut tag = |part: String| spec.file = spec.file.with_extension(format!("{part}.vdm"));
+        if tip_m != spec.build.tool_tip_radius_m {
+            tag(format!("tip{}mm", tip_m * 1e3));
+        }
+        if let Some(young_pa) = self.young_pa {
+            tag(format!("young-{young_pa}pa"));
+        }
+        if let Some(poisson) = self.poisson {
+            tag(format!("poisson-{poisson}"));
+        }
+        if let Some(max_modes) = self.max_modes {
+            tag(format!("modes-{max_modes}"));
+        }
+        if !self.inclusions.is_empty() {
+            tag(format!("inclusions-{}", inclusions_tag(&self.inclusions)));
+        }
+        spec.build.tool_tip_radius_m = tip_m;
+        spec.young_pa = self.young_pa;
+        spec.poisson = self.poisson;
+        spec.build.pgd.max_modes = self.max_modes.unwrap_or(spec.build.pgd.max_modes);
+        spec.inclusions = self.inclusions.clone();
+        spec
     }
 }
 
@@ -99,37 +155,21 @@ pub fn scene_of(
         (Detail::Full, Some(tip)) => tip,
         _ => detail.tip_radius_m(),
     };
-    let spec = |organ: &SceneOrgan| {
-        let mut spec = detail.vademecum(dir, organ.organ);
-        if tip != spec.build.tool_tip_radius_m {
-            spec.build.tool_tip_radius_m = tip;
-            spec.file = dir.join(format!("{}.tip{}mm.vdm", organ.organ.name(), tip * 1e3));
-        }
-        if let Some(young_pa) = organ.young_pa {
-            spec.young_pa = Some(young_pa);
-            spec.file = spec.file.with_extension(format!("young-{young_pa}pa.vdm"));
-        }
-        if !organ.inclusions.is_empty() {
-            spec.inclusions = organ.inclusions.clone();
-            let tag = format!("inclusions-{}.vdm", inclusions_tag(&organ.inclusions));
-            spec.file = spec.file.with_extension(tag);
-        }
-        spec
-    };
     let loaded = organs
         .iter()
         .map(|organ| {
-            let (vademecum, mesh) = ensure_vademecum(&spec(organ), on_stale)?;
-            Ok((organ.organ, Arc::new(vademecum), mesh))
+            let spec = organ.vademecum(dir, detail, tip);
+            let (vademecum, mesh) = ensure_vademecum(&spec, on_stale)?;
+            Ok((organ.name.clone(), Arc::new(vademecum), mesh))
         })
         .collect::<Result<Vec<_>, String>>()?;
     let attachments: Vec<AttachmentSpec> = loaded
         .iter()
-        .flat_map(|(organ, vademecum, mesh)| attachments_of(*organ, vademecum, mesh))
+        .flat_map(|(name, vademecum, mesh)| attachments_of(name, vademecum, mesh))
         .collect();
     let organs: Vec<(String, Arc<Vademecum>)> = loaded
         .into_iter()
-        .map(|(organ, vademecum, _)| (organ.name().to_owned(), vademecum))
+        .map(|(name, vademecum, _)| (name, vademecum))
         .collect();
     let coupling = Coupling::new(&organs, &attachments, &CouplingSettings::default())
         .map_err(|e| e.to_string())?;
@@ -151,7 +191,7 @@ fn inclusions_tag(inclusions: &[Inclusion]) -> String {
 /// The attachments `organ` carries: each `attached_<other>` node set of its mesh, as the free
 /// load positions it covers (an organ clamped at its attachment hangs from it and carries
 /// nothing there).
-fn attachments_of(organ: Organ, vademecum: &Vademecum, mesh: &TetMesh) -> Vec<AttachmentSpec> {
+fn attachments_of(organ: &str, vademecum: &Vademecum, mesh: &TetMesh) -> Vec<AttachmentSpec> {
     let sets = &mesh.regions().node_sets;
     let clamped: BTreeSet<usize> = sets
         .get(region::CLAMPED)
@@ -171,7 +211,7 @@ fn attachments_of(organ: Organ, vademecum: &Vademecum, mesh: &TetMesh) -> Vec<At
                 .filter(|&m| nodes.contains(&(vademecum.positions[m] as usize)))
                 .collect();
             Some(AttachmentSpec {
-                carrier: organ.name().to_owned(),
+                carrier: organ.to_owned(),
                 carried: carried.to_owned(),
                 interface,
             })

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use crate::fem::{Inclusion, Law, Material};
 use crate::mesh::TetMesh;
+use crate::mesh::io::{ImportOptions, load};
 use crate::mesh::organs::{self, Organ, OrganSettings, region};
 use crate::pgd::{self, BuildSettings, OrganModel, Vademecum, VademecumError};
 
@@ -20,15 +21,40 @@ pub enum OnStale {
     Refuse,
 }
 
-/// What the trainer wants of one organ's vademecum: the generated organ at a mesh
-/// resolution, its material under a law, built with these settings, kept in `file`.
+/// Where an organ's mesh comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum OrganSource {
+    /// Generated (at the spec's mesh settings).
+    Generated(Organ),
+    /// Read from a tetrahedral mesh file with `clamped` and `accessible` node sets; its tissue
+    /// is the liver's unless given.
+    File(PathBuf),
+}
+
+impl OrganSource {
+    /// The generated organ whose material is the default.
+    fn material_of(&self) -> Organ {
+        match self {
+            OrganSource::Generated(organ) => *organ,
+            OrganSource::File(_) => Organ::Liver,
+        }
+    }
+}
+
+/// What the trainer wants of one organ's vademecum: the organ's mesh (generated at a
+/// resolution, or from a file), its material under a law, built with these settings, kept in
+/// `file`.
 #[derive(Clone, Debug)]
 pub struct VademecumSpec {
-    pub organ: Organ,
+    /// What the organ is called in messages.
+    pub name: String,
+    pub source: OrganSource,
     pub law: Law,
     pub mesh: OrganSettings,
     /// The tissue's Young's modulus (Pa) when not the organ's own.
     pub young_pa: Option<f64>,
+    /// The tissue's Poisson's ratio when not the organs' own.
+    pub poisson: Option<f64>,
     /// Stiffer or softer regions in the organ's tissue (none by default).
     pub inclusions: Vec<Inclusion>,
     pub build: BuildSettings,
@@ -39,10 +65,12 @@ impl VademecumSpec {
     /// The organ's default vademecum (the papers' mesh, default settings) under `dir`.
     pub fn default_in(dir: &Path, organ: Organ, law: Law) -> Self {
         Self {
-            organ,
+            name: organ.name().to_owned(),
+            source: OrganSource::Generated(organ),
             law,
             mesh: OrganSettings::default(),
             young_pa: None,
+            poisson: None,
             inclusions: Vec::new(),
             build: BuildSettings::default(),
             file: dir.join(format!("{}.vdm", organ.name())),
@@ -55,10 +83,11 @@ impl VademecumSpec {
             Law::Linear => "linear",
             Law::KirchhoffSaintVenant => "ksv",
         };
-        let mut command = format!(
-            "cargo run --release --bin pgd -- build {} --law {law}",
-            self.organ.name()
-        );
+        let source = match &self.source {
+            OrganSource::Generated(organ) => organ.name().to_owned(),
+            OrganSource::File(path) => path.display().to_string(),
+        };
+        let mut command = format!("cargo run --release --bin pgd -- build {source} --law {law}");
         let (mesh, build) = (OrganSettings::default(), BuildSettings::default());
         if self.mesh.resolution != mesh.resolution {
             command += &format!(" --resolution {}", self.mesh.resolution);
@@ -72,8 +101,14 @@ impl VademecumSpec {
         if self.build.local_radius_m != build.local_radius_m {
             command += &format!(" --local-radius-mm {}", self.build.local_radius_m * 1e3);
         }
+        if self.build.pgd.max_modes != build.pgd.max_modes {
+            command += &format!(" --max-modes {}", self.build.pgd.max_modes);
+        }
         if let Some(young_pa) = self.young_pa {
             command += &format!(" --young-pa {young_pa}");
+        }
+        if let Some(poisson) = self.poisson {
+            command += &format!(" --poisson {poisson}");
         }
         for inclusion in &self.inclusions {
             command += &format!(" --inclusion {}", inclusion_arg(inclusion));
@@ -89,12 +124,18 @@ pub fn ensure_vademecum(
     spec: &VademecumSpec,
     on_stale: OnStale,
 ) -> Result<(Vademecum, TetMesh), String> {
-    let organ = spec.organ;
-    let mesh = organs::generate(organ, &spec.mesh).map_err(|e| format!("{}: {e}", organ.name()))?;
-    let mut material = pgd::organ::material(organ, spec.law);
-    if let Some(young_pa) = spec.young_pa {
-        material.young_pa = young_pa;
-    }
+    let name = &spec.name;
+    let mesh = match &spec.source {
+        OrganSource::Generated(organ) => {
+            organs::generate(*organ, &spec.mesh).map_err(|e| format!("{name}: {e}"))?
+        }
+        OrganSource::File(path) => {
+            load(path, &ImportOptions::default()).map_err(|e| format!("{name}: {e}"))?
+        }
+    };
+    let mut material = pgd::organ::material(spec.source.material_of(), spec.law);
+    material.young_pa = spec.young_pa.unwrap_or(material.young_pa);
+    material.poisson = spec.poisson.unwrap_or(material.poisson);
     let why = match checked(spec, &mesh, &material) {
         Ok(vademecum) => return Ok((vademecum, mesh)),
         Err(why) => why,
@@ -106,15 +147,15 @@ pub fn ensure_vademecum(
     eprintln!("{why}\nbuilding it now (the same as `{command}`):");
     let model = pgd::organ::clamped_model(mesh.clone(), material)
         .and_then(|model| model.with_inclusions(&spec.inclusions))
-        .map_err(|e| format!("{}: {e}", organ.name()))?;
+        .map_err(|e| format!("{name}: {e}"))?;
     let organ_model = OrganModel {
-        source: organ.name().into(),
+        source: name.clone(),
         model: &model,
         clamped_region: region::CLAMPED.into(),
         accessible_region: region::ACCESSIBLE.into(),
     };
     let (vademecum, _) = pgd::build(&organ_model, &spec.build, &Bar::default())
-        .map_err(|e| format!("{}: {e}", organ.name()))?;
+        .map_err(|e| format!("{name}: {e}"))?;
     let file = &spec.file;
     pgd::save(file, &vademecum).map_err(|e| e.to_string())?;
     let [csv, png] = super::write_of_header(file, &vademecum.header)?;

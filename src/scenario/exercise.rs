@@ -6,7 +6,7 @@ use std::mem::take;
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use super::format::{Scenario, Spot, Task, TaskKind, spot_name};
+use super::format::{OrganEntry, Scenario, Spot, Task, TaskKind, spot_name};
 use crate::pgd::SurfacePoint;
 
 /// What the haptic loop knows of one tick, for scoring.
@@ -292,7 +292,7 @@ impl Exercise {
 
 impl Running {
     /// The task starting at `time_s`, told to the trainee as `description`.
-    fn start(task: &Task, description: String, organs: &[String], time_s: f64) -> Self {
+    fn start(task: &Task, description: String, organs: &[OrganEntry], time_s: f64) -> Self {
         let (force_limit_n, targets, band_min_n) = match task {
             Task::ForceControl {
                 min_force_n,
@@ -343,7 +343,7 @@ impl Running {
             force_sum: 0.0,
             organ: match task {
                 Task::ForceControl { organ, .. } | Task::Palpation { organ, .. } => {
-                    organs.iter().position(|o| o == organ)
+                    organs.iter().position(|o| &o.name == organ)
                 }
                 // Retraction watches its organ through its region site.
                 Task::SafeNavigation { .. } | Task::Retraction { .. } => None,

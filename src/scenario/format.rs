@@ -3,9 +3,12 @@
 //! refused (a misspelt field would otherwise be silently ignored). `docs/scenarios.md` is the
 //! reference page for this file.
 
-use serde::Deserialize;
+use std::path::PathBuf;
 
-use super::units::{Millimetres, Newtons, Pascals, Ratio, Scale, Seconds};
+use serde::de::{self, MapAccess, Visitor};
+use serde::{Deserialize, Deserializer};
+
+use super::units::{Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, Seconds};
 
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -15,16 +18,14 @@ pub struct Scenario {
     pub briefing: String,
     #[serde(default)]
     pub difficulty: Difficulty,
-    /// The organs in the scene, by name: liver, gallbladder, pancreas, duodenum.
-    pub organs: Vec<String>,
+    /// The organs in the scene: a generated one by name (liver, gallbladder, pancreas,
+    /// duodenum), or `Organ(…)` for a mesh file or a tissue or vademecum of its own.
+    #[serde(deserialize_with = "organ_list")]
+    pub organs: Vec<OrganEntry>,
     #[serde(default)]
     pub tool: Tool,
     #[serde(default)]
     pub device: Device,
-    /// Organs whose tissue is stiffer or softer than the organ's own (a fibrotic liver). The
-    /// organ's vademecum is built for it (the first run of the scenario builds it).
-    #[serde(default)]
-    pub tissues: Vec<Tissue>,
     /// Stiffer lumps hidden in the organs' tissue, such as tumours, for palpation. The
     /// organ's vademecum is built with them (the first run of the scenario builds it).
     #[serde(default)]
@@ -133,12 +134,74 @@ impl Spot {
     }
 }
 
-/// An organ's tissue, when not its own default.
+/// An organ of the scene, written `Organ(name: …, …)`, or its name alone for a generated organ
+/// with its own tissue. Its vademecum is built for what is given here (the first run of the
+/// scenario builds it).
 #[derive(Clone, Debug, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Tissue {
-    pub organ: String,
-    pub young_pa: Pascals,
+#[serde(rename = "Organ", deny_unknown_fields)]
+pub struct OrganEntry {
+    /// What tasks and nodules call it; a generated organ's name unless `mesh` is given.
+    pub name: String,
+    /// A tetrahedral mesh file (.msh, .vtk, .vtu, in metres) with node sets `clamped` (held
+    /// fixed) and `accessible` (where the tool may touch), written relative to the scenario's
+    /// folder (read as such: the path here is resolved).
+    #[serde(default)]
+    pub mesh: Option<PathBuf>,
+    /// Its tissue's Young's modulus, when not the organ's own (for a mesh file: the liver's).
+    #[serde(default)]
+    pub young_pa: Option<Pascals>,
+    /// Its tissue's Poisson's ratio, when not the organs' 0.48.
+    #[serde(default)]
+    pub poisson_ratio: Option<PoissonRatio>,
+    /// At most this many separated modes in its vademecum, when not the builder's default.
+    #[serde(default)]
+    pub max_modes: Option<ModeCount>,
+}
+
+impl OrganEntry {
+    /// A generated organ with its own tissue and default vademecum.
+    pub fn named(name: &str) -> Self {
+        Self {
+            name: name.to_owned(),
+            mesh: None,
+            young_pa: None,
+            poisson_ratio: None,
+            max_modes: None,
+        }
+    }
+}
+
+/// The `organs` list: each entry a name or an `Organ(…)`.
+fn organ_list<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<OrganEntry>, D::Error> {
+    Vec::<OrganItem>::deserialize(deserializer)
+        .map(|items| items.into_iter().map(|i| i.0).collect())
+}
+
+/// One entry of `organs`, as a name or in full.
+struct OrganItem(OrganEntry);
+
+impl<'de> Deserialize<'de> for OrganItem {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_any(OrganVisitor).map(OrganItem)
+    }
+}
+
+struct OrganVisitor;
+
+impl<'de> Visitor<'de> for OrganVisitor {
+    type Value = OrganEntry;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("an organ's name such as \"liver\", or Organ(name: …, mesh: …)")
+    }
+
+    fn visit_str<E: de::Error>(self, name: &str) -> Result<OrganEntry, E> {
+        Ok(OrganEntry::named(name))
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<OrganEntry, A::Error> {
+        OrganEntry::deserialize(de::value::MapAccessDeserializer::new(map))
+    }
 }
 
 /// A sphere of stiffer tissue inside an organ.
@@ -151,6 +214,19 @@ pub struct Nodule {
     pub radius_mm: Millimetres,
     /// Its Young's modulus over the organ's (tumours are several times stiffer).
     pub stiffness_ratio: Ratio,
+}
+
+impl Scenario {
+    /// The organ called `name`, if the scene has it.
+    pub fn organ(&self, name: &str) -> Option<&OrganEntry> {
+        self.organs.iter().find(|o| o.name == name)
+    }
+
+    /// The scene's organs' names, as a list to read.
+    pub fn organ_names(&self) -> String {
+        let names: Vec<&str> = self.organs.iter().map(|o| o.name.as_str()).collect();
+        names.join(", ")
+    }
 }
 
 impl Nodule {

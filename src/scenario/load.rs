@@ -7,8 +7,8 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use super::format::{Scenario, Task};
-use crate::mesh::organs::Organ;
+use super::format::{OrganEntry, Scenario, Task};
+use crate::mesh::organs::{Organ, region};
 
 /// Where every reference of the scenario format is explained.
 const REFERENCE: &str = "docs/scenarios.md";
@@ -70,8 +70,12 @@ pub fn parse(file: &Path, text: &str) -> Result<Scenario, ScenarioError> {
             hint,
         }
     };
-    let mut de = ron::Deserializer::from_str(text).map_err(|e| syntax(e, String::new()))?;
-    let scenario: Scenario = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+    // Optional fields are written as their value, without `Some(…)`.
+    let options =
+        ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+    let mut de = ron::Deserializer::from_str_with_options(text, &options)
+        .map_err(|e| syntax(e, String::new()))?;
+    let mut scenario: Scenario = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         // serde_path_to_error writes `?` for a step it cannot name and `.` for the root.
         let field = e.path().to_string().replace('?', "");
         let field = field.trim_matches('.').to_owned();
@@ -79,6 +83,11 @@ pub fn parse(file: &Path, text: &str) -> Result<Scenario, ScenarioError> {
     })?;
     de.end()
         .map_err(|e| syntax(de.span_error(e), String::new()))?;
+    // Mesh files are written relative to the scenario's folder.
+    let folder = file.parent().unwrap_or(Path::new(""));
+    for mesh in scenario.organs.iter_mut().filter_map(|o| o.mesh.as_mut()) {
+        *mesh = folder.join(&*mesh);
+    }
     let problems = check(&scenario);
     match problems.into_iter().next() {
         None => Ok(scenario),
@@ -136,29 +145,21 @@ impl Problem {
 /// What is wrong with a scenario as a whole, in file order.
 fn check(scenario: &Scenario) -> Vec<Problem> {
     let mut problems = Vec::new();
-    let known: Vec<&str> = Organ::ABDOMEN.iter().map(|o| o.name()).collect();
     if scenario.organs.is_empty() {
         problems.push(Problem {
             field: "organs".into(),
             anchors: vec!["organs".into()],
             message: "the scene has no organs".into(),
-            hint: format!("name at least one of: {}", known.join(", ")),
+            hint: format!("name at least one of: {}", generated_organs()),
         });
     }
     for (k, organ) in scenario.organs.iter().enumerate() {
-        let anchors = vec!["organs".into(), format!("\"{organ}\"")];
-        if !known.contains(&organ.as_str()) {
+        problems.extend(check_organ(k, organ));
+        if scenario.organs[..k].iter().any(|o| o.name == organ.name) {
             problems.push(Problem {
                 field: format!("organs[{k}]"),
-                anchors,
-                message: format!("there is no organ `{organ}`"),
-                hint: format!("the organs are: {}", known.join(", ")),
-            });
-        } else if scenario.organs[..k].contains(organ) {
-            problems.push(Problem {
-                field: format!("organs[{k}]"),
-                anchors,
-                message: format!("`{organ}` is named twice"),
+                anchors: vec!["organs".into(), format!("\"{}\"", organ.name)],
+                message: format!("`{}` is named twice", organ.name),
                 hint: "name each organ once".into(),
             });
         }
@@ -166,26 +167,6 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
     for (k, nodule) in scenario.nodules.iter().enumerate() {
         let field = format!("nodules[{k}].organ");
         problems.extend(not_in_scene(scenario, &nodule.organ, field, "nodules"));
-    }
-    for (k, tissue) in scenario.tissues.iter().enumerate() {
-        let field = format!("tissues[{k}].organ");
-        problems.extend(not_in_scene(
-            scenario,
-            &tissue.organ,
-            field.clone(),
-            "tissues",
-        ));
-        if scenario.tissues[..k]
-            .iter()
-            .any(|t| t.organ == tissue.organ)
-        {
-            problems.push(Problem {
-                field,
-                anchors: vec!["tissues".into(), format!("\"{}\"", tissue.organ)],
-                message: format!("the {} is given a tissue twice", tissue.organ),
-                hint: "give each organ one Tissue(…)".into(),
-            });
-        }
     }
     if scenario.tasks.is_empty() {
         problems.push(Problem {
@@ -286,6 +267,57 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
     }
 }
 
+fn generated_organs() -> String {
+    let names: Vec<&str> = Organ::ABDOMEN.iter().map(|o| o.name()).collect();
+    names.join(", ")
+}
+
+/// A problem with the scene's `k`th organ: a generated one that does not exist, or a mesh file
+/// that does not read or lacks the regions a vademecum needs.
+fn check_organ(k: usize, organ: &OrganEntry) -> Option<Problem> {
+    let name = &organ.name;
+    let Some(mesh) = &organ.mesh else {
+        return Organ::from_name(name).is_none().then(|| Problem {
+            field: format!("organs[{k}]"),
+            anchors: vec!["organs".into(), format!("\"{name}\"")],
+            message: format!("there is no organ `{name}`"),
+            hint: format!(
+                "the generated organs are: {}; an organ of your own needs its mesh: Organ(name: \"{name}\", mesh: \"{name}.vtu\")",
+                generated_organs()
+            ),
+        });
+    };
+    let problem = |message: String, hint: &str| Problem {
+        field: format!("organs[{k}].mesh"),
+        anchors: vec!["organs".into(), format!("\"{name}\""), "mesh".into()],
+        message,
+        hint: hint.into(),
+    };
+    let regions_hint = "name the fixed nodes `clamped` and the surface the tool may touch `accessible` (Gmsh physical groups, VTK point data); `pgd mesh FILE` lists a mesh's regions";
+    match crate::mesh::io::load(mesh, &Default::default()) {
+        Err(e) => Some(problem(
+            e.to_string(),
+            "a tetrahedral mesh in metres (.msh, .vtk or .vtu), its path relative to the scenario's folder",
+        )),
+        Ok(tets) => {
+            let missing = if tets.node_set(region::CLAMPED).is_err() {
+                Some(format!(
+                    "no `{}` node set (the nodes held fixed)",
+                    region::CLAMPED
+                ))
+            } else if tets.face_set(region::ACCESSIBLE).is_err() {
+                Some(format!(
+                    "no `{}` surface (where the tool may touch)",
+                    region::ACCESSIBLE
+                ))
+            } else {
+                None
+            };
+            missing.map(|what| problem(format!("{} has {what}", mesh.display()), regions_hint))
+        }
+    }
+}
+
 /// A problem if holding for `hold_s` (at `field`) cannot fit in the task's time limit.
 fn hold_fits(hold_s: f64, time_limit_s: f64, field: String) -> Option<Problem> {
     (hold_s >= time_limit_s).then(|| Problem {
@@ -298,11 +330,11 @@ fn hold_fits(hold_s: f64, time_limit_s: f64, field: String) -> Option<Problem> {
 
 /// A problem if `organ`, named at `field` in the `section` of the file, is not in the scene.
 fn not_in_scene(scenario: &Scenario, organ: &str, field: String, section: &str) -> Option<Problem> {
-    (!scenario.organs.iter().any(|o| o == organ)).then(|| Problem {
+    scenario.organ(organ).is_none().then(|| Problem {
         field,
         anchors: vec![section.into(), format!("\"{organ}\"")],
         message: format!("`{organ}` is not in this scenario's organs"),
-        hint: format!("the scene has: {}", scenario.organs.join(", ")),
+        hint: format!("the scene has: {}", scenario.organ_names()),
     })
 }
 

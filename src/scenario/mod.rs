@@ -11,8 +11,8 @@ mod units;
 
 pub use exercise::{Exercise, NoduleSite, Progress, RegionSite, Sample, Sites, TaskMetrics};
 pub use format::{
-    Device, Difficulty, Nodule, Rubric, Scenario, Spot, Task, TaskKind, Tissue, Tool, metres,
+    Device, Difficulty, Nodule, OrganEntry, Rubric, Scenario, Spot, Task, TaskKind, Tool, metres,
 };
 pub use load::{ScenarioError, load, parse};
 pub use score::{Scorecard, TaskScore, score};
-pub use units::{Millimetres, Newtons, Pascals, Ratio, Scale, Seconds};
+pub use units::{Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, Seconds};

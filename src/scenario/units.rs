@@ -123,3 +123,38 @@ impl TryFrom<f64> for Ratio {
         }
     }
 }
+
+/// A Poisson's ratio of soft tissue: from 0 to 0.499 (incompressible at 0.5, which linear
+/// elements lock on).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct PoissonRatio(pub f64);
+
+impl TryFrom<f64> for PoissonRatio {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (0.0..=0.499).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v} is not a Poisson's ratio of soft tissue: from 0 to 0.499 (organs are about 0.45 to 0.49)"
+            )),
+        }
+    }
+}
+
+/// A number of vademecum modes: from 1 to 400.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(try_from = "u64")]
+pub struct ModeCount(pub usize);
+
+impl TryFrom<u64> for ModeCount {
+    type Error = String;
+    fn try_from(value: u64) -> Result<Self, String> {
+        match value {
+            1..=400 => Ok(Self(value as usize)),
+            v => Err(format!(
+                "{v} modes: from 1 to 400 (the builder stops earlier when its error target is met)"
+            )),
+        }
+    }
+}

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use pgd_surgery::mesh::io::{ImportError, ImportOptions, load, write_vtu};
+use pgd_surgery::mesh::organs::{self, Organ, OrganSettings};
 use pgd_surgery::mesh::{QualityReport, box_mesh};
 
 /// Writes `contents` to a fresh file with this name in a per-test directory.
@@ -121,6 +122,35 @@ fn vtu_round_trip_keeps_geometry_and_node_sets() {
         assert!((a - b).norm() < 1e-15);
     }
     assert_eq!(back.node_set("x0").unwrap(), mesh.node_set("x0").unwrap());
+}
+
+/// A face set (the generated liver's `accessible` surface) travels through .vtu as its nodes
+/// and reads back as the same faces: the boundary triangles whose corners all lie in it.
+#[test]
+fn vtu_round_trip_keeps_face_sets() {
+    let settings = OrganSettings {
+        resolution: 0.25,
+        ..OrganSettings::default()
+    };
+    let mesh = organs::generate(Organ::Liver, &settings).unwrap();
+    let path = file("liver.vtu", b"");
+    write_vtu(&path, &mesh, &[]).unwrap();
+    let back = load(&path, &ImportOptions::default()).unwrap();
+    let faces = |m: &pgd_surgery::mesh::TetMesh| {
+        let mut faces: Vec<[usize; 3]> = m
+            .face_set("accessible")
+            .unwrap()
+            .iter()
+            .map(|f| {
+                let mut f = *f;
+                f.sort_unstable();
+                f
+            })
+            .collect();
+        faces.sort_unstable();
+        faces
+    };
+    assert_eq!(faces(&back), faces(&mesh));
 }
 
 /// A cube of side 4 cm written in millimetres, as CAD tools do.

@@ -12,7 +12,8 @@ use pgd_surgery::app::exercise::{Outcome, run_simulated, scenario_scene};
 use pgd_surgery::app::scene::{Detail, default_scene};
 use pgd_surgery::cli::{OnStale, write_report};
 use pgd_surgery::haptics::{Scripted, TICK_S, Trajectory};
-use pgd_surgery::mesh::organs::Organ;
+use pgd_surgery::mesh::io::write_vtu;
+use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate};
 use pgd_surgery::scenario::{Scenario, load, parse};
 
 const TRAINER: &str = env!("CARGO_BIN_EXE_trainer");
@@ -217,10 +218,16 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "not a workspace scale",
         ),
         (
-            "tissue-not-in-scene",
-            5,
-            "tissues[0].organ",
-            "`pancreas` is not in this scenario",
+            "organ-mesh-missing",
+            6,
+            "organs[0].mesh",
+            "no-such-kidney.vtu",
+        ),
+        (
+            "organ-unknown-field",
+            7,
+            "organs[0].stiffness_pa",
+            "stiffness_pa",
         ),
     ];
     for (name, line, field, message) in cases {
@@ -357,47 +364,88 @@ fn retraction_measures_the_region_and_the_organs_around() {
     assert!(careless.longest_hold_s < careless.hold_s.unwrap());
 }
 
-/// A scenario's `tissues` build the organ's vademecum for that tissue: the liver given twice
+/// An organ's `young_pa` builds its vademecum for that tissue: the liver given twice
 /// its Young's modulus pushes back twice as hard on the same scripted press (linear
 /// elasticity at a fixed indentation: force ∝ E; tolerance 0.2 %, for the f32 storage and the
 /// build's convergence tolerance; 2.000 measured), with no other organ in the scene to add
 /// contact.
 #[test]
 fn a_stiffer_tissue_pushes_back_harder_in_proportion() {
-    let text = |tissues: &str| {
-        format!(
-            r#"Scenario(title: "Press", briefing: "Press.", organs: ["liver"], {tissues}
-                tasks: [ForceControl(organ: "liver", min_force_n: 0.15, max_force_n: 0.35,
-                                     hold_s: 30.0, time_limit_s: 40.0)])"#
-        )
-    };
     let file = Path::new("stiff-liver.scenario.ron");
     let young_pa = 2.0 * pgd_surgery::pgd::organ::young_pa(Organ::Liver);
     let stiff = parse(
         file,
-        &text(&format!(
-            "tissues: [Tissue(organ: \"liver\", young_pa: {young_pa})],"
-        )),
+        &one_organ_press(
+            &format!("Organ(name: \"liver\", young_pa: {young_pa})"),
+            "liver",
+        ),
     )
     .unwrap();
-    let plain = parse(file, &text("")).unwrap();
-    let holding = |scenario: Scenario| {
-        let dir = vademecums();
-        scenario_scene(&scenario, dir, Detail::Coarse, OnStale::Rebuild).unwrap();
-        let trace = run_scenario(scenario, "liver-steady-press", "competent").force_trace;
-        let held: Vec<f64> = trace
-            .iter()
-            .filter(|(t, _)| (2.0..4.0).contains(t))
-            .map(|(_, f)| *f)
-            .collect();
-        held.iter().sum::<f64>() / held.len() as f64
-    };
-    let (stiff_n, plain_n) = (holding(stiff), holding(plain));
+    let plain = parse(file, &one_organ_press("\"liver\"", "liver")).unwrap();
+    let (stiff_n, plain_n) = (held_force_n(stiff), held_force_n(plain));
     let ratio = stiff_n / plain_n;
     eprintln!("held {stiff_n:.4} N on the stiff liver, {plain_n:.4} N on the plain one");
     assert!(plain_n > 0.1, "{plain_n} N");
     assert!(
         (ratio - 2.0).abs() < 0.004,
         "{stiff_n} N against {plain_n} N: ratio {ratio}"
+    );
+}
+
+/// A scenario of one organ (`entry` in `organs`) pressed by the liver's steady-press task.
+fn one_organ_press(entry: &str, organ: &str) -> String {
+    format!(
+        r#"Scenario(title: "Press", briefing: "Press.", organs: [{entry}],
+            tasks: [ForceControl(organ: "{organ}", min_force_n: 0.15, max_force_n: 0.35,
+                                 hold_s: 30.0, time_limit_s: 40.0)])"#
+    )
+}
+
+/// The mean force (N) the competent steady-press script holds from 2 s to 4 s on `scenario`'s
+/// scene (its vademecums built first if missing).
+fn held_force_n(scenario: Scenario) -> f64 {
+    scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap();
+    let trace = run_scenario(scenario, "liver-steady-press", "competent").force_trace;
+    let held: Vec<f64> = trace
+        .iter()
+        .filter(|(t, _)| (2.0..4.0).contains(t))
+        .map(|(_, f)| *f)
+        .collect();
+    held.iter().sum::<f64>() / held.len() as f64
+}
+
+/// An organ read from a mesh file runs as the generated organ written to that file: the
+/// coarse liver saved as .vtu (with its regions), named relative to the scenario's folder, is
+/// built from the file with the liver's tissue (a mesh file's default) and pushes back on
+/// the same press as the generated liver does. The file keeps coordinates to 1e-9 relative or
+/// better, so the two vademecums are built on the same mesh; 1e-6 relative allows for the
+/// rounding.
+#[test]
+fn an_organ_from_a_mesh_file_feels_as_the_organ_it_was_written_from() {
+    let folder = Path::new(env!("CARGO_TARGET_TMPDIR")).join("mesh-organ");
+    std::fs::create_dir_all(folder.join("meshes")).unwrap();
+    let settings = OrganSettings {
+        resolution: 0.25,
+        ..OrganSettings::default()
+    };
+    let liver = generate(Organ::Liver, &settings).unwrap();
+    write_vtu(&folder.join("meshes/my-liver.vtu"), &liver, &[]).unwrap();
+    let file = folder.join("my-liver.scenario.ron");
+    let entry = r#"Organ(name: "my-liver", mesh: "meshes/my-liver.vtu")"#;
+    std::fs::write(&file, one_organ_press(entry, "my-liver")).unwrap();
+    let from_file = load(&file).unwrap();
+    assert_eq!(
+        from_file.organs[0].mesh.as_deref(),
+        Some(folder.join("meshes/my-liver.vtu").as_path())
+    );
+    let generated = parse(&file, &one_organ_press("\"liver\"", "liver")).unwrap();
+    let (file_n, generated_n) = (held_force_n(from_file), held_force_n(generated));
+    eprintln!(
+        "held {file_n:.6} N on the liver from the file, {generated_n:.6} N on the generated one"
+    );
+    assert!(generated_n > 0.1, "{generated_n} N");
+    assert!(
+        ((file_n - generated_n) / generated_n).abs() < 1e-6,
+        "{file_n} N against {generated_n} N"
     );
 }

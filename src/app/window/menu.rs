@@ -151,7 +151,7 @@ fn menu_text(menu: &Menu) -> String {
                     "{mark} {}  ({}; {})\n      {name}",
                     s.title,
                     s.difficulty.name(),
-                    s.organs.join(", ")
+                    s.organ_names()
                 ),
                 Err(e) => {
                     let first = e.lines().next().unwrap_or_default();
@@ -463,7 +463,7 @@ mod tests {
             "the haptic thread was not offered the new world"
         );
         let lesson = app.world().resource::<Lesson>();
-        assert_eq!(lesson.scenario.organs, ["pancreas"]);
+        assert_eq!(lesson.scenario.organ_names(), "pancreas");
         assert_eq!(lessons.take().len(), 2);
 
         tap(&mut app, KeyCode::KeyM);

@@ -1,6 +1,6 @@
 //! The scenario as a Bevy asset, reloaded when the educator saves its file: `trainer run FILE`
 //! loads FILE through [`ScenarioLoader`] (the same reading and checks as `trainer validate`)
-//! from its folder, which Bevy watches. An edit that keeps the scene (organs, tissues,
+//! from its folder, which Bevy watches. An edit that keeps the scene (organs,
 //! nodules, tool, device) replaces the scenario: on the briefing at once, during an exercise from the next
 //! attempt. An edit that changes the scene, or that does not read, is reported at the bottom
 //! of the window and changes nothing.
@@ -164,7 +164,7 @@ fn apply_edits(
         let file = watched.file.display();
         notice.0 = if !same_scene(&lesson.scenario, &edited.0) {
             format!(
-                "{file}: the organs, tissues, nodules, tool or device changed: restart the trainer to use them"
+                "{file}: the organs, nodules, tool or device changed: restart the trainer to use them"
             )
         } else {
             lesson.scenario = edited.0.clone();
@@ -182,11 +182,7 @@ fn apply_edits(
 
 /// Whether two scenarios run on the same haptic scene.
 pub(super) fn same_scene(a: &Scenario, b: &Scenario) -> bool {
-    a.organs == b.organs
-        && a.tissues == b.tissues
-        && a.nodules == b.nodules
-        && a.tool == b.tool
-        && a.device == b.device
+    a.organs == b.organs && a.nodules == b.nodules && a.tool == b.tool && a.device == b.device
 }
 
 /// A saved edit that does not read: its error, with file, line and field, on screen.

@@ -11,13 +11,13 @@ mod tokens;
 mod vtk;
 mod vtu;
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
 
 use nalgebra::Point3;
 use thiserror::Error;
 
-use super::{MeshError, QualityReport, Regions, TetMesh};
+use super::{MeshError, QualityReport, Regions, Surface, TetMesh};
 pub use surface::{SurfaceMesh, read_obj, read_stl, tetrahedralize};
 pub use vtu::write_vtu;
 
@@ -79,6 +79,8 @@ impl RawMesh {
                 reason,
             });
         }
+        // Formats that carry regions as node sets (VTK point data) give no faces.
+        let faces_from_nodes = self.face_sets.is_empty();
         let mut node_sets = self.node_sets;
         for (name, faces) in &self.face_sets {
             let mut nodes: Vec<usize> = faces.iter().flatten().copied().collect();
@@ -90,8 +92,39 @@ impl RawMesh {
             node_sets,
             face_sets: self.face_sets,
         };
-        Ok(TetMesh::new(file, self.nodes, self.tets, regions)?)
+        let mut mesh = TetMesh::new(file, self.nodes, self.tets, regions)?;
+        if faces_from_nodes {
+            add_surface_faces_of_node_sets(&mut mesh)?;
+        }
+        Ok(mesh)
     }
+}
+
+/// Gives each node set the face set of the boundary triangles whose corners all lie in it, if
+/// there are any: a region given by its nodes (as VTK files give them) can then name where the
+/// tool may load the surface (`accessible`), which a vademecum build takes as faces.
+fn add_surface_faces_of_node_sets(mesh: &mut TetMesh) -> Result<(), MeshError> {
+    let surface = Surface::extract(mesh);
+    let derived: Vec<(String, Vec<[usize; 3]>)> = mesh
+        .regions()
+        .node_sets
+        .iter()
+        .map(|(name, nodes)| {
+            let set: HashSet<usize> = nodes.iter().copied().collect();
+            let faces = surface
+                .triangles
+                .iter()
+                .filter(|face| face.iter().all(|n| set.contains(n)))
+                .copied()
+                .collect();
+            (name.clone(), faces)
+        })
+        .filter(|(_, faces): &(String, Vec<[usize; 3]>)| !faces.is_empty())
+        .collect();
+    for (name, faces) in derived {
+        mesh.set_face_set(&name, faces)?;
+    }
+    Ok(())
 }
 
 /// Options for reading surfaces, which must be tetrahedralized.

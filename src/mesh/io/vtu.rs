@@ -1,7 +1,8 @@
 //! VTK XML unstructured grids (`.vtu`), ASCII data arrays: read, and written for ParaView.
 //!
-//! Node sets travel as `UInt8` point-data arrays named `region:<name>` (1 = in the set), so a
-//! mesh written here reads back with its node sets.
+//! Regions travel as `UInt8` point-data arrays named `region:<name>` (1 = in the set): node
+//! sets as they are, face sets as their faces' corners, which read back as the node set and
+//! the surface faces within it.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -210,9 +211,9 @@ pub fn write_vtu(path: &Path, mesh: &TetMesh, vectors: &[(&str, &[f64])]) -> std
     out.push_str("\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
     out.push_str(&format!("{VTK_TETRA} ").repeat(m));
     out.push_str("\n</DataArray>\n</Cells>\n<PointData>\n");
-    for (name, nodes) in &mesh.regions().node_sets {
+    for (name, nodes) in region_nodes(mesh) {
         let mut flags = vec![0u8; n];
-        for &node in nodes {
+        for node in nodes {
             flags[node] = 1;
         }
         let _ = writeln!(
@@ -238,6 +239,26 @@ pub fn write_vtu(path: &Path, mesh: &TetMesh, vectors: &[(&str, &[f64])]) -> std
     }
     out.push_str("</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
     std::fs::write(path, out)
+}
+
+/// Every region as the nodes it holds: the node sets, and each face set without a node set of
+/// its name as its faces' corners (read back, these give the surface faces again).
+fn region_nodes(mesh: &TetMesh) -> Vec<(&String, Vec<usize>)> {
+    let regions = mesh.regions();
+    let mut sets: Vec<(&String, Vec<usize>)> = regions
+        .node_sets
+        .iter()
+        .map(|(name, nodes)| (name, nodes.clone()))
+        .collect();
+    for (name, faces) in &regions.face_sets {
+        if !regions.node_sets.contains_key(name) {
+            let mut nodes: Vec<usize> = faces.iter().flatten().copied().collect();
+            nodes.sort_unstable();
+            nodes.dedup();
+            sets.push((name, nodes));
+        }
+    }
+    sets
 }
 
 fn xml_escape(s: &str) -> String {
