@@ -254,10 +254,11 @@ fn validate(files: &[PathBuf]) -> ExitCode {
     for file in files {
         match scenario::load(file) {
             Ok(s) => println!(
-                "{}: ok ({}, {} tasks)",
+                "{}: ok ({}, {} task{})",
                 file.display(),
                 s.title,
-                s.tasks.len()
+                s.tasks.len(),
+                if s.tasks.len() == 1 { "" } else { "s" }
             ),
             Err(e) => {
                 eprintln!("{e}");

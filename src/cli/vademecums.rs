@@ -89,11 +89,14 @@ impl VademecumSpec {
         };
         let mut command = format!("cargo run --release --bin pgd -- build {source} --law {law}");
         let (mesh, build) = (OrganSettings::default(), BuildSettings::default());
-        if self.mesh.resolution != mesh.resolution {
-            command += &format!(" --resolution {}", self.mesh.resolution);
-        }
-        if self.mesh.seed != mesh.seed {
-            command += &format!(" --seed {}", self.mesh.seed);
+        // A mesh file's mesh is as it is: the generator's settings do not apply.
+        if let OrganSource::Generated(_) = self.source {
+            if self.mesh.resolution != mesh.resolution {
+                command += &format!(" --resolution {}", self.mesh.resolution);
+            }
+            if self.mesh.seed != mesh.seed {
+                command += &format!(" --seed {}", self.mesh.seed);
+            }
         }
         if self.build.tool_tip_radius_m != build.tool_tip_radius_m {
             command += &format!(" --tool-radius-mm {}", self.build.tool_tip_radius_m * 1e3);

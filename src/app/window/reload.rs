@@ -164,7 +164,7 @@ fn apply_edits(
         let file = watched.file.display();
         notice.0 = if !same_scene(&lesson.scenario, &edited.0) {
             format!(
-                "{file}: the organs, nodules, tool or device changed: restart the trainer to use them"
+                "{file}: the organs, nodules, tool or device changed: choose it again on the menu (M) to use them"
             )
         } else {
             lesson.scenario = edited.0.clone();
@@ -278,7 +278,7 @@ mod tests {
 
         std::fs::write(&file, scenario_text("Press the spleen.", "pancreas", 0.3)).unwrap();
         update_until(&mut app, "the scene change refused", |app| {
-            texts(app).contains("restart the trainer")
+            texts(app).contains("choose it again on the menu")
         });
         std::fs::write(&file, scenario_text("Too hard.", "liver", 30.0)).unwrap();
         update_until(&mut app, "the bad value shown", |app| {
