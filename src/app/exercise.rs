@@ -9,7 +9,7 @@ use nalgebra::Vector3;
 use super::haptic::{ExerciseLink, ExerciseRun, HapticLoop, HapticScene, TickClock};
 use super::scene::{Detail, SceneOrgan, scene_of};
 use crate::cli::{OnStale, OrganSource};
-use crate::contact::ContactSurface;
+use crate::contact::{ContactSurface, CouplingSettings};
 use crate::haptics::{HapticDevice, TICK_S};
 use crate::mesh::organs::Organ;
 use crate::scenario::{
@@ -30,10 +30,29 @@ pub fn scenario_scene(
         .map(|entry| scene_organ(scenario, entry))
         .collect::<Result<_, String>>()?;
     let tip = scenario.tool.tip_radius_m();
-    let mut scene = scene_of(&organs, Some(tip), dir, detail, on_stale)?;
+    let mut scene = scene_of(
+        &organs,
+        Some(tip),
+        &coupling_of(scenario),
+        dir,
+        detail,
+        on_stale,
+    )?;
     scene.safety.max_force_n = scenario.device.max_force_n.0;
     scene.workspace.scale = scenario.device.workspace_scale.0;
     Ok(scene)
+}
+
+/// The contact a scenario asks for, the defaults where it says nothing.
+fn coupling_of(scenario: &Scenario) -> CouplingSettings {
+    let mut settings = CouplingSettings::default();
+    if let Some(master) = &scenario.contact.master {
+        settings.master = master.clone();
+    }
+    if let Some(spacing) = scenario.contact.lattice_mm {
+        settings.distance.spacing_m = spacing.metres();
+    }
+    settings
 }
 
 /// The scene's organ a scenario's entry describes, with its nodules in its tissue.

@@ -69,7 +69,8 @@ impl Detail {
 /// or stale, unless `on_stale` refuses); the tool is the one they were built for.
 pub fn default_scene(dir: &Path, detail: Detail, on_stale: OnStale) -> Result<HapticScene, String> {
     let organs = SCENE_ORGANS.map(SceneOrgan::from);
-    scene_of(&organs, None, dir, detail, on_stale)
+    let coupling = CouplingSettings::default();
+    scene_of(&organs, None, &coupling, dir, detail, on_stale)
 }
 
 /// An organ of a scene: its mesh, its tissue (with any stiffer or softer regions in it) and
@@ -147,6 +148,7 @@ impl SceneOrgan {
 pub fn scene_of(
     organs: &[SceneOrgan],
     tip_radius_m: Option<f64>,
+    coupling: &CouplingSettings,
     dir: &Path,
     detail: Detail,
     on_stale: OnStale,
@@ -171,8 +173,7 @@ pub fn scene_of(
         .into_iter()
         .map(|(name, vademecum, _)| (name, vademecum))
         .collect();
-    let coupling = Coupling::new(&organs, &attachments, &CouplingSettings::default())
-        .map_err(|e| e.to_string())?;
+    let coupling = Coupling::new(&organs, &attachments, coupling).map_err(|e| e.to_string())?;
     Ok(HapticScene {
         organs,
         probe: Probe { tip_radius_m: tip },

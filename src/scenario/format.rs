@@ -30,6 +30,9 @@ pub struct Scenario {
     /// organ's vademecum is built with them (the first run of the scenario builds it).
     #[serde(default)]
     pub nodules: Vec<Nodule>,
+    /// How the organs touch each other.
+    #[serde(default)]
+    pub contact: Contact,
     /// Done in order: each task starts when the one before is done or out of time.
     pub tasks: Vec<Task>,
     #[serde(default)]
@@ -104,6 +107,21 @@ impl Default for Device {
             workspace_scale: default_workspace_scale(),
         }
     }
+}
+
+/// Organ/organ contact: the master organ carries a distance field on a lattice around it,
+/// against which the other organs' surface nodes are tested every tick.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Contact {
+    /// The organ carrying the distance field (the gallbladder when left out; with neither in
+    /// the scene the organs do not touch).
+    #[serde(default)]
+    pub master: Option<String>,
+    /// The lattice's spacing: about the depth a node may sink before it is pushed out (2 mm
+    /// when left out; finer costs memory and set-up time).
+    #[serde(default)]
+    pub lattice_mm: Option<Millimetres>,
 }
 
 /// A point in the scene's frame (millimetres; x to the patient's left, y anterior, z to the

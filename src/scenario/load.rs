@@ -168,6 +168,14 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
         let field = format!("nodules[{k}].organ");
         problems.extend(not_in_scene(scenario, &nodule.organ, field, "nodules"));
     }
+    if let Some(master) = &scenario.contact.master {
+        problems.extend(not_in_scene(
+            scenario,
+            master,
+            "contact.master".into(),
+            "contact",
+        ));
+    }
     if scenario.tasks.is_empty() {
         problems.push(Problem {
             field: "tasks".into(),

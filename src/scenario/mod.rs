@@ -11,7 +11,8 @@ mod units;
 
 pub use exercise::{Exercise, NoduleSite, Progress, RegionSite, Sample, Sites, TaskMetrics};
 pub use format::{
-    Device, Difficulty, Nodule, OrganEntry, Rubric, Scenario, Spot, Task, TaskKind, Tool, metres,
+    Contact, Device, Difficulty, Nodule, OrganEntry, Rubric, Scenario, Spot, Task, TaskKind, Tool,
+    metres,
 };
 pub use load::{ScenarioError, load, parse};
 pub use score::{Scorecard, TaskScore, score};

@@ -224,6 +224,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "no-such-kidney.vtu",
         ),
         (
+            "contact-master-not-in-scene",
+            6,
+            "contact.master",
+            "`liver` is not in this scenario",
+        ),
+        (
             "organ-unknown-field",
             7,
             "organs[0].stiffness_pa",
@@ -447,5 +453,40 @@ fn an_organ_from_a_mesh_file_feels_as_the_organ_it_was_written_from() {
     assert!(
         ((file_n - generated_n) / generated_n).abs() < 1e-6,
         "{file_n} N against {generated_n} N"
+    );
+}
+
+/// A scenario's contact master carries the distance field the other organs are tested
+/// against: with the liver chosen (on a coarse 8 mm lattice, quick to build), the scene's one contact pair tests the
+/// gallbladder's nodes against the liver, where by default it is the other way round.
+#[test]
+fn the_scenario_chooses_the_contact_master() {
+    let text = |contact: &str| {
+        format!(
+            r#"Scenario(title: "Press", briefing: "Press.", organs: ["liver", "gallbladder"], {contact}
+                tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3,
+                                     hold_s: 1.0, time_limit_s: 5.0)])"#
+        )
+    };
+    let file = Path::new("master.scenario.ron");
+    let pairs = |contact: &str| {
+        let scenario = parse(file, &text(contact)).unwrap();
+        let scene =
+            scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap();
+        let name = |k: usize| scene.organs[k].0.clone();
+        let coupling = scene.coupling.expect("two organs that touch are coupled");
+        let pairs: Vec<(String, String)> = coupling
+            .pairs
+            .iter()
+            .map(|p| (name(p.master), name(p.shell)))
+            .collect();
+        pairs
+    };
+    let liver = || "liver".to_owned();
+    let gallbladder = || "gallbladder".to_owned();
+    assert_eq!(pairs(""), [(gallbladder(), liver())]);
+    assert_eq!(
+        pairs(r#"contact: Contact(master: "liver", lattice_mm: 8.0),"#),
+        [(liver(), gallbladder())]
     );
 }

@@ -164,7 +164,7 @@ fn apply_edits(
         let file = watched.file.display();
         notice.0 = if !same_scene(&lesson.scenario, &edited.0) {
             format!(
-                "{file}: the organs, nodules, tool or device changed: choose it again on the menu (M) to use them"
+                "{file}: the organs, nodules, contact, tool or device changed: choose it again on the menu (M) to use them"
             )
         } else {
             lesson.scenario = edited.0.clone();
