@@ -45,7 +45,10 @@ pub fn scenario_scene(
 
 /// The contact a scenario asks for, the defaults where it says nothing.
 fn coupling_of(scenario: &Scenario) -> CouplingSettings {
-    let mut settings = CouplingSettings::default();
+    let mut settings = CouplingSettings {
+        pointshell: scenario.contact.pointshell,
+        ..CouplingSettings::default()
+    };
     if let Some(master) = &scenario.contact.master {
         settings.master = master.clone();
     }

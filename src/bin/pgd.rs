@@ -4,7 +4,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
-use pgd_surgery::app::scene::Detail;
+use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, scene_of};
+use pgd_surgery::contact::{CouplingSettings, PointshellDensity};
 use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
 use pgd_surgery::mesh::io::{ImportOptions, write_vtu};
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, region};
@@ -233,6 +234,9 @@ enum BenchTarget {
         /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
         #[arg(long, default_value = "vademecums")]
         vademecums: PathBuf,
+        /// A dense pointshell (nodes and triangle centres) instead of the boundary nodes.
+        #[arg(long)]
+        dense: bool,
         /// Print the report as JSON instead of a table.
         #[arg(long)]
         json: bool,
@@ -360,11 +364,23 @@ fn main() -> ExitCode {
                     ticks,
                     coarse,
                     vademecums,
+                    dense,
                     json,
                 },
         } => {
             let detail = if coarse { Detail::Coarse } else { Detail::Full };
-            let scene = match pgd_surgery::app::scene::default_scene(
+            let coupling = CouplingSettings {
+                pointshell: match dense {
+                    true => PointshellDensity::Dense,
+                    false => PointshellDensity::Nodes,
+                },
+                ..CouplingSettings::default()
+            };
+            let organs = SCENE_ORGANS.map(SceneOrgan::from);
+            let scene = match scene_of(
+                &organs,
+                None,
+                &coupling,
                 &vademecums,
                 detail,
                 cli::OnStale::Rebuild,

@@ -12,7 +12,7 @@ use super::modal_rows::{concatenate, step_ranges};
 use super::penalty::{OrganPose, PairOutput, PenaltySettings};
 use super::{
     Attachment, ContactError, ContactPair, ContactSurface, DistanceField, DistanceSettings,
-    Pointshell,
+    Pointshell, PointshellDensity,
 };
 use crate::pgd::{Deformation, RigidCarry, Vademecum};
 
@@ -22,6 +22,7 @@ pub struct CouplingSettings {
     /// The organ carrying the distance field (paper 000: the gallbladder).
     pub master: String,
     pub distance: DistanceSettings,
+    pub pointshell: PointshellDensity,
     pub penalty: PenaltySettings,
 }
 
@@ -30,6 +31,7 @@ impl Default for CouplingSettings {
         Self {
             master: "gallbladder".into(),
             distance: DistanceSettings::default(),
+            pointshell: PointshellDensity::default(),
             penalty: PenaltySettings::default(),
         }
     }
@@ -94,8 +96,13 @@ impl Coupling {
                 if shell == master || attached(master, shell) {
                     continue;
                 }
-                let nodes =
-                    Pointshell::boundary(shell_vademecum, master_vademecum, &surface, &field);
+                let nodes = Pointshell::new(
+                    shell_vademecum,
+                    master_vademecum,
+                    &surface,
+                    &field,
+                    settings.pointshell,
+                );
                 if nodes.is_empty() {
                     continue;
                 }

@@ -22,7 +22,7 @@ pub use coupling::{AttachmentSpec, Coupling, CouplingSettings};
 pub use distance::{DistanceField, DistanceSample, DistanceSettings, LatticeCache};
 pub use modal_rows::ModalRows;
 pub use penalty::{ContactPair, OrganPose, PairOutput, PairReport, PenaltySettings};
-pub use pointshell::Pointshell;
+pub use pointshell::{Pointshell, PointshellDensity};
 pub use projected_cg::Convergence;
 pub use surface::{ContactError, ContactSurface, SurfaceHit};
 pub use tool::{Probe, Target, ToolContact, press};

@@ -15,32 +15,45 @@ pub struct ModalRows {
     values: Vec<f32>,
 }
 
+/// A point of a surface as a weighted sum of load positions (a position itself: one, weight
+/// 1; a point inside a triangle: its corners, weighted by its barycentric coordinates).
+pub type Blend = [(usize, f64)];
+
 impl ModalRows {
-    /// The spatial modes (displacement per unit coefficient, m) at volume nodes `nodes`.
-    pub fn displacements(vademecum: &Vademecum, nodes: impl Iterator<Item = usize>) -> Self {
-        Self::gather(vademecum, nodes, |step, mode, node| {
-            vademecum.mode_at_node(step, mode, node)
+    /// The spatial modes (displacement per unit coefficient, m) at surface points, each a
+    /// blend of load positions (interpolated from their volume nodes).
+    pub fn displacements<'a>(
+        vademecum: &Vademecum,
+        points: impl Iterator<Item = &'a Blend>,
+    ) -> Self {
+        Self::gather(vademecum, points, |step, mode, position| {
+            vademecum.mode_at_node(step, mode, vademecum.positions[position] as usize)
         })
     }
 
-    /// The parametric modes (coefficient per newton) at load positions `positions`.
-    pub fn loads(vademecum: &Vademecum, positions: impl Iterator<Item = usize>) -> Self {
-        Self::gather(vademecum, positions, |step, mode, position| {
+    /// The parametric modes (coefficient per newton) at surface points, each a blend of load
+    /// positions (a force there is shared among them by the blend's weights).
+    pub fn loads<'a>(vademecum: &Vademecum, points: impl Iterator<Item = &'a Blend>) -> Self {
+        Self::gather(vademecum, points, |step, mode, position| {
             vademecum.load_mode_at(step, mode, position)
         })
     }
 
-    fn gather(
+    fn gather<'a>(
         vademecum: &Vademecum,
-        items: impl Iterator<Item = usize>,
+        points: impl Iterator<Item = &'a Blend>,
         value: impl Fn(usize, usize, usize) -> Vector3<f64>,
     ) -> Self {
         let modes = vademecum.total_modes();
         let mut values = Vec::new();
-        for item in items {
+        for blend in points {
             for step in 0..vademecum.steps.len() {
                 for mode in 0..vademecum.modes(step) {
-                    values.extend(value(step, mode, item).iter().map(|&v| v as f32));
+                    let v: Vector3<f64> = blend
+                        .iter()
+                        .map(|&(position, w)| value(step, mode, position) * w)
+                        .sum();
+                    values.extend(v.iter().map(|&v| v as f32));
                 }
             }
         }

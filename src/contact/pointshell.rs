@@ -1,8 +1,10 @@
-//! A pointshell: the nodes of one organ that probe the master's distance field, with what the
-//! contact stage needs of each, gathered once (rest position and distance, penalty area, the
-//! organ's modes there, and the master position that takes the reaction).
+//! A pointshell: the points of one organ's surface that probe the master's distance field (its
+//! boundary nodes, or denser), with what the contact stage needs of each, gathered once (rest
+//! position and distance, penalty area, the organ's modes there, and the master position that
+//! takes the reaction). Everywhere below, "node" means a point of the pointshell.
 
 use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
 
 use super::modal_rows::ModalRows;
 use super::{ContactSurface, DistanceField};
@@ -10,7 +12,8 @@ use crate::pgd::Vademecum;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pointshell {
-    /// Load positions of the shell organ.
+    /// The shell organ's load position that weighs most in each point (the point itself,
+    /// or a corner of the triangle it lies in).
     pub positions: Vec<u32>,
     pub rest_m: Vec<Vector3<f32>>,
     /// The master's rest distance at each node (m), from the lattice.
@@ -30,49 +33,64 @@ pub struct Pointshell {
     pub mode_bounds: Vec<f32>,
 }
 
+/// How densely a pointshell samples its organ's surface.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum PointshellDensity {
+    /// The accessible load positions (the boundary nodes).
+    #[default]
+    Nodes,
+    /// The positions and the centre of every accessible triangle: about three times as many
+    /// points, so that contact is felt between nodes and more nodes push at once.
+    Dense,
+}
+
+/// A candidate point: where it is at rest, and the positions it blends.
+struct Candidate {
+    rest_m: Vector3<f64>,
+    blend: Vec<(usize, f64)>,
+    area_m2: f64,
+}
+
 impl Pointshell {
-    /// Every accessible position of `shell` inside the master's lattice: the boundary nodes
-    /// that can meet the master at all.
-    pub fn boundary(
+    /// The points of `shell` inside the master's lattice, at `density`: those that can meet
+    /// the master at all.
+    pub fn new(
         shell: &Vademecum,
         master: &Vademecum,
         master_surface: &ContactSurface,
         field: &DistanceField,
+        density: PointshellDensity,
     ) -> Self {
-        let inside: Vec<(u32, f64, Vector3<f64>)> = (0..shell.positions.len())
-            .filter_map(|m| {
-                let p = Vector3::from(shell.position_coords_m[m].map(f64::from));
-                let sample = field.at_rest(&p)?;
-                Some((m as u32, sample.distance_m, sample.normal))
+        let inside: Vec<(Candidate, f64, Vector3<f64>)> = candidates(shell, density)
+            .into_iter()
+            .filter_map(|c| {
+                let sample = field.at_rest(&c.rest_m)?;
+                Some((c, sample.distance_m, sample.normal))
             })
             .collect();
-        let positions: Vec<u32> = inside.iter().map(|n| n.0).collect();
-        let rest_m: Vec<Vector3<f32>> = positions
+        let blends: Vec<&[(usize, f64)]> = inside.iter().map(|n| &n.0.blend[..]).collect();
+        let rest_m: Vec<Vector3<f32>> = inside
             .iter()
-            .map(|&m| Vector3::from(shell.position_coords_m[m as usize]))
+            .map(|n| n.0.rest_m.map(|c| c as f32))
             .collect();
-        let master_positions: Vec<u32> = rest_m
+        let master_positions: Vec<u32> = inside
             .iter()
-            .map(|p| nearest_corner(master, master_surface, &p.map(f64::from)))
+            .map(|n| nearest_corner(master, master_surface, &n.0.rest_m))
             .collect();
-        let displacement = ModalRows::displacements(
-            shell,
-            positions
-                .iter()
-                .map(|&m| shell.positions[m as usize] as usize),
-        );
+        let master_points: Vec<[(usize, f64); 1]> = master_positions
+            .iter()
+            .map(|&m| [(m as usize, 1.0)])
+            .collect();
+        let displacement = ModalRows::displacements(shell, blends.iter().copied());
         Self {
+            positions: blends.iter().map(|b| dominant(b)).collect(),
             rest_distance_m: inside.iter().map(|n| n.1 as f32).collect(),
             rest_normal: inside.iter().map(|n| n.2).collect(),
-            area_m2: positions
-                .iter()
-                .map(|&m| shell.position_areas_m2[m as usize])
-                .collect(),
-            load: ModalRows::loads(shell, positions.iter().map(|&m| m as usize)),
-            master_load: ModalRows::loads(master, master_positions.iter().map(|&m| m as usize)),
+            area_m2: inside.iter().map(|n| n.0.area_m2 as f32).collect(),
+            load: ModalRows::loads(shell, blends.iter().copied()),
+            master_load: ModalRows::loads(master, master_points.iter().map(|p| &p[..])),
             mode_bounds: displacement.bounds(),
             displacement,
-            positions,
             rest_m,
             master_positions,
         }
@@ -90,6 +108,43 @@ impl Pointshell {
     pub fn movement_bound_m(&self, alpha: &[f32]) -> f32 {
         super::modal_rows::movement_bound(alpha, &self.mode_bounds)
     }
+}
+
+/// The points a pointshell at `density` may take from `shell`: each accessible position with
+/// its lumped area, and (dense) each accessible triangle's centre, which then takes half the
+/// triangle's area from its corners, so that the whole surface is covered once.
+fn candidates(shell: &Vademecum, density: PointshellDensity) -> Vec<Candidate> {
+    let at = |m: usize| Vector3::from(shell.position_coords_m[m].map(f64::from));
+    let mut points: Vec<Candidate> = (0..shell.positions.len())
+        .map(|m| Candidate {
+            rest_m: at(m),
+            blend: vec![(m, 1.0)],
+            area_m2: shell.position_areas_m2[m] as f64,
+        })
+        .collect();
+    if density == PointshellDensity::Dense {
+        for triangle in &shell.triangles {
+            let [a, b, c] = triangle.map(|m| m as usize);
+            let area_m2 = 0.5 * (at(b) - at(a)).cross(&(at(c) - at(a))).norm();
+            for m in [a, b, c] {
+                points[m].area_m2 -= area_m2 / 6.0;
+            }
+            points.push(Candidate {
+                rest_m: (at(a) + at(b) + at(c)) / 3.0,
+                blend: [a, b, c].map(|m| (m, 1.0 / 3.0)).to_vec(),
+                area_m2: area_m2 / 2.0,
+            });
+        }
+    }
+    points
+}
+
+/// The position that weighs most in `blend`: where a point's load steps are read.
+fn dominant(blend: &[(usize, f64)]) -> u32 {
+    blend
+        .iter()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(0, |&(m, _)| m as u32)
 }
 
 /// The master position nearest `p` on its rest surface: the corner of the closest triangle

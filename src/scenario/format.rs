@@ -8,6 +8,8 @@ use std::path::PathBuf;
 use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 
+use crate::contact::PointshellDensity;
+
 use super::units::{Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, Seconds};
 
 #[derive(Clone, Debug, PartialEq, Deserialize)]
@@ -122,6 +124,10 @@ pub struct Contact {
     /// when left out; finer costs memory and set-up time).
     #[serde(default)]
     pub lattice_mm: Option<Millimetres>,
+    /// Which points of the other organs are tested: `Nodes` (their surface nodes, the
+    /// default) or `Dense` (also their surface triangles' centres).
+    #[serde(default)]
+    pub pointshell: PointshellDensity,
 }
 
 /// A point in the scene's frame (millimetres; x to the patient's left, y anterior, z to the

@@ -8,10 +8,11 @@ use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{
     HapticLoop, HapticScene, OrganCoupling, OrganDeformation, OrganIndex, TickClock,
 };
-use pgd_surgery::app::scene::{Detail, default_scene};
+use pgd_surgery::app::scene::{Detail, SceneOrgan, default_scene, scene_of};
 use pgd_surgery::cli::OnStale;
-use pgd_surgery::contact::PairReport;
+use pgd_surgery::contact::{CouplingSettings, PairReport, PointshellDensity};
 use pgd_surgery::haptics::{PressTarget, Scripted, TICK_S, Trajectory, TrajectoryRow};
+use pgd_surgery::mesh::organs::Organ;
 use pgd_surgery::pgd::{Deformation, Vademecum};
 
 pub fn scene() -> &'static HapticScene {
@@ -98,10 +99,38 @@ pub struct Tick {
     pub organs: Vec<Deformation>,
 }
 
+/// The same scene with a dense pointshell on the liver and the other organs.
+pub fn dense_scene() -> &'static HapticScene {
+    static SCENE: OnceLock<HapticScene> = OnceLock::new();
+    SCENE.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("contact-vademecums");
+        scene(); // builds the vademecums if they are missing
+        let organs = Organ::ABDOMEN.map(SceneOrgan::from);
+        let settings = CouplingSettings {
+            pointshell: PointshellDensity::Dense,
+            ..CouplingSettings::default()
+        };
+        scene_of(
+            &organs,
+            None,
+            &settings,
+            &dir,
+            Detail::Coarse,
+            OnStale::Refuse,
+        )
+        .unwrap()
+    })
+}
+
 /// Runs `trajectory` through the coupled scene's haptic schedule, tick by tick.
 pub fn run(trajectory: Trajectory, ticks: u64) -> (HapticLoop, Vec<Tick>) {
+    run_on(scene(), trajectory, ticks)
+}
+
+/// [`run`] on `scene`.
+pub fn run_on(scene: &HapticScene, trajectory: Trajectory, ticks: u64) -> (HapticLoop, Vec<Tick>) {
     let device = Box::new(Scripted::new("push", trajectory));
-    let mut haptic = HapticLoop::new(scene(), device).unwrap();
+    let mut haptic = HapticLoop::new(scene, device).unwrap();
     let mut record = Vec::new();
     for tick in 0..ticks {
         haptic.tick(TickClock {

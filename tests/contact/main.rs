@@ -7,7 +7,9 @@ mod common;
 use common::*;
 use nalgebra::{Point3, Vector3};
 use pgd_surgery::app::haptic::{DeviceForce, HapticLoop, HapticScene};
-use pgd_surgery::contact::LatticeCache;
+use pgd_surgery::contact::{
+    ContactSurface, DistanceField, DistanceSettings, LatticeCache, Pointshell, PointshellDensity,
+};
 use pgd_surgery::haptics::Scripted;
 use pgd_surgery::seam::{from_parry, to_parry};
 
@@ -42,6 +44,63 @@ fn pressing_the_gallbladder_into_the_liver_deforms_the_liver_and_stays_shallow()
     assert!(last.organs[l].loads.iter().all(|load| !load.is_active()));
     assert!(moved_m > 0.05e-3, "liver moved {moved_m} m");
     assert_shallow(record);
+}
+
+/// A dense pointshell samples the liver's surface at its nodes and its triangles' centres:
+/// with a lattice that holds the whole liver, it has one point per node and per accessible
+/// triangle, and its points' areas add up to the nodes' (the surface is covered once; f32
+/// sums, 1e-5 relative), each positive.
+#[test]
+fn a_dense_pointshell_covers_the_surface_once() {
+    let (_, liver) = organ("liver");
+    let (_, gallbladder) = organ("gallbladder");
+    let surface = ContactSurface::new(gallbladder).unwrap();
+    let everywhere = DistanceSettings {
+        spacing_m: 0.02,
+        margin_m: 0.3,
+    };
+    let field = DistanceField::build(gallbladder, &surface, &everywhere);
+    let shell = |density| Pointshell::new(liver, gallbladder, &surface, &field, density);
+    let (nodes, dense) = (
+        shell(PointshellDensity::Nodes),
+        shell(PointshellDensity::Dense),
+    );
+    assert_eq!(nodes.len(), liver.positions.len());
+    assert_eq!(dense.len(), liver.positions.len() + liver.triangles.len());
+    let total = |p: &Pointshell| p.area_m2.iter().map(|&a| a as f64).sum::<f64>();
+    let (a, b) = (total(&nodes), total(&dense));
+    eprintln!(
+        "area {:.2} cm² at the nodes, {:.2} cm² densely",
+        a * 1e4,
+        b * 1e4
+    );
+    assert!(((a - b) / a).abs() < 1e-5, "{a} m² against {b} m²");
+    assert!(dense.area_m2.iter().all(|&a| a > 0.0));
+}
+
+/// The gallbladder pressed into the liver with a dense pointshell: more points push, none
+/// deeper than one lattice cell, and the forces on the two organs balance.
+#[test]
+#[ignore = "not met yet: 10 points push against 3 nodes, but with more points in contact the tool and the contact fight as in the test below: a point 8.4 mm deep with the force solve at its 12-product cap, and the press diverges (200 mm) when the cap is raised to 200"]
+fn pressing_with_a_dense_pointshell_pushes_more_points_and_stays_shallow() {
+    let target = facing("gallbladder", -Vector3::z());
+    let (_, record) = run_on(dense_scene(), push(&target, 0.012, PUSH_S, 0.5), TICKS);
+    let (dense, nodes) = (
+        liver_pair(record.last().unwrap()),
+        liver_pair(pushed().last().unwrap()),
+    );
+    eprintln!(
+        "{} points push densely, {} nodes otherwise",
+        dense.nodes_in_contact, nodes.nodes_in_contact
+    );
+    assert!(dense.nodes_in_contact > nodes.nodes_in_contact);
+    assert_shallow(&record);
+    let g = organ("gallbladder").0;
+    for tick in &record {
+        let on_shells: Vector3<f64> = tick.pairs.iter().map(|p| p.2.force_on_shell_n).sum();
+        let on_master = tick.organs[g].coupling_force_n;
+        assert!((on_master + on_shells).norm() <= 1e-12 * on_shells.norm().max(1e-9));
+    }
 }
 
 /// No liver node ever deeper in the gallbladder than one lattice cell.

@@ -458,7 +458,8 @@ fn an_organ_from_a_mesh_file_feels_as_the_organ_it_was_written_from() {
 
 /// A scenario's contact master carries the distance field the other organs are tested
 /// against: with the liver chosen (on a coarse 8 mm lattice, quick to build), the scene's one contact pair tests the
-/// gallbladder's nodes against the liver, where by default it is the other way round.
+/// gallbladder's nodes against the liver, where by default it is the other way round; and a
+/// dense pointshell tests more than twice as many of the liver's points.
 #[test]
 fn the_scenario_chooses_the_contact_master() {
     let text = |contact: &str| {
@@ -469,16 +470,20 @@ fn the_scenario_chooses_the_contact_master() {
         )
     };
     let file = Path::new("master.scenario.ron");
-    let pairs = |contact: &str| {
+    let coupling = |contact: &str| {
         let scenario = parse(file, &text(contact)).unwrap();
         let scene =
             scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap();
-        let name = |k: usize| scene.organs[k].0.clone();
+        let names: Vec<String> = scene.organs.iter().map(|o| o.0.clone()).collect();
         let coupling = scene.coupling.expect("two organs that touch are coupled");
+        (names, coupling)
+    };
+    let pairs = |contact: &str| {
+        let (names, coupling) = coupling(contact);
         let pairs: Vec<(String, String)> = coupling
             .pairs
             .iter()
-            .map(|p| (name(p.master), name(p.shell)))
+            .map(|p| (names[p.master].clone(), names[p.shell].clone()))
             .collect();
         pairs
     };
@@ -488,5 +493,11 @@ fn the_scenario_chooses_the_contact_master() {
     assert_eq!(
         pairs(r#"contact: Contact(master: "liver", lattice_mm: 8.0),"#),
         [(liver(), gallbladder())]
+    );
+    let points = |contact: &str| coupling(contact).1.pairs[0].pointshell().len();
+    let (nodes, dense) = (points(""), points("contact: Contact(pointshell: Dense),"));
+    assert!(
+        dense > 2 * nodes,
+        "{dense} dense points against {nodes} nodes"
     );
 }
