@@ -256,6 +256,7 @@ mod tests {
 
     use bevy::state::app::StatesPlugin;
 
+    use super::super::testing::{scene_without_organs, stage, tap, texts};
     use super::*;
     use crate::scenario::{Progress, Sample, Sites, parse};
 
@@ -278,7 +279,7 @@ mod tests {
         let lesson = Lesson {
             scenario,
             file: PathBuf::from("quick.scenario.ron"),
-            scene: super::super::scene_without_organs(),
+            scene: scene_without_organs(),
             link: link.clone(),
         };
         setup(
@@ -287,19 +288,6 @@ mod tests {
             Lessons::default(),
         );
         (app, link)
-    }
-
-    fn stage(app: &App) -> Stage {
-        *app.world().resource::<State<Stage>>().get()
-    }
-
-    fn panel_text(app: &mut App) -> String {
-        let mut texts = app.world_mut().query::<&Text>();
-        texts
-            .iter(app.world())
-            .map(|t| t.0.clone())
-            .collect::<Vec<_>>()
-            .join("\n")
     }
 
     /// The exercise ended without the trainee touching the organ: a failed force control.
@@ -313,18 +301,6 @@ mod tests {
         }
         assert!(exercise.finished());
         exercise
-    }
-
-    /// Presses `key` for one frame, then lets it go for another.
-    fn tap(app: &mut App, key: KeyCode) {
-        app.world_mut()
-            .resource_mut::<ButtonInput<KeyCode>>()
-            .press(key);
-        app.update();
-        let mut keys = app.world_mut().resource_mut::<ButtonInput<KeyCode>>();
-        keys.release_all();
-        keys.clear();
-        app.update();
     }
 
     /// The haptic side ends the exercise, unscored, and says so in its snapshot.
@@ -348,7 +324,7 @@ mod tests {
         app.update();
         app.update();
         assert_eq!(stage(&app), Stage::Briefing);
-        assert!(panel_text(&mut app).contains("Press the liver."));
+        assert!(texts(&mut app).contains("Press the liver."));
         assert!(
             !link.started(),
             "the exercise began before the trainee was ready"
@@ -357,11 +333,11 @@ mod tests {
         tap(&mut app, KeyCode::Space);
         assert_eq!(stage(&app), Stage::Exercise);
         assert!(link.started());
-        assert!(!panel_text(&mut app).contains("Press the liver."));
+        assert!(!texts(&mut app).contains("Press the liver."));
 
         end_exercise(&mut app, &link);
         assert_eq!(stage(&app), Stage::Debrief);
-        let debrief = panel_text(&mut app);
+        let debrief = texts(&mut app);
         assert!(
             debrief.contains("FAILED") && debrief.contains("Esc"),
             "{debrief}"
@@ -381,11 +357,11 @@ mod tests {
         tap(&mut app, KeyCode::Space);
         end_exercise(&mut app, &link);
         assert_eq!(stage(&app), Stage::Debrief);
-        assert!(panel_text(&mut app).contains("R to try again"));
+        assert!(texts(&mut app).contains("R to try again"));
 
         tap(&mut app, KeyCode::KeyR);
         assert_eq!(stage(&app), Stage::Briefing);
-        assert!(panel_text(&mut app).contains("Press the liver."));
+        assert!(texts(&mut app).contains("Press the liver."));
         assert!(!link.started());
         app.world_mut().resource_mut::<Snapshot>().0.exercise = None;
         tap(&mut app, KeyCode::Space);

@@ -324,7 +324,7 @@ mod tests {
     use bevy::state::app::StatesPlugin;
 
     use super::super::lesson::{self, Opening};
-    use super::super::scene_without_organs;
+    use super::super::testing::{scene_without_organs, stage, tap, texts};
     use super::*;
 
     fn scenario_text(title: &str, organ: &str) -> String {
@@ -394,27 +394,6 @@ mod tests {
             swap,
             lessons,
         }
-    }
-
-    fn stage(app: &App) -> Stage {
-        *app.world().resource::<State<Stage>>().get()
-    }
-
-    fn texts(app: &mut App) -> String {
-        let mut texts = app.world_mut().query::<&Text>();
-        let all: Vec<String> = texts.iter(app.world()).map(|t| t.0.clone()).collect();
-        all.join("\n")
-    }
-
-    fn tap(app: &mut App, key: KeyCode) {
-        app.world_mut()
-            .resource_mut::<ButtonInput<KeyCode>>()
-            .press(key);
-        app.update();
-        let mut keys = app.world_mut().resource_mut::<ButtonInput<KeyCode>>();
-        keys.release_all();
-        keys.clear();
-        app.update();
     }
 
     /// Updates until the chosen scenario's briefing opens (the loader is a thread), at most 20 s.

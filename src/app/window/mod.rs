@@ -13,6 +13,8 @@ mod menu;
 mod organs;
 mod reload;
 mod screenshot;
+#[cfg(test)]
+mod testing;
 pub mod tissue;
 mod tool;
 
@@ -146,18 +148,4 @@ pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
     frames::setup(&mut app, log.clone());
     let exit = app.run();
     (exit, log.report())
-}
-
-/// A scene without organs, for the window's stages in a headless app.
-#[cfg(test)]
-fn scene_without_organs() -> HapticScene {
-    HapticScene {
-        organs: Vec::new(),
-        probe: crate::contact::Probe {
-            tip_radius_m: 0.006,
-        },
-        workspace: crate::haptics::Workspace::default(),
-        safety: crate::haptics::SafetySettings::default(),
-        coupling: None,
-    }
 }

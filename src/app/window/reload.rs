@@ -202,6 +202,7 @@ mod tests {
 
     use bevy::state::app::StatesPlugin;
 
+    use super::super::testing::{scene_without_organs, texts};
     use super::*;
     use crate::app::haptic::{ExerciseLink, ExerciseRun};
     use crate::app::window::bridge::Snapshot;
@@ -221,7 +222,7 @@ mod tests {
         let lesson = Lesson {
             scenario: load(file).unwrap(),
             file: file.to_owned(),
-            scene: super::super::scene_without_organs(),
+            scene: scene_without_organs(),
             link: link.clone(),
         };
         let mut app = App::new();
@@ -244,12 +245,6 @@ mod tests {
             std::thread::sleep(Duration::from_millis(20));
             app.update();
         }
-    }
-
-    fn texts(app: &mut App) -> String {
-        let mut texts = app.world_mut().query::<&Text>();
-        let all: Vec<String> = texts.iter(app.world()).map(|t| t.0.clone()).collect();
-        all.join("\n")
     }
 
     /// Saved on the briefing, an edit is shown at once and is what the exercise runs; an edit
