@@ -105,19 +105,15 @@ impl SceneOrgan {
     /// Its vademecum at `detail` for a tool tip of `tip_m`, kept under `dir` in a file named
     /// after what differs from the defaults.
     fn vademecum(&self, dir: &Path, detail: Detail, tip_m: f64) -> VademecumSpec {
-        let (base, file) = match &self.source {
-            OrganSource::Generated(organ) => (*organ, format!("{}.vdm", self.name)),
+        let file = match &self.source {
+            OrganSource::Generated(_) => format!("{}.vdm", self.name),
             OrganSource::File(path) => {
                 let stem = path.file_stem().unwrap_or_default().to_string_lossy();
-                (Organ::Liver, format!("{}.mesh-{stem}.vdm", self.name))
+                format!("{}.mesh-{stem}.vdm", self.name)
             }
         };
-        let mut spec = detail.applied(VademecumSpec {
-            name: self.name.clone(),
-            source: self.source.clone(),
-            file: dir.join(file),
-            ..VademecumSpec::default_in(dir, base, Law::Linear)
-        });
+        let spec = VademecumSpec::new(&self.name, self.source.clone(), Law::Linear, dir.join(file));
+        let mut spec = detail.applied(spec);
         let mut tag = |part: String| spec.file = spec.file.with_extension(format!("{part}.vdm"));
         if tip_m != spec.build.tool_tip_radius_m {
             tag(format!("tip{}mm", tip_m * 1e3));

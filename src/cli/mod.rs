@@ -11,5 +11,5 @@ mod vademecums;
 pub use convergence::{StepCurve, write as write_convergence, write_of_header};
 pub use progress::Bar;
 pub use report::{summary, write_report};
-pub use source::{MeshSource, load_source};
-pub use vademecums::{OnStale, OrganSource, VademecumSpec, ensure_vademecum, parse_inclusion};
+pub use source::{MeshSource, OrganSource, load_source};
+pub use vademecums::{OnStale, VademecumSpec, ensure_vademecum, parse_inclusion};

@@ -1,6 +1,7 @@
-//! What `pgd` commands accept as a mesh: a generated organ's name or a mesh file.
+//! Where an organ's mesh comes from: a generated organ or a mesh file, as `pgd` commands take
+//! it (by name or path) and as the trainer's scenarios give it.
 
-use std::path::Path;
+use std::path::PathBuf;
 
 use crate::mesh::TetMesh;
 use crate::mesh::io::{ImportOptions, load};
@@ -15,12 +16,50 @@ pub struct MeshSource<'a> {
 
 /// The organ, if the source names one, and its mesh; errors are ready to print.
 pub fn load_source(source: &MeshSource) -> Result<(Option<Organ>, TetMesh), String> {
-    match Organ::from_name(source.name) {
-        Some(organ) => organs::generate(organ, &source.organ)
-            .map(|mesh| (Some(organ), mesh))
-            .map_err(|e| format!("{}: {e}", source.name)),
-        None => load(Path::new(source.name), &source.import)
-            .map(|mesh| (None, mesh))
-            .map_err(|e| e.to_string()),
+    let origin = match Organ::from_name(source.name) {
+        Some(organ) => OrganSource::Generated(organ),
+        None => OrganSource::File(PathBuf::from(source.name)),
+    };
+    let mesh = origin.load(&source.organ, &source.import)?;
+    Ok((origin.organ(), mesh))
+}
+
+/// Where an organ's mesh comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum OrganSource {
+    /// Generated (at the given settings).
+    Generated(Organ),
+    /// Read from a tetrahedral mesh file with a `clamped` node set and an `accessible`
+    /// surface; its tissue is the liver's unless given.
+    File(PathBuf),
+}
+
+impl OrganSource {
+    /// The generated organ, if it is one.
+    pub fn organ(&self) -> Option<Organ> {
+        match self {
+            OrganSource::Generated(organ) => Some(*organ),
+            OrganSource::File(_) => None,
+        }
+    }
+
+    /// The generated organ whose material is the default (the liver's for a mesh file).
+    pub fn material_of(&self) -> Organ {
+        self.organ().unwrap_or(Organ::Liver)
+    }
+
+    /// The mesh: generated at `settings`, or read with `import`; an error names the organ or
+    /// the file.
+    pub fn load(
+        &self,
+        settings: &OrganSettings,
+        import: &ImportOptions,
+    ) -> Result<TetMesh, String> {
+        match self {
+            OrganSource::Generated(organ) => {
+                organs::generate(*organ, settings).map_err(|e| format!("{}: {e}", organ.name()))
+            }
+            OrganSource::File(path) => load(path, import).map_err(|e| e.to_string()),
+        }
     }
 }

@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 
 use crate::fem::{Inclusion, Law, Material};
 use crate::mesh::TetMesh;
-use crate::mesh::io::{ImportOptions, load};
-use crate::mesh::organs::{self, Organ, OrganSettings, region};
+use crate::mesh::io::ImportOptions;
+use crate::mesh::organs::{Organ, OrganSettings, region};
 use crate::pgd::{self, BuildSettings, OrganModel, Vademecum, VademecumError};
 
-use super::Bar;
+use super::{Bar, OrganSource};
 
 /// What to do with a missing or stale vademecum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -19,26 +19,6 @@ pub enum OnStale {
     Rebuild,
     /// Fail with the command that builds it.
     Refuse,
-}
-
-/// Where an organ's mesh comes from.
-#[derive(Clone, Debug, PartialEq)]
-pub enum OrganSource {
-    /// Generated (at the spec's mesh settings).
-    Generated(Organ),
-    /// Read from a tetrahedral mesh file with `clamped` and `accessible` node sets; its tissue
-    /// is the liver's unless given.
-    File(PathBuf),
-}
-
-impl OrganSource {
-    /// The generated organ whose material is the default.
-    fn material_of(&self) -> Organ {
-        match self {
-            OrganSource::Generated(organ) => *organ,
-            OrganSource::File(_) => Organ::Liver,
-        }
-    }
 }
 
 /// What the trainer wants of one organ's vademecum: the organ's mesh (generated at a
@@ -64,16 +44,23 @@ pub struct VademecumSpec {
 impl VademecumSpec {
     /// The organ's default vademecum (the papers' mesh, default settings) under `dir`.
     pub fn default_in(dir: &Path, organ: Organ, law: Law) -> Self {
+        let file = dir.join(format!("{}.vdm", organ.name()));
+        Self::new(organ.name(), OrganSource::Generated(organ), law, file)
+    }
+
+    /// The vademecum of the organ `name` from `source` under `law`, default settings and
+    /// tissue, kept in `file`.
+    pub fn new(name: &str, source: OrganSource, law: Law, file: PathBuf) -> Self {
         Self {
-            name: organ.name().to_owned(),
-            source: OrganSource::Generated(organ),
+            name: name.to_owned(),
+            source,
             law,
             mesh: OrganSettings::default(),
             young_pa: None,
             poisson: None,
             inclusions: Vec::new(),
             build: BuildSettings::default(),
-            file: dir.join(format!("{}.vdm", organ.name())),
+            file,
         }
     }
 
@@ -128,14 +115,7 @@ pub fn ensure_vademecum(
     on_stale: OnStale,
 ) -> Result<(Vademecum, TetMesh), String> {
     let name = &spec.name;
-    let mesh = match &spec.source {
-        OrganSource::Generated(organ) => {
-            organs::generate(*organ, &spec.mesh).map_err(|e| format!("{name}: {e}"))?
-        }
-        OrganSource::File(path) => {
-            load(path, &ImportOptions::default()).map_err(|e| format!("{name}: {e}"))?
-        }
-    };
+    let mesh = spec.source.load(&spec.mesh, &ImportOptions::default())?;
     let mut material = pgd::organ::material(spec.source.material_of(), spec.law);
     material.young_pa = spec.young_pa.unwrap_or(material.young_pa);
     material.poisson = spec.poisson.unwrap_or(material.poisson);

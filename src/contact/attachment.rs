@@ -52,8 +52,7 @@ impl Attachment {
             .map(|r| Matrix3::identity() * r.norm_squared() - r * r.transpose())
             .sum();
         let inverse = inertia.try_inverse().unwrap_or_else(Matrix3::zeros);
-        let points: Vec<[(usize, f64); 1]> = interface.iter().map(|&m| [(m, 1.0)]).collect();
-        let rows = ModalRows::displacements(v, points.iter().map(|p| &p[..]));
+        let rows = ModalRows::displacements(v, interface.iter().map(|&m| [(m, 1.0)]));
         let modes = v.total_modes();
         let mut translation = vec![Vector3::zeros(); modes];
         let mut rotation = vec![Vector3::zeros(); modes];

@@ -15,16 +15,16 @@ pub struct ModalRows {
     values: Vec<f32>,
 }
 
-/// A point of a surface as a weighted sum of load positions (a position itself: one, weight
-/// 1; a point inside a triangle: its corners, weighted by its barycentric coordinates).
+/// A point of a surface as a weighted sum of load positions (a position itself: `[(m, 1.0)]`;
+/// a point inside a triangle: its corners, weighted by its barycentric coordinates).
 pub type Blend = [(usize, f64)];
 
 impl ModalRows {
     /// The spatial modes (displacement per unit coefficient, m) at surface points, each a
     /// blend of load positions (interpolated from their volume nodes).
-    pub fn displacements<'a>(
+    pub fn displacements<B: AsRef<Blend>>(
         vademecum: &Vademecum,
-        points: impl Iterator<Item = &'a Blend>,
+        points: impl Iterator<Item = B>,
     ) -> Self {
         Self::gather(vademecum, points, |step, mode, position| {
             vademecum.mode_at_node(step, mode, vademecum.positions[position] as usize)
@@ -33,15 +33,15 @@ impl ModalRows {
 
     /// The parametric modes (coefficient per newton) at surface points, each a blend of load
     /// positions (a force there is shared among them by the blend's weights).
-    pub fn loads<'a>(vademecum: &Vademecum, points: impl Iterator<Item = &'a Blend>) -> Self {
+    pub fn loads<B: AsRef<Blend>>(vademecum: &Vademecum, points: impl Iterator<Item = B>) -> Self {
         Self::gather(vademecum, points, |step, mode, position| {
             vademecum.load_mode_at(step, mode, position)
         })
     }
 
-    fn gather<'a>(
+    fn gather<B: AsRef<Blend>>(
         vademecum: &Vademecum,
-        points: impl Iterator<Item = &'a Blend>,
+        points: impl Iterator<Item = B>,
         value: impl Fn(usize, usize, usize) -> Vector3<f64>,
     ) -> Self {
         let modes = vademecum.total_modes();
@@ -50,6 +50,7 @@ impl ModalRows {
             for step in 0..vademecum.steps.len() {
                 for mode in 0..vademecum.modes(step) {
                     let v: Vector3<f64> = blend
+                        .as_ref()
                         .iter()
                         .map(|&(position, w)| value(step, mode, position) * w)
                         .sum();

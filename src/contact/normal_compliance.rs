@@ -68,12 +68,8 @@ impl OrganRows {
 
 impl NormalCompliance {
     pub fn new(nodes: &Pointshell, master: &Vademecum, shell: &Vademecum) -> Self {
-        let master_points: Vec<[(usize, f64); 1]> = nodes
-            .master_positions
-            .iter()
-            .map(|&m| [(m as usize, 1.0)])
-            .collect();
-        let master_rows = ModalRows::displacements(master, master_points.iter().map(|p| &p[..]));
+        let master_points = nodes.master_positions.iter().map(|&m| [(m as usize, 1.0)]);
+        let master_rows = ModalRows::displacements(master, master_points);
         let project = |rows: &ModalRows| -> Vec<f32> {
             (0..nodes.len())
                 .flat_map(|i| rows.along(i, nodes.rest_normal[i].map(|c| c as f32)))

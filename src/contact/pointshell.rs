@@ -68,7 +68,6 @@ impl Pointshell {
                 Some((c, sample.distance_m, sample.normal))
             })
             .collect();
-        let blends: Vec<&[(usize, f64)]> = inside.iter().map(|n| &n.0.blend[..]).collect();
         let rest_m: Vec<Vector3<f32>> = inside
             .iter()
             .map(|n| n.0.rest_m.map(|c| c as f32))
@@ -77,18 +76,17 @@ impl Pointshell {
             .iter()
             .map(|n| nearest_corner(master, master_surface, &n.0.rest_m))
             .collect();
-        let master_points: Vec<[(usize, f64); 1]> = master_positions
-            .iter()
-            .map(|&m| [(m as usize, 1.0)])
-            .collect();
-        let displacement = ModalRows::displacements(shell, blends.iter().copied());
+        let displacement = ModalRows::displacements(shell, inside.iter().map(|n| &n.0.blend));
         Self {
-            positions: blends.iter().map(|b| dominant(b)).collect(),
+            positions: inside.iter().map(|n| dominant(&n.0.blend)).collect(),
             rest_distance_m: inside.iter().map(|n| n.1 as f32).collect(),
             rest_normal: inside.iter().map(|n| n.2).collect(),
             area_m2: inside.iter().map(|n| n.0.area_m2 as f32).collect(),
-            load: ModalRows::loads(shell, blends.iter().copied()),
-            master_load: ModalRows::loads(master, master_points.iter().map(|p| &p[..])),
+            load: ModalRows::loads(shell, inside.iter().map(|n| &n.0.blend)),
+            master_load: ModalRows::loads(
+                master,
+                master_positions.iter().map(|&m| [(m as usize, 1.0)]),
+            ),
             mode_bounds: displacement.bounds(),
             displacement,
             rest_m,

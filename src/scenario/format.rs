@@ -166,8 +166,8 @@ impl Spot {
 pub struct OrganEntry {
     /// What tasks and nodules call it; a generated organ's name unless `mesh` is given.
     pub name: String,
-    /// A tetrahedral mesh file (.msh, .vtk, .vtu, in metres) with node sets `clamped` (held
-    /// fixed) and `accessible` (where the tool may touch), written relative to the scenario's
+    /// A tetrahedral mesh file (.msh, .vtk, .vtu, in metres) with a node set `clamped` (held
+    /// fixed) and a surface `accessible` (where the tool may touch), written relative to the scenario's
     /// folder (read as such: the path here is resolved).
     #[serde(default)]
     pub mesh: Option<PathBuf>,

@@ -5,12 +5,12 @@
 //! to the haptic thread, and the window redrawn on it; then its briefing opens.
 
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::thread::JoinHandle;
 
 use bevy::prelude::*;
 
-use super::bridge::{HapticLink, Snapshot};
+use super::bridge::HapticLink;
 use super::lesson::{Lesson, Lessons, Stage, spawn_panel};
 use super::{FrameSet, SceneChanged};
 use crate::app::exercise::{prepare, sites_on};
@@ -54,7 +54,7 @@ struct MenuText;
 #[derive(Resource)]
 struct Loading {
     title: String,
-    task: Mutex<Option<JoinHandle<Result<Prepared, String>>>>,
+    task: Option<JoinHandle<Result<Prepared, String>>>,
 }
 
 /// A lesson ready to run: its haptic world (parked, with its exercise offered) and the end of
@@ -224,7 +224,7 @@ fn choose_on_enter(
         Ok(task) => {
             commands.insert_resource(Loading {
                 title,
-                task: Mutex::new(Some(task)),
+                task: Some(task),
             });
             next.set(Stage::Loading);
         }
@@ -277,22 +277,18 @@ fn show_loading(mut commands: Commands, loading: Res<Loading>) {
 #[allow(clippy::too_many_arguments)]
 fn finish_loading(
     mut commands: Commands,
-    loading: Res<Loading>,
+    mut loading: ResMut<Loading>,
     plan: Res<MenuPlan>,
     lessons: Res<Lessons>,
     mut link: ResMut<HapticLink>,
-    mut snapshot: ResMut<Snapshot>,
     mut menu: ResMut<Menu>,
     mut changed: MessageWriter<SceneChanged>,
     mut next: ResMut<NextState<Stage>>,
 ) {
-    let Ok(mut task) = loading.task.lock() else {
-        return;
-    };
-    if !task.as_ref().is_some_and(JoinHandle::is_finished) {
+    if !loading.task.as_ref().is_some_and(JoinHandle::is_finished) {
         return;
     }
-    let result = task.take().map(|t| {
+    let result = loading.task.take().map(|t| {
         t.join()
             .unwrap_or_else(|_| Err("the loader panicked".into()))
     });
@@ -300,8 +296,8 @@ fn finish_loading(
     match result {
         Some(Ok(prepared)) => {
             plan.swap.offer(prepared.haptic);
+            // This frame's snapshot is read from the new scene's end, after this stage.
             link.change_scene(prepared.lesson.scene.clone(), prepared.snapshots);
-            *snapshot = Snapshot::default();
             lessons.add(&prepared.lesson);
             commands.insert_resource(prepared.lesson);
             menu.problem = None;
@@ -323,6 +319,7 @@ mod tests {
 
     use bevy::state::app::StatesPlugin;
 
+    use super::super::bridge::Snapshot;
     use super::super::lesson::{self, Opening};
     use super::super::testing::{scene_without_organs, stage, tap, texts};
     use super::*;

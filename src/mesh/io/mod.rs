@@ -83,10 +83,9 @@ impl RawMesh {
         let faces_from_nodes = self.face_sets.is_empty();
         let mut node_sets = self.node_sets;
         for (name, faces) in &self.face_sets {
-            let mut nodes: Vec<usize> = faces.iter().flatten().copied().collect();
-            nodes.sort_unstable();
-            nodes.dedup();
-            node_sets.entry(name.clone()).or_insert(nodes);
+            node_sets
+                .entry(name.clone())
+                .or_insert_with(|| face_nodes(faces));
         }
         let regions = Regions {
             node_sets,
@@ -98,6 +97,14 @@ impl RawMesh {
         }
         Ok(mesh)
     }
+}
+
+/// The nodes of `faces`, ascending, each once.
+fn face_nodes(faces: &[[usize; 3]]) -> Vec<usize> {
+    let mut nodes: Vec<usize> = faces.iter().flatten().copied().collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
 }
 
 /// Gives each node set the face set of the boundary triangles whose corners all lie in it, if

@@ -252,10 +252,7 @@ fn region_nodes(mesh: &TetMesh) -> Vec<(&String, Vec<usize>)> {
         .collect();
     for (name, faces) in &regions.face_sets {
         if !regions.node_sets.contains_key(name) {
-            let mut nodes: Vec<usize> = faces.iter().flatten().copied().collect();
-            nodes.sort_unstable();
-            nodes.dedup();
-            sets.push((name, nodes));
+            sets.push((name, super::face_nodes(faces)));
         }
     }
     sets
