@@ -13,7 +13,7 @@ use parry3d::query::PointQuery;
 use serde::Serialize;
 
 use crate::app::haptic::HapticScene;
-use crate::contact::{ContactPair, OrganPose, PairOutput};
+use crate::contact::{ContactPair, OrganPose, PairOutput, ToolHold};
 use crate::pgd::{RigidCarry, Vademecum};
 use crate::seam::{to_parry, trimesh};
 
@@ -136,18 +136,24 @@ impl Run {
         let [master_c, shell_c] = &mut self.coefficients;
         master_c.fill(0.0);
         shell_c.fill(0.0);
+        let free = ToolHold::default();
+        let (mut master_moved_m, mut shell_moved_m) = (Vector3::zeros(), Vector3::zeros());
         self.pair.tick(
             OrganPose {
                 alpha: &self.alpha[0],
                 carry: &self.carry,
+                hold: &free,
             },
             OrganPose {
                 alpha: &self.alpha[1],
                 carry: &self.still,
+                hold: &free,
             },
             PairOutput {
                 master: master_c,
                 shell: shell_c,
+                master_tool_moved_m: &mut master_moved_m,
+                shell_tool_moved_m: &mut shell_moved_m,
             },
         );
     }

@@ -12,9 +12,9 @@ use super::modal_rows::{concatenate, step_ranges};
 use super::penalty::{OrganPose, PairOutput, PenaltySettings};
 use super::{
     Attachment, ContactError, ContactPair, ContactSurface, DistanceField, DistanceSettings,
-    Pointshell, PointshellDensity,
+    Pointshell, PointshellDensity, ToolHold,
 };
-use crate::pgd::{Deformation, RigidCarry, Vademecum};
+use crate::pgd::{Deformation, Patch, PatchLoad, RigidCarry, Vademecum};
 
 /// Which organ is the master, and how the coupling is set up.
 #[derive(Clone, Debug, PartialEq)]
@@ -52,6 +52,8 @@ struct CoupledOrgan {
     coupling: Vec<f64>,
     coupling_force_n: Vector3<f64>,
     carry: RigidCarry,
+    hold: ToolHold,
+    tool_moved_m: Vector3<f64>,
 }
 
 #[derive(Clone)]
@@ -123,6 +125,8 @@ impl Coupling {
                 coupling: vec![0.0; v.total_modes()],
                 coupling_force_n: Vector3::zeros(),
                 carry: RigidCarry::default(),
+                hold: ToolHold::default(),
+                tool_moved_m: Vector3::zeros(),
             })
             .collect();
         Ok(Self {
@@ -144,12 +148,28 @@ impl Coupling {
         concatenate(&deformation.coefficients, &mut organ.alpha);
     }
 
+    /// Takes how the tool holds organ `index` this tick: it presses on `patch` with `load`,
+    /// or not at all.
+    pub fn hold(&mut self, index: usize, vademecum: &Vademecum, patch: &Patch, load: &PatchLoad) {
+        let hold = &mut self.organs[index].hold;
+        match load.is_active() {
+            true => hold.hold(vademecum, patch, load),
+            false => hold.release(),
+        }
+    }
+
+    /// How the tool holds organ `index` this tick.
+    pub fn tool_hold(&self, index: usize) -> &ToolHold {
+        &self.organs[index].hold
+    }
+
     /// One tick of every attachment and pair.
     pub fn tick(&mut self) {
         for organ in &mut self.organs {
             organ.coupling.fill(0.0);
             organ.coupling_force_n = Vector3::zeros();
             organ.carry = RigidCarry::default();
+            organ.tool_moved_m = Vector3::zeros();
         }
         for a in &self.attachments {
             self.organs[a.carried].carry = a.carry(&self.organs[a.carrier].alpha);
@@ -160,20 +180,30 @@ impl Coupling {
                 OrganPose {
                     alpha: &master.alpha,
                     carry: &master.carry,
+                    hold: &master.hold,
                 },
                 OrganPose {
                     alpha: &shell.alpha,
                     carry: &shell.carry,
+                    hold: &shell.hold,
                 },
                 PairOutput {
                     master: &mut master.coupling,
                     shell: &mut shell.coupling,
+                    master_tool_moved_m: &mut master.tool_moved_m,
+                    shell_tool_moved_m: &mut shell.tool_moved_m,
                 },
             );
             let force = pair.report().force_on_shell_n;
             shell.coupling_force_n += force;
             master.coupling_force_n -= force;
         }
+    }
+
+    /// How far (m) this tick's contact forces move the surface under the tool holding organ
+    /// `index`: the tool's load follows it in the same tick ([`super::hold`]).
+    pub fn tool_moved_m(&self, index: usize) -> Vector3<f64> {
+        self.organs[index].tool_moved_m
     }
 
     /// Hands organ `index` its coupling of this tick.

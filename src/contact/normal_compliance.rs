@@ -1,10 +1,13 @@
 //! The normal compliance `A` of a contact pair: how the nodes' normal forces change their
 //! distances to the master, through both organs' modal compliance (the shell node pushed out,
 //! the master pushed back). Rows are projected on the rest normals once, so applying it over
-//! a set of nodes costs `4 · nodes · (shell modes + master modes)` products: a few times per
-//! tick in the contact's force solve, and a power iteration for the loop gain `λ_max(KA)` at
-//! set-up.
+//! a set of nodes costs `4 · nodes · (shell modes + master modes)` products, a few times per
+//! tick in the contact's force solve. Its diagonal sets the penalties. Where the tool holds an organ, its part of `A` takes the tool's answer as a rank-one
+//! change ([`super::hold`]).
 
+use nalgebra::Vector3;
+
+use super::hold::ToolHold;
 use super::modal_rows::ModalRows;
 use super::pointshell::Pointshell;
 use crate::pgd::Vademecum;
@@ -31,22 +34,61 @@ struct OrganRows {
     /// `Σ_j load_j v_j` and `Σ_j displacement_j v_j` for the forces `v` being applied.
     by_load: Vec<f32>,
     by_displacement: Vec<f32>,
+    /// Whether the tool holds the organ this tick, and then per node and direction `a`: how
+    /// far the tool's answer to a metre's move of its patch along `a` moves the node's
+    /// distance (`displacement_i · Y e_a`), and how far a unit force on the node moves the
+    /// patch along `a` (`load_i · Bᵀ e_a`, m/N).
+    held: bool,
+    by_tool: Vec<[f32; 3]>,
+    moves_tool: Vec<[f32; 3]>,
+    /// `Σ_j moves_tool_j v_j` and `Σ_j by_tool_j v_j` for the forces `v`.
+    tool_moved: [f32; 3],
+    tool_answers: [f32; 3],
 }
 
 impl OrganRows {
     fn new(modes: usize, displacement: Vec<f32>, load: Vec<f32>) -> Self {
+        let count = displacement.len() / modes.max(1);
         Self {
             modes,
             displacement,
             load,
             by_load: vec![0.0; modes],
             by_displacement: vec![0.0; modes],
+            held: false,
+            by_tool: vec![[0.0; 3]; count],
+            moves_tool: vec![[0.0; 3]; count],
+            tool_moved: [0.0; 3],
+            tool_answers: [0.0; 3],
         }
     }
 
-    fn rows(&self, i: usize) -> (&[f32], &[f32]) {
-        let range = i * self.modes..(i + 1) * self.modes;
-        (&self.displacement[range.clone()], &self.load[range])
+    /// Takes the tool's hold of this tick for the nodes of `set`.
+    fn hold(&mut self, set: &[u32], hold: &ToolHold) {
+        self.held = hold.is_held();
+        if !self.held {
+            return;
+        }
+        for &i in set {
+            let i = i as usize;
+            let range = i * self.modes..(i + 1) * self.modes;
+            let (displacement, load) = (&self.displacement[range.clone()], &self.load[range]);
+            self.by_tool[i] = [0, 1, 2].map(|a| dot(displacement, &hold.coefficients_per_m[a]));
+            self.moves_tool[i] = [0, 1, 2].map(|a| dot(load, &hold.moved_per_coefficient_m[a]));
+        }
+    }
+
+    /// How far the surface under the tool moves (m) when the normal forces on the nodes of
+    /// `set` change by `change_n`.
+    fn tool_moved_m(&self, set: &[u32], change_n: &[f64]) -> Vector3<f64> {
+        if !self.held {
+            return Vector3::zeros();
+        }
+        set.iter()
+            .map(|&i| {
+                Vector3::from(self.moves_tool[i as usize].map(f64::from)) * change_n[i as usize]
+            })
+            .sum()
     }
 
     fn gather(&mut self, set: &[u32], v: &[f64]) {
@@ -58,11 +100,41 @@ impl OrganRows {
             axpy(f, &self.load[range.clone()], &mut self.by_load);
             axpy(f, &self.displacement[range], &mut self.by_displacement);
         }
+        if self.held {
+            let weigh = |per: &[[f32; 3]], a: usize| -> f32 {
+                set.iter()
+                    .map(|&i| per[i as usize][a] * v[i as usize] as f32)
+                    .sum()
+            };
+            self.tool_moved = [0, 1, 2].map(|a| weigh(&self.moves_tool, a));
+            self.tool_answers = [0, 1, 2].map(|a| weigh(&self.by_tool, a));
+        }
     }
 
+    fn rows(&self, i: usize) -> (&[f32], &[f32]) {
+        let range = i * self.modes..(i + 1) * self.modes;
+        (&self.displacement[range.clone()], &self.load[range])
+    }
+
+    /// `A_ii` of this organ (m/N): how far a unit force on node `i` moves it.
+    fn diagonal(&self, i: usize) -> f64 {
+        let (displacement, load) = self.rows(i);
+        dot(displacement, load) as f64
+    }
+
+    /// `(A v)_i` of this organ: the symmetric part of `D Lᵀ`, less, where the tool holds
+    /// it, that of `D Y B Lᵀ`.
     fn answer(&self, i: usize) -> f32 {
         let (displacement, load) = self.rows(i);
-        0.5 * (dot(displacement, &self.by_load) + dot(load, &self.by_displacement))
+        let free = dot(displacement, &self.by_load) + dot(load, &self.by_displacement);
+        let held = match self.held {
+            true => {
+                dot(&self.by_tool[i], &self.tool_moved)
+                    + dot(&self.moves_tool[i], &self.tool_answers)
+            }
+            false => 0.0,
+        };
+        0.5 * (free - held)
     }
 }
 
@@ -91,6 +163,30 @@ impl NormalCompliance {
         }
     }
 
+    /// Node `i`'s own compliance in the stiffer of the two organs (m/N), 0 where neither
+    /// moves it (both clamped there).
+    pub fn stiffer_diagonal(&self, i: usize) -> f64 {
+        let own = [self.shell.diagonal(i), self.master.diagonal(i)];
+        own.into_iter()
+            .filter(|&a| a > 0.0)
+            .fold(0.0, |m: f64, a| if m == 0.0 { a } else { m.min(a) })
+    }
+
+    /// Takes the tool's hold of each organ for this tick's nodes `set`.
+    pub fn hold(&mut self, set: &[u32], master: &ToolHold, shell: &ToolHold) {
+        self.master.hold(set, master);
+        self.shell.hold(set, shell);
+    }
+
+    /// How far the surface under the tool moves on the master and on the shell organ (m)
+    /// when the normal forces on the nodes of `set` change by `change_n`.
+    pub fn tool_moves_m(&self, set: &[u32], change_n: &[f64]) -> (Vector3<f64>, Vector3<f64>) {
+        (
+            self.master.tool_moved_m(set, change_n),
+            self.shell.tool_moved_m(set, change_n),
+        )
+    }
+
     /// `out[i] = (A v)[i]` for every node `i` of `set` (m), from normal forces `v` (N) on
     /// those nodes; other entries of `out` are left alone.
     pub fn apply(&mut self, set: &[u32], v: &[f64], out: &mut [f64]) {
@@ -101,37 +197,7 @@ impl NormalCompliance {
             out[i] = (self.shell.answer(i) + self.master.answer(i)) as f64;
         }
     }
-
-    /// `λ_max(KA)` over `set` by power iteration, with penalties `stiffness[i]` (N/m).
-    pub fn loop_gain(&mut self, set: &[u32], stiffness: &[f64]) -> f64 {
-        let n = stiffness.len();
-        let (mut v, mut w) = (vec![0.0; n], vec![0.0; n]);
-        set.iter().for_each(|&i| v[i as usize] = 1.0);
-        let mut gain = 0.0;
-        for _ in 0..POWER_ITERATIONS {
-            self.apply(set, &v, &mut w);
-            let norm = set
-                .iter()
-                .map(|&i| (stiffness[i as usize] * w[i as usize]).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            let previous = set
-                .iter()
-                .map(|&i| v[i as usize].powi(2))
-                .sum::<f64>()
-                .sqrt();
-            if norm == 0.0 {
-                return 0.0;
-            }
-            gain = norm / previous;
-            set.iter()
-                .for_each(|&i| v[i as usize] = stiffness[i as usize] * w[i as usize] / norm);
-        }
-        gain
-    }
 }
-
-const POWER_ITERATIONS: usize = 60;
 
 fn axpy(a: f32, x: &[f32], y: &mut [f32]) {
     y.iter_mut().zip(x).for_each(|(y, x)| *y += a * x);

@@ -1,8 +1,7 @@
 //! Penalty contact between the master and one pointshell organ, one tick at a time.
 //!
 //! A pointshell node inside the master's deformed zero level set (`d < 0`) is pushed out by
-//! `F = −k · d · n` (`k` = the penalty per area × the node's area); the master takes `−F` at its
-//! nearest position. Both forces become modal coefficients of their organs, so the contact
+//! `F = −k · d · n` (`k`: the node's penalty); the master takes `−F` at its nearest position. Both forces become modal coefficients of their organs, so the contact
 //! deforms both, and the next tick sees the moved surfaces.
 //!
 //! **Stability.** The vademecums are quasi-static: a force moves the surfaces at once, with no
@@ -18,19 +17,25 @@
 //! - the energy falls every tick whatever `k`: no divergence, no overshoot, no chatter;
 //! - a node pushes only while `f > 0`, and lets go when it comes out, with no force left
 //!   pulling or pushing at a distance;
-//! - the force on a node is continuous in its depth, zero at `d = 0`, and with the minimum
-//!   reached every tick, it follows a slow push smoothly (`tests/contact`).
+//! - the force on a node is continuous in its depth, zero at `d = 0`.
 //!
-//! **The penalty `k`** (per area) is set once, so that every pointshell node pushing at once
-//! would have loop gain `G` ([`PenaltySettings::loop_gain`]): the stiffest contact the pair
-//! can have is `G` times stiffer than the tissue behind it, so an overlap the organs are
-//! pushed into is cut to about `1 / (1 + G)` of itself at equilibrium.
+//! Where the tool holds an organ, `A` is that organ's compliance with the patch under the
+//! tool held, and the solve reports how far the forces' change moved that patch, which the
+//! tool's load follows in the same tick ([`super::hold`]).
+//!
+//! **The penalty `k`** of each node is [`PenaltySettings::stiffness_ratio`] times as stiff as
+//! the stiffer of the two organs there, so that an overlap pushed into one node alone is cut
+//! to at most `1 / (1 + ratio)` of itself at equilibrium, whatever holds the organs. It needs
+//! no softer `k` for stability: the energy falls every tick whatever `k`. (Set once for the
+//! whole pointshell's loop gain, the first choice, it came out at 5–10 N/m a node on the
+//! floppy coarse gallbladder, and a gallbladder held by the tool sank into the liver.)
 
 use std::ops::Range;
 use std::sync::Arc;
 
 use nalgebra::Vector3;
 
+use super::hold::ToolHold;
 use super::modal_rows::step_ranges;
 use super::normal_compliance::NormalCompliance;
 use super::pointshell::Pointshell;
@@ -38,19 +43,20 @@ use super::projected_cg::{Convergence, ProjectedCg};
 use super::{DistanceField, LatticeCache};
 use crate::pgd::{RigidCarry, Vademecum};
 
-/// The loop gain `G` of the penalty (see the module's documentation) and how far each tick
-/// solves for the forces.
+/// How stiff the penalties are (see the module's documentation) and how far each tick solves
+/// for the forces.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PenaltySettings {
-    pub loop_gain: f64,
+    /// How many times stiffer than the stiffer organ at a node its penalty is.
+    pub stiffness_ratio: f64,
     pub convergence: Convergence,
 }
 
 impl Default for PenaltySettings {
-    /// `G` = 1000 cuts an overlap the whole pointshell is pushed into to 0.1 % of itself.
+    /// 1000 cuts an overlap pushed into one node to 0.1 % of itself.
     fn default() -> Self {
         Self {
-            loop_gain: 1000.0,
+            stiffness_ratio: 1000.0,
             convergence: Convergence::default(),
         }
     }
@@ -62,12 +68,16 @@ pub struct OrganPose<'a> {
     /// Modal coefficients, all load steps concatenated.
     pub alpha: &'a [f32],
     pub carry: &'a RigidCarry,
+    /// How the tool holds it this tick.
+    pub hold: &'a ToolHold,
 }
 
 /// The contact of the last tick, for reports and tests.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PairReport {
     pub nodes_in_contact: usize,
+    /// The pointshell area of the nodes that push (m²).
+    pub contact_area_m2: f64,
     /// Nodes whose force was evaluated (not culled).
     pub nodes_evaluated: usize,
     /// The deepest penetration (m, positive), 0 without contact.
@@ -97,6 +107,8 @@ pub struct ContactPair {
     gradient_m: Vec<f64>,
     /// Nodes that push or are pushed into, this tick.
     active: Vec<u32>,
+    /// Per node, the force the last tick left (N), then how the solve changed it.
+    change_n: Vec<f64>,
     compliance: NormalCompliance,
     solver: ProjectedCg,
     convergence: Convergence,
@@ -104,10 +116,13 @@ pub struct ContactPair {
     report: PairReport,
 }
 
-/// Per organ, where this tick's contact coefficients go (all load steps concatenated).
+/// Per organ, where this tick's contact coefficients go (all load steps concatenated), and
+/// where the move (m) the contact forces' change makes under the tool holding it goes.
 pub struct PairOutput<'a> {
     pub master: &'a mut [f64],
     pub shell: &'a mut [f64],
+    pub master_tool_moved_m: &'a mut Vector3<f64>,
+    pub shell_tool_moved_m: &'a mut Vector3<f64>,
 }
 
 impl ContactPair {
@@ -119,14 +134,8 @@ impl ContactPair {
         nodes: Pointshell,
         settings: &PenaltySettings,
     ) -> Self {
-        let mut compliance = NormalCompliance::new(&nodes, &master_vademecum, &shell_vademecum);
-        let all: Vec<u32> = (0..nodes.len() as u32).collect();
-        let areas: Vec<f64> = nodes.area_m2.iter().map(|&a| a as f64).collect();
-        let per_stiffness = compliance.loop_gain(&all, &areas);
-        let stiffness_n_per_m3 = match per_stiffness > 0.0 {
-            true => settings.loop_gain / per_stiffness,
-            false => 0.0,
-        };
+        let compliance = NormalCompliance::new(&nodes, &master_vademecum, &shell_vademecum);
+        let stiffness_n_per_m = penalties(&compliance, nodes.len(), settings.stiffness_ratio);
         let count = nodes.len();
         Self {
             master,
@@ -136,12 +145,13 @@ impl ContactPair {
             field,
             master_vademecum,
             shell_vademecum,
-            stiffness_n_per_m: areas.iter().map(|a| a * stiffness_n_per_m3).collect(),
+            stiffness_n_per_m,
             nodes,
             force_n: vec![0.0; count],
             normal: vec![Vector3::zeros(); count],
             gradient_m: vec![0.0; count],
             active: Vec::with_capacity(count),
+            change_n: vec![0.0; count],
             compliance,
             solver: ProjectedCg::new(count),
             convergence: settings.convergence,
@@ -185,6 +195,10 @@ impl ContactPair {
             report.deepest_m = report.deepest_m.max(depth_m);
         }
         let compliance = &mut self.compliance;
+        compliance.hold(&self.active, master.hold, shell.hold);
+        for &i in &self.active {
+            self.change_n[i as usize] = -self.force_n[i as usize];
+        }
         report.products = self.solver.solve(
             &self.active,
             &self.stiffness_n_per_m,
@@ -194,9 +208,16 @@ impl ContactPair {
             &self.convergence,
         );
         for &i in &self.active {
+            self.change_n[i as usize] += self.force_n[i as usize];
+        }
+        let (master_moved_m, shell_moved_m) = compliance.tool_moves_m(&self.active, &self.change_n);
+        *out.master_tool_moved_m += master_moved_m;
+        *out.shell_tool_moved_m += shell_moved_m;
+        for &i in &self.active {
             let i = i as usize;
             if self.force_n[i] > 0.0 {
                 report.nodes_in_contact += 1;
+                report.contact_area_m2 += self.nodes.area_m2[i] as f64;
                 report.force_on_shell_n += self.normal[i] * self.force_n[i];
                 self.add_loads(i, out.master, out.shell);
             }
@@ -251,6 +272,24 @@ impl ContactPair {
             master,
         );
     }
+}
+
+/// Each node's penalty (N/m): `ratio` times as stiff as the stiffer of the two organs there,
+/// so that an overlap pushed into one node alone is cut to at most `1 / (1 + ratio)` of
+/// itself. A node neither organ can move takes the stiffest penalty of the others.
+fn penalties(compliance: &NormalCompliance, count: usize, ratio: f64) -> Vec<f64> {
+    let mut stiffness: Vec<f64> = (0..count)
+        .map(|i| {
+            let a = compliance.stiffer_diagonal(i);
+            if a > 0.0 { ratio / a } else { 0.0 }
+        })
+        .collect();
+    let stiffest = stiffness.iter().copied().fold(0.0, f64::max);
+    stiffness
+        .iter_mut()
+        .filter(|k| **k == 0.0)
+        .for_each(|k| *k = stiffest);
+    stiffness
 }
 
 /// How far a rigid carry can move any point of the lattice (m).

@@ -1,6 +1,6 @@
 //! A pointshell: the points of one organ's surface that probe the master's distance field (its
 //! boundary nodes, or denser), with what the contact stage needs of each, gathered once (rest
-//! position and distance, penalty area, the organ's modes there, and the master position that
+//! position and distance, area, the organ's modes there, and the master position that
 //! takes the reaction). Everywhere below, "node" means a point of the pointshell.
 
 use nalgebra::Vector3;
@@ -20,7 +20,8 @@ pub struct Pointshell {
     pub rest_distance_m: Vec<f32>,
     /// The rest field's outward direction at each node.
     pub rest_normal: Vec<Vector3<f64>>,
-    /// Lumped surface area of each node (m²): its share of the penalty.
+    /// Lumped surface area of each node (m²): what it covers of the surface, summed into the
+    /// area in contact.
     pub area_m2: Vec<f32>,
     /// The shell organ's displacement and load modes at each node.
     pub displacement: ModalRows,

@@ -1,16 +1,22 @@
 //! The rigid probe and the load it puts on an organ.
 //!
 //! The tool tip is a sphere. Its contact point `s` is the surface point below the sphere's
-//! centre on the deformed surface: the rest surface moved by the organ's other loads (the tool's
-//! own load is what is being solved for; under a frictionless tip the point that touches it is
-//! the one below its centre). The surface there must move further by the tip's penetration
-//! along the normal; the load that does so is the vademecum's 3 × 3 compliance at `s`,
-//! inverted (for a KSV vademecum, the secant over its load steps).
+//! centre on the deformed surface (the rest surface moved by all the organ's loads). The tip
+//! holds the surface under it, averaged over its contact patch: along the normal, as deep as
+//! the tip reaches into the surface as the organ's other loads have moved it; sideways, where
+//! it was at rest, whatever the other loads do. The load that does so is the vademecum's 3 × 3
+//! patch compliance at `s`, inverted (for a KSV vademecum, the secant over its load steps),
+//! times the displacement the tool must add. With no other load on the organ that is the
+//! tip's penetration along the normal. Holding the surface sideways too, against the other
+//! loads, makes the tool a spring on the patch: its answer to them derives from an energy, so
+//! the tool and organ contact can be solved as one problem ([`super::hold`]). A tool that
+//! let the others move the surface sideways, yet held it sideways against its own load, drove
+//! the gallbladder into the liver with the contact, tick after tick.
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use super::{ContactSurface, SurfaceHit};
+use super::{ContactSurface, SurfaceHit, ToolHold};
 use crate::pgd::{BuildSettings, Patch, PatchLoad, SurfacePoint, Vademecum};
 
 /// A rigid probe with a spherical tip.
@@ -33,63 +39,92 @@ impl Default for Probe {
 pub struct ToolContact {
     /// The contact point on the rest surface.
     pub hit: SurfaceHit,
-    /// How far the organ's other loads have moved the surface there (m).
+    /// How far the organ's other loads have moved the surface there (m), averaged over the
+    /// tool's patch.
     pub moved_m: Vector3<f64>,
     /// How far the tip reaches below the rest surface, along the normal (m); clamped to the
     /// vademecum's valid range.
     pub depth_m: f64,
-    /// The displacement imposed on the surface under the tool (m).
+    /// The displacement the tool's load adds to the surface under it (m): into the surface by
+    /// the depth, and back sideways by what the other loads moved it.
     pub indentation_m: Vector3<f64>,
     /// The force on the organ (N); the device renders its opposite.
     pub force_n: Vector3<f64>,
 }
 
-/// What the tool presses: an organ's vademecum, its contact surface, and how far its other
-/// loads have moved each surface point (m).
-pub struct Target<'a, F: Fn(&SurfacePoint) -> Vector3<f64>> {
+/// What the tool presses: an organ's vademecum, its contact surface, how far each load
+/// position has moved under the organ's other loads, and how far each surface point has moved
+/// under all its loads (the tool's of the last tick included) (m).
+pub struct Target<'a, F, G>
+where
+    F: Fn(usize) -> Vector3<f64>,
+    G: Fn(&SurfacePoint) -> Vector3<f64>,
+{
     pub vademecum: &'a Vademecum,
     pub surface: &'a ContactSurface,
     pub moved_by_others: F,
+    pub moved_by_all: G,
 }
 
 /// Presses `probe`, its tip centred at `tip_m`, into `target`: sets `load` to the force that
 /// makes the surface follow the tip and returns the contact, or releases `load` when the tip
 /// does not touch. `patch` is scratch space kept between ticks: nothing is allocated once it
 /// and `load` have grown.
-pub fn press<F: Fn(&SurfacePoint) -> Vector3<f64>>(
-    target: &Target<F>,
+pub fn press<F, G>(
+    target: &Target<F, G>,
     probe: &Probe,
     tip_m: &Vector3<f64>,
     patch: &mut Patch,
     load: &mut PatchLoad,
-) -> Option<ToolContact> {
+) -> Option<ToolContact>
+where
+    F: Fn(usize) -> Vector3<f64>,
+    G: Fn(&SurfacePoint) -> Vector3<f64>,
+{
     let vademecum = target.vademecum;
-    let Some(contact) = touch(target, probe, tip_m) else {
+    let Some(contact) = touch(target, probe, tip_m, patch) else {
         load.release();
         return None;
     };
-    vademecum.patch_into(&contact.hit.at, patch);
     let force_n = vademecum.patch_force_for_indentation(patch, &contact.indentation_m);
     load.shares.clone_from(&patch.shares);
     load.force_n = force_n;
     Some(ToolContact { force_n, ..contact })
 }
 
-/// Where and how deep the tip presses, before the force is known. The point below the tip on
-/// the moved surface is found by projecting the tip moved back by the other loads'
-/// displacement (one correction: that displacement varies slowly along the surface).
-fn touch<F: Fn(&SurfacePoint) -> Vector3<f64>>(
-    target: &Target<F>,
+/// Where and how deep the tip presses, before the force is known, and the patch under it.
+/// - The point below the tip is found on the surface as all loads have moved it (one
+///   correction: the displacement varies slowly along the surface). The other loads alone
+///   would not do: an organ pressed against another carries the two loads' large, opposite
+///   displacements (the coarse gallbladder's floppy modes, tens of centimetres each way), and
+///   the point found with one of them jumped across the surface from tick to tick.
+/// - What the other loads moved is averaged over the patch with the patch's shares, as the
+///   patch compliance averages the tool's own displacement. Taken at one point instead, the
+///   tool's answer to a contact force did not match what the contact solve expected, and on
+///   the floppy gallbladder held by the tool the contact's compliance is the small difference
+///   of the two ([`super::hold`]).
+fn touch<F, G>(
+    target: &Target<F, G>,
     probe: &Probe,
     tip_m: &Vector3<f64>,
-) -> Option<ToolContact> {
+    patch: &mut Patch,
+) -> Option<ToolContact>
+where
+    F: Fn(usize) -> Vector3<f64>,
+    G: Fn(&SurfacePoint) -> Vector3<f64>,
+{
     let (vademecum, surface) = (target.vademecum, target.surface);
     let mut hit = surface.closest(tip_m)?;
-    let mut moved_m = (target.moved_by_others)(&hit.at);
-    if moved_m != Vector3::zeros() {
-        hit = surface.closest(&(tip_m - moved_m))?;
-        moved_m = (target.moved_by_others)(&hit.at);
+    let moved_by_all = (target.moved_by_all)(&hit.at);
+    if moved_by_all != Vector3::zeros() {
+        hit = surface.closest(&(tip_m - moved_by_all))?;
     }
+    vademecum.patch_into(&hit.at, patch);
+    let moved_m: Vector3<f64> = patch
+        .shares
+        .iter()
+        .map(|&(position, share)| (target.moved_by_others)(position) * share)
+        .sum();
     let depth_m = probe.tip_radius_m - (tip_m - hit.point_m - moved_m).dot(&hit.normal);
     if depth_m <= 0.0 {
         return None;
@@ -98,11 +133,42 @@ fn touch<F: Fn(&SurfacePoint) -> Vector3<f64>>(
         1 => depth_m,
         _ => depth_m.min(vademecum.valid_indentation_m()),
     };
+    let sideways_m = moved_m - hit.normal * moved_m.dot(&hit.normal);
     Some(ToolContact {
         hit,
         moved_m,
         depth_m,
-        indentation_m: -hit.normal * depth_m,
+        indentation_m: -hit.normal * depth_m - sideways_m,
         force_n: Vector3::zeros(),
     })
+}
+
+/// The tool, where it is, answers the contact forces of the tick moving the surface under it
+/// by `moved_m` ([`super::ToolHold`]): it takes the move back, so its depth grows by the move
+/// along the normal, and its load by the hold's stiffness times the move (exact for a linear
+/// vademecum; for a KSV one the next tick's press takes the secant and its range again). A
+/// depth that reaches zero lets go.
+pub fn follow(
+    contact: &mut Option<ToolContact>,
+    load: &mut PatchLoad,
+    hold: &ToolHold,
+    moved_m: &Vector3<f64>,
+) {
+    let Some(touch) = contact else {
+        return;
+    };
+    if !hold.is_held() || *moved_m == Vector3::zeros() {
+        return;
+    }
+    touch.depth_m += moved_m.dot(&touch.hit.normal);
+    if touch.depth_m <= 0.0 {
+        *contact = None;
+        load.release();
+        return;
+    }
+    let change_n = hold.stiffness_n_per_m() * -moved_m;
+    touch.moved_m += moved_m;
+    touch.indentation_m -= moved_m;
+    touch.force_n += change_n;
+    load.force_n += change_n;
 }

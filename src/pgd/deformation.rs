@@ -166,14 +166,29 @@ impl Deformation {
         at: &SurfacePoint,
         skip: usize,
     ) -> Vector3<f64> {
-        let mut u = self.carry.at(&vademecum.point(at));
-        for (corner, weight) in vademecum.triangles[at.triangle].iter().zip(at.barycentric) {
-            let node = vademecum.positions[*corner as usize] as usize;
-            for (step, coupling) in self.coupling.iter().enumerate() {
-                for (mode, &c) in coupling.iter().enumerate() {
-                    if c != 0.0 {
-                        u += vademecum.mode_at_node(step, mode, node) * (c * weight);
-                    }
+        vademecum.triangles[at.triangle]
+            .iter()
+            .zip(at.barycentric)
+            .map(|(&corner, weight)| {
+                self.position_displacement_without(vademecum, corner as usize, skip) * weight
+            })
+            .sum()
+    }
+
+    /// [`Self::displacement_without`] at load position `position`.
+    pub fn position_displacement_without(
+        &self,
+        vademecum: &Vademecum,
+        position: usize,
+        skip: usize,
+    ) -> Vector3<f64> {
+        let rest = Vector3::from(vademecum.position_coords_m[position].map(f64::from));
+        let node = vademecum.positions[position] as usize;
+        let mut u = self.carry.at(&rest);
+        for (step, coupling) in self.coupling.iter().enumerate() {
+            for (mode, &c) in coupling.iter().enumerate() {
+                if c != 0.0 {
+                    u += vademecum.mode_at_node(step, mode, node) * c;
                 }
             }
         }
@@ -183,19 +198,8 @@ impl Deformation {
             .enumerate()
             .filter(|&(slot, load)| slot != skip && load.is_active());
         for (_, load) in others {
-            for (corner, weight) in vademecum.triangles[at.triangle].iter().zip(at.barycentric) {
-                let node = vademecum.positions[*corner as usize] as usize;
-                let mut at_node = Vector3::zeros();
-                for step in 0..vademecum.steps.len() {
-                    vademecum.add_node_displacement(
-                        step,
-                        &load.shares,
-                        &load.force_n,
-                        node,
-                        &mut at_node,
-                    );
-                }
-                u += at_node * weight;
+            for step in 0..vademecum.steps.len() {
+                vademecum.add_node_displacement(step, &load.shares, &load.force_n, node, &mut u);
             }
         }
         u

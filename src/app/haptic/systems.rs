@@ -8,7 +8,7 @@ use super::resources::{
     Device, DeviceForce, FaultLog, ForceTrace, OrganCoupling, Safety, TickClock, Tool,
 };
 use super::snapshot::{LoopTiming, SnapshotPublisher};
-use crate::contact::{Target, press};
+use crate::contact::{Target, follow, press};
 use crate::haptics::Fault;
 use crate::pgd::SurfacePoint;
 
@@ -49,24 +49,27 @@ pub fn tool_contact(
             continue;
         };
         let deformation = &mut deformation.0;
-        // Split the borrow: other loads are read while the tool's slot is written.
-        let mut tool_load = std::mem::take(&mut deformation.loads[OrganDeformation::TOOL]);
+        let touch = &mut *touch;
         let target = Target {
             vademecum: &body.vademecum,
             surface: &body.surface,
-            moved_by_others: |at: &SurfacePoint| {
-                deformation.displacement_without(&body.vademecum, at, OrganDeformation::TOOL)
+            moved_by_others: |position: usize| {
+                let tool = OrganDeformation::TOOL;
+                deformation.position_displacement_without(&body.vademecum, position, tool)
             },
+            moved_by_all: |at: &SurfacePoint| deformation.displacement(&body.vademecum, at),
         };
-        let touch = &mut *touch;
         touch.contact = press(
             &target,
             &tool.probe,
             &sample.tip_m,
             &mut touch.patch,
-            &mut tool_load,
+            &mut touch.next_load,
         );
-        deformation.loads[OrganDeformation::TOOL] = tool_load;
+        std::mem::swap(
+            &mut deformation.loads[OrganDeformation::TOOL],
+            &mut touch.next_load,
+        );
     }
 }
 
@@ -77,23 +80,39 @@ pub fn evaluate_modes(mut organs: Query<(&OrganBody, &mut OrganDeformation)>) {
     }
 }
 
-/// Organ against organ: hands every organ's coefficients to the coupling, ticks its pairs and
-/// attachments, and gives each organ its coupling loads and carry (felt through the tool from
-/// the next tick on, as the surface under it moves).
+/// Organ against organ: hands every organ's coefficients and the tool's hold on it to the
+/// coupling, ticks its pairs and attachments, and gives each organ its coupling loads and
+/// carry. The tool's load follows the contact's push in the same tick, so the trainee feels
+/// the organ behind at once.
 pub fn organ_contact(
     coupling: Option<ResMut<OrganCoupling>>,
-    mut organs: Query<(&OrganIndex, &mut OrganDeformation)>,
+    mut organs: Query<(
+        &OrganIndex,
+        &OrganBody,
+        &mut ToolTouch,
+        &mut OrganDeformation,
+    )>,
 ) {
     let Some(mut coupling) = coupling else {
         return;
     };
     let coupling = &mut coupling.0;
-    for (index, deformation) in &organs {
-        coupling.read(index.0, &deformation.0);
+    for (index, body, touch, deformation) in &organs {
+        let deformation = &deformation.0;
+        coupling.read(index.0, deformation);
+        let load = &deformation.loads[OrganDeformation::TOOL];
+        coupling.hold(index.0, &body.vademecum, &touch.patch, load);
     }
     coupling.tick();
-    for (index, mut deformation) in &mut organs {
-        coupling.write(index.0, &mut deformation.0);
+    for (index, _, mut touch, mut deformation) in &mut organs {
+        let deformation = &mut deformation.0;
+        coupling.write(index.0, deformation);
+        follow(
+            &mut touch.contact,
+            &mut deformation.loads[OrganDeformation::TOOL],
+            coupling.tool_hold(index.0),
+            &coupling.tool_moved_m(index.0),
+        );
     }
 }
 
