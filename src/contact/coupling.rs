@@ -12,9 +12,9 @@ use super::modal_rows::{concatenate, step_ranges};
 use super::penalty::{OrganPose, PairOutput, PenaltySettings};
 use super::{
     Attachment, ContactError, ContactPair, ContactSurface, DistanceField, DistanceSettings,
-    Pointshell, PointshellDensity, ToolHold,
+    Pointshell, PointshellDensity, ToolContact, ToolHold,
 };
-use crate::pgd::{Deformation, Patch, PatchLoad, RigidCarry, Vademecum};
+use crate::pgd::{Deformation, PatchLoad, RigidCarry, Vademecum};
 
 /// Which organ is the master, and how the coupling is set up.
 #[derive(Clone, Debug, PartialEq)]
@@ -148,19 +148,20 @@ impl Coupling {
         concatenate(&deformation.coefficients, &mut organ.alpha);
     }
 
-    /// Takes how the tool holds organ `index` this tick: it presses on `patch` with `load`,
+    /// Takes how the tool holds organ `index` this tick: it presses as `contact` with `load`,
     /// or not at all.
-    pub fn hold(&mut self, index: usize, vademecum: &Vademecum, patch: &Patch, load: &PatchLoad) {
+    pub fn hold(
+        &mut self,
+        index: usize,
+        vademecum: &Vademecum,
+        contact: Option<&ToolContact>,
+        load: &PatchLoad,
+    ) {
         let hold = &mut self.organs[index].hold;
-        match load.is_active() {
-            true => hold.hold(vademecum, patch, load),
-            false => hold.release(),
+        match contact {
+            Some(contact) => hold.hold(vademecum, contact, load),
+            None => hold.release(),
         }
-    }
-
-    /// How the tool holds organ `index` this tick.
-    pub fn tool_hold(&self, index: usize) -> &ToolHold {
-        &self.organs[index].hold
     }
 
     /// One tick of every attachment and pair.

@@ -18,14 +18,13 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::pgd::{Patch, PatchLoad, Vademecum};
+use super::ToolContact;
+use crate::pgd::{PatchLoad, Vademecum};
 
 /// One organ's hold by the tool this tick, linearized (see the module's documentation).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ToolHold {
     held: bool,
-    /// `K`: the tool's load per metre the surface under it is moved (N/m).
-    stiffness_n_per_m: Matrix3<f64>,
     /// `Y`, direction after direction: the modal coefficients of `K e_a`, all load steps
     /// concatenated (per metre).
     pub(super) coefficients_per_m: [Vec<f32>; 3],
@@ -41,31 +40,31 @@ impl ToolHold {
         self.held
     }
 
-    pub fn stiffness_n_per_m(&self) -> &Matrix3<f64> {
-        &self.stiffness_n_per_m
-    }
-
-    /// The tool presses the organ on `patch` with `load`: takes its answer to a move of the
-    /// surface under it. Allocates nothing once grown.
-    pub fn hold(&mut self, vademecum: &Vademecum, patch: &Patch, load: &PatchLoad) {
-        let stiffness = vademecum.compliance(patch, &load.force_n).try_inverse();
-        self.held = load.is_active() && stiffness.is_some();
-        let Some(stiffness) = stiffness.filter(|_| self.held) else {
+    /// The tool presses the organ as `contact` with `load`: takes its answer to a move of
+    /// the surface under it. Allocates nothing once grown.
+    pub fn hold(&mut self, vademecum: &Vademecum, contact: &ToolContact, load: &PatchLoad) {
+        let stiffness = &contact.stiffness_n_per_m;
+        self.held = load.is_active() && *stiffness != Matrix3::zeros();
+        if !self.held {
             return;
-        };
-        self.stiffness_n_per_m = stiffness;
+        }
         for a in 0..3 {
             self.coefficients_per_m[a].clear();
             self.moved_per_coefficient_m[a].clear();
-            self.gather_coefficients(vademecum, a, load);
+            self.gather_coefficients(vademecum, &stiffness.column(a).into(), a, load);
             self.gather_moves(vademecum, a, load);
         }
     }
 
     /// `Y e_a`. A KSV vademecum picks its load steps by the force's size, so the load `K e_a`
     /// is scaled to the tool's force and its coefficients back.
-    fn gather_coefficients(&mut self, vademecum: &Vademecum, a: usize, load: &PatchLoad) {
-        let direction: Vector3<f64> = self.stiffness_n_per_m.column(a).into();
+    fn gather_coefficients(
+        &mut self,
+        vademecum: &Vademecum,
+        direction: &Vector3<f64>,
+        a: usize,
+        load: &PatchLoad,
+    ) {
         let scale = match vademecum.steps.len() {
             1 => 1.0,
             _ => load.force_n.norm() / direction.norm(),

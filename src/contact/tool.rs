@@ -13,10 +13,10 @@
 //! let the others move the surface sideways, yet held it sideways against its own load, drove
 //! the gallbladder into the liver with the contact, tick after tick.
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::{ContactSurface, SurfaceHit, ToolHold};
+use super::{ContactSurface, SurfaceHit};
 use crate::pgd::{BuildSettings, Patch, PatchLoad, SurfacePoint, Vademecum};
 
 /// A rigid probe with a spherical tip.
@@ -48,6 +48,8 @@ pub struct ToolContact {
     /// The displacement the tool's load adds to the surface under it (m): into the surface by
     /// the depth, and back sideways by what the other loads moved it.
     pub indentation_m: Vector3<f64>,
+    /// How the force changes with the indentation (N/m): the inverse of the patch compliance.
+    pub stiffness_n_per_m: Matrix3<f64>,
     /// The force on the organ (N); the device renders its opposite.
     pub force_n: Vector3<f64>,
 }
@@ -86,10 +88,14 @@ where
         load.release();
         return None;
     };
-    let force_n = vademecum.patch_force_for_indentation(patch, &contact.indentation_m);
+    let (force_n, stiffness_n_per_m) = vademecum.patch_press(patch, &contact.indentation_m);
     load.shares.clone_from(&patch.shares);
     load.force_n = force_n;
-    Some(ToolContact { force_n, ..contact })
+    Some(ToolContact {
+        force_n,
+        stiffness_n_per_m,
+        ..contact
+    })
 }
 
 /// Where and how deep the tip presses, before the force is known, and the patch under it.
@@ -139,6 +145,7 @@ where
         moved_m,
         depth_m,
         indentation_m: -hit.normal * depth_m - sideways_m,
+        stiffness_n_per_m: Matrix3::zeros(),
         force_n: Vector3::zeros(),
     })
 }
@@ -148,16 +155,11 @@ where
 /// along the normal, and its load by the hold's stiffness times the move (exact for a linear
 /// vademecum; for a KSV one the next tick's press takes the secant and its range again). A
 /// depth that reaches zero lets go.
-pub fn follow(
-    contact: &mut Option<ToolContact>,
-    load: &mut PatchLoad,
-    hold: &ToolHold,
-    moved_m: &Vector3<f64>,
-) {
+pub fn follow(contact: &mut Option<ToolContact>, load: &mut PatchLoad, moved_m: &Vector3<f64>) {
     let Some(touch) = contact else {
         return;
     };
-    if !hold.is_held() || *moved_m == Vector3::zeros() {
+    if *moved_m == Vector3::zeros() {
         return;
     }
     touch.depth_m += moved_m.dot(&touch.hit.normal);
@@ -166,7 +168,7 @@ pub fn follow(
         load.release();
         return;
     }
-    let change_n = hold.stiffness_n_per_m() * -moved_m;
+    let change_n = touch.stiffness_n_per_m * -moved_m;
     touch.moved_m += moved_m;
     touch.indentation_m -= moved_m;
     touch.force_n += change_n;

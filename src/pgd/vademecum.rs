@@ -343,17 +343,28 @@ impl Vademecum {
         patch: &Patch,
         indentation_m: &Vector3<f64>,
     ) -> Vector3<f64> {
+        self.patch_press(patch, indentation_m).0
+    }
+
+    /// [`Self::patch_force_for_indentation`] and the stiffness it used (N/m, the inverse of
+    /// the patch compliance, the secant one for a KSV vademecum; zero if singular): how the
+    /// force would change for a change of the indentation.
+    pub fn patch_press(
+        &self,
+        patch: &Patch,
+        indentation_m: &Vector3<f64>,
+    ) -> (Vector3<f64>, Matrix3<f64>) {
         let solve = |c: Matrix3<f64>| {
-            c.try_inverse()
-                .map_or_else(Vector3::zeros, |inverse| inverse * indentation_m)
+            let stiffness = c.try_inverse().unwrap_or_else(Matrix3::zeros);
+            (stiffness * indentation_m, stiffness)
         };
-        let mut force = solve(self.step_compliance(0, patch));
+        let mut press = solve(self.step_compliance(0, patch));
         if self.steps.len() > 1 {
             for _ in 0..SECANT_ITERATIONS {
-                force = solve(self.compliance(patch, &force));
+                press = solve(self.compliance(patch, &press.0));
             }
         }
-        force
+        press
     }
 
     /// The displacement field (m, all dofs) for a force (N) at `at`.

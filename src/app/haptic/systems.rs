@@ -101,7 +101,7 @@ pub fn organ_contact(
         let deformation = &deformation.0;
         coupling.read(index.0, deformation);
         let load = &deformation.loads[OrganDeformation::TOOL];
-        coupling.hold(index.0, &body.vademecum, &touch.patch, load);
+        coupling.hold(index.0, &body.vademecum, touch.contact.as_ref(), load);
     }
     coupling.tick();
     for (index, _, mut touch, mut deformation) in &mut organs {
@@ -110,7 +110,6 @@ pub fn organ_contact(
         follow(
             &mut touch.contact,
             &mut deformation.loads[OrganDeformation::TOOL],
-            coupling.tool_hold(index.0),
             &coupling.tool_moved_m(index.0),
         );
     }
