@@ -136,24 +136,21 @@ impl Run {
         let [master_c, shell_c] = &mut self.coefficients;
         master_c.fill(0.0);
         shell_c.fill(0.0);
-        let free = ToolHold::default();
-        let (mut master_moved_m, mut shell_moved_m) = (Vector3::zeros(), Vector3::zeros());
+        let (mut master_hold, mut shell_hold) = (ToolHold::default(), ToolHold::default());
         self.pair.tick(
             OrganPose {
                 alpha: &self.alpha[0],
                 carry: &self.carry,
-                hold: &free,
             },
             OrganPose {
                 alpha: &self.alpha[1],
                 carry: &self.still,
-                hold: &free,
             },
             PairOutput {
                 master: master_c,
                 shell: shell_c,
-                master_tool_moved_m: &mut master_moved_m,
-                shell_tool_moved_m: &mut shell_moved_m,
+                master_hold: &mut master_hold,
+                shell_hold: &mut shell_hold,
             },
         );
     }

@@ -53,7 +53,6 @@ struct CoupledOrgan {
     coupling_force_n: Vector3<f64>,
     carry: RigidCarry,
     hold: ToolHold,
-    tool_moved_m: Vector3<f64>,
 }
 
 #[derive(Clone)]
@@ -126,7 +125,6 @@ impl Coupling {
                 coupling_force_n: Vector3::zeros(),
                 carry: RigidCarry::default(),
                 hold: ToolHold::default(),
-                tool_moved_m: Vector3::zeros(),
             })
             .collect();
         Ok(Self {
@@ -150,16 +148,10 @@ impl Coupling {
 
     /// Takes how the tool holds organ `index` this tick: it presses as `contact` with `load`,
     /// or not at all.
-    pub fn hold(
-        &mut self,
-        index: usize,
-        vademecum: &Vademecum,
-        contact: Option<&ToolContact>,
-        load: &PatchLoad,
-    ) {
+    pub fn hold(&mut self, index: usize, contact: Option<&ToolContact>, load: &PatchLoad) {
         let hold = &mut self.organs[index].hold;
         match contact {
-            Some(contact) => hold.hold(vademecum, contact, load),
+            Some(contact) => hold.hold(contact, load),
             None => hold.release(),
         }
     }
@@ -170,7 +162,7 @@ impl Coupling {
             organ.coupling.fill(0.0);
             organ.coupling_force_n = Vector3::zeros();
             organ.carry = RigidCarry::default();
-            organ.tool_moved_m = Vector3::zeros();
+            organ.hold.moved_m = Vector3::zeros();
         }
         for a in &self.attachments {
             self.organs[a.carried].carry = a.carry(&self.organs[a.carrier].alpha);
@@ -181,18 +173,16 @@ impl Coupling {
                 OrganPose {
                     alpha: &master.alpha,
                     carry: &master.carry,
-                    hold: &master.hold,
                 },
                 OrganPose {
                     alpha: &shell.alpha,
                     carry: &shell.carry,
-                    hold: &shell.hold,
                 },
                 PairOutput {
                     master: &mut master.coupling,
                     shell: &mut shell.coupling,
-                    master_tool_moved_m: &mut master.tool_moved_m,
-                    shell_tool_moved_m: &mut shell.tool_moved_m,
+                    master_hold: &mut master.hold,
+                    shell_hold: &mut shell.hold,
                 },
             );
             let force = pair.report().force_on_shell_n;
@@ -204,7 +194,7 @@ impl Coupling {
     /// How far (m) this tick's contact forces move the surface under the tool holding organ
     /// `index`: the tool's load follows it in the same tick ([`super::hold`]).
     pub fn tool_moved_m(&self, index: usize) -> Vector3<f64> {
-        self.organs[index].tool_moved_m
+        self.organs[index].hold.moved_m()
     }
 
     /// Hands organ `index` its coupling of this tick.

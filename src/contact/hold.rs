@@ -21,10 +21,18 @@ use nalgebra::{Matrix3, Vector3};
 use super::ToolContact;
 use crate::pgd::{PatchLoad, Vademecum};
 
-/// One organ's hold by the tool this tick, linearized (see the module's documentation).
+/// One organ's hold by the tool this tick, linearized (see the module's documentation): the
+/// press it answers, its rows (computed only when a contact pair pushes, as most ticks that
+/// press an organ have no contact to answer), and how far the contact forces moved the patch.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ToolHold {
     held: bool,
+    /// Whether the rows are those of this tick's press.
+    ready: bool,
+    /// `K`: the tool's load per metre the patch is moved (N/m).
+    stiffness_n_per_m: Matrix3<f64>,
+    /// The tool's load (a copy, its buffer kept from tick to tick).
+    load: PatchLoad,
     /// `Y`, direction after direction: the modal coefficients of `K e_a`, all load steps
     /// concatenated (per metre).
     pub(super) coefficients_per_m: [Vec<f32>; 3],
@@ -33,57 +41,74 @@ pub struct ToolHold {
     pub(super) moved_per_coefficient_m: [Vec<f32>; 3],
     /// One load step's coefficients, before they are scaled.
     scratch: Vec<f64>,
+    /// How far this tick's contact forces moved the patch (m).
+    pub(super) moved_m: Vector3<f64>,
 }
 
 impl ToolHold {
-    pub fn is_held(&self) -> bool {
-        self.held
+    /// Whether the tool holds the organ and the rows are ready.
+    pub fn is_ready(&self) -> bool {
+        self.held && self.ready
     }
 
-    /// The tool presses the organ as `contact` with `load`: takes its answer to a move of
-    /// the surface under it. Allocates nothing once grown.
-    pub fn hold(&mut self, vademecum: &Vademecum, contact: &ToolContact, load: &PatchLoad) {
-        let stiffness = &contact.stiffness_n_per_m;
-        self.held = load.is_active() && *stiffness != Matrix3::zeros();
-        if !self.held {
+    /// How far this tick's contact forces moved the surface under the tool (m).
+    pub fn moved_m(&self) -> Vector3<f64> {
+        self.moved_m
+    }
+
+    /// The tool presses the organ as `contact` with `load` this tick. Allocates nothing once
+    /// grown.
+    pub fn hold(&mut self, contact: &ToolContact, load: &PatchLoad) {
+        self.stiffness_n_per_m = contact.stiffness_n_per_m;
+        self.held = load.is_active() && self.stiffness_n_per_m != Matrix3::zeros();
+        self.ready = false;
+        self.load.clone_from(load);
+    }
+
+    /// The tool does not press the organ this tick.
+    pub fn release(&mut self) {
+        self.held = false;
+        self.ready = false;
+    }
+
+    /// Computes the rows of this tick's press, once.
+    pub(super) fn prepare(&mut self, vademecum: &Vademecum) {
+        if !self.held || self.ready {
             return;
         }
         for a in 0..3 {
             self.coefficients_per_m[a].clear();
             self.moved_per_coefficient_m[a].clear();
-            self.gather_coefficients(vademecum, &stiffness.column(a).into(), a, load);
-            self.gather_moves(vademecum, a, load);
+            let direction = self.stiffness_n_per_m.column(a).into();
+            self.gather_coefficients(vademecum, &direction, a);
+            self.gather_moves(vademecum, a);
         }
+        self.ready = true;
     }
 
     /// `Y e_a`. A KSV vademecum picks its load steps by the force's size, so the load `K e_a`
     /// is scaled to the tool's force and its coefficients back.
-    fn gather_coefficients(
-        &mut self,
-        vademecum: &Vademecum,
-        direction: &Vector3<f64>,
-        a: usize,
-        load: &PatchLoad,
-    ) {
+    fn gather_coefficients(&mut self, vademecum: &Vademecum, direction: &Vector3<f64>, a: usize) {
         let scale = match vademecum.steps.len() {
             1 => 1.0,
-            _ => load.force_n.norm() / direction.norm(),
+            _ => self.load.force_n.norm() / direction.norm(),
         };
         for step in 0..vademecum.steps.len() {
             self.scratch.clear();
             self.scratch.resize(vademecum.modes(step), 0.0);
             let force = direction * scale;
-            vademecum.add_coefficients(step, &load.shares, &force, &mut self.scratch);
+            vademecum.add_coefficients(step, &self.load.shares, &force, &mut self.scratch);
             let per_m = self.scratch.iter().map(|c| (c / scale) as f32);
             self.coefficients_per_m[a].extend(per_m);
         }
     }
 
     /// `B`'s row `a`: each mode's displacement along `e_a`, averaged over the patch.
-    fn gather_moves(&mut self, vademecum: &Vademecum, a: usize, load: &PatchLoad) {
+    fn gather_moves(&mut self, vademecum: &Vademecum, a: usize) {
         for step in 0..vademecum.steps.len() {
             for mode in 0..vademecum.modes(step) {
-                let moved: f64 = load
+                let moved: f64 = self
+                    .load
                     .shares
                     .iter()
                     .map(|&(position, share)| {
@@ -94,10 +119,5 @@ impl ToolHold {
                 self.moved_per_coefficient_m[a].push(moved as f32);
             }
         }
-    }
-
-    /// The tool does not press the organ.
-    pub fn release(&mut self) {
-        self.held = false;
     }
 }

@@ -65,7 +65,7 @@ impl OrganRows {
 
     /// Takes the tool's hold of this tick for the nodes of `set`.
     fn hold(&mut self, set: &[u32], hold: &ToolHold) {
-        self.held = hold.is_held();
+        self.held = hold.is_ready();
         if !self.held {
             return;
         }

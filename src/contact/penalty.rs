@@ -68,8 +68,6 @@ pub struct OrganPose<'a> {
     /// Modal coefficients, all load steps concatenated.
     pub alpha: &'a [f32],
     pub carry: &'a RigidCarry,
-    /// How the tool holds it this tick.
-    pub hold: &'a ToolHold,
 }
 
 /// The contact of the last tick, for reports and tests.
@@ -117,12 +115,13 @@ pub struct ContactPair {
 }
 
 /// Per organ, where this tick's contact coefficients go (all load steps concatenated), and
-/// where the move (m) the contact forces' change makes under the tool holding it goes.
+/// the tool's hold on it, which takes the move the contact forces' change makes under the
+/// tool.
 pub struct PairOutput<'a> {
     pub master: &'a mut [f64],
     pub shell: &'a mut [f64],
-    pub master_tool_moved_m: &'a mut Vector3<f64>,
-    pub shell_tool_moved_m: &'a mut Vector3<f64>,
+    pub master_hold: &'a mut ToolHold,
+    pub shell_hold: &'a mut ToolHold,
 }
 
 impl ContactPair {
@@ -194,8 +193,12 @@ impl ContactPair {
             let depth_m = self.measure(i, master, shell);
             report.deepest_m = report.deepest_m.max(depth_m);
         }
+        if !self.active.is_empty() {
+            out.master_hold.prepare(&self.master_vademecum);
+            out.shell_hold.prepare(&self.shell_vademecum);
+        }
         let compliance = &mut self.compliance;
-        compliance.hold(&self.active, master.hold, shell.hold);
+        compliance.hold(&self.active, out.master_hold, out.shell_hold);
         for &i in &self.active {
             self.change_n[i as usize] = -self.force_n[i as usize];
         }
@@ -211,8 +214,8 @@ impl ContactPair {
             self.change_n[i as usize] += self.force_n[i as usize];
         }
         let (master_moved_m, shell_moved_m) = compliance.tool_moves_m(&self.active, &self.change_n);
-        *out.master_tool_moved_m += master_moved_m;
-        *out.shell_tool_moved_m += shell_moved_m;
+        out.master_hold.moved_m += master_moved_m;
+        out.shell_hold.moved_m += shell_moved_m;
         for &i in &self.active {
             let i = i as usize;
             if self.force_n[i] > 0.0 {

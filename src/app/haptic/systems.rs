@@ -86,25 +86,20 @@ pub fn evaluate_modes(mut organs: Query<(&OrganBody, &mut OrganDeformation)>) {
 /// the organ behind at once.
 pub fn organ_contact(
     coupling: Option<ResMut<OrganCoupling>>,
-    mut organs: Query<(
-        &OrganIndex,
-        &OrganBody,
-        &mut ToolTouch,
-        &mut OrganDeformation,
-    )>,
+    mut organs: Query<(&OrganIndex, &mut ToolTouch, &mut OrganDeformation)>,
 ) {
     let Some(mut coupling) = coupling else {
         return;
     };
     let coupling = &mut coupling.0;
-    for (index, body, touch, deformation) in &organs {
+    for (index, touch, deformation) in &organs {
         let deformation = &deformation.0;
         coupling.read(index.0, deformation);
         let load = &deformation.loads[OrganDeformation::TOOL];
-        coupling.hold(index.0, &body.vademecum, touch.contact.as_ref(), load);
+        coupling.hold(index.0, touch.contact.as_ref(), load);
     }
     coupling.tick();
-    for (index, _, mut touch, mut deformation) in &mut organs {
+    for (index, mut touch, mut deformation) in &mut organs {
         let deformation = &mut deformation.0;
         coupling.write(index.0, deformation);
         follow(
