@@ -2,8 +2,8 @@
 //! distances to the master, through both organs' modal compliance (the shell node pushed out,
 //! the master pushed back). Rows are projected on the rest normals once, so applying it over
 //! a set of nodes costs `4 · nodes · (shell modes + master modes)` products, a few times per
-//! tick in the contact's force solve. Its diagonal sets the penalties. Where the tool holds an organ, its part of `A` takes the tool's answer as a rank-one
-//! change ([`super::hold`]).
+//! tick in the contact's force solve. Its diagonal sets the penalties. Where the tool holds an
+//! organ, its part of `A` takes the tool's answer as a change of rank 3 ([`super::hold`]).
 
 use nalgebra::Vector3;
 
@@ -169,7 +169,8 @@ impl NormalCompliance {
         let own = [self.shell.diagonal(i), self.master.diagonal(i)];
         own.into_iter()
             .filter(|&a| a > 0.0)
-            .fold(0.0, |m: f64, a| if m == 0.0 { a } else { m.min(a) })
+            .reduce(f64::min)
+            .unwrap_or(0.0)
     }
 
     /// Takes the tool's hold of each organ for this tick's nodes `set`.

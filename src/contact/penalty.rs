@@ -1,8 +1,9 @@
 //! Penalty contact between the master and one pointshell organ, one tick at a time.
 //!
 //! A pointshell node inside the master's deformed zero level set (`d < 0`) is pushed out by
-//! `F = −k · d · n` (`k`: the node's penalty); the master takes `−F` at its nearest position. Both forces become modal coefficients of their organs, so the contact
-//! deforms both, and the next tick sees the moved surfaces.
+//! `F = −k · d · n` (`k`: the node's penalty); the master takes `−F` at its nearest
+//! position. Both forces become modal coefficients of their organs, so the contact deforms
+//! both, and the next tick sees the moved surfaces.
 //!
 //! **Stability.** The vademecums are quasi-static: a force moves the surfaces at once, with no
 //! inertia to slow it, so the penalty fed straight back (`f = −k d`, then the surfaces move,
@@ -125,7 +126,7 @@ pub struct PairOutput<'a> {
 }
 
 impl ContactPair {
-    /// Sets up the pair: the penalty from the loop gain of the whole shell.
+    /// Sets up the pair: each node's penalty from the stiffer organ's compliance there.
     pub fn new(
         (master, master_vademecum): (usize, Arc<Vademecum>),
         (shell, shell_vademecum): (usize, Arc<Vademecum>),
