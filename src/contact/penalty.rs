@@ -99,10 +99,8 @@ pub struct ContactPair {
     shell_steps: Vec<Range<usize>>,
     /// Penalty per node (N/m): per area (N/m³) times its area.
     stiffness_n_per_m: Vec<f64>,
-    /// Per node: the normal force (N, ≥ 0), its direction, and the energy's gradient
-    /// `d + f/k` (m).
+    /// Per node: the normal force (N, ≥ 0) and the energy's gradient `d + f/k` (m).
     force_n: Vec<f64>,
-    normal: Vec<Vector3<f64>>,
     gradient_m: Vec<f64>,
     /// Nodes that push or are pushed into, this tick.
     active: Vec<u32>,
@@ -148,7 +146,6 @@ impl ContactPair {
             stiffness_n_per_m,
             nodes,
             force_n: vec![0.0; count],
-            normal: vec![Vector3::zeros(); count],
             gradient_m: vec![0.0; count],
             active: Vec::with_capacity(count),
             change_n: vec![0.0; count],
@@ -174,16 +171,17 @@ impl ContactPair {
 
     /// One tick: measures every node that can touch (or still pushes), solves for the forces,
     /// and adds both organs' contact coefficients to `out`. Nodes farther at rest than
-    /// everything can move are skipped with one comparison: the lattice values move by at
-    /// most the field's bound, and the point itself by the shell's bound and both carries,
-    /// across an interpolated distance whose slope is at most `√3` (trilinear, per axis at
-    /// most 1).
+    /// everything can move are skipped with one comparison: the point where the distance is
+    /// read moves by at most the field's bound (the master's modes), the shell's bound and
+    /// both carries, across an interpolated distance whose slope is at most `√3` (trilinear,
+    /// per axis at most 1).
     pub fn tick(&mut self, master: OrganPose, shell: OrganPose, out: PairOutput) {
         self.cache.next_tick(&self.field);
-        let point_moves = self.nodes.movement_bound_m(shell.alpha)
+        let point_moves = self.field.movement_bound_m(master.alpha)
+            + self.nodes.movement_bound_m(shell.alpha)
             + carry_bound_m(master.carry, &self.field)
             + carry_bound_m(shell.carry, &self.field);
-        let reach = self.field.movement_bound_m(master.alpha) + 3f32.sqrt() * point_moves;
+        let reach = 3f32.sqrt() * point_moves;
         let mut report = PairReport::default();
         self.active.clear();
         for i in 0..self.nodes.len() {
@@ -222,7 +220,7 @@ impl ContactPair {
             if self.force_n[i] > 0.0 {
                 report.nodes_in_contact += 1;
                 report.contact_area_m2 += self.nodes.area_m2[i] as f64;
-                report.force_on_shell_n += self.normal[i] * self.force_n[i];
+                report.force_on_shell_n += self.nodes.rest_normal[i] * self.force_n[i];
                 self.add_loads(i, out.master, out.shell);
             }
         }
@@ -237,23 +235,23 @@ impl ContactPair {
         p += shell.carry.at(&rest);
         // The master's lattice is at rest: pull the point back through the master's carry.
         let q = p - master.carry.at(&p);
-        let Some(sample) = self.field.sample(&q, master.alpha, &mut self.cache) else {
+        let Some(distance_m) = self.field.distance_m(&q, master.alpha, &mut self.cache) else {
             self.force_n[i] = 0.0;
             return 0.0;
         };
         let k = self.stiffness_n_per_m[i];
-        let gradient = sample.distance_m + self.force_n[i] / k;
+        let gradient = distance_m + self.force_n[i] / k;
         if self.force_n[i] > 0.0 || gradient < 0.0 {
-            self.normal[i] = sample.normal;
             self.gradient_m[i] = gradient;
             self.active.push(i as u32);
         }
-        (-sample.distance_m).max(0.0)
+        (-distance_m).max(0.0)
     }
 
     /// Node `i`'s force on the shell organ and its reaction on the master, as coefficients.
+    /// It pushes along the node's rest normal, the direction `A` is projected on.
     fn add_loads(&self, i: usize, master: &mut [f64], shell: &mut [f64]) {
-        let force = self.normal[i] * self.force_n[i];
+        let force = self.nodes.rest_normal[i] * self.force_n[i];
         let (s, m) = (
             self.nodes.positions[i] as usize,
             self.nodes.master_positions[i] as usize,

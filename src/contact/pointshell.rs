@@ -18,7 +18,10 @@ pub struct Pointshell {
     pub rest_m: Vec<Vector3<f32>>,
     /// The master's rest distance at each node (m), from the lattice.
     pub rest_distance_m: Vec<f32>,
-    /// The rest field's outward direction at each node.
+    /// The rest field's outward direction at each node: the direction its penalty pushes
+    /// and `A` is projected on, fixed so that the two agree (read each tick where the
+    /// master's displacement brought the node from, it tilted up to about 10° from `A`'s,
+    /// and the sideways part of the force sent the tool-held gallbladder 13 mm into the liver).
     pub rest_normal: Vec<Vector3<f64>>,
     /// Lumped surface area of each node (m²): what it covers of the surface, summed into the
     /// area in contact.
