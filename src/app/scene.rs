@@ -9,7 +9,7 @@ use nalgebra::Vector3;
 
 use super::haptic::HapticScene;
 use crate::cli::{OnStale, OrganSource, VademecumSpec, ensure_vademecum};
-use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, Probe};
+use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, FieldOrigin, Probe};
 use crate::fem::{Inclusion, Law};
 use crate::haptics::{PressTarget, SafetySettings, Workspace};
 use crate::mesh::TetMesh;
@@ -153,11 +153,15 @@ pub fn scene_of(
         (Detail::Full, Some(tip)) => tip,
         _ => detail.tip_radius_m(),
     };
+    let mut field_file = None;
     let loaded = organs
         .iter()
         .map(|organ| {
             let spec = organ.vademecum(dir, detail, tip);
             let (vademecum, mesh) = ensure_vademecum(&spec, on_stale)?;
+            if organ.name == coupling.master {
+                field_file = Some(spec.field_file());
+            }
             Ok((organ.name.clone(), Arc::new(vademecum), mesh))
         })
         .collect::<Result<Vec<_>, String>>()?;
@@ -169,7 +173,11 @@ pub fn scene_of(
         .into_iter()
         .map(|(name, vademecum, _)| (name, vademecum))
         .collect();
-    let coupling = Coupling::new(&organs, &attachments, coupling).map_err(|e| e.to_string())?;
+    let (coupling, origin) = Coupling::new(&organs, &attachments, coupling, field_file.as_deref())
+        .map_err(|e| e.to_string())?;
+    if let Some(origin @ FieldOrigin::Built { .. }) = origin {
+        eprintln!("distance field: {origin}");
+    }
     Ok(HapticScene {
         organs,
         probe: Probe { tip_radius_m: tip },

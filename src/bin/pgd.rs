@@ -5,7 +5,9 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, scene_of};
-use pgd_surgery::contact::{CouplingSettings, PointshellDensity};
+use pgd_surgery::contact::{
+    ContactSurface, CouplingSettings, DistanceField, DistanceSettings, PointshellDensity,
+};
 use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
 use pgd_surgery::mesh::io::{ImportOptions, write_vtu};
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, region};
@@ -54,6 +56,11 @@ enum Command {
         /// Where to write the vademecum.
         #[arg(long, value_name = "FILE.vdm")]
         out: Option<PathBuf>,
+        /// Also precompute the organ's distance field for organ-against-organ contact, as
+        /// a scene's contact master needs it (the gallbladder by default), and write it beside
+        /// the vademecum (FILE.vdf). The trainer otherwise builds it on first use.
+        #[arg(long)]
+        distance_field: bool,
         /// Print the build report as JSON.
         #[arg(long)]
         json: bool,
@@ -298,10 +305,11 @@ fn main() -> ExitCode {
             material,
             build,
             out,
+            distance_field,
             json,
         } => {
             let out = out.unwrap_or_else(|| default_vademecum(&mesh));
-            match build_vademecum(&mesh, &material, &build, &out) {
+            match build_vademecum(&mesh, &material, &build, &out, distance_field) {
                 Ok(report) if json => print_json(&report),
                 Ok(report) => {
                     print_build_report(&report, &out);
@@ -490,6 +498,7 @@ fn build_vademecum(
     material: &MaterialArgs,
     build: &BuildArgs,
     out: &Path,
+    distance_field: bool,
 ) -> Result<BuildReport, String> {
     let (organ, tet_mesh) = mesh.load()?;
     let inclusions = &material.inclusion;
@@ -507,7 +516,26 @@ fn build_vademecum(
         .map_err(|e| format!("{}: {e}", mesh.source))?;
     pgd::save(out, &vademecum).map_err(|e| e.to_string())?;
     write_convergence(out, &vademecum.header)?;
+    if distance_field {
+        write_distance_field(&vademecum, &out.with_extension("vdf"))?;
+    }
     Ok(report)
+}
+
+/// Precomputes the distance field of `vademecum` on the default lattice and writes it.
+fn write_distance_field(vademecum: &pgd::Vademecum, path: &Path) -> Result<(), String> {
+    let started = std::time::Instant::now();
+    let surface = ContactSurface::new(vademecum).map_err(|e| e.to_string())?;
+    let field = DistanceField::build(vademecum, &surface, &DistanceSettings::default());
+    field.save(path).map_err(|e| e.to_string())?;
+    eprintln!(
+        "distance field: {} lattice nodes, {} modes, built in {:.1} s, written to {}",
+        field.node_count(),
+        vademecum.total_modes(),
+        started.elapsed().as_secs_f64(),
+        path.display()
+    );
+    Ok(())
 }
 
 fn print_build_report(report: &BuildReport, out: &Path) {

@@ -42,6 +42,12 @@ pub struct VademecumSpec {
 }
 
 impl VademecumSpec {
+    /// Where the distance field of this vademecum is kept when its organ is a contact master:
+    /// beside it, `.vdf` for `.vdm`.
+    pub fn field_file(&self) -> PathBuf {
+        self.file.with_extension("vdf")
+    }
+
     /// The organ's default vademecum (the papers' mesh, default settings) under `dir`.
     pub fn default_in(dir: &Path, organ: Organ, law: Law) -> Self {
         let file = dir.join(format!("{}.vdm", organ.name()));

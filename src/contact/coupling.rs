@@ -4,6 +4,7 @@
 //! into its [`Deformation`]. Nothing is allocated once set up.
 
 use std::ops::Range;
+use std::path::Path;
 use std::sync::Arc;
 
 use nalgebra::Vector3;
@@ -12,7 +13,7 @@ use super::modal_rows::{concatenate, step_ranges};
 use super::penalty::{OrganPose, PairOutput, PenaltySettings};
 use super::{
     Attachment, ContactError, ContactPair, ContactSurface, DistanceField, DistanceSettings,
-    Pointshell, PointshellDensity, ToolContact, ToolHold,
+    FieldOrigin, Pointshell, PointshellDensity, ToolContact, ToolHold,
 };
 use crate::pgd::{Deformation, PatchLoad, RigidCarry, Vademecum};
 
@@ -66,11 +67,14 @@ impl Coupling {
     /// Sets up the coupling of `organs` (names and vademecums, the scene's order): the master's
     /// distance field, a pair with every organ not attached to it whose boundary comes within
     /// the field's lattice, and the attachments. No master in the scene: no contact pairs.
+    /// The field is read from `field_file` when it holds this master's (and built and saved
+    /// there otherwise: the returned origin says which), or built in memory without one.
     pub fn new(
         organs: &[(String, Arc<Vademecum>)],
         attachments: &[AttachmentSpec],
         settings: &CouplingSettings,
-    ) -> Result<Self, ContactError> {
+        field_file: Option<&Path>,
+    ) -> Result<(Self, Option<FieldOrigin>), ContactError> {
         let index = |name: &str| organs.iter().position(|(n, _)| n == name);
         let attachments: Vec<Attachment> = attachments
             .iter()
@@ -85,14 +89,24 @@ impl Coupling {
                 .any(|a| (a.carrier, a.carried) == (x, y) || (a.carrier, a.carried) == (y, x))
         };
         let mut pairs = Vec::new();
+        let mut origin = None;
         if let Some(master) = index(&settings.master) {
             let master_vademecum = &organs[master].1;
             let surface = ContactSurface::new(master_vademecum)?;
-            let field = Arc::new(DistanceField::build(
-                master_vademecum,
-                &surface,
-                &settings.distance,
-            ));
+            let field = match field_file {
+                Some(path) => {
+                    let (field, how) = DistanceField::load_or_build(
+                        master_vademecum,
+                        &surface,
+                        &settings.distance,
+                        path,
+                    );
+                    origin = Some(how);
+                    field
+                }
+                None => DistanceField::build(master_vademecum, &surface, &settings.distance),
+            };
+            let field = Arc::new(field);
             for (shell, (_, shell_vademecum)) in organs.iter().enumerate() {
                 if shell == master || attached(master, shell) {
                     continue;
@@ -127,11 +141,12 @@ impl Coupling {
                 hold: ToolHold::default(),
             })
             .collect();
-        Ok(Self {
+        let coupling = Self {
             pairs,
             attachments,
             organs,
-        })
+        };
+        Ok((coupling, origin))
     }
 
     /// Whether it couples anything at all.

@@ -1,16 +1,14 @@
-//! The vademecum file: `vademecums/<organ>.vdm`.
-//!
-//! Layout (little-endian): the magic `PGDVADEM`, the format version (u32), the byte lengths of
-//! the header and the payload (u64 each), the header as JSON (self-describing: mesh hash,
-//! material, regions, load directions and steps, build settings), the payload (arrays, each
-//! prefixed by its length, modes as f32), and a BLAKE3 checksum of everything before it.
-//! Saving writes a temporary file and renames it, so a failed save never leaves half a file.
+//! The vademecum file: `vademecums/<organ>.vdm`, in the [`container`](super::container)
+//! layout with the magic `PGDVADEM`. Its header is JSON (self-describing: mesh hash,
+//! material, regions, load directions and steps, build settings); its payload the arrays,
+//! modes as f32.
 
 use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
 use super::BuildSettings;
+use super::container::{self, Kind, Reader, put};
 use super::local::LocalPart;
 use super::vademecum::{Header, Step, Vademecum};
 use crate::fem::{Inclusion, Material};
@@ -18,9 +16,11 @@ use crate::mesh::TetMesh;
 
 /// Bumped on any change of layout or meaning; older files are refused, not misread.
 pub const FORMAT_VERSION: u32 = 2;
-const MAGIC: &[u8; 8] = b"PGDVADEM";
-const PREFIX_BYTES: usize = 8 + 4 + 8 + 8;
-const CHECKSUM_BYTES: usize = 32;
+const KIND: Kind = Kind {
+    magic: b"PGDVADEM",
+    version: FORMAT_VERSION,
+    name: "vademecum",
+};
 
 #[derive(Debug, Error)]
 pub enum VademecumError {
@@ -29,8 +29,12 @@ pub enum VademecumError {
         file: PathBuf,
         source: std::io::Error,
     },
-    #[error("{file}: not a vademecum file (it does not start with PGDVADEM)")]
-    NotAVademecum { file: PathBuf },
+    #[error("{file}: not a {kind} file (it does not start with {magic})")]
+    NotAVademecum {
+        file: PathBuf,
+        kind: &'static str,
+        magic: String,
+    },
     #[error(
         "{file}: format version {found}, but this build reads version {expected}; rebuild it with `pgd build`"
     )]
@@ -74,6 +78,14 @@ pub enum VademecumError {
         found: String,
     },
     #[error(
+        "{file}: built for another vademecum (inputs hash {found}, this one {expected}); it is rebuilt"
+    )]
+    OtherVademecum {
+        file: PathBuf,
+        expected: String,
+        found: String,
+    },
+    #[error(
         "{file}: not written: its header would not read back the same ({why}); nothing was saved"
     )]
     Unwritable { file: PathBuf, why: String },
@@ -81,21 +93,11 @@ pub enum VademecumError {
 
 /// Writes `vademecum` to `path` atomically.
 pub fn save(path: &Path, vademecum: &Vademecum) -> Result<(), VademecumError> {
-    let io = |source| VademecumError::Io {
-        file: path.to_path_buf(),
-        source,
-    };
     check_round_trip(&vademecum.header).map_err(|why| VademecumError::Unwritable {
         file: path.to_path_buf(),
         why,
     })?;
-    let bytes = encode(vademecum);
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(io)?;
-    }
-    let temporary = path.with_extension("vdm.partial");
-    std::fs::write(&temporary, &bytes).map_err(io)?;
-    std::fs::rename(&temporary, path).map_err(io)
+    container::write_atomically(path, &encode(vademecum))
 }
 
 /// The bytes of the file `save` writes.
@@ -113,48 +115,27 @@ fn check_round_trip(header: &Header) -> Result<(), String> {
 
 pub fn encode(vademecum: &Vademecum) -> Vec<u8> {
     let header = serde_json::to_vec_pretty(&vademecum.header).expect("plain data serializes");
-    let payload = payload(vademecum);
-    let mut bytes = Vec::with_capacity(PREFIX_BYTES + header.len() + payload.len() + 32);
-    bytes.extend_from_slice(MAGIC);
-    bytes.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-    bytes.extend_from_slice(&(header.len() as u64).to_le_bytes());
-    bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    bytes.extend_from_slice(&header);
-    bytes.extend_from_slice(&payload);
-    let checksum = blake3::hash(&bytes);
-    bytes.extend_from_slice(checksum.as_bytes());
-    bytes
+    container::encode(&KIND, &header, &payload(vademecum))
 }
 
 /// Reads only the header of `path` (cheap: for staleness checks and listings).
 pub fn read_header(path: &Path) -> Result<Header, VademecumError> {
-    let bytes = read_bytes(path)?;
+    let bytes = container::read(path)?;
     let (header, _) = checked_parts(path, &bytes)?;
     Ok(header)
 }
 
 /// Reads and checks a vademecum file.
 pub fn load(path: &Path) -> Result<Vademecum, VademecumError> {
-    decode(path, &read_bytes(path)?)
+    decode(path, &container::read(path)?)
 }
 
 /// Checks and reads the bytes of a vademecum file; `path` names it in errors.
 pub fn decode(path: &Path, bytes: &[u8]) -> Result<Vademecum, VademecumError> {
     let (header, payload) = checked_parts(path, bytes)?;
-    let mut reader = Reader {
-        file: path,
-        bytes: payload,
-    };
-    let vademecum = read_payload(&mut reader, header)?;
+    let vademecum = read_payload(&mut Reader::new(path, payload), header)?;
     validate(path, &vademecum)?;
     Ok(vademecum)
-}
-
-fn read_bytes(path: &Path) -> Result<Vec<u8>, VademecumError> {
-    std::fs::read(path).map_err(|source| VademecumError::Io {
-        file: path.to_path_buf(),
-        source,
-    })
 }
 
 impl Vademecum {
@@ -208,45 +189,14 @@ impl Vademecum {
     }
 }
 
-/// Checks magic, version, length and checksum; returns the header and the payload bytes.
+/// Checks the container; returns the header and the payload bytes.
 fn checked_parts<'a>(path: &Path, bytes: &'a [u8]) -> Result<(Header, &'a [u8]), VademecumError> {
-    let file = || path.to_path_buf();
-    if bytes.len() < PREFIX_BYTES || &bytes[..8] != MAGIC {
-        return Err(VademecumError::NotAVademecum { file: file() });
-    }
-    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
-    if version != FORMAT_VERSION {
-        return Err(VademecumError::Version {
-            file: file(),
-            found: version,
-            expected: FORMAT_VERSION,
-        });
-    }
-    let header_len = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
-    let payload_len = u64::from_le_bytes(bytes[20..28].try_into().expect("8 bytes"));
-    let expected = (PREFIX_BYTES as u64)
-        .saturating_add(header_len)
-        .saturating_add(payload_len)
-        .saturating_add(CHECKSUM_BYTES as u64);
-    if (bytes.len() as u64) < expected {
-        return Err(VademecumError::Truncated {
-            file: file(),
-            expected,
-            found: bytes.len() as u64,
-        });
-    }
-    let body = expected as usize - CHECKSUM_BYTES;
-    if blake3::hash(&bytes[..body]).as_bytes() != &bytes[body..expected as usize] {
-        return Err(VademecumError::Corrupted { file: file() });
-    }
-    let header_end = PREFIX_BYTES + header_len as usize;
-    let header = serde_json::from_slice(&bytes[PREFIX_BYTES..header_end]).map_err(|e| {
-        VademecumError::Malformed {
-            file: file(),
-            what: format!("header: {e}"),
-        }
+    let (header, payload) = container::checked_parts(&KIND, path, bytes)?;
+    let header = serde_json::from_slice(header).map_err(|e| VademecumError::Malformed {
+        file: path.to_path_buf(),
+        what: format!("header: {e}"),
     })?;
-    Ok((header, &bytes[header_end..body]))
+    Ok((header, payload))
 }
 
 fn payload(v: &Vademecum) -> Vec<u8> {
@@ -269,69 +219,6 @@ fn payload(v: &Vademecum) -> Vec<u8> {
         put(&mut out, &l.correction);
     }
     out
-}
-
-/// Four-byte little-endian values: the payload's only element types.
-trait Word: Copy {
-    fn to_bytes(self) -> [u8; 4];
-    fn from_bytes(bytes: [u8; 4]) -> Self;
-}
-
-impl Word for u32 {
-    fn to_bytes(self) -> [u8; 4] {
-        self.to_le_bytes()
-    }
-    fn from_bytes(bytes: [u8; 4]) -> Self {
-        Self::from_le_bytes(bytes)
-    }
-}
-
-impl Word for f32 {
-    fn to_bytes(self) -> [u8; 4] {
-        self.to_le_bytes()
-    }
-    fn from_bytes(bytes: [u8; 4]) -> Self {
-        Self::from_le_bytes(bytes)
-    }
-}
-
-fn put<T: Word>(out: &mut Vec<u8>, values: &[T]) {
-    out.extend_from_slice(&(values.len() as u64).to_le_bytes());
-    for &v in values {
-        out.extend_from_slice(&v.to_bytes());
-    }
-}
-
-struct Reader<'a> {
-    file: &'a Path,
-    bytes: &'a [u8],
-}
-
-impl Reader<'_> {
-    fn malformed(&self, what: &str) -> VademecumError {
-        VademecumError::Malformed {
-            file: self.file.to_path_buf(),
-            what: what.to_string(),
-        }
-    }
-
-    fn take<T: Word>(&mut self, what: &str) -> Result<Vec<T>, VademecumError> {
-        if self.bytes.len() < 8 {
-            return Err(self.malformed(what));
-        }
-        let (len, rest) = self.bytes.split_at(8);
-        let len = u64::from_le_bytes(len.try_into().expect("8 bytes"));
-        let size = len
-            .checked_mul(4)
-            .filter(|&s| s <= rest.len() as u64)
-            .ok_or_else(|| self.malformed(what))? as usize;
-        let (data, rest) = rest.split_at(size);
-        self.bytes = rest;
-        Ok(data
-            .chunks_exact(4)
-            .map(|c| T::from_bytes(c.try_into().expect("4 bytes")))
-            .collect())
-    }
 }
 
 fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumError> {
@@ -362,9 +249,7 @@ fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumEr
             },
         });
     }
-    if !r.bytes.is_empty() {
-        return Err(r.malformed("payload (bytes left after the last step)"));
-    }
+    r.finish()?;
     Ok(Vademecum {
         header,
         positions,

@@ -3,6 +3,7 @@
 //! cannot carry (see `docs/pgd.md`). Plain Rust, no Bevy.
 
 mod build;
+pub mod container;
 mod deformation;
 mod enrichment;
 mod error_curve;

@@ -3,6 +3,7 @@
 //! to the deformed gallbladder, and the attachments.
 
 mod common;
+mod field_file;
 
 use common::*;
 use nalgebra::{Point3, Vector3};

@@ -19,11 +19,15 @@
 //! tool, within `local_radius_m` of it). `tests/contact` measures the result against the
 //! exact distance to the deformed surface.
 
+mod file;
+
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
 use super::ContactSurface;
 use crate::pgd::Vademecum;
+
+pub use file::FieldOrigin;
 
 /// How the lattice is laid out.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -45,7 +49,7 @@ impl Default for DistanceSettings {
 }
 
 /// Per lattice node: the rest distance and its unit gradient, then three values per mode.
-const HEAD: usize = 4;
+pub(super) const HEAD: usize = 4;
 
 /// Fixed-point steps `y ← x − u(y)` towards the rest point `y` that the master's displacement
 /// `u` brings to `x`. The first is exact where the surface near `x` moves rigidly; the second
@@ -55,8 +59,11 @@ const PULLBACK_STEPS: usize = 2;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct DistanceField {
+    /// A hash of what the field is built from (`file::inputs_of`): tells a stored field
+    /// built from another vademecum.
+    inputs: String,
+    settings: DistanceSettings,
     origin_m: Vector3<f64>,
-    spacing_m: f64,
     dims: [usize; 3],
     modes: usize,
     /// `HEAD + 3 modes` values per lattice node, x fastest.
@@ -112,8 +119,9 @@ impl DistanceField {
         let dims = [0, 1, 2].map(|c| (extent[c] / settings.spacing_m).ceil() as usize + 1);
         let modes = vademecum.total_modes();
         let mut field = Self {
+            inputs: file::inputs_of(vademecum),
+            settings: *settings,
             origin_m,
-            spacing_m: settings.spacing_m,
             dims,
             modes,
             values: Vec::new(),
@@ -183,12 +191,12 @@ impl DistanceField {
     }
 
     pub fn spacing_m(&self) -> f64 {
-        self.spacing_m
+        self.settings.spacing_m
     }
 
     /// How far the lattice's farthest point lies from `centre_m` (m).
     pub fn farthest_from_m(&self, centre_m: &Vector3<f64>) -> f64 {
-        let extent = Vector3::from(self.dims.map(|n| (n - 1) as f64)) * self.spacing_m;
+        let extent = Vector3::from(self.dims.map(|n| (n - 1) as f64)) * self.settings.spacing_m;
         let far = (self.origin_m - centre_m)
             .abs()
             .sup(&(self.origin_m + extent - centre_m).abs());
@@ -202,7 +210,7 @@ impl DistanceField {
     fn node_point(&self, node: usize) -> Vector3<f64> {
         let [nx, ny, _] = self.dims;
         let ijk = [node % nx, (node / nx) % ny, node / (nx * ny)];
-        self.origin_m + Vector3::from(ijk.map(|i| i as f64)) * self.spacing_m
+        self.origin_m + Vector3::from(ijk.map(|i| i as f64)) * self.settings.spacing_m
     }
 
     /// `Σ_k |α_k| max|U^k|`: no point of the master moves farther than this (m), so no
@@ -284,7 +292,7 @@ impl DistanceField {
     /// The lattice cell holding `x` (its lowest node) and the trilinear weights of its eight
     /// corners, in [`Self::corners`] order.
     fn cell(&self, x: &Vector3<f64>) -> Option<(usize, [f64; 8])> {
-        let local = (x - self.origin_m) / self.spacing_m;
+        let local = (x - self.origin_m) / self.settings.spacing_m;
         let mut base = [0usize; 3];
         let mut t = [0.0; 3];
         for c in 0..3 {

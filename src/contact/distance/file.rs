@@ -1,0 +1,180 @@
+//! The distance field's file, `<vademecum>.vdf` beside the master's vademecum: the
+//! distance-field vademecum, precomputed offline (`pgd build --distance-field`) or on a
+//! scene's first use, then loaded.
+//!
+//! The [`container`] layout with the magic `PGDDISTF`; the header (JSON) holds the hash of the
+//! field's inputs, the lattice settings and its layout; the payload the lattice values and the
+//! per-mode bounds. A field built from another vademecum or with other lattice settings is
+//! refused, so the trainer never runs on a stale one.
+
+use std::fmt;
+use std::path::Path;
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use super::{ContactSurface, DistanceField, DistanceSettings, HEAD};
+use crate::pgd::container::{self, Kind, Reader, put};
+use crate::pgd::{Vademecum, VademecumError};
+
+const KIND: Kind = Kind {
+    magic: b"PGDDISTF",
+    version: 1,
+    name: "distance field",
+};
+
+#[derive(Debug, PartialEq, Serialize, Deserialize)]
+struct FieldHeader {
+    inputs: String,
+    settings: DistanceSettings,
+    origin_m: [f64; 3],
+    dims: [usize; 3],
+    modes: usize,
+}
+
+/// Where a scene's distance field came from.
+#[derive(Debug)]
+pub enum FieldOrigin {
+    Loaded,
+    /// Built now, because the stored one could not be used (`why`); `saved` says whether it
+    /// was stored for the next time.
+    Built {
+        why: VademecumError,
+        saved: Result<(), VademecumError>,
+    },
+}
+
+impl fmt::Display for FieldOrigin {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        match self {
+            Self::Loaded => write!(f, "loaded"),
+            Self::Built { why, saved } => {
+                write!(f, "{why}; built it now")?;
+                match saved {
+                    Ok(()) => write!(f, " and saved it for the next time"),
+                    Err(e) => write!(f, ", but could not save it: {e}"),
+                }
+            }
+        }
+    }
+}
+
+/// A hash of what a field is built from: the master's accessible surface at rest and its
+/// modes there.
+pub fn inputs_of(vademecum: &Vademecum) -> String {
+    let mut hasher = blake3::Hasher::new();
+    for p in vademecum.position_coords_m.as_flattened() {
+        hasher.update(&p.to_le_bytes());
+    }
+    for t in vademecum.triangles.as_flattened() {
+        hasher.update(&t.to_le_bytes());
+    }
+    for step in 0..vademecum.steps.len() {
+        for mode in 0..vademecum.modes(step) {
+            for &node in &vademecum.positions {
+                let u = vademecum.mode_at_node(step, mode, node as usize);
+                u.iter().for_each(|c| {
+                    hasher.update(&(*c as f32).to_le_bytes());
+                });
+            }
+        }
+    }
+    hasher.finalize().to_hex()[..16].to_owned()
+}
+
+impl DistanceField {
+    /// The field of `vademecum` stored at `path` if it was built from the same vademecum with
+    /// the same `settings`; otherwise built now and saved there.
+    pub fn load_or_build(
+        vademecum: &Vademecum,
+        surface: &ContactSurface,
+        settings: &DistanceSettings,
+        path: &Path,
+    ) -> (Self, FieldOrigin) {
+        let stored = Self::load(path).and_then(|field| {
+            field.check_for(path, vademecum, settings)?;
+            Ok(field)
+        });
+        match stored {
+            Ok(field) => (field, FieldOrigin::Loaded),
+            Err(why) => {
+                let field = Self::build(vademecum, surface, settings);
+                let saved = field.save(path);
+                (field, FieldOrigin::Built { why, saved })
+            }
+        }
+    }
+
+    /// Refuses a field built from another vademecum than `vademecum` or with other lattice
+    /// settings than `settings`.
+    pub fn check_for(
+        &self,
+        path: &Path,
+        vademecum: &Vademecum,
+        settings: &DistanceSettings,
+    ) -> Result<(), VademecumError> {
+        let expected = inputs_of(vademecum);
+        if self.inputs != expected {
+            return Err(VademecumError::OtherVademecum {
+                file: path.to_path_buf(),
+                expected,
+                found: self.inputs.clone(),
+            });
+        }
+        if self.settings != *settings {
+            return Err(VademecumError::OtherSettings {
+                file: path.to_path_buf(),
+                expected: format!("{settings:?}"),
+                found: format!("{:?}", self.settings),
+            });
+        }
+        Ok(())
+    }
+
+    /// Writes the field to `path` atomically.
+    pub fn save(&self, path: &Path) -> Result<(), VademecumError> {
+        let header = FieldHeader {
+            inputs: self.inputs.clone(),
+            settings: self.settings,
+            origin_m: self.origin_m.into(),
+            dims: self.dims,
+            modes: self.modes,
+        };
+        let header = serde_json::to_vec_pretty(&header).expect("plain data serializes");
+        let mut payload = Vec::with_capacity(4 * (self.values.len() + self.mode_bounds.len()));
+        put(&mut payload, &self.values);
+        put(&mut payload, &self.mode_bounds);
+        container::write_atomically(path, &container::encode(&KIND, &header, &payload))
+    }
+
+    /// Reads and checks a field file.
+    pub fn load(path: &Path) -> Result<Self, VademecumError> {
+        let bytes = container::read(path)?;
+        let (header, payload) = container::checked_parts(&KIND, path, &bytes)?;
+        let header: FieldHeader =
+            serde_json::from_slice(header).map_err(|e| VademecumError::Malformed {
+                file: path.to_path_buf(),
+                what: format!("header: {e}"),
+            })?;
+        let mut reader = Reader::new(path, payload);
+        let values: Vec<f32> = reader.take("lattice values")?;
+        let mode_bounds: Vec<f32> = reader.take("mode bounds")?;
+        reader.finish()?;
+        let nodes: usize = header.dims.iter().product();
+        if values.len() != nodes * (HEAD + 3 * header.modes)
+            || mode_bounds.len() != header.modes
+            || header.dims.iter().any(|&n| n < 2)
+        {
+            return Err(reader.malformed("lattice (its size does not match its header)"));
+        }
+        Ok(Self {
+            inputs: header.inputs,
+            settings: header.settings,
+            origin_m: Vector3::from(header.origin_m),
+            dims: header.dims,
+            modes: header.modes,
+            values,
+            mode_bounds,
+        })
+    }
+}
