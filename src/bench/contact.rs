@@ -3,6 +3,11 @@
 //! master pressed into the shell organ until at least 400 nodes push, against the brute-force
 //! check of every pointshell node against the exact deformed master surface (parry3d), timed
 //! in the same run.
+//!
+//! Pressed free, the master (the floppy gallbladder) swings out of the shell organ and few
+//! nodes push. The `held` case presses a rigid copy of the master (its modes zeroed: held
+//! still, as by an instrument), so that the shell organ alone gives way and as many nodes push
+//! as its pointshell allows.
 
 use std::fmt;
 use std::sync::Arc;
@@ -13,7 +18,10 @@ use parry3d::query::PointQuery;
 use serde::Serialize;
 
 use crate::app::haptic::HapticScene;
-use crate::contact::{ContactPair, OrganPose, PairOutput, ToolHold};
+use crate::contact::{
+    ContactPair, ContactSurface, CouplingSettings, DistanceField, OrganPose, PairOutput,
+    Pointshell, ToolHold,
+};
 use crate::pgd::{RigidCarry, Vademecum};
 use crate::seam::{to_parry, trimesh};
 
@@ -52,8 +60,13 @@ pub struct ContactBenchReport {
     pub cases: Vec<StageFigures>,
 }
 
-/// Times the scene's master against its largest pointshell over `ticks` ticks per case.
-pub fn run(scene: &HapticScene, ticks: usize) -> Result<ContactBenchReport, String> {
+/// Times the scene's master against its largest pointshell over `ticks` ticks per case;
+/// `settings` are those the scene's coupling was set up with.
+pub fn run(
+    scene: &HapticScene,
+    settings: &CouplingSettings,
+    ticks: usize,
+) -> Result<ContactBenchReport, String> {
     let coupling = scene
         .coupling
         .as_ref()
@@ -68,14 +81,46 @@ pub fn run(scene: &HapticScene, ticks: usize) -> Result<ContactBenchReport, Stri
     let apart = time_case(pair, master, shell, 0.0, ticks);
     let pressed =
         press_depth(pair, master, shell).map(|depth| time_case(pair, master, shell, depth, ticks));
+    let (held_pair, held_master) = held(pair, master, shell, settings)?;
+    let held = press_depth(&held_pair, &held_master, shell).map(|depth| StageFigures {
+        case: "held",
+        ..time_case(&held_pair, &held_master, shell, depth, ticks)
+    });
     Ok(ContactBenchReport {
         master: master.0.clone(),
         shell: shell.0.clone(),
         pointshell_nodes: pair.pointshell().len(),
         lattice_nodes: pair.field().node_count(),
         ticks,
-        cases: std::iter::once(apart).chain(pressed).collect(),
+        cases: std::iter::once(apart).chain(pressed).chain(held).collect(),
     })
+}
+
+/// The pair again with a rigid copy of the master: its modes zeroed, so that neither its field
+/// nor its part of the compliance moves.
+fn held(
+    pair: &ContactPair,
+    master: &Organ,
+    shell: &Organ,
+    settings: &CouplingSettings,
+) -> Result<(ContactPair, Organ), String> {
+    let mut rigid = (*master.1).clone();
+    for step in &mut rigid.steps {
+        step.spatial.fill(0.0);
+        step.local.correction.fill(0.0);
+    }
+    let surface = ContactSurface::new(&rigid).map_err(|e| e.to_string())?;
+    let field = DistanceField::build(&rigid, &surface, &settings.distance);
+    let nodes = Pointshell::new(&shell.1, &rigid, &surface, &field, settings.pointshell);
+    let rigid = Arc::new(rigid);
+    let pair = ContactPair::new(
+        (pair.master, rigid.clone()),
+        (pair.shell, shell.1.clone()),
+        Arc::new(field),
+        nodes,
+        &settings.penalty,
+    );
+    Ok((pair, (master.0.clone(), rigid)))
 }
 
 /// The master carried `depth_m` into the shell organ, along the mean direction from it to the

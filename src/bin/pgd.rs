@@ -398,7 +398,7 @@ fn main() -> ExitCode {
             };
             print_report(
                 "pgd bench contact",
-                bench::contact::run(&scene, ticks),
+                bench::contact::run(&scene, &coupling, ticks),
                 json,
             )
         }
