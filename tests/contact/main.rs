@@ -26,6 +26,15 @@ fn pushed() -> &'static Vec<Tick> {
     })
 }
 
+/// The same push where the tool touches the gallbladder alone, clear of the duodenum.
+fn pushed_alone() -> &'static Vec<Tick> {
+    static RECORD: std::sync::OnceLock<Vec<Tick>> = std::sync::OnceLock::new();
+    RECORD.get_or_init(|| {
+        let target = facing_clear_of("gallbladder", -Vector3::z(), "duodenum");
+        run(push(&target, 0.012, PUSH_S, 0.5), TICKS).1
+    })
+}
+
 fn liver_pair(tick: &Tick) -> &pgd_surgery::contact::PairReport {
     let (g, l) = (organ("gallbladder").0, organ("liver").0);
     &tick.pairs.iter().find(|p| (p.0, p.1) == (g, l)).unwrap().2
@@ -138,8 +147,8 @@ fn contact_forces_on_the_two_organs_are_equal_and_opposite() {
 }
 
 /// The liver pair's total contact force per tick, and its peak.
-fn contact_force_series() -> (Vec<f64>, f64) {
-    let totals: Vec<f64> = pushed()
+fn contact_force_series(record: &[Tick]) -> (Vec<f64>, f64) {
+    let totals: Vec<f64> = record
         .iter()
         .map(|t| liver_pair(t).force_on_shell_n.norm())
         .collect();
@@ -151,9 +160,8 @@ fn contact_force_series() -> (Vec<f64>, f64) {
 /// the force rises without zig-zagging: a force that turns back more than a handful of times
 /// over the 1,700 ticks of contact is chattering (one steepest-descent step per tick turned
 /// back 280 times).
-#[test]
-fn a_slow_push_keeps_contact_without_flicker_or_zig_zag() {
-    let (totals, peak) = contact_force_series();
+fn assert_no_flicker_or_zig_zag(record: &[Tick]) {
+    let (totals, peak) = contact_force_series(record);
     let first = totals
         .iter()
         .position(|&f| f > 0.0)
@@ -168,10 +176,10 @@ fn a_slow_push_keeps_contact_without_flicker_or_zig_zag() {
     assert!(reversals <= 10, "the force turned back {reversals} times");
 }
 
-#[test]
-#[ignore = "not met yet: a step of 2.5 % of the peak (5.1 % before the pulled-back field and the penalty along the rest normal)"]
-fn a_slow_push_changes_the_contact_force_smoothly() {
-    let (totals, peak) = contact_force_series();
+/// The push ramps the overlap over 2000 ticks: a smooth response changes by about 1/2000 of
+/// the peak per tick; the bound allows ten times that, 0.5 % of the peak.
+fn assert_smooth(record: &[Tick]) {
+    let (totals, peak) = contact_force_series(record);
     let largest_step = totals
         .windows(2)
         .map(|w| (w[1] - w[0]).abs())
@@ -180,12 +188,33 @@ fn a_slow_push_changes_the_contact_force_smoothly() {
         "peak {peak:.5} N, largest step {largest_step:.2e} N ({:.2} % of peak)",
         100.0 * largest_step / peak
     );
-    // The push ramps the overlap over 2000 ticks: a smooth response changes by about
-    // 1/2000 of the peak per tick; allow ten times that.
     assert!(
         largest_step <= 0.005 * peak,
         "a step of {largest_step} N against a peak of {peak} N"
     );
+}
+
+#[test]
+fn a_slow_push_keeps_contact_without_flicker_or_zig_zag() {
+    assert_no_flicker_or_zig_zag(pushed());
+}
+
+/// Where the tool touches the gallbladder alone, the organ contact alone sets the force's
+/// course: measured, 0 reversals and steps of at most 0.09 % of the peak.
+#[test]
+fn a_slow_push_on_the_gallbladder_alone_changes_the_contact_force_smoothly() {
+    assert_no_flicker_or_zig_zag(pushed_alone());
+    assert_smooth(pushed_alone());
+}
+
+/// The push that also presses the duodenum: at one tick the tool's contact point on the
+/// duodenum jumps 4 mm across a groove (two parts of its surface nearly as close to the tip),
+/// its force there steps from 0.8 to 1.9 mN, and the duodenum's carry moves the gallbladder
+/// 0.6 mm at once.
+#[test]
+#[ignore = "not met yet: a step of 2.5 % of the peak, at the tick where the tool's point on the duodenum jumps across a groove (5.1 % before the pulled-back field and the penalty along the rest normal)"]
+fn a_slow_push_changes_the_contact_force_smoothly() {
+    assert_smooth(pushed());
 }
 
 /// The exact signed distance (m) to a closed-enough triangle surface: the closest point's
@@ -391,9 +420,7 @@ fn the_trainee_feels_the_liver_behind_the_gallbladder() {
 /// about 1.2 s. Solved together, the deepest liver node stays under 0.01 mm.
 #[test]
 fn pressed_where_the_tool_touches_the_gallbladder_alone_the_liver_stays_out() {
-    let target = facing_clear_of("gallbladder", -Vector3::z(), "duodenum");
-    let (_, record) = run(push(&target, 0.012, PUSH_S, 0.5), TICKS);
-    assert_shallow(&record);
+    assert_shallow(pushed_alone());
 }
 
 /// While the contact pushes the gallbladder back onto the tool, the tool holds the surface
