@@ -76,20 +76,26 @@ pub struct DistanceField {
 #[derive(Clone, Debug, Default)]
 pub struct LatticeCache {
     tick: u32,
-    stamps: Vec<u32>,
-    displacements: Vec<Vector3<f32>>,
+    nodes: Vec<Stamped>,
+}
+
+/// A lattice node's displacement and the tick it was computed on, side by side: one cache
+/// line for both.
+#[derive(Clone, Copy, Debug, Default)]
+struct Stamped {
+    tick: u32,
+    displacement: [f32; 3],
 }
 
 impl LatticeCache {
     /// Forgets the last tick's values (O(1): stamps, not clearing).
     pub fn next_tick(&mut self, field: &DistanceField) {
-        if self.stamps.len() != field.node_count() {
-            self.stamps = vec![0; field.node_count()];
-            self.displacements = vec![Vector3::zeros(); field.node_count()];
+        if self.nodes.len() != field.node_count() {
+            self.nodes = vec![Stamped::default(); field.node_count()];
         }
         self.tick = self.tick.wrapping_add(1);
         if self.tick == 0 {
-            self.stamps.fill(0);
+            self.nodes.fill(Stamped::default());
             self.tick = 1;
         }
     }
@@ -229,26 +235,28 @@ impl DistanceField {
         alpha: &[f32],
         cache: &mut LatticeCache,
     ) -> Option<f64> {
-        let mut y = *x;
+        let (mut base, mut weights) = self.cell(x)?;
+        let mut corners = self.corner_values(base, alpha, cache);
         for _ in 0..PULLBACK_STEPS {
-            y = x - self.displacement(&y, alpha, cache)?;
+            let y = x - corners.displacement(&weights);
+            let (next, next_weights) = self.cell(&y)?;
+            if next != base {
+                corners = self.corner_values(next, alpha, cache);
+                base = next;
+            }
+            weights = next_weights;
         }
-        Some(self.at_rest(&y)?.distance_m)
+        Some(corners.rest_distance_m(&weights))
     }
 
-    /// The master's displacement interpolated at `x`, or `None` outside the lattice.
-    fn displacement(
-        &self,
-        x: &Vector3<f64>,
-        alpha: &[f32],
-        cache: &mut LatticeCache,
-    ) -> Option<Vector3<f64>> {
-        let (base, weights) = self.cell(x)?;
-        let mut u = Vector3::zeros();
-        for (node, w) in self.corners(base).zip(weights) {
-            u += self.node_displacement(node, alpha, cache).map(f64::from) * w;
+    /// The rest distance and this tick's displacement at the corners of the cell at `base`.
+    fn corner_values(&self, base: usize, alpha: &[f32], cache: &mut LatticeCache) -> Corners {
+        let mut corners = Corners::default();
+        for (k, node) in self.corners(base).enumerate() {
+            corners.rest_m[k] = self.values[node * self.stride()];
+            corners.displacement_m[k] = self.node_displacement(node, alpha, cache);
         }
-        Some(u)
+        corners
     }
 
     /// The rest distance and direction at a point, or `None` outside the lattice: trilinear
@@ -270,22 +278,22 @@ impl DistanceField {
     }
 
     /// One lattice node's displacement `Σ_k α_k U^k`, once per tick.
-    fn node_displacement(
-        &self,
-        node: usize,
-        alpha: &[f32],
-        cache: &mut LatticeCache,
-    ) -> Vector3<f32> {
-        if cache.stamps[node] == cache.tick {
-            return cache.displacements[node];
+    fn node_displacement(&self, node: usize, alpha: &[f32], cache: &mut LatticeCache) -> [f32; 3] {
+        let stamped = &mut cache.nodes[node];
+        if stamped.tick == cache.tick {
+            return stamped.displacement;
         }
         let modes = &self.values[node * self.stride() + HEAD..(node + 1) * self.stride()];
-        let mut u = Vector3::zeros();
+        let mut u = [0.0f32; 3];
         for (m, &a) in modes.chunks_exact(3).zip(alpha) {
-            u += Vector3::new(m[0], m[1], m[2]) * a;
+            for c in 0..3 {
+                u[c] += a * m[c];
+            }
         }
-        cache.stamps[node] = cache.tick;
-        cache.displacements[node] = u;
+        *stamped = Stamped {
+            tick: cache.tick,
+            displacement: u,
+        };
         u
     }
 
@@ -300,19 +308,24 @@ impl DistanceField {
             if !(0.0..=cells).contains(&local[c]) {
                 return None;
             }
-            let i = (local[c].floor() as usize).min(self.dims[c] - 2);
+            // Non-negative here, so truncation is the floor (no call into libm).
+            let i = (local[c] as usize).min(self.dims[c] - 2);
             base[c] = i;
             t[c] = local[c] - i as f64;
         }
         let [nx, ny, _] = self.dims;
-        let weights = std::array::from_fn(|corner| {
-            (0..3)
-                .map(|c| match (corner >> c) & 1 {
-                    0 => 1.0 - t[c],
-                    _ => t[c],
-                })
-                .product()
-        });
+        let [x1, y1, z1] = t;
+        let (x0, y0, z0) = (1.0 - x1, 1.0 - y1, 1.0 - z1);
+        let weights = [
+            x0 * y0 * z0,
+            x1 * y0 * z0,
+            x0 * y1 * z0,
+            x1 * y1 * z0,
+            x0 * y0 * z1,
+            x1 * y0 * z1,
+            x0 * y1 * z1,
+            x1 * y1 * z1,
+        ];
         Some((base[0] + nx * (base[1] + ny * base[2]), weights))
     }
 
@@ -334,4 +347,33 @@ fn bounds(vademecum: &Vademecum) -> (Vector3<f64>, Vector3<f64>) {
         max = max.sup(&p);
     }
     (min, max)
+}
+
+/// A cell's eight corners, as [`DistanceField::distance_m`] reads them: the rest distance and
+/// this tick's displacement of each, so that pull-back steps landing in the same cell read the
+/// lattice once.
+#[derive(Default)]
+struct Corners {
+    rest_m: [f32; 8],
+    displacement_m: [[f32; 3]; 8],
+}
+
+impl Corners {
+    fn displacement(&self, weights: &[f64; 8]) -> Vector3<f64> {
+        let mut u = [0.0; 3];
+        for (corner, &w) in self.displacement_m.iter().zip(weights) {
+            for c in 0..3 {
+                u[c] += w * corner[c] as f64;
+            }
+        }
+        Vector3::from(u)
+    }
+
+    fn rest_distance_m(&self, weights: &[f64; 8]) -> f64 {
+        self.rest_m
+            .iter()
+            .zip(weights)
+            .map(|(&d, &w)| w * d as f64)
+            .sum()
+    }
 }
