@@ -100,6 +100,7 @@ fn a_scene_loads_its_stored_field_and_rebuilds_a_stale_one() {
     let _ = std::fs::remove_file(&path);
     let load_or_build = || DistanceField::load_or_build(gallbladder, &surface, &LATTICE, &path);
     let (built, origin) = load_or_build();
+    assert!(origin.to_string().contains("not built yet"), "{origin}");
     match origin {
         FieldOrigin::Built { why, saved } => {
             assert!(matches!(why, VademecumError::Io { .. }), "{why}");

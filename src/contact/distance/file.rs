@@ -49,7 +49,14 @@ impl fmt::Display for FieldOrigin {
         match self {
             Self::Loaded => write!(f, "loaded"),
             Self::Built { why, saved } => {
-                write!(f, "{why}; built it now")?;
+                match why {
+                    VademecumError::Io { file, source }
+                        if source.kind() == std::io::ErrorKind::NotFound =>
+                    {
+                        write!(f, "{}: not built yet; built it now", file.display())?
+                    }
+                    _ => write!(f, "{why}; built it now")?,
+                }
                 match saved {
                     Ok(()) => write!(f, " and saved it for the next time"),
                     Err(e) => write!(f, ", but could not save it: {e}"),
