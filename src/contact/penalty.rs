@@ -97,7 +97,7 @@ pub struct ContactPair {
     shell_vademecum: Arc<Vademecum>,
     master_steps: Vec<Range<usize>>,
     shell_steps: Vec<Range<usize>>,
-    /// Penalty per node (N/m): per area (N/m³) times its area.
+    /// Penalty per node (N/m): the stiffness ratio over the stiffer organ's compliance there.
     stiffness_n_per_m: Vec<f64>,
     /// Per node: the normal force (N, ≥ 0) and the energy's gradient `d + f/k` (m).
     force_n: Vec<f64>,

@@ -166,13 +166,12 @@ impl Deformation {
         at: &SurfacePoint,
         skip: usize,
     ) -> Vector3<f64> {
-        vademecum.triangles[at.triangle]
-            .iter()
-            .zip(at.barycentric)
-            .map(|(&corner, weight)| {
-                self.position_displacement_without(vademecum, corner as usize, skip) * weight
-            })
-            .sum()
+        let corners = vademecum.triangles[at.triangle];
+        let nodes: [(usize, f64); 3] = std::array::from_fn(|k| {
+            let node = vademecum.positions[corners[k] as usize] as usize;
+            (node, at.barycentric[k])
+        });
+        self.nodes_displacement_without(vademecum, &vademecum.point(at), &nodes, skip)
     }
 
     /// [`Self::displacement_without`] at load position `position`.
@@ -184,11 +183,25 @@ impl Deformation {
     ) -> Vector3<f64> {
         let rest = Vector3::from(vademecum.position_coords_m[position].map(f64::from));
         let node = vademecum.positions[position] as usize;
-        let mut u = self.carry.at(&rest);
+        self.nodes_displacement_without(vademecum, &rest, &[(node, 1.0)], skip)
+    }
+
+    /// [`Self::displacement_without`] at the point at rest `rest` that blends volume nodes
+    /// (`(node, weight)`): each load's modal coefficients are computed once for the blend.
+    fn nodes_displacement_without(
+        &self,
+        vademecum: &Vademecum,
+        rest: &Vector3<f64>,
+        nodes: &[(usize, f64)],
+        skip: usize,
+    ) -> Vector3<f64> {
+        let mut u = self.carry.at(rest);
         for (step, coupling) in self.coupling.iter().enumerate() {
             for (mode, &c) in coupling.iter().enumerate() {
                 if c != 0.0 {
-                    u += vademecum.mode_at_node(step, mode, node) * c;
+                    for &(node, w) in nodes {
+                        u += vademecum.mode_at_node(step, mode, node) * (c * w);
+                    }
                 }
             }
         }
@@ -199,7 +212,7 @@ impl Deformation {
             .filter(|&(slot, load)| slot != skip && load.is_active());
         for (_, load) in others {
             for step in 0..vademecum.steps.len() {
-                vademecum.add_node_displacement(step, &load.shares, &load.force_n, node, &mut u);
+                vademecum.add_blend_displacement(step, &load.shares, &load.force_n, nodes, &mut u);
             }
         }
         u

@@ -458,16 +458,17 @@ impl Vademecum {
         }
     }
 
-    /// Adds to `u` the displacement (m) of volume node `node` under a force on `shares` in
-    /// load step `step`: the modes at that node and, where the node is in a loaded position's
-    /// near field, its correction (the lists are sorted: a binary search each). Allocates
-    /// nothing: what contact needs of a surface moved by other loads.
-    pub fn add_node_displacement(
+    /// Adds to `u` the displacement (m) of a blend of volume nodes (`(node, weight)`) under a
+    /// force on `shares` in load step `step`: the modes there, each mode's coefficient computed
+    /// once for the whole blend, and, where a node is in a loaded position's near field, its
+    /// correction (the lists are sorted: a binary search each). Allocates nothing: what
+    /// contact needs of a surface moved by other loads.
+    pub fn add_blend_displacement(
         &self,
         step: usize,
         shares: &[(usize, f64)],
         force_n: &Vector3<f64>,
-        node: usize,
+        blend: &[(usize, f64)],
         u: &mut Vector3<f64>,
     ) {
         let step_data = &self.steps[step];
@@ -478,16 +479,20 @@ impl Vademecum {
             .zip(step_data.parametric.chunks_exact(params));
         for (x, y) in modes {
             let c = self.mode_coefficient(step, y, shares, force_n);
-            *u += Vector3::from_fn(|k, _| c * x[3 * node + k] as f64);
+            for &(node, w) in blend {
+                *u += Vector3::from_fn(|k, _| c * w * x[3 * node + k] as f64);
+            }
         }
         let local = &step_data.local;
         for &(i, l) in shares {
             let range = local.corrections_of(i);
             let nodes = &local.correction_nodes[range.clone()];
-            if let Ok(k) = nodes.binary_search(&(node as u32)) {
-                let e = range.start + k;
-                let l = self.step_share(step, i, l, force_n);
-                *u += correction_value(&local.correction[9 * e..9 * e + 9], force_n) * l;
+            let l = self.step_share(step, i, l, force_n);
+            for &(node, w) in blend {
+                if let Ok(k) = nodes.binary_search(&(node as u32)) {
+                    let e = range.start + k;
+                    *u += correction_value(&local.correction[9 * e..9 * e + 9], force_n) * (l * w);
+                }
             }
         }
     }

@@ -167,8 +167,8 @@ pub struct OrganEntry {
     /// What tasks and nodules call it; a generated organ's name unless `mesh` is given.
     pub name: String,
     /// A tetrahedral mesh file (.msh, .vtk, .vtu, in metres) with a node set `clamped` (held
-    /// fixed) and a surface `accessible` (where the tool may touch), written relative to the scenario's
-    /// folder (read as such: the path here is resolved).
+    /// fixed) and a surface `accessible` (where the tool may touch), written relative to the
+    /// scenario's folder (read as such: the path here is resolved).
     #[serde(default)]
     pub mesh: Option<PathBuf>,
     /// Its tissue's Young's modulus, when not the organ's own (for a mesh file: the liver's).
