@@ -6,7 +6,7 @@
 
 use std::time::Instant;
 
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
 use crate::fem::{DirectSolver, Dirichlet, FemError, FemModel, FreePattern, Law, Loads, Material};
@@ -112,7 +112,7 @@ fn indentation_load(model: &FemModel) -> Result<Loads, FemError> {
     loads.add_point_load(
         mesh,
         &surface,
-        Point3::new(0.09, 0.05, 0.08),
+        (Point3::new(0.09, 0.05, 0.08), Vector3::z()),
         [0.0, 0.0, -0.1],
         0.015,
     )?;

@@ -140,7 +140,7 @@ fn fem_contact(
     loads.add_point_load(
         model.mesh(),
         &surface,
-        nalgebra::Point3::from(target.point_m),
+        (nalgebra::Point3::from(target.point_m), target.normal),
         force_n.into(),
         PressMotion::default().tip_radius_m,
     )?;

@@ -19,7 +19,7 @@ pub use element::{ElementMatrix, ElementVector, TetGeometry};
 pub use error::FemError;
 pub use inclusion::Inclusion;
 pub use linear_solver::{DirectSolver, Factorization};
-pub use loads::{Loads, PatchKernel, patch_weight};
+pub use loads::{Loads, PatchKernel, on_pressed_side, patch_weight};
 pub use mass::{consistent_mass, lumped_mass};
 pub use material::{Law, Material, TISSUE_DENSITY_KG_M3};
 pub use model::FemModel;

@@ -86,6 +86,15 @@ impl Surface {
             .sum()
     }
 
+    /// Unit outward normal per surface vertex (area-weighted over its triangles).
+    pub fn vertex_normals(&self, mesh: &TetMesh) -> Vec<Vector3<f64>> {
+        let coords: Vec<[f64; 3]> = self.nodes.iter().map(|&n| mesh.nodes()[n].into()).collect();
+        vertex_normals(&self.local_triangles(), &coords)
+            .into_iter()
+            .map(Vector3::from)
+            .collect()
+    }
+
     /// Lumped area per surface vertex (a third of each adjacent triangle), in m².
     pub fn vertex_areas(&self, mesh: &TetMesh) -> Vec<f64> {
         let mut areas = vec![0.0; self.nodes.len()];

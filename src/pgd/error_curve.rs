@@ -19,8 +19,13 @@ pub struct ErrorCurve {
     pub separated: Vec<f64>,
     /// The best energy error any separated sum of as many terms can reach (Eckart–Young).
     pub optimal: Vec<f64>,
-    /// L2 error of the whole vademecum (separated sum + exact near field): the estimator.
+    /// L2 error of the whole vademecum (separated sum + exact near field) over all node-centred
+    /// loads together, weighted by area.
     pub field: Vec<f64>,
+    /// The 95th percentile over the node-centred loads of each load's own relative L2 error
+    /// (absent in files written before it was recorded).
+    #[serde(default)]
+    pub field_p95: Vec<f64>,
 }
 
 /// Tracks the energy error of a separated field as modes are added, for the error estimator.
@@ -97,14 +102,25 @@ pub fn optimal_errors(gram: &[f64], weights: &[f64], max_modes: usize) -> Vec<f6
 }
 
 /// The error estimator of a build: the relative L2 error of the whole vademecum (separated sum
-/// plus the exact near field) over every node-centred load, weighted by area. It is exact, not
-/// estimated: the exact responses are at hand, and are turned into the residual of the
-/// separated sum one mode at a time.
+/// plus the exact near field) for every node-centred load. It is exact, not estimated: the
+/// exact responses are at hand, and are turned into the residual of the separated sum one mode
+/// at a time.
 pub struct FieldError<'a> {
     weights: &'a [f64],
     near: &'a [Vec<u32>],
     free_index: &'a [usize],
-    total: f64,
+    /// Per load, the squared norm of its exact response.
+    totals: Vec<f64>,
+}
+
+/// The vademecum's error with the modes so far.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FieldErrors {
+    /// All loads together, weighted by area: dominated by the softest regions.
+    pub overall: f64,
+    /// The 95th percentile of the loads' own relative errors: a stiff region's loads, whose
+    /// responses are small, count as much as a soft one's.
+    pub p95: f64,
 }
 
 impl<'a> FieldError<'a> {
@@ -118,14 +134,14 @@ impl<'a> FieldError<'a> {
             weights,
             near,
             free_index: &stiffness.model.dofs().free_index,
-            total: 1.0,
+            totals: Vec::new(),
         };
-        estimator.total = estimator.weighted_far_norm(responses, false);
+        estimator.totals = estimator.squared_norms(responses, false);
         estimator
     }
 
-    /// Subtracts mode `X Yᵀ` (X over all dofs) from `residual`, returns the relative error.
-    pub fn subtract_mode(&self, residual: &mut Responses, x: &[f64], y: &[f64]) -> f64 {
+    /// Subtracts mode `X Yᵀ` (X over all dofs) from `residual`, returns the relative errors.
+    pub fn subtract_mode(&self, residual: &mut Responses, x: &[f64], y: &[f64]) -> FieldErrors {
         let x_free: Vec<f64> = self
             .free_index
             .iter()
@@ -143,11 +159,30 @@ impl<'a> FieldError<'a> {
                     .zip(&x_free)
                     .for_each(|(ri, xi)| *ri -= yp * xi);
             });
-        (self.weighted_far_norm(residual, true) / self.total).sqrt()
+        self.errors(&self.squared_norms(residual, true))
     }
 
-    /// `Σ_p w_p ‖r_p‖²`, leaving out each load's near field when `far_only`.
-    fn weighted_far_norm(&self, columns: &Responses, far_only: bool) -> f64 {
+    fn errors(&self, far: &[f64]) -> FieldErrors {
+        let weighted = |v: &[f64]| v.iter().zip(self.weights).map(|(a, w)| a * w).sum::<f64>();
+        let mut own: Vec<f64> = far
+            .iter()
+            .zip(&self.totals)
+            .filter(|(_, t)| **t > 0.0)
+            .map(|(f, t)| (f / t).sqrt())
+            .collect();
+        own.sort_by(f64::total_cmp);
+        let p95 = match own.len() {
+            0 => 0.0,
+            n => own[((0.95 * (n - 1) as f64).round() as usize).min(n - 1)],
+        };
+        FieldErrors {
+            overall: (weighted(far) / weighted(&self.totals)).sqrt(),
+            p95,
+        }
+    }
+
+    /// Per load, `‖r_p‖²`, leaving out its near field when `far_only`.
+    fn squared_norms(&self, columns: &Responses, far_only: bool) -> Vec<f64> {
         (0..columns.count())
             .into_par_iter()
             .map(|p| {
@@ -165,8 +200,8 @@ impl<'a> FieldError<'a> {
                 }
                 // |r|² minus its near part cancels to rounding when the near field covers
                 // the whole organ: never below zero.
-                self.weights[p] * sum.max(0.0)
+                sum.max(0.0)
             })
-            .sum()
+            .collect()
     }
 }

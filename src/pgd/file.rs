@@ -15,7 +15,7 @@ use crate::fem::{Inclusion, Material};
 use crate::mesh::TetMesh;
 
 /// Bumped on any change of layout or meaning; older files are refused, not misread.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 const KIND: Kind = Kind {
     magic: b"PGDVADEM",
     version: FORMAT_VERSION,
@@ -204,6 +204,7 @@ fn payload(v: &Vademecum) -> Vec<u8> {
     put(&mut out, &v.positions);
     put(&mut out, v.position_coords_m.as_flattened());
     put(&mut out, &v.position_areas_m2);
+    put(&mut out, v.position_normals.as_flattened());
     put(&mut out, v.triangles.as_flattened());
     put(&mut out, &v.reference_compliance_m_per_n);
     put(&mut out, &[v.steps.len() as u32]);
@@ -226,6 +227,11 @@ fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumEr
     let coords: Vec<f32> = r.take("position coordinates")?;
     let position_coords_m = coords.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     let position_areas_m2 = r.take("position areas")?;
+    let normals: Vec<f32> = r.take("position normals")?;
+    let position_normals = normals
+        .chunks_exact(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect();
     let flat: Vec<u32> = r.take("triangles")?;
     if !flat.len().is_multiple_of(3) {
         return Err(r.malformed("triangles"));
@@ -255,6 +261,7 @@ fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumEr
         positions,
         position_coords_m,
         position_areas_m2,
+        position_normals,
         triangles,
         reference_compliance_m_per_n,
         steps,
@@ -277,8 +284,11 @@ fn validate(path: &Path, v: &Vademecum) -> Result<(), VademecumError> {
     if v.triangles.iter().flatten().any(|&i| i as usize >= m) {
         return fail("triangles (an index beyond the positions)");
     }
-    if v.position_coords_m.len() != m || v.position_areas_m2.len() != m {
-        return fail("position coordinates or areas (one per position expected)");
+    if v.position_coords_m.len() != m
+        || v.position_areas_m2.len() != m
+        || v.position_normals.len() != m
+    {
+        return fail("position coordinates, areas or normals (one per position expected)");
     }
     if v.reference_compliance_m_per_n.len() != m {
         return fail("reference compliances (one per position expected)");

@@ -18,6 +18,45 @@ pub fn young_pa(organ: Organ) -> f64 {
     }
 }
 
+/// The tool an organ is pressed with and the region around it the trainee watches.
+///
+/// The abdominal organs are pressed by laparoscopic instruments (a 12 mm tip) and watched over
+/// 2 cm around it (the dimple and its rim). The cornea (11.5 mm across, 0.5 mm thick) is
+/// pressed by a 1 mm ophthalmic spatula and watched over the bending length of its shell,
+/// `√(R t) ≈ √(7.8 mm × 0.5 mm) ≈ 2 mm`, beyond which a load on a thin shell is felt only
+/// through its global shape. With the abdominal radii the cornea lay wholly inside every
+/// load's near field: one mode, a 3.7 GB file (docs/pgd.md).
+pub fn tool_radii_m(organ: Option<Organ>) -> ToolRadii {
+    match organ {
+        Some(Organ::Cornea) => ToolRadii {
+            tool_tip_m: 0.5e-3,
+            watched_m: 2e-3,
+        },
+        _ => ToolRadii {
+            tool_tip_m: 6e-3,
+            watched_m: 0.02,
+        },
+    }
+}
+
+/// See [`tool_radii_m`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ToolRadii {
+    pub tool_tip_m: f64,
+    /// The field is watched within this distance (m) of the tool's centre.
+    pub watched_m: f64,
+}
+
+impl ToolRadii {
+    /// The radius (m) around each loaded node within which the vademecum keeps the exact
+    /// response: the watched region plus the patch, so that the nodes a tool's patch loads,
+    /// up to a tool radius from its centre, all carry their exact response over the whole
+    /// watched region, and the field there is exact by linearity.
+    pub fn near_field_m(&self) -> f64 {
+        self.watched_m + self.tool_tip_m
+    }
+}
+
 /// Nearly incompressible soft tissue, as in paper 000.
 pub const POISSON: f64 = 0.48;
 

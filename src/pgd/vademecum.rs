@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::BuildSettings;
 use super::error_curve::ErrorCurve;
 use super::local::LocalPart;
-use crate::fem::{Inclusion, Material, patch_weight};
+use crate::fem::{Inclusion, Material, on_pressed_side, patch_weight};
 
 /// What the vademecum was built from and how: enough to refuse a stale file and to say how it
 /// was made.
@@ -101,6 +101,9 @@ pub struct Vademecum {
     pub position_coords_m: Vec<[f32; 3]>,
     /// Lumped surface area (m²) of each load position: its weight in a tool patch.
     pub position_areas_m2: Vec<f32>,
+    /// Unit outward normal of each load position: a patch loads only the positions on its
+    /// own side of a thin wall ([`on_pressed_side`]).
+    pub position_normals: Vec<[f32; 3]>,
     /// The accessible triangles, as position indices.
     pub triangles: Vec<[u32; 3]>,
     /// Per position, the largest self-compliance of the linear step (m/N): turns a force into
@@ -178,6 +181,15 @@ impl Vademecum {
             .sum()
     }
 
+    /// Which way accessible triangle `t` faces: the sum of its corners' outward normals (the
+    /// surface's, whatever the order of the triangle's corners), as a tool patch on it sees it.
+    pub fn triangle_facing(&self, t: usize) -> Vector3<f64> {
+        self.triangles[t]
+            .iter()
+            .map(|&m| Vector3::from(self.position_normals[m as usize].map(f64::from)))
+            .sum()
+    }
+
     /// The tool's contact patch centred at `at`, the same kernel as the full FEM load. A patch
     /// narrower than the mesh (no node inside it) falls back to the triangle's corners.
     pub fn patch(&self, at: &SurfacePoint) -> Patch {
@@ -194,8 +206,13 @@ impl Vademecum {
         let radius_m = self.header.settings.tool_tip_radius_m;
         let local = &self.steps[0].local;
         let corners = self.triangles[at.triangle];
+        let facing = self.triangle_facing(at.triangle);
         let weights = local.neighbours_of(corners[0] as usize).filter_map(|e| {
             let m = local.neighbours[e] as usize;
+            let normal = Vector3::from(self.position_normals[m].map(f64::from));
+            if !on_pressed_side(&normal, &facing) {
+                return None;
+            }
             let p = Vector3::from(self.position_coords_m[m].map(f64::from));
             let w = patch_weight(
                 self.position_areas_m2[m] as f64,

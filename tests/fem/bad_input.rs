@@ -1,6 +1,6 @@
 //! Bad input gets an error that says what and where; nothing panics.
 
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector3};
 use pgd_surgery::fem::{Dirichlet, FemError, FemModel, Law, Loads, Material, NewtonSettings};
 use pgd_surgery::mesh::{MeshError, TetMesh, box_mesh};
 
@@ -155,7 +155,7 @@ fn a_point_load_radius_below_the_mesh_spacing_is_refused() {
         .add_point_load(
             &mesh,
             &surface,
-            Point3::new(0.025, 0.025, 0.1),
+            (Point3::new(0.025, 0.025, 0.1), Vector3::z()),
             [0.0, 0.0, -1.0],
             1e-3,
         )

@@ -67,7 +67,7 @@ fn a_regularized_point_load_keeps_its_total_and_stays_local() {
     let radius = 0.012;
     let mut loads = Loads::new(mesh.node_count());
     loads
-        .add_point_load(&mesh, &surface, point, force, radius)
+        .add_point_load(&mesh, &surface, (point, Vector3::z()), force, radius)
         .unwrap();
     assert!((loads.total_force_n() - Vector3::from(force)).norm() < 1e-14);
     // Only nodes within the radius carry load, and their load-weighted centroid is the point.
@@ -95,4 +95,32 @@ fn a_regularized_point_load_keeps_its_total_and_stays_local() {
         (centroid - point.coords).norm() < 0.1 * radius,
         "load centroid {centroid:?} far from {point:?}"
     );
+}
+
+/// A 12 mm patch on a 3 mm wall reaches the far face in distance, but the tool presses only
+/// the face it touches: no share on the bottom face, and the whole force on the top one.
+#[test]
+fn a_point_load_on_a_thin_wall_loads_only_the_pressed_face() {
+    let wall = [0.06, 0.05, 0.003];
+    let mesh = box_mesh(wall, [12, 10, 1]).unwrap();
+    let surface = Surface::extract(&mesh);
+    let force = [0.0, 0.0, -0.3];
+    let mut loads = Loads::new(mesh.node_count());
+    loads
+        .add_point_load(
+            &mesh,
+            &surface,
+            (Point3::new(0.03, 0.025, wall[2]), Vector3::z()),
+            force,
+            0.012,
+        )
+        .unwrap();
+    let on_face = |z: f64| -> f64 {
+        (0..mesh.node_count())
+            .filter(|&n| (mesh.nodes()[n].z - z).abs() < 1e-9)
+            .map(|n| loads.as_slice()[3 * n + 2])
+            .sum()
+    };
+    assert_eq!(on_face(0.0), 0.0, "the far face carries load");
+    assert!((on_face(wall[2]) - force[2]).abs() < 1e-14);
 }

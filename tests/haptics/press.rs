@@ -10,13 +10,14 @@ use pgd_surgery::mesh::Surface;
 use crate::common::{haptic, liver, press, run, scripted, tick_at};
 
 /// The 3 × 3 compliance (m/N) of full FEM at `point` for the tool's patch load: the
-/// patch-averaged displacement under unit forces along each axis.
-fn fem_compliance(point: Point3<f64>) -> Matrix3<f64> {
+/// patch-averaged displacement under unit forces along each axis; the patch is on the side of
+/// the surface `facing` faces.
+fn fem_compliance(point: Point3<f64>, facing: &Vector3<f64>) -> Matrix3<f64> {
     let model = &liver().model;
     let mesh = model.mesh();
     let radius = liver().vademecum.header.settings.tool_tip_radius_m;
     let kernel = PatchKernel::new(mesh, &Surface::extract(mesh), radius).unwrap();
-    let shares = kernel.shares(point).unwrap();
+    let shares = kernel.shares(point, facing).unwrap();
     let mut c = Matrix3::zeros();
     for d in 0..3 {
         let mut loads = Loads::new(mesh.node_count());
@@ -61,7 +62,8 @@ fn a_scripted_press_matches_full_fem() {
         (contact.depth_m - motion.depth_m).abs() < 2e-4,
         "{contact:?}"
     );
-    let reference = fem_compliance(Point3::from(contact.hit.point_m))
+    let facing = liver().vademecum.triangle_facing(contact.hit.at.triangle);
+    let reference = fem_compliance(Point3::from(contact.hit.point_m), &facing)
         .try_inverse()
         .unwrap()
         * contact.indentation_m;
