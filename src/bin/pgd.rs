@@ -194,7 +194,8 @@ struct BuildArgs {
     /// other organs and mesh files).
     #[arg(long)]
     local_radius_mm: Option<f64>,
-    /// Target relative L2 error of the field (global modes + exact near field).
+    /// Target of the estimator: each node-centred load's relative L2 error of the field (global
+    /// modes + exact near field), root mean square over the loads.
     #[arg(long, default_value_t = BuildSettings::default().target_error)]
     target_error: f64,
     /// At most this many PGD modes per load step.
@@ -581,8 +582,8 @@ fn print_build_report(report: &BuildReport, out: &Path) {
         );
         let field = |curve: &[f64]| curve.last().map_or(f64::NAN, |e| 100.0 * e);
         println!(
-            "  vademecum field error (global + near field, node-centred loads): {:.1} % over \
-             all loads, {:.1} % p95 of each load's own",
+            "  vademecum field error (global + near field) of each node-centred load: {:.1} % \
+             rms, {:.1} % p95",
             field(&step.curve.field),
             field(&step.curve.field_p95)
         );

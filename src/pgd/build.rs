@@ -34,8 +34,10 @@ pub struct BuildSettings {
     pub tool_tip_radius_m: f64,
     /// Nodes within this distance (m) of a load get its exact response (the local correction).
     pub local_radius_m: f64,
-    /// Target relative L2 error of the vademecum's field over all node-centred loads (the
-    /// estimator); enrichment stops there or at the cap.
+    /// Target of the estimator: each node-centred load's relative L2 error of the vademecum's
+    /// field, root mean square over the loads; enrichment stops there or at the cap. The
+    /// default, 10 %, is the bound the targets set on the field the trainee watches; the
+    /// near field makes it exact around the tool, so this bounds the rest of the organ.
     pub target_error: f64,
     pub pgd: PgdSettings,
     /// Kirchhoff–Saint Venant only: the indentation (m) under the tool at each load step after
@@ -58,7 +60,7 @@ impl BuildSettings {
         Self {
             tool_tip_radius_m: radii.tool_tip_m,
             local_radius_m: radii.near_field_m(),
-            target_error: 0.05,
+            target_error: 0.1,
             pgd: PgdSettings::default(),
             load_steps_m: DEFAULT_LOAD_STEPS_M.to_vec(),
             secant: SecantSettings::default(),
@@ -420,16 +422,16 @@ fn separated_part(
             .push(energy.add_mode(field, stiffness, loads));
         let k = field.modes() - 1;
         let errors = estimator.subtract_mode(residual, &field.spatial[k], &field.parametric[k]);
-        curve.field.push(errors.overall);
+        curve.field.push(errors.rms);
         curve.field_p95.push(errors.p95);
         progress.advance(1);
         progress.message(&format!(
-            "mode {}: error {:.2} % overall, {:.2} % p95 per load",
+            "mode {}: error {:.2} % rms, {:.2} % p95 over the loads",
             field.modes(),
-            100.0 * errors.overall,
+            100.0 * errors.rms,
             100.0 * errors.p95
         ));
-        errors.overall > settings.target_error
+        errors.rms > settings.target_error
     })?;
     Ok((field, modes, curve))
 }

@@ -19,8 +19,8 @@ pub struct ErrorCurve {
     pub separated: Vec<f64>,
     /// The best energy error any separated sum of as many terms can reach (Eckart–Young).
     pub optimal: Vec<f64>,
-    /// L2 error of the whole vademecum (separated sum + exact near field) over all node-centred
-    /// loads together, weighted by area.
+    /// The estimator: each node-centred load's relative L2 error of the whole vademecum
+    /// (separated sum + exact near field), their root mean square weighted by area.
     pub field: Vec<f64>,
     /// The 95th percentile over the node-centred loads of each load's own relative L2 error
     /// (absent in files written before it was recorded).
@@ -102,7 +102,7 @@ pub fn optimal_errors(gram: &[f64], weights: &[f64], max_modes: usize) -> Vec<f6
 }
 
 /// The error estimator of a build: the relative L2 error of the whole vademecum (separated sum
-/// plus the exact near field) for every node-centred load. It is exact, not estimated: the
+/// plus the exact near field) for every node-centred load, each relative to its own response. It is exact, not estimated: the
 /// exact responses are at hand, and are turned into the residual of the separated sum one mode
 /// at a time.
 pub struct FieldError<'a> {
@@ -113,13 +113,15 @@ pub struct FieldError<'a> {
     totals: Vec<f64>,
 }
 
-/// The vademecum's error with the modes so far.
+/// The vademecum's error with the modes so far, from each load's own relative error: a stiff
+/// region's loads, whose responses are small, count as much as a soft one's. (The error of
+/// all loads together is dominated by the softest regions: on the pancreas it was met with 3
+/// modes while loads near its clamped ends were 69 % off, p95.)
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FieldErrors {
-    /// All loads together, weighted by area: dominated by the softest regions.
-    pub overall: f64,
-    /// The 95th percentile of the loads' own relative errors: a stiff region's loads, whose
-    /// responses are small, count as much as a soft one's.
+    /// Root mean square over the loads, weighted by area: the stopping criterion.
+    pub rms: f64,
+    /// The 95th percentile.
     pub p95: f64,
 }
 
@@ -163,20 +165,26 @@ impl<'a> FieldError<'a> {
     }
 
     fn errors(&self, far: &[f64]) -> FieldErrors {
-        let weighted = |v: &[f64]| v.iter().zip(self.weights).map(|(a, w)| a * w).sum::<f64>();
-        let mut own: Vec<f64> = far
-            .iter()
-            .zip(&self.totals)
-            .filter(|(_, t)| **t > 0.0)
-            .map(|(f, t)| (f / t).sqrt())
-            .collect();
+        let (mut squares, mut area) = (0.0, 0.0);
+        let mut own = Vec::with_capacity(far.len());
+        for ((f, t), w) in far.iter().zip(&self.totals).zip(self.weights) {
+            if *t > 0.0 {
+                squares += w * f / t;
+                area += w;
+                own.push((f / t).sqrt());
+            }
+        }
         own.sort_by(f64::total_cmp);
         let p95 = match own.len() {
             0 => 0.0,
             n => own[((0.95 * (n - 1) as f64).round() as usize).min(n - 1)],
         };
         FieldErrors {
-            overall: (weighted(far) / weighted(&self.totals)).sqrt(),
+            rms: if area > 0.0 {
+                (squares / area).sqrt()
+            } else {
+                0.0
+            },
             p95,
         }
     }

@@ -15,7 +15,7 @@ use crate::fem::{Inclusion, Material};
 use crate::mesh::TetMesh;
 
 /// Bumped on any change of layout or meaning; older files are refused, not misread.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 const KIND: Kind = Kind {
     magic: b"PGDVADEM",
     version: FORMAT_VERSION,
