@@ -63,7 +63,11 @@ pub fn run(organ: Organ, laws: &[Law], repeats: usize) -> Result<VademecumBenchR
             accessible_region: region::ACCESSIBLE.into(),
         };
         let started = Instant::now();
-        let (vademecum, report) = pgd::build(&organ_model, &BuildSettings::default(), &Silent)?;
+        let (vademecum, report) = pgd::build(
+            &organ_model,
+            &BuildSettings::for_organ(Some(organ)),
+            &Silent,
+        )?;
         let build_seconds = started.elapsed().as_secs_f64();
         let sum = |f: fn(&pgd::StepReport) -> f64| report.steps.iter().map(f).sum::<f64>();
         let (brute, pgd_s) = (sum(|s| s.brute_force_seconds), sum(|s| s.pgd_seconds));

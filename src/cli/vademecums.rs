@@ -54,9 +54,10 @@ impl VademecumSpec {
         Self::new(organ.name(), OrganSource::Generated(organ), law, file)
     }
 
-    /// The vademecum of the organ `name` from `source` under `law`, default settings and
-    /// tissue, kept in `file`.
+    /// The vademecum of the organ `name` from `source` under `law`, the organ's default
+    /// settings and tissue, kept in `file`.
     pub fn new(name: &str, source: OrganSource, law: Law, file: PathBuf) -> Self {
+        let build = BuildSettings::for_organ(source.organ());
         Self {
             name: name.to_owned(),
             source,
@@ -65,7 +66,7 @@ impl VademecumSpec {
             young_pa: None,
             poisson: None,
             inclusions: Vec::new(),
-            build: BuildSettings::default(),
+            build,
             file,
         }
     }
@@ -81,7 +82,8 @@ impl VademecumSpec {
             OrganSource::File(path) => path.display().to_string(),
         };
         let mut command = format!("cargo run --release --bin pgd -- build {source} --law {law}");
-        let (mesh, build) = (OrganSettings::default(), BuildSettings::default());
+        let mesh = OrganSettings::default();
+        let build = BuildSettings::for_organ(self.source.organ());
         // A mesh file's mesh is as it is: the generator's settings do not apply.
         if let OrganSource::Generated(_) = self.source {
             if self.mesh.resolution != mesh.resolution {
