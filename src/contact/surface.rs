@@ -4,7 +4,7 @@
 
 use nalgebra::{Point3, Vector3};
 use parry3d::query::PointQueryWithLocation;
-use parry3d::shape::TriMesh;
+use parry3d::shape::{TriMesh, TrianglePointLocation};
 
 use crate::pgd::{SurfacePoint, Vademecum};
 use crate::seam::{from_parry, to_parry};
@@ -30,6 +30,10 @@ pub struct SurfaceHit {
 pub struct ContactSurface {
     mesh: TriMesh,
     normals: Vec<Vector3<f64>>,
+    /// Per vertex, the triangles around it (`vertex_triangles[offsets[v]..offsets[v + 1]]`):
+    /// the neighbourhood a tracked contact point searches.
+    offsets: Vec<u32>,
+    vertex_triangles: Vec<u32>,
 }
 
 impl ContactSurface {
@@ -51,7 +55,79 @@ impl ContactSurface {
                 reason: e.to_string(),
             }
         })?;
-        Ok(Self { mesh, normals })
+        let (offsets, vertex_triangles) =
+            triangles_around(&vademecum.triangles, vademecum.position_coords_m.len());
+        Ok(Self {
+            mesh,
+            normals,
+            offsets,
+            vertex_triangles,
+        })
+    }
+
+    /// The surface point a contact at `previous` moves to for `query_m`: the closest point
+    /// among the triangles around `previous` (two rings), unless another part of the surface
+    /// is closer by more than `switch_m`. A point found globally jumps across a groove when its
+    /// two sides are about as close (the tool's patch and force jump with it); tracked, it
+    /// slides along the side it is on. Without `previous`, the closest point.
+    pub fn tracked(
+        &self,
+        query_m: &Vector3<f64>,
+        previous: Option<&SurfacePoint>,
+        switch_m: f64,
+    ) -> Option<SurfaceHit> {
+        let global = self.closest(query_m)?;
+        let Some(local) = previous.and_then(|at| self.closest_around(query_m, at, switch_m)) else {
+            return Some(global);
+        };
+        let distance = |hit: &SurfaceHit| (hit.point_m - query_m).norm();
+        if distance(&global) < distance(&local) - switch_m {
+            Some(global)
+        } else {
+            Some(local)
+        }
+    }
+
+    /// The closest point to `query_m` within `reach_m` of `previous` on the triangles within
+    /// two rings of its triangle.
+    fn closest_around(
+        &self,
+        query_m: &Vector3<f64>,
+        previous: &SurfacePoint,
+        reach_m: f64,
+    ) -> Option<SurfaceHit> {
+        let triangle = previous.triangle;
+        let vertices = self.mesh.vertices();
+        let from = self.mesh.indices()[triangle]
+            .iter()
+            .zip(previous.barycentric)
+            .map(|(&v, l)| from_parry(vertices[v as usize]).coords * l)
+            .sum::<Vector3<f64>>();
+        let ring = |t: usize| {
+            self.mesh.indices()[t].into_iter().flat_map(|v| {
+                let v = v as usize;
+                self.vertex_triangles[self.offsets[v] as usize..self.offsets[v + 1] as usize]
+                    .iter()
+                    .map(|&t| t as usize)
+            })
+        };
+        let query = to_parry(&Point3::from(*query_m));
+        ring(triangle)
+            .flat_map(ring)
+            .map(|t| {
+                let (projection, location) = self
+                    .mesh
+                    .triangle(t as u32)
+                    .project_local_point_and_get_location(query, false);
+                ((projection.point - query).length(), t, projection, location)
+            })
+            .filter(|(_, _, projection, _)| {
+                (from_parry(projection.point).coords - from).norm() <= reach_m
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .and_then(|(_, t, projection, location)| {
+                self.hit(t as u32, from_parry(projection.point).coords, location)
+            })
     }
 
     /// The closest surface point to `query_m`, or none for a non-finite query.
@@ -62,6 +138,15 @@ impl ContactSurface {
         let (projection, (triangle, location)) = self
             .mesh
             .project_local_point_and_get_location(to_parry(&Point3::from(*query_m)), false);
+        self.hit(triangle, from_parry(projection.point).coords, location)
+    }
+
+    fn hit(
+        &self,
+        triangle: u32,
+        point_m: Vector3<f64>,
+        location: TrianglePointLocation,
+    ) -> Option<SurfaceHit> {
         let barycentric = location.barycentric_coordinates()?.map(f64::from);
         let corners = self.mesh.indices()[triangle as usize];
         let normal = corners
@@ -75,8 +160,28 @@ impl ContactSurface {
                 triangle: triangle as usize,
                 barycentric,
             },
-            point_m: from_parry(projection.point).coords,
+            point_m,
             normal,
         })
     }
+}
+
+/// Per vertex, the triangles that use it, as offsets and a flat list.
+fn triangles_around(triangles: &[[u32; 3]], vertices: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut offsets = vec![0u32; vertices + 1];
+    for &v in triangles.iter().flatten() {
+        offsets[v as usize + 1] += 1;
+    }
+    for v in 0..vertices {
+        offsets[v + 1] += offsets[v];
+    }
+    let mut filled = offsets.clone();
+    let mut list = vec![0u32; offsets[vertices] as usize];
+    for (t, triangle) in triangles.iter().enumerate() {
+        for &v in triangle {
+            list[filled[v as usize] as usize] = t as u32;
+            filled[v as usize] += 1;
+        }
+    }
+    (offsets, list)
 }

@@ -70,12 +70,13 @@ where
 
 /// Presses `probe`, its tip centred at `tip_m`, into `target`: sets `load` to the force that
 /// makes the surface follow the tip and returns the contact, or releases `load` when the tip
-/// does not touch. `patch` is scratch space kept between ticks: nothing is allocated once it
-/// and `load` have grown.
+/// does not touch. `previous` is the last tick's contact point, which the new one tracks
+/// ([`ContactSurface::tracked`]). `patch` is scratch space kept between ticks: nothing is
+/// allocated once it and `load` have grown.
 pub fn press<F, G>(
     target: &Target<F, G>,
     probe: &Probe,
-    tip_m: &Vector3<f64>,
+    (tip_m, previous): (&Vector3<f64>, Option<&SurfacePoint>),
     patch: &mut Patch,
     load: &mut PatchLoad,
 ) -> Option<ToolContact>
@@ -84,7 +85,7 @@ where
     G: Fn(&SurfacePoint) -> Vector3<f64>,
 {
     let vademecum = target.vademecum;
-    let Some(contact) = touch(target, probe, tip_m, patch) else {
+    let Some(contact) = touch(target, probe, (tip_m, previous), patch) else {
         load.release();
         return None;
     };
@@ -98,9 +99,14 @@ where
     })
 }
 
+/// A tracked contact point moves to another part of the surface only when that part is
+/// closer to the tip by this many tip radii.
+const SWITCH_TIP_RADII: f64 = 0.25;
+
 /// Where and how deep the tip presses, before the force is known, and the patch under it.
 /// - The point below the tip is found on the surface as all loads have moved it (one
-///   correction: the displacement varies slowly along the surface). The other loads alone
+///   correction: the displacement varies slowly along the surface), tracked from the last
+///   tick's point, so that it slides along a groove's side instead of jumping to the other. The other loads alone
 ///   would not do: an organ pressed against another carries the two loads' large, opposite
 ///   displacements (the coarse gallbladder's floppy modes, tens of centimetres each way), and
 ///   the point found with one of them jumped across the surface from tick to tick.
@@ -112,7 +118,7 @@ where
 fn touch<F, G>(
     target: &Target<F, G>,
     probe: &Probe,
-    tip_m: &Vector3<f64>,
+    (tip_m, previous): (&Vector3<f64>, Option<&SurfacePoint>),
     patch: &mut Patch,
 ) -> Option<ToolContact>
 where
@@ -120,10 +126,15 @@ where
     G: Fn(&SurfacePoint) -> Vector3<f64>,
 {
     let (vademecum, surface) = (target.vademecum, target.surface);
-    let mut hit = surface.closest(tip_m)?;
+    let switch_m = SWITCH_TIP_RADII * probe.tip_radius_m;
+    let mut hit = surface.tracked(tip_m, previous, switch_m)?;
     let moved_by_all = (target.moved_by_all)(&hit.at);
     if moved_by_all != Vector3::zeros() {
-        hit = surface.closest(&(tip_m - moved_by_all))?;
+        hit = surface.tracked(
+            &(tip_m - moved_by_all),
+            previous.or(Some(&hit.at)),
+            switch_m,
+        )?;
     }
     vademecum.patch_into(&hit.at, patch);
     let moved_m: Vector3<f64> = patch

@@ -91,7 +91,7 @@ fn a_dense_pointshell_covers_the_surface_once() {
 /// The gallbladder pressed into the liver with a dense pointshell: more points push, none
 /// deeper than one lattice cell, and the forces on the two organs balance.
 #[test]
-#[ignore = "not met yet: the dense press now holds (deepest point 1.2 mm, below the 2 mm cell), but at the end 1 point pushes where the boundary nodes alone have 2"]
+#[ignore = "not met yet: at the end as many points push densely as the boundary nodes alone have (2 and 2): the liver's modes clear the intrusion with a few forces"]
 fn pressing_with_a_dense_pointshell_pushes_more_points_and_stays_shallow() {
     let target = facing("gallbladder", -Vector3::z());
     let (_, record) = run_on(dense_scene(), push(&target, 0.012, PUSH_S, 0.5), TICKS);
@@ -207,12 +207,13 @@ fn a_slow_push_on_the_gallbladder_alone_changes_the_contact_force_smoothly() {
     assert_smooth(pushed_alone());
 }
 
-/// The push that also presses the duodenum: at one tick the tool's contact point on the
-/// duodenum jumps 4 mm across a groove (two parts of its surface nearly as close to the tip),
-/// its force there steps from 0.8 to 1.9 mN, and the duodenum's carry moves the gallbladder
-/// 0.6 mm at once.
+/// The push that also presses the duodenum, where the tip meets a groove: two parts of its
+/// surface nearly as close. Found afresh each tick, the tool's contact point jumped 4 mm
+/// across it at one tick, its force there stepped from 0.8 to 1.9 mN, the duodenum's carry
+/// moved the gallbladder 0.6 mm at once, and the contact force stepped by 2.6 % of its peak.
+/// Tracked from tick to tick (`ContactSurface::tracked`), it slides along its side: measured,
+/// steps of at most 0.14 % (bound 0.5 %).
 #[test]
-#[ignore = "not met yet: a step of 2.5 % of the peak, at the tick where the tool's point on the duodenum jumps across a groove (5.1 % before the pulled-back field and the penalty along the rest normal)"]
 fn a_slow_push_changes_the_contact_force_smoothly() {
     assert_smooth(pushed());
 }

@@ -59,10 +59,11 @@ pub fn tool_contact(
             },
             moved_by_all: |at: &SurfacePoint| deformation.displacement(&body.vademecum, at),
         };
+        let previous = touch.contact.map(|contact| contact.hit.at);
         touch.contact = press(
             &target,
             &tool.probe,
-            &sample.tip_m,
+            (&sample.tip_m, previous.as_ref()),
             &mut touch.patch,
             &mut touch.next_load,
         );
