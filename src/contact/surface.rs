@@ -66,7 +66,7 @@ impl ContactSurface {
     }
 
     /// The surface point a contact at `previous` moves to for `query_m`: the closest point
-    /// among the triangles around `previous` (two rings), unless another part of the surface
+    /// among the triangles around `previous`, unless another part of the surface
     /// is closer by more than `switch_m`. A point found globally jumps across a groove when its
     /// two sides are about as close (the tool's patch and force jump with it); tracked, it
     /// slides along the side it is on. Without `previous`, the closest point.
@@ -88,8 +88,9 @@ impl ContactSurface {
         }
     }
 
-    /// The closest point to `query_m` within `reach_m` of `previous` on the triangles within
-    /// two rings of its triangle.
+    /// The closest point to `query_m` within `reach_m` of `previous` on the triangles that
+    /// share a corner with its triangle (a few shared ones are projected twice: cheaper than
+    /// sorting them out).
     fn closest_around(
         &self,
         query_m: &Vector3<f64>,
@@ -113,7 +114,6 @@ impl ContactSurface {
         };
         let query = to_parry(&Point3::from(*query_m));
         ring(triangle)
-            .flat_map(ring)
             .map(|t| {
                 let (projection, location) = self
                     .mesh
