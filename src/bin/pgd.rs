@@ -560,8 +560,12 @@ fn write_distance_field(vademecum: &pgd::Vademecum, path: &Path) -> Result<(), S
 
 fn print_build_report(report: &BuildReport, out: &Path) {
     println!(
-        "{} load positions x 3 directions = {} parameters, {} free dofs",
-        report.positions, report.parameters, report.free_dofs
+        "{} load positions x 3 directions = {} parameters, {} free dofs; a load's near field \
+         holds {:.1} % of the nodes on average",
+        report.positions,
+        report.parameters,
+        report.free_dofs,
+        100.0 * report.near_field_share
     );
     for (k, step) in report.steps.iter().enumerate() {
         let n = step.modes_kept;

@@ -120,8 +120,15 @@ pub struct BuildReport {
     /// KSV load steps left out because their fixed point did not converge: the vademecum's
     /// valid range stops before them.
     pub failed_step: Option<StepReport>,
+    /// The share of the organ's nodes in a load's near field, on average: near 1, every load
+    /// keeps its exact response everywhere (a large file, few modes).
+    pub near_field_share: f64,
     pub total_seconds: f64,
 }
+
+/// Above this [`BuildReport::near_field_share`] the build warns that the near field is too
+/// wide for the organ.
+pub const WIDE_NEAR_FIELD_SHARE: f64 = 0.5;
 
 /// Where the tool may press, in load-position numbering.
 struct Accessible {
@@ -220,6 +227,17 @@ pub fn build(
         progress,
     };
     let (steps, reports, failed_step) = load_steps(&context)?;
+    let near_field_share = steps[0].local.correction_nodes.len() as f64
+        / (patches.positions.len() * mesh.node_count()) as f64;
+    if near_field_share > WIDE_NEAR_FIELD_SHARE {
+        progress.message(&format!(
+            "the near field ({:.1} mm) holds {:.0} % of the organ's nodes for an average load: \
+             the file is large and the modes carry little; an organ this size wants a smaller \
+             --local-radius-mm (and a tool to match, --tool-radius-mm)",
+            settings.local_radius_m * 1e3,
+            100.0 * near_field_share
+        ));
+    }
     let header = Header {
         source: organ.source.clone(),
         mesh_hash: mesh_hash(mesh),
@@ -252,6 +270,7 @@ pub fn build(
         free_dofs: stiffness.free_count(),
         steps: reports,
         failed_step,
+        near_field_share,
         total_seconds: started.elapsed().as_secs_f64(),
     };
     Ok((vademecum, report))

@@ -17,7 +17,10 @@ mod stiffness;
 mod vademecum;
 mod validate;
 
-pub use build::{BuildReport, BuildSettings, DEFAULT_LOAD_STEPS_M, OrganModel, StepReport, build};
+pub use build::{
+    BuildReport, BuildSettings, DEFAULT_LOAD_STEPS_M, OrganModel, StepReport,
+    WIDE_NEAR_FIELD_SHARE, build,
+};
 pub use deformation::{Deformation, PatchLoad, RigidCarry};
 pub use enrichment::{ModeReport, PgdSettings, enrich};
 pub use error_curve::{EnergyError, ErrorCurve, optimal_errors};

@@ -4,7 +4,9 @@
 use nalgebra::Vector3;
 use pgd_surgery::fem::{Dirichlet, FemModel, Law, Loads, Material, NewtonSettings};
 use pgd_surgery::mesh::box_mesh;
-use pgd_surgery::pgd::{BuildSettings, Silent, Vademecum, ValidationSettings, build, validate};
+use pgd_surgery::pgd::{
+    BuildSettings, Silent, Vademecum, ValidationSettings, WIDE_NEAR_FIELD_SHARE, build, validate,
+};
 
 use crate::common::{block_mesh, block_model, build_block, organ, settings};
 
@@ -188,4 +190,26 @@ fn the_estimator_is_each_loads_own_error_against_full_fem() {
         (p95 - built_p95).abs() < 1e-4 * built_p95.max(1e-3),
         "{p95} against {built_p95}"
     );
+}
+
+/// The build reports how much of the organ a load's near field holds: all of it when the
+/// radius exceeds the organ (the cornea under the abdominal radii kept one mode and 3.7 GB),
+/// which it flags; a fraction with the block's own radius.
+#[test]
+fn the_build_reports_a_near_field_too_wide_for_the_organ() {
+    let model = block_model(block_mesh([6, 4, 3]));
+    let share = |local_radius_m: f64| {
+        let settings = BuildSettings {
+            local_radius_m,
+            ..settings(2, 1e-9)
+        };
+        build(&organ(&model), &settings, &Silent)
+            .unwrap()
+            .1
+            .near_field_share
+    };
+    let (own, whole) = (share(0.015), share(1.0));
+    eprintln!("near-field share: {own:.3} with 15 mm, {whole:.3} with 1 m");
+    assert!(own < WIDE_NEAR_FIELD_SHARE, "{own}");
+    assert!((whole - 1.0).abs() < 1e-12, "{whole}");
 }
