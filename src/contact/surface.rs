@@ -104,20 +104,16 @@ impl ContactSurface {
             .zip(previous.barycentric)
             .map(|(&v, l)| from_parry(vertices[v as usize]).coords * l)
             .sum::<Vector3<f64>>();
-        let ring = |t: usize| {
-            self.mesh.indices()[t].into_iter().flat_map(|v| {
-                let v = v as usize;
-                self.vertex_triangles[self.offsets[v] as usize..self.offsets[v + 1] as usize]
-                    .iter()
-                    .map(|&t| t as usize)
-            })
-        };
+        let around = self.mesh.indices()[triangle].into_iter().flat_map(|v| {
+            let v = v as usize;
+            &self.vertex_triangles[self.offsets[v] as usize..self.offsets[v + 1] as usize]
+        });
         let query = to_parry(&Point3::from(*query_m));
-        ring(triangle)
-            .map(|t| {
+        around
+            .map(|&t| {
                 let (projection, location) = self
                     .mesh
-                    .triangle(t as u32)
+                    .triangle(t)
                     .project_local_point_and_get_location(query, false);
                 ((projection.point - query).length(), t, projection, location)
             })
@@ -126,7 +122,7 @@ impl ContactSurface {
             })
             .min_by(|a, b| a.0.total_cmp(&b.0))
             .and_then(|(_, t, projection, location)| {
-                self.hit(t as u32, from_parry(projection.point).coords, location)
+                self.hit(t, from_parry(projection.point).coords, location)
             })
     }
 
