@@ -338,14 +338,14 @@ fn main() -> ExitCode {
         } => {
             let file = vademecum.unwrap_or_else(|| default_vademecum(&mesh));
             let settings = |organ| {
-                let defaults = ValidationSettings::for_organ(organ);
-                let deepest_m =
-                    max_indentation_mm.map_or(defaults.indentation_range_m.1, |mm| mm * 1e-3);
-                ValidationSettings {
+                let defaults = ValidationSettings {
                     samples,
                     seed: sample_seed,
-                    indentation_range_m: (0.1 * deepest_m, deepest_m),
-                    ..defaults
+                    ..ValidationSettings::for_organ(organ)
+                };
+                match max_indentation_mm {
+                    Some(mm) => defaults.deepest_indentation(mm * 1e-3),
+                    None => defaults,
                 }
             };
             match validate_vademecum(&mesh, &file, settings) {

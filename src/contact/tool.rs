@@ -106,10 +106,11 @@ const SWITCH_TIP_RADII: f64 = 0.25;
 /// Where and how deep the tip presses, before the force is known, and the patch under it.
 /// - The point below the tip is found on the surface as all loads have moved it (one
 ///   correction: the displacement varies slowly along the surface), tracked from the last
-///   tick's point, so that it slides along a groove's side instead of jumping to the other. The other loads alone
-///   would not do: an organ pressed against another carries the two loads' large, opposite
-///   displacements (the coarse gallbladder's floppy modes, tens of centimetres each way), and
-///   the point found with one of them jumped across the surface from tick to tick.
+///   tick's point, so that it slides along a groove's side instead of jumping to the other.
+///   The other loads alone would not do: an organ pressed against another carries the two
+///   loads' large, opposite displacements (the coarse gallbladder's floppy modes, tens of
+///   centimetres each way), and the point found with one of them jumped across the surface
+///   from tick to tick.
 /// - What the other loads moved is averaged over the patch with the patch's shares, as the
 ///   patch compliance averages the tool's own displacement. Taken at one point instead, the
 ///   tool's answer to a contact force did not match what the contact solve expected, and on

@@ -11,6 +11,7 @@ use super::load_patches::LoadOperator;
 use super::responses::Responses;
 use super::separated::{SeparatedField, dot};
 use super::stiffness::RestStiffness;
+use super::validate::Statistics;
 
 /// Relative errors by number of modes, index `n − 1` for `n` modes.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -102,9 +103,9 @@ pub fn optimal_errors(gram: &[f64], weights: &[f64], max_modes: usize) -> Vec<f6
 }
 
 /// The error estimator of a build: the relative L2 error of the whole vademecum (separated sum
-/// plus the exact near field) for every node-centred load, each relative to its own response. It is exact, not estimated: the
-/// exact responses are at hand, and are turned into the residual of the separated sum one mode
-/// at a time.
+/// plus the exact near field) for every node-centred load, each relative to its own response.
+/// It is exact, not estimated: the exact responses are at hand, and are turned into the
+/// residual of the separated sum one mode at a time.
 pub struct FieldError<'a> {
     weights: &'a [f64],
     near: &'a [Vec<u32>],
@@ -174,18 +175,13 @@ impl<'a> FieldError<'a> {
                 own.push((f / t).sqrt());
             }
         }
-        own.sort_by(f64::total_cmp);
-        let p95 = match own.len() {
-            0 => 0.0,
-            n => own[((0.95 * (n - 1) as f64).round() as usize).min(n - 1)],
-        };
         FieldErrors {
             rms: if area > 0.0 {
                 (squares / area).sqrt()
             } else {
                 0.0
             },
-            p95,
+            p95: Statistics::of(own.into_iter()).p95,
         }
     }
 

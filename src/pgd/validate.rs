@@ -39,21 +39,34 @@ impl Default for ValidationSettings {
 }
 
 impl ValidationSettings {
-    /// Loads sized to `organ`'s tool ([`tool_radii_m`]): indentations from a third of the tool
-    /// radius to ten thirds of it (2–20 mm under the abdominal 6 mm tool, what a trainee
-    /// makes), and the field "near the tool" measured over the region the trainee watches
-    /// (2 cm for the abdominal organs, as the targets say).
+    /// Loads sized to `organ`'s tool ([`tool_radii_m`]): indentations up to ten thirds of the
+    /// tool radius (20 mm under the abdominal 6 mm tool, what a trainee makes), and the field
+    /// "near the tool" measured over the region the trainee watches (2 cm for the abdominal
+    /// organs, as the targets say).
     pub fn for_organ(organ: Option<Organ>) -> Self {
         let radii = tool_radii_m(organ);
         Self {
             samples: 60,
             seed: 7,
-            indentation_range_m: (radii.tool_tip_m / 3.0, radii.tool_tip_m * 10.0 / 3.0),
+            indentation_range_m: up_to(radii.tool_tip_m * 10.0 / 3.0),
             max_tilt_deg: 45.0,
             near_radius_m: radii.watched_m,
             newton_load_steps: 4,
         }
     }
+
+    /// These settings with indentations up to `deepest_m` instead.
+    pub fn deepest_indentation(self, deepest_m: f64) -> Self {
+        Self {
+            indentation_range_m: up_to(deepest_m),
+            ..self
+        }
+    }
+}
+
+/// Indentations from a tenth of `deepest_m` to it.
+fn up_to(deepest_m: f64) -> (f64, f64) {
+    (0.1 * deepest_m, deepest_m)
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
