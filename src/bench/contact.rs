@@ -191,6 +191,7 @@ impl Run {
                 alpha: &self.alpha[1],
                 carry: &self.still,
             },
+            None,
             PairOutput {
                 master: master_c,
                 shell: shell_c,

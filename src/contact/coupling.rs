@@ -13,7 +13,7 @@ use super::modal_rows::{concatenate, step_ranges};
 use super::penalty::{OrganPose, PairOutput, PenaltySettings};
 use super::{
     Attachment, ContactError, ContactPair, ContactSurface, DistanceField, DistanceSettings,
-    FieldOrigin, Pointshell, PointshellDensity, ToolContact, ToolHold,
+    FieldOrigin, NearField, Pointshell, PointshellDensity, ToolContact, ToolHold,
 };
 use crate::pgd::{Deformation, PatchLoad, RigidCarry, Vademecum};
 
@@ -61,6 +61,8 @@ pub struct Coupling {
     pub pairs: Vec<ContactPair>,
     pub attachments: Vec<Attachment>,
     organs: Vec<CoupledOrgan>,
+    /// The master's index and its near-field displacement, where it has pairs.
+    master: Option<(usize, NearField)>,
 }
 
 impl Coupling {
@@ -90,6 +92,7 @@ impl Coupling {
         };
         let mut pairs = Vec::new();
         let mut origin = None;
+        let mut near = None;
         if let Some(master) = index(&settings.master) {
             let master_vademecum = &organs[master].1;
             let surface = ContactSurface::new(master_vademecum)?;
@@ -129,6 +132,9 @@ impl Coupling {
                     &settings.penalty,
                 ));
             }
+            if !pairs.is_empty() {
+                near = Some((master, NearField::new(master_vademecum.clone())));
+            }
         }
         let organs = organs
             .iter()
@@ -145,6 +151,7 @@ impl Coupling {
             pairs,
             attachments,
             organs,
+            master: near,
         };
         Ok((coupling, origin))
     }
@@ -155,10 +162,13 @@ impl Coupling {
     }
 
     /// Takes organ `index`'s state for this tick: its coefficients (the coupling of the last
-    /// tick included).
+    /// tick included), and the master's loads for their near-field corrections.
     pub fn read(&mut self, index: usize, deformation: &Deformation) {
         let organ = &mut self.organs[index];
         concatenate(&deformation.coefficients, &mut organ.alpha);
+        if let Some((_, near)) = self.master.as_mut().filter(|(m, _)| *m == index) {
+            near.set_loads(&deformation.loads);
+        }
     }
 
     /// Takes how the tool holds organ `index` this tick: it presses as `contact` with `load`,
@@ -193,6 +203,7 @@ impl Coupling {
                     alpha: &shell.alpha,
                     carry: &shell.carry,
                 },
+                self.master.as_mut().map(|(_, near)| near),
                 PairOutput {
                     master: &mut master.coupling,
                     shell: &mut shell.coupling,

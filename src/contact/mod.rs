@@ -20,7 +20,10 @@ mod tool;
 
 pub use attachment::Attachment;
 pub use coupling::{AttachmentSpec, Coupling, CouplingSettings};
-pub use distance::{DistanceField, DistanceSample, DistanceSettings, FieldOrigin, LatticeCache};
+pub use distance::{
+    DistanceField, DistanceSample, DistanceSettings, FieldOrigin, LatticeCache, MasterShape,
+    NearField,
+};
 pub use hold::ToolHold;
 pub use modal_rows::ModalRows;
 pub use penalty::{ContactPair, OrganPose, PairOutput, PairReport, PenaltySettings};

@@ -41,7 +41,7 @@ use super::modal_rows::step_ranges;
 use super::normal_compliance::NormalCompliance;
 use super::pointshell::Pointshell;
 use super::projected_cg::{Convergence, ProjectedCg};
-use super::{DistanceField, LatticeCache};
+use super::{DistanceField, LatticeCache, MasterShape, NearField};
 use crate::pgd::{RigidCarry, Vademecum};
 
 /// How stiff the penalties are (see the module's documentation) and how far each tick solves
@@ -170,14 +170,22 @@ impl ContactPair {
     }
 
     /// One tick: measures every node that can touch (or still pushes), solves for the forces,
-    /// and adds both organs' contact coefficients to `out`. Nodes farther at rest than
+    /// and adds both organs' contact coefficients to `out`. `near` is the master's near-field
+    /// displacement, summed here on the first node measured. Nodes farther at rest than
     /// everything can move are skipped with one comparison: the point where the distance is
-    /// read moves by at most the field's bound (the master's modes), the shell's bound and
-    /// both carries, across an interpolated distance whose slope is at most `√3` (trilinear,
-    /// per axis at most 1).
-    pub fn tick(&mut self, master: OrganPose, shell: OrganPose, out: PairOutput) {
+    /// read moves by at most the field's bound (the master's modes), the near field's, the
+    /// shell's bound and both carries, across an interpolated distance whose slope is at most
+    /// `√3` (trilinear, per axis at most 1).
+    pub fn tick(
+        &mut self,
+        master: OrganPose,
+        shell: OrganPose,
+        mut near: Option<&mut NearField>,
+        out: PairOutput,
+    ) {
         self.cache.next_tick(&self.field);
         let point_moves = self.field.movement_bound_m(master.alpha)
+            + near.as_ref().map_or(0.0, |n| n.bound_m())
             + self.nodes.movement_bound_m(shell.alpha)
             + carry_bound_m(master.carry, &self.field)
             + carry_bound_m(shell.carry, &self.field);
@@ -189,7 +197,14 @@ impl ContactPair {
                 continue;
             }
             report.nodes_evaluated += 1;
-            let depth_m = self.measure(i, master, shell);
+            if let Some(near) = near.as_deref_mut() {
+                near.gather();
+            }
+            let shape = MasterShape {
+                alpha: master.alpha,
+                near: near.as_deref(),
+            };
+            let depth_m = self.measure(i, &shape, master.carry, shell);
             report.deepest_m = report.deepest_m.max(depth_m);
         }
         if !self.active.is_empty() {
@@ -229,13 +244,19 @@ impl ContactPair {
 
     /// Node `i`'s distance to the master and the energy's gradient there; joins the active set
     /// if it pushes or is inside. Returns how deep it is (m, 0 outside).
-    fn measure(&mut self, i: usize, master: OrganPose, shell: OrganPose) -> f64 {
+    fn measure(
+        &mut self,
+        i: usize,
+        master: &MasterShape,
+        master_carry: &RigidCarry,
+        shell: OrganPose,
+    ) -> f64 {
         let rest = self.nodes.rest_m[i].map(f64::from);
         let mut p = rest + self.nodes.displacement.apply(i, shell.alpha).map(f64::from);
         p += shell.carry.at(&rest);
         // The master's lattice is at rest: pull the point back through the master's carry.
-        let q = p - master.carry.at(&p);
-        let Some(distance_m) = self.field.distance_m(&q, master.alpha, &mut self.cache) else {
+        let q = p - master_carry.at(&p);
+        let Some(distance_m) = self.field.distance_m(&q, master, &mut self.cache) else {
             self.force_n[i] = 0.0;
             return 0.0;
         };

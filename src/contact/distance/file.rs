@@ -13,13 +13,14 @@ use std::path::Path;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use super::{ContactSurface, DistanceField, DistanceSettings, HEAD};
+use super::{ClosestPoint, ContactSurface, DistanceField, DistanceSettings, HEAD};
 use crate::pgd::container::{self, Kind, Reader, put};
 use crate::pgd::{Vademecum, VademecumError};
 
 const KIND: Kind = Kind {
     magic: b"PGDDISTF",
-    version: 1,
+    // 2: each lattice node's closest rest point, for the near-field corrections.
+    version: 2,
     name: "distance field",
 };
 
@@ -151,6 +152,10 @@ impl DistanceField {
         let mut payload = Vec::with_capacity(4 * (self.values.len() + self.mode_bounds.len()));
         put(&mut payload, &self.values);
         put(&mut payload, &self.mode_bounds);
+        let corners: Vec<u32> = self.closest.iter().flat_map(|p| p.corners).collect();
+        let weights: Vec<f32> = self.closest.iter().flat_map(|p| p.weights).collect();
+        put(&mut payload, &corners);
+        put(&mut payload, &weights);
         container::write_atomically(path, &container::encode(&KIND, &header, &payload))
     }
 
@@ -166,14 +171,26 @@ impl DistanceField {
         let mut reader = Reader::new(path, payload);
         let values: Vec<f32> = reader.take("lattice values")?;
         let mode_bounds: Vec<f32> = reader.take("mode bounds")?;
+        let corners: Vec<u32> = reader.take("closest points' corners")?;
+        let weights: Vec<f32> = reader.take("closest points' weights")?;
         reader.finish()?;
         let nodes: usize = header.dims.iter().product();
         if values.len() != nodes * (HEAD + 3 * header.modes)
             || mode_bounds.len() != header.modes
+            || corners.len() != 3 * nodes
+            || weights.len() != 3 * nodes
             || header.dims.iter().any(|&n| n < 2)
         {
             return Err(reader.malformed("lattice (its size does not match its header)"));
         }
+        let closest = corners
+            .chunks_exact(3)
+            .zip(weights.chunks_exact(3))
+            .map(|(c, w)| ClosestPoint {
+                corners: [c[0], c[1], c[2]],
+                weights: [w[0], w[1], w[2]],
+            })
+            .collect();
         Ok(Self {
             inputs: header.inputs,
             settings: header.settings,
@@ -182,6 +199,7 @@ impl DistanceField {
             modes: header.modes,
             values,
             mode_bounds,
+            closest,
         })
     }
 }
