@@ -171,11 +171,11 @@ impl ContactPair {
 
     /// One tick: measures every node that can touch (or still pushes), solves for the forces,
     /// and adds both organs' contact coefficients to `out`. `near` is the master's near-field
-    /// displacement, summed here on the first node measured. Nodes farther at rest than
+    /// displacement, summed here where a load presses the master. Nodes farther at rest than
     /// everything can move are skipped with one comparison: the point where the distance is
-    /// read moves by at most the field's bound (the master's modes), the near field's, the
-    /// shell's bound and both carries, across an interpolated distance whose slope is at most
-    /// `√3` (trilinear, per axis at most 1).
+    /// read moves by at most the field's bound (the master's modes), the shell's bound, both
+    /// carries and, where it reaches, the near field's ([`Self::near_moves_m`]), across an
+    /// interpolated distance whose slope is at most `√3` (trilinear, per axis at most 1).
     pub fn tick(
         &mut self,
         master: OrganPose,
@@ -184,22 +184,24 @@ impl ContactPair {
         out: PairOutput,
     ) {
         self.cache.next_tick(&self.field);
+        if let Some(near) = near.as_deref_mut().filter(|near| near.is_active()) {
+            near.gather();
+        }
         let point_moves = self.field.movement_bound_m(master.alpha)
-            + near.as_ref().map_or(0.0, |n| n.bound_m())
             + self.nodes.movement_bound_m(shell.alpha)
             + carry_bound_m(master.carry, &self.field)
             + carry_bound_m(shell.carry, &self.field);
-        let reach = 3f32.sqrt() * point_moves;
         let mut report = PairReport::default();
         self.active.clear();
         for i in 0..self.nodes.len() {
+            let near_moves = near.as_ref().map_or(0.0, |near| {
+                self.near_moves_m(i, near, point_moves + near.largest_m())
+            });
+            let reach = 3f32.sqrt() * (point_moves + near_moves);
             if self.nodes.rest_distance_m[i] > reach && self.force_n[i] == 0.0 {
                 continue;
             }
             report.nodes_evaluated += 1;
-            if let Some(near) = near.as_deref_mut() {
-                near.gather();
-            }
             let shape = MasterShape {
                 alpha: master.alpha,
                 near: near.as_deref(),
@@ -240,6 +242,17 @@ impl ContactPair {
             }
         }
         self.report = report;
+    }
+
+    /// How far (m) the master's near field can move the distance node `i` reads, given that
+    /// the point it reads from moves by at most `moves_m` (all motions, the near field's
+    /// included): the lattice nodes it reads lie within `r = moves_m + √3 · spacing` of its
+    /// rest point, their distances within `r` of its own, and so their closest rest points
+    /// within `2r + rest distance` of it. No near-field motion there, none read.
+    fn near_moves_m(&self, i: usize, near: &NearField, moves_m: f32) -> f32 {
+        let r = (moves_m as f64) + 3f64.sqrt() * self.field.spacing_m();
+        let within = 2.0 * r + self.nodes.rest_distance_m[i].abs() as f64;
+        near.largest_near_m(&self.nodes.rest_m[i].map(f64::from), within)
     }
 
     /// Node `i`'s distance to the master and the energy's gradient there; joins the active set

@@ -10,8 +10,7 @@
 //! ([`super::DistanceField`]).
 //!
 //! Only the corrections at surface positions are read (on the full gallbladder a third of
-//! each position's near-field nodes), and only on ticks where a pointshell node comes within
-//! reach of the master ([`NearField::gather`] is lazy).
+//! each position's near-field nodes), and only on ticks where a load presses the master.
 
 use std::sync::Arc;
 
@@ -26,9 +25,38 @@ struct SurfaceEntries {
     offsets: Vec<Vec<u32>>,
     /// `(correction entry, surface position)`.
     entries: Vec<Vec<(u32, u32)>>,
-    /// Per step and load position: no correction at a surface position is longer than this per
-    /// newton of load (m/N; the entry's Frobenius norm, which bounds its action).
-    bound_m_per_n: Vec<Vec<f32>>,
+    /// Per step and load position: the box around the surface positions its corrections reach.
+    support: Vec<Vec<Aabb>>,
+}
+
+/// An axis-aligned box (m); empty when `min > max`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Aabb {
+    min: Vector3<f64>,
+    max: Vector3<f64>,
+}
+
+impl Aabb {
+    const EMPTY: Self = Self {
+        min: Vector3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY),
+        max: Vector3::new(f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY),
+    };
+
+    fn grow(&mut self, other: &Self) {
+        self.min = self.min.inf(&other.min);
+        self.max = self.max.sup(&other.max);
+    }
+
+    /// How far `p` lies from the box (m); infinite from an empty one.
+    fn distance_m(&self, p: &Vector3<f64>) -> f64 {
+        if self.min.x > self.max.x {
+            return f64::INFINITY;
+        }
+        (self.min - p)
+            .sup(&(p - self.max))
+            .sup(&Vector3::zeros())
+            .norm()
+    }
 }
 
 impl SurfaceEntries {
@@ -37,26 +65,30 @@ impl SurfaceEntries {
         for (m, &node) in vademecum.positions.iter().enumerate() {
             position_of[node as usize] = m as u32;
         }
+        let at = |m: u32| Vector3::from(vademecum.position_coords_m[m as usize].map(f64::from));
         let mut lists = Self::default();
         for step in &vademecum.steps {
             let local = &step.local;
-            let (mut offsets, mut entries, mut bounds) = (vec![0], Vec::new(), Vec::new());
+            let (mut offsets, mut entries) = (vec![0], Vec::new());
+            let mut support = Vec::new();
             for i in 0..vademecum.positions.len() {
-                let mut bound = 0.0f32;
+                let mut reach = Aabb::EMPTY;
                 for e in local.corrections_of(i) {
                     let m = position_of[local.correction_nodes[e] as usize];
                     if m != u32::MAX {
                         entries.push((e as u32, m));
-                        let values = &local.correction[9 * e..9 * e + 9];
-                        bound = bound.max(values.iter().map(|v| v * v).sum::<f32>().sqrt());
+                        reach.grow(&Aabb {
+                            min: at(m),
+                            max: at(m),
+                        });
                     }
                 }
                 offsets.push(entries.len() as u32);
-                bounds.push(bound);
+                support.push(reach);
             }
             lists.offsets.push(offsets);
             lists.entries.push(entries);
-            lists.bound_m_per_n.push(bounds);
+            lists.support.push(support);
         }
         lists
     }
@@ -77,8 +109,13 @@ pub struct NearField {
     /// Ticks seen (`set_loads` calls), and the last one gathered on.
     tick: u64,
     gathered_on: Option<u64>,
-    /// The bound of the loads last gathered (m).
-    gathered_bound_m: f32,
+    /// The box outside which the near field moves no surface position this tick: this tick's
+    /// loads', and the last tick's where they were gathered and relaxed into this one.
+    support: Aabb,
+    /// The support as it was when last gathered, and the farthest the near field then moved a
+    /// surface position (m).
+    gathered_support: Aabb,
+    gathered_largest_m: f32,
     displacement_m: Vec<[f32; 3]>,
 }
 
@@ -102,27 +139,47 @@ impl NearField {
             loads: Vec::new(),
             tick: 0,
             gathered_on: None,
-            gathered_bound_m: 0.0,
+            support: Aabb::EMPTY,
+            gathered_support: Aabb::EMPTY,
+            gathered_largest_m: 0.0,
             displacement_m: vec![[0.0; 3]; count],
         }
     }
 
     /// Takes this tick's loads on the master (the tool's patches); their corrections are summed
-    /// when first asked for.
+    /// by [`Self::gather`].
     pub fn set_loads(&mut self, loads: &[PatchLoad]) {
         loads.clone_into(&mut self.loads);
         self.tick += 1;
+        let mut support = Aabb::EMPTY;
+        for_each_share(&self.vademecum, &self.loads, |step, position, _| {
+            support.grow(&self.entries.support[step][position]);
+        });
+        if self.gathered_on.is_some_and(|tick| tick + 1 == self.tick) {
+            support.grow(&self.gathered_support);
+        }
+        self.support = support;
     }
 
-    /// No surface position moves farther than this (m) by the near field of this tick.
-    pub fn bound_m(&self) -> f32 {
-        let mut bound = 0.0;
-        for_each_share(&self.vademecum, &self.loads, |step, position, force| {
-            bound += force.norm() as f32 * self.entries.bound_m_per_n[step][position];
-        });
-        match self.gathered_on {
-            Some(tick) if tick + 1 >= self.tick => bound.max(self.gathered_bound_m),
-            _ => bound,
+    /// Whether the near field moves anything this tick.
+    pub fn is_active(&self) -> bool {
+        self.support.min.x <= self.support.max.x
+    }
+
+    /// How far (m) the near field moves the surface positions within `within_m` of `point_m` at
+    /// most, as gathered this tick: 0 where it moves none of them.
+    pub fn largest_near_m(&self, point_m: &Vector3<f64>, within_m: f64) -> f32 {
+        match self.support.distance_m(point_m) <= within_m {
+            true => self.largest_m(),
+            false => 0.0,
+        }
+    }
+
+    /// How far (m) the near field moves any surface position, as gathered this tick.
+    pub fn largest_m(&self) -> f32 {
+        match self.gathered_on == Some(self.tick) {
+            true => self.gathered_largest_m,
+            false => 0.0,
         }
     }
 
@@ -134,9 +191,8 @@ impl NearField {
             Some(tick) if tick + 1 == self.tick => 1.0 - RELAXATION,
             _ => 0.0,
         };
-        let bound = self.bound_m();
         self.gathered_on = Some(self.tick);
-        self.gathered_bound_m = bound;
+        self.gathered_support = self.support;
         for u in &mut self.displacement_m {
             *u = u.map(|c| c * keep);
         }
@@ -144,15 +200,21 @@ impl NearField {
         let (vademecum, entries) = (self.vademecum.clone(), self.entries.clone());
         let loads = std::mem::take(&mut self.loads);
         for_each_share(&vademecum, &loads, |step, position, force| {
+            let f = force.map(|c| c as f32 * share);
+            let values = &vademecum.steps[step].local.correction;
             for &(e, m) in entries.of(step, position) {
-                let u = vademecum.correction(step, e as usize, force);
-                let slot = &mut self.displacement_m[m as usize];
-                for c in 0..3 {
-                    slot[c] += share * u[c] as f32;
-                }
+                let v: &[f32; 9] = values[9 * e as usize..][..9]
+                    .try_into()
+                    .expect("nine values");
+                add_correction(&mut self.displacement_m[m as usize], v, &f);
             }
         });
         self.loads = loads;
+        self.gathered_largest_m = self
+            .displacement_m
+            .iter()
+            .map(|u| Vector3::from(*u).norm())
+            .fold(0.0, f32::max);
     }
 
     /// Position `position`'s near-field displacement (m) as gathered this tick, zero before.
@@ -161,6 +223,15 @@ impl NearField {
             Some(u) if self.gathered_on == Some(self.tick) => *u,
             _ => [0.0; 3],
         }
+    }
+}
+
+/// Adds a correction entry (`[d * 3 + c]`, see [`crate::pgd::LocalPart`]) under `force` to
+/// `u`, in f32: the gather's inner loop, nine multiply-adds per entry.
+#[inline]
+fn add_correction(u: &mut [f32; 3], values: &[f32; 9], force: &Vector3<f32>) {
+    for c in 0..3 {
+        u[c] += values[c] * force[0] + values[3 + c] * force[1] + values[6 + c] * force[2];
     }
 }
 
