@@ -8,6 +8,7 @@
 //! - its **near-field correction**: the exact response minus the separated sum, at every node
 //!   within the local radius, so the dimple under the tool has the exact shape.
 
+use nalgebra::{RealField, Vector3};
 use rayon::prelude::*;
 
 use super::load_patches::LoadPatches;
@@ -107,6 +108,17 @@ impl LocalPart {
 
     pub fn neighbours_of(&self, m: usize) -> std::ops::Range<usize> {
         self.neighbour_offsets[m] as usize..self.neighbour_offsets[m + 1] as usize
+    }
+
+    /// Correction entry `e` under a load `force` on its position: that node's residual
+    /// displacement (m), in the force's precision (f64 for the whole field, f32 where the
+    /// contact sums many entries each tick).
+    pub fn residual<T: RealField + Copy>(&self, e: usize, force: &Vector3<T>) -> Vector3<T> {
+        let values = &self.correction[9 * e..9 * e + 9];
+        let value = |i: usize| nalgebra::convert::<f64, T>(values[i] as f64);
+        Vector3::from_fn(|c, _| {
+            value(c) * force[0] + value(3 + c) * force[1] + value(6 + c) * force[2]
+        })
     }
 
     pub fn corrections_of(&self, m: usize) -> std::ops::Range<usize> {

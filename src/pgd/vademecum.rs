@@ -467,7 +467,7 @@ impl Vademecum {
             }
             for e in local.corrections_of(i) {
                 let node = local.correction_nodes[e] as usize;
-                let value = self.correction(step, e, force_n);
+                let value = local.residual(e, force_n);
                 for c in 0..3 {
                     u[3 * node + c] += l * value[c];
                 }
@@ -508,17 +508,10 @@ impl Vademecum {
             for &(node, w) in blend {
                 if let Ok(k) = nodes.binary_search(&(node as u32)) {
                     let e = range.start + k;
-                    *u += self.correction(step, e, force_n) * (l * w);
+                    *u += local.residual(e, force_n) * (l * w);
                 }
             }
         }
-    }
-
-    /// Near-field correction entry `entry` of load step `step` (see [`LocalPart`]) under a
-    /// load `force_n` on its position: that node's residual displacement (m).
-    pub fn correction(&self, step: usize, entry: usize, force_n: &Vector3<f64>) -> Vector3<f64> {
-        let values = &self.steps[step].local.correction[9 * entry..9 * entry + 9];
-        Vector3::from_fn(|c, _| (0..3).map(|d| values[3 * d + c] as f64 * force_n[d]).sum())
     }
 
     fn add_step_field(

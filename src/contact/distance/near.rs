@@ -100,7 +100,8 @@ impl SurfaceEntries {
 }
 
 /// The near-field displacement (m) of the master's surface positions under its loads of this
-/// tick, summed on first use and relaxed ([`RELAXATION`]). Allocates nothing once grown.
+/// tick, summed by [`NearField::gather`] on ticks where a load presses the master, and relaxed
+/// ([`RELAXATION`]). Allocates nothing once grown.
 #[derive(Clone, Debug)]
 pub struct NearField {
     vademecum: Arc<Vademecum>,
@@ -127,6 +128,11 @@ pub struct NearField {
 /// alternating mode. The field lags the tool by about a tick (1 ms) and is exact once the tool
 /// holds still.
 const RELAXATION: f32 = 0.5;
+
+/// A near-field motion (m) below what the f32 lattice resolves (6 nm at 0.1 m): once the tool
+/// has let go and the relaxed field has decayed below it, the field is no longer carried or
+/// gathered, rather than halved every tick for ever.
+const NEGLIGIBLE_M: f32 = 1e-9;
 
 impl NearField {
     /// Indexes the corrections at `vademecum`'s surface positions (once per scene).
@@ -155,7 +161,8 @@ impl NearField {
         for_each_share(&self.vademecum, &self.loads, |step, position, _| {
             support.grow(&self.entries.support[step][position]);
         });
-        if self.gathered_on.is_some_and(|tick| tick + 1 == self.tick) {
+        let carried = self.gathered_largest_m > NEGLIGIBLE_M;
+        if carried && self.gathered_on.is_some_and(|tick| tick + 1 == self.tick) {
             support.grow(&self.gathered_support);
         }
         self.support = support;
@@ -169,8 +176,9 @@ impl NearField {
     /// How far (m) the near field moves the surface positions within `within_m` of `point_m` at
     /// most, as gathered this tick: 0 where it moves none of them.
     pub fn largest_near_m(&self, point_m: &Vector3<f64>, within_m: f64) -> f32 {
-        match self.support.distance_m(point_m) <= within_m {
-            true => self.largest_m(),
+        let largest = self.largest_m();
+        match largest > 0.0 && self.support.distance_m(point_m) <= within_m {
+            true => largest,
             false => 0.0,
         }
     }
@@ -200,13 +208,12 @@ impl NearField {
         let (vademecum, entries) = (self.vademecum.clone(), self.entries.clone());
         let loads = std::mem::take(&mut self.loads);
         for_each_share(&vademecum, &loads, |step, position, force| {
-            let f = force.map(|c| c as f32 * share);
-            let values = &vademecum.steps[step].local.correction;
+            let force = force.map(|c| c as f32 * share);
+            let local = &vademecum.steps[step].local;
             for &(e, m) in entries.of(step, position) {
-                let v: &[f32; 9] = values[9 * e as usize..][..9]
-                    .try_into()
-                    .expect("nine values");
-                add_correction(&mut self.displacement_m[m as usize], v, &f);
+                let u = local.residual(e as usize, &force);
+                let slot = &mut self.displacement_m[m as usize];
+                *slot = [slot[0] + u.x, slot[1] + u.y, slot[2] + u.z];
             }
         });
         self.loads = loads;
@@ -223,15 +230,6 @@ impl NearField {
             Some(u) if self.gathered_on == Some(self.tick) => *u,
             _ => [0.0; 3],
         }
-    }
-}
-
-/// Adds a correction entry (`[d * 3 + c]`, see [`crate::pgd::LocalPart`]) under `force` to
-/// `u`, in f32: the gather's inner loop, nine multiply-adds per entry.
-#[inline]
-fn add_correction(u: &mut [f32; 3], values: &[f32; 9], force: &Vector3<f32>) {
-    for c in 0..3 {
-        u[c] += values[c] * force[0] + values[3 + c] * force[1] + values[6 + c] * force[2];
     }
 }
 
