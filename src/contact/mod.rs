@@ -7,6 +7,7 @@
 //!   the organ they hang from ([`Attachment`]).
 
 mod attachment;
+mod clearance;
 mod coupling;
 mod distance;
 mod hold;

@@ -36,6 +36,7 @@ use std::sync::Arc;
 
 use nalgebra::Vector3;
 
+use super::clearance::{Clearance, Moving};
 use super::hold::ToolHold;
 use super::modal_rows::step_ranges;
 use super::normal_compliance::NormalCompliance;
@@ -51,6 +52,10 @@ pub struct PenaltySettings {
     /// How many times stiffer than the stiffer organ at a node its penalty is.
     pub stiffness_ratio: f64,
     pub convergence: Convergence,
+    /// Skip nodes measured clear of the master while nothing has moved far enough since to
+    /// close the gap ([`Clearance`]). Off, every node within reach is measured every tick:
+    /// the same forces, more work (tests compare the two).
+    pub skip_clear_nodes: bool,
 }
 
 impl Default for PenaltySettings {
@@ -59,6 +64,7 @@ impl Default for PenaltySettings {
         Self {
             stiffness_ratio: 1000.0,
             convergence: Convergence::default(),
+            skip_clear_nodes: true,
         }
     }
 }
@@ -110,6 +116,8 @@ pub struct ContactPair {
     solver: ProjectedCg,
     convergence: Convergence,
     cache: LatticeCache,
+    /// Which nodes are known clear of the master; `None` where every node is measured.
+    clearance: Option<Clearance>,
     report: PairReport,
 }
 
@@ -153,6 +161,7 @@ impl ContactPair {
             solver: ProjectedCg::new(count),
             convergence: settings.convergence,
             cache: LatticeCache::default(),
+            clearance: settings.skip_clear_nodes.then(|| Clearance::new(count)),
             report: PairReport::default(),
         }
     }
@@ -171,11 +180,7 @@ impl ContactPair {
 
     /// One tick: measures every node that can touch (or still pushes), solves for the forces,
     /// and adds both organs' contact coefficients to `out`. `near` is the master's near-field
-    /// displacement, summed here where a load presses the master. Nodes farther at rest than
-    /// everything can move are skipped with one comparison: the point where the distance is
-    /// read moves by at most the field's bound (the master's modes), the shell's bound, both
-    /// carries and, where it reaches, the near field's ([`Self::near_moves_m`]), across an
-    /// interpolated distance whose slope is at most `√3` (trilinear, per axis at most 1).
+    /// displacement, summed here where a load presses the master.
     pub fn tick(
         &mut self,
         master: OrganPose,
@@ -187,28 +192,7 @@ impl ContactPair {
         if let Some(near) = near.as_deref_mut().filter(|near| near.is_active()) {
             near.gather();
         }
-        let point_moves = self.field.movement_bound_m(master.alpha)
-            + self.nodes.movement_bound_m(shell.alpha)
-            + carry_bound_m(master.carry, &self.field)
-            + carry_bound_m(shell.carry, &self.field);
-        let mut report = PairReport::default();
-        self.active.clear();
-        for i in 0..self.nodes.len() {
-            let near_moves = near.as_ref().map_or(0.0, |near| {
-                self.near_moves_m(i, near, point_moves + near.largest_m())
-            });
-            let reach = 3f32.sqrt() * (point_moves + near_moves);
-            if self.nodes.rest_distance_m[i] > reach && self.force_n[i] == 0.0 {
-                continue;
-            }
-            report.nodes_evaluated += 1;
-            let shape = MasterShape {
-                alpha: master.alpha,
-                near: near.as_deref(),
-            };
-            let depth_m = self.measure(i, &shape, master.carry, shell);
-            report.deepest_m = report.deepest_m.max(depth_m);
-        }
+        let mut report = self.measure_within_reach(master, shell, near.as_deref());
         if !self.active.is_empty() {
             out.master_hold.prepare(&self.master_vademecum);
             out.shell_hold.prepare(&self.shell_vademecum);
@@ -244,6 +228,65 @@ impl ContactPair {
         self.report = report;
     }
 
+    /// Measures every node that pushes or can touch, and collects the active set. Skipped with
+    /// a comparison or two:
+    /// - nodes farther at rest than everything can move: the point where the distance is read
+    ///   moves by at most the field's bound (the master's modes), the shell's bound, both
+    ///   carries and, where it reaches, the near field's ([`Self::near_moves_m`]), across an
+    ///   interpolated distance whose slope is at most `√3` (trilinear, per axis at most 1);
+    /// - nodes measured clear not long ago, where little has moved since ([`Clearance`]).
+    fn measure_within_reach(
+        &mut self,
+        master: OrganPose,
+        shell: OrganPose,
+        near: Option<&NearField>,
+    ) -> PairReport {
+        let point_moves = self.field.movement_bound_m(master.alpha)
+            + self.nodes.movement_bound_m(shell.alpha)
+            + carry_bound_m(master.carry, &self.field)
+            + carry_bound_m(shell.carry, &self.field);
+        if let Some(clearance) = &mut self.clearance {
+            clearance.advance(
+                Moving {
+                    pose: master,
+                    bounds: self.field.mode_bounds(),
+                },
+                Moving {
+                    pose: shell,
+                    bounds: &self.nodes.mode_bounds,
+                },
+                &self.field,
+                near.map_or(0.0, NearField::largest_change_m),
+            );
+        }
+        let shape = MasterShape {
+            alpha: master.alpha,
+            near,
+        };
+        let mut report = PairReport::default();
+        self.active.clear();
+        for i in 0..self.nodes.len() {
+            if self.force_n[i] == 0.0 && self.can_skip(i, point_moves, near) {
+                continue;
+            }
+            report.nodes_evaluated += 1;
+            let depth_m = self.measure(i, &shape, master.carry, shell);
+            report.deepest_m = report.deepest_m.max(depth_m);
+        }
+        report
+    }
+
+    /// Whether node `i`, pushing nothing, can be left unmeasured this tick: out of reach from
+    /// rest, or known clear.
+    fn can_skip(&self, i: usize, point_moves: f32, near: Option<&NearField>) -> bool {
+        let near_moves = near.map_or(0.0, |near| {
+            self.near_moves_m(i, near, point_moves + near.largest_m())
+        });
+        let reach = 3f32.sqrt() * (point_moves + near_moves);
+        self.nodes.rest_distance_m[i] > reach
+            || self.clearance.as_ref().is_some_and(|c| c.is_clear(i))
+    }
+
     /// How far (m) the master's near field can move the distance node `i` reads, given that
     /// the point it reads from moves by at most `moves_m` (all motions, the near field's
     /// included): the lattice nodes it reads lie within `r = moves_m + √3 · spacing` of its
@@ -273,6 +316,9 @@ impl ContactPair {
             self.force_n[i] = 0.0;
             return 0.0;
         };
+        if let Some(clearance) = &mut self.clearance {
+            clearance.measured(i, distance_m);
+        }
         let k = self.stiffness_n_per_m[i];
         let gradient = distance_m + self.force_n[i] / k;
         if self.force_n[i] > 0.0 || gradient < 0.0 {

@@ -103,23 +103,38 @@ pub struct Tick {
 pub fn dense_scene() -> &'static HapticScene {
     static SCENE: OnceLock<HapticScene> = OnceLock::new();
     SCENE.get_or_init(|| {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("contact-vademecums");
-        scene(); // builds the vademecums if they are missing
-        let organs = Organ::ABDOMEN.map(SceneOrgan::from);
-        let settings = CouplingSettings {
+        scene_with(&CouplingSettings {
             pointshell: PointshellDensity::Dense,
             ..CouplingSettings::default()
-        };
-        scene_of(
-            &organs,
-            None,
-            &settings,
-            &dir,
-            Detail::Coarse,
-            OnStale::Refuse,
-        )
-        .unwrap()
+        })
     })
+}
+
+/// The same scene measuring every pointshell node within reach every tick, none skipped as
+/// known clear.
+pub fn measuring_every_node_scene() -> &'static HapticScene {
+    static SCENE: OnceLock<HapticScene> = OnceLock::new();
+    SCENE.get_or_init(|| {
+        let mut settings = CouplingSettings::default();
+        settings.penalty.skip_clear_nodes = false;
+        scene_with(&settings)
+    })
+}
+
+/// The coarse scene with other coupling settings, on the same vademecums.
+fn scene_with(settings: &CouplingSettings) -> HapticScene {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("contact-vademecums");
+    scene(); // builds the vademecums if they are missing
+    let organs = Organ::ABDOMEN.map(SceneOrgan::from);
+    scene_of(
+        &organs,
+        None,
+        settings,
+        &dir,
+        Detail::Coarse,
+        OnStale::Refuse,
+    )
+    .unwrap()
 }
 
 /// Runs `trajectory` through the coupled scene's haptic schedule, tick by tick.

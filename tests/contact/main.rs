@@ -2,6 +2,7 @@
 //! the liver through the whole haptic schedule, the distance field against the exact distance
 //! to the deformed gallbladder, and the attachments.
 
+mod clearance;
 mod common;
 mod field_file;
 mod near_field;

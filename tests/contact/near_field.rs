@@ -108,3 +108,41 @@ fn the_near_field_follows_its_loads_half_a_tick_at_a_time() {
         assert!((ratio - expected).abs() < 1e-5, "{ratios:?}");
     }
 }
+
+/// How far the near field moved a surface position since the last tick, as it reports it for
+/// the contact's skip of clear nodes: the largest change read at the positions, tick by tick,
+/// including the tick it appears and the tick it is gone.
+#[test]
+fn the_near_field_reports_how_far_it_moved_since_the_last_tick() {
+    let (g, deformation) = loaded_gallbladder();
+    let (_, gallbladder) = organ("gallbladder");
+    let mut near = NearField::new(scene().organs[g].1.clone());
+    let read = |near: &NearField| -> Vec<Vector3<f64>> {
+        (0..gallbladder.positions.len())
+            .map(|m| Vector3::from(near.at(m)).map(f64::from))
+            .collect()
+    };
+    let mut doubled = deformation.loads.clone();
+    doubled.iter_mut().for_each(|l| l.force_n *= 2.0);
+    let mut last = read(&near);
+    for loads in [&deformation.loads, &doubled, &doubled, &vec![]] {
+        near.set_loads(loads);
+        if near.is_active() && !loads.is_empty() {
+            near.gather();
+        }
+        let now = read(&near);
+        let moved = now
+            .iter()
+            .zip(&last)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        let reported = near.largest_change_m() as f64;
+        eprintln!("moved {moved:.3e} m, reported {reported:.3e} m");
+        assert!(moved > 0.0);
+        assert!(
+            (reported - moved).abs() <= 1e-5 * moved,
+            "{reported} m against {moved} m"
+        );
+        last = now;
+    }
+}

@@ -258,6 +258,11 @@ impl DistanceField {
         self.origin_m + Vector3::from(ijk.map(|i| i as f64)) * self.settings.spacing_m
     }
 
+    /// Per mode, the largest `|U^k|` over the lattice.
+    pub fn mode_bounds(&self) -> &[f32] {
+        &self.mode_bounds
+    }
+
     /// `Σ_k |α_k| max|U^k|`: no point of the master moves farther than this (m), so no
     /// interpolated distance changes by more than `√3` times it (trilinear interpolation of a
     /// 1-Lipschitz field).

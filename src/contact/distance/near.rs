@@ -117,7 +117,12 @@ pub struct NearField {
     /// surface position (m).
     gathered_support: Aabb,
     gathered_largest_m: f32,
+    /// The farthest the near field moved a surface position from the last tick's (m), as
+    /// gathered.
+    gathered_change_m: f32,
     displacement_m: Vec<[f32; 3]>,
+    /// This tick's corrections, before relaxing (m).
+    sum_m: Vec<[f32; 3]>,
 }
 
 /// The share of this tick's corrections in the near field the contact reads; the rest is the
@@ -148,7 +153,9 @@ impl NearField {
             support: Aabb::EMPTY,
             gathered_support: Aabb::EMPTY,
             gathered_largest_m: 0.0,
+            gathered_change_m: 0.0,
             displacement_m: vec![[0.0; 3]; count],
+            sum_m: vec![[0.0; 3]; count],
         }
     }
 
@@ -191,6 +198,16 @@ impl NearField {
         }
     }
 
+    /// How far (m) the near field moved any surface position since the last tick.
+    pub fn largest_change_m(&self) -> f32 {
+        match self.gathered_on {
+            Some(tick) if tick == self.tick => self.gathered_change_m,
+            // Gathered the tick before, not now: it has dropped to zero.
+            Some(tick) if tick + 1 == self.tick => self.gathered_largest_m,
+            _ => 0.0,
+        }
+    }
+
     /// Sums this tick's corrections at the surface positions, once per tick, relaxed with the
     /// last tick's where it was gathered too.
     pub fn gather(&mut self) {
@@ -201,27 +218,36 @@ impl NearField {
         };
         self.gathered_on = Some(self.tick);
         self.gathered_support = self.support;
-        for u in &mut self.displacement_m {
-            *u = u.map(|c| c * keep);
+        self.sum_corrections();
+        let (mut largest, mut change) = (0.0f32, 0.0f32);
+        for (u, sum) in self.displacement_m.iter_mut().zip(&self.sum_m) {
+            // The field of a tick not gathered was zero.
+            let last = match keep > 0.0 {
+                true => Vector3::from(*u),
+                false => Vector3::zeros(),
+            };
+            let relaxed = last * keep + Vector3::from(*sum) * (1.0 - keep);
+            largest = largest.max(relaxed.norm());
+            change = change.max((relaxed - last).norm());
+            *u = relaxed.into();
         }
-        let share = 1.0 - keep;
+        self.gathered_largest_m = largest;
+        self.gathered_change_m = change;
+    }
+
+    /// This tick's corrections at the surface positions, unrelaxed, into `sum_m`.
+    fn sum_corrections(&mut self) {
+        self.sum_m.fill([0.0; 3]);
         let (vademecum, entries) = (self.vademecum.clone(), self.entries.clone());
-        let loads = std::mem::take(&mut self.loads);
-        for_each_share(&vademecum, &loads, |step, position, force| {
-            let force = force.map(|c| c as f32 * share);
+        for_each_share(&vademecum, &self.loads, |step, position, force| {
+            let force = force.map(|c| c as f32);
             let local = &vademecum.steps[step].local;
             for &(e, m) in entries.of(step, position) {
                 let u = local.residual(e as usize, &force);
-                let slot = &mut self.displacement_m[m as usize];
+                let slot = &mut self.sum_m[m as usize];
                 *slot = [slot[0] + u.x, slot[1] + u.y, slot[2] + u.z];
             }
         });
-        self.loads = loads;
-        self.gathered_largest_m = self
-            .displacement_m
-            .iter()
-            .map(|u| Vector3::from(*u).norm())
-            .fold(0.0, f32::max);
     }
 
     /// Position `position`'s near-field displacement (m) as gathered this tick, zero before.
