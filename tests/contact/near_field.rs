@@ -146,3 +146,33 @@ fn the_near_field_reports_how_far_it_moved_since_the_last_tick() {
         last = now;
     }
 }
+
+/// The vectorized sum of a correction entry (`LocalPart::add_residual`, four lanes per
+/// column) is the entry's residual, at every entry including the last, whose third column
+/// ends the array; lane 3 is scratch.
+#[test]
+fn a_correction_entry_summed_four_lanes_at_a_time_is_its_residual() {
+    let (_, gallbladder) = organ("gallbladder");
+    let local = &gallbladder.steps[0].local;
+    let force = [0.004f32, -0.01, 0.007];
+    let entries = local.correction.len() / 9;
+    let mut checked = 0;
+    for e in (0..entries).step_by(97).chain([entries - 1]) {
+        let mut sum = [0.0f32, 0.0, 0.0, 5.0];
+        local.add_residual(e, &force, &mut sum);
+        let expected = local.residual(e, &Vector3::from(force));
+        for c in 0..3 {
+            // f32 rounding of a three-term sum, relative to its terms.
+            let term = |d: usize| local.correction[9 * e + 3 * d + c] * force[d];
+            let scale: f32 = (0..3).map(|d| term(d).abs()).sum();
+            assert!(
+                (sum[c] - expected[c]).abs() <= 1e-6 * scale,
+                "entry {e}, component {c}: {} against {}",
+                sum[c],
+                expected[c]
+            );
+            checked += (scale > 0.0) as usize;
+        }
+    }
+    assert!(checked > 100, "only {checked} non-zero components");
+}

@@ -122,7 +122,8 @@ pub struct NearField {
     gathered_change_m: f32,
     displacement_m: Vec<[f32; 3]>,
     /// This tick's corrections, before relaxing (m).
-    sum_m: Vec<[f32; 3]>,
+    /// Lane 3 is scratch ([`crate::pgd::LocalPart::add_residual`]).
+    sum_m: Vec<[f32; 4]>,
 }
 
 /// The share of this tick's corrections in the near field the contact reads; the rest is the
@@ -155,7 +156,7 @@ impl NearField {
             gathered_largest_m: 0.0,
             gathered_change_m: 0.0,
             displacement_m: vec![[0.0; 3]; count],
-            sum_m: vec![[0.0; 3]; count],
+            sum_m: vec![[0.0; 4]; count],
         }
     }
 
@@ -226,7 +227,7 @@ impl NearField {
                 true => Vector3::from(*u),
                 false => Vector3::zeros(),
             };
-            let relaxed = last * keep + Vector3::from(*sum) * (1.0 - keep);
+            let relaxed = last * keep + Vector3::new(sum[0], sum[1], sum[2]) * (1.0 - keep);
             largest = largest.max(relaxed.norm());
             change = change.max((relaxed - last).norm());
             *u = relaxed.into();
@@ -237,15 +238,13 @@ impl NearField {
 
     /// This tick's corrections at the surface positions, unrelaxed, into `sum_m`.
     fn sum_corrections(&mut self) {
-        self.sum_m.fill([0.0; 3]);
+        self.sum_m.fill([0.0; 4]);
         let (vademecum, entries) = (self.vademecum.clone(), self.entries.clone());
         for_each_share(&vademecum, &self.loads, |step, position, force| {
-            let force = force.map(|c| c as f32);
+            let force = [0, 1, 2].map(|c| force[c] as f32);
             let local = &vademecum.steps[step].local;
             for &(e, m) in entries.of(step, position) {
-                let u = local.residual(e as usize, &force);
-                let slot = &mut self.sum_m[m as usize];
-                *slot = [slot[0] + u.x, slot[1] + u.y, slot[2] + u.z];
+                local.add_residual(e as usize, &force, &mut self.sum_m[m as usize]);
             }
         });
     }
