@@ -277,14 +277,15 @@ impl ContactPair {
     }
 
     /// Whether node `i`, pushing nothing, can be left unmeasured this tick: out of reach from
-    /// rest, or known clear.
+    /// rest, or known clear. The cheaper check first.
     fn can_skip(&self, i: usize, point_moves: f32, near: Option<&NearField>) -> bool {
+        if self.clearance.as_ref().is_some_and(|c| c.is_clear(i)) {
+            return true;
+        }
         let near_moves = near.map_or(0.0, |near| {
             self.near_moves_m(i, near, point_moves + near.largest_m())
         });
-        let reach = 3f32.sqrt() * (point_moves + near_moves);
-        self.nodes.rest_distance_m[i] > reach
-            || self.clearance.as_ref().is_some_and(|c| c.is_clear(i))
+        self.nodes.rest_distance_m[i] > 3f32.sqrt() * (point_moves + near_moves)
     }
 
     /// How far (m) the master's near field can move the distance node `i` reads, given that

@@ -69,22 +69,25 @@ impl ContactSurface {
     /// among the triangles around `previous`, unless another part of the surface
     /// is closer by more than `switch_m`. A point found globally jumps across a groove when its
     /// two sides are about as close (the tool's patch and force jump with it); tracked, it
-    /// slides along the side it is on. Without `previous`, the closest point.
+    /// slides along the side it is on. Without `previous`, the closest point. The search for
+    /// another part stops at the distance that would win, which prunes most of the tree (it
+    /// was the tool's largest cost in the tick: four organs, twice each).
     pub fn tracked(
         &self,
         query_m: &Vector3<f64>,
         previous: Option<&SurfacePoint>,
         switch_m: f64,
     ) -> Option<SurfaceHit> {
-        let global = self.closest(query_m)?;
+        if !query_m.iter().all(|c| c.is_finite()) {
+            return None;
+        }
         let Some(local) = previous.and_then(|at| self.closest_around(query_m, at, switch_m)) else {
-            return Some(global);
+            return self.closest(query_m);
         };
-        let distance = |hit: &SurfaceHit| (hit.point_m - query_m).norm();
-        if distance(&global) < distance(&local) - switch_m {
-            Some(global)
-        } else {
-            Some(local)
+        let wins_within_m = (local.point_m - query_m).norm() - switch_m;
+        match self.closest_within(query_m, wins_within_m) {
+            Some(global) if (global.point_m - query_m).norm() < wins_within_m => Some(global),
+            _ => Some(local),
         }
     }
 
@@ -128,12 +131,21 @@ impl ContactSurface {
 
     /// The closest surface point to `query_m`, or none for a non-finite query.
     pub fn closest(&self, query_m: &Vector3<f64>) -> Option<SurfaceHit> {
-        if !query_m.iter().all(|c| c.is_finite()) {
+        self.closest_within(query_m, f64::INFINITY)
+    }
+
+    /// The closest surface point to `query_m` if it lies within `max_m` of it.
+    fn closest_within(&self, query_m: &Vector3<f64>, max_m: f64) -> Option<SurfaceHit> {
+        if !query_m.iter().all(|c| c.is_finite()) || max_m <= 0.0 {
             return None;
         }
         let (projection, (triangle, location)) = self
             .mesh
-            .project_local_point_and_get_location(to_parry(&Point3::from(*query_m)), false);
+            .project_local_point_and_get_location_with_max_dist(
+                to_parry(&Point3::from(*query_m)),
+                false,
+                max_m.min(f32::MAX as f64) as f32,
+            )?;
         self.hit(triangle, from_parry(projection.point).coords, location)
     }
 
