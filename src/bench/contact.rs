@@ -22,7 +22,7 @@ use crate::contact::{
     ContactPair, ContactSurface, CouplingSettings, DistanceField, OrganPose, PairOutput,
     Pointshell, ToolHold,
 };
-use crate::pgd::{RigidCarry, Vademecum};
+use crate::pgd::{PointLoad, RigidCarry, Vademecum};
 use crate::seam::{to_parry, trimesh};
 
 /// Nodes in contact the pressed case asks for (the figure).
@@ -160,6 +160,8 @@ struct Run {
     still: RigidCarry,
     coefficients: [Vec<f64>; 2],
     alpha: [Vec<f32>; 2],
+    /// The contact's point loads, master then shell (unused: the field is not formed).
+    points: [Vec<PointLoad>; 2],
 }
 
 impl Run {
@@ -171,6 +173,7 @@ impl Run {
             still: RigidCarry::default(),
             coefficients: modes.map(|m| vec![0.0; m]),
             alpha: modes.map(|m| vec![0.0; m]),
+            points: [Vec::new(), Vec::new()],
         }
     }
 
@@ -182,6 +185,9 @@ impl Run {
         master_c.fill(0.0);
         shell_c.fill(0.0);
         let (mut master_hold, mut shell_hold) = (ToolHold::default(), ToolHold::default());
+        let [master_points, shell_points] = &mut self.points;
+        master_points.clear();
+        shell_points.clear();
         self.pair.tick(
             OrganPose {
                 alpha: &self.alpha[0],
@@ -195,6 +201,8 @@ impl Run {
             PairOutput {
                 master: master_c,
                 shell: shell_c,
+                master_points,
+                shell_points,
                 master_hold: &mut master_hold,
                 shell_hold: &mut shell_hold,
             },

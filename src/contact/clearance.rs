@@ -57,14 +57,15 @@ impl Clearance {
     }
 
     /// Adds how far (m) a node's read point, or the master's surface under it, can have moved
-    /// since the last tick: through either organ's modes or carry, or the master's near field
-    /// (`near_moved_m`). Everything counts as moved on the first tick.
+    /// since the last tick: through either organ's modes or carry, or what moves a distance
+    /// beyond them (`near_moved_m`: the master's near field, the contact forces' own
+    /// dimples). Everything counts as moved on the first tick.
     pub fn advance(
         &mut self,
         master: Moving,
         shell: Moving,
         field: &DistanceField,
-        near_moved_m: f32,
+        near_moved_m: f64,
     ) {
         let moved_m = match &self.last {
             Some(last) => {
@@ -72,7 +73,7 @@ impl Clearance {
                     + change_bound(shell.pose.alpha, &last.shell, shell.bounds)
                     + carry_change_m(master.pose.carry, &last.master_carry, field)
                     + carry_change_m(shell.pose.carry, &last.shell_carry, field)
-                    + near_moved_m as f64
+                    + near_moved_m
             }
             None => f64::INFINITY,
         };

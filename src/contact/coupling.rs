@@ -15,7 +15,7 @@ use super::{
     Attachment, ContactError, ContactPair, ContactSurface, DistanceField, DistanceSettings,
     FieldOrigin, NearField, Pointshell, PointshellDensity, ToolContact, ToolHold,
 };
-use crate::pgd::{Deformation, PatchLoad, RigidCarry, Vademecum};
+use crate::pgd::{Deformation, PatchLoad, PointLoad, RigidCarry, Vademecum};
 
 /// Which organ is the master, and how the coupling is set up.
 #[derive(Clone, Debug, PartialEq)]
@@ -51,6 +51,7 @@ struct CoupledOrgan {
     steps: Vec<Range<usize>>,
     alpha: Vec<f32>,
     coupling: Vec<f64>,
+    coupling_points: Vec<PointLoad>,
     coupling_force_n: Vector3<f64>,
     carry: RigidCarry,
     hold: ToolHold,
@@ -142,6 +143,7 @@ impl Coupling {
                 steps: step_ranges(v),
                 alpha: Vec::with_capacity(v.total_modes()),
                 coupling: vec![0.0; v.total_modes()],
+                coupling_points: Vec::new(),
                 coupling_force_n: Vector3::zeros(),
                 carry: RigidCarry::default(),
                 hold: ToolHold::default(),
@@ -185,6 +187,7 @@ impl Coupling {
     pub fn tick(&mut self) {
         for organ in &mut self.organs {
             organ.coupling.fill(0.0);
+            organ.coupling_points.clear();
             organ.coupling_force_n = Vector3::zeros();
             organ.carry = RigidCarry::default();
             organ.hold.moved_m = Vector3::zeros();
@@ -207,6 +210,8 @@ impl Coupling {
                 PairOutput {
                     master: &mut master.coupling,
                     shell: &mut shell.coupling,
+                    master_points: &mut master.coupling_points,
+                    shell_points: &mut shell.coupling_points,
                     master_hold: &mut master.hold,
                     shell_hold: &mut shell.hold,
                 },
@@ -229,6 +234,9 @@ impl Coupling {
         for (step, range) in organ.steps.iter().enumerate() {
             deformation.coupling[step].copy_from_slice(&organ.coupling[range.clone()]);
         }
+        deformation
+            .coupling_points
+            .clone_from(&organ.coupling_points);
         deformation.coupling_force_n = organ.coupling_force_n;
         deformation.carry = organ.carry;
     }

@@ -11,6 +11,7 @@ mod clearance;
 mod coupling;
 mod distance;
 mod hold;
+mod local_compliance;
 mod modal_rows;
 mod normal_compliance;
 mod penalty;

@@ -1,13 +1,16 @@
 //! The normal compliance `A` of a contact pair: how the nodes' normal forces change their
 //! distances to the master, through both organs' modal compliance (the shell node pushed out,
-//! the master pushed back). Rows are projected on the rest normals once, so applying it over
-//! a set of nodes costs `4 · nodes · (shell modes + master modes)` products, a few times per
-//! tick in the contact's force solve. Its diagonal sets the penalties. Where the tool holds an
-//! organ, its part of `A` takes the tool's answer as a change of rank 3 ([`super::hold`]).
+//! the master pushed back) and their near-field corrections between nodes close together
+//! ([`LocalCompliance`]). Modal rows are projected on the rest normals once, so applying it
+//! over a set of nodes costs `4 · nodes · (shell modes + master modes)` products plus a
+//! sparse row per node, a few times per tick in the contact's force solve. Its diagonal sets
+//! the penalties. Where the tool holds an organ, its modal part of `A` takes the tool's
+//! answer as a change of rank 3 ([`super::hold`]).
 
 use nalgebra::Vector3;
 
 use super::hold::ToolHold;
+use super::local_compliance::LocalCompliance;
 use super::modal_rows::ModalRows;
 use super::pointshell::Pointshell;
 use crate::pgd::Vademecum;
@@ -16,6 +19,7 @@ use crate::pgd::Vademecum;
 pub struct NormalCompliance {
     shell: OrganRows,
     master: OrganRows,
+    local: LocalCompliance,
 }
 
 /// One organ's part of `A`, per node along its normal: how far the organ's modes move the
@@ -160,13 +164,23 @@ impl NormalCompliance {
                 negate(project(&master_rows)),
                 negate(project(&nodes.master_load)),
             ),
+            local: LocalCompliance::new(nodes, master, shell),
         }
+    }
+
+    /// The near-field part of `A`.
+    pub fn local(&self) -> &LocalCompliance {
+        &self.local
     }
 
     /// Node `i`'s own compliance in the stiffer of the two organs (m/N), 0 where neither
     /// moves it (both clamped there).
     pub fn stiffer_diagonal(&self, i: usize) -> f64 {
-        let own = [self.shell.diagonal(i), self.master.diagonal(i)];
+        let [shell_local, master_local] = self.local.own_m_per_n(i);
+        let own = [
+            self.shell.diagonal(i) + shell_local,
+            self.master.diagonal(i) + master_local,
+        ];
         own.into_iter()
             .filter(|&a| a > 0.0)
             .reduce(f64::min)
@@ -197,6 +211,7 @@ impl NormalCompliance {
             let i = i as usize;
             out[i] = (self.shell.answer(i) + self.master.answer(i)) as f64;
         }
+        self.local.add_product(set, v, out);
     }
 }
 

@@ -43,7 +43,7 @@ use super::normal_compliance::NormalCompliance;
 use super::pointshell::Pointshell;
 use super::projected_cg::{Convergence, ProjectedCg};
 use super::{DistanceField, LatticeCache, MasterShape, NearField};
-use crate::pgd::{RigidCarry, Vademecum};
+use crate::pgd::{PointLoad, RigidCarry, Vademecum};
 
 /// How stiff the penalties are (see the module's documentation) and how far each tick solves
 /// for the forces.
@@ -118,15 +118,21 @@ pub struct ContactPair {
     cache: LatticeCache,
     /// Which nodes are known clear of the master; `None` where every node is measured.
     clearance: Option<Clearance>,
+    /// How far the last solve's change of the forces can have moved any distance through
+    /// the near-field part of `A` (m): part of what moved since for the clearance.
+    local_change_m: f64,
     report: PairReport,
 }
 
-/// Per organ, where this tick's contact coefficients go (all load steps concatenated), and
-/// the tool's hold on it, which takes the move the contact forces' change makes under the
-/// tool.
+/// Per organ, where this tick's contact coefficients go (all load steps concatenated), the
+/// contact loads themselves (for their near-field corrections where the field is formed),
+/// and the tool's hold on it, which takes the move the contact forces' change makes under
+/// the tool.
 pub struct PairOutput<'a> {
     pub master: &'a mut [f64],
     pub shell: &'a mut [f64],
+    pub master_points: &'a mut Vec<PointLoad>,
+    pub shell_points: &'a mut Vec<PointLoad>,
     pub master_hold: &'a mut ToolHold,
     pub shell_hold: &'a mut ToolHold,
 }
@@ -162,6 +168,7 @@ impl ContactPair {
             convergence: settings.convergence,
             cache: LatticeCache::default(),
             clearance: settings.skip_clear_nodes.then(|| Clearance::new(count)),
+            local_change_m: 0.0,
             report: PairReport::default(),
         }
     }
@@ -214,6 +221,7 @@ impl ContactPair {
             self.change_n[i as usize] += self.force_n[i as usize];
         }
         let (master_moved_m, shell_moved_m) = compliance.tool_moves_m(&self.active, &self.change_n);
+        self.local_change_m = compliance.local().change_bound_m(&self.active, &self.change_n);
         out.master_hold.moved_m += master_moved_m;
         out.shell_hold.moved_m += shell_moved_m;
         for &i in &self.active {
@@ -223,6 +231,7 @@ impl ContactPair {
                 report.contact_area_m2 += self.nodes.area_m2[i] as f64;
                 report.force_on_shell_n += self.nodes.rest_normal[i] * self.force_n[i];
                 self.add_loads(i, out.master, out.shell);
+                self.add_points(i, out.master_points, out.shell_points);
             }
         }
         self.report = report;
@@ -235,12 +244,16 @@ impl ContactPair {
     ///   carries and, where it reaches, the near field's ([`Self::near_moves_m`]), across an
     ///   interpolated distance whose slope is at most `√3` (trilinear, per axis at most 1);
     /// - nodes measured clear not long ago, where little has moved since ([`Clearance`]).
+    ///
+    /// The forces already pushing dimple both organs (the near-field part of `A`), which moves
+    /// the point read by at most their sum times the node's largest pull.
     fn measure_within_reach(
         &mut self,
         master: OrganPose,
         shell: OrganPose,
         near: Option<&NearField>,
     ) -> PairReport {
+        let pushing_n: f64 = self.active.iter().map(|&i| self.force_n[i as usize]).sum();
         let point_moves = self.field.movement_bound_m(master.alpha)
             + self.nodes.movement_bound_m(shell.alpha)
             + carry_bound_m(master.carry, &self.field)
@@ -256,7 +269,7 @@ impl ContactPair {
                     bounds: &self.nodes.mode_bounds,
                 },
                 &self.field,
-                near.map_or(0.0, NearField::largest_change_m),
+                near.map_or(0.0, NearField::largest_change_m) as f64 + self.local_change_m,
             );
         }
         let shape = MasterShape {
@@ -266,7 +279,7 @@ impl ContactPair {
         let mut report = PairReport::default();
         self.active.clear();
         for i in 0..self.nodes.len() {
-            if self.force_n[i] == 0.0 && self.can_skip(i, point_moves, near) {
+            if self.force_n[i] == 0.0 && self.can_skip(i, point_moves, near, pushing_n) {
                 continue;
             }
             report.nodes_evaluated += 1;
@@ -278,14 +291,21 @@ impl ContactPair {
 
     /// Whether node `i`, pushing nothing, can be left unmeasured this tick: out of reach from
     /// rest, or known clear. The cheaper check first.
-    fn can_skip(&self, i: usize, point_moves: f32, near: Option<&NearField>) -> bool {
+    fn can_skip(
+        &self,
+        i: usize,
+        point_moves: f32,
+        near: Option<&NearField>,
+        pushing_n: f64,
+    ) -> bool {
         if self.clearance.as_ref().is_some_and(|c| c.is_clear(i)) {
             return true;
         }
         let near_moves = near.map_or(0.0, |near| {
             self.near_moves_m(i, near, point_moves + near.largest_m())
         });
-        self.nodes.rest_distance_m[i] > 3f32.sqrt() * (point_moves + near_moves)
+        let closing_m = self.compliance.local().closing_bound_m(i, pushing_n) as f32;
+        self.nodes.rest_distance_m[i] > 3f32.sqrt() * (point_moves + near_moves + closing_m)
     }
 
     /// How far (m) the master's near field can move the distance node `i` reads, given that
@@ -311,6 +331,10 @@ impl ContactPair {
         let rest = self.nodes.rest_m[i].map(f64::from);
         let mut p = rest + self.nodes.displacement.apply(i, shell.alpha).map(f64::from);
         p += shell.carry.at(&rest);
+        // The forces already pushing dimple both organs apart along the node's normal: read
+        // where the node is against the dimpled master, near its surface, rather than deep
+        // inside the master's modal shape and corrected after.
+        p += self.nodes.rest_normal[i] * self.compliance.local().gap_m(i, &self.force_n);
         // The master's lattice is at rest: pull the point back through the master's carry.
         let q = p - master_carry.at(&p);
         let Some(distance_m) = self.field.distance_m(&q, master, &mut self.cache) else {
@@ -327,6 +351,20 @@ impl ContactPair {
             self.active.push(i as u32);
         }
         (-distance_m).max(0.0)
+    }
+
+    /// Node `i`'s force on the shell organ, shared among its positions, and its reaction on
+    /// the master, as point loads.
+    fn add_points(&self, i: usize, master: &mut Vec<PointLoad>, shell: &mut Vec<PointLoad>) {
+        let force = self.nodes.rest_normal[i] * self.force_n[i];
+        shell.extend(self.nodes.blends[i].iter().map(|&(position, w)| PointLoad {
+            position,
+            force_n: force * w,
+        }));
+        master.push(PointLoad {
+            position: self.nodes.master_positions[i] as usize,
+            force_n: -force,
+        });
     }
 
     /// Node `i`'s force on the shell organ and its reaction on the master, as coefficients.

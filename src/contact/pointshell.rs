@@ -15,6 +15,9 @@ pub struct Pointshell {
     /// The shell organ's load position that weighs most in each point (the point itself,
     /// or a corner of the triangle it lies in).
     pub positions: Vec<u32>,
+    /// The shell organ's load positions each node blends, with their weights (a boundary
+    /// node: itself alone; a triangle's centre: its corners): where its force is shared.
+    pub blends: Vec<Vec<(usize, f64)>>,
     pub rest_m: Vec<Vector3<f32>>,
     /// The master's rest distance at each node (m), from the lattice.
     pub rest_distance_m: Vec<f32>,
@@ -83,6 +86,7 @@ impl Pointshell {
         let displacement = ModalRows::displacements(shell, inside.iter().map(|n| &n.0.blend));
         Self {
             positions: inside.iter().map(|n| dominant(&n.0.blend)).collect(),
+            blends: inside.iter().map(|n| n.0.blend.clone()).collect(),
             rest_distance_m: inside.iter().map(|n| n.1 as f32).collect(),
             rest_normal: inside.iter().map(|n| n.2).collect(),
             area_m2: inside.iter().map(|n| n.0.area_m2 as f32).collect(),

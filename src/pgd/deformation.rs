@@ -42,6 +42,20 @@ impl PatchLoad {
     }
 }
 
+/// A force on one load position: organ contact's loads, whose modes are in the coupling's
+/// coefficients and whose near-field correction is added where the field is formed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLoad {
+    pub position: usize,
+    pub force_n: Vector3<f64>,
+}
+
+impl PointLoad {
+    fn shares(&self) -> [(usize, f64); 1] {
+        [(self.position, 1.0)]
+    }
+}
+
 /// A small rigid motion: `u(p) = t + ω × (p − c)`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RigidCarry {
@@ -65,9 +79,11 @@ pub struct Deformation {
     /// `coefficients[step][mode]`: the loads' and the coupling's together.
     pub coefficients: Vec<Vec<f64>>,
     /// The coefficients of the loads other organs put on this one (organ contact, an
-    /// attached organ's pull), set by the contact stage each tick; modes only, as contact
-    /// loads are spread too wide for the near-field corrections to matter.
+    /// attached organ's pull), set by the contact stage each tick.
     pub coupling: Vec<Vec<f64>>,
+    /// The contact loads among them, for their near-field corrections: the dimple each
+    /// contact force makes, which its modes are too smooth to show.
+    pub coupling_points: Vec<PointLoad>,
     /// The total force (N) of those loads.
     pub coupling_force_n: Vector3<f64>,
     /// How the organ it is attached to carries it along.
@@ -81,6 +97,7 @@ impl Clone for Deformation {
             loads: self.loads.clone(),
             coefficients: self.coefficients.clone(),
             coupling: self.coupling.clone(),
+            coupling_points: self.coupling_points.clone(),
             coupling_force_n: self.coupling_force_n,
             carry: self.carry,
         }
@@ -90,6 +107,7 @@ impl Clone for Deformation {
         self.loads.clone_from(&source.loads);
         self.coefficients.clone_from(&source.coefficients);
         self.coupling.clone_from(&source.coupling);
+        self.coupling_points.clone_from(&source.coupling_points);
         self.coupling_force_n = source.coupling_force_n;
         self.carry = source.carry;
     }
@@ -105,6 +123,7 @@ impl Deformation {
             loads: vec![PatchLoad::default(); load_slots],
             coefficients: zeros.clone(),
             coupling: zeros,
+            coupling_points: Vec::new(),
             coupling_force_n: Vector3::zeros(),
             carry: RigidCarry::default(),
         }
@@ -122,13 +141,16 @@ impl Deformation {
     }
 
     /// The whole displacement field (m, `3 × nodes`) into `u`: the modes with the current
-    /// coefficients plus each load's near-field correction.
+    /// coefficients plus each load's near-field correction, the contact loads' included.
     pub fn field_into(&self, vademecum: &Vademecum, u: &mut [f64]) {
         u.fill(0.0);
         for (step, coefficients) in self.coefficients.iter().enumerate() {
             vademecum.add_modes(step, coefficients, u);
             for load in self.loads.iter().filter(|l| l.is_active()) {
                 vademecum.add_corrections(step, &load.shares, &load.force_n, u);
+            }
+            for point in &self.coupling_points {
+                vademecum.add_corrections(step, &point.shares(), &point.force_n, u);
             }
         }
     }
@@ -203,6 +225,11 @@ impl Deformation {
                         u += vademecum.mode_at_node(step, mode, node) * (c * w);
                     }
                 }
+            }
+        }
+        for point in &self.coupling_points {
+            for step in 0..vademecum.steps.len() {
+                vademecum.add_blend_corrections(step, &point.shares(), &point.force_n, nodes, &mut u);
             }
         }
         let others = self

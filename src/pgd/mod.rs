@@ -21,7 +21,7 @@ pub use build::{
     BuildReport, BuildSettings, DEFAULT_LOAD_STEPS_M, OrganModel, StepReport,
     WIDE_NEAR_FIELD_SHARE, build,
 };
-pub use deformation::{Deformation, PatchLoad, RigidCarry};
+pub use deformation::{Deformation, PatchLoad, PointLoad, RigidCarry};
 pub use enrichment::{ModeReport, PgdSettings, enrich};
 pub use error_curve::{EnergyError, ErrorCurve, optimal_errors};
 pub use file::{FORMAT_VERSION, VademecumError, decode, encode, load, read_header, save};

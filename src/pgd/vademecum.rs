@@ -500,7 +500,20 @@ impl Vademecum {
                 *u += Vector3::from_fn(|k, _| c * w * x[3 * node + k] as f64);
             }
         }
-        let local = &step_data.local;
+        self.add_blend_corrections(step, shares, force_n, blend, u);
+    }
+
+    /// The near-field part of [`Self::add_blend_displacement`]: what a force whose modes are
+    /// already counted adds at the blend.
+    pub fn add_blend_corrections(
+        &self,
+        step: usize,
+        shares: &[(usize, f64)],
+        force_n: &Vector3<f64>,
+        blend: &[(usize, f64)],
+        u: &mut Vector3<f64>,
+    ) {
+        let local = &self.steps[step].local;
         for &(i, l) in shares {
             let range = local.corrections_of(i);
             let nodes = &local.correction_nodes[range.clone()];

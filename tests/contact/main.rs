@@ -92,9 +92,10 @@ fn a_dense_pointshell_covers_the_surface_once() {
 }
 
 /// The gallbladder pressed into the liver with a dense pointshell: more points push, none
-/// deeper than one lattice cell, and the forces on the two organs balance.
+/// deeper than one lattice cell, and the forces on the two organs balance. Measured: 9
+/// points against 6 nodes (2 and 2 while contact loads moved the organs through their modes
+/// alone, which cleared the intrusion with a few forces).
 #[test]
-#[ignore = "not met yet: at the end as many points push densely as the boundary nodes alone have (2 and 2): the liver's modes clear the intrusion with a few forces"]
 fn pressing_with_a_dense_pointshell_pushes_more_points_and_stays_shallow() {
     let target = facing("gallbladder", -Vector3::z());
     let (_, record) = run_on(dense_scene(), push(&target, 0.012, PUSH_S, 0.5), TICKS);
@@ -245,11 +246,14 @@ fn exact_distance(mesh: &parry3d::shape::TriMesh, x: &Vector3<f64>) -> f64 {
 }
 
 /// The gallbladder's accessible surface at the end of the push: deformed by its whole field
-/// (`modes_only == false`) or by its modes alone, carried by the duodenum either way.
+/// (`modes_only == false`) or by its modes alone, carried by the duodenum either way. The
+/// dimples the liver's contact forces make are left out: the field does not carry them, the
+/// contact adds them to each distance it reads (`local_compliance`, checked against full FEM).
 fn deformed_gallbladder(modes_only: bool) -> Vec<[f32; 3]> {
     let last = pushed().last().unwrap();
     let (g, gallbladder) = organ("gallbladder");
-    let deformation = &last.organs[g];
+    let mut deformation = last.organs[g].clone();
+    deformation.coupling_points.clear();
     let mut field = vec![0.0; gallbladder.dof_count()];
     let mut positions = Vec::new();
     deformation.deformed_surface(gallbladder, &mut field, &mut positions);
@@ -526,3 +530,4 @@ fn the_tool_holds_the_surface_under_it_while_the_contact_pushes() {
     }
     assert!(checked > 10, "{checked} ticks checked");
 }
+
