@@ -70,8 +70,10 @@ impl LocalCompliance {
                 if !near.can_couple(i, j) {
                     continue;
                 }
-                let s = |a: usize, b: usize| correction_along(shell, &shell_side(a), &shell_side(b));
-                let m = |a: usize, b: usize| correction_along(master, &master_side(a), &master_side(b));
+                let s =
+                    |a: usize, b: usize| correction_along(shell, &shell_side(a), &shell_side(b));
+                let m =
+                    |a: usize, b: usize| correction_along(master, &master_side(a), &master_side(b));
                 if i == j {
                     own_m_per_n[i] = [s(i, i), m(i, i)];
                 }

@@ -221,7 +221,9 @@ impl ContactPair {
             self.change_n[i as usize] += self.force_n[i as usize];
         }
         let (master_moved_m, shell_moved_m) = compliance.tool_moves_m(&self.active, &self.change_n);
-        self.local_change_m = compliance.local().change_bound_m(&self.active, &self.change_n);
+        self.local_change_m = compliance
+            .local()
+            .change_bound_m(&self.active, &self.change_n);
         out.master_hold.moved_m += master_moved_m;
         out.shell_hold.moved_m += shell_moved_m;
         for &i in &self.active {

@@ -229,7 +229,13 @@ impl Deformation {
         }
         for point in &self.coupling_points {
             for step in 0..vademecum.steps.len() {
-                vademecum.add_blend_corrections(step, &point.shares(), &point.force_n, nodes, &mut u);
+                vademecum.add_blend_corrections(
+                    step,
+                    &point.shares(),
+                    &point.force_n,
+                    nodes,
+                    &mut u,
+                );
             }
         }
         let others = self

@@ -4,6 +4,7 @@
 
 mod clearance;
 mod common;
+mod dimples;
 mod field_file;
 mod near_field;
 
@@ -530,4 +531,3 @@ fn the_tool_holds_the_surface_under_it_while_the_contact_pushes() {
     }
     assert!(checked > 10, "{checked} ticks checked");
 }
-
