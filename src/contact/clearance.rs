@@ -57,9 +57,8 @@ impl Clearance {
     }
 
     /// Adds how far (m) a node's read point, or the master's surface under it, can have moved
-    /// since the last tick: through either organ's modes or carry, or what moves a distance
-    /// beyond them (`near_moved_m`: the master's near field, the contact forces' own
-    /// dimples). Everything counts as moved on the first tick.
+    /// since the last tick: through either organ's modes or carry, or the master's near field
+    /// (`near_moved_m`). Everything counts as moved on the first tick.
     pub fn advance(
         &mut self,
         master: Moving,
@@ -96,6 +95,12 @@ impl Clearance {
     /// Whether node `i` is still clear of the master.
     pub fn is_clear(&self, i: usize) -> bool {
         self.clear_until_m[i] > self.drift_m
+    }
+
+    /// Node `i`'s distance moved by up to `by_m` beyond what every node's drift covers (the
+    /// contact forces' own dimples, which reach a few nodes each).
+    pub fn moved(&mut self, i: usize, by_m: f64) {
+        self.clear_until_m[i] -= by_m;
     }
 
     /// Node `i` was measured `distance_m` from the master this tick (negative inside).

@@ -22,7 +22,8 @@ use nalgebra::Vector3;
 use super::pointshell::Pointshell;
 use crate::pgd::Vademecum;
 
-/// Compressed rows, one per pointshell node, symmetric (each pair once per row).
+/// Compressed rows, one per pointshell node, symmetric (each pair once per row), and what
+/// each tick derives from them for the nodes it works on.
 #[derive(Clone, Debug, Default)]
 pub struct LocalCompliance {
     offsets: Vec<u32>,
@@ -32,13 +33,22 @@ pub struct LocalCompliance {
     values_m_per_n: Vec<f64>,
     /// Per node, each organ's own `a_ii`: `[shell, master]` (m/N).
     own_m_per_n: Vec<[f64; 2]>,
-    /// Per node, the largest `|a_ij|` of its row, and the largest `−a_ij` (a force pulling
-    /// the node closer, as a Poisson bulge can): bounds for the cull and the clearance.
-    largest_m_per_n: Vec<f64>,
+    /// Per node, the largest `−a_ij` of its row (a force pulling the node closer, as a
+    /// Poisson bulge can): the cull's bound.
     largest_pull_m_per_n: Vec<f64>,
-    /// Scratch: which nodes the product in progress covers.
-    member: Vec<bool>,
+    /// Per node, `Σ_j a_ij f_j` for the forces pushing at the start of the tick (m), and
+    /// the nodes where it is not zero.
+    gap_m: Vec<f64>,
+    gapped: Vec<u32>,
+    /// The block of `a` between the nodes of this tick's force solve, dense (row-major, in
+    /// the order of the set), and each node's place in the set.
+    block_m_per_n: Vec<f64>,
+    slot: Vec<u32>,
+    /// Scratch: the vector being multiplied, gathered in the set's order.
+    gathered: Vec<f64>,
 }
+
+const NO_SLOT: u32 = u32::MAX;
 
 /// One organ's side of a node: the load positions it blends and the normal it is pushed along.
 struct Side<'a> {
@@ -94,13 +104,12 @@ impl LocalCompliance {
         let mut part = Self {
             offsets: vec![0],
             own_m_per_n,
-            member: vec![false; count],
+            gap_m: vec![0.0; count],
+            slot: vec![NO_SLOT; count],
             ..Self::default()
         };
         for row in rows {
-            let largest = row.iter().map(|e| e.1.abs()).fold(0.0, f64::max);
             let pull = row.iter().map(|e| -e.1).fold(0.0, f64::max);
-            part.largest_m_per_n.push(largest);
             part.largest_pull_m_per_n.push(pull);
             part.columns.extend(row.iter().map(|e| e.0));
             part.values_m_per_n.extend(row.iter().map(|e| e.1));
@@ -119,15 +128,36 @@ impl LocalCompliance {
         self.own_m_per_n[i]
     }
 
-    /// `Σ_j a_ij f_j`: how far the forces `force_n` dimple node `i`'s distance (m) beyond
-    /// their modes.
-    pub fn gap_m(&self, i: usize, force_n: &[f64]) -> f64 {
-        let (columns, values) = self.row(i);
-        columns
-            .iter()
-            .zip(values)
-            .map(|(&j, a)| a * force_n[j as usize])
-            .sum()
+    /// Takes the forces pushing at the start of the tick (`force_n` on the nodes of
+    /// `pushing`): spread along their rows (the matrix is symmetric), at a cost of the pushing
+    /// nodes' rows rather than every measured node's.
+    pub fn dimple(&mut self, pushing: &[u32], force_n: &[f64]) {
+        for &i in &self.gapped {
+            self.gap_m[i as usize] = 0.0;
+        }
+        self.gapped.clear();
+        for &j in pushing {
+            let f = force_n[j as usize];
+            if f == 0.0 {
+                continue;
+            }
+            let range = self.offsets[j as usize] as usize..self.offsets[j as usize + 1] as usize;
+            for (&i, a) in self.columns[range.clone()]
+                .iter()
+                .zip(&self.values_m_per_n[range])
+            {
+                if self.gap_m[i as usize] == 0.0 {
+                    self.gapped.push(i);
+                }
+                self.gap_m[i as usize] += a * f;
+            }
+        }
+    }
+
+    /// `Σ_j a_ij f_j`: how far the forces taken by [`Self::dimple`] move node `i`'s distance
+    /// (m) beyond their modes.
+    pub fn gap_m(&self, i: usize) -> f64 {
+        self.gap_m[i]
     }
 
     /// How far (m) forces summing to `total_n` can at most bring node `i` closer.
@@ -135,28 +165,64 @@ impl LocalCompliance {
         self.largest_pull_m_per_n[i] * total_n
     }
 
-    /// How far (m) a change of the forces on the nodes of `set` by `change_n` can at most
-    /// move any node's distance.
-    pub fn change_bound_m(&self, set: &[u32], change_n: &[f64]) -> f64 {
-        set.iter()
-            .map(|&j| change_n[j as usize].abs() * self.largest_m_per_n[j as usize])
-            .sum()
+    /// Calls `moved(i, m)` with how far (m) at most a change of the forces on the nodes of
+    /// `set` by `change_n` moves node `i`'s distance, for every node it moves.
+    pub fn spread_change(&self, set: &[u32], change_n: &[f64], mut moved: impl FnMut(usize, f64)) {
+        for &j in set {
+            let change = change_n[j as usize].abs();
+            if change == 0.0 {
+                continue;
+            }
+            let (columns, values) = self.row(j as usize);
+            for (&i, a) in columns.iter().zip(values) {
+                moved(i as usize, a.abs() * change);
+            }
+        }
     }
 
-    /// Adds `Σ_j a_ij v_j` over `j` in `set` to `out[i]` for every `i` in `set`.
-    pub fn add_product(&mut self, set: &[u32], v: &[f64], out: &mut [f64]) {
-        set.iter().for_each(|&j| self.member[j as usize] = true);
-        for &i in set {
-            let (columns, values) = self.row(i as usize);
-            let sum: f64 = columns
+    /// Sets up the block of the tick's force solve over the nodes of `set`: one pass over
+    /// their rows, so that each product costs `set²` rather than their rows' length.
+    pub fn prepare(&mut self, set: &[u32]) {
+        for (k, &i) in set.iter().enumerate() {
+            self.slot[i as usize] = k as u32;
+        }
+        let n = set.len();
+        self.block_m_per_n.clear();
+        self.block_m_per_n.resize(n * n, 0.0);
+        for (r, &i) in set.iter().enumerate() {
+            let range = self.offsets[i as usize] as usize..self.offsets[i as usize + 1] as usize;
+            for (&j, &a) in self.columns[range.clone()]
                 .iter()
-                .zip(values)
-                .filter(|&(&j, _)| self.member[j as usize])
-                .map(|(&j, a)| a * v[j as usize])
-                .sum();
+                .zip(&self.values_m_per_n[range])
+            {
+                if let Some(c) = self.slot_of(j) {
+                    self.block_m_per_n[r * n + c] = a;
+                }
+            }
+        }
+        for &i in set {
+            self.slot[i as usize] = NO_SLOT;
+        }
+    }
+
+    fn slot_of(&self, j: u32) -> Option<usize> {
+        match self.slot[j as usize] {
+            NO_SLOT => None,
+            c => Some(c as usize),
+        }
+    }
+
+    /// Adds `Σ_j a_ij v_j` over `j` in `set` to `out[i]` for every `i` in `set`, the set
+    /// [`Self::prepare`] took.
+    pub fn add_product(&mut self, set: &[u32], v: &[f64], out: &mut [f64]) {
+        let n = set.len();
+        debug_assert_eq!(self.block_m_per_n.len(), n * n, "prepared for another set");
+        self.gathered.clear();
+        self.gathered.extend(set.iter().map(|&j| v[j as usize]));
+        for (&i, row) in set.iter().zip(self.block_m_per_n.chunks_exact(n)) {
+            let sum: f64 = row.iter().zip(&self.gathered).map(|(a, v)| a * v).sum();
             out[i as usize] += sum;
         }
-        set.iter().for_each(|&j| self.member[j as usize] = false);
     }
 }
 
@@ -217,5 +283,100 @@ impl<'a> Nearness<'a> {
             .sum::<f64>()
             .sqrt();
         (rest(i) - rest(j)).norm() <= self.shell_reach_m || master_apart <= self.master_reach_m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A symmetric sparse matrix over five nodes (node 4 couples with none), as rows, and
+    /// the same matrix dense.
+    fn example() -> (LocalCompliance, [[f64; 5]; 5]) {
+        let pairs = [
+            (0, 0, 0.5),
+            (0, 1, 0.2),
+            (1, 1, 0.4),
+            (1, 3, -0.05),
+            (2, 2, 0.3),
+            (3, 3, 0.6),
+        ];
+        let mut dense = [[0.0; 5]; 5];
+        let mut rows = vec![Vec::new(); 5];
+        for (i, j, a) in pairs {
+            dense[i][j] = a;
+            dense[j][i] = a;
+            rows[i].push((j as u32, a));
+            if i != j {
+                rows[j].push((i as u32, a));
+            }
+        }
+        (LocalCompliance::from_rows(rows, vec![[0.0; 2]; 5]), dense)
+    }
+
+    /// The product over a set of nodes, through the block `prepare` builds, is the dense
+    /// product restricted to the set, whatever `v` holds outside it.
+    #[test]
+    fn the_product_over_a_set_is_the_dense_one_restricted_to_it() {
+        let (mut part, dense) = example();
+        let set = [3u32, 0, 1];
+        let v = [1.0, -2.0, 100.0, 0.5, 7.0];
+        part.prepare(&set);
+        let mut out = [0.0; 5];
+        part.add_product(&set, &v, &mut out);
+        for &i in &set {
+            let i = i as usize;
+            let expected: f64 = set
+                .iter()
+                .map(|&j| dense[i][j as usize] * v[j as usize])
+                .sum();
+            assert!(
+                (out[i] - expected).abs() < 1e-15,
+                "node {i}: {} against {expected}",
+                out[i]
+            );
+        }
+        assert_eq!(
+            (out[2], out[4]),
+            (0.0, 0.0),
+            "nodes outside the set are left alone"
+        );
+    }
+
+    /// The dimples of the pushing nodes' forces are the dense product with the forces, and
+    /// a second tick's forces replace the first's.
+    #[test]
+    fn the_dimples_are_the_matrix_times_the_forces_pushing() {
+        let (mut part, dense) = example();
+        let force = [0.0, 2.0, 0.0, 1.0, 0.0];
+        part.dimple(&[0, 1, 3], &[0.0, 5.0, 0.0, 3.0, 0.0]);
+        part.dimple(&[1, 3], &force);
+        for i in 0..5 {
+            let expected: f64 = (0..5).map(|j| dense[i][j] * force[j]).sum();
+            assert!((part.gap_m(i) - expected).abs() < 1e-15, "node {i}");
+        }
+    }
+
+    /// No node's dimple changes by more than the spread change says.
+    #[test]
+    fn a_change_of_the_forces_moves_no_dimple_beyond_its_bound() {
+        let (mut part, dense) = example();
+        let set = [0u32, 1, 3];
+        let (before, after) = ([0.0, 1.0, 0.0, 2.0, 0.0], [0.5, 0.2, 0.0, 2.5, 0.0]);
+        let change: Vec<f64> = (0..5).map(|j| after[j] - before[j]).collect();
+        let mut bound = [0.0; 5];
+        part.spread_change(&set, &change, |i, by_m| bound[i] += by_m);
+        part.dimple(&set, &before);
+        let gaps: Vec<f64> = (0..5).map(|i| part.gap_m(i)).collect();
+        part.dimple(&set, &after);
+        for i in 0..5 {
+            let moved = (part.gap_m(i) - gaps[i]).abs();
+            assert!(
+                moved <= bound[i] + 1e-15,
+                "node {i}: {moved} beyond {}",
+                bound[i]
+            );
+        }
+        assert!(bound[1] > 0.0 && bound[4] == 0.0);
     }
 }

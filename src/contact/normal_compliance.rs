@@ -173,6 +173,10 @@ impl NormalCompliance {
         &self.local
     }
 
+    pub fn local_mut(&mut self) -> &mut LocalCompliance {
+        &mut self.local
+    }
+
     /// Node `i`'s own compliance in the stiffer of the two organs (m/N), 0 where neither
     /// moves it (both clamped there).
     pub fn stiffer_diagonal(&self, i: usize) -> f64 {

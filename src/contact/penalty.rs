@@ -118,9 +118,6 @@ pub struct ContactPair {
     cache: LatticeCache,
     /// Which nodes are known clear of the master; `None` where every node is measured.
     clearance: Option<Clearance>,
-    /// How far the last solve's change of the forces can have moved any distance through
-    /// the near-field part of `A` (m): part of what moved since for the clearance.
-    local_change_m: f64,
     report: PairReport,
 }
 
@@ -168,7 +165,6 @@ impl ContactPair {
             convergence: settings.convergence,
             cache: LatticeCache::default(),
             clearance: settings.skip_clear_nodes.then(|| Clearance::new(count)),
-            local_change_m: 0.0,
             report: PairReport::default(),
         }
     }
@@ -206,6 +202,7 @@ impl ContactPair {
         }
         let compliance = &mut self.compliance;
         compliance.hold(&self.active, out.master_hold, out.shell_hold);
+        compliance.local_mut().prepare(&self.active);
         for &i in &self.active {
             self.change_n[i as usize] = -self.force_n[i as usize];
         }
@@ -221,9 +218,12 @@ impl ContactPair {
             self.change_n[i as usize] += self.force_n[i as usize];
         }
         let (master_moved_m, shell_moved_m) = compliance.tool_moves_m(&self.active, &self.change_n);
-        self.local_change_m = compliance
-            .local()
-            .change_bound_m(&self.active, &self.change_n);
+        if let Some(clearance) = &mut self.clearance {
+            let moved = |i: usize, by_m: f64| clearance.moved(i, by_m);
+            compliance
+                .local()
+                .spread_change(&self.active, &self.change_n, moved);
+        }
         out.master_hold.moved_m += master_moved_m;
         out.shell_hold.moved_m += shell_moved_m;
         for &i in &self.active {
@@ -256,6 +256,9 @@ impl ContactPair {
         near: Option<&NearField>,
     ) -> PairReport {
         let pushing_n: f64 = self.active.iter().map(|&i| self.force_n[i as usize]).sum();
+        self.compliance
+            .local_mut()
+            .dimple(&self.active, &self.force_n);
         let point_moves = self.field.movement_bound_m(master.alpha)
             + self.nodes.movement_bound_m(shell.alpha)
             + carry_bound_m(master.carry, &self.field)
@@ -271,7 +274,7 @@ impl ContactPair {
                     bounds: &self.nodes.mode_bounds,
                 },
                 &self.field,
-                near.map_or(0.0, NearField::largest_change_m) as f64 + self.local_change_m,
+                near.map_or(0.0, NearField::largest_change_m) as f64,
             );
         }
         let shape = MasterShape {
@@ -336,7 +339,7 @@ impl ContactPair {
         // The forces already pushing dimple both organs apart along the node's normal: read
         // where the node is against the dimpled master, near its surface, rather than deep
         // inside the master's modal shape and corrected after.
-        p += self.nodes.rest_normal[i] * self.compliance.local().gap_m(i, &self.force_n);
+        p += self.nodes.rest_normal[i] * self.compliance.local().gap_m(i);
         // The master's lattice is at rest: pull the point back through the master's carry.
         let q = p - master_carry.at(&p);
         let Some(distance_m) = self.field.distance_m(&q, master, &mut self.cache) else {
