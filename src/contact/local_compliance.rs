@@ -33,9 +33,6 @@ pub struct LocalCompliance {
     values_m_per_n: Vec<f64>,
     /// Per node, each organ's own `a_ii`: `[shell, master]` (m/N).
     own_m_per_n: Vec<[f64; 2]>,
-    /// Per node, the largest `−a_ij` of its row (a force pulling the node closer, as a
-    /// Poisson bulge can): the cull's bound.
-    largest_pull_m_per_n: Vec<f64>,
     /// Per node, `Σ_j a_ij f_j` for the forces pushing at the start of the tick (m), and
     /// the nodes where it is not zero.
     gap_m: Vec<f64>,
@@ -109,8 +106,6 @@ impl LocalCompliance {
             ..Self::default()
         };
         for row in rows {
-            let pull = row.iter().map(|e| -e.1).fold(0.0, f64::max);
-            part.largest_pull_m_per_n.push(pull);
             part.columns.extend(row.iter().map(|e| e.0));
             part.values_m_per_n.extend(row.iter().map(|e| e.1));
             part.offsets.push(part.columns.len() as u32);
@@ -158,11 +153,6 @@ impl LocalCompliance {
     /// (m) beyond their modes.
     pub fn gap_m(&self, i: usize) -> f64 {
         self.gap_m[i]
-    }
-
-    /// How far (m) forces summing to `total_n` can at most bring node `i` closer.
-    pub fn closing_bound_m(&self, i: usize, total_n: f64) -> f64 {
-        self.largest_pull_m_per_n[i] * total_n
     }
 
     /// Calls `moved(i, m)` with how far (m) at most a change of the forces on the nodes of

@@ -248,14 +248,13 @@ impl ContactPair {
     /// - nodes measured clear not long ago, where little has moved since ([`Clearance`]).
     ///
     /// The forces already pushing dimple both organs (the near-field part of `A`), which moves
-    /// the point read by at most their sum times the node's largest pull.
+    /// each node's read point along its normal by its dimple: known before the node is read.
     fn measure_within_reach(
         &mut self,
         master: OrganPose,
         shell: OrganPose,
         near: Option<&NearField>,
     ) -> PairReport {
-        let pushing_n: f64 = self.active.iter().map(|&i| self.force_n[i as usize]).sum();
         self.compliance
             .local_mut()
             .dimple(&self.active, &self.force_n);
@@ -284,7 +283,7 @@ impl ContactPair {
         let mut report = PairReport::default();
         self.active.clear();
         for i in 0..self.nodes.len() {
-            if self.force_n[i] == 0.0 && self.can_skip(i, point_moves, near, pushing_n) {
+            if self.force_n[i] == 0.0 && self.can_skip(i, point_moves, near) {
                 continue;
             }
             report.nodes_evaluated += 1;
@@ -296,21 +295,15 @@ impl ContactPair {
 
     /// Whether node `i`, pushing nothing, can be left unmeasured this tick: out of reach from
     /// rest, or known clear. The cheaper check first.
-    fn can_skip(
-        &self,
-        i: usize,
-        point_moves: f32,
-        near: Option<&NearField>,
-        pushing_n: f64,
-    ) -> bool {
+    fn can_skip(&self, i: usize, point_moves: f32, near: Option<&NearField>) -> bool {
         if self.clearance.as_ref().is_some_and(|c| c.is_clear(i)) {
             return true;
         }
+        let moves = point_moves + self.compliance.local().gap_m(i).abs() as f32;
         let near_moves = near.map_or(0.0, |near| {
-            self.near_moves_m(i, near, point_moves + near.largest_m())
+            self.near_moves_m(i, near, moves + near.largest_m())
         });
-        let closing_m = self.compliance.local().closing_bound_m(i, pushing_n) as f32;
-        self.nodes.rest_distance_m[i] > 3f32.sqrt() * (point_moves + near_moves + closing_m)
+        self.nodes.rest_distance_m[i] > 3f32.sqrt() * (moves + near_moves)
     }
 
     /// How far (m) the master's near field can move the distance node `i` reads, given that
