@@ -54,6 +54,8 @@ struct Side<'a> {
 }
 
 impl LocalCompliance {
+    /// Both organs' corrections between the nodes of `nodes`, once per pair at setup:
+    /// O(nodes²) distance checks and a few binary searches per pair close enough.
     pub fn new(nodes: &Pointshell, master: &Vademecum, shell: &Vademecum) -> Self {
         let count = nodes.len();
         let master_blends: Vec<[(usize, f64); 1]> = nodes
@@ -69,6 +71,8 @@ impl LocalCompliance {
             blend: &master_blends[i],
             normal: &nodes.rest_normal[i],
         };
+        let s = |a: usize, b: usize| correction_along(shell, &shell_side(a), &shell_side(b));
+        let m = |a: usize, b: usize| correction_along(master, &master_side(a), &master_side(b));
         let near = Nearness::new(nodes, master, shell);
         let mut rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); count];
         let mut own_m_per_n = vec![[0.0; 2]; count];
@@ -77,10 +81,6 @@ impl LocalCompliance {
                 if !near.can_couple(i, j) {
                     continue;
                 }
-                let s =
-                    |a: usize, b: usize| correction_along(shell, &shell_side(a), &shell_side(b));
-                let m =
-                    |a: usize, b: usize| correction_along(master, &master_side(a), &master_side(b));
                 if i == j {
                     own_m_per_n[i] = [s(i, i), m(i, i)];
                 }
