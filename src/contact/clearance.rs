@@ -29,6 +29,10 @@ pub struct Clearance {
     drift_m: f64,
     /// Per node, the summed drift up to which it is clear (m).
     clear_until_m: Vec<f64>,
+    /// Per node, how far its read point was shifted along its normal when it was measured
+    /// (m): the contact forces' dimple, known exactly every tick, so that only its net
+    /// change since counts.
+    shift_at_m: Vec<f64>,
     /// The last tick's poses, to bound what moved since; none before the first tick.
     last: Option<LastPoses>,
 }
@@ -52,6 +56,7 @@ impl Clearance {
         Self {
             drift_m: 0.0,
             clear_until_m: vec![f64::NEG_INFINITY; count],
+            shift_at_m: vec![0.0; count],
             last: None,
         }
     }
@@ -92,20 +97,17 @@ impl Clearance {
         last.shell_carry = *shell.pose.carry;
     }
 
-    /// Whether node `i` is still clear of the master.
-    pub fn is_clear(&self, i: usize) -> bool {
-        self.clear_until_m[i] > self.drift_m
+    /// Whether node `i`, its read point now shifted by `shift_m` along its normal, is still
+    /// clear of the master.
+    pub fn is_clear(&self, i: usize, shift_m: f64) -> bool {
+        self.clear_until_m[i] - (shift_m - self.shift_at_m[i]).abs() > self.drift_m
     }
 
-    /// Node `i`'s distance moved by up to `by_m` beyond what every node's drift covers (the
-    /// contact forces' own dimples, which reach a few nodes each).
-    pub fn moved(&mut self, i: usize, by_m: f64) {
-        self.clear_until_m[i] -= by_m;
-    }
-
-    /// Node `i` was measured `distance_m` from the master this tick (negative inside).
-    pub fn measured(&mut self, i: usize, distance_m: f64) {
+    /// Node `i` was measured `distance_m` from the master this tick (negative inside), its
+    /// read point shifted by `shift_m` along its normal.
+    pub fn measured(&mut self, i: usize, distance_m: f64, shift_m: f64) {
         self.clear_until_m[i] = self.drift_m + distance_m / SAFETY;
+        self.shift_at_m[i] = shift_m;
     }
 }
 
@@ -184,5 +186,21 @@ mod tests {
             largest >= 0.98 * bound,
             "largest {largest} m, bound {bound} m"
         );
+    }
+
+    /// A node measured clear stays clear while its read point's shift changes less than its
+    /// budget, whichever way, and a shift that comes back costs nothing.
+    #[test]
+    fn a_shift_counts_by_its_net_change_since_the_measurement() {
+        let mut clearance = Clearance::new(1);
+        clearance.measured(0, 6e-3, 2e-3);
+        // Budget: 6 mm / SAFETY = 1 mm.
+        assert!(clearance.is_clear(0, 2e-3));
+        assert!(clearance.is_clear(0, 2.9e-3));
+        assert!(clearance.is_clear(0, 1.1e-3));
+        assert!(!clearance.is_clear(0, 3.1e-3));
+        assert!(!clearance.is_clear(0, 0.9e-3));
+        clearance.measured(0, -1e-3, 0.0);
+        assert!(!clearance.is_clear(0, 0.0), "a node inside is never clear");
     }
 }

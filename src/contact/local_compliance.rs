@@ -113,11 +113,6 @@ impl LocalCompliance {
         part
     }
 
-    fn row(&self, i: usize) -> (&[u32], &[f64]) {
-        let range = self.offsets[i] as usize..self.offsets[i + 1] as usize;
-        (&self.columns[range.clone()], &self.values_m_per_n[range])
-    }
-
     /// Node `i`'s own local compliance in the shell organ and in the master (m/N).
     pub fn own_m_per_n(&self, i: usize) -> [f64; 2] {
         self.own_m_per_n[i]
@@ -153,21 +148,6 @@ impl LocalCompliance {
     /// (m) beyond their modes.
     pub fn gap_m(&self, i: usize) -> f64 {
         self.gap_m[i]
-    }
-
-    /// Calls `moved(i, m)` with how far (m) at most a change of the forces on the nodes of
-    /// `set` by `change_n` moves node `i`'s distance, for every node it moves.
-    pub fn spread_change(&self, set: &[u32], change_n: &[f64], mut moved: impl FnMut(usize, f64)) {
-        for &j in set {
-            let change = change_n[j as usize].abs();
-            if change == 0.0 {
-                continue;
-            }
-            let (columns, values) = self.row(j as usize);
-            for (&i, a) in columns.iter().zip(values) {
-                moved(i as usize, a.abs() * change);
-            }
-        }
     }
 
     /// Sets up the block of the tick's force solve over the nodes of `set`: one pass over
@@ -345,28 +325,5 @@ mod tests {
             let expected: f64 = row.iter().zip(&force).map(|(a, f)| a * f).sum();
             assert!((part.gap_m(i) - expected).abs() < 1e-15, "node {i}");
         }
-    }
-
-    /// No node's dimple changes by more than the spread change says.
-    #[test]
-    fn a_change_of_the_forces_moves_no_dimple_beyond_its_bound() {
-        let (mut part, _) = example();
-        let set = [0u32, 1, 3];
-        let (before, after) = ([0.0, 1.0, 0.0, 2.0, 0.0], [0.5, 0.2, 0.0, 2.5, 0.0]);
-        let change: Vec<f64> = (0..5).map(|j| after[j] - before[j]).collect();
-        let mut bound = [0.0; 5];
-        part.spread_change(&set, &change, |i, by_m| bound[i] += by_m);
-        part.dimple(&set, &before);
-        let gaps: Vec<f64> = (0..5).map(|i| part.gap_m(i)).collect();
-        part.dimple(&set, &after);
-        for i in 0..5 {
-            let moved = (part.gap_m(i) - gaps[i]).abs();
-            assert!(
-                moved <= bound[i] + 1e-15,
-                "node {i}: {moved} beyond {}",
-                bound[i]
-            );
-        }
-        assert!(bound[1] > 0.0 && bound[4] == 0.0);
     }
 }

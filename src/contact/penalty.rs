@@ -218,12 +218,6 @@ impl ContactPair {
             self.change_n[i as usize] += self.force_n[i as usize];
         }
         let (master_moved_m, shell_moved_m) = compliance.tool_moves_m(&self.active, &self.change_n);
-        if let Some(clearance) = &mut self.clearance {
-            let moved = |i: usize, by_m: f64| clearance.moved(i, by_m);
-            compliance
-                .local()
-                .spread_change(&self.active, &self.change_n, moved);
-        }
         out.master_hold.moved_m += master_moved_m;
         out.shell_hold.moved_m += shell_moved_m;
         for &i in &self.active {
@@ -296,10 +290,15 @@ impl ContactPair {
     /// Whether node `i`, pushing nothing, can be left unmeasured this tick: out of reach from
     /// rest, or known clear. The cheaper check first.
     fn can_skip(&self, i: usize, point_moves: f32, near: Option<&NearField>) -> bool {
-        if self.clearance.as_ref().is_some_and(|c| c.is_clear(i)) {
+        let shift_m = self.compliance.local().gap_m(i);
+        if self
+            .clearance
+            .as_ref()
+            .is_some_and(|c| c.is_clear(i, shift_m))
+        {
             return true;
         }
-        let moves = point_moves + self.compliance.local().gap_m(i).abs() as f32;
+        let moves = point_moves + shift_m.abs() as f32;
         let near_moves = near.map_or(0.0, |near| {
             self.near_moves_m(i, near, moves + near.largest_m())
         });
@@ -332,7 +331,8 @@ impl ContactPair {
         // The forces already pushing dimple both organs apart along the node's normal: read
         // where the node is against the dimpled master, near its surface, rather than deep
         // inside the master's modal shape and corrected after.
-        p += self.nodes.rest_normal[i] * self.compliance.local().gap_m(i);
+        let shift_m = self.compliance.local().gap_m(i);
+        p += self.nodes.rest_normal[i] * shift_m;
         // The master's lattice is at rest: pull the point back through the master's carry.
         let q = p - master_carry.at(&p);
         let Some(distance_m) = self.field.distance_m(&q, master, &mut self.cache) else {
@@ -340,7 +340,7 @@ impl ContactPair {
             return 0.0;
         };
         if let Some(clearance) = &mut self.clearance {
-            clearance.measured(i, distance_m);
+            clearance.measured(i, distance_m, shift_m);
         }
         let k = self.stiffness_n_per_m[i];
         let gradient = distance_m + self.force_n[i] / k;
