@@ -2,7 +2,8 @@
 //!
 //! A pointshell node inside the master's deformed zero level set (`d < 0`) is pushed out by
 //! `F = −k · d · n` (`k`: the node's penalty); the master takes `−F` at its nearest
-//! position. Both forces become modal coefficients of their organs, so the contact deforms
+//! position. Both forces become modal coefficients of their organs and point loads whose
+//! near-field corrections dimple them ([`super::local_compliance`]), so the contact deforms
 //! both, and the next tick sees the moved surfaces.
 //!
 //! **Stability.** The vademecums are quasi-static: a force moves the surfaces at once, with no
