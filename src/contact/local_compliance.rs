@@ -58,11 +58,8 @@ impl LocalCompliance {
     /// O(nodes²) distance checks and a few binary searches per pair close enough.
     pub fn new(nodes: &Pointshell, master: &Vademecum, shell: &Vademecum) -> Self {
         let count = nodes.len();
-        let master_blends: Vec<[(usize, f64); 1]> = nodes
-            .master_positions
-            .iter()
-            .map(|&m| [(m as usize, 1.0)])
-            .collect();
+        let master_blends: Vec<[(usize, f64); 1]> =
+            (0..count).map(|i| nodes.master_blend(i)).collect();
         let shell_side = |i: usize| Side {
             blend: &nodes.blends[i],
             normal: &nodes.rest_normal[i],
@@ -113,6 +110,11 @@ impl LocalCompliance {
         part
     }
 
+    /// Where row `i`'s entries lie in `columns` and `values_m_per_n`.
+    fn row_range(&self, i: u32) -> std::ops::Range<usize> {
+        self.offsets[i as usize] as usize..self.offsets[i as usize + 1] as usize
+    }
+
     /// Node `i`'s own local compliance in the shell organ and in the master (m/N).
     pub fn own_m_per_n(&self, i: usize) -> [f64; 2] {
         self.own_m_per_n[i]
@@ -131,7 +133,7 @@ impl LocalCompliance {
             if f == 0.0 {
                 continue;
             }
-            let range = self.offsets[j as usize] as usize..self.offsets[j as usize + 1] as usize;
+            let range = self.row_range(j);
             for (&i, a) in self.columns[range.clone()]
                 .iter()
                 .zip(&self.values_m_per_n[range])
@@ -160,7 +162,7 @@ impl LocalCompliance {
         self.block_m_per_n.clear();
         self.block_m_per_n.resize(n * n, 0.0);
         for (r, &i) in set.iter().enumerate() {
-            let range = self.offsets[i as usize] as usize..self.offsets[i as usize + 1] as usize;
+            let range = self.row_range(i);
             for (&j, &a) in self.columns[range.clone()]
                 .iter()
                 .zip(&self.values_m_per_n[range])
@@ -189,7 +191,8 @@ impl LocalCompliance {
         debug_assert_eq!(self.block_m_per_n.len(), n * n, "prepared for another set");
         self.gathered.clear();
         self.gathered.extend(set.iter().map(|&j| v[j as usize]));
-        for (&i, row) in set.iter().zip(self.block_m_per_n.chunks_exact(n)) {
+        // An empty set has an empty block: no rows, and no chunk of size zero.
+        for (&i, row) in set.iter().zip(self.block_m_per_n.chunks_exact(n.max(1))) {
             let sum: f64 = row.iter().zip(&self.gathered).map(|(a, v)| a * v).sum();
             out[i as usize] += sum;
         }

@@ -144,7 +144,7 @@ impl OrganRows {
 
 impl NormalCompliance {
     pub fn new(nodes: &Pointshell, master: &Vademecum, shell: &Vademecum) -> Self {
-        let master_points = nodes.master_positions.iter().map(|&m| [(m as usize, 1.0)]);
+        let master_points = (0..nodes.len()).map(|i| nodes.master_blend(i));
         let master_rows = ModalRows::displacements(master, master_points);
         let project = |rows: &ModalRows| -> Vec<f32> {
             (0..nodes.len())

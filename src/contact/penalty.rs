@@ -371,7 +371,7 @@ impl ContactPair {
     fn add_loads(&self, i: usize, master: &mut [f64], shell: &mut [f64]) {
         let force = self.nodes.rest_normal[i] * self.force_n[i];
         let (s, m) = (
-            self.nodes.positions[i] as usize,
+            self.nodes.position(i),
             self.nodes.master_positions[i] as usize,
         );
         let shell_vademecum = &self.shell_vademecum;

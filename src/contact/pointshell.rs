@@ -12,9 +12,6 @@ use crate::pgd::Vademecum;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pointshell {
-    /// The shell organ's load position that weighs most in each point (the point itself,
-    /// or a corner of the triangle it lies in).
-    pub positions: Vec<u32>,
     /// The shell organ's load positions each node blends, with their weights (a boundary
     /// node: itself alone; a triangle's centre: its corners): where its force is shared.
     pub blends: Vec<Vec<(usize, f64)>>,
@@ -85,7 +82,6 @@ impl Pointshell {
             .collect();
         let displacement = ModalRows::displacements(shell, inside.iter().map(|n| &n.0.blend));
         Self {
-            positions: inside.iter().map(|n| dominant(&n.0.blend)).collect(),
             blends: inside.iter().map(|n| n.0.blend.clone()).collect(),
             rest_distance_m: inside.iter().map(|n| n.1 as f32).collect(),
             rest_normal: inside.iter().map(|n| n.2).collect(),
@@ -93,7 +89,7 @@ impl Pointshell {
             load: ModalRows::loads(shell, inside.iter().map(|n| &n.0.blend)),
             master_load: ModalRows::loads(
                 master,
-                master_positions.iter().map(|&m| [(m as usize, 1.0)]),
+                master_positions.iter().map(|&m| master_blend(m)),
             ),
             mode_bounds: displacement.bounds(),
             displacement,
@@ -103,11 +99,22 @@ impl Pointshell {
     }
 
     pub fn len(&self) -> usize {
-        self.positions.len()
+        self.blends.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.positions.is_empty()
+        self.blends.is_empty()
+    }
+
+    /// The shell organ's load position that weighs most in node `i` (the node itself, or a
+    /// corner of the triangle it lies in): where its load steps are read.
+    pub fn position(&self, i: usize) -> usize {
+        dominant(&self.blends[i])
+    }
+
+    /// The master position that takes node `i`'s reaction, as a blend.
+    pub fn master_blend(&self, i: usize) -> [(usize, f64); 1] {
+        master_blend(self.master_positions[i])
     }
 
     /// `Σ_k |α_k| max|X^k|`: no node moves farther than this (m).
@@ -146,11 +153,16 @@ fn candidates(shell: &Vademecum, density: PointshellDensity) -> Vec<Candidate> {
 }
 
 /// The position that weighs most in `blend`: where a point's load steps are read.
-fn dominant(blend: &[(usize, f64)]) -> u32 {
+fn dominant(blend: &[(usize, f64)]) -> usize {
     blend
         .iter()
         .max_by(|a, b| a.1.total_cmp(&b.1))
-        .map_or(0, |&(m, _)| m as u32)
+        .map_or(0, |&(m, _)| m)
+}
+
+/// Master position `m` alone, as a blend.
+fn master_blend(m: u32) -> [(usize, f64); 1] {
+    [(m as usize, 1.0)]
 }
 
 /// The master position nearest `p` on its rest surface: the corner of the closest triangle
