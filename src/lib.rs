@@ -11,6 +11,7 @@ pub mod cli;
 pub mod contact;
 pub mod fem;
 pub mod haptics;
+pub mod kernels;
 pub mod mesh;
 pub mod pgd;
 pub mod scenario;

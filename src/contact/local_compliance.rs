@@ -20,6 +20,7 @@
 use nalgebra::Vector3;
 
 use super::pointshell::Pointshell;
+use crate::kernels::dot;
 use crate::pgd::Vademecum;
 
 /// Compressed rows, one per pointshell node, symmetric (each pair once per row), and what
@@ -193,8 +194,7 @@ impl LocalCompliance {
         self.gathered.extend(set.iter().map(|&j| v[j as usize]));
         // An empty set has an empty block: no rows, and no chunk of size zero.
         for (&i, row) in set.iter().zip(self.block_m_per_n.chunks_exact(n.max(1))) {
-            let sum: f64 = row.iter().zip(&self.gathered).map(|(a, v)| a * v).sum();
-            out[i as usize] += sum;
+            out[i as usize] += dot(row, &self.gathered);
         }
     }
 }

@@ -13,6 +13,7 @@ use super::hold::ToolHold;
 use super::local_compliance::LocalCompliance;
 use super::modal_rows::ModalRows;
 use super::pointshell::Pointshell;
+use crate::kernels::{axpy, dot};
 use crate::pgd::Vademecum;
 
 #[derive(Clone, Debug, Default)]
@@ -217,12 +218,4 @@ impl NormalCompliance {
         }
         self.local.add_product(set, v, out);
     }
-}
-
-fn axpy(a: f32, x: &[f32], y: &mut [f32]) {
-    y.iter_mut().zip(x).for_each(|(y, x)| *y += a * x);
-}
-
-fn dot(a: &[f32], b: &[f32]) -> f32 {
-    a.iter().zip(b).map(|(a, b)| a * b).sum()
 }

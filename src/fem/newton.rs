@@ -8,6 +8,7 @@
 
 use super::linear_solver::DirectSolver;
 use super::{FemError, FemModel, Loads};
+use crate::kernels::dot;
 
 /// How a static solve proceeds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -193,10 +194,6 @@ impl FemModel {
         let relative = if reference > 0.0 { r / reference } else { r };
         (residual, relative)
     }
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 fn norm(values: impl Iterator<Item = f64>) -> f64 {

@@ -9,9 +9,10 @@
 //! - `R` fixed: `S = (Fᵀ R − U_nᵀ K R) / (Rᵀ K R)` — closed form, no solve.
 
 use super::load_patches::LoadOperator;
-use super::separated::{SeparatedField, dot};
+use super::separated::SeparatedField;
 use super::stiffness::RestStiffness;
 use crate::fem::FemError;
+use crate::kernels::dot;
 
 /// How the enrichment proceeds and when it stops.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

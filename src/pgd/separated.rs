@@ -1,5 +1,7 @@
 //! A field in separated form, `u(x, p) ≈ Σ_k X^k(x) · Y^k(p)`: the computational vademecum.
 
+use crate::kernels::dot;
+
 /// Spatial modes over all dofs (prescribed ones zero) and parametric modes over the load
 /// parameters, pairwise.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -35,8 +37,4 @@ impl SeparatedField {
         self.spatial.push(spatial);
         self.parametric.push(parametric);
     }
-}
-
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
