@@ -6,7 +6,8 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, scene_of};
 use pgd_surgery::contact::{
-    ContactSurface, CouplingSettings, DistanceField, DistanceSettings, PointshellDensity,
+    ContactSurface, CouplingSettings, DistanceField, DistanceSettings, PenaltySettings,
+    PointshellDensity,
 };
 use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
 use pgd_surgery::mesh::io::{ImportOptions, write_vtu};
@@ -252,8 +253,22 @@ enum BenchTarget {
         #[arg(long, default_value = "vademecums")]
         vademecums: PathBuf,
         /// A dense pointshell (nodes and triangle centres) instead of the boundary nodes.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "subdivide")]
         dense: bool,
+        /// A pointshell of the centres of each surface triangle cut N times along each edge
+        /// (N² points a triangle) instead of the boundary nodes.
+        #[arg(long, value_name = "N", value_parser = cli::parse_subdivisions)]
+        subdivide: Option<u8>,
+        /// How many times stiffer than the tissue each node's penalty is: 1000 (the
+        /// trainer's) cuts an overlap to 0.1 %; 1 leaves half of it, as a one-pass penalty
+        /// does, so that far more nodes stay inside and push.
+        #[arg(
+            long,
+            value_name = "RATIO",
+            default_value_t = PenaltySettings::default().stiffness_ratio,
+            value_parser = cli::parse_stiffness_ratio
+        )]
+        stiffness_ratio: f64,
         /// Print the report as JSON instead of a table.
         #[arg(long)]
         json: bool,
@@ -388,14 +403,21 @@ fn main() -> ExitCode {
                     coarse,
                     vademecums,
                     dense,
+                    subdivide,
+                    stiffness_ratio,
                     json,
                 },
         } => {
             let detail = if coarse { Detail::Coarse } else { Detail::Full };
             let coupling = CouplingSettings {
-                pointshell: match dense {
-                    true => PointshellDensity::Dense,
-                    false => PointshellDensity::Nodes,
+                pointshell: match (dense, subdivide) {
+                    (_, Some(n)) => PointshellDensity::Subdivided(n),
+                    (true, None) => PointshellDensity::Dense,
+                    (false, None) => PointshellDensity::Nodes,
+                },
+                penalty: PenaltySettings {
+                    stiffness_ratio,
+                    ..PenaltySettings::default()
                 },
                 ..CouplingSettings::default()
             };

@@ -46,7 +46,14 @@ pub enum PointshellDensity {
     /// The positions and the centre of every accessible triangle: about three times as many
     /// points, so that contact is felt between nodes and more nodes push at once.
     Dense,
+    /// Every accessible triangle cut into `n²` equal triangles (`n` along each edge), one point
+    /// at each one's centre: as fine as asked, each point blending its triangle's corners.
+    Subdivided(u8),
 }
+
+/// How many times a [`PointshellDensity::Subdivided`] pointshell may cut each edge: 8 gives
+/// 64 points a triangle, some 50 per node of the surface.
+pub const SUBDIVISIONS: std::ops::RangeInclusive<u8> = 1..=8;
 
 /// A candidate point: where it is at rest, and the positions it blends.
 struct Candidate {
@@ -128,6 +135,13 @@ impl Pointshell {
 /// triangle's area from its corners, so that the whole surface is covered once.
 fn candidates(shell: &Vademecum, density: PointshellDensity) -> Vec<Candidate> {
     let at = |m: usize| Vector3::from(shell.position_coords_m[m].map(f64::from));
+    if let PointshellDensity::Subdivided(n) = density {
+        return shell
+            .triangles
+            .iter()
+            .flat_map(|t| subdivided(t.map(|m| m as usize), at, n.max(1)))
+            .collect();
+    }
     let mut points: Vec<Candidate> = (0..shell.positions.len())
         .map(|m| Candidate {
             rest_m: at(m),
@@ -150,6 +164,33 @@ fn candidates(shell: &Vademecum, density: PointshellDensity) -> Vec<Candidate> {
         }
     }
     points
+}
+
+/// The centres of the `n²` triangles that cut triangle `corners` `n` times along each edge:
+/// per row `i` of the cut, `n − i` triangles pointing like the whole and `n − i − 1` turned
+/// over, each a `1/n²` of its area.
+fn subdivided(
+    corners: [usize; 3],
+    at: impl Fn(usize) -> Vector3<f64>,
+    n: u8,
+) -> impl Iterator<Item = Candidate> {
+    let [a, b, c] = corners;
+    let area_m2 = 0.5 * (at(b) - at(a)).cross(&(at(c) - at(a))).norm() / f64::from(n).powi(2);
+    let (pa, pb, pc) = (at(a), at(b), at(c));
+    let n = f64::from(n);
+    let upright = (0..n as u32).flat_map(move |i| (0..n as u32 - i).map(move |j| (i, j, 1.0)));
+    let turned = (0..n as u32)
+        .flat_map(move |i| (0..(n as u32 - i).saturating_sub(1)).map(move |j| (i, j, 2.0)));
+    upright.chain(turned).map(move |(i, j, third)| {
+        // The centre's barycentric weights on `b` and `c`.
+        let (s, t) = ((i as f64 + third / 3.0) / n, (j as f64 + third / 3.0) / n);
+        let weights = [1.0 - s - t, s, t];
+        Candidate {
+            rest_m: pa * weights[0] + pb * weights[1] + pc * weights[2],
+            blend: vec![(a, weights[0]), (b, weights[1]), (c, weights[2])],
+            area_m2,
+        }
+    })
 }
 
 /// The position that weighs most in `blend`: where a point's load steps are read.
@@ -176,4 +217,47 @@ fn nearest_corner(master: &Vademecum, surface: &ContactSurface, p: &Vector3<f64>
         .max_by(|&a, &b| hit.at.barycentric[a].total_cmp(&hit.at.barycentric[b]))
         .expect("three corners");
     corners[best]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Cut `n` times along each edge, a triangle gives `n²` points, each inside it with
+    /// weights that sum to one and place it where it is, covering the triangle's area once,
+    /// no two at the same place.
+    #[test]
+    fn a_subdivided_triangle_is_covered_once_by_points_inside_it() {
+        let corners = [
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(0.03, 0.0, 0.0),
+            Vector3::new(0.01, 0.02, 0.005),
+        ];
+        let whole_m2 = 0.5
+            * (corners[1] - corners[0])
+                .cross(&(corners[2] - corners[0]))
+                .norm();
+        for n in 1..=5u8 {
+            let points: Vec<Candidate> = subdivided([0, 1, 2], |m| corners[m], n).collect();
+            assert_eq!(points.len(), usize::from(n).pow(2), "n = {n}");
+            let area_m2: f64 = points.iter().map(|p| p.area_m2).sum();
+            assert!((area_m2 - whole_m2).abs() < 1e-12 * whole_m2, "n = {n}");
+            for p in &points {
+                let weights: f64 = p.blend.iter().map(|b| b.1).sum();
+                assert!((weights - 1.0).abs() < 1e-12);
+                assert!(p.blend.iter().all(|b| b.1 > 0.0), "inside: {:?}", p.blend);
+                let at: Vector3<f64> = p.blend.iter().map(|&(m, w)| corners[m] * w).sum();
+                assert!((at - p.rest_m).norm() < 1e-15);
+            }
+            for (k, p) in points.iter().enumerate() {
+                assert!(
+                    points[..k]
+                        .iter()
+                        .all(|q| (q.rest_m - p.rest_m).norm() > 1e-6),
+                    "n = {n}: two points at {:?}",
+                    p.rest_m
+                );
+            }
+        }
+    }
 }

@@ -125,7 +125,8 @@ pub struct Contact {
     #[serde(default)]
     pub lattice_mm: Option<Millimetres>,
     /// Which points of the other organs are tested: `Nodes` (their surface nodes, the
-    /// default) or `Dense` (also their surface triangles' centres).
+    /// default), `Dense` (also their surface triangles' centres) or `Subdivided(n)` (the
+    /// centres of each surface triangle cut `n` times along each edge, `n` from 1 to 8).
     #[serde(default)]
     pub pointshell: PointshellDensity,
 }

@@ -8,6 +8,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use super::format::{OrganEntry, Scenario, Task};
+use crate::contact::{PointshellDensity, SUBDIVISIONS};
 use crate::mesh::organs::{Organ, region};
 
 /// Where every reference of the scenario format is explained.
@@ -175,6 +176,20 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
             "contact.master".into(),
             "contact",
         ));
+    }
+    if let PointshellDensity::Subdivided(n) = scenario.contact.pointshell
+        && !SUBDIVISIONS.contains(&n)
+    {
+        problems.push(Problem {
+            field: "contact.pointshell".into(),
+            anchors: vec!["contact".into(), "Subdivided".into()],
+            message: format!("a triangle cut {n} times along each edge"),
+            hint: format!(
+                "cut each triangle {} to {} times (n² points a triangle), or use `Nodes` or `Dense`",
+                SUBDIVISIONS.start(),
+                SUBDIVISIONS.end()
+            ),
+        });
     }
     if scenario.tasks.is_empty() {
         problems.push(Problem {

@@ -1,0 +1,44 @@
+//! Parsers for the contact benchmark's options, with errors that say the range.
+
+use crate::contact::SUBDIVISIONS;
+
+/// A `--subdivide` count within [`SUBDIVISIONS`].
+pub fn parse_subdivisions(text: &str) -> Result<u8, String> {
+    let n: u8 = text.parse().map_err(|e| format!("`{text}`: {e}"))?;
+    match SUBDIVISIONS.contains(&n) {
+        true => Ok(n),
+        false => Err(format!(
+            "`{n}`: cut each triangle {} to {} times",
+            SUBDIVISIONS.start(),
+            SUBDIVISIONS.end()
+        )),
+    }
+}
+
+/// A penalty's stiffness ratio: positive and finite.
+pub fn parse_stiffness_ratio(text: &str) -> Result<f64, String> {
+    let ratio: f64 = text.parse().map_err(|e| format!("`{text}`: {e}"))?;
+    match ratio.is_finite() && ratio > 0.0 {
+        true => Ok(ratio),
+        false => Err(format!(
+            "`{text}`: a penalty is a positive, finite number of times the tissue's stiffness"
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_options_take_their_range_and_name_what_is_wrong() {
+        assert_eq!(parse_subdivisions("3"), Ok(3));
+        assert!(parse_subdivisions("0").unwrap_err().contains("1 to 8"));
+        assert!(parse_subdivisions("9").unwrap_err().contains("1 to 8"));
+        assert!(parse_subdivisions("two").unwrap_err().contains("`two`"));
+        assert_eq!(parse_stiffness_ratio("1e3"), Ok(1000.0));
+        for bad in ["0", "-1", "inf", "NaN"] {
+            assert!(parse_stiffness_ratio(bad).is_err(), "{bad}");
+        }
+    }
+}
