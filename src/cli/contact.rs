@@ -1,18 +1,11 @@
 //! Parsers for the contact benchmark's options, with errors that say the range.
 
-use crate::contact::SUBDIVISIONS;
+use crate::contact::check_subdivisions;
 
-/// A `--subdivide` count within [`SUBDIVISIONS`].
+/// A `--subdivide` count within [`crate::contact::SUBDIVISIONS`].
 pub fn parse_subdivisions(text: &str) -> Result<u8, String> {
     let n: u8 = text.parse().map_err(|e| format!("`{text}`: {e}"))?;
-    match SUBDIVISIONS.contains(&n) {
-        true => Ok(n),
-        false => Err(format!(
-            "`{n}`: cut each triangle {} to {} times",
-            SUBDIVISIONS.start(),
-            SUBDIVISIONS.end()
-        )),
-    }
+    check_subdivisions(n)
 }
 
 /// A penalty's stiffness ratio: positive and finite.

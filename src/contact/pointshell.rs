@@ -55,6 +55,19 @@ pub enum PointshellDensity {
 /// 64 points a triangle, some 50 per node of the surface.
 pub const SUBDIVISIONS: std::ops::RangeInclusive<u8> = 1..=8;
 
+/// `n` itself where a [`PointshellDensity::Subdivided`] pointshell may cut each edge `n`
+/// times, or what is wrong with it: the one check the scenario and the command line share.
+pub fn check_subdivisions(n: u8) -> Result<u8, String> {
+    match SUBDIVISIONS.contains(&n) {
+        true => Ok(n),
+        false => Err(format!(
+            "a triangle cut {n} times along each edge: cut it {} to {} times (n² points a triangle)",
+            SUBDIVISIONS.start(),
+            SUBDIVISIONS.end()
+        )),
+    }
+}
+
 /// A candidate point: where it is at rest, and the positions it blends.
 struct Candidate {
     rest_m: Vector3<f64>,
@@ -132,7 +145,8 @@ impl Pointshell {
 
 /// The points a pointshell at `density` may take from `shell`: each accessible position with
 /// its lumped area, and (dense) each accessible triangle's centre, which then takes half the
-/// triangle's area from its corners, so that the whole surface is covered once.
+/// triangle's area from its corners, so that the whole surface is covered once; subdivided,
+/// the centres of each triangle's pieces alone.
 fn candidates(shell: &Vademecum, density: PointshellDensity) -> Vec<Candidate> {
     let at = |m: usize| Vector3::from(shell.position_coords_m[m].map(f64::from));
     if let PointshellDensity::Subdivided(n) = density {
@@ -175,15 +189,15 @@ fn subdivided(
     n: u8,
 ) -> impl Iterator<Item = Candidate> {
     let [a, b, c] = corners;
-    let area_m2 = 0.5 * (at(b) - at(a)).cross(&(at(c) - at(a))).norm() / f64::from(n).powi(2);
     let (pa, pb, pc) = (at(a), at(b), at(c));
-    let n = f64::from(n);
-    let upright = (0..n as u32).flat_map(move |i| (0..n as u32 - i).map(move |j| (i, j, 1.0)));
-    let turned = (0..n as u32)
-        .flat_map(move |i| (0..(n as u32 - i).saturating_sub(1)).map(move |j| (i, j, 2.0)));
-    upright.chain(turned).map(move |(i, j, third)| {
+    let cuts = f64::from(n);
+    let area_m2 = 0.5 * (pb - pa).cross(&(pc - pa)).norm() / cuts.powi(2);
+    let upright = (0..n).flat_map(move |i| (0..n - i).map(move |j| (i, j, 1.0)));
+    let turned = (0..n).flat_map(move |i| (0..n - i - 1).map(move |j| (i, j, 2.0)));
+    upright.chain(turned).map(move |(i, j, thirds)| {
         // The centre's barycentric weights on `b` and `c`.
-        let (s, t) = ((i as f64 + third / 3.0) / n, (j as f64 + third / 3.0) / n);
+        let along = |k: u8| (f64::from(k) + thirds / 3.0) / cuts;
+        let (s, t) = (along(i), along(j));
         let weights = [1.0 - s - t, s, t];
         Candidate {
             rest_m: pa * weights[0] + pb * weights[1] + pc * weights[2],

@@ -8,7 +8,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use super::format::{OrganEntry, Scenario, Task};
-use crate::contact::{PointshellDensity, SUBDIVISIONS};
+use crate::contact::{PointshellDensity, check_subdivisions};
 use crate::mesh::organs::{Organ, region};
 
 /// Where every reference of the scenario format is explained.
@@ -178,17 +178,15 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
         ));
     }
     if let PointshellDensity::Subdivided(n) = scenario.contact.pointshell
-        && !SUBDIVISIONS.contains(&n)
+        && let Err(message) = check_subdivisions(n)
     {
         problems.push(Problem {
             field: "contact.pointshell".into(),
             anchors: vec!["contact".into(), "Subdivided".into()],
-            message: format!("a triangle cut {n} times along each edge"),
-            hint: format!(
-                "cut each triangle {} to {} times (n² points a triangle), or use `Nodes` or `Dense`",
-                SUBDIVISIONS.start(),
-                SUBDIVISIONS.end()
-            ),
+            message,
+            hint:
+                "or test the surface nodes alone (`Nodes`) or with the triangles' centres (`Dense`)"
+                    .into(),
         });
     }
     if scenario.tasks.is_empty() {

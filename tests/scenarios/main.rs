@@ -230,6 +230,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "`liver` is not in this scenario",
         ),
         (
+            "pointshell-cut-too-fine",
+            6,
+            "contact.pointshell",
+            "cut 20 times along each edge",
+        ),
+        (
             "organ-unknown-field",
             7,
             "organs[0].stiffness_pa",
