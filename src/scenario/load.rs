@@ -184,9 +184,7 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
             field: "contact.pointshell".into(),
             anchors: vec!["contact".into(), "Subdivided".into()],
             message,
-            hint:
-                "or test the surface nodes alone (`Nodes`) or with the triangles' centres (`Dense`)"
-                    .into(),
+            hint: "a coarser pointshell: `Nodes` tests the surface nodes, `Dense` adds the triangles' centres".into(),
         });
     }
     if scenario.tasks.is_empty() {
