@@ -1,0 +1,483 @@
+//! The part of a contact pair's normal compliance `A` that the modes cannot carry: how a
+//! contact force dimples both organs near where it pushes.
+//!
+//! A few smooth modes are far too stiff under a point load (issue 4's table: rank 50, felt
+//! force 2,000 % off), so with modes alone a few pushing nodes moved the liver clear of a
+//! whole intrusion, and the contact felt stiffer than the tissue. Every load position of a
+//! vademecum stores its near-field correction (its exact response minus the modes, at every
+//! node within the local radius), so the exact compliance between two nodes close enough is
+//! the modal one plus `a_ij = Σ_ab w_ia w_jb n_i · R_b(a) · n_j` over the positions `a`, `b`
+//! they blend (symmetrized), for both organs (the shell organ at the nodes' load positions,
+//! the master at the positions that take the reactions). It acts in two places:
+//! - `A` takes it in the force solve, so the solve sees the tissue as soft as it is;
+//! - each measured distance takes it times the forces already pushing, because the modal
+//!   coefficients the distance is read with carry only the modal part of their effect.
+//!
+//! **Kept per position, not per node.** `a = G S Gᵀ`: `Gᵀ` sums the nodes' normal forces
+//! into forces at the positions, along a few directions each (`G` is sparse, a node's row its
+//! blend), and `S` holds the corrections between positions. A pointshell finer than the mesh
+//! (`Subdivided(n)`, `n²` points a triangle) then costs what the mesh costs: kept per node,
+//! its rows grew with `n²` and the solve's dense block with the square of the nodes pushing,
+//! half of a 400-point press's tick (session 17). A position loaded by nodes of one normal
+//! (a boundary node alone at its position) keeps one direction, so the block of a pointshell
+//! of nodes stays its size.
+//!
+//! The linear load step's corrections are used (contact forces are spread over many nodes,
+//! each well inside the first step), and each pair's own forces only: a reaction another pair
+//! puts on the master dimples it for that pair alone.
+
+mod organ_part;
+mod sparse;
+
+use nalgebra::Vector3;
+
+use self::organ_part::OrganPart;
+use self::sparse::{Scattered, SparseRows};
+use super::pointshell::Pointshell;
+use crate::kernels::dot;
+use crate::pgd::Vademecum;
+
+/// The near-field compliance as `G S Gᵀ`, and the same between the nodes, with what each
+/// tick derives from them. The two organs' directions are numbered one after the other, the
+/// shell organ's first.
+///
+/// Each form serves where it is smaller. The dimples spread each pushing node's force to
+/// every node within reach: through the directions, a few rows per position reached, rather
+/// than a row per node reached (hundreds of entries long on a subdivided pointshell). The
+/// force solve works on the pushing nodes alone: their block between the nodes is smaller
+/// than between their directions, since on the master each position takes reactions along
+/// several normals and so keeps three directions (measured on `--subdivide 3`: 312 nodes
+/// pushing reach 525 directions, 390 of them the master's).
+#[derive(Clone, Debug, Default)]
+pub struct LocalCompliance {
+    /// `G`: per node, the directions its normal force loads and its distance reads, with
+    /// their coefficients (weight times the cosine to the node's normal).
+    reads: SparseRows,
+    /// `Gᵀ`: per direction, the nodes that read it.
+    readers: SparseRows,
+    /// `S` between directions (m/N), both organs, symmetric, no entry across organs.
+    compliance: SparseRows,
+    /// `a = G S Gᵀ` between nodes (m/N), symmetric.
+    between_nodes: SparseRows,
+    /// Per node, each organ's own `a_ii`: `[shell, master]` (m/N).
+    own_m_per_n: Vec<[f64; 2]>,
+    /// This tick's dimples: the pushing forces summed per direction (N), how far they move
+    /// each direction (m), and each node's `Σ_j a_ij f_j` (m).
+    loads_n: Scattered,
+    moves_m: Scattered,
+    gaps_m: Scattered,
+    block: SolveBlock,
+}
+
+/// The block of `a` between the nodes of this tick's force solve, dense.
+#[derive(Clone, Debug, Default)]
+struct SolveBlock {
+    /// The nodes it was built for: a tick whose set is the same keeps it (a press at rest).
+    set: Vec<u32>,
+    /// Row-major, in the order of the set.
+    values_m_per_n: Vec<f64>,
+    /// Each node's place in the set, and per node of a new set its place in the last one.
+    slot: Vec<u32>,
+    kept: Vec<u32>,
+    /// Scratch: the next block, while the last one is copied from.
+    next: Vec<f64>,
+    /// Scratch: the vector being multiplied, gathered in the set's order.
+    gathered: Vec<f64>,
+}
+
+const NO_SLOT: u32 = u32::MAX;
+
+impl LocalCompliance {
+    /// Both organs' corrections between the positions `nodes` loads, once per pair at setup.
+    pub fn new(nodes: &Pointshell, master: &Vademecum, shell: &Vademecum) -> Self {
+        let parts = [
+            OrganPart::new(shell, nodes.blends.iter().cloned()),
+            OrganPart::new(
+                master,
+                (0..nodes.len()).map(|i| nodes.master_blend(i).to_vec()),
+            ),
+        ];
+        Self::assemble(&parts, &nodes.rest_normal)
+    }
+
+    /// `G`, `S` and `a` from the two organs' parts (shell, master), nodes along `normals`.
+    fn assemble(parts: &[OrganPart; 2], normals: &[Vector3<f64>]) -> Self {
+        let count = normals.len();
+        let mut reads: Vec<Vec<(u32, f64)>> = vec![Vec::new(); count];
+        let mut compliance = Vec::new();
+        let mut first_direction = 0;
+        let mut shell_directions = 0;
+        for (o, part) in parts.iter().enumerate() {
+            let directions = part.directions(normals);
+            let numbers;
+            (numbers, first_direction) = numbering(first_direction, &directions);
+            for (i, blend) in part.blends.iter().enumerate() {
+                for &(a, w) in blend {
+                    for (k, e) in directions[a].iter().enumerate() {
+                        let c = w * normals[i].dot(e);
+                        if c != 0.0 {
+                            reads[i].push((numbers[a] + k as u32, c));
+                        }
+                    }
+                }
+            }
+            let (directions, numbers) = (&directions, &numbers);
+            for (a, row) in part.blocks.iter().enumerate() {
+                for d in &directions[a] {
+                    compliance.push(
+                        row.iter()
+                            .flat_map(|(&b, s)| {
+                                let d = s.tr_mul(d);
+                                directions[b]
+                                    .iter()
+                                    .enumerate()
+                                    .map(move |(l, e)| (numbers[b] + l as u32, d.dot(e)))
+                            })
+                            .filter(|e| e.1 != 0.0)
+                            .collect::<Vec<_>>(),
+                    );
+                }
+            }
+            if o == 0 {
+                shell_directions = first_direction as usize;
+            }
+        }
+        for row in &mut reads {
+            row.sort_by_key(|e| e.0);
+        }
+        let reads = SparseRows::from_rows(reads);
+        let compliance = SparseRows::from_rows(compliance);
+        let directions = compliance.rows();
+        let mut part = Self {
+            readers: reads.transpose(directions),
+            reads,
+            compliance,
+            loads_n: Scattered::new(directions),
+            moves_m: Scattered::new(directions),
+            gaps_m: Scattered::new(count),
+            block: SolveBlock {
+                slot: vec![NO_SLOT; count],
+                ..SolveBlock::default()
+            },
+            ..Self::default()
+        };
+        part.between_nodes = SparseRows::from_rows((0..count).map(|i| part.row_between_nodes(i)));
+        part.own_m_per_n = (0..count).map(|i| part.own(i, shell_directions)).collect();
+        part
+    }
+
+    /// Row `i` of `a = G S Gᵀ`, columns ascending.
+    fn row_between_nodes(&mut self, i: usize) -> Vec<(u32, f64)> {
+        self.spread(std::iter::once((i as u32, 1.0)));
+        let mut row: Vec<(u32, f64)> = self
+            .gaps_m
+            .touched()
+            .iter()
+            .map(|&j| (j, self.gaps_m.get(j as usize)))
+            .filter(|e| e.1 != 0.0)
+            .collect();
+        row.sort_by_key(|e| e.0);
+        row
+    }
+
+    /// Node `i`'s `a_ii` in each organ: `Σ_de G_id S_de G_ie` over the organ's directions
+    /// (the shell organ's below `shell_directions`).
+    fn own(&self, i: usize, shell_directions: usize) -> [f64; 2] {
+        let (directions, coefficients) = self.reads.row(i);
+        let mut own = [0.0; 2];
+        for (&d, &c) in directions.iter().zip(coefficients) {
+            for (&e, &g) in directions.iter().zip(coefficients) {
+                let organ = usize::from(d as usize >= shell_directions);
+                own[organ] += c * g * self.compliance.get(d as usize, e as usize);
+            }
+        }
+        own
+    }
+
+    /// Node `i`'s own local compliance in the shell organ and in the master (m/N).
+    pub fn own_m_per_n(&self, i: usize) -> [f64; 2] {
+        self.own_m_per_n[i]
+    }
+
+    /// Takes the forces pushing at the start of the tick (`force_n` on the nodes of
+    /// `pushing`).
+    pub fn dimple(&mut self, pushing: &[u32], force_n: &[f64]) {
+        let forces = pushing
+            .iter()
+            .map(|&j| (j, force_n[j as usize]))
+            .filter(|e| e.1 != 0.0);
+        self.spread(forces);
+    }
+
+    /// `gaps_m = a f` for the normal forces `(node, f)`: summed per direction, moved through
+    /// `S`, read by the nodes, at a cost of the directions they reach rather than every
+    /// node's.
+    fn spread(&mut self, forces: impl Iterator<Item = (u32, f64)>) {
+        self.gaps_m.clear();
+        for (j, f) in forces {
+            let (directions, coefficients) = self.reads.row(j as usize);
+            for (&d, &c) in directions.iter().zip(coefficients) {
+                self.loads_n.add(d as usize, c * f);
+            }
+        }
+        for &d in self.loads_n.touched() {
+            let f = self.loads_n.get(d as usize);
+            let (directions, values) = self.compliance.row(d as usize);
+            for (&e, &s) in directions.iter().zip(values) {
+                self.moves_m.add(e as usize, s * f);
+            }
+        }
+        for &e in self.moves_m.touched() {
+            let u = self.moves_m.get(e as usize);
+            let (nodes, coefficients) = self.readers.row(e as usize);
+            for (&i, &c) in nodes.iter().zip(coefficients) {
+                self.gaps_m.add(i as usize, c * u);
+            }
+        }
+        self.loads_n.clear();
+        self.moves_m.clear();
+    }
+
+    /// `Σ_j a_ij f_j`: how far the forces taken by [`Self::dimple`] move node `i`'s distance
+    /// (m) beyond their modes.
+    pub fn gap_m(&self, i: usize) -> f64 {
+        self.gaps_m.get(i)
+    }
+
+    /// Sets up the block of the tick's force solve over the nodes of `set`, so that each
+    /// product costs `set²` rather than their rows' length. Entries between nodes the last
+    /// tick's block held are copied from it; only the nodes new to the set have their rows
+    /// read (on a subdivided pointshell those rows are some 1,500 entries long, and the set
+    /// changes by a few nodes from tick to tick).
+    pub fn prepare(&mut self, set: &[u32]) {
+        let block = &mut self.block;
+        if block.set == set {
+            return;
+        }
+        for (k, &i) in block.set.iter().enumerate() {
+            block.slot[i as usize] = k as u32;
+        }
+        block.kept.clear();
+        block
+            .kept
+            .extend(set.iter().map(|&i| block.slot[i as usize]));
+        for &i in &block.set {
+            block.slot[i as usize] = NO_SLOT;
+        }
+        for (k, &i) in set.iter().enumerate() {
+            block.slot[i as usize] = k as u32;
+        }
+        let (n, last) = (set.len(), block.set.len());
+        block.next.clear();
+        block.next.resize(n * n, 0.0);
+        for (r, &p) in block.kept.iter().enumerate().filter(|e| *e.1 != NO_SLOT) {
+            let old_row = &block.values_m_per_n[p as usize * last..][..last];
+            for (c, &q) in block.kept.iter().enumerate().filter(|e| *e.1 != NO_SLOT) {
+                block.next[r * n + c] = old_row[q as usize];
+            }
+        }
+        for (r, &i) in set.iter().enumerate() {
+            if block.kept[r] != NO_SLOT {
+                continue;
+            }
+            let (columns, values) = self.between_nodes.row(i as usize);
+            for (&j, &a) in columns.iter().zip(values) {
+                let c = block.slot[j as usize] as usize;
+                if c != NO_SLOT as usize {
+                    block.next[r * n + c] = a;
+                    block.next[c * n + r] = a;
+                }
+            }
+        }
+        for &i in set {
+            block.slot[i as usize] = NO_SLOT;
+        }
+        std::mem::swap(&mut block.values_m_per_n, &mut block.next);
+        block.set.clear();
+        block.set.extend_from_slice(set);
+    }
+
+    /// Adds `Σ_j a_ij v_j` over `j` in `set` to `out[i]` for every `i` in `set`, the set
+    /// [`Self::prepare`] took.
+    pub fn add_product(&mut self, set: &[u32], v: &[f64], out: &mut [f64]) {
+        let block = &mut self.block;
+        let n = set.len();
+        debug_assert_eq!(
+            block.values_m_per_n.len(),
+            n * n,
+            "prepared for another set"
+        );
+        block.gathered.clear();
+        block.gathered.extend(set.iter().map(|&j| v[j as usize]));
+        // An empty set has an empty block: no rows, and no chunk of size zero.
+        for (&i, row) in set.iter().zip(block.values_m_per_n.chunks_exact(n.max(1))) {
+            out[i as usize] += dot(row, &block.gathered);
+        }
+    }
+}
+
+/// The number of each position's first direction, counting on from `first`, and the next
+/// number free.
+fn numbering(first: u32, directions: &[Vec<Vector3<f64>>]) -> (Vec<u32>, u32) {
+    let mut next = first;
+    let numbers = directions
+        .iter()
+        .map(|d| {
+            next += d.len() as u32;
+            next - d.len() as u32
+        })
+        .collect();
+    (numbers, next)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    use nalgebra::Matrix3;
+
+    use super::*;
+
+    /// Four nodes on three shell positions and two master positions. Position 0 of the shell
+    /// is loaded by nodes of two normals, position 1 by one normal (nodes 1 and 3), position 2
+    /// by two; each organ's `S` is a symmetric matrix with one pair of positions out of reach.
+    fn example() -> ([OrganPart; 2], Vec<Vector3<f64>>) {
+        let normals = vec![
+            Vector3::new(0.0, 0.0, 1.0),
+            Vector3::new(0.6, 0.0, 0.8),
+            Vector3::new(0.0, -0.8, 0.6),
+            Vector3::new(0.6, 0.0, 0.8),
+        ];
+        let shell_blends = vec![
+            vec![(0, 1.0)],
+            vec![(1, 1.0)],
+            vec![(0, 0.5), (2, 0.5)],
+            vec![(1, 0.3), (2, 0.7)],
+        ];
+        let master_blends = vec![
+            vec![(0, 1.0)],
+            vec![(0, 1.0)],
+            vec![(1, 1.0)],
+            vec![(1, 1.0)],
+        ];
+        let parts = [
+            OrganPart {
+                blends: shell_blends,
+                blocks: symmetric_blocks(3, 1.0, &[(1, 2)]),
+            },
+            OrganPart {
+                blends: master_blends,
+                blocks: symmetric_blocks(2, 0.3, &[]),
+            },
+        ];
+        (parts, normals)
+    }
+
+    /// Blocks of a symmetric positive matrix over `positions` (diagonally dominant), with the
+    /// pairs of `apart` left out.
+    fn symmetric_blocks(
+        positions: usize,
+        scale: f64,
+        apart: &[(usize, usize)],
+    ) -> Vec<BTreeMap<usize, Matrix3<f64>>> {
+        let n = 3 * positions;
+        let value = |r: usize, c: usize| match r == c {
+            true => scale * (n as f64),
+            false => scale * 0.1 * ((r * c + r + c) % 7) as f64,
+        };
+        (0..positions)
+            .map(|a| {
+                (0..positions)
+                    .filter(|&b| !apart.contains(&(a, b)) && !apart.contains(&(b, a)))
+                    .map(|b| (b, Matrix3::from_fn(|c, d| value(3 * a + c, 3 * b + d))))
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// `a_ij = Σ_ab w_ia w_jb n_i · S_ab · n_j` for one organ, straight from the parts.
+    fn direct(part: &OrganPart, normals: &[Vector3<f64>], i: usize, j: usize) -> f64 {
+        let mut sum = 0.0;
+        for &(a, wa) in &part.blends[i] {
+            for &(b, wb) in &part.blends[j] {
+                if let Some(s) = part.blocks[a].get(&b) {
+                    sum += wa * wb * normals[i].dot(&(s * normals[j]));
+                }
+            }
+        }
+        sum
+    }
+
+    fn dense(parts: &[OrganPart; 2], normals: &[Vector3<f64>]) -> Vec<Vec<f64>> {
+        let n = normals.len();
+        (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| parts.iter().map(|p| direct(p, normals, i, j)).sum())
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// A position loaded along one normal keeps one direction, one loaded along two the
+    /// three axes.
+    #[test]
+    fn a_position_keeps_one_direction_where_its_nodes_share_a_normal() {
+        let (parts, normals) = example();
+        let counts: Vec<usize> = parts[0].directions(&normals).iter().map(Vec::len).collect();
+        assert_eq!(counts, [3, 1, 3]);
+    }
+
+    /// The product over a set of nodes, through the block `prepare` builds from the last
+    /// set's, is the dense product restricted to the set, whatever `v` holds outside it.
+    #[test]
+    fn the_product_over_a_set_is_the_dense_one_restricted_to_it() {
+        let (parts, normals) = example();
+        let a = dense(&parts, &normals);
+        let mut part = LocalCompliance::assemble(&parts, &normals);
+        let set = [3u32, 0, 2];
+        let v = [1.0, 100.0, -2.0, 0.5];
+        part.prepare(&[0, 1, 3]);
+        part.prepare(&set);
+        let mut out = [0.0; 4];
+        part.add_product(&set, &v, &mut out);
+        for &i in &set {
+            let i = i as usize;
+            let expected: f64 = set.iter().map(|&j| a[i][j as usize] * v[j as usize]).sum();
+            assert!(
+                (out[i] - expected).abs() < 1e-12 * expected.abs(),
+                "node {i}: {} against {expected}",
+                out[i]
+            );
+        }
+        assert_eq!(out[1], 0.0, "nodes outside the set are left alone");
+    }
+
+    /// The dimples of the pushing nodes' forces are the dense product with the forces, a
+    /// second tick's forces replace the first's, and each node's own compliance is the
+    /// diagonal of its organ's part.
+    #[test]
+    fn the_dimples_are_the_matrix_times_the_forces_pushing() {
+        let (parts, normals) = example();
+        let a = dense(&parts, &normals);
+        let mut part = LocalCompliance::assemble(&parts, &normals);
+        let force = [0.0, 2.0, 0.0, 1.0];
+        part.dimple(&[0, 1, 3], &[5.0, 1.0, 0.0, 3.0]);
+        part.dimple(&[1, 3, 2], &force);
+        for (i, row) in a.iter().enumerate() {
+            let expected: f64 = row.iter().zip(&force).map(|(a, f)| a * f).sum();
+            assert!(
+                (part.gap_m(i) - expected).abs() < 1e-12 * expected.abs(),
+                "node {i}: {} against {expected}",
+                part.gap_m(i)
+            );
+            for (o, organ) in parts.iter().enumerate() {
+                let own = direct(organ, &normals, i, i);
+                assert!(
+                    (part.own_m_per_n(i)[o] - own).abs() < 1e-12 * own,
+                    "node {i}"
+                );
+            }
+        }
+    }
+}

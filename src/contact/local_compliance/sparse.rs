@@ -1,0 +1,133 @@
+//! The two sparse containers the near-field compliance is kept and applied in.
+
+/// Compressed rows: row `i`'s entries are `columns[offsets[i]..offsets[i + 1]]` with their
+/// `values`, columns ascending.
+#[derive(Clone, Debug, Default)]
+pub(super) struct SparseRows {
+    offsets: Vec<u32>,
+    columns: Vec<u32>,
+    values: Vec<f64>,
+}
+
+impl SparseRows {
+    /// From each row's entries, columns ascending within each.
+    pub(super) fn from_rows(rows: impl IntoIterator<Item = Vec<(u32, f64)>>) -> Self {
+        let mut sparse = Self {
+            offsets: vec![0],
+            ..Self::default()
+        };
+        for row in rows {
+            debug_assert!(row.windows(2).all(|w| w[0].0 < w[1].0), "unsorted row");
+            sparse.columns.extend(row.iter().map(|e| e.0));
+            sparse.values.extend(row.iter().map(|e| e.1));
+            sparse.offsets.push(sparse.columns.len() as u32);
+        }
+        sparse
+    }
+
+    pub(super) fn rows(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Row `i`'s columns and values.
+    pub(super) fn row(&self, i: usize) -> (&[u32], &[f64]) {
+        let range = self.offsets[i] as usize..self.offsets[i + 1] as usize;
+        (&self.columns[range.clone()], &self.values[range])
+    }
+
+    /// Entry `(i, j)`, 0 where the row holds none.
+    pub(super) fn get(&self, i: usize, j: usize) -> f64 {
+        let (columns, values) = self.row(i);
+        columns
+            .binary_search(&(j as u32))
+            .map_or(0.0, |k| values[k])
+    }
+
+    /// The transpose, with `columns` rows.
+    pub(super) fn transpose(&self, columns: usize) -> Self {
+        let mut rows = vec![Vec::new(); columns];
+        for i in 0..self.rows() {
+            let (js, values) = self.row(i);
+            for (&j, &value) in js.iter().zip(values) {
+                rows[j as usize].push((i as u32, value));
+            }
+        }
+        Self::from_rows(rows)
+    }
+}
+
+/// A vector mostly zero, with the list of the entries touched since it was last cleared, so
+/// that clearing it costs what was touched rather than its length.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Scattered {
+    values: Vec<f64>,
+    marked: Vec<bool>,
+    touched: Vec<u32>,
+}
+
+impl Scattered {
+    pub(super) fn new(len: usize) -> Self {
+        Self {
+            values: vec![0.0; len],
+            marked: vec![false; len],
+            touched: Vec::new(),
+        }
+    }
+
+    pub(super) fn add(&mut self, i: usize, value: f64) {
+        if !self.marked[i] {
+            self.marked[i] = true;
+            self.touched.push(i as u32);
+        }
+        self.values[i] += value;
+    }
+
+    pub(super) fn get(&self, i: usize) -> f64 {
+        self.values[i]
+    }
+
+    /// The entries added to since the last clear, each once.
+    pub(super) fn touched(&self) -> &[u32] {
+        &self.touched
+    }
+
+    pub(super) fn clear(&mut self) {
+        for &i in &self.touched {
+            self.values[i as usize] = 0.0;
+            self.marked[i as usize] = false;
+        }
+        self.touched.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_transpose_swaps_rows_and_columns() {
+        let rows = SparseRows::from_rows([vec![(0, 1.0), (2, 2.0)], vec![], vec![(1, 3.0)]]);
+        let transposed = rows.transpose(3);
+        for i in 0..3 {
+            for j in 0..3 {
+                assert_eq!(rows.get(i, j), transposed.get(j, i), "({i}, {j})");
+            }
+        }
+        assert_eq!(rows.get(0, 2), 2.0);
+    }
+
+    #[test]
+    fn a_scattered_vector_clears_what_was_touched_and_lists_each_once() {
+        let mut v = Scattered::new(4);
+        v.add(2, 1.0);
+        v.add(0, 0.5);
+        v.add(2, -1.0);
+        assert_eq!(v.touched(), &[2, 0]);
+        assert_eq!(v.get(2), 0.0);
+        v.clear();
+        assert!(v.touched().is_empty());
+        assert_eq!(v.get(0), 0.0);
+        v.add(0, 1.0);
+        assert_eq!((v.get(0), v.touched()), (1.0, &[0u32][..]));
+    }
+}
