@@ -111,33 +111,8 @@ impl LocalCompliance {
             let directions = part.directions(normals);
             let numbers;
             (numbers, first_direction) = numbering(first_direction, &directions);
-            for (i, blend) in part.blends.iter().enumerate() {
-                for &(a, w) in blend {
-                    for (k, e) in directions[a].iter().enumerate() {
-                        let c = w * normals[i].dot(e);
-                        if c != 0.0 {
-                            reads[i].push((numbers[a] + k as u32, c));
-                        }
-                    }
-                }
-            }
-            let (directions, numbers) = (&directions, &numbers);
-            for (a, row) in part.blocks.iter().enumerate() {
-                for d in &directions[a] {
-                    compliance.push(
-                        row.iter()
-                            .flat_map(|(&b, s)| {
-                                let d = s.tr_mul(d);
-                                directions[b]
-                                    .iter()
-                                    .enumerate()
-                                    .map(move |(l, e)| (numbers[b] + l as u32, d.dot(e)))
-                            })
-                            .filter(|e| e.1 != 0.0)
-                            .collect::<Vec<_>>(),
-                    );
-                }
-            }
+            add_reads(&mut reads, part, normals, &directions, &numbers);
+            compliance.extend(direction_rows(part, &directions, &numbers));
             if o == 0 {
                 shell_directions = first_direction as usize;
             }
@@ -314,6 +289,50 @@ impl LocalCompliance {
             out[i as usize] += dot(row, &block.gathered);
         }
     }
+}
+
+/// Adds to each node's row of `G` the directions of `part` its force loads: its weight at
+/// each position times the cosine of each direction there to its normal.
+fn add_reads(
+    reads: &mut [Vec<(u32, f64)>],
+    part: &OrganPart,
+    normals: &[Vector3<f64>],
+    directions: &[Vec<Vector3<f64>>],
+    numbers: &[u32],
+) {
+    for (i, blend) in part.blends.iter().enumerate() {
+        for &(a, w) in blend {
+            for (k, e) in directions[a].iter().enumerate() {
+                let c = w * normals[i].dot(e);
+                if c != 0.0 {
+                    reads[i].push((numbers[a] + k as u32, c));
+                }
+            }
+        }
+    }
+}
+
+/// `part`'s rows of `S` between directions, `d · S_ab · e`, columns ascending.
+fn direction_rows(
+    part: &OrganPart,
+    directions: &[Vec<Vector3<f64>>],
+    numbers: &[u32],
+) -> Vec<Vec<(u32, f64)>> {
+    let mut rows = Vec::new();
+    for (a, blocks) in part.blocks.iter().enumerate() {
+        for d in &directions[a] {
+            let mut row = Vec::new();
+            for (&b, s) in blocks {
+                let sd = s.tr_mul(d);
+                for (l, e) in directions[b].iter().enumerate() {
+                    row.push((numbers[b] + l as u32, sd.dot(e)));
+                }
+            }
+            row.retain(|e| e.1 != 0.0);
+            rows.push(row);
+        }
+    }
+    rows
 }
 
 /// The number of each position's first direction, counting on from `first`, and the next
