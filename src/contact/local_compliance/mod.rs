@@ -141,7 +141,7 @@ impl LocalCompliance {
         part
     }
 
-    /// Row `i` of `a = G S Gᵀ`, columns ascending.
+    /// Row `i` of `a = G S Gᵀ`, columns ascending, leaving no dimple behind.
     fn row_between_nodes(&mut self, i: usize) -> Vec<(u32, f64)> {
         self.spread(std::iter::once((i as u32, 1.0)));
         let mut row: Vec<(u32, f64)> = self
@@ -151,6 +151,7 @@ impl LocalCompliance {
             .map(|&j| (j, self.gaps_m.get(j as usize)))
             .filter(|e| e.1 != 0.0)
             .collect();
+        self.gaps_m.clear();
         row.sort_by_key(|e| e.0);
         row
     }

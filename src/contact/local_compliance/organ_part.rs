@@ -85,8 +85,9 @@ fn near_field_blocks(
             let Some(&a) = number_of_node.get(&local.correction_nodes[e]) else {
                 continue;
             };
-            let values = &local.correction[9 * e..9 * e + 9];
-            let r = Matrix3::from_fn(|c, d| 0.5 * values[3 * d + c] as f64);
+            let column = |d: Vector3<f64>| local.residual(e, &d);
+            let r = 0.5
+                * Matrix3::from_columns(&[Vector3::x(), Vector3::y(), Vector3::z()].map(column));
             *blocks[a].entry(b).or_insert_with(Matrix3::zeros) += r;
             *blocks[b].entry(a).or_insert_with(Matrix3::zeros) += r.transpose();
         }
