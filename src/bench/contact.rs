@@ -28,10 +28,14 @@ use crate::seam::{to_parry, trimesh};
 /// Nodes in contact the pressed case asks for (the figure).
 const PRESSED_NODES: usize = 400;
 
-/// Ticks a press is given to settle before its nodes in contact are counted or timed: the
-/// depth search and the timed run see the same contact (fine pointshells under a soft
-/// penalty first push with hundreds of nodes, then settle on far fewer).
-const SETTLE_TICKS: usize = 100;
+/// The most ticks a press is given to settle before its nodes in contact are counted or
+/// timed, so that the depth search and the timed run see the same contact (fine pointshells
+/// under a soft penalty first push with hundreds of nodes, then settle on far fewer, over
+/// some hundreds of ticks).
+const SETTLE_TICKS: usize = 1000;
+
+/// Ticks in a row whose force solve took no product: the press has settled.
+const SETTLED_TICKS: usize = 20;
 
 /// A scene's organ: its name and vademecum.
 type Organ = (String, Arc<Vademecum>);
@@ -146,7 +150,7 @@ fn press_depth(pair: &ContactPair, master: &Organ, shell: &Organ) -> Option<f64>
     let mut most = (0, None);
     for depth in (1..=30).map(|mm| mm as f64 * 1e-3) {
         let mut run = Run::new(pair, master, shell, carry_into(pair, depth));
-        (0..SETTLE_TICKS).for_each(|_| run.tick());
+        run.settle();
         let in_contact = run.pair.report().nodes_in_contact;
         if in_contact >= PRESSED_NODES {
             return Some(depth);
@@ -179,6 +183,21 @@ impl Run {
             coefficients: modes.map(|m| vec![0.0; m]),
             alpha: modes.map(|m| vec![0.0; m]),
             points: [Vec::new(), Vec::new()],
+        }
+    }
+
+    /// Ticks until [`SETTLED_TICKS`] in a row take no product, or [`SETTLE_TICKS`] in all.
+    fn settle(&mut self) {
+        let mut still = 0;
+        for _ in 0..SETTLE_TICKS {
+            self.tick();
+            still = match self.pair.report().products {
+                0 => still + 1,
+                _ => 0,
+            };
+            if still == SETTLED_TICKS {
+                return;
+            }
         }
     }
 
@@ -223,7 +242,7 @@ fn time_case(
     ticks: usize,
 ) -> StageFigures {
     let mut run = Run::new(pair, master, shell, carry_into(pair, depth_m));
-    (0..SETTLE_TICKS).for_each(|_| run.tick());
+    run.settle();
     let mut products = Vec::with_capacity(ticks);
     let mut times: Vec<Duration> = (0..ticks)
         .map(|_| {

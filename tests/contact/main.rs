@@ -301,7 +301,7 @@ fn distance_errors(modes_only: bool) -> (f64, f64) {
         near: (!modes_only).then_some(&near),
     };
     let mut cache = LatticeCache::default();
-    cache.next_tick(distance);
+    cache.next_tick(distance, &shape);
     let normals = gallbladder.rest_normals();
     let tool = last.organs[g].loads[0].shares.first().map(|s| s.0).unwrap();
     let tool_at = Vector3::from(gallbladder.position_coords_m[tool].map(f64::from));

@@ -61,13 +61,27 @@ pub struct LocalCompliance {
     between_nodes: SparseRows,
     /// Per node, each organ's own `a_ii`: `[shell, master]` (m/N).
     own_m_per_n: Vec<[f64; 2]>,
-    /// This tick's dimples: the pushing forces summed per direction (N), how far they move
-    /// each direction (m), and each node's `Σ_j a_ij f_j` (m).
+    /// The dimples: each node's `Σ_j a_ij f_j` (m) for the forces of [`Self::spread_n`],
+    /// and the scratch a change of them passes through: per node, per direction summed, and
+    /// how far that moves each direction (m).
+    gaps_m: Scattered,
+    changes_n: Scattered,
     loads_n: Scattered,
     moves_m: Scattered,
-    gaps_m: Scattered,
+    /// The forces the dimples hold (N, per node) and the nodes where they are not zero.
+    spread_n: Vec<f64>,
+    spread_nodes: Vec<u32>,
+    /// Ticks since the dimples were last summed whole rather than changed.
+    ticks_changed: u32,
+    /// The largest dimple of any node this tick (m).
+    largest_gap_m: f64,
     block: SolveBlock,
 }
+
+/// How many ticks the dimples are changed by the forces' changes before they are summed whole
+/// again: each change leaves rounding behind (1e-16 of the dimple), which a second's worth
+/// cannot make felt, and the whole sum costs no more than a tick where every force changed.
+const TICKS_BETWEEN_WHOLE_SUMS: u32 = 1000;
 
 /// The block of `a` between the nodes of this tick's force solve, dense.
 #[derive(Clone, Debug, Default)]
@@ -130,6 +144,8 @@ impl LocalCompliance {
             loads_n: Scattered::new(directions),
             moves_m: Scattered::new(directions),
             gaps_m: Scattered::new(count),
+            changes_n: Scattered::new(count),
+            spread_n: vec![0.0; count],
             block: SolveBlock {
                 slot: vec![NO_SLOT; count],
                 ..SolveBlock::default()
@@ -176,20 +192,65 @@ impl LocalCompliance {
     }
 
     /// Takes the forces pushing at the start of the tick (`force_n` on the nodes of
-    /// `pushing`).
+    /// `pushing`) into the dimples, through how they changed since the last tick: a press at
+    /// rest, or one where a few nodes' forces change, costs what changed rather than every
+    /// pushing node's reach (on `--subdivide 4`, 317 points pushing at rest, 69 µs a tick).
     pub fn dimple(&mut self, pushing: &[u32], force_n: &[f64]) {
-        let forces = pushing
+        self.ticks_changed += 1;
+        if self.ticks_changed >= TICKS_BETWEEN_WHOLE_SUMS {
+            self.forget_forces();
+        }
+        for &j in &self.spread_nodes {
+            self.changes_n.add(j as usize, -self.spread_n[j as usize]);
+            self.spread_n[j as usize] = 0.0;
+        }
+        self.spread_nodes.clear();
+        for &j in pushing {
+            let f = force_n[j as usize];
+            if f != 0.0 {
+                self.changes_n.add(j as usize, f);
+                self.spread_n[j as usize] = f;
+                self.spread_nodes.push(j);
+            }
+        }
+        let changes = std::mem::take(&mut self.changes_n);
+        self.spread(
+            changes
+                .touched()
+                .iter()
+                .map(|&j| (j, changes.get(j as usize)))
+                .filter(|e| e.1 != 0.0),
+        );
+        self.changes_n = changes;
+        self.changes_n.clear();
+        let gaps = &self.gaps_m;
+        self.largest_gap_m = gaps
+            .touched()
             .iter()
-            .map(|&j| (j, force_n[j as usize]))
-            .filter(|e| e.1 != 0.0);
-        self.spread(forces);
+            .map(|&i| gaps.get(i as usize).abs())
+            .fold(0.0, f64::max);
     }
 
-    /// `gaps_m = a f` for the normal forces `(node, f)`: summed per direction, moved through
-    /// `S`, read by the nodes, at a cost of the directions they reach rather than every
-    /// node's.
-    fn spread(&mut self, forces: impl Iterator<Item = (u32, f64)>) {
+    /// The largest of [`Self::gap_m`] over the nodes (m): bounds how far the dimples moved
+    /// any node's read point.
+    pub fn largest_gap_m(&self) -> f64 {
+        self.largest_gap_m
+    }
+
+    /// Drops every force from the dimples, so that the next are summed whole.
+    fn forget_forces(&mut self) {
         self.gaps_m.clear();
+        for &j in &self.spread_nodes {
+            self.spread_n[j as usize] = 0.0;
+        }
+        self.spread_nodes.clear();
+        self.ticks_changed = 0;
+    }
+
+    /// Adds `a f` to the dimples for the normal forces `(node, f)`: summed per direction,
+    /// moved through `S`, read by the nodes, at a cost of the directions they reach rather
+    /// than every node's.
+    fn spread(&mut self, forces: impl Iterator<Item = (u32, f64)>) {
         for (j, f) in forces {
             let (directions, coefficients) = self.reads.row(j as usize);
             for (&d, &c) in directions.iter().zip(coefficients) {
@@ -473,6 +534,17 @@ mod tests {
         assert_eq!(out[1], 0.0, "nodes outside the set are left alone");
     }
 
+    fn assert_dimples(part: &LocalCompliance, a: &[Vec<f64>], force: &[f64], tick: usize) {
+        for (i, row) in a.iter().enumerate() {
+            let expected: f64 = row.iter().zip(force).map(|(a, f)| a * f).sum();
+            assert!(
+                (part.gap_m(i) - expected).abs() < 1e-12 * expected.abs(),
+                "tick {tick}, node {i}: {} against {expected}",
+                part.gap_m(i)
+            );
+        }
+    }
+
     /// The dimples of the pushing nodes' forces are the dense product with the forces, a
     /// second tick's forces replace the first's, and each node's own compliance is the
     /// diagonal of its organ's part.
@@ -484,13 +556,8 @@ mod tests {
         let force = [0.0, 2.0, 0.0, 1.0];
         part.dimple(&[0, 1, 3], &[5.0, 1.0, 0.0, 3.0]);
         part.dimple(&[1, 3, 2], &force);
-        for (i, row) in a.iter().enumerate() {
-            let expected: f64 = row.iter().zip(&force).map(|(a, f)| a * f).sum();
-            assert!(
-                (part.gap_m(i) - expected).abs() < 1e-12 * expected.abs(),
-                "node {i}: {} against {expected}",
-                part.gap_m(i)
-            );
+        assert_dimples(&part, &a, &force, 1);
+        for i in 0..normals.len() {
             for (o, organ) in parts.iter().enumerate() {
                 let own = direct(organ, &normals, i, i);
                 assert!(
@@ -498,6 +565,29 @@ mod tests {
                     "node {i}"
                 );
             }
+        }
+    }
+
+    /// Ticks on, changed by how their forces change: nodes start and stop pushing, some keep
+    /// their force, and past the ticks between whole sums the dimples are still the dense
+    /// product with the forces of the tick.
+    #[test]
+    fn the_dimples_follow_the_forces_from_tick_to_tick() {
+        let (parts, normals) = example();
+        let a = dense(&parts, &normals);
+        let mut part = LocalCompliance::assemble(&parts, &normals);
+        let ticks = 2 * TICKS_BETWEEN_WHOLE_SUMS as usize + 3;
+        for tick in 0..ticks {
+            let force: Vec<f64> = (0..4)
+                .map(|j| match (tick + j) % 5 {
+                    0 => 0.0,
+                    1 => 1.5,
+                    _ => ((tick * 7 + j * 3) % 11) as f64 * 0.25,
+                })
+                .collect();
+            let pushing: Vec<u32> = (0..4).filter(|&j| force[j as usize] > 0.0).collect();
+            part.dimple(&pushing, &force);
+            assert_dimples(&part, &a, &force, tick);
         }
     }
 }
