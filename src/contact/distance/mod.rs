@@ -100,9 +100,11 @@ pub(super) struct ClosestPoint {
 pub struct LatticeCache {
     tick: u32,
     nodes: Vec<Stamped>,
-    /// The master's coefficients the values are for; `None` where a near field moved it too
-    /// (or before the first tick).
-    alpha: Option<Vec<f32>>,
+    /// The master's coefficients the values are for, where `alpha_known`: not where a near
+    /// field moved it too, nor before the first tick. Kept in place, so that a tick allocates
+    /// nothing.
+    alpha: Vec<f32>,
+    alpha_known: bool,
 }
 
 /// A lattice node's displacement and the tick it was computed on, side by side: one cache
@@ -121,13 +123,16 @@ impl LatticeCache {
     pub fn next_tick(&mut self, field: &DistanceField, shape: &MasterShape) {
         if self.nodes.len() != field.node_count() {
             self.nodes = vec![Stamped::default(); field.node_count()];
-            self.alpha = None;
+            self.alpha_known = false;
         }
-        let unchanged = shape.near.is_none() && self.alpha.as_deref() == Some(shape.alpha);
-        if unchanged {
+        let held = shape.near.is_none();
+        if held && self.alpha_known && self.alpha == shape.alpha {
             return;
         }
-        self.alpha = shape.near.is_none().then(|| shape.alpha.to_vec());
+        self.alpha_known = held;
+        if held {
+            shape.alpha.clone_into(&mut self.alpha);
+        }
         self.tick = self.tick.wrapping_add(1);
         if self.tick == 0 {
             self.nodes.fill(Stamped::default());
