@@ -67,14 +67,30 @@ pub struct ContactBenchReport {
     pub lattice_nodes: usize,
     pub ticks: usize,
     pub cases: Vec<StageFigures>,
+    /// How many cases were asked for: fewer figures means a press never pushed.
+    #[serde(skip)]
+    cases_asked: usize,
 }
 
-/// Times the scene's master against its largest pointshell over `ticks` ticks per case;
-/// `settings` are those the scene's coupling was set up with.
+/// The cases the benchmark can time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Case {
+    /// The organs apart: culling alone.
+    Apart,
+    /// The master, free to deform, carried into the shell organ.
+    Pressed,
+    /// A rigid copy of the master carried in: the shell organ alone gives way.
+    Held,
+}
+
+/// Times the scene's master against its largest pointshell over `ticks` ticks per case in
+/// `cases` (every case where none is named); `settings` are those the scene's coupling was
+/// set up with.
 pub fn run(
     scene: &HapticScene,
     settings: &CouplingSettings,
     ticks: usize,
+    cases: &[Case],
 ) -> Result<ContactBenchReport, String> {
     let coupling = scene
         .coupling
@@ -85,23 +101,38 @@ pub fn run(
         .iter()
         .max_by_key(|p| p.pointshell().len())
         .ok_or("the scene's master meets no other organ")?;
+    let cases = match cases {
+        [] => &[Case::Apart, Case::Pressed, Case::Held],
+        named => named,
+    };
     let master = &scene.organs[pair.master];
     let shell = &scene.organs[pair.shell];
-    let apart = time_case(pair, master, shell, 0.0, ticks);
-    let pressed =
-        press_depth(pair, master, shell).map(|depth| time_case(pair, master, shell, depth, ticks));
-    let (held_pair, held_master) = held(pair, master, shell, settings)?;
-    let held = press_depth(&held_pair, &held_master, shell).map(|depth| StageFigures {
-        case: "held",
-        ..time_case(&held_pair, &held_master, shell, depth, ticks)
-    });
+    let apart = cases
+        .contains(&Case::Apart)
+        .then(|| time_case(pair, master, shell, 0.0, ticks));
+    let pressed = cases
+        .contains(&Case::Pressed)
+        .then(|| press_depth(pair, master, shell))
+        .flatten()
+        .map(|depth| time_case(pair, master, shell, depth, ticks));
+    let held = match cases.contains(&Case::Held) {
+        true => {
+            let (held_pair, held_master) = held(pair, master, shell, settings)?;
+            press_depth(&held_pair, &held_master, shell).map(|depth| StageFigures {
+                case: "held",
+                ..time_case(&held_pair, &held_master, shell, depth, ticks)
+            })
+        }
+        false => None,
+    };
     Ok(ContactBenchReport {
         master: master.0.clone(),
         shell: shell.0.clone(),
         pointshell_nodes: pair.pointshell().len(),
         lattice_nodes: pair.field().node_count(),
         ticks,
-        cases: std::iter::once(apart).chain(pressed).chain(held).collect(),
+        cases: apart.into_iter().chain(pressed).chain(held).collect(),
+        cases_asked: cases.len(),
     })
 }
 
@@ -341,7 +372,7 @@ impl fmt::Display for ContactBenchReport {
                 c.speedup
             )?;
         }
-        if self.cases.len() == 1 {
+        if self.cases.len() < self.cases_asked {
             writeln!(
                 f,
                 "(no depth up to 30 mm puts {PRESSED_NODES} nodes in contact)"

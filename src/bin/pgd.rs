@@ -269,6 +269,10 @@ enum BenchTarget {
             value_parser = cli::parse_stiffness_ratio
         )]
         stiffness_ratio: f64,
+        /// The cases to time (all by default): apart, pressed (the master free), held (a
+        /// rigid master).
+        #[arg(long = "case", value_enum, value_name = "CASE")]
+        cases: Vec<bench::contact::Case>,
         /// Print the report as JSON instead of a table.
         #[arg(long)]
         json: bool,
@@ -405,6 +409,7 @@ fn main() -> ExitCode {
                     dense,
                     subdivide,
                     stiffness_ratio,
+                    cases,
                     json,
                 },
         } => {
@@ -435,7 +440,7 @@ fn main() -> ExitCode {
             };
             print_report(
                 "pgd bench contact",
-                bench::contact::run(&scene, &coupling, ticks),
+                bench::contact::run(&scene, &coupling, ticks, &cases),
                 json,
             )
         }

@@ -91,30 +91,6 @@ impl ModalRows {
             .map(move |x| x[0] * n.x + x[1] * n.y + x[2] * n.z)
     }
 
-    /// Adds `weight(step) · Y^k · force` to the coefficients `out` (all steps concatenated):
-    /// the modal coefficients of a force at chosen position `i`.
-    pub fn add_force(
-        &self,
-        i: usize,
-        force_n: &Vector3<f64>,
-        steps: &[Range<usize>],
-        weight: impl Fn(usize) -> f64,
-        out: &mut [f64],
-    ) {
-        let f = force_n.map(|c| c as f32);
-        let row = self.row(i);
-        for (step, range) in steps.iter().enumerate() {
-            let w = weight(step);
-            if w == 0.0 {
-                continue;
-            }
-            for k in range.clone() {
-                let y = &row[3 * k..3 * k + 3];
-                out[k] += w * (y[0] * f.x + y[1] * f.y + y[2] * f.z) as f64;
-            }
-        }
-    }
-
     /// Per mode, the largest `|X^k|` over the chosen nodes: bounds how far they can move.
     pub fn bounds(&self) -> Vec<f32> {
         let mut bounds = vec![0.0f32; self.modes];

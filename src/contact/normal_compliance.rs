@@ -7,6 +7,8 @@
 //! the penalties. Where the tool holds an organ, its modal part of `A` takes the tool's
 //! answer as a change of rank 3 ([`super::hold`]).
 
+use std::ops::Range;
+
 use nalgebra::Vector3;
 
 use super::hold::ToolHold;
@@ -32,7 +34,7 @@ pub struct NormalCompliance {
 /// symmetric `A`, so its symmetric part is applied: `½ (displacement_i · load_j +
 /// load_i · displacement_j)`, one more pass over the same rows.
 #[derive(Clone, Debug, Default)]
-struct OrganRows {
+pub(super) struct OrganRows {
     modes: usize,
     displacement: Vec<f32>,
     load: Vec<f32>,
@@ -121,6 +123,31 @@ impl OrganRows {
         (&self.displacement[range.clone()], &self.load[range])
     }
 
+    /// Adds the coefficients of a normal force `force_n` (N) on node `i` to `out` (all load
+    /// steps concatenated, `steps` where each lies), each step's share weighed by `weight`.
+    /// The row is the one `A` projects on the node's normal: one product a mode, in a run
+    /// the compiler vectorizes, where the force's three components took three.
+    pub(super) fn add_force(
+        &self,
+        i: usize,
+        force_n: f64,
+        steps: &[Range<usize>],
+        weight: impl Fn(usize) -> f64,
+        out: &mut [f64],
+    ) {
+        let row = &self.load[i * self.modes..(i + 1) * self.modes];
+        for (step, range) in steps.iter().enumerate() {
+            let w = weight(step) * force_n;
+            if w == 0.0 {
+                continue;
+            }
+            let (out, row) = (&mut out[range.clone()], &row[range.clone()]);
+            out.iter_mut()
+                .zip(row)
+                .for_each(|(o, &l)| *o += w * f64::from(l));
+        }
+    }
+
     /// `A_ii` of this organ (m/N): how far a unit force on node `i` moves it.
     fn diagonal(&self, i: usize) -> f64 {
         let (displacement, load) = self.rows(i);
@@ -167,6 +194,17 @@ impl NormalCompliance {
             ),
             local: LocalCompliance::new(nodes, master, shell),
         }
+    }
+
+    /// The shell organ's rows: the coefficients a node's push takes.
+    pub(super) fn shell_rows(&self) -> &OrganRows {
+        &self.shell
+    }
+
+    /// The master's rows: the coefficients a node's reaction takes (its `load` rows carry the
+    /// reaction's sign).
+    pub(super) fn master_rows(&self) -> &OrganRows {
+        &self.master
     }
 
     /// The near-field part of `A`.

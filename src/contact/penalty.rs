@@ -111,13 +111,12 @@ pub struct ContactPair {
     gradient_m: Vec<f64>,
     /// Nodes that push or are pushed into, this tick.
     active: Vec<u32>,
-    /// The nodes by their rest distance to the master, nearest first: those beyond what can
-    /// move this tick are passed over with one binary search rather than a test each (on
-    /// `--subdivide 5`, 8,745 points: 31 µs a tick with the organs apart).
-    nearest_first: Vec<u32>,
-    /// Scratch: nodes pushing at the last tick that now lie beyond that reach, measured all
-    /// the same so that they let go.
-    beyond_reach: Vec<u32>,
+    /// Scratch: the nodes this tick may measure. The pointshell's nodes lie nearest first, so
+    /// those beyond what can move this tick are passed over with one binary search rather
+    /// than a test each (on `--subdivide 5`, 8,745 points: 31 µs a tick with the organs
+    /// apart); then those not known clear, and the nodes pushing beyond that reach, so that
+    /// they let go.
+    candidates: Vec<u32>,
     /// Per node, the force the last tick left (N), then how the solve changed it.
     change_n: Vec<f64>,
     compliance: NormalCompliance,
@@ -154,7 +153,6 @@ impl ContactPair {
         let compliance = NormalCompliance::new(&nodes, &master_vademecum, &shell_vademecum);
         let stiffness_n_per_m = penalties(&compliance, nodes.len(), settings.stiffness_ratio);
         let count = nodes.len();
-        let nearest_first = nearest_first(&nodes.rest_distance_m);
         Self {
             master,
             shell,
@@ -168,8 +166,7 @@ impl ContactPair {
             force_n: vec![0.0; count],
             gradient_m: vec![0.0; count],
             active: Vec::with_capacity(count),
-            nearest_first,
-            beyond_reach: Vec::new(),
+            candidates: Vec::with_capacity(count),
             change_n: vec![0.0; count],
             compliance,
             solver: ProjectedCg::new(count),
@@ -262,6 +259,7 @@ impl ContactPair {
         self.compliance
             .local_mut()
             .dimple(&self.active, &self.force_n);
+        let local = self.compliance.local();
         let point_moves = self.field.movement_bound_m(master.alpha)
             + self.nodes.movement_bound_m(shell.alpha)
             + carry_bound_m(master.carry, &self.field)
@@ -279,6 +277,9 @@ impl ContactPair {
                 &self.field,
                 near.map_or(0.0, NearField::largest_change_m) as f64,
             );
+            for &i in local.dimpled_nodes() {
+                clearance.dimpled(i as usize, local.gap_m(i as usize));
+            }
         }
         let shape = MasterShape {
             alpha: master.alpha,
@@ -286,26 +287,23 @@ impl ContactPair {
         };
         self.cache.next_tick(&self.field, &shape);
         let reach_m = 3f32.sqrt()
-            * (point_moves
-                + self.compliance.local().largest_gap_m() as f32
-                + near.map_or(0.0, NearField::largest_m));
+            * (point_moves + local.largest_gap_m() as f32 + near.map_or(0.0, NearField::largest_m));
         let rest_m = &self.nodes.rest_distance_m;
-        self.beyond_reach.clear();
-        self.beyond_reach.extend(
+        let within = rest_m.partition_point(|&d| d <= reach_m);
+        self.candidates.clear();
+        match &mut self.clearance {
+            Some(clearance) => clearance.candidates(within, &mut self.candidates),
+            None => self.candidates.extend(0..within as u32),
+        }
+        self.candidates.extend(
             self.active
                 .iter()
                 .filter(|&&i| self.force_n[i as usize] > 0.0 && rest_m[i as usize] > reach_m),
         );
-        let within = self
-            .nearest_first
-            .partition_point(|&i| rest_m[i as usize] <= reach_m);
         let mut report = PairReport::default();
         self.active.clear();
-        for k in 0..within + self.beyond_reach.len() {
-            let i = match k.checked_sub(within) {
-                None => self.nearest_first[k] as usize,
-                Some(b) => self.beyond_reach[b] as usize,
-            };
+        for k in 0..self.candidates.len() {
+            let i = self.candidates[k] as usize;
             if self.force_n[i] == 0.0 && self.can_skip(i, point_moves, near) {
                 continue;
             }
@@ -379,6 +377,9 @@ impl ContactPair {
         if self.force_n[i] > 0.0 || gradient < 0.0 {
             self.gradient_m[i] = gradient;
             self.active.push(i as u32);
+            if let Some(clearance) = &mut self.clearance {
+                clearance.keep_measuring(i);
+            }
         }
         (-distance_m).max(0.0)
     }
@@ -400,26 +401,25 @@ impl ContactPair {
     /// Node `i`'s force on the shell organ and its reaction on the master, as coefficients.
     /// It pushes along the node's rest normal, the direction `A` is projected on.
     fn add_loads(&self, i: usize, master: &mut [f64], shell: &mut [f64]) {
-        let force = self.nodes.rest_normal[i] * self.force_n[i];
+        let f = self.force_n[i];
+        let force = self.nodes.rest_normal[i] * f;
         let (s, m) = (
             self.nodes.position(i),
             self.nodes.master_positions[i] as usize,
         );
-        let shell_vademecum = &self.shell_vademecum;
-        self.nodes.load.add_force(
+        let (shell_vademecum, master_vademecum) = (&self.shell_vademecum, &self.master_vademecum);
+        self.compliance.shell_rows().add_force(
             i,
-            &force,
+            f,
             &self.shell_steps,
             |step| shell_vademecum.step_share(step, s, 1.0, &force),
             shell,
         );
-        let reaction = -force;
-        let master_vademecum = &self.master_vademecum;
-        self.nodes.master_load.add_force(
+        self.compliance.master_rows().add_force(
             i,
-            &reaction,
+            f,
             &self.master_steps,
-            |step| master_vademecum.step_share(step, m, 1.0, &reaction),
+            |step| master_vademecum.step_share(step, m, 1.0, &-force),
             master,
         );
     }
@@ -441,13 +441,6 @@ fn penalties(compliance: &NormalCompliance, count: usize, ratio: f64) -> Vec<f64
         .filter(|k| **k == 0.0)
         .for_each(|k| *k = stiffest);
     stiffness
-}
-
-/// The nodes ordered by their rest distance, nearest first.
-fn nearest_first(rest_distance_m: &[f32]) -> Vec<u32> {
-    let mut order: Vec<u32> = (0..rest_distance_m.len() as u32).collect();
-    order.sort_by(|&a, &b| rest_distance_m[a as usize].total_cmp(&rest_distance_m[b as usize]));
-    order
 }
 
 /// How far a rigid carry can move any point of the lattice (m).

@@ -10,6 +10,9 @@ use super::modal_rows::ModalRows;
 use super::{ContactSurface, DistanceField};
 use crate::pgd::Vademecum;
 
+/// The nodes are kept in order of their rest distance to the master, nearest first: those
+/// that can touch this tick are a leading run (found with one binary search), and the
+/// contact's per-node arrays are read in runs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pointshell {
     /// The shell organ's load positions each node blends, with their weights (a boundary
@@ -85,13 +88,14 @@ impl Pointshell {
         field: &DistanceField,
         density: PointshellDensity,
     ) -> Self {
-        let inside: Vec<(Candidate, f64, Vector3<f64>)> = candidates(shell, density)
+        let mut inside: Vec<(Candidate, f64, Vector3<f64>)> = candidates(shell, density)
             .into_iter()
             .filter_map(|c| {
                 let sample = field.at_rest(&c.rest_m)?;
                 Some((c, sample.distance_m, sample.normal))
             })
             .collect();
+        inside.sort_by(|a, b| a.1.total_cmp(&b.1));
         let rest_m: Vec<Vector3<f32>> = inside
             .iter()
             .map(|n| n.0.rest_m.map(|c| c as f32))

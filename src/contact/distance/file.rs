@@ -3,9 +3,10 @@
 //! scene's first use, then loaded.
 //!
 //! The [`container`] layout with the magic `PGDDISTF`; the header (JSON) holds the hash of the
-//! field's inputs, the lattice settings and its layout; the payload the lattice values and the
-//! per-mode bounds. A field built from another vademecum or with other lattice settings is
-//! refused, so the trainer never runs on a stale one.
+//! field's inputs, the lattice settings and its layout; the payload the lattice's rest
+//! distances, its modes' displacements, the per-mode bounds and each node's closest rest
+//! point. A field built from another vademecum or with other lattice settings is refused, so
+//! the trainer never runs on a stale one.
 
 use std::fmt;
 use std::path::Path;
@@ -20,7 +21,8 @@ use crate::pgd::{Vademecum, VademecumError};
 const KIND: Kind = Kind {
     magic: b"PGDDISTF",
     // 2: each lattice node's closest rest point, for the near-field corrections.
-    version: 2,
+    // 3: the rest distances apart from the modes' displacements.
+    version: 3,
     name: "distance field",
 };
 
@@ -149,8 +151,11 @@ impl DistanceField {
             modes: self.modes,
         };
         let header = serde_json::to_vec_pretty(&header).expect("plain data serializes");
-        let mut payload = Vec::with_capacity(4 * (self.values.len() + self.mode_bounds.len()));
-        put(&mut payload, &self.values);
+        let rest = self.rest.as_flattened();
+        let mut payload =
+            Vec::with_capacity(4 * (rest.len() + self.modal.len() + self.mode_bounds.len()));
+        put(&mut payload, rest);
+        put(&mut payload, &self.modal);
         put(&mut payload, &self.mode_bounds);
         let corners: Vec<u32> = self.closest.iter().flat_map(|p| p.corners).collect();
         let weights: Vec<f32> = self.closest.iter().flat_map(|p| p.weights).collect();
@@ -169,13 +174,15 @@ impl DistanceField {
                 what: format!("header: {e}"),
             })?;
         let mut reader = Reader::new(path, payload);
-        let values: Vec<f32> = reader.take("lattice values")?;
+        let rest: Vec<f32> = reader.take("rest distances")?;
+        let modal: Vec<f32> = reader.take("modes' displacements")?;
         let mode_bounds: Vec<f32> = reader.take("mode bounds")?;
         let corners: Vec<u32> = reader.take("closest points' corners")?;
         let weights: Vec<f32> = reader.take("closest points' weights")?;
         reader.finish()?;
         let nodes: usize = header.dims.iter().product();
-        if values.len() != nodes * (HEAD + 3 * header.modes)
+        if rest.len() != nodes * HEAD
+            || modal.len() != nodes * 3 * header.modes
             || mode_bounds.len() != header.modes
             || corners.len() != 3 * nodes
             || weights.len() != 3 * nodes
@@ -197,7 +204,11 @@ impl DistanceField {
             origin_m: Vector3::from(header.origin_m),
             dims: header.dims,
             modes: header.modes,
-            values,
+            rest: rest
+                .chunks_exact(HEAD)
+                .map(|r| [r[0], r[1], r[2], r[3]])
+                .collect(),
+            modal,
             mode_bounds,
             closest,
         })

@@ -27,14 +27,16 @@
 //! surface: p95 0.23 mm beyond 25 mm of the tool and 0.46 mm within, against 1.5 mm and
 //! 9.2 mm without the corrections.
 
+mod cell;
 mod file;
 mod near;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 use rayon::prelude::*;
 
 use super::ContactSurface;
 use crate::pgd::Vademecum;
+use cell::{Cell, normal_stretch};
 
 pub use file::FieldOrigin;
 pub use near::NearField;
@@ -78,8 +80,11 @@ pub struct DistanceField {
     origin_m: Vector3<f64>,
     dims: [usize; 3],
     modes: usize,
-    /// `HEAD + 3 modes` values per lattice node, x fastest.
-    values: Vec<f32>,
+    /// Per lattice node, x fastest: the rest distance and its unit gradient. Apart from the
+    /// modes, so that a cell's corners share cache lines.
+    rest: Vec<[f32; HEAD]>,
+    /// Per lattice node, `3 × modes` values: each mode's displacement there.
+    modal: Vec<f32>,
     /// Per mode, the largest `|U^k|` over the lattice: bounds how far the field can move.
     mode_bounds: Vec<f32>,
     /// Per lattice node, its closest rest point on the master's surface, where it reads the
@@ -179,27 +184,32 @@ impl DistanceField {
             origin_m,
             dims,
             modes,
-            values: Vec::new(),
+            rest: Vec::new(),
+            modal: Vec::new(),
             mode_bounds: vec![0.0; modes],
             closest: Vec::new(),
         };
-        let stride = field.stride();
+        let stride = HEAD + 3 * modes;
         let mut values = vec![0.0f32; field.node_count() * stride];
         let closest = values
             .par_chunks_mut(stride)
             .enumerate()
             .map(|(node, out)| field.fill_node(vademecum, surface, node, out))
             .collect();
-        for node in values.chunks_exact(stride) {
-            for (bound, u) in field
-                .mode_bounds
-                .iter_mut()
-                .zip(node[HEAD..].chunks_exact(3))
-            {
+        field.rest = values
+            .chunks_exact(stride)
+            .map(|node| [node[0], node[1], node[2], node[3]])
+            .collect();
+        field.modal = values
+            .chunks_exact(stride)
+            .flat_map(|node| &node[HEAD..])
+            .copied()
+            .collect();
+        for node in field.modal.chunks_exact(3 * modes.max(1)) {
+            for (bound, u) in field.mode_bounds.iter_mut().zip(node.chunks_exact(3)) {
                 *bound = bound.max(Vector3::from_column_slice(u).norm());
             }
         }
-        field.values = values;
         field.closest = closest;
         field
     }
@@ -274,10 +284,6 @@ impl DistanceField {
         (below + above).norm()
     }
 
-    fn stride(&self) -> usize {
-        HEAD + 3 * self.modes
-    }
-
     fn node_point(&self, node: usize) -> Vector3<f64> {
         let [nx, ny, _] = self.dims;
         let ijk = [node % nx, (node / nx) % ny, node / (nx * ny)];
@@ -305,29 +311,35 @@ impl DistanceField {
         shape: &MasterShape,
         cache: &mut LatticeCache,
     ) -> Option<f64> {
-        let spacing_m = self.settings.spacing_m;
-        let (mut base, mut cell) = self.cell(x)?;
-        let mut corners = self.corner_values(base, shape, cache);
+        let mut cell = self.cell(x)?;
+        let mut corners = self.corner_values(cell.base, shape, cache);
         for _ in 0..PULLBACK_STEPS {
-            let y = x - corners.displacement(&cell.weights);
-            let (next, next_cell) = self.cell(&y)?;
-            if next != base {
-                corners = self.corner_values(next, shape, cache);
-                base = next;
+            let u = cell.interpolate(&corners.displacement_m);
+            let y = x - Vector3::from(u.map(f64::from));
+            let next = self.cell(&y)?;
+            if next == cell {
+                // Where the point stays put, the fixed point is reached: the steps after
+                // would repeat this one (a master held still, or not moving there).
+                break;
             }
-            cell = next_cell;
+            if next.base != cell.base {
+                corners = self.corner_values(next.base, shape, cache);
+            }
+            cell = next;
         }
-        let stretch = corners.normal_stretch(&cell, spacing_m);
-        Some(corners.rest_distance_m(&cell.weights) / stretch)
+        let [rest_m, gradient @ ..] = cell.interpolate(&corners.rest);
+        let per_m = (1.0 / self.settings.spacing_m) as f32;
+        let slopes = cell
+            .slopes(&corners.displacement_m)
+            .map(|s| s.map(|s| s * per_m));
+        Some(f64::from(rest_m / normal_stretch(&slopes, gradient)))
     }
 
     /// The rest distance and this tick's displacement at the corners of the cell at `base`.
     fn corner_values(&self, base: usize, shape: &MasterShape, cache: &mut LatticeCache) -> Corners {
         let mut corners = Corners::default();
         for (k, node) in self.corners(base).enumerate() {
-            let head = &self.values[node * self.stride()..node * self.stride() + HEAD];
-            corners.rest_m[k] = head[0];
-            corners.gradient[k] = [head[1], head[2], head[3]];
+            corners.rest[k] = self.rest[node];
             corners.displacement_m[k] = self.node_displacement(node, shape, cache);
         }
         corners
@@ -337,17 +349,12 @@ impl DistanceField {
     /// interpolation of the lattice's values. The direction is the rest gradient, so that of
     /// a penalty varies smoothly from cell to cell.
     pub fn at_rest(&self, x: &Vector3<f64>) -> Option<DistanceSample> {
-        let (base, cell) = self.cell(x)?;
-        let mut distance_m = 0.0;
-        let mut gradient = Vector3::zeros();
-        for (node, w) in self.corners(base).zip(cell.weights) {
-            let head = &self.values[node * self.stride()..node * self.stride() + HEAD];
-            distance_m += w * head[0] as f64;
-            gradient += Vector3::new(head[1], head[2], head[3]).map(f64::from) * w;
-        }
+        let cell = self.cell(x)?;
+        let corners = std::array::from_fn(|k| self.rest[self.corner(cell.base, k)]);
+        let [distance_m, gradient @ ..] = cell.interpolate(&corners).map(f64::from);
         Some(DistanceSample {
             distance_m,
-            normal: gradient.try_normalize(1e-9)?,
+            normal: Vector3::from(gradient).try_normalize(1e-9)?,
         })
     }
 
@@ -363,7 +370,8 @@ impl DistanceField {
         if stamped.tick == cache.tick {
             return stamped.displacement;
         }
-        let modes = &self.values[node * self.stride() + HEAD..(node + 1) * self.stride()];
+        let stride = 3 * self.modes;
+        let modes = &self.modal[node * stride..(node + 1) * stride];
         let mut u = [0.0f32; 3];
         for (m, &a) in modes.chunks_exact(3).zip(shape.alpha) {
             for c in 0..3 {
@@ -387,7 +395,7 @@ impl DistanceField {
     }
 
     /// The lattice cell holding `x` (its lowest node) and where `x` lies in it.
-    fn cell(&self, x: &Vector3<f64>) -> Option<(usize, Trilinear)> {
+    fn cell(&self, x: &Vector3<f64>) -> Option<Cell> {
         let local = (x - self.origin_m) / self.settings.spacing_m;
         let mut base = [0usize; 3];
         let mut t = [0.0; 3];
@@ -399,17 +407,23 @@ impl DistanceField {
             // Non-negative here, so truncation is the floor (no call into libm).
             let i = (local[c] as usize).min(self.dims[c] - 2);
             base[c] = i;
-            t[c] = local[c] - i as f64;
+            t[c] = (local[c] - i as f64) as f32;
         }
         let [nx, ny, _] = self.dims;
-        Some((base[0] + nx * (base[1] + ny * base[2]), Trilinear::at(t)))
+        Some(Cell {
+            base: base[0] + nx * (base[1] + ny * base[2]),
+            t,
+        })
+    }
+
+    /// Corner `k` of the cell at `base` (in [`Cell`]'s order).
+    fn corner(&self, base: usize, k: usize) -> usize {
+        let [nx, ny, _] = self.dims;
+        base + (k & 1) + nx * ((k >> 1) & 1) + nx * ny * ((k >> 2) & 1)
     }
 
     fn corners(&self, base: usize) -> impl Iterator<Item = usize> {
-        let [nx, ny, _] = self.dims;
-        (0..8).map(move |corner| {
-            base + (corner & 1) + nx * ((corner >> 1) & 1) + nx * ny * ((corner >> 2) & 1)
-        })
+        (0..8).map(move |k| self.corner(base, k))
     }
 }
 
@@ -425,99 +439,13 @@ fn bounds(vademecum: &Vademecum) -> (Vector3<f64>, Vector3<f64>) {
     (min, max)
 }
 
-/// A point in a lattice cell: its coordinates there (0 to 1 per axis) and the trilinear
-/// weights of the cell's eight corners, in [`DistanceField::corners`] order (corner `k` lies
-/// at `t_c = 1` along axis `c` where bit `c` of `k` is set).
-#[derive(Clone, Copy, Debug)]
-struct Trilinear {
-    t: [f64; 3],
-    weights: [f64; 8],
-}
-
-impl Trilinear {
-    fn at(t: [f64; 3]) -> Self {
-        let weights = std::array::from_fn(|k| (0..3).map(|c| Self::factor(t, k, c)).product());
-        Self { t, weights }
-    }
-
-    /// Corner `k`'s weight factor along axis `c`.
-    fn factor(t: [f64; 3], k: usize, c: usize) -> f64 {
-        if k >> c & 1 == 1 { t[c] } else { 1.0 - t[c] }
-    }
-
-    /// The gradient of corner `k`'s weight (per metre, for cells `spacing_m` wide).
-    fn weight_gradient(&self, k: usize, spacing_m: f64) -> Vector3<f64> {
-        Vector3::from_fn(|c, _| {
-            let slope = if k >> c & 1 == 1 { 1.0 } else { -1.0 };
-            let others: f64 = (0..3)
-                .filter(|&o| o != c)
-                .map(|o| Self::factor(self.t, k, o))
-                .product();
-            slope * others / spacing_m
-        })
-    }
-}
-
-/// A cell's eight corners, as [`DistanceField::distance_m`] reads them: the rest distance, its
-/// direction and this tick's displacement of each, so that pull-back steps landing in the same
+/// A cell's eight corners, as [`DistanceField::distance_m`] reads them: the rest distance and
+/// its direction, and this tick's displacement, so that pull-back steps landing in the same
 /// cell read the lattice once.
 #[derive(Default)]
 struct Corners {
-    rest_m: [f32; 8],
-    gradient: [[f32; 3]; 8],
+    rest: [[f32; HEAD]; 8],
     displacement_m: [[f32; 3]; 8],
-}
-
-impl Corners {
-    /// How much the displacement stretches distances along the surface's normal at the rest
-    /// point `cell`: the pulled-back distance divided by this is the deformed one to first
-    /// order. The rest distance has unit gradient `g`; carried through the deformation
-    /// `F = I + ∇u` its gradient becomes `F⁻ᵀ g`, whose length is the stretch. Where the surface
-    /// turns under the tool, a point 3 mm off it is otherwise read 3 mm off along the rest
-    /// normal, which the deformation has tilted. 1 where `F` is singular or no direction is
-    /// known.
-    fn normal_stretch(&self, cell: &Trilinear, spacing_m: f64) -> f64 {
-        let gradient: Vector3<f64> = (0..8)
-            .map(|k| Vector3::from(self.gradient[k]).map(f64::from) * cell.weights[k])
-            .sum();
-        let stretch = self
-            .deformation(cell, spacing_m)
-            .try_inverse()
-            .zip(gradient.try_normalize(1e-9))
-            .map(|(inverse, g)| (inverse.transpose() * g).norm());
-        match stretch {
-            Some(s) if s.is_finite() && s > 1e-3 => s,
-            _ => 1.0,
-        }
-    }
-
-    /// The deformation gradient `F = I + ∇u` of the interpolated displacement at `cell`.
-    fn deformation(&self, cell: &Trilinear, spacing_m: f64) -> Matrix3<f64> {
-        let mut f = Matrix3::identity();
-        for k in 0..8 {
-            let u = Vector3::from(self.displacement_m[k]).map(f64::from);
-            f += u * cell.weight_gradient(k, spacing_m).transpose();
-        }
-        f
-    }
-
-    fn displacement(&self, weights: &[f64; 8]) -> Vector3<f64> {
-        let mut u = [0.0; 3];
-        for (corner, &w) in self.displacement_m.iter().zip(weights) {
-            for c in 0..3 {
-                u[c] += w * corner[c] as f64;
-            }
-        }
-        Vector3::from(u)
-    }
-
-    fn rest_distance_m(&self, weights: &[f64; 8]) -> f64 {
-        self.rest_m
-            .iter()
-            .zip(weights)
-            .map(|(&d, &w)| w * d as f64)
-            .sum()
-    }
 }
 
 #[cfg(test)]
@@ -533,7 +461,8 @@ mod tests {
             origin_m: Vector3::new(1e-3, -2e-3, 0.0),
             dims: [3, 4, 5],
             modes: 0,
-            values: Vec::new(),
+            rest: Vec::new(),
+            modal: Vec::new(),
             mode_bounds: Vec::new(),
             closest: Vec::new(),
         }
