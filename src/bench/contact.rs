@@ -7,7 +7,8 @@
 //! Pressed free, the master (the floppy gallbladder) swings out of the shell organ and few
 //! nodes push. The `held` case presses a rigid copy of the master (its modes zeroed: held
 //! still, as by an instrument), so that the shell organ alone gives way and as many nodes push
-//! as its pointshell allows.
+//! as its pointshell allows. Held still, a press settles and the forces stop changing; the
+//! `sliding` case then moves the held master sideways, so that every tick's contact changes.
 
 use std::fmt;
 use std::sync::Arc;
@@ -37,6 +38,11 @@ const SETTLE_TICKS: usize = 1000;
 /// Ticks in a row whose force solve took no product: the press has settled.
 const SETTLED_TICKS: usize = 20;
 
+/// How fast the `sliding` case moves the master sideways (m per tick: 10 mm/s at 1 kHz, a
+/// slow sweep of an instrument), and how far to either side of where it settled.
+const SLIDE_M_PER_TICK: f64 = 10e-6;
+const SLIDE_REACH_M: f64 = 2e-3;
+
 /// A scene's organ: its name and vademecum.
 type Organ = (String, Arc<Vademecum>);
 
@@ -45,6 +51,7 @@ pub struct StageFigures {
     pub case: &'static str,
     /// How far the master is carried into the shell organ (m).
     pub pressed_m: f64,
+    /// Nodes pushing, median per tick.
     pub nodes_in_contact: usize,
     pub nodes_evaluated: usize,
     /// Products with the normal compliance the force solve took, median per tick.
@@ -81,6 +88,19 @@ pub enum Case {
     Pressed,
     /// A rigid copy of the master carried in: the shell organ alone gives way.
     Held,
+    /// The held master, once settled, slid sideways back and forth at 10 mm/s.
+    Sliding,
+}
+
+impl Case {
+    fn name(self) -> &'static str {
+        match self {
+            Case::Apart => "apart",
+            Case::Pressed => "pressed",
+            Case::Held => "held",
+            Case::Sliding => "sliding",
+        }
+    }
 }
 
 /// Times the scene's master against its largest pointshell over `ticks` ticks per case in
@@ -102,36 +122,48 @@ pub fn run(
         .max_by_key(|p| p.pointshell().len())
         .ok_or("the scene's master meets no other organ")?;
     let cases = match cases {
-        [] => &[Case::Apart, Case::Pressed, Case::Held],
+        [] => &[Case::Apart, Case::Pressed, Case::Held, Case::Sliding],
         named => named,
     };
     let master = &scene.organs[pair.master];
     let shell = &scene.organs[pair.shell];
     let apart = cases
         .contains(&Case::Apart)
-        .then(|| time_case(pair, master, shell, 0.0, ticks));
+        .then(|| time_case(Case::Apart, pair, master, shell, 0.0, ticks));
     let pressed = cases
         .contains(&Case::Pressed)
         .then(|| press_depth(pair, master, shell))
         .flatten()
-        .map(|depth| time_case(pair, master, shell, depth, ticks));
-    let held = match cases.contains(&Case::Held) {
-        true => {
-            let (held_pair, held_master) = held(pair, master, shell, settings)?;
-            press_depth(&held_pair, &held_master, shell).map(|depth| StageFigures {
-                case: "held",
-                ..time_case(&held_pair, &held_master, shell, depth, ticks)
-            })
+        .map(|depth| time_case(Case::Pressed, pair, master, shell, depth, ticks));
+    let mut held_cases = vec![];
+    if cases
+        .iter()
+        .any(|c| matches!(c, Case::Held | Case::Sliding))
+    {
+        let (held_pair, held_master) = held(pair, master, shell, settings)?;
+        if let Some(depth) = press_depth(&held_pair, &held_master, shell) {
+            for &case in cases
+                .iter()
+                .filter(|c| matches!(c, Case::Held | Case::Sliding))
+            {
+                held_cases.push(time_case(
+                    case,
+                    &held_pair,
+                    &held_master,
+                    shell,
+                    depth,
+                    ticks,
+                ));
+            }
         }
-        false => None,
-    };
+    }
     Ok(ContactBenchReport {
         master: master.0.clone(),
         shell: shell.0.clone(),
         pointshell_nodes: pair.pointshell().len(),
         lattice_nodes: pair.field().node_count(),
         ticks,
-        cases: apart.into_iter().chain(pressed).chain(held).collect(),
+        cases: apart.into_iter().chain(pressed).chain(held_cases).collect(),
         cases_asked: cases.len(),
     })
 }
@@ -265,7 +297,10 @@ impl Run {
     }
 }
 
+/// Settles the master carried `depth_m` into the shell organ, then times `ticks` ticks of
+/// `case` (the master still, or sliding).
 fn time_case(
+    case: Case,
     pair: &ContactPair,
     master: &Organ,
     shell: &Organ,
@@ -274,25 +309,32 @@ fn time_case(
 ) -> StageFigures {
     let mut run = Run::new(pair, master, shell, carry_into(pair, depth_m));
     run.settle();
+    let (settled, sideways) = (run.carry.translation_m, sideways(&run.carry.translation_m));
     let mut products = Vec::with_capacity(ticks);
+    let mut in_contact = Vec::with_capacity(ticks);
     let mut times: Vec<Duration> = (0..ticks)
-        .map(|_| {
+        .map(|tick| {
+            if case == Case::Sliding {
+                run.carry.translation_m = settled + sideways * slide_m(tick);
+            }
             let start = Instant::now();
             run.tick();
             let elapsed = start.elapsed();
             products.push(run.pair.report().products);
+            in_contact.push(run.pair.report().nodes_in_contact);
             elapsed
         })
         .collect();
     times.sort();
     products.sort();
+    in_contact.sort();
     let brute = brute_force_us(pair, &master.1, &run.carry, ticks.min(200));
     let p50 = micros(times[times.len() / 2]);
     let report = run.pair.report();
     StageFigures {
-        case: if depth_m == 0.0 { "apart" } else { "pressed" },
+        case: case.name(),
         pressed_m: depth_m,
-        nodes_in_contact: report.nodes_in_contact,
+        nodes_in_contact: in_contact[in_contact.len() / 2],
         nodes_evaluated: report.nodes_evaluated,
         solve_products: products[products.len() / 2],
         stage_p50_us: p50,
@@ -300,6 +342,31 @@ fn time_case(
         brute_force_p50_us: brute,
         speedup: brute / p50,
     }
+}
+
+/// A unit direction square to `pressed`.
+fn sideways(pressed: &Vector3<f64>) -> Vector3<f64> {
+    let across = match pressed.x.abs() < 0.9 * pressed.norm() {
+        true => Vector3::x(),
+        false => Vector3::y(),
+    };
+    pressed
+        .cross(&across)
+        .try_normalize(1e-12)
+        .unwrap_or(across)
+}
+
+/// How far the sliding master is to one side at `tick` (m): out to [`SLIDE_REACH_M`], back
+/// through the start to the other side, and back, at [`SLIDE_M_PER_TICK`].
+fn slide_m(tick: usize) -> f64 {
+    let quarter = (SLIDE_REACH_M / SLIDE_M_PER_TICK).round() as usize;
+    let phase = tick % (4 * quarter);
+    let steps = match phase {
+        p if p < quarter => p as f64,
+        p if p < 3 * quarter => (2 * quarter) as f64 - p as f64,
+        p => p as f64 - (4 * quarter) as f64,
+    };
+    steps * SLIDE_M_PER_TICK
 }
 
 /// The median over `ticks` of the brute-force check (µs).

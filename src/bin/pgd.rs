@@ -270,7 +270,7 @@ enum BenchTarget {
         )]
         stiffness_ratio: f64,
         /// The cases to time (all by default): apart, pressed (the master free), held (a
-        /// rigid master).
+        /// rigid master, settled), sliding (the held master moved sideways at 10 mm/s).
         #[arg(long = "case", value_enum, value_name = "CASE")]
         cases: Vec<bench::contact::Case>,
         /// Print the report as JSON instead of a table.

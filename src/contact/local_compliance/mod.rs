@@ -75,8 +75,9 @@ pub struct LocalCompliance {
     ticks_changed: u32,
     /// The largest dimple of any node this tick (m).
     largest_gap_m: f64,
-    /// The nodes whose dimple changed this tick (some more than once).
-    dimpled: Vec<u32>,
+    /// How this tick changed each node's dimple (m); the nodes it holds are those whose dimple
+    /// changed, each once.
+    gap_changes_m: Scattered,
     block: SolveBlock,
 }
 
@@ -146,6 +147,7 @@ impl LocalCompliance {
             loads_n: Scattered::new(directions),
             moves_m: Scattered::new(directions),
             gaps_m: Scattered::new(count),
+            gap_changes_m: Scattered::new(count),
             changes_n: Scattered::new(count),
             spread_n: vec![0.0; count],
             block: SolveBlock {
@@ -170,7 +172,7 @@ impl LocalCompliance {
             .filter(|e| e.1 != 0.0)
             .collect();
         self.gaps_m.clear();
-        self.dimpled.clear();
+        self.gap_changes_m.clear();
         row.sort_by_key(|e| e.0);
         row
     }
@@ -200,7 +202,7 @@ impl LocalCompliance {
     /// pushing node's reach (on `--subdivide 4`, 317 points pushing at rest, 69 µs a tick).
     pub fn dimple(&mut self, pushing: &[u32], force_n: &[f64]) {
         self.ticks_changed += 1;
-        self.dimpled.clear();
+        self.gap_changes_m.clear();
         let forgot = self.ticks_changed >= TICKS_BETWEEN_WHOLE_SUMS;
         if forgot {
             self.forget_forces();
@@ -247,14 +249,16 @@ impl LocalCompliance {
         self.largest_gap_m
     }
 
-    /// The nodes whose dimple [`Self::dimple`] changed this tick, some more than once.
+    /// The nodes whose dimple [`Self::dimple`] changed this tick, each once.
     pub fn dimpled_nodes(&self) -> &[u32] {
-        &self.dimpled
+        self.gap_changes_m.touched()
     }
 
     /// Drops every force from the dimples, so that the next are summed whole.
     fn forget_forces(&mut self) {
-        self.dimpled.extend_from_slice(self.gaps_m.touched());
+        for &i in self.gaps_m.touched() {
+            self.gap_changes_m.add(i as usize, 0.0);
+        }
         self.gaps_m.clear();
         for &j in &self.spread_nodes {
             self.spread_n[j as usize] = 0.0;
@@ -284,9 +288,12 @@ impl LocalCompliance {
             let u = self.moves_m.get(e as usize);
             let (nodes, coefficients) = self.readers.row(e as usize);
             for (&i, &c) in nodes.iter().zip(coefficients) {
-                self.gaps_m.add(i as usize, c * u);
+                self.gap_changes_m.add(i as usize, c * u);
             }
-            self.dimpled.extend_from_slice(nodes);
+        }
+        for &i in self.gap_changes_m.touched() {
+            self.gaps_m
+                .add(i as usize, self.gap_changes_m.get(i as usize));
         }
         let moved = !self.moves_m.touched().is_empty();
         self.loads_n.clear();
@@ -557,7 +564,7 @@ mod tests {
         for (i, row) in a.iter().enumerate() {
             let expected: f64 = row.iter().zip(force).map(|(a, f)| a * f).sum();
             assert!(
-                (part.gap_m(i) - expected).abs() < 1e-12 * expected.abs(),
+                (part.gap_m(i) - expected).abs() <= 1e-12 * expected.abs(),
                 "tick {tick}, node {i}: {} against {expected}",
                 part.gap_m(i)
             );
@@ -589,16 +596,21 @@ mod tests {
 
     /// Ticks on, changed by how their forces change: nodes start and stop pushing, some keep
     /// their force, and past the ticks between whole sums the dimples are still the dense
-    /// product with the forces of the tick.
+    /// product with the forces of the tick. Every node whose dimple changed is reported so
+    /// (the clearance wakes it), each once, also where a whole sum drops every force.
     #[test]
     fn the_dimples_follow_the_forces_from_tick_to_tick() {
         let (parts, normals) = example();
         let a = dense(&parts, &normals);
         let mut part = LocalCompliance::assemble(&parts, &normals);
         let ticks = 2 * TICKS_BETWEEN_WHOLE_SUMS as usize + 3;
+        let mut last_gaps = [0.0; 4];
         for tick in 0..ticks {
+            // On the ticks that sum whole, nothing pushes: every dimple falls to zero.
+            let whole = (tick + 1) % TICKS_BETWEEN_WHOLE_SUMS as usize == 0;
             let force: Vec<f64> = (0..4)
                 .map(|j| match (tick + j) % 5 {
+                    _ if whole => 0.0,
                     0 => 0.0,
                     1 => 1.5,
                     _ => ((tick * 7 + j * 3) % 11) as f64 * 0.25,
@@ -607,6 +619,18 @@ mod tests {
             let pushing: Vec<u32> = (0..4).filter(|&j| force[j as usize] > 0.0).collect();
             part.dimple(&pushing, &force);
             assert_dimples(&part, &a, &force, tick);
+            let mut dimpled = part.dimpled_nodes().to_vec();
+            dimpled.sort();
+            dimpled.dedup();
+            assert_eq!(dimpled.len(), part.dimpled_nodes().len(), "tick {tick}");
+            for i in 0..4 {
+                let changed = part.gap_m(i) != last_gaps[i];
+                assert!(
+                    !changed || dimpled.contains(&(i as u32)),
+                    "tick {tick}, node {i}"
+                );
+                last_gaps[i] = part.gap_m(i);
+            }
         }
     }
 }
