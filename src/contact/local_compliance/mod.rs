@@ -623,13 +623,13 @@ mod tests {
             dimpled.sort();
             dimpled.dedup();
             assert_eq!(dimpled.len(), part.dimpled_nodes().len(), "tick {tick}");
-            for i in 0..4 {
-                let changed = part.gap_m(i) != last_gaps[i];
+            for (i, last) in last_gaps.iter_mut().enumerate() {
+                let changed = part.gap_m(i) != *last;
                 assert!(
                     !changed || dimpled.contains(&(i as u32)),
                     "tick {tick}, node {i}"
                 );
-                last_gaps[i] = part.gap_m(i);
+                *last = part.gap_m(i);
             }
         }
     }
