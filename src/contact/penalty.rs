@@ -246,7 +246,8 @@ impl ContactPair {
     ///   moves by at most the field's bound (the master's modes), the shell's bound, both
     ///   carries and, where it reaches, the near field's ([`Self::near_moves_m`]), across an
     ///   interpolated distance whose slope is at most `√3` (trilinear, per axis at most 1);
-    /// - nodes measured clear not long ago, where little has moved since ([`Clearance`]).
+    /// - nodes measured clear not long ago, where little has moved since ([`Clearance`]), a
+    ///   block of them at a time where all are surely clear.
     ///
     /// The forces already pushing dimple both organs (the near-field part of `A`), which moves
     /// each node's read point along its normal by its dimple: known before the node is read.
