@@ -172,8 +172,8 @@ impl OrganRows {
 
 impl NormalCompliance {
     pub fn new(nodes: &Pointshell, master: &Vademecum, shell: &Vademecum) -> Self {
-        let master_points = (0..nodes.len()).map(|i| nodes.master_blend(i));
-        let master_rows = ModalRows::displacements(master, master_points);
+        let master_points = || (0..nodes.len()).map(|i| nodes.master_blend(i));
+        let master_rows = ModalRows::displacements(master, master_points());
         let project = |rows: &ModalRows| -> Vec<f32> {
             (0..nodes.len())
                 .flat_map(|i| rows.along(i, nodes.rest_normal[i].map(|c| c as f32)))
@@ -185,12 +185,12 @@ impl NormalCompliance {
             shell: OrganRows::new(
                 shell.total_modes(),
                 project(&nodes.displacement),
-                project(&nodes.load),
+                project(&ModalRows::loads(shell, nodes.blends.iter())),
             ),
             master: OrganRows::new(
                 master.total_modes(),
                 negate(project(&master_rows)),
-                negate(project(&nodes.master_load)),
+                negate(project(&ModalRows::loads(master, master_points()))),
             ),
             local: LocalCompliance::new(nodes, master, shell),
         }

@@ -29,13 +29,11 @@ pub struct Pointshell {
     /// Lumped surface area of each node (m²): what it covers of the surface, summed into the
     /// area in contact.
     pub area_m2: Vec<f32>,
-    /// The shell organ's displacement and load modes at each node.
+    /// The shell organ's displacement modes at each node (its load modes, needed only along
+    /// the node's normal, are kept by the pair's compliance).
     pub displacement: ModalRows,
-    pub load: ModalRows,
     /// The master position nearest each node at rest: where the reaction goes.
     pub master_positions: Vec<u32>,
-    /// The master's load modes there.
-    pub master_load: ModalRows,
     /// Per shell mode, the largest displacement of any node.
     pub mode_bounds: Vec<f32>,
 }
@@ -110,11 +108,6 @@ impl Pointshell {
             rest_distance_m: inside.iter().map(|n| n.1 as f32).collect(),
             rest_normal: inside.iter().map(|n| n.2).collect(),
             area_m2: inside.iter().map(|n| n.0.area_m2 as f32).collect(),
-            load: ModalRows::loads(shell, inside.iter().map(|n| &n.0.blend)),
-            master_load: ModalRows::loads(
-                master,
-                master_positions.iter().map(|&m| master_blend(m)),
-            ),
             mode_bounds: displacement.bounds(),
             displacement,
             rest_m,
