@@ -17,37 +17,33 @@
 //! into forces at the positions, along a few directions each (`G` is sparse, a node's row its
 //! blend), and `S` holds the corrections between positions. A pointshell finer than the mesh
 //! (`Subdivided(n)`, `n²` points a triangle) then costs what the mesh costs: kept per node,
-//! its rows grew with `n²` and the solve's dense block with the square of the nodes pushing,
-//! half of a 400-point press's tick (session 17). A position loaded by nodes of one normal
-//! (a boundary node alone at its position) keeps one direction, so the block of a pointshell
-//! of nodes stays its size.
+//! its rows grew with `n²` (some 4,000 entries a node on `--subdivide 5`), and the solve's
+//! dense block with the square of the nodes pushing. A position loaded by nodes of one normal
+//! (a boundary node alone at its position) keeps one direction.
 //!
 //! The linear load step's corrections are used (contact forces are spread over many nodes,
 //! each well inside the first step), and each pair's own forces only: a reaction another pair
 //! puts on the master dimples it for that pair alone.
 
 mod organ_part;
+mod solve_block;
 mod sparse;
 
 use nalgebra::Vector3;
 
 use self::organ_part::OrganPart;
+use self::solve_block::SolveBlock;
 use self::sparse::{Scattered, SparseRows};
 use super::pointshell::Pointshell;
-use crate::kernels::dot;
 use crate::pgd::Vademecum;
 
-/// The near-field compliance as `G S Gᵀ`, and the same between the nodes, with what each
-/// tick derives from them. The two organs' directions are numbered one after the other, the
-/// shell organ's first.
+/// The near-field compliance as `G S Gᵀ`, with what each tick derives from it. The two
+/// organs' directions are numbered one after the other, the shell organ's first.
 ///
-/// Each form serves where it is smaller. The dimples spread each pushing node's force to
-/// every node within reach: through the directions, a few rows per position reached, rather
-/// than a row per node reached (hundreds of entries long on a subdivided pointshell). The
-/// force solve works on the pushing nodes alone: their block between the nodes is smaller
-/// than between their directions, since on the master each position takes reactions along
-/// several normals and so keeps three directions (measured on `--subdivide 3`: 312 nodes
-/// pushing reach 525 directions, 390 of them the master's).
+/// The dimples spread each pushing node's force to every node within reach: through the
+/// directions, a few rows per position reached, rather than a row per node reached. The force
+/// solve works on the pushing nodes alone, through `G` and `S` restricted to them
+/// ([`SolveBlock`]).
 #[derive(Clone, Debug, Default)]
 pub struct LocalCompliance {
     /// `G`: per node, the directions its normal force loads and its distance reads, with
@@ -57,8 +53,6 @@ pub struct LocalCompliance {
     readers: SparseRows,
     /// `S` between directions (m/N), both organs, symmetric, no entry across organs.
     compliance: SparseRows,
-    /// `a = G S Gᵀ` between nodes (m/N), symmetric.
-    between_nodes: SparseRows,
     /// Per node, each organ's own `a_ii`: `[shell, master]` (m/N).
     own_m_per_n: Vec<[f64; 2]>,
     /// The dimples: each node's `Σ_j a_ij f_j` (m) for the forces of [`Self::spread_n`],
@@ -85,24 +79,6 @@ pub struct LocalCompliance {
 /// again: each change leaves rounding behind (1e-16 of the dimple), which a second's worth
 /// cannot make felt, and the whole sum costs no more than a tick where every force changed.
 const TICKS_BETWEEN_WHOLE_SUMS: u32 = 1000;
-
-/// The block of `a` between the nodes of this tick's force solve, dense.
-#[derive(Clone, Debug, Default)]
-struct SolveBlock {
-    /// The nodes it was built for: a tick whose set is the same keeps it (a press at rest).
-    set: Vec<u32>,
-    /// Row-major, in the order of the set.
-    values_m_per_n: Vec<f64>,
-    /// Each node's place in the set, and per node of a new set its place in the last one.
-    slot: Vec<u32>,
-    kept: Vec<u32>,
-    /// Scratch: the next block, while the last one is copied from.
-    next: Vec<f64>,
-    /// Scratch: the vector being multiplied, gathered in the set's order.
-    gathered: Vec<f64>,
-}
-
-const NO_SLOT: u32 = u32::MAX;
 
 impl LocalCompliance {
     /// Both organs' corrections between the positions `nodes` loads, once per pair at setup.
@@ -150,31 +126,11 @@ impl LocalCompliance {
             gap_changes_m: Scattered::new(count),
             changes_n: Scattered::new(count),
             spread_n: vec![0.0; count],
-            block: SolveBlock {
-                slot: vec![NO_SLOT; count],
-                ..SolveBlock::default()
-            },
+            block: SolveBlock::new(directions),
             ..Self::default()
         };
-        part.between_nodes = SparseRows::from_rows((0..count).map(|i| part.row_between_nodes(i)));
         part.own_m_per_n = (0..count).map(|i| part.own(i, shell_directions)).collect();
         part
-    }
-
-    /// Row `i` of `a = G S Gᵀ`, columns ascending, leaving no dimple behind.
-    fn row_between_nodes(&mut self, i: usize) -> Vec<(u32, f64)> {
-        self.spread(std::iter::once((i as u32, 1.0)));
-        let mut row: Vec<(u32, f64)> = self
-            .gaps_m
-            .touched()
-            .iter()
-            .map(|&j| (j, self.gaps_m.get(j as usize)))
-            .filter(|e| e.1 != 0.0)
-            .collect();
-        self.gaps_m.clear();
-        self.gap_changes_m.clear();
-        row.sort_by_key(|e| e.0);
-        row
     }
 
     /// Node `i`'s `a_ii` in each organ: `Σ_de G_id S_de G_ie` over the organ's directions
@@ -308,74 +264,15 @@ impl LocalCompliance {
     }
 
     /// Sets up the block of the tick's force solve over the nodes of `set`, so that each
-    /// product costs `set²` rather than their rows' length. Entries between nodes the last
-    /// tick's block held are copied from it; only the nodes new to the set have their rows
-    /// read (on a subdivided pointshell those rows are some 1,500 entries long, and the set
-    /// changes by a few nodes from tick to tick).
+    /// product costs the entries of `G` and `S` between them ([`SolveBlock`]).
     pub fn prepare(&mut self, set: &[u32]) {
-        let block = &mut self.block;
-        if block.set == set {
-            return;
-        }
-        for (k, &i) in block.set.iter().enumerate() {
-            block.slot[i as usize] = k as u32;
-        }
-        block.kept.clear();
-        block
-            .kept
-            .extend(set.iter().map(|&i| block.slot[i as usize]));
-        for &i in &block.set {
-            block.slot[i as usize] = NO_SLOT;
-        }
-        for (k, &i) in set.iter().enumerate() {
-            block.slot[i as usize] = k as u32;
-        }
-        let (n, last) = (set.len(), block.set.len());
-        block.next.clear();
-        block.next.resize(n * n, 0.0);
-        for (r, &p) in block.kept.iter().enumerate().filter(|e| *e.1 != NO_SLOT) {
-            let old_row = &block.values_m_per_n[p as usize * last..][..last];
-            for (c, &q) in block.kept.iter().enumerate().filter(|e| *e.1 != NO_SLOT) {
-                block.next[r * n + c] = old_row[q as usize];
-            }
-        }
-        for (r, &i) in set.iter().enumerate() {
-            if block.kept[r] != NO_SLOT {
-                continue;
-            }
-            let (columns, values) = self.between_nodes.row(i as usize);
-            for (&j, &a) in columns.iter().zip(values) {
-                let c = block.slot[j as usize] as usize;
-                if c != NO_SLOT as usize {
-                    block.next[r * n + c] = a;
-                    block.next[c * n + r] = a;
-                }
-            }
-        }
-        for &i in set {
-            block.slot[i as usize] = NO_SLOT;
-        }
-        std::mem::swap(&mut block.values_m_per_n, &mut block.next);
-        block.set.clear();
-        block.set.extend_from_slice(set);
+        self.block.prepare(set, &self.reads, &self.compliance);
     }
 
     /// Adds `Σ_j a_ij v_j` over `j` in `set` to `out[i]` for every `i` in `set`, the set
     /// [`Self::prepare`] took.
     pub fn add_product(&mut self, set: &[u32], v: &[f64], out: &mut [f64]) {
-        let block = &mut self.block;
-        let n = set.len();
-        debug_assert_eq!(
-            block.values_m_per_n.len(),
-            n * n,
-            "prepared for another set"
-        );
-        block.gathered.clear();
-        block.gathered.extend(set.iter().map(|&j| v[j as usize]));
-        // An empty set has an empty block: no rows, and no chunk of size zero.
-        for (&i, row) in set.iter().zip(block.values_m_per_n.chunks_exact(n.max(1))) {
-            out[i as usize] += dot(row, &block.gathered);
-        }
+        self.block.add_product(set, v, out);
     }
 }
 
@@ -535,29 +432,39 @@ mod tests {
         assert_eq!(counts, [3, 1, 3]);
     }
 
-    /// The product over a set of nodes, through the block `prepare` builds from the last
-    /// set's, is the dense product restricted to the set, whatever `v` holds outside it.
+    /// The product over a set of nodes is the dense product restricted to the set, whatever
+    /// `v` holds outside it, set after set: the directions read change, stay the same while
+    /// the set's order changes, change for as many others (nodes 1 and 3 read 7 directions,
+    /// nodes 0 and 3 another 7), then shrink.
     #[test]
     fn the_product_over_a_set_is_the_dense_one_restricted_to_it() {
         let (parts, normals) = example();
         let a = dense(&parts, &normals);
         let mut part = LocalCompliance::assemble(&parts, &normals);
-        let set = [3u32, 0, 2];
         let v = [1.0, 100.0, -2.0, 0.5];
-        part.prepare(&[0, 1, 3]);
-        part.prepare(&set);
-        let mut out = [0.0; 4];
-        part.add_product(&set, &v, &mut out);
-        for &i in &set {
-            let i = i as usize;
-            let expected: f64 = set.iter().map(|&j| a[i][j as usize] * v[j as usize]).sum();
-            assert!(
-                (out[i] - expected).abs() < 1e-12 * expected.abs(),
-                "node {i}: {} against {expected}",
-                out[i]
-            );
+        for set in [
+            &[0u32, 1, 3][..],
+            &[3, 0, 2],
+            &[2, 3, 0],
+            &[1, 3],
+            &[0, 3],
+            &[1],
+        ] {
+            part.prepare(set);
+            let mut out = [0.0; 4];
+            part.add_product(set, &v, &mut out);
+            for i in 0..4 {
+                let expected: f64 = match set.contains(&(i as u32)) {
+                    true => set.iter().map(|&j| a[i][j as usize] * v[j as usize]).sum(),
+                    false => 0.0,
+                };
+                assert!(
+                    (out[i] - expected).abs() <= 1e-12 * expected.abs(),
+                    "set {set:?}, node {i}: {} against {expected}",
+                    out[i]
+                );
+            }
         }
-        assert_eq!(out[1], 0.0, "nodes outside the set are left alone");
     }
 
     fn assert_dimples(part: &LocalCompliance, a: &[Vec<f64>], force: &[f64], tick: usize) {

@@ -12,17 +12,34 @@ pub(super) struct SparseRows {
 impl SparseRows {
     /// From each row's entries, columns ascending within each.
     pub(super) fn from_rows(rows: impl IntoIterator<Item = Vec<(u32, f64)>>) -> Self {
-        let mut sparse = Self {
-            offsets: vec![0],
-            ..Self::default()
-        };
+        let mut sparse = Self::default();
+        sparse.clear();
         for row in rows {
-            debug_assert!(row.windows(2).all(|w| w[0].0 < w[1].0), "unsorted row");
-            sparse.columns.extend(row.iter().map(|e| e.0));
-            sparse.values.extend(row.iter().map(|e| e.1));
-            sparse.offsets.push(sparse.columns.len() as u32);
+            sparse.push_row(row);
         }
         sparse
+    }
+
+    /// Drops every row, keeping the storage.
+    pub(super) fn clear(&mut self) {
+        self.offsets.clear();
+        self.offsets.push(0);
+        self.columns.clear();
+        self.values.clear();
+    }
+
+    /// Appends a row, its entries' columns ascending.
+    pub(super) fn push_row(&mut self, entries: impl IntoIterator<Item = (u32, f64)>) {
+        let start = self.columns.len();
+        for (column, value) in entries {
+            self.columns.push(column);
+            self.values.push(value);
+        }
+        debug_assert!(
+            self.columns[start..].windows(2).all(|w| w[0] < w[1]),
+            "unsorted row"
+        );
+        self.offsets.push(self.columns.len() as u32);
     }
 
     pub(super) fn rows(&self) -> usize {
