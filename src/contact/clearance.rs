@@ -12,9 +12,13 @@
 //!
 //! The nodes are not tested one by one each tick: under a press every node lies within the
 //! bound from rest (on `--subdivide 5`, all 8,745 points, a third of the stage's tick with 400
-//! pushing), and most are known clear for hundreds of ticks. Each node keeps the drift up to
-//! which it is surely clear (its *wake*), and blocks of nodes their earliest wake, so that
-//! [`Clearance::candidates`] passes over a block with one comparison.
+//! pushing), and most are known clear for hundreds of ticks. Each block of nodes keeps a drift
+//! up to which all its nodes are surely clear (its *wake*), so that
+//! [`Clearance::candidates`] passes over a block with one comparison. The contact forces'
+//! dimples shift the nodes' read points too; a block's wake is lowered each tick by a bound
+//! of how far they shifted any of its nodes ([`super::LocalCompliance::block_shift_m`]),
+//! without visiting the nodes (a sliding press changes the dimples of some 8,000 nodes a
+//! tick, of which about 1,200 are read).
 
 use super::DistanceField;
 use super::penalty::OrganPose;
@@ -31,25 +35,31 @@ const SAFETY: f64 = 6.0;
 
 /// Nodes per block of wakes: small enough that a block holding a node to measure costs little
 /// to scan, large enough that the blocks are few.
-const BLOCK: usize = 64;
+pub(super) const BLOCK: usize = 64;
 
 #[derive(Clone, Debug, Default)]
 pub struct Clearance {
     /// The motion bound summed over every tick so far (m).
     drift_m: f64,
-    /// Per node, the summed drift up to which it is clear (m).
+    /// Per node, the summed drift up to which it is clear (m) while its read point's shift
+    /// stays where it was measured; −∞ for a node measured every tick (it pushes or is pushed
+    /// into).
     clear_until_m: Vec<f64>,
     /// Per node, how far its read point was shifted along its normal when it was measured
     /// (m): the contact forces' dimple, known exactly every tick, so that only its net
     /// change since counts.
     shift_at_m: Vec<f64>,
-    /// Per node, a drift up to which it is surely clear: `clear_until_m` less how far its
-    /// shift has changed since it was measured, lowered as its dimple changes; −∞ for a node
-    /// measured every tick (it pushes or is pushed into).
+    /// Per node, a drift up to which it is surely clear, less the shift of its block since
+    /// the block was last scanned (its *wake*): exact when it is measured or its shift read,
+    /// lowered by its block's shift when its block is scanned without reading it.
     wake_m: Vec<f64>,
-    /// Per block of [`BLOCK`] nodes, at most its earliest wake: lowered with a node's,
-    /// raised to the true least when the block is scanned.
+    /// Per block of [`BLOCK`] nodes, a drift up to which all its nodes are surely clear:
+    /// lowered as a node is measured closer or its dimple may have shifted, raised to the
+    /// true least when the block is scanned.
     block_wake_m: Vec<f64>,
+    /// Per block, how far the dimples may have shifted any of its nodes since it was last
+    /// scanned (m).
+    block_shift_m: Vec<f64>,
     /// The last tick's poses, to bound what moved since; none before the first tick.
     last: Option<LastPoses>,
 }
@@ -76,6 +86,7 @@ impl Clearance {
             shift_at_m: vec![0.0; count],
             wake_m: vec![f64::NEG_INFINITY; count],
             block_wake_m: vec![f64::NEG_INFINITY; count.div_ceil(BLOCK)],
+            block_shift_m: vec![0.0; count.div_ceil(BLOCK)],
             last: None,
         }
     }
@@ -120,10 +131,11 @@ impl Clearance {
         last.shell_carry = *shell.pose.carry;
     }
 
-    /// Whether node `i`, its read point now shifted by `shift_m` along its normal, is still
-    /// clear of the master.
-    pub fn is_clear(&self, i: usize, shift_m: f64) -> bool {
-        self.clear_until_m[i] - (shift_m - self.shift_at_m[i]).abs() > self.drift_m
+    /// The drift up to which node `i`, its read point now shifted by `shift_m` along its
+    /// normal, is surely clear of the master (m): its budget, less how far the shift moved
+    /// since it was measured.
+    fn exact_wake_m(&self, i: usize, shift_m: f64) -> f64 {
+        self.clear_until_m[i] - (shift_m - self.shift_at_m[i]).abs()
     }
 
     /// Node `i` was measured `distance_m` from the master this tick (negative inside), its
@@ -152,47 +164,56 @@ impl Clearance {
 
     /// Node `i` pushes or is pushed into: it is measured every tick, whatever its clearance.
     pub fn keep_measuring(&mut self, i: usize) {
+        self.clear_until_m[i] = f64::NEG_INFINITY;
         self.wake_m[i] = f64::NEG_INFINITY;
         self.lower_block(i);
     }
 
-    /// Node `i`'s read point is now shifted by `shift_m` along its normal (its dimple
-    /// changed this tick): it wakes as much earlier as the shift moved from where it was
-    /// measured.
-    pub fn dimpled(&mut self, i: usize, shift_m: f64) {
-        let wake = self.clear_until_m[i] - (shift_m - self.shift_at_m[i]).abs();
-        if wake < self.wake_m[i] {
-            self.wake_m[i] = wake;
-            self.lower_block(i);
-        }
+    /// The dimples may have shifted the read point of any node in block `b` by up to
+    /// `shift_m` this tick: the block wakes as much earlier.
+    pub fn shifted(&mut self, b: usize, shift_m: f64) {
+        self.block_wake_m[b] -= shift_m;
+        self.block_shift_m[b] += shift_m;
     }
 
+    /// Node `i`'s wake was just set exactly: the block's wake is lowered to it. The block's
+    /// shift so far does not apply to the node, but is taken off every node of the block at
+    /// its next scan, so the node's wake is raised by as much.
     fn lower_block(&mut self, i: usize) {
-        let block = &mut self.block_wake_m[i / BLOCK];
-        *block = block.min(self.wake_m[i]);
+        let b = i / BLOCK;
+        self.block_wake_m[b] = self.block_wake_m[b].min(self.wake_m[i]);
+        self.wake_m[i] += self.block_shift_m[b];
     }
 
-    /// Adds to `out` the nodes below `count` that may not be clear: every node not surely
-    /// clear is there ([`Self::is_clear`] then decides), and a block of nodes all surely clear
-    /// costs one comparison.
-    pub fn candidates(&mut self, count: usize, out: &mut Vec<u32>) {
+    /// Adds to `out` the nodes below `count` not surely clear, their read points now shifted
+    /// by `shift_m(i)` along their normals, and raises the wake of each block it scans to its
+    /// least; a block of nodes all surely clear costs one comparison. Within a scanned block,
+    /// a node's shift is read only where its wake, less the block's shift, no longer clears
+    /// it.
+    pub fn candidates(&mut self, count: usize, shift_m: impl Fn(usize) -> f64, out: &mut Vec<u32>) {
         let drift_m = self.drift_m;
-        for (block, least) in self.block_wake_m.iter_mut().enumerate() {
+        for block in 0..self.block_wake_m.len() {
             let start = block * BLOCK;
             if start >= count {
                 break;
             }
-            if *least > drift_m {
+            if self.block_wake_m[block] > drift_m {
                 continue;
             }
-            let wakes = &self.wake_m[start..self.wake_m.len().min(start + BLOCK)];
-            *least = wakes.iter().copied().fold(f64::INFINITY, f64::min);
-            let within = wakes.len().min(count - start);
-            out.extend(
-                (start..start + within)
-                    .filter(|&i| self.wake_m[i] <= drift_m)
-                    .map(|i| i as u32),
-            );
+            let shifted_m = std::mem::take(&mut self.block_shift_m[block]);
+            let mut least = f64::INFINITY;
+            for i in start..self.clear_until_m.len().min(start + BLOCK) {
+                let mut wake = self.wake_m[i] - shifted_m;
+                if wake <= drift_m && wake != f64::NEG_INFINITY {
+                    wake = self.exact_wake_m(i, shift_m(i));
+                }
+                self.wake_m[i] = wake;
+                least = least.min(wake);
+                if wake <= drift_m && i < count {
+                    out.push(i as u32);
+                }
+            }
+            self.block_wake_m[block] = least;
         }
     }
 }
@@ -274,6 +295,19 @@ mod tests {
         );
     }
 
+    /// The nodes `candidates` lists below `count`, node `i`'s read point shifted by
+    /// `shifts_m[i]`.
+    fn listed(clearance: &mut Clearance, count: usize, shifts_m: &[f64]) -> Vec<u32> {
+        let mut out = Vec::new();
+        clearance.candidates(count, |i| shifts_m[i], &mut out);
+        out
+    }
+
+    /// Whether a one-node clearance leaves its node unlisted, shifted by `shift_m`.
+    fn is_clear(clearance: &mut Clearance, shift_m: f64) -> bool {
+        listed(clearance, 1, &[shift_m]).is_empty()
+    }
+
     /// A node measured clear stays clear while its read point's shift changes less than its
     /// budget, whichever way, and a shift that comes back costs nothing.
     #[test]
@@ -281,64 +315,119 @@ mod tests {
         let mut clearance = Clearance::new(1);
         clearance.measured(0, 6e-3, 2e-3);
         // Budget: 6 mm / SAFETY = 1 mm.
-        assert!(clearance.is_clear(0, 2e-3));
-        assert!(clearance.is_clear(0, 2.9e-3));
-        assert!(clearance.is_clear(0, 1.1e-3));
-        assert!(!clearance.is_clear(0, 3.1e-3));
-        assert!(!clearance.is_clear(0, 0.9e-3));
+        for (shift_m, clear) in [
+            (2e-3, true),
+            (2.9e-3, true),
+            (1.1e-3, true),
+            (3.1e-3, false),
+            (0.9e-3, false),
+        ] {
+            // Told of each shift, as the dimples tell it, so that the block is scanned.
+            clearance.shifted(0, 2e-3);
+            assert_eq!(is_clear(&mut clearance, shift_m), clear, "{shift_m} m");
+        }
         clearance.measured(0, -1e-3, 0.0);
-        assert!(!clearance.is_clear(0, 0.0), "a node inside is never clear");
-    }
-
-    /// The nodes `candidates` lists below `count`.
-    fn listed(clearance: &mut Clearance, count: usize) -> Vec<u32> {
-        let mut out = Vec::new();
-        clearance.candidates(count, &mut out);
-        out
+        assert!(
+            !is_clear(&mut clearance, 0.0),
+            "a node inside is never clear"
+        );
     }
 
     /// Every node not surely clear is listed, across blocks, and only below `count`; one
-    /// measured clear is not, until its dimple moves its read point past its budget, or it
-    /// pushes.
+    /// measured clear is not, until its dimple moves its read point past its budget and its
+    /// block is told so, or it pushes.
     #[test]
     fn the_candidates_are_the_nodes_not_known_clear() {
         let count = 3 * BLOCK + 5;
         let mut clearance = Clearance::new(count);
+        let mut shifts_m = vec![0.0; count];
         let all: Vec<u32> = (0..count as u32).collect();
-        assert_eq!(listed(&mut clearance, count), all, "none measured yet");
+        assert_eq!(
+            listed(&mut clearance, count, &shifts_m),
+            all,
+            "none measured yet"
+        );
         for i in 0..count {
             clearance.measured(i, 6e-3, 0.0);
         }
         // Inside, and clear by a budget already spent: measured every tick.
         clearance.measured(1, -1e-3, 0.0);
         clearance.measured(BLOCK + 7, 0.0, 0.0);
-        assert_eq!(listed(&mut clearance, count), [1, BLOCK as u32 + 7]);
-        assert_eq!(listed(&mut clearance, BLOCK), [1], "beyond the count");
-        // Budget 1 mm: a dimple of 0.9 mm keeps the node clear, 1.1 mm does not, however it
-        // got there.
-        let (a, b) = (2 * BLOCK + 3, 3 * BLOCK + 4);
-        clearance.dimpled(a, 0.9e-3);
-        clearance.dimpled(b, 0.5e-3);
-        assert_eq!(listed(&mut clearance, count), [1, BLOCK as u32 + 7]);
-        clearance.dimpled(b, -1.1e-3);
+        let always = [1, BLOCK as u32 + 7];
+        assert_eq!(listed(&mut clearance, count, &shifts_m), always);
         assert_eq!(
-            listed(&mut clearance, count),
+            listed(&mut clearance, BLOCK, &shifts_m),
+            [1],
+            "beyond the count"
+        );
+        // Budget 1 mm: a dimple of 0.9 mm keeps the node clear, 1.1 mm does not, however it
+        // got there; a block is scanned only once told of a shift.
+        let (a, b) = (2 * BLOCK + 3, 3 * BLOCK + 4);
+        shifts_m[a] = 0.9e-3;
+        clearance.shifted(a / BLOCK, 0.9e-3);
+        shifts_m[b] = 0.5e-3;
+        clearance.shifted(b / BLOCK, 0.5e-3);
+        assert_eq!(listed(&mut clearance, count, &shifts_m), always);
+        shifts_m[b] = -1.1e-3;
+        assert_eq!(
+            listed(&mut clearance, count, &shifts_m),
+            always,
+            "the block not told: not scanned"
+        );
+        clearance.shifted(b / BLOCK, 1.6e-3);
+        assert_eq!(
+            listed(&mut clearance, count, &shifts_m),
             [1, BLOCK as u32 + 7, b as u32]
         );
         // A node that pushes is listed though measured clear; measured again, it is not.
         clearance.keep_measuring(a);
-        let listed_now = listed(&mut clearance, count);
-        assert_eq!(listed_now, [1, BLOCK as u32 + 7, a as u32, b as u32]);
-        clearance.measured(a, 6e-3, 0.0);
-        clearance.measured(b, 6e-3, -1.1e-3);
-        assert_eq!(listed(&mut clearance, count), [1, BLOCK as u32 + 7]);
-        for &i in &listed_now {
-            assert_eq!(
-                clearance.is_clear(i as usize, 0.0),
-                i as usize == a,
-                "node {i}: listed or not, `is_clear` decides"
-            );
+        assert_eq!(
+            listed(&mut clearance, count, &shifts_m),
+            [1, BLOCK as u32 + 7, a as u32, b as u32]
+        );
+        clearance.measured(a, 6e-3, shifts_m[a]);
+        clearance.measured(b, 6e-3, shifts_m[b]);
+        assert_eq!(listed(&mut clearance, count, &shifts_m), always);
+    }
+
+    /// A scanned block reads the shift of only those nodes its shift may have woken, and a
+    /// node measured closer after its block shifted is listed though its wake carries the
+    /// block's shift.
+    #[test]
+    fn a_scanned_block_reads_only_the_shifts_that_may_wake_a_node() {
+        let mut clearance = Clearance::new(BLOCK);
+        for i in 0..BLOCK {
+            // Budgets: 1 mm for the even nodes, 10 mm for the odd ones.
+            let distance_m = if i % 2 == 0 { 6e-3 } else { 60e-3 };
+            clearance.measured(i, distance_m, 0.0);
         }
+        let read = std::cell::RefCell::new(Vec::new());
+        let listed = |clearance: &mut Clearance, shift_m: f64| {
+            read.borrow_mut().clear();
+            let mut out = Vec::new();
+            clearance.candidates(
+                BLOCK,
+                |i| {
+                    read.borrow_mut().push(i as u32);
+                    shift_m
+                },
+                &mut out,
+            );
+            out
+        };
+        assert!(listed(&mut clearance, 0.0).is_empty());
+        clearance.shifted(0, 2e-3);
+        assert!(listed(&mut clearance, 0.5e-3).is_empty());
+        let even: Vec<u32> = (0..BLOCK as u32).step_by(2).collect();
+        assert_eq!(
+            *read.borrow(),
+            even,
+            "the odd nodes' 10 mm budgets clear 2 mm"
+        );
+        // The block's wake: the even nodes' 0.5 mm, less 0.2 mm, still above the drift.
+        clearance.shifted(0, 0.2e-3);
+        clearance.measured(1, 0.0, 0.5e-3);
+        assert_eq!(listed(&mut clearance, 0.5e-3), [1]);
     }
 
     /// A node read outside the lattice stays clear for as far as it lies outside, with no
@@ -347,8 +436,9 @@ mod tests {
     fn a_node_outside_the_lattice_is_clear_until_it_can_reach_it() {
         let mut clearance = Clearance::new(1);
         clearance.outside_lattice(0, 1e-3, 0.0);
-        assert!(clearance.is_clear(0, 0.9e-3));
-        assert!(clearance.is_clear(0, -0.9e-3));
-        assert!(!clearance.is_clear(0, 1.1e-3));
+        for (shift_m, clear) in [(0.9e-3, true), (-0.9e-3, true), (1.1e-3, false)] {
+            clearance.shifted(0, 1.1e-3);
+            assert_eq!(is_clear(&mut clearance, shift_m), clear, "{shift_m} m");
+        }
     }
 }

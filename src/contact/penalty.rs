@@ -278,8 +278,8 @@ impl ContactPair {
                 &self.field,
                 near.map_or(0.0, NearField::largest_change_m) as f64,
             );
-            for &i in local.dimpled_nodes() {
-                clearance.dimpled(i as usize, local.gap_m(i as usize));
+            for &b in local.shifted_blocks() {
+                clearance.shifted(b as usize, local.block_shift_m(b as usize));
             }
         }
         let shape = MasterShape {
@@ -293,7 +293,9 @@ impl ContactPair {
         let within = rest_m.partition_point(|&d| d <= reach_m);
         self.candidates.clear();
         match &mut self.clearance {
-            Some(clearance) => clearance.candidates(within, &mut self.candidates),
+            Some(clearance) => {
+                clearance.candidates(within, |i| local.gap_m(i), &mut self.candidates)
+            }
             None => self.candidates.extend(0..within as u32),
         }
         self.candidates.extend(
@@ -305,27 +307,26 @@ impl ContactPair {
         self.active.clear();
         for k in 0..self.candidates.len() {
             let i = self.candidates[k] as usize;
-            if self.force_n[i] == 0.0 && self.can_skip(i, point_moves, near) {
+            let shift_m = self.compliance.local().gap_m(i);
+            if self.force_n[i] == 0.0 && self.out_of_reach(i, shift_m, point_moves, near) {
                 continue;
             }
             report.nodes_evaluated += 1;
-            let depth_m = self.measure(i, &shape, master.carry, shell);
+            let depth_m = self.measure(i, shift_m, &shape, master.carry, shell);
             report.deepest_m = report.deepest_m.max(depth_m);
         }
         report
     }
 
-    /// Whether node `i`, pushing nothing, can be left unmeasured this tick: out of reach from
-    /// rest, or known clear. The cheaper check first.
-    fn can_skip(&self, i: usize, point_moves: f32, near: Option<&NearField>) -> bool {
-        let shift_m = self.compliance.local().gap_m(i);
-        if self
-            .clearance
-            .as_ref()
-            .is_some_and(|c| c.is_clear(i, shift_m))
-        {
-            return true;
-        }
+    /// Whether node `i`, pushing nothing, its read point shifted by its dimple `shift_m`,
+    /// cannot reach the master from rest this tick.
+    fn out_of_reach(
+        &self,
+        i: usize,
+        shift_m: f64,
+        point_moves: f32,
+        near: Option<&NearField>,
+    ) -> bool {
         let moves = point_moves + shift_m.abs() as f32;
         let near_moves = near.map_or(0.0, |near| {
             self.near_moves_m(i, near, moves + near.largest_m())
@@ -349,6 +350,7 @@ impl ContactPair {
     fn measure(
         &mut self,
         i: usize,
+        shift_m: f64,
         master: &MasterShape,
         master_carry: &RigidCarry,
         shell: OrganPose,
@@ -359,7 +361,6 @@ impl ContactPair {
         // The forces already pushing dimple both organs apart along the node's normal: read
         // where the node is against the dimpled master, near its surface, rather than deep
         // inside the master's modal shape and corrected after.
-        let shift_m = self.compliance.local().gap_m(i);
         p += self.nodes.rest_normal[i] * shift_m;
         // The master's lattice is at rest: pull the point back through the master's carry.
         let q = p - master_carry.at(&p);

@@ -34,6 +34,7 @@ use nalgebra::Vector3;
 use self::organ_part::OrganPart;
 use self::solve_block::SolveBlock;
 use self::sparse::{Scattered, SparseRows};
+use super::clearance::BLOCK;
 use super::pointshell::Pointshell;
 use crate::pgd::Vademecum;
 
@@ -49,29 +50,33 @@ pub struct LocalCompliance {
     /// `G`: per node, the directions its normal force loads and its distance reads, with
     /// their coefficients (weight times the cosine to the node's normal).
     reads: SparseRows,
-    /// `Gᵀ`: per direction, the nodes that read it.
-    readers: SparseRows,
+    /// Per direction, the blocks of [`BLOCK`] nodes that read it, each with the largest
+    /// `|G_id|` among its nodes: bounds how far a move of the direction shifts any of them.
+    block_readers: SparseRows,
+    /// The largest `Σ_d |G_id|` of any node: bounds the dimples by the directions' moves.
+    largest_read_sum: f64,
     /// `S` between directions (m/N), both organs, symmetric, no entry across organs.
     compliance: SparseRows,
     /// Per node, each organ's own `a_ii`: `[shell, master]` (m/N).
     own_m_per_n: Vec<[f64; 2]>,
-    /// The dimples: each node's `Σ_j a_ij f_j` (m) for the forces of [`Self::spread_n`],
-    /// and the scratch a change of them passes through: per node, per direction summed, and
+    /// How far the forces of [`Self::spread_n`] move each direction, `S Gᵀ f` (m): node
+    /// `i`'s dimple `Σ_j a_ij f_j` is its row of `G` times these, read when it is measured.
+    moves_m: Scattered,
+    /// The scratch a change of the forces passes through: per node, per direction summed, and
     /// how far that moves each direction (m).
-    gaps_m: Scattered,
     changes_n: Scattered,
     loads_n: Scattered,
-    moves_m: Scattered,
+    move_changes_m: Scattered,
     /// The forces the dimples hold (N, per node) and the nodes where they are not zero.
     spread_n: Vec<f64>,
     spread_nodes: Vec<u32>,
     /// Ticks since the dimples were last summed whole rather than changed.
     ticks_changed: u32,
-    /// The largest dimple of any node this tick (m).
+    /// At least the largest dimple of any node this tick (m).
     largest_gap_m: f64,
-    /// How this tick changed each node's dimple (m); the nodes it holds are those whose dimple
-    /// changed, each once.
-    gap_changes_m: Scattered,
+    /// Per block of nodes, at least how far this tick changed the dimple of any of its nodes
+    /// (m); the blocks it holds are those where one may have changed.
+    block_shifts_m: Scattered,
     block: SolveBlock,
 }
 
@@ -117,13 +122,16 @@ impl LocalCompliance {
         let compliance = SparseRows::from_rows(compliance);
         let directions = compliance.rows();
         let mut part = Self {
-            readers: reads.transpose(directions),
+            block_readers: block_readers(&reads, directions),
+            largest_read_sum: (0..count)
+                .map(|i| reads.row(i).1.iter().map(|c| c.abs()).sum())
+                .fold(0.0, f64::max),
             reads,
             compliance,
             loads_n: Scattered::new(directions),
             moves_m: Scattered::new(directions),
-            gaps_m: Scattered::new(count),
-            gap_changes_m: Scattered::new(count),
+            move_changes_m: Scattered::new(directions),
+            block_shifts_m: Scattered::new(count.div_ceil(BLOCK)),
             changes_n: Scattered::new(count),
             spread_n: vec![0.0; count],
             block: SolveBlock::new(directions),
@@ -158,7 +166,7 @@ impl LocalCompliance {
     /// pushing node's reach (on `--subdivide 4`, 317 points pushing at rest, 69 µs a tick).
     pub fn dimple(&mut self, pushing: &[u32], force_n: &[f64]) {
         self.ticks_changed += 1;
-        self.gap_changes_m.clear();
+        self.block_shifts_m.clear();
         let forgot = self.ticks_changed >= TICKS_BETWEEN_WHOLE_SUMS;
         if forgot {
             self.forget_forces();
@@ -187,35 +195,42 @@ impl LocalCompliance {
         self.changes_n = changes;
         self.changes_n.clear();
         if !(moved || forgot) {
-            // The same gaps: a press at rest keeps its largest (a pass over every node its
-            // dimples reach, a seventh of such a tick with 400 points pushing).
+            // The same moves: a press at rest keeps its largest dimple.
             return;
         }
-        let gaps = &self.gaps_m;
-        self.largest_gap_m = gaps
+        let moves = &self.moves_m;
+        let largest_move_m = moves
             .touched()
             .iter()
-            .map(|&i| gaps.get(i as usize).abs())
+            .map(|&e| moves.get(e as usize).abs())
             .fold(0.0, f64::max);
+        self.largest_gap_m = self.largest_read_sum * largest_move_m;
     }
 
-    /// The largest of [`Self::gap_m`] over the nodes (m): bounds how far the dimples moved
-    /// any node's read point.
+    /// At least the largest of [`Self::gap_m`] over the nodes (m): bounds how far the dimples
+    /// moved any node's read point.
     pub fn largest_gap_m(&self) -> f64 {
         self.largest_gap_m
     }
 
-    /// The nodes whose dimple [`Self::dimple`] changed this tick, each once.
-    pub fn dimpled_nodes(&self) -> &[u32] {
-        self.gap_changes_m.touched()
+    /// The blocks of [`BLOCK`] nodes (node `i` in block `i / BLOCK`) where [`Self::dimple`]
+    /// may have changed a dimple this tick, each once.
+    pub fn shifted_blocks(&self) -> &[u32] {
+        self.block_shifts_m.touched()
+    }
+
+    /// At least how far (m) this tick changed the dimple of any node in block `b`.
+    pub fn block_shift_m(&self, b: usize) -> f64 {
+        self.block_shifts_m.get(b)
     }
 
     /// Drops every force from the dimples, so that the next are summed whole.
     fn forget_forces(&mut self) {
-        for &i in self.gaps_m.touched() {
-            self.gap_changes_m.add(i as usize, 0.0);
+        for &e in self.moves_m.touched() {
+            let moved_m = self.moves_m.get(e as usize).abs();
+            mark_shifted(&self.block_readers, e, moved_m, &mut self.block_shifts_m);
         }
-        self.gaps_m.clear();
+        self.moves_m.clear();
         for &j in &self.spread_nodes {
             self.spread_n[j as usize] = 0.0;
         }
@@ -223,9 +238,9 @@ impl LocalCompliance {
         self.ticks_changed = 0;
     }
 
-    /// Adds `a f` to the dimples for the normal forces `(node, f)`: summed per direction,
-    /// moved through `S`, read by the nodes, at a cost of the directions they reach rather
-    /// than every node's. Returns whether any direction moved.
+    /// Adds `S Gᵀ f` to the directions' moves for the normal forces `(node, f)`: summed per
+    /// direction, moved through `S`, at a cost of the directions they reach; the blocks whose
+    /// nodes read a moved direction are marked shifted. Returns whether any direction moved.
     fn spread(&mut self, forces: impl Iterator<Item = (u32, f64)>) -> bool {
         for (j, f) in forces {
             let (directions, coefficients) = self.reads.row(j as usize);
@@ -237,30 +252,34 @@ impl LocalCompliance {
             let f = self.loads_n.get(d as usize);
             let (directions, values) = self.compliance.row(d as usize);
             for (&e, &s) in directions.iter().zip(values) {
-                self.moves_m.add(e as usize, s * f);
+                self.move_changes_m.add(e as usize, s * f);
             }
         }
-        for &e in self.moves_m.touched() {
-            let u = self.moves_m.get(e as usize);
-            let (nodes, coefficients) = self.readers.row(e as usize);
-            for (&i, &c) in nodes.iter().zip(coefficients) {
-                self.gap_changes_m.add(i as usize, c * u);
-            }
+        for &e in self.move_changes_m.touched() {
+            let change_m = self.move_changes_m.get(e as usize);
+            self.moves_m.add(e as usize, change_m);
+            mark_shifted(
+                &self.block_readers,
+                e,
+                change_m.abs(),
+                &mut self.block_shifts_m,
+            );
         }
-        for &i in self.gap_changes_m.touched() {
-            self.gaps_m
-                .add(i as usize, self.gap_changes_m.get(i as usize));
-        }
-        let moved = !self.moves_m.touched().is_empty();
+        let moved = !self.move_changes_m.touched().is_empty();
         self.loads_n.clear();
-        self.moves_m.clear();
+        self.move_changes_m.clear();
         moved
     }
 
     /// `Σ_j a_ij f_j`: how far the forces taken by [`Self::dimple`] move node `i`'s distance
-    /// (m) beyond their modes.
+    /// (m) beyond their modes, `G` times the directions' moves.
     pub fn gap_m(&self, i: usize) -> f64 {
-        self.gaps_m.get(i)
+        let (directions, coefficients) = self.reads.row(i);
+        directions
+            .iter()
+            .zip(coefficients)
+            .map(|(&d, &c)| c * self.moves_m.get(d as usize))
+            .sum()
     }
 
     /// Sets up the block of the tick's force solve over the nodes of `set`, so that each
@@ -273,6 +292,33 @@ impl LocalCompliance {
     /// [`Self::prepare`] took.
     pub fn add_product(&mut self, set: &[u32], v: &[f64], out: &mut [f64]) {
         self.block.add_product(set, v, out);
+    }
+}
+
+/// Per direction, the blocks of [`BLOCK`] nodes whose rows of `G` (`reads`) hold it, each
+/// with the largest `|G_id|` in the block, blocks ascending.
+fn block_readers(reads: &SparseRows, directions: usize) -> SparseRows {
+    let mut rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); directions];
+    for i in 0..reads.rows() {
+        let block = (i / BLOCK) as u32;
+        let (columns, coefficients) = reads.row(i);
+        for (&d, &c) in columns.iter().zip(coefficients) {
+            let row = &mut rows[d as usize];
+            match row.last_mut() {
+                Some(last) if last.0 == block => last.1 = last.1.max(c.abs()),
+                _ => row.push((block, c.abs())),
+            }
+        }
+    }
+    SparseRows::from_rows(rows)
+}
+
+/// Marks the blocks reading direction `e` as shifted by as much as a move of `moved_m` (m)
+/// there can shift their nodes.
+fn mark_shifted(block_readers: &SparseRows, e: u32, moved_m: f64, shifts: &mut Scattered) {
+    let (blocks, coefficients) = block_readers.row(e as usize);
+    for (&b, &c) in blocks.iter().zip(coefficients) {
+        shifts.add(b as usize, c * moved_m);
     }
 }
 
@@ -467,11 +513,22 @@ mod tests {
         }
     }
 
-    fn assert_dimples(part: &LocalCompliance, a: &[Vec<f64>], force: &[f64], tick: usize) {
+    /// The dimples are `a f`, to within rounding: 1e-12 of the largest dimple any forces up to
+    /// `largest_force_n` a node can make (changed tick by tick, a node's dimple keeps the
+    /// rounding of forces gone, which an exact zero shows).
+    fn assert_dimples(
+        part: &LocalCompliance,
+        a: &[Vec<f64>],
+        force: &[f64],
+        largest_force_n: f64,
+        tick: usize,
+    ) {
+        let row_sums = a.iter().map(|row| row.iter().map(|v| v.abs()).sum::<f64>());
+        let tolerance = 1e-12 * largest_force_n * row_sums.fold(0.0, f64::max);
         for (i, row) in a.iter().enumerate() {
             let expected: f64 = row.iter().zip(force).map(|(a, f)| a * f).sum();
             assert!(
-                (part.gap_m(i) - expected).abs() <= 1e-12 * expected.abs(),
+                (part.gap_m(i) - expected).abs() <= tolerance,
                 "tick {tick}, node {i}: {} against {expected}",
                 part.gap_m(i)
             );
@@ -489,7 +546,7 @@ mod tests {
         let force = [0.0, 2.0, 0.0, 1.0];
         part.dimple(&[0, 1, 3], &[5.0, 1.0, 0.0, 3.0]);
         part.dimple(&[1, 3, 2], &force);
-        assert_dimples(&part, &a, &force, 1);
+        assert_dimples(&part, &a, &force, 5.0, 1);
         for i in 0..normals.len() {
             for (o, organ) in parts.iter().enumerate() {
                 let own = direct(organ, &normals, i, i);
@@ -501,42 +558,75 @@ mod tests {
         }
     }
 
+    /// Three blocks of nodes: block `k`'s nodes load position `k` of each organ, and
+    /// positions 1 and 2 are out of each other's reach, so that forces in block 1 alone move
+    /// no direction block 2 reads.
+    fn three_blocks() -> ([OrganPart; 2], Vec<Vector3<f64>>) {
+        let (_, four_normals) = example();
+        let count = 2 * BLOCK + 4;
+        let normals = (0..count).map(|i| four_normals[i % 4]).collect();
+        let blends = || (0..count).map(|i| vec![(i / BLOCK, 1.0)]).collect();
+        let parts = [
+            OrganPart {
+                blends: blends(),
+                blocks: symmetric_blocks(3, 1.0, &[(1, 2)]),
+            },
+            OrganPart {
+                blends: blends(),
+                blocks: symmetric_blocks(3, 0.3, &[(1, 2)]),
+            },
+        ];
+        (parts, normals)
+    }
+
     /// Ticks on, changed by how their forces change: nodes start and stop pushing, some keep
     /// their force, and past the ticks between whole sums the dimples are still the dense
-    /// product with the forces of the tick. Every node whose dimple changed is reported so
-    /// (the clearance wakes it), each once, also where a whole sum drops every force.
+    /// product with the forces of the tick. Each block's reported shift bounds how far every
+    /// one of its nodes' dimples changed, also where a whole sum drops every force; a block
+    /// whose dimples cannot have changed is not reported; the largest dimple bounds them all.
     #[test]
     fn the_dimples_follow_the_forces_from_tick_to_tick() {
-        let (parts, normals) = example();
+        let (parts, normals) = three_blocks();
+        let count = normals.len();
         let a = dense(&parts, &normals);
         let mut part = LocalCompliance::assemble(&parts, &normals);
         let ticks = 2 * TICKS_BETWEEN_WHOLE_SUMS as usize + 3;
-        let mut last_gaps = [0.0; 4];
+        let mut last_gaps = vec![0.0f64; count];
         for tick in 0..ticks {
-            // On the ticks that sum whole, nothing pushes: every dimple falls to zero.
+            // On the ticks that sum whole, nothing pushes: every dimple falls to zero. Two
+            // ticks in six, block 1 alone pushes.
             let whole = (tick + 1) % TICKS_BETWEEN_WHOLE_SUMS as usize == 0;
-            let force: Vec<f64> = (0..4)
+            let block_1_alone = (tick / 2) % 3 == 0;
+            let force: Vec<f64> = (0..count)
                 .map(|j| match (tick + j) % 5 {
                     _ if whole => 0.0,
+                    _ if block_1_alone && j / BLOCK != 1 => 0.0,
                     0 => 0.0,
                     1 => 1.5,
                     _ => ((tick * 7 + j * 3) % 11) as f64 * 0.25,
                 })
                 .collect();
-            let pushing: Vec<u32> = (0..4).filter(|&j| force[j as usize] > 0.0).collect();
+            let pushing: Vec<u32> = (0..count as u32)
+                .filter(|&j| force[j as usize] > 0.0)
+                .collect();
             part.dimple(&pushing, &force);
-            assert_dimples(&part, &a, &force, tick);
-            let mut dimpled = part.dimpled_nodes().to_vec();
-            dimpled.sort();
-            dimpled.dedup();
-            assert_eq!(dimpled.len(), part.dimpled_nodes().len(), "tick {tick}");
+            assert_dimples(&part, &a, &force, 2.5, tick);
+            let shifted = part.shifted_blocks();
+            if block_1_alone && tick % 2 == 1 && !whole && tick > 1 {
+                assert!(!shifted.contains(&2), "tick {tick}: {shifted:?}");
+            }
             for (i, last) in last_gaps.iter_mut().enumerate() {
-                let changed = part.gap_m(i) != *last;
+                let (gap, b) = (part.gap_m(i), i / BLOCK);
+                let bound = match shifted.contains(&(b as u32)) {
+                    true => part.block_shift_m(b) + 1e-12 * (gap.abs() + last.abs()),
+                    false => 0.0,
+                };
                 assert!(
-                    !changed || dimpled.contains(&(i as u32)),
-                    "tick {tick}, node {i}"
+                    (gap - *last).abs() <= bound,
+                    "tick {tick}, node {i}: {last} to {gap}, block {b} shifted {bound}"
                 );
-                *last = part.gap_m(i);
+                assert!(gap.abs() <= part.largest_gap_m(), "tick {tick}, node {i}");
+                *last = gap;
             }
         }
     }

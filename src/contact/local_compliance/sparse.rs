@@ -59,18 +59,6 @@ impl SparseRows {
             .binary_search(&(j as u32))
             .map_or(0.0, |k| values[k])
     }
-
-    /// The transpose, with `columns` rows.
-    pub(super) fn transpose(&self, columns: usize) -> Self {
-        let mut rows = vec![Vec::new(); columns];
-        for i in 0..self.rows() {
-            let (js, values) = self.row(i);
-            for (&j, &value) in js.iter().zip(values) {
-                rows[j as usize].push((i as u32, value));
-            }
-        }
-        Self::from_rows(rows)
-    }
 }
 
 /// A vector mostly zero, with the list of the entries touched since it was last cleared, so
@@ -120,18 +108,6 @@ impl Scattered {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_transpose_swaps_rows_and_columns() {
-        let rows = SparseRows::from_rows([vec![(0, 1.0), (2, 2.0)], vec![], vec![(1, 3.0)]]);
-        let transposed = rows.transpose(3);
-        for i in 0..3 {
-            for j in 0..3 {
-                assert_eq!(rows.get(i, j), transposed.get(j, i), "({i}, {j})");
-            }
-        }
-        assert_eq!(rows.get(0, 2), 2.0);
-    }
 
     #[test]
     fn a_scattered_vector_clears_what_was_touched_and_lists_each_once() {
