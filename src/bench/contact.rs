@@ -21,7 +21,7 @@ use serde::Serialize;
 use crate::app::haptic::HapticScene;
 use crate::contact::{
     ContactPair, ContactSurface, CouplingSettings, DistanceField, OrganPose, PairOutput,
-    Pointshell, ToolHold,
+    PairReport, Pointshell, ToolHold,
 };
 use crate::pgd::{PointLoad, RigidCarry, Vademecum};
 use crate::seam::{to_parry, trimesh};
@@ -112,21 +112,11 @@ pub fn run(
     ticks: usize,
     cases: &[Case],
 ) -> Result<ContactBenchReport, String> {
-    let coupling = scene
-        .coupling
-        .as_ref()
-        .ok_or("the scene has no organ contact")?;
-    let pair = coupling
-        .pairs
-        .iter()
-        .max_by_key(|p| p.pointshell().len())
-        .ok_or("the scene's master meets no other organ")?;
+    let (pair, master, shell) = largest_pair(scene)?;
     let cases = match cases {
         [] => &[Case::Apart, Case::Pressed, Case::Held, Case::Sliding],
         named => named,
     };
-    let master = &scene.organs[pair.master];
-    let shell = &scene.organs[pair.shell];
     let apart = cases
         .contains(&Case::Apart)
         .then(|| time_case(Case::Apart, pair, master, shell, 0.0, ticks));
@@ -166,6 +156,38 @@ pub fn run(
         cases: apart.into_iter().chain(pressed).chain(held_cases).collect(),
         cases_asked: cases.len(),
     })
+}
+
+/// The scene's pair with the largest pointshell, its master and its shell organ.
+fn largest_pair(scene: &HapticScene) -> Result<(&ContactPair, &Organ, &Organ), String> {
+    let coupling = scene
+        .coupling
+        .as_ref()
+        .ok_or("the scene has no organ contact")?;
+    let pair = coupling
+        .pairs
+        .iter()
+        .max_by_key(|p| p.pointshell().len())
+        .ok_or("the scene's master meets no other organ")?;
+    Ok((pair, &scene.organs[pair.master], &scene.organs[pair.shell]))
+}
+
+/// The pair of [`run`] with its master, free to deform, carried `depth_m` into the shell
+/// organ: the pair's report of each of `ticks` ticks (the contact tests check that a deep
+/// press settles).
+pub fn free_press(
+    scene: &HapticScene,
+    depth_m: f64,
+    ticks: usize,
+) -> Result<Vec<PairReport>, String> {
+    let (pair, master, shell) = largest_pair(scene)?;
+    let mut run = Run::new(pair, master, shell, carry_into(pair, depth_m));
+    Ok((0..ticks)
+        .map(|_| {
+            run.tick();
+            *run.pair.report()
+        })
+        .collect())
 }
 
 /// The pair again with a rigid copy of the master: its modes zeroed, so that neither its field

@@ -17,6 +17,7 @@ mod normal_compliance;
 mod penalty;
 mod pointshell;
 mod projected_cg;
+mod relaxation;
 mod surface;
 mod tool;
 

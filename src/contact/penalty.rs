@@ -21,6 +21,11 @@
 //!   pulling or pushing at a distance;
 //! - the force on a node is continuous in its depth, zero at `d = 0`.
 //!
+//! `A` is a model of how the forces move the surfaces, along the nodes' rest normals. Where
+//! it is wrong (a free master carried deep swings sideways), the next tick's measurement says
+//! so, and a change of the forces that flips from tick to tick is taken in part
+//! ([`Relaxation`]) rather than buzzing at 500 Hz.
+//!
 //! Where the tool holds an organ, `A` is that organ's compliance with the patch under the
 //! tool held, and the solve reports how far the forces' change moved that patch, which the
 //! tool's load follows in the same tick ([`super::hold`]).
@@ -43,6 +48,7 @@ use super::modal_rows::step_ranges;
 use super::normal_compliance::NormalCompliance;
 use super::pointshell::Pointshell;
 use super::projected_cg::{Convergence, ProjectedCg};
+use super::relaxation::Relaxation;
 use super::{DistanceField, LatticeCache, MasterShape, NearField};
 use crate::pgd::{PointLoad, RigidCarry, Vademecum};
 
@@ -122,6 +128,8 @@ pub struct ContactPair {
     compliance: NormalCompliance,
     solver: ProjectedCg,
     convergence: Convergence,
+    /// How much of each tick's change of the forces is taken.
+    relaxation: Relaxation,
     cache: LatticeCache,
     /// Which nodes are known clear of the master; `None` where every node is measured.
     clearance: Option<Clearance>,
@@ -170,6 +178,7 @@ impl ContactPair {
             change_n: vec![0.0; count],
             compliance,
             solver: ProjectedCg::new(count),
+            relaxation: Relaxation::new(count),
             convergence: settings.convergence,
             cache: LatticeCache::default(),
             clearance: settings.skip_clear_nodes.then(|| Clearance::new(count)),
@@ -221,10 +230,9 @@ impl ContactPair {
             &mut self.gradient_m,
             &self.convergence,
         );
-        for &i in &self.active {
-            self.change_n[i as usize] += self.force_n[i as usize];
-        }
-        let (master_moved_m, shell_moved_m) = compliance.tool_moves_m(&self.active, &self.change_n);
+        self.relax();
+        let (master_moved_m, shell_moved_m) =
+            self.compliance.tool_moves_m(&self.active, &self.change_n);
         out.master_hold.moved_m += master_moved_m;
         out.shell_hold.moved_m += shell_moved_m;
         for &i in &self.active {
@@ -384,6 +392,24 @@ impl ContactPair {
             }
         }
         (-distance_m).max(0.0)
+    }
+
+    /// Takes the share of the solve's change of the forces that [`Relaxation`] allows, and
+    /// leaves that change in `change_n`.
+    fn relax(&mut self) {
+        for &i in &self.active {
+            self.change_n[i as usize] += self.force_n[i as usize];
+        }
+        let share = self.relaxation.share(&self.active, &self.change_n);
+        if share == 1.0 {
+            return;
+        }
+        for &i in &self.active {
+            let i = i as usize;
+            let asked = self.change_n[i];
+            self.change_n[i] = share * asked;
+            self.force_n[i] = (self.force_n[i] - asked + self.change_n[i]).max(0.0);
+        }
     }
 
     /// Node `i`'s force on the shell organ, shared among its positions, and its reaction on

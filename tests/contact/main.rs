@@ -4,6 +4,7 @@
 
 mod clearance;
 mod common;
+mod deep_press;
 mod dimples;
 mod field_file;
 mod near_field;
