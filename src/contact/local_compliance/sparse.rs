@@ -110,6 +110,23 @@ mod tests {
     use super::*;
 
     #[test]
+    fn rows_pushed_read_back_and_clear() {
+        let mut rows = SparseRows::from_rows([vec![(0, 1.0), (2, 2.0)], vec![]]);
+        rows.push_row([(1, 3.0)]);
+        assert_eq!(rows.rows(), 3);
+        assert_eq!(rows.row(0), (&[0u32, 2][..], &[1.0, 2.0][..]));
+        assert_eq!(
+            (rows.get(0, 2), rows.get(0, 1), rows.get(2, 1)),
+            (2.0, 0.0, 3.0)
+        );
+        assert!(rows.row(1).0.is_empty());
+        rows.clear();
+        assert_eq!(rows.rows(), 0);
+        rows.push_row([(4, 5.0)]);
+        assert_eq!((rows.rows(), rows.get(0, 4)), (1, 5.0));
+    }
+
+    #[test]
     fn a_scattered_vector_clears_what_was_touched_and_lists_each_once() {
         let mut v = Scattered::new(4);
         v.add(2, 1.0);
