@@ -49,9 +49,9 @@ pub struct Clearance {
     /// (m): the contact forces' dimple, known exactly every tick, so that only its net
     /// change since counts.
     shift_at_m: Vec<f64>,
-    /// Per node, a drift up to which it is surely clear, less the shift of its block since
-    /// the block was last scanned (its *wake*): exact when it is measured or its shift read,
-    /// lowered by its block's shift when its block is scanned without reading it.
+    /// Per node, its *wake*: less its block's shift since the block was last scanned, a drift
+    /// up to which the node is surely clear. Exact when the node is measured or its shift is
+    /// read; lowered by its block's shift when the block is scanned without reading it.
     wake_m: Vec<f64>,
     /// Per block of [`BLOCK`] nodes, a drift up to which all its nodes are surely clear:
     /// lowered as a node is measured closer or its dimple may have shifted, raised to the

@@ -353,8 +353,9 @@ impl ContactPair {
         near.largest_near_m(&self.nodes.rest_m[i].map(f64::from), within)
     }
 
-    /// Node `i`'s distance to the master and the energy's gradient there; joins the active set
-    /// if it pushes or is inside. Returns how deep it is (m, 0 outside).
+    /// Node `i`'s distance to the master, read with its dimple `shift_m`, and the energy's
+    /// gradient there; joins the active set if it pushes or is inside. Returns how deep it is
+    /// (m, 0 outside).
     fn measure(
         &mut self,
         i: usize,
