@@ -372,7 +372,7 @@ impl ContactPair {
         // inside the master's modal shape and corrected after.
         p += self.nodes.rest_normal[i] * shift_m;
         // The master's lattice is at rest: pull the point back through the master's carry.
-        let q = p - master_carry.at(&p);
+        let q = master_carry.pull_back(&p);
         let Some(distance_m) = self.field.distance_m(&q, master, &mut self.cache) else {
             self.force_n[i] = 0.0;
             if let Some(clearance) = &mut self.clearance {

@@ -70,6 +70,16 @@ impl RigidCarry {
     pub fn at(&self, p: &Vector3<f64>) -> Vector3<f64> {
         self.translation_m + self.rotation_rad.cross(&(p - self.centre_m))
     }
+
+    /// The point that the carry moves to `x`: `p` with `p + at(p) = x`. With `W = [ω]×`,
+    /// `p − c = (I + W)⁻¹ (x − c − t)`, and `(I + W)⁻¹ = I − (W − W²) / (1 + |ω|²)`. Taken as
+    /// `x − at(x)` instead, a carry turned by 0.09 rad left errors of a millimetre 5 cm away.
+    pub fn pull_back(&self, x: &Vector3<f64>) -> Vector3<f64> {
+        let w = &self.rotation_rad;
+        let v = x - self.centre_m - self.translation_m;
+        let wv = w.cross(&v);
+        self.centre_m + v - (wv - w.cross(&wv)) / (1.0 + w.norm_squared())
+    }
 }
 
 /// The loads on an organ and, per load step, the modal coefficients of their sum.
@@ -260,5 +270,30 @@ impl Deformation {
     /// The sum of the forces (N) applied to the organ, the coupling's included.
     pub fn total_force_n(&self) -> Vector3<f64> {
         self.loads.iter().map(|l| l.force_n).sum::<Vector3<f64>>() + self.coupling_force_n
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The pull-back inverts the carry exactly, however far it turns, where `x − at(x)` is
+    /// off by the square of the turn.
+    #[test]
+    fn a_carry_pulled_back_returns_every_point() {
+        let carry = RigidCarry {
+            translation_m: Vector3::new(0.003, -0.002, 0.001),
+            rotation_rad: Vector3::new(0.05, 0.3, -0.2),
+            centre_m: Vector3::new(0.1, 0.0, -0.05),
+        };
+        for p in [
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(0.15, -0.04, 0.02),
+            Vector3::new(-0.05, 0.08, -0.1),
+        ] {
+            let x = p + carry.at(&p);
+            assert!((carry.pull_back(&x) - p).norm() < 1e-15, "{p}");
+            assert!((x - carry.at(&x) - p).norm() > 1e-4, "{p}");
+        }
     }
 }

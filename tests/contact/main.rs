@@ -315,7 +315,7 @@ fn distance_errors(modes_only: bool) -> (f64, f64) {
         let rest = Vector3::from(gallbladder.position_coords_m[m].map(f64::from));
         for offset_mm in [-1.5, -0.5, 0.5, 1.5, 3.0] {
             let x = Vector3::from(p.map(f64::from)) + normals[m] * offset_mm * 1e-3;
-            let q = x - deformation.carry.at(&x);
+            let q = deformation.carry.pull_back(&x);
             let Some(distance_m) = distance.distance_m(&q, &shape, &mut cache) else {
                 continue;
             };
