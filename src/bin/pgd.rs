@@ -253,12 +253,15 @@ enum BenchTarget {
         #[arg(long, default_value = "vademecums")]
         vademecums: PathBuf,
         /// A dense pointshell (nodes and triangle centres) instead of the boundary nodes.
-        #[arg(long, conflicts_with = "subdivide")]
+        #[arg(long, conflicts_with_all = ["subdivide", "sparse"])]
         dense: bool,
         /// A pointshell of the centres of each surface triangle cut N times along each edge
         /// (N² points a triangle) instead of the boundary nodes.
-        #[arg(long, value_name = "N", value_parser = cli::parse_subdivisions)]
+        #[arg(long, value_name = "N", value_parser = cli::parse_subdivisions, conflicts_with = "sparse")]
         subdivide: Option<u8>,
+        /// A sparse pointshell: the boundary nodes kept at least MM millimetres apart.
+        #[arg(long, value_name = "MM", value_parser = cli::parse_spacing)]
+        sparse: Option<u8>,
         /// How many times stiffer than the tissue each node's penalty is: 1000 (the
         /// trainer's) cuts an overlap to 0.1 %; 1 leaves half of it, as a one-pass penalty
         /// does, so that far more nodes stay inside and push.
@@ -408,6 +411,7 @@ fn main() -> ExitCode {
                     vademecums,
                     dense,
                     subdivide,
+                    sparse,
                     stiffness_ratio,
                     cases,
                     json,
@@ -415,10 +419,11 @@ fn main() -> ExitCode {
         } => {
             let detail = if coarse { Detail::Coarse } else { Detail::Full };
             let coupling = CouplingSettings {
-                pointshell: match (dense, subdivide) {
-                    (_, Some(n)) => PointshellDensity::Subdivided(n),
-                    (true, None) => PointshellDensity::Dense,
-                    (false, None) => PointshellDensity::Nodes,
+                pointshell: match (dense, subdivide, sparse) {
+                    (_, Some(n), _) => PointshellDensity::Subdivided(n),
+                    (_, _, Some(mm)) => PointshellDensity::Sparse(mm),
+                    (true, ..) => PointshellDensity::Dense,
+                    (false, ..) => PointshellDensity::Nodes,
                 },
                 penalty: PenaltySettings {
                     stiffness_ratio,

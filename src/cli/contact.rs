@@ -1,11 +1,17 @@
 //! Parsers for the contact benchmark's options, with errors that say the range.
 
-use crate::contact::check_subdivisions;
+use crate::contact::{check_spacing, check_subdivisions};
 
 /// A `--subdivide` count within [`crate::contact::SUBDIVISIONS`].
 pub fn parse_subdivisions(text: &str) -> Result<u8, String> {
     let n: u8 = text.parse().map_err(|e| format!("`{text}`: {e}"))?;
     check_subdivisions(n)
+}
+
+/// A `--sparse` spacing (mm) within [`crate::contact::SPARSE_SPACINGS_MM`].
+pub fn parse_spacing(text: &str) -> Result<u8, String> {
+    let mm: u8 = text.parse().map_err(|e| format!("`{text}`: {e}"))?;
+    check_spacing(mm)
 }
 
 /// A penalty's stiffness ratio: positive and finite.
@@ -29,6 +35,10 @@ mod tests {
         assert!(parse_subdivisions("0").unwrap_err().contains("1 to 8"));
         assert!(parse_subdivisions("9").unwrap_err().contains("1 to 8"));
         assert!(parse_subdivisions("two").unwrap_err().contains("`two`"));
+        assert_eq!(parse_spacing("6"), Ok(6));
+        assert!(parse_spacing("0").unwrap_err().contains("1 to 50 mm"));
+        assert!(parse_spacing("51").unwrap_err().contains("1 to 50 mm"));
+        assert!(parse_spacing("6.5").unwrap_err().contains("`6.5`"));
         assert_eq!(parse_stiffness_ratio("1e3"), Ok(1000.0));
         for bad in ["0", "-1", "inf", "NaN"] {
             assert!(parse_stiffness_ratio(bad).is_err(), "{bad}");

@@ -9,7 +9,7 @@ mod report;
 mod source;
 mod vademecums;
 
-pub use contact::{parse_stiffness_ratio, parse_subdivisions};
+pub use contact::{parse_spacing, parse_stiffness_ratio, parse_subdivisions};
 pub use convergence::{StepCurve, write as write_convergence, write_of_header};
 pub use progress::Bar;
 pub use report::{summary, write_report};

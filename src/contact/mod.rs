@@ -30,7 +30,10 @@ pub use distance::{
 pub use hold::ToolHold;
 pub use modal_rows::ModalRows;
 pub use penalty::{ContactPair, OrganPose, PairOutput, PairReport, PenaltySettings};
-pub use pointshell::{Pointshell, PointshellDensity, SUBDIVISIONS, check_subdivisions};
+pub use pointshell::{
+    Pointshell, PointshellDensity, SPARSE_SPACINGS_MM, SUBDIVISIONS, check_spacing,
+    check_subdivisions,
+};
 pub use projected_cg::Convergence;
 pub use surface::{ContactError, ContactSurface, SurfaceHit};
 pub use tool::{Probe, Target, ToolContact, follow, press};

@@ -1,7 +1,7 @@
-//! A pointshell: the points of one organ's surface that probe the master's distance field (its
-//! boundary nodes, or denser), with what the contact stage needs of each, gathered once (rest
-//! position and distance, area, the organ's modes there, and the master position that
-//! takes the reaction). Everywhere below, "node" means a point of the pointshell.
+//! A pointshell: the points of one organ's surface that probe the master's distance field
+//! (its boundary nodes, denser or sparser), with what the contact stage needs of each,
+//! gathered once (rest position and distance, area, the organ's modes there, and the master
+//! position that takes the reaction). Everywhere below, "node" means a point of the pointshell.
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -50,14 +50,47 @@ pub enum PointshellDensity {
     /// Every accessible triangle cut into `n²` equal triangles (`n` along each edge), one point
     /// at each one's centre: as fine as asked, each point blending its triangle's corners.
     Subdivided(u8),
+    /// The boundary nodes thinned to at least this many millimetres apart, each node kept
+    /// taking the area of those left out nearest it, so that the surface is still covered
+    /// once: fewer points where the mesh is finer than the contact needs.
+    Sparse(u8),
+}
+
+impl PointshellDensity {
+    /// Itself where its count is within range, or what is wrong with it: the one check the
+    /// scenario and the command line share.
+    pub fn check(self) -> Result<Self, String> {
+        match self {
+            Self::Subdivided(n) => check_subdivisions(n).map(Self::Subdivided),
+            Self::Sparse(mm) => check_spacing(mm).map(Self::Sparse),
+            Self::Nodes | Self::Dense => Ok(self),
+        }
+    }
 }
 
 /// How many times a [`PointshellDensity::Subdivided`] pointshell may cut each edge: 8 gives
 /// 64 points a triangle, some 50 per node of the surface.
 pub const SUBDIVISIONS: std::ops::RangeInclusive<u8> = 1..=8;
 
+/// How far apart (mm) a [`PointshellDensity::Sparse`] pointshell may keep its nodes: at 1 mm
+/// it keeps every node of these meshes, at 50 mm a few per organ.
+pub const SPARSE_SPACINGS_MM: std::ops::RangeInclusive<u8> = 1..=50;
+
+/// `mm` itself where a [`PointshellDensity::Sparse`] pointshell may keep its nodes `mm`
+/// millimetres apart, or what is wrong with it.
+pub fn check_spacing(mm: u8) -> Result<u8, String> {
+    match SPARSE_SPACINGS_MM.contains(&mm) {
+        true => Ok(mm),
+        false => Err(format!(
+            "nodes kept {mm} mm apart: keep them {} to {} mm apart",
+            SPARSE_SPACINGS_MM.start(),
+            SPARSE_SPACINGS_MM.end()
+        )),
+    }
+}
+
 /// `n` itself where a [`PointshellDensity::Subdivided`] pointshell may cut each edge `n`
-/// times, or what is wrong with it: the one check the scenario and the command line share.
+/// times, or what is wrong with it.
 pub fn check_subdivisions(n: u8) -> Result<u8, String> {
     match SUBDIVISIONS.contains(&n) {
         true => Ok(n),
@@ -70,6 +103,7 @@ pub fn check_subdivisions(n: u8) -> Result<u8, String> {
 }
 
 /// A candidate point: where it is at rest, and the positions it blends.
+#[derive(Clone)]
 struct Candidate {
     rest_m: Vector3<f64>,
     blend: Vec<(usize, f64)>,
@@ -143,7 +177,7 @@ impl Pointshell {
 /// The points a pointshell at `density` may take from `shell`: each accessible position with
 /// its lumped area, and (dense) each accessible triangle's centre, which then takes half the
 /// triangle's area from its corners, so that the whole surface is covered once; subdivided,
-/// the centres of each triangle's pieces alone.
+/// the centres of each triangle's pieces alone; sparse, the positions thinned.
 fn candidates(shell: &Vademecum, density: PointshellDensity) -> Vec<Candidate> {
     let at = |m: usize| Vector3::from(shell.position_coords_m[m].map(f64::from));
     if let PointshellDensity::Subdivided(n) = density {
@@ -160,6 +194,9 @@ fn candidates(shell: &Vademecum, density: PointshellDensity) -> Vec<Candidate> {
             area_m2: shell.position_areas_m2[m] as f64,
         })
         .collect();
+    if let PointshellDensity::Sparse(mm) = density {
+        return thinned(points, f64::from(mm) * 1e-3);
+    }
     if density == PointshellDensity::Dense {
         for triangle in &shell.triangles {
             let [a, b, c] = triangle.map(|m| m as usize);
@@ -175,6 +212,69 @@ fn candidates(shell: &Vademecum, density: PointshellDensity) -> Vec<Candidate> {
         }
     }
     points
+}
+
+/// The points, in order, that lie at least `spacing_m` from every point kept before them;
+/// each point left out gives its area to the nearest point kept, which lies within
+/// `spacing_m` of it. Neighbours are looked up in a grid of `spacing_m` cells.
+fn thinned(points: Vec<Candidate>, spacing_m: f64) -> Vec<Candidate> {
+    let mut grid = SpacingGrid::new(spacing_m);
+    let mut kept: Vec<Candidate> = Vec::new();
+    let mut left_out = Vec::new();
+    for point in points {
+        match grid.nearest(&kept, &point.rest_m) {
+            Some(_) => left_out.push(point),
+            None => {
+                grid.insert(&point.rest_m, kept.len());
+                kept.push(point);
+            }
+        }
+    }
+    for point in left_out {
+        let k = grid
+            .nearest(&kept, &point.rest_m)
+            .expect("a point was left out for a kept one within the spacing");
+        kept[k].area_m2 += point.area_m2;
+    }
+    kept
+}
+
+/// Kept points by cell of a cubic grid as wide as the spacing: the points within the
+/// spacing of any point lie in its cell or the 26 around it.
+struct SpacingGrid {
+    spacing_m: f64,
+    cells: std::collections::HashMap<[i64; 3], Vec<usize>>,
+}
+
+impl SpacingGrid {
+    fn new(spacing_m: f64) -> Self {
+        Self {
+            spacing_m,
+            cells: std::collections::HashMap::new(),
+        }
+    }
+
+    fn cell(&self, p: &Vector3<f64>) -> [i64; 3] {
+        [0, 1, 2].map(|c| (p[c] / self.spacing_m).floor() as i64)
+    }
+
+    fn insert(&mut self, p: &Vector3<f64>, index: usize) {
+        self.cells.entry(self.cell(p)).or_default().push(index);
+    }
+
+    /// The kept point nearest `p` closer than the spacing, if any.
+    fn nearest(&self, kept: &[Candidate], p: &Vector3<f64>) -> Option<usize> {
+        let [x, y, z] = self.cell(p);
+        let around = (-1..=1)
+            .flat_map(|i| (-1..=1).flat_map(move |j| (-1..=1).map(move |k| [x + i, y + j, z + k])));
+        around
+            .filter_map(|cell| self.cells.get(&cell))
+            .flatten()
+            .map(|&k| (k, (kept[k].rest_m - p).norm()))
+            .filter(|&(_, d)| d < self.spacing_m)
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(k, _)| k)
+    }
 }
 
 /// The centres of the `n²` triangles that cut triangle `corners` `n` times along each edge:
@@ -233,6 +333,48 @@ fn nearest_corner(master: &Vademecum, surface: &ContactSurface, p: &Vector3<f64>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Thinned, a grid of points 1 mm apart keeps points no two closer than the spacing,
+    /// leaves none out farther than the spacing from a kept one, and keeps the area whole.
+    /// Brute force over every pair is the reference the grid's lookups are checked against.
+    #[test]
+    fn a_thinned_pointshell_keeps_points_apart_and_the_area_whole() {
+        let grid: Vec<Candidate> = (0..15)
+            .flat_map(|i| (0..12).map(move |j| (i, j)))
+            .map(|(i, j)| Candidate {
+                rest_m: Vector3::new(i as f64, j as f64, 0.1 * (i * j) as f64) * 1e-3,
+                blend: vec![(i * 12 + j, 1.0)],
+                area_m2: 1e-6 * (1.0 + (i + j) as f64 / 10.0),
+            })
+            .collect();
+        let whole_m2: f64 = grid.iter().map(|p| p.area_m2).sum();
+        for spacing_mm in [0.5, 1.5, 3.0, 7.0] {
+            let spacing_m = spacing_mm * 1e-3;
+            let rest: Vec<Vector3<f64>> = grid.iter().map(|p| p.rest_m).collect();
+            let kept = thinned(grid.clone(), spacing_m);
+            for (k, p) in kept.iter().enumerate() {
+                for q in &kept[..k] {
+                    assert!((p.rest_m - q.rest_m).norm() >= spacing_m, "{spacing_mm} mm");
+                }
+            }
+            for r in &rest {
+                let nearest = kept
+                    .iter()
+                    .map(|p| (p.rest_m - r).norm())
+                    .fold(f64::INFINITY, f64::min);
+                assert!(nearest < spacing_m, "{spacing_mm} mm: {r}");
+            }
+            let kept_m2: f64 = kept.iter().map(|p| p.area_m2).sum();
+            assert!(
+                (kept_m2 - whole_m2).abs() < 1e-12 * whole_m2,
+                "{spacing_mm} mm"
+            );
+            match spacing_mm < 1.0 {
+                true => assert_eq!(kept.len(), grid.len(), "points 1 mm apart are all kept"),
+                false => assert!(kept.len() < grid.len(), "{spacing_mm} mm"),
+            }
+        }
+    }
 
     /// Cut `n` times along each edge, a triangle gives `n²` points, each inside it with
     /// weights that sum to one and place it where it is, covering the triangle's area once,

@@ -125,8 +125,9 @@ pub struct Contact {
     #[serde(default)]
     pub lattice_mm: Option<Millimetres>,
     /// Which points of the other organs are tested: `Nodes` (their surface nodes, the
-    /// default), `Dense` (also their surface triangles' centres) or `Subdivided(n)` (the
-    /// centres of each surface triangle cut `n` times along each edge, `n` from 1 to 8).
+    /// default), `Dense` (also their surface triangles' centres), `Subdivided(n)` (the
+    /// centres of each surface triangle cut `n` times along each edge, `n` from 1 to 8) or
+    /// `Sparse(mm)` (the surface nodes, kept at least `mm` millimetres apart, 1 to 50).
     #[serde(default)]
     pub pointshell: PointshellDensity,
 }

@@ -8,7 +8,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use super::format::{OrganEntry, Scenario, Task};
-use crate::contact::{PointshellDensity, check_subdivisions};
+use crate::contact::PointshellDensity;
 use crate::mesh::organs::{Organ, region};
 
 /// Where every reference of the scenario format is explained.
@@ -177,14 +177,22 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
             "contact",
         ));
     }
-    if let PointshellDensity::Subdivided(n) = scenario.contact.pointshell
-        && let Err(message) = check_subdivisions(n)
-    {
+    if let Err(message) = scenario.contact.pointshell.check() {
+        let (variant, hint) = match scenario.contact.pointshell {
+            PointshellDensity::Sparse(_) => (
+                "Sparse",
+                "`Nodes` tests every surface node; `Sparse(mm)` keeps them at least `mm` apart",
+            ),
+            _ => (
+                "Subdivided",
+                "a coarser pointshell: `Nodes` tests the surface nodes, `Dense` adds the triangles' centres",
+            ),
+        };
         problems.push(Problem {
             field: "contact.pointshell".into(),
-            anchors: vec!["contact".into(), "Subdivided".into()],
+            anchors: vec!["contact".into(), variant.into()],
             message,
-            hint: "a coarser pointshell: `Nodes` tests the surface nodes, `Dense` adds the triangles' centres".into(),
+            hint: hint.into(),
         });
     }
     if scenario.tasks.is_empty() {

@@ -110,6 +110,17 @@ pub fn dense_scene() -> &'static HapticScene {
     })
 }
 
+/// The same scene with the liver's and the other organs' nodes thinned to 15 mm apart.
+pub fn sparse_scene() -> &'static HapticScene {
+    static SCENE: OnceLock<HapticScene> = OnceLock::new();
+    SCENE.get_or_init(|| {
+        scene_with(&CouplingSettings {
+            pointshell: PointshellDensity::Sparse(15),
+            ..CouplingSettings::default()
+        })
+    })
+}
+
 /// The same scene measuring every pointshell node within reach every tick, none skipped as
 /// known clear.
 pub fn measuring_every_node_scene() -> &'static HapticScene {

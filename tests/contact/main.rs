@@ -93,6 +93,55 @@ fn a_dense_pointshell_covers_the_surface_once() {
     assert!(dense.area_m2.iter().all(|&a| a > 0.0));
 }
 
+/// Thinned to 15 mm, the liver's pointshell keeps fewer points, none two closer than that,
+/// every node within 15 mm of one kept, and the nodes' whole area (f32 sums, 1e-5 relative).
+#[test]
+fn a_sparse_pointshell_keeps_its_points_apart_and_covers_the_surface_once() {
+    let (_, liver) = organ("liver");
+    let (_, gallbladder) = organ("gallbladder");
+    let surface = ContactSurface::new(gallbladder).unwrap();
+    let everywhere = DistanceSettings {
+        spacing_m: 0.02,
+        margin_m: 0.3,
+    };
+    let field = DistanceField::build(gallbladder, &surface, &everywhere);
+    let shell = |density| Pointshell::new(liver, gallbladder, &surface, &field, density);
+    let (nodes, sparse) = (
+        shell(PointshellDensity::Nodes),
+        shell(PointshellDensity::Sparse(15)),
+    );
+    let total = |p: &Pointshell| p.area_m2.iter().map(|&a| a as f64).sum::<f64>();
+    let (a, b) = (total(&nodes), total(&sparse));
+    eprintln!(
+        "{} nodes, {} kept 15 mm apart; area {:.2} cm² against {:.2} cm²",
+        nodes.len(),
+        sparse.len(),
+        a * 1e4,
+        b * 1e4
+    );
+    assert!(sparse.len() < nodes.len());
+    assert!(((a - b) / a).abs() < 1e-5, "{a} m² against {b} m²");
+    let spacing_m = 0.015;
+    for (k, p) in sparse.rest_m.iter().enumerate() {
+        assert!(
+            sparse.rest_m[..k]
+                .iter()
+                .all(|q| (p - q).norm() as f64 >= spacing_m - 1e-6)
+        );
+    }
+    for p in &nodes.rest_m {
+        let nearest = sparse
+            .rest_m
+            .iter()
+            .map(|q| (p - q).norm())
+            .fold(f32::INFINITY, f32::min);
+        assert!(
+            (nearest as f64) < spacing_m + 1e-6,
+            "a node {nearest} m from every point kept"
+        );
+    }
+}
+
 /// The gallbladder pressed into the liver with a dense pointshell: more points push, none
 /// deeper than one lattice cell, and the forces on the two organs balance. Measured: 9
 /// points against 6 nodes (2 and 2 while contact loads moved the organs through their modes
@@ -110,6 +159,49 @@ fn pressing_with_a_dense_pointshell_pushes_more_points_and_stays_shallow() {
         dense.nodes_in_contact, nodes.nodes_in_contact
     );
     assert!(dense.nodes_in_contact > nodes.nodes_in_contact);
+    assert_shallow(&record);
+    let g = organ("gallbladder").0;
+    for tick in &record {
+        let on_shells: Vector3<f64> = tick.pairs.iter().map(|p| p.2.force_on_shell_n).sum();
+        let on_master = tick.organs[g].coupling_force_n;
+        assert!((on_master + on_shells).norm() <= 1e-12 * on_shells.norm().max(1e-9));
+    }
+}
+
+/// The gallbladder pressed into the liver with a sparse pointshell: contact still forms and
+/// pushes the liver, no point kept sinks deeper than one lattice cell, and the forces on the
+/// two organs balance. The total contact force is the press's, set by the tool and the two
+/// organs' compliance, whatever points carry it: within 10 % of the nodes' (measured: 4 of 30
+/// points push with 6.43 mN, 6 of 74 nodes with 6.37 mN). The nodes left out are not
+/// tested and may sink between the points kept.
+#[test]
+fn pressing_with_a_sparse_pointshell_still_pushes_and_stays_shallow() {
+    let target = facing("gallbladder", -Vector3::z());
+    let (_, record) = run_on(sparse_scene(), push(&target, 0.012, PUSH_S, 0.5), TICKS);
+    let (sparse, nodes) = (
+        liver_pair(record.last().unwrap()),
+        liver_pair(pushed().last().unwrap()),
+    );
+    let (f_sparse, f_nodes) = (
+        sparse.force_on_shell_n.norm(),
+        nodes.force_on_shell_n.norm(),
+    );
+    eprintln!(
+        "{} of {} points push sparsely, {:.2} mN; {} of {} nodes otherwise, {:.2} mN",
+        sparse.nodes_in_contact,
+        sparse_scene().coupling.as_ref().unwrap().pairs[0]
+            .pointshell()
+            .len(),
+        f_sparse * 1e3,
+        nodes.nodes_in_contact,
+        scene().coupling.as_ref().unwrap().pairs[0]
+            .pointshell()
+            .len(),
+        f_nodes * 1e3
+    );
+    assert!(sparse.nodes_in_contact > 0);
+    assert!(sparse.nodes_in_contact <= nodes.nodes_in_contact);
+    assert!((f_sparse - f_nodes).abs() < 0.1 * f_nodes);
     assert_shallow(&record);
     let g = organ("gallbladder").0;
     for tick in &record {

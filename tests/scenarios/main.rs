@@ -236,6 +236,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "cut 20 times along each edge",
         ),
         (
+            "pointshell-too-sparse",
+            6,
+            "contact.pointshell",
+            "kept 80 mm apart",
+        ),
+        (
             "organ-unknown-field",
             7,
             "organs[0].stiffness_pa",
@@ -466,8 +472,8 @@ fn an_organ_from_a_mesh_file_feels_as_the_organ_it_was_written_from() {
 
 /// A scenario's contact master carries the distance field the other organs are tested
 /// against: with the liver chosen (on a coarse 8 mm lattice, quick to build), the scene's one contact pair tests the
-/// gallbladder's nodes against the liver, where by default it is the other way round; and a
-/// dense pointshell tests more than twice as many of the liver's points.
+/// gallbladder's nodes against the liver, where by default it is the other way round; a
+/// dense pointshell tests more than twice as many of the liver's points, a sparse one fewer.
 #[test]
 fn the_scenario_chooses_the_contact_master() {
     let text = |contact: &str| {
@@ -507,5 +513,10 @@ fn the_scenario_chooses_the_contact_master() {
     assert!(
         dense > 2 * nodes,
         "{dense} dense points against {nodes} nodes"
+    );
+    let sparse = points("contact: Contact(pointshell: Sparse(15)),");
+    assert!(
+        sparse > 0 && sparse < nodes,
+        "{sparse} points 15 mm apart against {nodes} nodes"
     );
 }
