@@ -451,11 +451,27 @@ fn the_distance_field_agrees_with_the_exact_distance_to_the_deformed_gallbladder
     );
 }
 
+/// Paper 000 hangs the gallbladder and the pancreas from the duodenum: pressed 8 mm, 3 cm
+/// from each interface, the duodenum's interface moves and the organ it carries moves with it
+/// there (rms mismatch under a quarter of the motion). Measured: gallbladder 0.07 mm on
+/// 5.4 mm; pancreas 1.04 mm on 6.2 mm. The pancreas hangs over a wider interface (46
+/// positions, 24 mm rms from their centre, against 12 and 8 mm), which the duodenum strains
+/// by some 5 % as it bends: a rigid carry cannot follow that, and an affine one (0.35 mm)
+/// would stretch the whole pancreas by it.
 #[test]
-fn an_attached_organ_moves_with_the_organ_it_hangs_from() {
+fn the_gallbladder_moves_with_the_duodenum_it_hangs_from() {
+    assert_carried_by_the_duodenum("gallbladder");
+}
+
+#[test]
+fn the_pancreas_moves_with_the_duodenum_it_hangs_from() {
+    assert_carried_by_the_duodenum("pancreas");
+}
+
+fn assert_carried_by_the_duodenum(carried: &str) {
     let coupling = scene().coupling.as_ref().unwrap();
     let (d, duodenum) = organ("duodenum");
-    let (g, _) = organ("gallbladder");
+    let (g, _) = organ(carried);
     let attachment = coupling
         .attachments
         .iter()
@@ -500,7 +516,7 @@ fn an_attached_organ_moves_with_the_organ_it_hangs_from() {
     let n = interface.len() as f64;
     let (moved, mismatch) = ((moved / n).sqrt(), (mismatch / n).sqrt());
     eprintln!(
-        "interface moved {:.3} mm rms, the carried gallbladder differs by {:.3} mm rms; carry {:.3?} mm",
+        "interface moved {:.3} mm rms, the carried {carried} differs by {:.3} mm rms; carry {:.3?} mm",
         moved * 1e3,
         mismatch * 1e3,
         (carry.translation_m * 1e3).as_slice()
