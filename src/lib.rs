@@ -1,18 +1,24 @@
-//! A real-time surgery trainer built on PGD computational vademecums.
+//! A real-time surgery trainer built on PGD computational vademecums, in four layers
+//! (`docs/architecture.md`), each using only those below it:
 //!
-//! The numerical core is plain Rust with no Bevy: [`mesh`] (tetrahedral meshes and their
-//! regions), [`fem`] (finite elements, the reference every vademecum is checked against) and
-//! [`pgd`] (the vademecums).
-//! [`bench`] times it. [`app`] is the Bevy layer on top; the binaries in `src/bin` stay thin.
+//! - the numerical core, plain Rust with no Bevy: [`mesh`], [`fem`] (the reference every
+//!   vademecum is checked against), [`pgd`] (the vademecums), [`contact`], [`devices`] (the
+//!   device layer), [`scenario`] (exercises), [`dense_sums`], [`parry_interop`], and [`bench`],
+//!   which times them;
+//! - services: [`store`] (organs and vademecums on disk) and [`report`] (files for people);
+//! - [`app`], the Bevy layer: the 1 kHz haptic loop, the scene, the trainer window;
+//! - [`cli`], what the binaries' commands do and print; the binaries in `src/bin` stay thin.
 
 pub mod app;
 pub mod bench;
 pub mod cli;
 pub mod contact;
+pub mod dense_sums;
+pub mod devices;
 pub mod fem;
-pub mod haptics;
-pub mod kernels;
 pub mod mesh;
+pub mod parry_interop;
 pub mod pgd;
+pub mod report;
 pub mod scenario;
-pub mod seam;
+pub mod store;

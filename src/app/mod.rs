@@ -1,11 +1,13 @@
-//! The Bevy layer over the numerical core: the haptic world and its 1 kHz thread
-//! ([`haptic`]), the default scene ([`scene`]), a session of the trainer, headless or not
-//! ([`session`]), and the trainer window ([`window`]).
+//! The Bevy layer over the numerical core: the haptic loop's world and its 1 kHz thread
+//! ([`haptic`]), the default scene ([`scene`]), one attempt at a scenario ([`attempt`]), a
+//! run of the trainer, headless or in its window ([`launch`]), the trainer window
+//! ([`window`]) and the benchmark of the whole loop ([`bench`]).
 
-pub mod exercise;
+pub mod attempt;
+pub mod bench;
 pub mod haptic;
+pub mod launch;
 pub mod scene;
-pub mod session;
 pub mod window;
 
 /// The trainer's built-in scenario (its shipped file and its text): the window's default

@@ -8,13 +8,13 @@ use std::sync::Arc;
 use nalgebra::Vector3;
 
 use super::haptic::HapticScene;
-use crate::cli::{OnStale, OrganSource, VademecumSpec, ensure_vademecum};
 use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, FieldOrigin, Probe};
+use crate::devices::{PressTarget, SafetySettings, Workspace};
 use crate::fem::{Inclusion, Law};
-use crate::haptics::{PressTarget, SafetySettings, Workspace};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::{Organ, OrganSettings, region};
 use crate::pgd::{BuildSettings, Vademecum};
+use crate::store::{OnStale, OrganSource, VademecumSpec, ensure_vademecum};
 
 pub const SCENE_ORGANS: [Organ; 4] = Organ::ABDOMEN;
 

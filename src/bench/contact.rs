@@ -18,15 +18,14 @@ use nalgebra::{Point3, Vector3};
 use parry3d::query::PointQuery;
 use serde::Serialize;
 
-use crate::app::haptic::HapticScene;
 use crate::contact::{
-    ContactPair, ContactSurface, CouplingSettings, DistanceField, OrganPose, PairOutput,
+    ContactPair, ContactSurface, Coupling, CouplingSettings, DistanceField, OrganPose, PairOutput,
     PairReport, Pointshell, ToolHold,
 };
+use crate::parry_interop::{to_parry, trimesh};
 use crate::pgd::{PointLoad, RigidCarry, Vademecum};
-use crate::seam::{to_parry, trimesh};
 
-/// Nodes in contact the pressed case asks for (the figure).
+/// Nodes in contact the pressed case asks for (the target's figure, `docs/physics.md`).
 const PRESSED_NODES: usize = 400;
 
 /// The most ticks a press is given to settle before its nodes in contact are counted or
@@ -44,7 +43,7 @@ const SLIDE_M_PER_TICK: f64 = 10e-6;
 const SLIDE_REACH_M: f64 = 2e-3;
 
 /// A scene's organ: its name and vademecum.
-type Organ = (String, Arc<Vademecum>);
+pub type Organ = (String, Arc<Vademecum>);
 
 #[derive(Clone, Debug, Serialize)]
 pub struct StageFigures {
@@ -103,16 +102,17 @@ impl Case {
     }
 }
 
-/// Times the scene's master against its largest pointshell over `ticks` ticks per case in
-/// `cases` (every case where none is named); `settings` are those the scene's coupling was
-/// set up with.
+/// Times the coupling's master against its largest pointshell over `ticks` ticks per case in
+/// `cases` (every case where none is named); `organs` are the scene's, in the coupling's
+/// order, and `settings` those the coupling was set up with.
 pub fn run(
-    scene: &HapticScene,
+    organs: &[Organ],
+    coupling: &Coupling,
     settings: &CouplingSettings,
     ticks: usize,
     cases: &[Case],
 ) -> Result<ContactBenchReport, String> {
-    let (pair, master, shell) = largest_pair(scene)?;
+    let (pair, master, shell) = largest_pair(organs, coupling)?;
     let cases = match cases {
         [] => &[Case::Apart, Case::Pressed, Case::Held, Case::Sliding],
         named => named,
@@ -158,29 +158,29 @@ pub fn run(
     })
 }
 
-/// The scene's pair with the largest pointshell, its master and its shell organ.
-fn largest_pair(scene: &HapticScene) -> Result<(&ContactPair, &Organ, &Organ), String> {
-    let coupling = scene
-        .coupling
-        .as_ref()
-        .ok_or("the scene has no organ contact")?;
+/// The coupling's pair with the largest pointshell, its master and its shell organ.
+fn largest_pair<'a>(
+    organs: &'a [Organ],
+    coupling: &'a Coupling,
+) -> Result<(&'a ContactPair, &'a Organ, &'a Organ), String> {
     let pair = coupling
         .pairs
         .iter()
         .max_by_key(|p| p.pointshell().len())
         .ok_or("the scene's master meets no other organ")?;
-    Ok((pair, &scene.organs[pair.master], &scene.organs[pair.shell]))
+    Ok((pair, &organs[pair.master], &organs[pair.shell]))
 }
 
 /// The pair of [`run`] with its master, free to deform, carried `depth_m` into the shell
 /// organ: the pair's report of each of `ticks` ticks (the contact tests check that a deep
 /// press settles).
 pub fn free_press(
-    scene: &HapticScene,
+    organs: &[Organ],
+    coupling: &Coupling,
     depth_m: f64,
     ticks: usize,
 ) -> Result<Vec<PairReport>, String> {
-    let (pair, master, shell) = largest_pair(scene)?;
+    let (pair, master, shell) = largest_pair(organs, coupling)?;
     let mut run = Run::new(pair, master, shell, carry_into(pair, depth_m));
     Ok((0..ticks)
         .map(|_| {

@@ -1,7 +1,7 @@
 //! Rerunnable benchmarks of the numerical core, reported as medians and as ratios to a
-//! baseline measured in the same run. Run them with `pgd bench …`.
+//! baseline measured in the same run. Run them with `pgd bench …`. They depend on the core
+//! only; the haptic loop's benchmark runs the app's world and lives with it (`app::bench`).
 
 pub mod contact;
 pub mod fem;
-pub mod haptics;
 pub mod vademecum;

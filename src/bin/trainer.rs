@@ -4,14 +4,14 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use pgd_surgery::app::exercise::Outcome;
+use pgd_surgery::app::launch::WindowLesson;
 use pgd_surgery::app::scene::Detail;
-use pgd_surgery::app::session::WindowLesson;
 use pgd_surgery::app::window::{Opening, ScreenshotPlan};
-use pgd_surgery::app::{self, DEFAULT_SCENARIO, session};
-use pgd_surgery::cli::{self, OnStale};
-use pgd_surgery::haptics::{DeviceSpec, TimerMode};
+use pgd_surgery::app::{self, DEFAULT_SCENARIO, launch};
+use pgd_surgery::cli::{debrief, numbered, validate_scenarios};
+use pgd_surgery::devices::{DeviceSpec, TimerMode};
 use pgd_surgery::scenario;
+use pgd_surgery::store::OnStale;
 
 #[derive(Parser)]
 #[command(
@@ -84,7 +84,7 @@ enum Command {
     Run {
         /// The scenario, e.g. scenarios/liver-steady-press.scenario.ron.
         file: PathBuf,
-        /// Where the session report goes (JSON, a summary, a force plot).
+        /// Where the attempt's report goes (JSON, a summary, a force plot).
         #[arg(long, default_value = "reports")]
         report_dir: PathBuf,
     },
@@ -107,7 +107,7 @@ fn parse_timer(s: &str) -> Result<TimerMode, String> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     if let Some(Command::Validate { files }) = &cli.command {
-        return validate(files);
+        return validate_scenarios(files);
     }
     if !cli.headless
         && let Some(why) = app::missing_display()
@@ -128,7 +128,7 @@ fn main() -> ExitCode {
         true => cli.realtime.then_some(cli.timer),
         false => Some(cli.timer),
     };
-    let options = session::Options {
+    let options = launch::Options {
         vademecums: cli.vademecums.clone(),
         detail: match cli.coarse {
             true => Detail::Coarse,
@@ -165,10 +165,10 @@ fn main() -> ExitCode {
     if cli.headless {
         return match exercise {
             Some((scenario, file, report_dir)) => {
-                let outcome = session::run_scenario_headless(&options, scenario);
+                let outcome = launch::run_scenario_headless(&options, scenario);
                 debrief(outcome, file, None, report_dir, cli.json)
             }
-            None => finish(session::run_headless(&options), cli.json),
+            None => finish(launch::run_headless(&options), cli.json),
         };
     }
     let screenshot = cli.screenshot.clone().map(|path| ScreenshotPlan {
@@ -189,7 +189,7 @@ fn main() -> ExitCode {
         folder: Some(file.parent().unwrap_or(Path::new(".")).to_owned())
             .filter(|folder| folder.is_dir()),
     });
-    match session::open_window(&options, cli.exit_after_s, screenshot, lesson) {
+    match launch::open_window(&options, cli.exit_after_s, screenshot, lesson) {
         Ok((report, attempts)) => match report_dir {
             Some(dir) if !attempts.is_empty() => {
                 // With --json, stdout carries the scorecards alone.
@@ -219,23 +219,7 @@ fn main() -> ExitCode {
     }
 }
 
-/// Each attempt with its number among its scenario's attempts, when there were several.
-fn numbered(attempts: session::Attempts) -> Vec<(PathBuf, Option<usize>, Outcome)> {
-    let count = |file: &PathBuf| attempts.iter().filter(|(f, _)| f == file).count();
-    let counts: Vec<usize> = attempts.iter().map(|(file, _)| count(file)).collect();
-    let mut seen: Vec<PathBuf> = Vec::new();
-    attempts
-        .into_iter()
-        .zip(counts)
-        .map(|((file, outcome), count)| {
-            seen.push(file.clone());
-            let k = seen.iter().filter(|f| **f == file).count();
-            (file, (count > 1).then_some(k), outcome)
-        })
-        .collect()
-}
-
-fn finish(result: Result<session::Report, String>, json: bool) -> ExitCode {
+fn finish(result: Result<launch::Report, String>, json: bool) -> ExitCode {
     match result {
         Ok(report) => {
             report.print(json);
@@ -243,78 +227,6 @@ fn finish(result: Result<session::Report, String>, json: bool) -> ExitCode {
         }
         Err(e) => {
             eprintln!("trainer: {e}");
-            ExitCode::FAILURE
-        }
-    }
-}
-
-/// `trainer validate`: every file checked, every problem printed; fails if any file has one.
-fn validate(files: &[PathBuf]) -> ExitCode {
-    let mut failed = false;
-    for file in files {
-        match scenario::load(file) {
-            Ok(s) => println!(
-                "{}: ok ({}, {} task{})",
-                file.display(),
-                s.title,
-                s.tasks.len(),
-                if s.tasks.len() == 1 { "" } else { "s" }
-            ),
-            Err(e) => {
-                eprintln!("{e}");
-                failed = true;
-            }
-        }
-    }
-    if failed {
-        ExitCode::FAILURE
-    } else {
-        ExitCode::SUCCESS
-    }
-}
-
-/// The end of an exercise: its score printed (JSON with `json`) and its report written, named
-/// after the scenario's file (and the attempt, when the trainee retried).
-fn debrief(
-    outcome: Result<Outcome, String>,
-    file: &Path,
-    attempt: Option<usize>,
-    report_dir: &Path,
-    json: bool,
-) -> ExitCode {
-    let outcome = match outcome {
-        Ok(outcome) => outcome,
-        Err(e) => {
-            eprintln!("trainer: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
-    let name = file
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or("session");
-    let stem = name.trim_end_matches(".ron").trim_end_matches(".scenario");
-    let stem = match attempt {
-        Some(k) => format!("{stem}.attempt-{k}"),
-        None => stem.to_owned(),
-    };
-    let written = cli::write_report(report_dir, &stem, &outcome.card, &outcome.force_trace);
-    if json {
-        match serde_json::to_string_pretty(&outcome.card) {
-            Ok(text) => println!("{text}"),
-            Err(e) => eprintln!("trainer: could not write the JSON scorecard: {e}"),
-        }
-    } else {
-        print!("{}", cli::summary(&outcome.card));
-    }
-    match written {
-        Ok(paths) => {
-            let paths: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
-            eprintln!("report: {}", paths.join(", "));
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("trainer: the report was not written: {e}");
             ExitCode::FAILURE
         }
     }

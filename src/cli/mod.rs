@@ -1,17 +1,18 @@
-//! Terminal helpers shared by the binaries: progress bars and organ/mesh lookup. Kept out of
-//! the binaries so they stay thin, and out of the numerical core so it stays quiet.
+//! What the binaries' commands do and print, apart from parsing their arguments: `pgd build`,
+//! `validate` and `mesh`; `trainer validate` and the end of an attempt; the parsers of option
+//! values, with errors that name the range; how a command ends (JSON or a table, or an error).
+//! The binaries keep their clap option types beside them and call in here.
 
-mod contact;
-mod convergence;
-mod plot;
-mod progress;
-mod report;
-mod source;
-mod vademecums;
+mod output;
+mod parse;
+mod pgd_build;
+mod pgd_mesh;
+mod pgd_validate;
+mod trainer_commands;
 
-pub use contact::{parse_spacing, parse_stiffness_ratio, parse_subdivisions};
-pub use convergence::{StepCurve, write as write_convergence, write_of_header};
-pub use progress::Bar;
-pub use report::{summary, write_report};
-pub use source::{MeshSource, OrganSource, load_source};
-pub use vademecums::{OnStale, VademecumSpec, ensure_vademecum, parse_inclusion};
+pub use output::{fail, print_json, print_report};
+pub use parse::{parse_inclusion, parse_spacing, parse_stiffness_ratio, parse_subdivisions};
+pub use pgd_build::{build_vademecum, print_build_report};
+pub use pgd_mesh::report_mesh;
+pub use pgd_validate::{print_validation, validate_vademecum};
+pub use trainer_commands::{debrief, numbered, validate_scenarios};

@@ -3,8 +3,8 @@
 //!
 //! The rest-distance cull ([`super::ContactPair::tick`]) bounds what *can* move, from rest:
 //! on the floppy gallbladder, pressed by the tool, that bound reaches every liver node within
-//! centimetres, and each of them was measured every tick (session 15: up to 130 reads and
-//! 1,550 lattice nodes a tick while the tool slid over the gallbladder, 200 µs). Motion from
+//! centimetres (up to 130 reads and 1,550 lattice nodes a tick while the tool slides over the
+//! gallbladder, were each measured every tick). Motion from
 //! one tick to the next is micrometres, so a node measured 5 mm clear stays clear for hundreds
 //! of ticks. Each tick adds how far anything may have moved since the last
 //! ([`Clearance::advance`]); a node is skipped while that drift, summed since it was measured,
@@ -21,7 +21,8 @@
 //! tick, of which about 1,200 are read).
 
 use super::DistanceField;
-use super::penalty::OrganPose;
+use super::pointshell::BLOCK;
+use super::pose::OrganPose;
 use crate::pgd::RigidCarry;
 
 /// How many times the motion since a measurement the measured distance must exceed for the
@@ -32,10 +33,6 @@ use crate::pgd::RigidCarry;
 /// 1.5 for that slope. `√3 · 2 · 1.5 ≈ 5.2`; 6 leaves a margin. Exactness is tested: with and
 /// without the skip, every tick's forces are the same.
 const SAFETY: f64 = 6.0;
-
-/// Nodes per block of wakes: small enough that a block holding a node to measure costs little
-/// to scan, large enough that the blocks are few.
-pub(super) const BLOCK: usize = 64;
 
 #[derive(Clone, Debug, Default)]
 pub struct Clearance {

@@ -10,7 +10,8 @@ use std::sync::Arc;
 use nalgebra::Vector3;
 
 use super::modal_rows::{concatenate, step_ranges};
-use super::penalty::{OrganPose, PairOutput, PenaltySettings};
+use super::pair::{PairOutput, PenaltySettings};
+use super::pose::OrganPose;
 use super::{
     Attachment, ContactError, ContactPair, ContactSurface, DistanceField, DistanceSettings,
     FieldOrigin, NearField, Pointshell, PointshellDensity, ToolContact, ToolHold,

@@ -15,7 +15,7 @@ use super::hold::ToolHold;
 use super::local_compliance::LocalCompliance;
 use super::modal_rows::ModalRows;
 use super::pointshell::Pointshell;
-use crate::kernels::{axpy, dot};
+use crate::dense_sums::{axpy, dot};
 use crate::pgd::Vademecum;
 
 #[derive(Clone, Debug, Default)]

@@ -10,6 +10,12 @@ use super::modal_rows::ModalRows;
 use super::{ContactSurface, DistanceField};
 use crate::pgd::Vademecum;
 
+/// Nodes per block: the pointshell's nodes, nearest the master first, are taken in blocks
+/// this long wherever a tick passes over many of them at once (the clearance's wakes, the
+/// dimples' readers): small enough that a block holding a node to measure costs little to
+/// scan, large enough that the blocks are few.
+pub(super) const BLOCK: usize = 64;
+
 /// The nodes are kept in order of their rest distance to the master, nearest first: those
 /// that can touch this tick are a leading run (found with one binary search), and the
 /// contact's per-node arrays are read in runs.

@@ -1,5 +1,5 @@
 //! The contact forces of one tick: the minimum of the convex contact energy
-//! `E(f) = ½ fᵀ A f + Σ f²/2k + d₀ᵀ f` over `f ≥ 0` (see [`super::penalty`]), by conjugate
+//! `E(f) = ½ fᵀ A f + Σ f²/2k + d₀ᵀ f` over `f ≥ 0` (see [`super::pair`]), by conjugate
 //! gradients on the nodes that push, restarted whenever a node starts or stops pushing
 //! (Polyak's active-set method, preconditioned by the penalties).
 //!

@@ -8,7 +8,7 @@
 
 use super::linear_solver::DirectSolver;
 use super::{FemError, FemModel, Loads};
-use crate::kernels::dot;
+use crate::dense_sums::dot;
 
 /// How a static solve proceeds.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -10,7 +10,7 @@
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use super::VademecumError;
+use super::error::VademecumError;
 
 const PREFIX_BYTES: usize = 8 + 4 + 8 + 8;
 const CHECKSUM_BYTES: usize = 32;

@@ -11,8 +11,8 @@
 use super::load_patches::LoadOperator;
 use super::separated::SeparatedField;
 use super::stiffness::RestStiffness;
+use crate::dense_sums::dot;
 use crate::fem::FemError;
-use crate::kernels::dot;
 
 /// How the enrichment proceeds and when it stops.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -10,9 +10,9 @@ use rayon::prelude::*;
 use super::load_patches::LoadOperator;
 use super::responses::Responses;
 use super::separated::SeparatedField;
+use super::statistics::Statistics;
 use super::stiffness::RestStiffness;
-use super::validate::Statistics;
-use crate::kernels::dot;
+use crate::dense_sums::dot;
 
 /// Relative errors by number of modes, index `n − 1` for `n` modes.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]

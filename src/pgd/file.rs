@@ -3,13 +3,12 @@
 //! material, regions, load directions and steps, build settings); its payload the arrays,
 //! modes as f32.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use thiserror::Error;
-
-use super::BuildSettings;
 use super::container::{self, Kind, Reader, put};
+use super::error::VademecumError;
 use super::local::LocalPart;
+use super::settings::BuildSettings;
 use super::vademecum::{Header, Step, Vademecum};
 use crate::fem::{Inclusion, Material};
 use crate::mesh::TetMesh;
@@ -21,75 +20,6 @@ const KIND: Kind = Kind {
     version: FORMAT_VERSION,
     name: "vademecum",
 };
-
-#[derive(Debug, Error)]
-pub enum VademecumError {
-    #[error("{file}: {source}")]
-    Io {
-        file: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("{file}: not a {kind} file (it does not start with {magic})")]
-    NotAVademecum {
-        file: PathBuf,
-        kind: &'static str,
-        magic: String,
-    },
-    #[error(
-        "{file}: format version {found}, but this build reads version {expected}; rebuild it with `pgd build`"
-    )]
-    Version {
-        file: PathBuf,
-        found: u32,
-        expected: u32,
-    },
-    #[error("{file}: truncated: {found} bytes where the header announces {expected}")]
-    Truncated {
-        file: PathBuf,
-        expected: u64,
-        found: u64,
-    },
-    #[error("{file}: corrupted: the checksum does not match the contents")]
-    Corrupted { file: PathBuf },
-    #[error("{file}: malformed {what}")]
-    Malformed { file: PathBuf, what: String },
-    #[error(
-        "{file}: built for another mesh (mesh hash {found}, this mesh {expected}); rebuild it with `pgd build`"
-    )]
-    OtherMesh {
-        file: PathBuf,
-        expected: String,
-        found: String,
-    },
-    #[error(
-        "{file}: built for another material ({found}, wanted {expected}); rebuild it with `pgd build`"
-    )]
-    OtherMaterial {
-        file: PathBuf,
-        expected: String,
-        found: String,
-    },
-    #[error(
-        "{file}: built with other settings ({found}, wanted {expected}); rebuild it with `pgd build`"
-    )]
-    OtherSettings {
-        file: PathBuf,
-        expected: String,
-        found: String,
-    },
-    #[error(
-        "{file}: built for another vademecum (inputs hash {found}, this one {expected}); it is rebuilt"
-    )]
-    OtherVademecum {
-        file: PathBuf,
-        expected: String,
-        found: String,
-    },
-    #[error(
-        "{file}: not written: its header would not read back the same ({why}); nothing was saved"
-    )]
-    Unwritable { file: PathBuf, why: String },
-}
 
 /// Writes `vademecum` to `path` atomically.
 pub fn save(path: &Path, vademecum: &Vademecum) -> Result<(), VademecumError> {

@@ -7,11 +7,6 @@
 //! exactly at `s`, not for an interpolation of patches centred on nodes. The load matrix `F`
 //! (dofs × parameters) is never formed: it is applied, and transposed, node by node.
 
-use faer::{ColRef, MatRef};
-use rayon::prelude::*;
-
-use super::responses::Responses;
-use super::stiffness::RestStiffness;
 use crate::fem::{FemError, PatchKernel};
 use crate::mesh::{NOT_ON_SURFACE, Surface};
 
@@ -80,48 +75,5 @@ impl LoadOperator for LoadPatches {
         for (m, &node) in self.positions.iter().enumerate() {
             out[3 * m..3 * m + 3].copy_from_slice(&r[3 * node..3 * node + 3]);
         }
-    }
-}
-
-/// The right-hand side of a KSV load step, per unit force: `B = K Ũ` for the step's secant
-/// responses `Ũ` (the unit loads minus the nonlinear terms, `F − N(λŨ)/λ`), applied through
-/// `Ũ` and the rest stiffness so that the dense `B` is never stored.
-pub struct SecantLoads<'a> {
-    pub stiffness: &'a RestStiffness<'a>,
-    pub responses: &'a Responses,
-}
-
-impl LoadOperator for SecantLoads<'_> {
-    fn parameter_count(&self) -> usize {
-        self.responses.count()
-    }
-
-    /// `Ũ s` is a dense product over every response (the whole `Ũ`, hundreds of MB, streamed
-    /// once): faer's GEMV, on all cores.
-    fn apply(&self, s: &[f64], out: &mut [f64]) {
-        let responses = self.responses;
-        let u_all = MatRef::from_column_major_slice(&responses.columns, responses.rows, s.len());
-        let u = u_all * ColRef::from_slice(s);
-        let u: Vec<f64> = u.iter().copied().collect();
-        let mut ku = vec![0.0; u.len()];
-        self.stiffness.mul(&u, &mut ku);
-        for (v, &d) in ku.iter().zip(&self.stiffness.model.dofs().free_dofs) {
-            out[d] += v;
-        }
-    }
-
-    fn apply_transpose(&self, r: &[f64], out: &mut [f64]) {
-        let r_free = self.stiffness.restrict(r);
-        let mut kr = vec![0.0; r_free.len()];
-        self.stiffness.mul(&r_free, &mut kr);
-        out.par_iter_mut().enumerate().for_each(|(p, o)| {
-            *o = self
-                .responses
-                .column(p)
-                .iter()
-                .zip(&kr)
-                .map(|(a, b)| a * b)
-                .sum();
-        });
     }
 }

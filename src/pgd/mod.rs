@@ -6,6 +6,7 @@ mod build;
 pub mod container;
 mod deformation;
 mod enrichment;
+mod error;
 mod error_curve;
 mod file;
 mod load_patches;
@@ -13,25 +14,27 @@ mod local;
 pub mod organ;
 mod responses;
 mod separated;
+mod settings;
+mod statistics;
 mod stiffness;
 mod vademecum;
 mod validate;
 
-pub use build::{
-    BuildReport, BuildSettings, DEFAULT_LOAD_STEPS_M, OrganModel, StepReport,
-    WIDE_NEAR_FIELD_SHARE, build,
-};
+pub use build::{BuildReport, OrganModel, StepReport, WIDE_NEAR_FIELD_SHARE, build};
 pub use deformation::{Deformation, PatchLoad, PointLoad, RigidCarry};
 pub use enrichment::{ModeReport, PgdSettings, enrich};
+pub use error::VademecumError;
 pub use error_curve::{EnergyError, ErrorCurve, optimal_errors};
-pub use file::{FORMAT_VERSION, VademecumError, decode, encode, load, read_header, save};
-pub use load_patches::{LoadOperator, LoadPatches, SecantLoads};
+pub use file::{FORMAT_VERSION, decode, encode, load, read_header, save};
+pub use load_patches::{LoadOperator, LoadPatches};
 pub use local::LocalPart;
-pub use responses::{Responses, SecantReport, SecantSettings};
+pub use responses::{Responses, SecantLoads, SecantReport, SecantSettings};
 pub use separated::SeparatedField;
+pub use settings::{BuildSettings, DEFAULT_LOAD_STEPS_M};
+pub use statistics::Statistics;
 pub use stiffness::RestStiffness;
 pub use vademecum::{Header, Patch, Step, SurfacePoint, Vademecum};
-pub use validate::{Sample, Statistics, ValidationReport, ValidationSettings, validate};
+pub use validate::{Sample, ValidationReport, ValidationSettings, validate};
 
 use crate::mesh::TetMesh;
 

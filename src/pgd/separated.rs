@@ -1,6 +1,6 @@
 //! A field in separated form, `u(x, p) ≈ Σ_k X^k(x) · Y^k(p)`: the computational vademecum.
 
-use crate::kernels::dot;
+use crate::dense_sums::dot;
 
 /// Spatial modes over all dofs (prescribed ones zero) and parametric modes over the load
 /// parameters, pairwise.

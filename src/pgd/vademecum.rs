@@ -5,9 +5,9 @@
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::BuildSettings;
 use super::error_curve::ErrorCurve;
 use super::local::LocalPart;
+use super::settings::BuildSettings;
 use crate::fem::{Inclusion, Material, on_pressed_side, patch_weight};
 
 /// What the vademecum was built from and how: enough to refuse a stale file and to say how it

@@ -12,6 +12,7 @@ use serde::Serialize;
 
 use super::Progress;
 use super::organ::tool_radii_m;
+use super::statistics::Statistics;
 use super::vademecum::{SurfacePoint, Vademecum};
 use crate::fem::{FemError, FemModel, Loads, NewtonSettings, PatchKernel};
 use crate::mesh::organs::Organ;
@@ -80,31 +81,6 @@ pub struct Sample {
     pub field_error: f64,
     /// Relative L2 error over the nodes near the tool.
     pub near_field_error: f64,
-}
-
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct Statistics {
-    pub mean: f64,
-    pub p50: f64,
-    pub p95: f64,
-    pub max: f64,
-}
-
-impl Statistics {
-    pub fn of(values: impl Iterator<Item = f64>) -> Self {
-        let mut v: Vec<f64> = values.collect();
-        if v.is_empty() {
-            return Self::default();
-        }
-        v.sort_by(f64::total_cmp);
-        let at = |q: f64| v[((q * (v.len() - 1) as f64).round() as usize).min(v.len() - 1)];
-        Self {
-            mean: v.iter().sum::<f64>() / v.len() as f64,
-            p50: at(0.5),
-            p95: at(0.95),
-            max: v[v.len() - 1],
-        }
-    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -197,7 +197,7 @@ impl Exercise {
     /// The exercise of `scenario`, whose nodules and regions lie at `sites`.
     pub fn new(scenario: Scenario, sites: Sites) -> Self {
         let total_s: f64 = scenario.tasks.iter().map(Task::time_limit_s).sum();
-        let samples = (total_s / (PLOT_EVERY as f64 * crate::haptics::TICK_S)).ceil() as usize;
+        let samples = (total_s / (PLOT_EVERY as f64 * crate::devices::TICK_S)).ceil() as usize;
         Self {
             descriptions: scenario.tasks.iter().map(Task::description).collect(),
             scenario,

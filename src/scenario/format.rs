@@ -431,7 +431,7 @@ pub struct Rubric {
     /// Points lost per error (a forbidden zone entered, a press over the limit).
     #[serde(default = "default_error_penalty")]
     pub error_penalty: f64,
-    /// The session passes with this overall score (0–100) or more...
+    /// The attempt passes with this overall score (0–100) or more...
     #[serde(default = "default_pass_mark")]
     pub pass_mark: f64,
     /// ...and, if set, only with every task finished.

@@ -13,7 +13,7 @@ pub struct TaskScore {
     pub score: f64,
 }
 
-/// A session's result.
+/// An attempt's result.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Scorecard {
     pub title: String,

@@ -9,11 +9,11 @@ use pgd_surgery::app::haptic::{
     HapticLoop, HapticScene, OrganCoupling, OrganDeformation, OrganIndex, TickClock,
 };
 use pgd_surgery::app::scene::{Detail, SceneOrgan, default_scene, scene_of};
-use pgd_surgery::cli::OnStale;
 use pgd_surgery::contact::{CouplingSettings, PairReport, PointshellDensity};
-use pgd_surgery::haptics::{PressTarget, Scripted, TICK_S, Trajectory, TrajectoryRow};
+use pgd_surgery::devices::{PressTarget, Scripted, TICK_S, Trajectory, TrajectoryRow};
 use pgd_surgery::mesh::organs::Organ;
 use pgd_surgery::pgd::{Deformation, Vademecum};
+use pgd_surgery::store::OnStale;
 
 pub fn scene() -> &'static HapticScene {
     static SCENE: OnceLock<HapticScene> = OnceLock::new();

@@ -12,10 +12,9 @@ use crate::common::*;
 
 #[test]
 fn a_deep_free_press_settles_shallow_without_flipping() {
-    let reports = free_press(scene(), 0.020, 600).unwrap();
-    let spacing_m = scene().coupling.as_ref().unwrap().pairs[0]
-        .field()
-        .spacing_m();
+    let coupling = scene().coupling.as_deref().unwrap();
+    let reports = free_press(&scene().organs, coupling, 0.020, 600).unwrap();
+    let spacing_m = coupling.pairs[0].field().spacing_m();
     let settled = &reports[300..];
     let deepest_m = settled.iter().map(|r| r.deepest_m).fold(0.0, f64::max);
     let force_n = |r: &pgd_surgery::contact::PairReport| r.force_on_shell_n.norm();

@@ -37,7 +37,7 @@ fn exact_field(model: &FemModel, vademecum: &Vademecum, deformation: &Deformatio
 
 /// The displacement the contact loads give the organ in the trainer: their modes (the
 /// coupling's coefficients), and, unless `modes_only`, their near-field corrections. The
-/// tool's load is left out on both sides: its accuracy is the vademecum's (issue 4).
+/// tool's load is left out on both sides: its accuracy is the vademecum's (`tests/pgd`).
 fn trainer_field(vademecum: &Vademecum, deformation: &Deformation, modes_only: bool) -> Vec<f64> {
     let mut u = vec![0.0; vademecum.dof_count()];
     for (step, coefficients) in deformation.coupling.iter().enumerate() {

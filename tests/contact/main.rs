@@ -1,4 +1,4 @@
-//! Organ against organ (issue 8) on the coarse abdominal scene: the gallbladder pressed into
+//! Organ against organ on the coarse abdominal scene: the gallbladder pressed into
 //! the liver through the whole haptic schedule, the distance field against the exact distance
 //! to the deformed gallbladder, and the attachments.
 
@@ -16,8 +16,8 @@ use pgd_surgery::contact::{
     ContactSurface, DistanceField, DistanceSettings, LatticeCache, MasterShape, NearField,
     Pointshell, PointshellDensity,
 };
-use pgd_surgery::haptics::Scripted;
-use pgd_surgery::seam::{from_parry, to_parry};
+use pgd_surgery::devices::Scripted;
+use pgd_surgery::parry_interop::{from_parry, to_parry};
 
 /// 12 mm up into the gallbladder's underside over 2 s, held for half a second.
 const PUSH_S: f64 = 2.0;
@@ -368,7 +368,7 @@ fn distance_errors(modes_only: bool) -> (f64, f64) {
     let (g, gallbladder) = organ("gallbladder");
     let deformation = &last.organs[g];
     let positions = deformed_gallbladder(modes_only);
-    let mesh = pgd_surgery::seam::trimesh(&positions, &gallbladder.triangles).unwrap();
+    let mesh = pgd_surgery::parry_interop::trimesh(&positions, &gallbladder.triangles).unwrap();
     let coupling = scene().coupling.as_ref().unwrap();
     let distance = coupling.pairs[0].field();
     let alpha: Vec<f32> = deformation
@@ -496,7 +496,7 @@ fn assert_carried_by_the_duodenum(carried: &str) {
             dist(a).total_cmp(&dist(b))
         })
         .unwrap();
-    let target = pgd_surgery::haptics::PressTarget {
+    let target = pgd_surgery::devices::PressTarget {
         point_m: Vector3::from(duodenum.position_coords_m[nearest].map(f64::from)),
         normal: normals[nearest],
     };
@@ -569,7 +569,7 @@ fn the_tool_holds_the_surface_under_it_while_the_contact_pushes() {
     use pgd_surgery::app::haptic::{
         OrganBody, OrganCoupling, OrganDeformation, OrganIndex, TickClock, Tool, ToolTouch,
     };
-    use pgd_surgery::haptics::TICK_S;
+    use pgd_surgery::devices::TICK_S;
     let target = facing_clear_of("gallbladder", -Vector3::z(), "duodenum");
     let device = Box::new(Scripted::new("push", push(&target, 0.012, PUSH_S, 0.5)));
     let mut haptic = HapticLoop::new(scene(), device).unwrap();

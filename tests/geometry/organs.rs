@@ -9,7 +9,7 @@ use parry3d::query::PointQuery;
 use parry3d::shape::{TriMesh, TriMeshFlags};
 use pgd_surgery::mesh::organs::{self, Abdomen, Organ, OrganSettings, region};
 use pgd_surgery::mesh::{QualityReport, Surface, TetMesh};
-use pgd_surgery::seam::to_parry;
+use pgd_surgery::parry_interop::to_parry;
 
 /// Each default organ, generated once for all tests of this file.
 fn organ(o: Organ) -> TetMesh {
@@ -228,7 +228,8 @@ fn neighbouring_organs_touch_without_overlapping() {
                     b.name()
                 );
                 let projection = shape_b.project_local_point(to_parry(p), false);
-                closest = closest.min((pgd_surgery::seam::from_parry(projection.point) - p).norm());
+                closest = closest
+                    .min((pgd_surgery::parry_interop::from_parry(projection.point) - p).norm());
             }
             if touching.contains(&(*a, *b)) || touching.contains(&(*b, *a)) {
                 assert!(

@@ -7,11 +7,11 @@ use std::sync::{Arc, OnceLock};
 use pgd_surgery::app::haptic::{ForceTrace, HapticLoop, HapticScene};
 use pgd_surgery::app::scene::press_targets;
 use pgd_surgery::contact::Probe;
-use pgd_surgery::fem::{FemModel, Law};
-use pgd_surgery::haptics::{
+use pgd_surgery::devices::{
     HapticDevice, PressMotion, PressTarget, SafetySettings, Scripted, Trajectory, Workspace,
     press_and_slide,
 };
+use pgd_surgery::fem::{FemModel, Law};
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate, region};
 use pgd_surgery::pgd::{BuildSettings, OrganModel, Silent, Vademecum, build, organ};
 

@@ -3,7 +3,7 @@
 use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{OrganDeformation, ToolTouch};
 use pgd_surgery::contact::ContactSurface;
-use pgd_surgery::haptics::{DeviceSample, SafetySettings, Trajectory, TrajectoryRow};
+use pgd_surgery::devices::{DeviceSample, SafetySettings, Trajectory, TrajectoryRow};
 use pgd_surgery::pgd::{Deformation, PatchLoad, SurfacePoint, Vademecum};
 
 use crate::common::{TIP_RADIUS_M, haptic, liver, run, scripted, target};

@@ -4,7 +4,7 @@
 use std::time::Duration;
 
 use nalgebra::Vector3;
-use pgd_surgery::haptics::{
+use pgd_surgery::devices::{
     DeviceSpec, Fault, Histogram, SafetyFilter, SafetySettings, Trajectory, TrajectoryError,
 };
 

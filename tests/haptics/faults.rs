@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{FaultLog, TickClock};
-use pgd_surgery::haptics::{
+use pgd_surgery::devices::{
     DeviceError, DeviceLimits, DeviceSample, HapticDevice, PressMotion, SafetySettings, Scripted,
 };
 

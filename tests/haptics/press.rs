@@ -3,8 +3,8 @@
 
 use nalgebra::{Matrix3, Point3, Vector3};
 use pgd_surgery::app::haptic::ToolTouch;
+use pgd_surgery::devices::{PressMotion, SafetySettings};
 use pgd_surgery::fem::{Loads, NewtonSettings, PatchKernel};
-use pgd_surgery::haptics::{PressMotion, SafetySettings};
 use pgd_surgery::mesh::Surface;
 
 use crate::common::{haptic, liver, press, run, scripted, tick_at};

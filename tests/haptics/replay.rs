@@ -1,6 +1,6 @@
-//! The same script twice gives bit-identical forces, and so does a recorded session replayed.
+//! The same script twice gives bit-identical forces, and so does a recorded run replayed.
 
-use pgd_surgery::haptics::{PressMotion, Recorder, SafetySettings, Trajectory};
+use pgd_surgery::devices::{PressMotion, Recorder, SafetySettings, Trajectory};
 
 use crate::common::{haptic, press, run, scripted, tick_at};
 
@@ -29,7 +29,7 @@ fn the_same_script_twice_gives_bit_identical_forces() {
 }
 
 #[test]
-fn a_recorded_session_replays_to_the_same_forces() {
+fn a_recorded_run_replays_to_the_same_forces() {
     let motion = PressMotion::default();
     let ticks = tick_at(press(&motion).duration_s());
     let file = std::env::temp_dir().join(format!("haptic-record-{}.csv", std::process::id()));

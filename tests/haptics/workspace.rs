@@ -1,7 +1,7 @@
 //! A scaled workspace: the tool moves `scale` times as far as the device's handle.
 
 use pgd_surgery::app::haptic::HapticLoop;
-use pgd_surgery::haptics::{PressMotion, SafetySettings, Trajectory, TrajectoryRow, Workspace};
+use pgd_surgery::devices::{PressMotion, SafetySettings, Trajectory, TrajectoryRow, Workspace};
 
 use crate::common::{press, run, scene, scripted, tick_at};
 

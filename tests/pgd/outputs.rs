@@ -1,10 +1,11 @@
 //! What the offline tools hand to users: the convergence table and plot, and the trainer's
 //! refusal of a vademecum that does not fit its organ.
 
-use pgd_surgery::cli::{self, OnStale, StepCurve, VademecumSpec};
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::organs::Organ;
 use pgd_surgery::pgd::save;
+use pgd_surgery::report::{self, StepCurve};
+use pgd_surgery::store::{self, OnStale, VademecumSpec};
 
 use crate::common::{block_mesh, block_model, build_block};
 
@@ -25,7 +26,7 @@ fn the_convergence_curves_are_written_as_csv_and_png() {
         indentation_m: 0.0,
         curve,
     }];
-    let [csv, png] = cli::write_convergence(&file, &steps).unwrap();
+    let [csv, png] = report::write_convergence(&file, &steps).unwrap();
     let table = std::fs::read_to_string(csv).unwrap();
     let rows: Vec<&str> = table.lines().skip(1).collect();
     assert_eq!(rows.len(), vademecum.modes(0));
@@ -42,14 +43,14 @@ fn the_convergence_curves_are_written_as_csv_and_png() {
 fn the_trainer_refuses_a_stale_or_missing_vademecum_with_the_command_to_run() {
     let dir = temp_dir("stale");
     let spec = VademecumSpec::default_in(&dir, Organ::Liver, Law::Linear);
-    let missing = cli::ensure_vademecum(&spec, OnStale::Refuse).unwrap_err();
+    let missing = store::ensure_vademecum(&spec, OnStale::Refuse).unwrap_err();
     assert!(
         missing.contains("liver.vdm") && missing.contains("pgd -- build liver"),
         "{missing}"
     );
     let model = block_model(block_mesh([4, 3, 2]));
     save(&spec.file, &build_block(&model, 2)).unwrap();
-    let stale = cli::ensure_vademecum(&spec, OnStale::Refuse).unwrap_err();
+    let stale = store::ensure_vademecum(&spec, OnStale::Refuse).unwrap_err();
     assert!(
         stale.contains("another mesh") && stale.contains("pgd -- build liver"),
         "{stale}"

@@ -8,13 +8,14 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use pgd_surgery::app::exercise::{Outcome, run_simulated, scenario_scene};
+use pgd_surgery::app::attempt::{Outcome, run_simulated, scenario_scene};
 use pgd_surgery::app::scene::{Detail, default_scene};
-use pgd_surgery::cli::{OnStale, write_report};
-use pgd_surgery::haptics::{Scripted, TICK_S, Trajectory};
+use pgd_surgery::devices::{Scripted, TICK_S, Trajectory};
 use pgd_surgery::mesh::io::write_vtu;
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate};
+use pgd_surgery::report::write_report;
 use pgd_surgery::scenario::{Scenario, load, parse};
+use pgd_surgery::store::OnStale;
 
 const TRAINER: &str = env!("CARGO_BIN_EXE_trainer");
 

@@ -15,8 +15,8 @@ use nalgebra::Vector3;
 use pgd_surgery::app::scene::{Detail, default_scene, press_targets};
 use pgd_surgery::app::window::Legend;
 use pgd_surgery::app::window::tissue::{mean_srgb, tissue};
-use pgd_surgery::cli::OnStale;
-use pgd_surgery::haptics::{DeviceSample, Trajectory, TrajectoryRow};
+use pgd_surgery::devices::{DeviceSample, Trajectory, TrajectoryRow};
+use pgd_surgery::store::OnStale;
 
 const TRAINER: &str = env!("CARGO_BIN_EXE_trainer");
 /// How deep the tool presses into the liver (m).

@@ -4,10 +4,10 @@
 //! The render side only ever reads the latest [`HapticSnapshot`].
 
 mod components;
-mod exercise;
 mod report;
 mod resources;
 mod runner;
+mod scoring;
 mod snapshot;
 mod systems;
 mod thread;
@@ -16,10 +16,10 @@ use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
 
 pub use components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
-pub use exercise::{ExerciseLink, ExerciseRun};
 pub use report::{ForceSummary, HeadlessReport, TickTimes};
 pub use resources::{Device, DeviceForce, FaultLog, ForceTrace, OrganCoupling, TickClock, Tool};
 pub use runner::{HapticLoop, HapticScene, SceneError};
+pub use scoring::{ExerciseLink, ExerciseRun};
 pub use snapshot::{HapticSnapshot, LoopTiming, OrganSnapshot};
 pub use thread::{HapticThread, RealTimeReport, SceneSwap, Scheduling};
 
@@ -70,10 +70,10 @@ pub fn haptic_schedule() -> Schedule {
         systems::compute_force.in_set(HapticSet::ComputeForce),
         systems::apply_safety.in_set(HapticSet::Safety),
         systems::write_device.in_set(HapticSet::WriteDevice),
-        exercise::score_tick.in_set(HapticSet::Score),
+        scoring::score_tick.in_set(HapticSet::Score),
         (
             systems::trace_force,
-            (exercise::publish_progress, systems::publish_snapshot).chain(),
+            (scoring::publish_progress, systems::publish_snapshot).chain(),
         )
             .in_set(HapticSet::Publish),
     ));

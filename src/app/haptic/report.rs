@@ -6,8 +6,7 @@ use std::time::Duration;
 use serde::Serialize;
 
 use super::resources::{DeviceForce, FaultLog};
-use super::runner::HapticLoop;
-use crate::haptics::{Histogram, TICK_S};
+use crate::devices::{Histogram, TICK_S};
 
 /// Quantiles of a tick duration (µs).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -76,20 +75,22 @@ pub struct HeadlessReport {
 }
 
 impl HeadlessReport {
+    /// The report of `ticks` ticks that sent `force` from `device` to `organs`, with the
+    /// faults of `log` and the compute times of `compute`.
     pub(super) fn new(
-        haptic: &mut HapticLoop,
+        (device, organs): (String, Vec<String>),
+        log: &FaultLog,
         ticks: u64,
         force: ForceSummary,
         compute: &Histogram,
     ) -> Self {
         let period = Duration::from_secs_f64(TICK_S);
         let overruns = compute.count_above(period);
-        let log = haptic.world().resource::<FaultLog>();
         Self {
-            device: haptic.device_name(),
+            device,
             faulted_ticks: log.faulted_ticks,
             faults: log.log.iter().map(|(t, f)| (*t, f.to_string())).collect(),
-            organs: haptic.organ_names(),
+            organs,
             ticks,
             simulated_s: ticks as f64 * TICK_S,
             force,

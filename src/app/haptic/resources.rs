@@ -7,7 +7,7 @@ use crate::contact::Coupling;
 use nalgebra::Vector3;
 
 use crate::contact::Probe;
-use crate::haptics::{DeviceSample, Fault, HapticDevice, SafetyFilter, Workspace};
+use crate::devices::{DeviceSample, Fault, HapticDevice, SafetyFilter, Workspace};
 
 #[derive(Resource)]
 pub struct Device(pub Box<dyn HapticDevice>);

@@ -12,7 +12,7 @@ use super::resources::{
 };
 use super::snapshot::{HapticSnapshot, OrganSnapshot, SnapshotPublisher};
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
-use crate::haptics::{HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S, Workspace};
+use crate::devices::{HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S, Workspace};
 use crate::pgd::{Deformation, Vademecum};
 
 /// What the haptic world is made of.
@@ -176,14 +176,16 @@ impl HapticLoop {
                 .any(|t| t.contact.is_some());
             forces.record(&force, touching);
         }
-        HeadlessReport::new(self, ticks, forces, &compute)
+        let names = (self.device_name(), self.organ_names());
+        let log = self.world.resource::<FaultLog>();
+        HeadlessReport::new(names, log, ticks, forces, &compute)
     }
 
     pub(super) fn device_name(&self) -> String {
         self.world.resource::<Device>().0.name().to_owned()
     }
 
-    pub(super) fn organ_names(&mut self) -> Vec<String> {
+    fn organ_names(&mut self) -> Vec<String> {
         let mut organs: Vec<(usize, String)> = self
             .world
             .query::<(&OrganIndex, &OrganBody)>()

@@ -9,7 +9,7 @@ use super::resources::{
 };
 use super::snapshot::{LoopTiming, SnapshotPublisher};
 use crate::contact::{Target, follow, press};
-use crate::haptics::Fault;
+use crate::devices::Fault;
 use crate::pgd::SurfacePoint;
 
 /// Reads the device into [`Tool`], mapped onto the scene. A non-finite sample or a device error is a fault and the

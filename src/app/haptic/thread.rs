@@ -12,7 +12,7 @@ use super::report::TickTimes;
 use super::resources::TickClock;
 use super::runner::HapticLoop;
 use super::snapshot::LoopTiming;
-use crate::haptics::{Histogram, Metronome, TICK_S, TimerMode};
+use crate::devices::{Histogram, Metronome, TICK_S, TimerMode};
 
 /// How well the thread kept time.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -107,7 +107,7 @@ impl HapticThread {
     }
 
     /// Stops the loop after its current tick; says how it kept time, and hands the loop back
-    /// (its world holds what the session measured).
+    /// (its world holds what the run measured).
     pub fn stop(self) -> (RealTimeReport, HapticLoop) {
         self.stop.store(true, Ordering::Relaxed);
         self.handle
@@ -222,7 +222,7 @@ mod tests {
     use crate::app::haptic::HapticScene;
     use crate::app::haptic::resources::{Device, Safety};
     use crate::contact::Probe;
-    use crate::haptics::{
+    use crate::devices::{
         DeviceSample, SafetySettings, Scripted, Trajectory, TrajectoryRow, Workspace,
     };
     use nalgebra::Vector3;

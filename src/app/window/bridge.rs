@@ -7,7 +7,7 @@ use bevy::prelude::*;
 
 use super::{FrameSet, WindowScene};
 use crate::app::haptic::{HapticScene, HapticSnapshot};
-use crate::haptics::VirtualHandle;
+use crate::devices::VirtualHandle;
 
 /// What the window holds of the haptic side.
 #[derive(Resource)]

@@ -49,7 +49,7 @@ pub fn legend(
     let eye = camera.1.translation();
     let meshes: Vec<_> = surfaces
         .iter()
-        .map(|s| crate::seam::trimesh(s.positions, s.triangles))
+        .map(|s| crate::parry_interop::trimesh(s.positions, s.triangles))
         .collect();
     let project = |p: Vec3| {
         camera
@@ -61,7 +61,7 @@ pub fn legend(
     let in_sight = |p: Vec3| {
         let (distance, dir) = ((p - eye).length(), (p - eye).normalize());
         let blocked_by_mesh = meshes.iter().flatten().any(|mesh| {
-            crate::seam::ray_distance(mesh, eye.to_array(), dir.to_array(), distance)
+            crate::parry_interop::ray_distance(mesh, eye.to_array(), dir.to_array(), distance)
                 .is_some_and(|hit| hit < distance - 1e-3)
         });
         let blocked_by_tool = tool.is_some_and(|(centre, radius)| {

@@ -12,9 +12,9 @@ use bevy::prelude::*;
 
 use super::FrameSet;
 use super::bridge::Snapshot;
-use crate::app::exercise::{outcome_of, sites_on};
+use crate::app::attempt::{outcome_of, sites_on};
 use crate::app::haptic::{ExerciseLink, HapticScene};
-use crate::cli;
+use crate::report;
 use crate::scenario::{Exercise, Scenario};
 
 /// Where the trainee is.
@@ -204,11 +204,11 @@ fn debrief_when_done(snapshot: Res<Snapshot>, mut next: ResMut<NextState<Stage>>
     }
 }
 
-/// Scores a copy of the ended exercise for the screen; the session scores the exercise itself
+/// Scores a copy of the ended exercise for the screen; the attempt scores the exercise itself
 /// for the report when the window closes.
 fn show_debrief(mut commands: Commands, lesson: Res<Lesson>) {
     let text = match lesson.link.ended_copy() {
-        Some(exercise) => cli::summary(&outcome_of(exercise).card),
+        Some(exercise) => report::summary(&outcome_of(exercise).card),
         None => "The exercise has ended.".to_owned(),
     };
     let text = format!(

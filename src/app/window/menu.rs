@@ -13,7 +13,7 @@ use bevy::prelude::*;
 use super::bridge::HapticLink;
 use super::lesson::{Lesson, Lessons, Stage, spawn_panel};
 use super::{FrameSet, SceneChanged};
-use crate::app::exercise::{prepare, sites_on};
+use crate::app::attempt::{prepare, sites_on};
 use crate::app::haptic::{ExerciseLink, HapticLoop, HapticScene, HapticSnapshot, SceneSwap};
 use crate::scenario::{self, Exercise, Scenario};
 

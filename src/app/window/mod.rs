@@ -30,7 +30,7 @@ pub use menu::{MenuPlan, SceneSource};
 pub use screenshot::ScreenshotPlan;
 
 use super::haptic::{HapticScene, HapticSnapshot};
-use crate::haptics::VirtualHandle;
+use crate::devices::VirtualHandle;
 
 /// Everything the window needs from the haptic side.
 pub struct WindowScene {
@@ -52,7 +52,7 @@ pub struct WindowScene {
     pub menu: Option<MenuPlan>,
 }
 
-/// The haptic side's f64 vectors as Bevy's (the Bevy end of the seam; parry's is `crate::seam`).
+/// The haptic side's f64 vectors as Bevy's (the Bevy end of the seam; parry's is `crate::parry_interop`).
 fn to_bevy(v: &nalgebra::Vector3<f64>) -> Vec3 {
     Vec3::from_array([v.x as f32, v.y as f32, v.z as f32])
 }

@@ -13,8 +13,8 @@ pub fn scene_without_organs() -> HapticScene {
         probe: crate::contact::Probe {
             tip_radius_m: 0.006,
         },
-        workspace: crate::haptics::Workspace::default(),
-        safety: crate::haptics::SafetySettings::default(),
+        workspace: crate::devices::Workspace::default(),
+        safety: crate::devices::SafetySettings::default(),
         coupling: None,
     }
 }

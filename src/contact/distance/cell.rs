@@ -2,8 +2,8 @@
 //! corners' values interpolated trilinearly, in `f32` as the lattice stores them.
 //!
 //! Interpolated as seven lerps per value (four along x, two along y, one along z) rather than
-//! eight weights: a read takes up to five cells (the pull-back's steps), and the weights, in
-//! `f64` products, were a quarter of a press's contact stage at rest (400 points, session 19).
+//! eight weights: a read takes up to five cells (the pull-back's steps), and the weights, in `f64` products,
+//! cost a quarter of a press's contact stage at rest (400 points).
 
 /// Where a point lies in its lattice cell: the cell's lowest node, and the point's coordinates
 /// in it (0 to 1 per axis). Corner `k` of a cell lies at `t_c = 1` along axis `c` where bit

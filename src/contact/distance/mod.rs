@@ -10,10 +10,10 @@
 //! over the modes, evaluated at most once per tick ([`LatticeCache`]); the rest distance then
 //! needs no modes at all.
 //!
-//! Why pulled back rather than linearized: the first version stored the first-order change
-//! `D^k = −∇d₀ · U^k`, which is exact only for a surface moving along its normal. The floppy
-//! gallbladder also moves sideways by millimetres, and its curvature turned that motion into
-//! errors of 1.1–1.8 mm (p95, `tests/contact`). Pulled back ([`PULLBACK_STEPS`]), a surface
+//! Why pulled back rather than linearized: a first-order change `D^k = −∇d₀ · U^k` is exact
+//! only for a surface moving along its normal. The floppy gallbladder also moves sideways by
+//! millimetres, and its curvature turns that motion into errors of 1.1–1.8 mm (p95,
+//! `tests/contact`) for the linearized field. Pulled back ([`PULLBACK_STEPS`]), a surface
 //! that moves rigidly near a point keeps its distance exactly, and the error falls to 0.4 mm.
 //! Where the surface turns (under the tool), the rest normal through `y` is tilted once
 //! deformed, and dividing by the stretch takes that in to first order: 0.70 → 0.46 mm p95
@@ -28,7 +28,7 @@
 //! 9.2 mm without the corrections.
 
 mod cell;
-mod file;
+mod field_file;
 mod near;
 
 use nalgebra::Vector3;
@@ -38,7 +38,7 @@ use super::ContactSurface;
 use crate::pgd::Vademecum;
 use cell::{Cell, normal_stretch};
 
-pub use file::FieldOrigin;
+pub use field_file::FieldOrigin;
 pub use near::NearField;
 
 /// How the lattice is laid out.
@@ -73,7 +73,7 @@ const PULLBACK_STEPS: usize = 4;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct DistanceField {
-    /// A hash of what the field is built from (`file::inputs_of`): tells a stored field
+    /// A hash of what the field is built from (`field_file::inputs_of`): tells a stored field
     /// built from another vademecum.
     inputs: String,
     settings: DistanceSettings,
@@ -179,7 +179,7 @@ impl DistanceField {
         let dims = [0, 1, 2].map(|c| (extent[c] / settings.spacing_m).ceil() as usize + 1);
         let modes = vademecum.total_modes();
         let mut field = Self {
-            inputs: file::inputs_of(vademecum),
+            inputs: field_file::inputs_of(vademecum),
             settings: *settings,
             origin_m,
             dims,

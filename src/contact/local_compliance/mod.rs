@@ -1,9 +1,9 @@
 //! The part of a contact pair's normal compliance `A` that the modes cannot carry: how a
 //! contact force dimples both organs near where it pushes.
 //!
-//! A few smooth modes are far too stiff under a point load (issue 4's table: rank 50, felt
-//! force 2,000 % off), so with modes alone a few pushing nodes moved the liver clear of a
-//! whole intrusion, and the contact felt stiffer than the tissue. Every load position of a
+//! A few smooth modes are far too stiff under a point load (a rank-50 truncation's felt force
+//! is 2,000 % off, `docs/pgd.md`), so with modes alone a few pushing nodes would move the
+//! liver clear of a whole intrusion, and the contact would feel stiffer than the tissue. Every load position of a
 //! vademecum stores its near-field correction (its exact response minus the modes, at every
 //! node within the local radius), so the exact compliance between two nodes close enough is
 //! the modal one plus `a_ij = Σ_ab w_ia w_jb n_i · R_b(a) · n_j` over the positions `a`, `b`
@@ -34,8 +34,7 @@ use nalgebra::Vector3;
 use self::organ_part::OrganPart;
 use self::solve_block::SolveBlock;
 use self::sparse::{Scattered, SparseRows};
-use super::clearance::BLOCK;
-use super::pointshell::Pointshell;
+use super::pointshell::{BLOCK, Pointshell};
 use crate::pgd::Vademecum;
 
 /// The near-field compliance as `G S Gᵀ`, with what each tick derives from it. The two

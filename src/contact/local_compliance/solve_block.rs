@@ -1,11 +1,11 @@
 //! The near-field part of `A` over the nodes of one tick's force solve, kept as `G S Gᵀ`
 //! restricted to the directions those nodes read.
 //!
-//! Why not the dense block between the nodes (sessions 17–20): on a subdivided pointshell the
+//! Why not the dense block between the nodes: on a subdivided pointshell the
 //! nodes pushing outnumber the positions they load, and `S` between those positions is
 //! sparse. Measured on `--subdivide 5` with 407 points sliding, they read 453 directions,
 //! with 11,178 entries of `S` between them and 12 of `G` a node: about 21,000 products
-//! against 166,000 for the dense block, which at 1.3 MB in `f64` did not even fit a core's
+//! against 166,000 for the dense block, which at 1.3 MB in `f64` does not even fit a core's
 //! L2. Nor is there a block to copy from tick to tick: only the set's rows of `G`
 //! (renumbered) and, when the directions change, `S` between them are gathered.
 

@@ -10,7 +10,7 @@ use parry3d::shape::{TriMesh, TriMeshFlags};
 use super::ImportError;
 use super::tokens::Tokens;
 use crate::mesh::{Implicit, TetMesh, stuff_to_node_count};
-use crate::seam::to_parry;
+use crate::parry_interop::to_parry;
 
 /// A surface is refused as implausibly large for an organ beyond this size (m): it was most
 /// likely written in millimetres.

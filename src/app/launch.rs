@@ -1,4 +1,4 @@
-//! A trainer session: the default scene, the device the options name, and the haptic loop —
+//! A run of the trainer: the default scene, the device the options name, and the haptic loop —
 //! headless on a simulated clock (deterministic) or the real one, or behind the window — and
 //! what it reports.
 
@@ -10,7 +10,7 @@ use serde::Serialize;
 use bevy::app::AppExit;
 use nalgebra::Vector3;
 
-use super::exercise::{Outcome, outcome_of, prepare, run_simulated, scenario_scene, sites_on};
+use super::attempt::{Outcome, outcome_of, prepare, run_simulated, scenario_scene, sites_on};
 use super::haptic::ExerciseRun;
 use super::haptic::{
     HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport, Scheduling,
@@ -19,12 +19,12 @@ use super::scene::{Detail, default_scene, press_targets};
 use super::window::{
     FrameReport, Lesson, Lessons, MenuPlan, Opening, SceneSource, ScreenshotPlan, WindowScene,
 };
-use crate::cli::OnStale;
-use crate::haptics::{
+use crate::devices::{
     DeviceSpec, HapticDevice, PressMotion, Recorder, Scripted, TICK_S, TimerMode, Trajectory,
     VirtualDevice, press_and_slide,
 };
 use crate::scenario::{Exercise, Scenario};
+use crate::store::OnStale;
 
 #[derive(Clone)]
 pub struct Options {

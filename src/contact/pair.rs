@@ -47,6 +47,7 @@ use super::hold::ToolHold;
 use super::modal_rows::step_ranges;
 use super::normal_compliance::NormalCompliance;
 use super::pointshell::Pointshell;
+use super::pose::OrganPose;
 use super::projected_cg::{Convergence, ProjectedCg};
 use super::relaxation::Relaxation;
 use super::{DistanceField, LatticeCache, MasterShape, NearField};
@@ -74,14 +75,6 @@ impl Default for PenaltySettings {
             skip_clear_nodes: true,
         }
     }
-}
-
-/// What an organ brings to the contact stage this tick.
-#[derive(Clone, Copy, Debug)]
-pub struct OrganPose<'a> {
-    /// Modal coefficients, all load steps concatenated.
-    pub alpha: &'a [f32],
-    pub carry: &'a RigidCarry,
 }
 
 /// The contact of the last tick, for reports and tests.

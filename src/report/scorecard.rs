@@ -1,4 +1,4 @@
-//! A training session's report on disk: the scorecard as JSON, a summary a trainee reads, and
+//! An attempt's report on disk: the scorecard as JSON, a summary a trainee reads, and
 //! a plot of the force against time with each task's limits drawn over its span.
 
 use std::fmt::Write as _;

@@ -107,7 +107,7 @@ impl ExerciseLink {
     }
 }
 
-/// The exercise under way, when the session runs a scenario: taken from the link when it is
+/// The exercise under way, when the run is of a scenario: taken from the link when it is
 /// started (so that, until then, the other side may replace it and drop the old one: the
 /// haptic thread drops no exercise), handed back to it when it has ended.
 #[derive(Resource)]

@@ -8,9 +8,10 @@ use crate::fem::{Inclusion, Law, Material};
 use crate::mesh::TetMesh;
 use crate::mesh::io::ImportOptions;
 use crate::mesh::organs::{Organ, OrganSettings, region};
-use crate::pgd::{self, BuildSettings, OrganModel, Vademecum, VademecumError};
+use crate::pgd::{self, BuildReport, BuildSettings, OrganModel, Vademecum, VademecumError};
 
 use super::{Bar, OrganSource};
+use crate::report;
 
 /// What to do with a missing or stale vademecum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -136,27 +137,55 @@ pub fn ensure_vademecum(
         return Err(format!("{why}\nbuild it with:\n  {command}"));
     }
     eprintln!("{why}\nbuilding it now (the same as `{command}`):");
-    let model = pgd::organ::clamped_model(mesh.clone(), material)
-        .and_then(|model| model.with_inclusions(&spec.inclusions))
-        .map_err(|e| format!("{name}: {e}"))?;
-    let organ_model = OrganModel {
-        source: name.clone(),
-        model: &model,
-        clamped_region: region::CLAMPED.into(),
-        accessible_region: region::ACCESSIBLE.into(),
+    let job = BuildJob {
+        source: name,
+        mesh: mesh.clone(),
+        material,
+        inclusions: &spec.inclusions,
+        settings: spec.build.clone(),
     };
-    let (vademecum, _) = pgd::build(&organ_model, &spec.build, &Bar::default())
-        .map_err(|e| format!("{name}: {e}"))?;
-    let file = &spec.file;
-    pgd::save(file, &vademecum).map_err(|e| e.to_string())?;
-    let [csv, png] = super::write_of_header(file, &vademecum.header)?;
+    let (vademecum, _, [csv, png]) = build_and_save(job, &spec.file)?;
     eprintln!(
         "wrote {} (convergence curves: {} and {})",
-        file.display(),
+        spec.file.display(),
         csv.display(),
         png.display()
     );
     Ok((vademecum, mesh))
+}
+
+/// What a vademecum is built from: an organ's mesh (`source` names it in messages), its
+/// material and stiffer regions, and the build settings.
+pub struct BuildJob<'a> {
+    pub source: &'a str,
+    pub mesh: TetMesh,
+    pub material: Material,
+    pub inclusions: &'a [Inclusion],
+    pub settings: BuildSettings,
+}
+
+/// Builds `job`'s vademecum with progress bars (the organ clamped at its `clamped` region,
+/// loaded over its `accessible` one) and saves it at `file`, with its convergence curves
+/// beside it; returns the vademecum, the build's report and the curves' files.
+pub fn build_and_save(
+    job: BuildJob,
+    file: &Path,
+) -> Result<(Vademecum, BuildReport, [PathBuf; 2]), String> {
+    let source = job.source;
+    let model = pgd::organ::clamped_model(job.mesh, job.material)
+        .and_then(|model| model.with_inclusions(job.inclusions))
+        .map_err(|e| format!("{source}: {e}"))?;
+    let organ_model = OrganModel {
+        source: source.to_owned(),
+        model: &model,
+        clamped_region: region::CLAMPED.into(),
+        accessible_region: region::ACCESSIBLE.into(),
+    };
+    let (vademecum, built) = pgd::build(&organ_model, &job.settings, &Bar::default())
+        .map_err(|e| format!("{source}: {e}"))?;
+    pgd::save(file, &vademecum).map_err(|e| e.to_string())?;
+    let curves = report::write_convergence_of(file, &vademecum.header)?;
+    Ok((vademecum, built, curves))
 }
 
 /// Loads the spec's file and refuses it unless it was built for `mesh`, `material` and the
@@ -179,26 +208,4 @@ fn inclusion_arg(inclusion: &Inclusion) -> String {
     let [x, y, z] = inclusion.centre_m.map(|c| c * 1e3);
     let radius_mm = inclusion.radius_m * 1e3;
     format!("{x},{y},{z},{radius_mm},{}", inclusion.stiffness_ratio)
-}
-
-/// Reads `X,Y,Z,RADIUS,RATIO` (lengths in mm) as `pgd build --inclusion` takes it.
-pub fn parse_inclusion(text: &str) -> Result<Inclusion, String> {
-    let numbers: Vec<f64> = text
-        .split(',')
-        .map(|part| part.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("`{text}`: {e}; expected X,Y,Z,RADIUS,RATIO (millimetres, ratio)"))?;
-    let [x, y, z, radius_mm, stiffness_ratio] = numbers[..] else {
-        return Err(format!(
-            "`{text}`: {} numbers; expected five: X,Y,Z,RADIUS,RATIO (millimetres, ratio)",
-            numbers.len()
-        ));
-    };
-    let inclusion = Inclusion {
-        centre_m: [x, y, z].map(|c| c * 1e-3),
-        radius_m: radius_mm * 1e-3,
-        stiffness_ratio,
-    };
-    inclusion.validate().map_err(|e| format!("`{text}`: {e}"))?;
-    Ok(inclusion)
 }

@@ -6,8 +6,8 @@ use nalgebra::{Point3, Vector3};
 use parry3d::query::PointQueryWithLocation;
 use parry3d::shape::{TriMesh, TrianglePointLocation};
 
+use crate::parry_interop::{from_parry, to_parry};
 use crate::pgd::{SurfacePoint, Vademecum};
-use crate::seam::{from_parry, to_parry};
 
 #[derive(Debug, thiserror::Error)]
 pub enum ContactError {

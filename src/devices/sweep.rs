@@ -4,7 +4,7 @@
 use nalgebra::Vector3;
 
 use super::{Trajectory, TrajectoryRow};
-use crate::haptics::DeviceSample;
+use crate::devices::DeviceSample;
 
 /// Where and how one press goes.
 #[derive(Clone, Copy, Debug, PartialEq)]

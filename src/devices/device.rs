@@ -57,7 +57,7 @@ pub enum DeviceError {
 pub trait HapticDevice: Send + Sync {
     fn name(&self) -> &str;
     fn limits(&self) -> DeviceLimits;
-    /// The device's state at `time_s` seconds into the session.
+    /// The device's state at `time_s` seconds into the run.
     fn read(&mut self, time_s: f64) -> Result<DeviceSample, DeviceError>;
     /// Sets the force (N) the device renders: already clamped and made safe by the caller.
     fn write_force(&mut self, force_n: &Vector3<f64>) -> Result<(), DeviceError>;

@@ -1,4 +1,4 @@
-//! A session that runs a scenario: its scene (organs, tool, device limit), its exercise inside
+//! One attempt at a scenario: its scene (organs, tool, device limit), its exercise inside
 //! the haptic world, and the scorecard when every task has ended or the device's script has.
 
 use std::path::Path;
@@ -8,14 +8,14 @@ use nalgebra::Vector3;
 
 use super::haptic::{ExerciseLink, ExerciseRun, HapticLoop, HapticScene, TickClock};
 use super::scene::{Detail, SceneOrgan, scene_of};
-use crate::cli::{OnStale, OrganSource};
 use crate::contact::{ContactSurface, CouplingSettings};
-use crate::haptics::{HapticDevice, TICK_S};
+use crate::devices::{HapticDevice, TICK_S};
 use crate::mesh::organs::Organ;
 use crate::scenario::{
     self, Exercise, Nodule, NoduleSite, OrganEntry, RegionSite, Scenario, Scorecard, Sites, Task,
     score,
 };
+use crate::store::{OnStale, OrganSource};
 
 /// The scene a scenario asks for, its vademecums from `dir`.
 pub fn scenario_scene(
@@ -82,7 +82,7 @@ fn scene_organ(scenario: &Scenario, entry: &OrganEntry) -> Result<SceneOrgan, St
     })
 }
 
-/// What a session of a scenario leaves: the scorecard and the force against time (100 Hz).
+/// What an attempt at a scenario leaves: the scorecard and the force against time (100 Hz).
 #[derive(Clone, Debug)]
 pub struct Outcome {
     pub card: Scorecard,

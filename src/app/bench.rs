@@ -1,4 +1,5 @@
-//! The haptic loop benchmark: tick compute time over a scripted sweep of the four-organ scene
+//! The haptic loop benchmark (`pgd bench haptics`), with the app because it runs the app's
+//! haptic world: tick compute time over a scripted sweep of the four-organ scene
 //! (simulated clock), per organ pressed, and against the same contact solved by full FEM;
 //! then the real-time loop's punctuality with each timer while the render side's CPU work
 //! (every organ's whole displacement field, 60 times a second) runs beside it.
@@ -8,16 +9,16 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use super::fem::median_ms;
-use crate::app::haptic::{
+use super::haptic::{
     HapticLoop, HapticScene, HapticThread, OrganDeformation, RealTimeReport, Scheduling, TickTimes,
 };
-use crate::app::scene::press_targets;
+use super::scene::press_targets;
+use crate::bench::fem::median_ms;
 use crate::contact::ContactSurface;
-use crate::fem::{FemError, Law, Loads, NewtonSettings};
-use crate::haptics::{
+use crate::devices::{
     HapticDevice, PressMotion, PressTarget, Scripted, TICK_S, TimerMode, press_and_slide,
 };
+use crate::fem::{FemError, Law, Loads, NewtonSettings};
 use crate::mesh::organs::{self, Organ, OrganSettings};
 use crate::mesh::{Surface, vertex_normals};
 use crate::pgd::{self, Deformation, PatchLoad};

@@ -1,4 +1,4 @@
-//! The haptic device side, free of Bevy: the device trait and its backends, the trajectory
+//! The device layer, free of Bevy: the device trait and its backends, the trajectory
 //! files they replay and record, the map from the device's workspace to the scene, the safety
 //! filter between the physics and the motors, and the clock that paces the 1 kHz loop.
 

@@ -1,6 +1,7 @@
-//! Parsers for the contact benchmark's options, with errors that say the range.
+//! Parsers of the binaries' option values, with errors that say the range or the form.
 
 use crate::contact::{check_spacing, check_subdivisions};
+use crate::fem::Inclusion;
 
 /// A `--subdivide` count within [`crate::contact::SUBDIVISIONS`].
 pub fn parse_subdivisions(text: &str) -> Result<u8, String> {
@@ -23,6 +24,28 @@ pub fn parse_stiffness_ratio(text: &str) -> Result<f64, String> {
             "`{text}`: a penalty is a positive, finite number of times the tissue's stiffness"
         )),
     }
+}
+
+/// Reads `X,Y,Z,RADIUS,RATIO` (lengths in mm) as `pgd build --inclusion` takes it.
+pub fn parse_inclusion(text: &str) -> Result<Inclusion, String> {
+    let numbers: Vec<f64> = text
+        .split(',')
+        .map(|part| part.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("`{text}`: {e}; expected X,Y,Z,RADIUS,RATIO (millimetres, ratio)"))?;
+    let [x, y, z, radius_mm, stiffness_ratio] = numbers[..] else {
+        return Err(format!(
+            "`{text}`: {} numbers; expected five: X,Y,Z,RADIUS,RATIO (millimetres, ratio)",
+            numbers.len()
+        ));
+    };
+    let inclusion = Inclusion {
+        centre_m: [x, y, z].map(|c| c * 1e-3),
+        radius_m: radius_mm * 1e-3,
+        stiffness_ratio,
+    };
+    inclusion.validate().map_err(|e| format!("`{text}`: {e}"))?;
+    Ok(inclusion)
 }
 
 #[cfg(test)]

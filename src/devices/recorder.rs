@@ -1,6 +1,6 @@
 //! The recorder: wraps any device and keeps what it reported, to be written as a trajectory the
 //! scripted device replays. Samples are kept in memory (about 100 bytes a tick: 6 MB a minute)
-//! and written when the session ends, so the haptic thread never waits on a disk.
+//! and written when the run ends, so the haptic thread never waits on a disk.
 
 use std::path::{Path, PathBuf};
 
@@ -60,7 +60,7 @@ impl HapticDevice for Recorder {
 }
 
 impl Drop for Recorder {
-    /// A session that ends keeps its recording; a failure to write is reported, not swallowed.
+    /// A run that ends keeps its recording; a failure to write is reported, not swallowed.
     fn drop(&mut self) {
         if self.recorded.rows.is_empty() {
             return;
@@ -71,7 +71,7 @@ impl Drop for Recorder {
                 self.recorded.rows.len(),
                 self.path.display()
             ),
-            Err(e) => eprintln!("recorder: could not write the session: {e}"),
+            Err(e) => eprintln!("recorder: could not write the recording: {e}"),
         }
     }
 }

@@ -1,0 +1,349 @@
+//! The options of `pgd`, as clap parses them, and their conversion into the library's
+//! settings.
+
+use std::path::{Path, PathBuf};
+
+use clap::{Args, Parser, Subcommand};
+use pgd_surgery::contact::{CouplingSettings, PenaltySettings, PointshellDensity};
+use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
+use pgd_surgery::mesh::TetMesh;
+use pgd_surgery::mesh::io::ImportOptions;
+use pgd_surgery::mesh::organs::{Organ, OrganSettings};
+use pgd_surgery::pgd::{self, BuildSettings, PgdSettings, ValidationSettings};
+use pgd_surgery::{bench, cli, store};
+
+#[derive(Parser)]
+#[command(
+    name = "pgd",
+    version,
+    about = "Offline tools of the PGD surgery trainer: organ meshes and benchmarks of the numerical core"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Generate an organ (liver, gallbladder, pancreas, duodenum, cornea) or read a mesh file
+    /// (.msh, .vtk, .vtu, or a closed .obj/.stl surface, which is tetrahedralized), and print
+    /// its statistics and quality report. Exits with status 1 if the mesh cannot be simulated.
+    Mesh {
+        #[command(flatten)]
+        mesh: MeshArgs,
+        /// Also write the mesh (with its regions) as .vtu for ParaView.
+        #[arg(long, value_name = "FILE.vtu")]
+        out: Option<PathBuf>,
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Build the vademecum of an organ or of a mesh file with `clamped` and `accessible`
+    /// regions: exact local responses, PGD global modes, and the brute-force baseline measured
+    /// in the same run. Writes vademecums/<name>.vdm unless --out says otherwise.
+    Build {
+        #[command(flatten)]
+        mesh: MeshArgs,
+        #[command(flatten)]
+        material: MaterialArgs,
+        #[command(flatten)]
+        build: BuildArgs,
+        /// Where to write the vademecum.
+        #[arg(long, value_name = "FILE.vdm")]
+        out: Option<PathBuf>,
+        /// Also precompute the organ's distance field for organ-against-organ contact, as
+        /// a scene's contact master needs it (the gallbladder by default), and write it beside
+        /// the vademecum (FILE.vdf). The trainer otherwise builds it on first use.
+        #[arg(long)]
+        distance_field: bool,
+        /// Print the build report as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Check a vademecum against full FEM on the same mesh at random loads it was not built on:
+    /// felt-force and displacement errors (mean, p50, p95), and the build's convergence
+    /// curves as CSV and PNG.
+    Validate {
+        #[command(flatten)]
+        mesh: MeshArgs,
+        /// The vademecum (default: vademecums/<source>.vdm).
+        #[arg(long, value_name = "FILE.vdm")]
+        vademecum: Option<PathBuf>,
+        /// Number of random loads.
+        #[arg(long, default_value_t = ValidationSettings::default().samples)]
+        samples: usize,
+        /// Seed of the random loads.
+        #[arg(long, default_value_t = ValidationSettings::default().seed)]
+        sample_seed: u64,
+        /// Largest indentation of the random loads, in millimetres (default: 10/3 of the
+        /// organ's tool radius, 20 for the abdominal organs; the smallest is a tenth of it).
+        #[arg(long)]
+        max_indentation_mm: Option<f64>,
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Time the numerical core and print medians (and ratios to a baseline run alongside).
+    Bench {
+        #[command(subcommand)]
+        what: BenchTarget,
+    },
+}
+
+/// Where the mesh comes from.
+#[derive(Args)]
+pub struct MeshArgs {
+    /// An organ (liver, gallbladder, pancreas, duodenum, cornea) or a mesh file.
+    pub source: String,
+    /// Organs: multiplies the node count (1 = the papers' sizes).
+    #[arg(long, default_value_t = 1.0)]
+    pub resolution: f64,
+    /// Organs: varies proportions deterministically (another patient).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Files: multiplies coordinates (0.001 for files in millimetres).
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// Surfaces (.obj, .stl): target node count of the tetrahedralization.
+    #[arg(long, default_value_t = 4000)]
+    pub nodes: usize,
+}
+
+impl MeshArgs {
+    pub fn load(&self) -> Result<(Option<Organ>, TetMesh), String> {
+        store::load_source(&store::MeshSource {
+            name: &self.source,
+            organ: OrganSettings {
+                resolution: self.resolution,
+                seed: self.seed,
+            },
+            import: ImportOptions {
+                scale: self.scale,
+                surface_nodes: self.nodes,
+            },
+        })
+    }
+
+    /// The file name a vademecum of this source gets by default.
+    pub fn stem(&self) -> String {
+        Path::new(&self.source)
+            .file_stem()
+            .map_or_else(|| self.source.clone(), |s| s.to_string_lossy().into_owned())
+    }
+}
+
+/// The material law of a build.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum LawArg {
+    /// Linear elasticity: one load step.
+    Linear,
+    /// Kirchhoff–Saint Venant by load steps: stiffens as the tool presses deeper.
+    Ksv,
+}
+
+impl LawArg {
+    pub fn law(self) -> Law {
+        match self {
+            LawArg::Linear => Law::Linear,
+            LawArg::Ksv => Law::KirchhoffSaintVenant,
+        }
+    }
+}
+
+#[derive(Args)]
+pub struct MaterialArgs {
+    /// Material law.
+    #[arg(long, value_enum, default_value = "linear")]
+    pub law: LawArg,
+    /// Young's modulus in Pa (default: the organ's, or the liver's 1.6 kPa for mesh files).
+    #[arg(long)]
+    pub young_pa: Option<f64>,
+    /// Poisson's ratio.
+    #[arg(long, default_value_t = pgd::organ::POISSON)]
+    pub poisson: f64,
+    /// A stiffer (or softer) sphere in the tissue, such as a tumour to find by palpation:
+    /// its centre and radius in millimetres and its Young's modulus over the organ's, as
+    /// `X,Y,Z,RADIUS,RATIO` (e.g. `10,-5,30,7,6`). Repeat for several.
+    #[arg(long, value_name = "X,Y,Z,RADIUS,RATIO", value_parser = cli::parse_inclusion)]
+    pub inclusion: Vec<Inclusion>,
+}
+
+impl MaterialArgs {
+    pub fn material(&self, organ: Option<Organ>) -> Result<Material, String> {
+        let law = self.law.law();
+        let young_pa = self
+            .young_pa
+            .unwrap_or_else(|| pgd::organ::young_pa(organ.unwrap_or(Organ::Liver)));
+        Material::new(law, young_pa, self.poisson, TISSUE_DENSITY_KG_M3).map_err(|e| e.to_string())
+    }
+}
+
+#[derive(Args)]
+pub struct BuildArgs {
+    /// Radius of the tool tip's contact patch, in millimetres: loads are spread over it
+    /// (default: 0.5 for the cornea, 6 for the other organs and mesh files).
+    #[arg(long)]
+    pub tool_radius_mm: Option<f64>,
+    /// Radius around each loaded node, in millimetres, where its exact response is stored
+    /// (default: the watched region plus the tool radius, 2.5 for the cornea, 26 for the
+    /// other organs and mesh files).
+    #[arg(long)]
+    pub local_radius_mm: Option<f64>,
+    /// Target of the estimator: each node-centred load's relative L2 error of the field (global
+    /// modes + exact near field), root mean square over the loads.
+    #[arg(long, default_value_t = BuildSettings::default().target_error)]
+    pub target_error: f64,
+    /// At most this many PGD modes per load step.
+    #[arg(long, default_value_t = PgdSettings::default().max_modes)]
+    pub max_modes: usize,
+    /// KSV: indentation under the tool at each load step after the linear one, in
+    /// millimetres, increasing. The deepest is the range the vademecum is valid over.
+    #[arg(long, value_delimiter = ',', default_values_t = pgd::DEFAULT_LOAD_STEPS_M.map(|m| m * 1e3))]
+    pub load_steps_mm: Vec<f64>,
+}
+
+impl BuildArgs {
+    pub fn settings(&self, organ: Option<Organ>) -> Result<BuildSettings, String> {
+        let defaults = BuildSettings::for_organ(organ);
+        let steps = &self.load_steps_mm;
+        if steps.iter().any(|s| !(s.is_finite() && *s > 0.0))
+            || steps.windows(2).any(|w| w[1] <= w[0])
+        {
+            return Err(format!(
+                "--load-steps-mm {steps:?}: expected positive indentations in increasing order"
+            ));
+        }
+        Ok(BuildSettings {
+            tool_tip_radius_m: self
+                .tool_radius_mm
+                .map_or(defaults.tool_tip_radius_m, |mm| mm * 1e-3),
+            local_radius_m: self
+                .local_radius_mm
+                .map_or(defaults.local_radius_m, |mm| mm * 1e-3),
+            target_error: self.target_error,
+            pgd: PgdSettings {
+                max_modes: self.max_modes,
+                ..PgdSettings::default()
+            },
+            load_steps_m: steps.iter().map(|s| s * 1e-3).collect(),
+            ..defaults
+        })
+    }
+}
+
+#[derive(Subcommand)]
+pub enum BenchTarget {
+    /// The organ-contact stage: one pair's tick with the organs apart and with the master
+    /// pressed until at least 400 pointshell nodes push, against parry's brute-force check of
+    /// every node against the deformed master surface.
+    Contact(ContactBenchArgs),
+    /// The haptic loop on the four-organ scene: tick compute time over a scripted sweep (all
+    /// organs, then each), the same press by full FEM, and real-time punctuality per timer.
+    Haptics {
+        /// Sweeps run per figure; the median is reported.
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Seconds of real-time ticking per timer.
+        #[arg(long, default_value_t = 5.0)]
+        realtime_seconds: f64,
+        /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
+        #[arg(long, default_value = "vademecums")]
+        vademecums: PathBuf,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Assembly, factorization and solve on a liver-sized mesh (~4,300 nodes, ~21,000 tets).
+    Fem {
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// How many times each step is timed; the median is reported.
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        /// Cubes along x, y, z of the benchmark box (six tets each).
+        #[arg(long, num_args = 3, value_names = ["NX", "NY", "NZ"])]
+        cells: Option<Vec<usize>>,
+    },
+    /// Build time and peak memory of an organ's vademecum (linear and KSV), and the online
+    /// evaluations: displacement under the tool, felt force, whole field, file load.
+    Vademecum {
+        /// The organ (liver, gallbladder, pancreas, duodenum, cornea).
+        #[arg(default_value = "liver")]
+        organ: String,
+        /// Material laws to build, in order (peak memory is the process's, so it only grows).
+        #[arg(long, value_enum, value_delimiter = ',', default_values = ["linear", "ksv"])]
+        laws: Vec<LawArg>,
+        /// Batches timed for each online evaluation; the median is reported.
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// `pgd bench contact`: the scene and the contact settings it is timed on.
+#[derive(Args)]
+pub struct ContactBenchArgs {
+    /// Ticks timed per case.
+    #[arg(long, default_value_t = 2000)]
+    pub ticks: usize,
+    /// The coarse scene (quarter-node organs, built in seconds) instead of the full one.
+    #[arg(long)]
+    pub coarse: bool,
+    /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
+    #[arg(long, default_value = "vademecums")]
+    pub vademecums: PathBuf,
+    /// A dense pointshell (nodes and triangle centres) instead of the boundary nodes.
+    #[arg(long, conflicts_with_all = ["subdivide", "sparse"])]
+    pub dense: bool,
+    /// A pointshell of the centres of each surface triangle cut N times along each edge
+    /// (N² points a triangle) instead of the boundary nodes.
+    #[arg(long, value_name = "N", value_parser = cli::parse_subdivisions, conflicts_with = "sparse")]
+    pub subdivide: Option<u8>,
+    /// A sparse pointshell: the boundary nodes kept at least MM millimetres apart.
+    #[arg(long, value_name = "MM", value_parser = cli::parse_spacing)]
+    pub sparse: Option<u8>,
+    /// How many times stiffer than the tissue each node's penalty is: 1000 (the
+    /// trainer's) cuts an overlap to 0.1 %; 1 leaves half of it, as a one-pass penalty
+    /// does, so that far more nodes stay inside and push.
+    #[arg(
+        long,
+        value_name = "RATIO",
+        default_value_t = PenaltySettings::default().stiffness_ratio,
+        value_parser = cli::parse_stiffness_ratio
+    )]
+    pub stiffness_ratio: f64,
+    /// The cases to time (all by default): apart, pressed (the master free), held (a
+    /// rigid master, settled), sliding (the held master moved sideways at 10 mm/s).
+    #[arg(long = "case", value_enum, value_name = "CASE")]
+    pub cases: Vec<bench::contact::Case>,
+    /// Print the report as JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl ContactBenchArgs {
+    /// The scene's coupling with the pointshell and penalty asked for.
+    pub fn coupling(&self) -> CouplingSettings {
+        CouplingSettings {
+            pointshell: match (self.dense, self.subdivide, self.sparse) {
+                (_, Some(n), _) => PointshellDensity::Subdivided(n),
+                (_, _, Some(mm)) => PointshellDensity::Sparse(mm),
+                (true, ..) => PointshellDensity::Dense,
+                (false, ..) => PointshellDensity::Nodes,
+            },
+            penalty: PenaltySettings {
+                stiffness_ratio: self.stiffness_ratio,
+                ..PenaltySettings::default()
+            },
+            ..CouplingSettings::default()
+        }
+    }
+}
+
+/// Where a vademecum of this source goes by default: `vademecums/<stem>.vdm`.
+pub fn default_vademecum(mesh: &MeshArgs) -> PathBuf {
+    PathBuf::from("vademecums").join(format!("{}.vdm", mesh.stem()))
+}

@@ -1,0 +1,181 @@
+//! `pgd`: offline work — organ meshes, vademecum builds and their validation, benchmarks. The
+//! options are in `args.rs`; the work is the library's.
+
+mod args;
+
+use std::process::ExitCode;
+
+use args::{BenchTarget, BuildArgs, Cli, Command, ContactBenchArgs, MaterialArgs, MeshArgs};
+use clap::Parser;
+use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, default_scene, scene_of};
+use pgd_surgery::cli::{self, fail, print_json, print_report};
+use pgd_surgery::fem::Law;
+use pgd_surgery::mesh::organs::Organ;
+use pgd_surgery::pgd::ValidationSettings;
+use pgd_surgery::store::{BuildJob, OnStale};
+use pgd_surgery::{app, bench};
+
+fn main() -> ExitCode {
+    match Cli::parse().command {
+        Command::Mesh { mesh, out, json } => match mesh.load() {
+            Ok((_, m)) => cli::report_mesh(&mesh.source, &m, out.as_deref(), json),
+            Err(e) => fail("pgd mesh", &e),
+        },
+        Command::Build {
+            mesh,
+            material,
+            build,
+            out,
+            distance_field,
+            json,
+        } => {
+            let out = out.unwrap_or_else(|| args::default_vademecum(&mesh));
+            let built = job(&mesh, &material, &build)
+                .and_then(|job| cli::build_vademecum(job, &out, distance_field));
+            match built {
+                Ok(report) if json => print_json(&report),
+                Ok(report) => {
+                    cli::print_build_report(&report, &out);
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail("pgd build", &e),
+            }
+        }
+        Command::Validate {
+            mesh,
+            vademecum,
+            samples,
+            sample_seed,
+            max_indentation_mm,
+            json,
+        } => {
+            let file = vademecum.unwrap_or_else(|| args::default_vademecum(&mesh));
+            let settings = |organ| {
+                let defaults = ValidationSettings {
+                    samples,
+                    seed: sample_seed,
+                    ..ValidationSettings::for_organ(organ)
+                };
+                match max_indentation_mm {
+                    Some(mm) => defaults.deepest_indentation(mm * 1e-3),
+                    None => defaults,
+                }
+            };
+            let validated = mesh
+                .load()
+                .and_then(|loaded| cli::validate_vademecum(&mesh.source, loaded, &file, settings));
+            match validated {
+                Ok(report) if json => print_json(&report),
+                Ok(report) => {
+                    cli::print_validation(&report);
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail("pgd validate", &e),
+            }
+        }
+        Command::Bench { what } => bench_command(what),
+    }
+}
+
+/// The build `pgd build` asks for: the mesh loaded, its material and settings resolved.
+fn job<'a>(
+    mesh: &'a MeshArgs,
+    material: &'a MaterialArgs,
+    build: &BuildArgs,
+) -> Result<BuildJob<'a>, String> {
+    let (organ, tet_mesh) = mesh.load()?;
+    Ok(BuildJob {
+        source: &mesh.source,
+        mesh: tet_mesh,
+        material: material.material(organ)?,
+        inclusions: &material.inclusion,
+        settings: build.settings(organ)?,
+    })
+}
+
+fn bench_command(what: BenchTarget) -> ExitCode {
+    match what {
+        BenchTarget::Vademecum {
+            organ,
+            laws,
+            repeats,
+            json,
+        } => {
+            let Some(organ) = Organ::from_name(&organ) else {
+                return fail(
+                    "pgd bench vademecum",
+                    &format!(
+                        "{organ}: not an organ (liver, gallbladder, pancreas, duodenum, cornea)"
+                    ),
+                );
+            };
+            let laws: Vec<Law> = laws.into_iter().map(args::LawArg::law).collect();
+            print_report(
+                "pgd bench vademecum",
+                bench::vademecum::run(organ, &laws, repeats),
+                json,
+            )
+        }
+        BenchTarget::Contact(options) => bench_contact(&options),
+        BenchTarget::Haptics {
+            repeats,
+            realtime_seconds,
+            vademecums,
+            json,
+        } => {
+            let scene = match default_scene(&vademecums, Detail::Full, OnStale::Rebuild) {
+                Ok(scene) => scene,
+                Err(e) => return fail("pgd bench haptics", &e),
+            };
+            print_report(
+                "pgd bench haptics",
+                app::bench::run(&scene, repeats, realtime_seconds),
+                json,
+            )
+        }
+        BenchTarget::Fem {
+            json,
+            repeats,
+            cells,
+        } => {
+            let cells = cells.map_or(bench::fem::LIVER_SIZED_CELLS, |c| [c[0], c[1], c[2]]);
+            print_report("pgd bench fem", bench::fem::run(cells, repeats), json)
+        }
+    }
+}
+
+/// `pgd bench contact`: the scene's organs and coupling set up as asked, then timed.
+fn bench_contact(options: &ContactBenchArgs) -> ExitCode {
+    let detail = if options.coarse {
+        Detail::Coarse
+    } else {
+        Detail::Full
+    };
+    let coupling = options.coupling();
+    let organs = SCENE_ORGANS.map(SceneOrgan::from);
+    let scene = match scene_of(
+        &organs,
+        None,
+        &coupling,
+        &options.vademecums,
+        detail,
+        OnStale::Rebuild,
+    ) {
+        Ok(scene) => scene,
+        Err(e) => return fail("pgd bench contact", &e),
+    };
+    let Some(pairs) = scene.coupling.as_deref() else {
+        return fail("pgd bench contact", "the scene has no organ contact");
+    };
+    print_report(
+        "pgd bench contact",
+        bench::contact::run(
+            &scene.organs,
+            pairs,
+            &coupling,
+            options.ticks,
+            &options.cases,
+        ),
+        options.json,
+    )
+}

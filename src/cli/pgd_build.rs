@@ -1,0 +1,131 @@
+//! `pgd build`: an organ's vademecum built, saved with its convergence curves (and its
+//! distance field if asked), and its report printed.
+
+use std::path::{Path, PathBuf};
+
+use crate::contact::{ContactSurface, DistanceField, DistanceSettings};
+use crate::pgd::{self, BuildReport};
+use crate::report;
+use crate::store::{self, BuildJob};
+
+/// Builds `job`'s vademecum with progress bars and saves it at `out` with its convergence
+/// curves beside it (named on stderr, so that `--json` output stays parseable), and its
+/// distance field (`out` with `.vdf`) if asked.
+pub fn build_vademecum(
+    job: BuildJob,
+    out: &Path,
+    distance_field: bool,
+) -> Result<BuildReport, String> {
+    let (vademecum, report, curves) = store::build_and_save(job, out)?;
+    print_curves(curves);
+    if distance_field {
+        write_distance_field(&vademecum, &out.with_extension("vdf"))?;
+    }
+    Ok(report)
+}
+
+/// Writes the build's convergence curves beside the vademecum and names them on stderr.
+pub fn write_convergence(vademecum: &Path, header: &pgd::Header) -> Result<(), String> {
+    report::write_convergence_of(vademecum, header).map(print_curves)
+}
+
+fn print_curves([csv, png]: [PathBuf; 2]) {
+    eprintln!(
+        "convergence curves: {} and {}",
+        csv.display(),
+        png.display()
+    );
+}
+
+/// Precomputes the distance field of `vademecum` on the default lattice and writes it.
+pub fn write_distance_field(vademecum: &pgd::Vademecum, path: &Path) -> Result<(), String> {
+    let started = std::time::Instant::now();
+    let surface = ContactSurface::new(vademecum).map_err(|e| e.to_string())?;
+    let field = DistanceField::build(vademecum, &surface, &DistanceSettings::default());
+    field.save(path).map_err(|e| e.to_string())?;
+    eprintln!(
+        "distance field: {} lattice nodes, {} modes, built in {:.1} s, written to {}",
+        field.node_count(),
+        vademecum.total_modes(),
+        started.elapsed().as_secs_f64(),
+        path.display()
+    );
+    Ok(())
+}
+
+/// The build report as the terminal shows it.
+pub fn print_build_report(report: &BuildReport, out: &Path) {
+    println!(
+        "{} load positions x 3 directions = {} parameters, {} free dofs; a load's near field \
+         holds {:.1} % of the nodes on average",
+        report.positions,
+        report.parameters,
+        report.free_dofs,
+        100.0 * report.near_field_share
+    );
+    for (k, step) in report.steps.iter().enumerate() {
+        let n = step.modes_kept;
+        let pgd_error = step.curve.separated.last().copied().unwrap_or(f64::NAN);
+        let optimal = step
+            .curve
+            .optimal
+            .get(n.wrapping_sub(1))
+            .copied()
+            .unwrap_or(f64::NAN);
+        println!(
+            "step {k} (indentation {:.1} mm): {n} modes, global-part energy error {:.1} % \
+             (optimal rank-{n}: {:.1} %, ratio {:.2})",
+            step.indentation_m * 1e3,
+            100.0 * pgd_error,
+            100.0 * optimal,
+            pgd_error / optimal
+        );
+        let field = |curve: &[f64]| curve.last().map_or(f64::NAN, |e| 100.0 * e);
+        println!(
+            "  vademecum field error (global + near field) of each node-centred load: {:.1} % \
+             rms, {:.1} % p95",
+            field(&step.curve.field),
+            field(&step.curve.field_p95)
+        );
+        println!(
+            "  time: PGD {:.1} s, brute force (solves + SVD) {:.1} s (PGD/brute force {:.2}), local part {:.1} s",
+            step.pgd_seconds,
+            step.brute_force_seconds,
+            step.pgd_seconds / step.brute_force_seconds,
+            step.local_seconds
+        );
+        if let Some(fixed_point) = &step.fixed_point {
+            print_fixed_point(fixed_point);
+        }
+    }
+    if let Some(failed) = &report.failed_step {
+        println!(
+            "KSV step {:.1} mm left out: its fixed point did not converge (the law loses \
+             stability under the tool); the vademecum is valid to {:.1} mm",
+            failed.indentation_m * 1e3,
+            report.steps.last().map_or(0.0, |s| s.indentation_m * 1e3)
+        );
+        if let Some(fixed_point) = &failed.fixed_point {
+            print_fixed_point(fixed_point);
+        }
+    }
+    let size = std::fs::metadata(out).map_or(0, |m| m.len());
+    println!(
+        "wrote {} ({:.1} MB) in {:.1} s",
+        out.display(),
+        size as f64 / 1e6,
+        report.total_seconds
+    );
+}
+
+fn print_fixed_point(report: &pgd::SecantReport) {
+    println!(
+        "  secant fixed point: {:.1} iterations per load on average, at most {}; \
+         {} of {} loads unconverged (largest last change {:.1e})",
+        report.mean_iterations(),
+        report.max_iterations,
+        report.unconverged,
+        report.responses,
+        report.worst_change
+    );
+}

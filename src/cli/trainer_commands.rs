@@ -1,0 +1,98 @@
+//! What the trainer prints and writes: `trainer validate`'s verdict on scenario files, and the
+//! end of an attempt (its score printed, its report written).
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use crate::app::attempt::Outcome;
+use crate::app::launch;
+use crate::report;
+use crate::scenario;
+
+/// Each attempt with its number among its scenario's attempts, when there were several.
+pub fn numbered(attempts: launch::Attempts) -> Vec<(PathBuf, Option<usize>, Outcome)> {
+    let count = |file: &PathBuf| attempts.iter().filter(|(f, _)| f == file).count();
+    let counts: Vec<usize> = attempts.iter().map(|(file, _)| count(file)).collect();
+    let mut seen: Vec<PathBuf> = Vec::new();
+    attempts
+        .into_iter()
+        .zip(counts)
+        .map(|((file, outcome), count)| {
+            seen.push(file.clone());
+            let k = seen.iter().filter(|f| **f == file).count();
+            (file, (count > 1).then_some(k), outcome)
+        })
+        .collect()
+}
+
+/// `trainer validate`: every file checked, every problem printed; fails if any file has one.
+pub fn validate_scenarios(files: &[PathBuf]) -> ExitCode {
+    let mut failed = false;
+    for file in files {
+        match scenario::load(file) {
+            Ok(s) => println!(
+                "{}: ok ({}, {} task{})",
+                file.display(),
+                s.title,
+                s.tasks.len(),
+                if s.tasks.len() == 1 { "" } else { "s" }
+            ),
+            Err(e) => {
+                eprintln!("{e}");
+                failed = true;
+            }
+        }
+    }
+    if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// The end of an exercise: its score printed (JSON with `json`) and its report written, named
+/// after the scenario's file (and the attempt, when the trainee retried).
+pub fn debrief(
+    outcome: Result<Outcome, String>,
+    file: &Path,
+    attempt: Option<usize>,
+    report_dir: &Path,
+    json: bool,
+) -> ExitCode {
+    let outcome = match outcome {
+        Ok(outcome) => outcome,
+        Err(e) => {
+            eprintln!("trainer: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let name = file
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or("attempt");
+    let stem = name.trim_end_matches(".ron").trim_end_matches(".scenario");
+    let stem = match attempt {
+        Some(k) => format!("{stem}.attempt-{k}"),
+        None => stem.to_owned(),
+    };
+    let written = report::write_report(report_dir, &stem, &outcome.card, &outcome.force_trace);
+    if json {
+        match serde_json::to_string_pretty(&outcome.card) {
+            Ok(text) => println!("{text}"),
+            Err(e) => eprintln!("trainer: could not write the JSON scorecard: {e}"),
+        }
+    } else {
+        print!("{}", report::summary(&outcome.card));
+    }
+    match written {
+        Ok(paths) => {
+            let paths: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+            eprintln!("report: {}", paths.join(", "));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("trainer: the report was not written: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

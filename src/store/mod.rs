@@ -1,0 +1,12 @@
+//! The organs and vademecums on disk, as the trainer and `pgd` find them: where an organ's
+//! mesh comes from (generated or a file), the vademecum each organ runs on, checked against
+//! its mesh, material and settings and rebuilt with progress shown when missing or stale.
+//! No Bevy: the app and both binaries call it.
+
+mod progress;
+mod source;
+mod vademecums;
+
+pub use progress::Bar;
+pub use source::{MeshSource, OrganSource, load_source};
+pub use vademecums::{BuildJob, OnStale, VademecumSpec, build_and_save, ensure_vademecum};
