@@ -2,9 +2,9 @@
 //! (`docs/architecture.md`), each using only those below it:
 //!
 //! - the numerical core, plain Rust with no Bevy: [`mesh`], [`fem`] (the reference every
-//!   vademecum is checked against), [`pgd`] (the vademecums), [`contact`], [`devices`] (the
-//!   device layer), [`scenario`] (exercises), [`dense_sums`], [`parry_interop`], and [`bench`],
-//!   which times them;
+//!   vademecum is checked against), [`pgd`] (the vademecums), [`contact`], [`cutting`],
+//!   [`devices`] (the device layer), [`scenario`] (exercises), [`dense_sums`],
+//!   [`parry_interop`], and [`bench`], which times them;
 //! - services: [`store`] (organs and vademecums on disk) and [`report`] (files for people);
 //! - [`app`], the Bevy layer: the 1 kHz haptic loop, the scene, the trainer window;
 //! - [`cli`], what the binaries' commands do and print; the binaries in `src/bin` stay thin.
@@ -13,6 +13,7 @@ pub mod app;
 pub mod bench;
 pub mod cli;
 pub mod contact;
+pub mod cutting;
 pub mod dense_sums;
 pub mod devices;
 pub mod fem;

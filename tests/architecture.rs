@@ -13,6 +13,7 @@ const LAYERS: [&[&str]; 4] = [
         "fem",
         "pgd",
         "contact",
+        "cutting",
         "devices",
         "scenario",
         "dense_sums",

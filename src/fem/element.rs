@@ -110,15 +110,22 @@ impl TetGeometry {
         let mut k = ElementMatrix::zeros();
         for a in 0..4 {
             for b in 0..4 {
-                let (ga, gb) = (self.grads[a], self.grads[b]);
-                let block = (ga * gb.transpose()) * lambda
-                    + (gb * ga.transpose()) * mu
-                    + Matrix3::identity() * (mu * ga.dot(&gb));
+                let block = self.elastic_block(a, b, lambda, mu);
                 k.fixed_view_mut::<3, 3>(3 * a, 3 * b)
                     .copy_from(&(block * self.volume_m3));
             }
         }
         k
+    }
+
+    /// The linear-elastic stiffness between corners `a` and `b` per unit volume:
+    /// `λ g_a g_bᵀ + μ g_b g_aᵀ + μ (g_a·g_b) I`. Enriched elements weigh it by how their
+    /// functions' factors vary over the element's pieces.
+    pub fn elastic_block(&self, a: usize, b: usize, lambda: f64, mu: f64) -> Matrix3<f64> {
+        let (ga, gb) = (self.grads[a], self.grads[b]);
+        (ga * gb.transpose()) * lambda
+            + (gb * ga.transpose()) * mu
+            + Matrix3::identity() * (mu * ga.dot(&gb))
     }
 
     /// Deformation gradient F and second Piola–Kirchhoff stress S of the KSV law.

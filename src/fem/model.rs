@@ -75,7 +75,7 @@ impl FemModel {
 
     /// The element's Lamé constants (λ, μ) in pascals: the material's, scaled by any inclusion
     /// the element lies in (both scale with Young's modulus at a fixed Poisson's ratio).
-    fn lame(&self, element: usize) -> (f64, f64) {
+    pub fn lame(&self, element: usize) -> (f64, f64) {
         let (lambda, mu) = self.material.lame();
         let scale = self.modulus_scale[element];
         (scale * lambda, scale * mu)

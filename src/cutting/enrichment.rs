@@ -1,0 +1,332 @@
+//! Which nodes a set of cut faces enriches, and how each element is integrated.
+//!
+//! Heaviside enrichment, shifted: a node `i` enriched by face `k` adds the function
+//! `N_i(x) (H_k(x) − H_k(x_i))`, with `H_k = ±1` the side of the face's plane. It vanishes at
+//! every node, so the nodal values stay the displacements, and inside the support it opens the
+//! jump across the face.
+//!
+//! **The cut front.** A node is enriched only when the face cuts its whole support: the
+//! support reaches both sides, and wherever it meets the plane, it meets it inside the face.
+//! The discontinuity therefore ends on the boundary of the last supports it crosses whole: the
+//! front is snapped to element faces, no tip enrichment. A crack is short of its true length
+//! by up to about one element, which converges away as the mesh is refined (the edge-crack
+//! test measures it), and costs no singular functions in the reduced basis. A node whose
+//! support the plane only grazes (less than [`SLIVER`] of its volume on one side) is not
+//! enriched: its enriched function would be all but null, and the system near singular.
+
+use std::collections::HashMap;
+
+use nalgebra::Point3;
+
+use super::clip::{self, Tet};
+use super::incision::CutFace;
+use crate::mesh::TetMesh;
+
+/// The smallest share of a support's volume on its smaller side for the node to be enriched.
+pub const SLIVER: f64 = 1e-4;
+
+/// Signed distances below this share of the mesh's size count as on the plane.
+const SNAP: f64 = 1e-9;
+
+/// One enriched function: node `node`, opened by face `face`, whose side of the plane is
+/// `node_side` (`+1` on the normal side or on the plane, `−1` otherwise).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Enriched {
+    pub node: usize,
+    pub face: usize,
+    pub node_side: i8,
+}
+
+/// One piece of an element, where each face's Heaviside function is constant.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Piece {
+    pub volume_m3: f64,
+    /// Per face the element's enriched functions name, in [`ElementCut::faces`]' order.
+    pub sides: Vec<i8>,
+}
+
+/// How one element is cut: the faces its enriched functions name, and its pieces.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ElementCut {
+    pub faces: Vec<usize>,
+    /// Indices into [`Enrichment::functions`] whose node is a corner of the element, with
+    /// that corner (0–3).
+    pub functions: Vec<(usize, usize)>,
+    pub pieces: Vec<Piece>,
+}
+
+/// The enrichment of a mesh by cut faces.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Enrichment {
+    pub functions: Vec<Enriched>,
+    /// Per element: its cut, empty where no enriched function reaches it.
+    pub elements: Vec<ElementCut>,
+}
+
+impl Enrichment {
+    pub fn new(mesh: &TetMesh, faces: &[CutFace]) -> Self {
+        let snap_m = SNAP * mesh_size_m(mesh);
+        let supports = supports(mesh);
+        let mut functions = Vec::new();
+        for (k, face) in faces.iter().enumerate() {
+            let phi: Vec<f64> = mesh
+                .nodes()
+                .iter()
+                .map(|p| snapped(face.signed_distance(p), snap_m))
+                .collect();
+            for (node, support) in supports.iter().enumerate() {
+                if cuts_whole_support(mesh, face, &phi, support, snap_m) {
+                    functions.push(Enriched {
+                        node,
+                        face: k,
+                        node_side: if phi[node] >= 0.0 { 1 } else { -1 },
+                    });
+                }
+            }
+        }
+        let elements = element_cuts(mesh, faces, &functions, snap_m);
+        Self {
+            functions,
+            elements,
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.functions.is_empty()
+    }
+
+    /// Whether the cuts leave a chunk of tissue that no held node holds (`held(node)`): its
+    /// stiffness would be singular. Each piece of an element sees each corner as that node
+    /// from the piece's side of every face enriching it; pieces that see a node the same way
+    /// share it, as elements of a mesh share nodes, and a chunk is a connected set of them.
+    pub fn detaches(&self, mesh: &TetMesh, held: impl Fn(usize) -> bool) -> bool {
+        let mut seen: HashMap<(usize, Vec<(usize, i8)>), usize> = HashMap::new();
+        let mut chunks = UnionFind::default();
+        let mut anchored = Vec::new();
+        for (tet, cut) in mesh.tets().iter().zip(&self.elements) {
+            let whole = [Piece {
+                volume_m3: 0.0,
+                sides: vec![],
+            }];
+            let pieces = if cut.pieces.is_empty() {
+                &whole[..]
+            } else {
+                &cut.pieces
+            };
+            for piece in pieces {
+                let corners = (0..4).map(|a| {
+                    let view: Vec<(usize, i8)> = cut
+                        .functions
+                        .iter()
+                        .filter(|&&(_, corner)| corner == a)
+                        .map(|&(j, _)| {
+                            let k = self.functions[j].face;
+                            let slot = cut.faces.iter().position(|&f| f == k).expect("named");
+                            (k, piece.sides[slot])
+                        })
+                        .collect();
+                    let key = (tet[a], view);
+                    let next = seen.len();
+                    let id = *seen.entry(key).or_insert_with(|| {
+                        anchored.push(held(tet[a]));
+                        next
+                    });
+                    chunks.grow(id + 1);
+                    id
+                });
+                let ids: Vec<usize> = corners.collect();
+                for w in ids.windows(2) {
+                    chunks.join(w[0], w[1]);
+                }
+            }
+        }
+        let mut held_chunk = vec![false; anchored.len()];
+        for (id, &a) in anchored.iter().enumerate() {
+            if a {
+                held_chunk[chunks.root(id)] = true;
+            }
+        }
+        (0..anchored.len()).any(|id| !held_chunk[chunks.root(id)])
+    }
+}
+
+/// Disjoint sets over `0..n`, grown on demand.
+#[derive(Default)]
+struct UnionFind {
+    parent: Vec<usize>,
+}
+
+impl UnionFind {
+    fn grow(&mut self, n: usize) {
+        while self.parent.len() < n {
+            self.parent.push(self.parent.len());
+        }
+    }
+
+    fn root(&mut self, mut i: usize) -> usize {
+        while self.parent[i] != i {
+            self.parent[i] = self.parent[self.parent[i]];
+            i = self.parent[i];
+        }
+        i
+    }
+
+    fn join(&mut self, a: usize, b: usize) {
+        let (a, b) = (self.root(a), self.root(b));
+        self.parent[a] = b;
+    }
+}
+
+/// Each node's elements.
+fn supports(mesh: &TetMesh) -> Vec<Vec<usize>> {
+    let mut out = vec![Vec::new(); mesh.node_count()];
+    for (t, tet) in mesh.tets().iter().enumerate() {
+        for &n in tet {
+            out[n].push(t);
+        }
+    }
+    out
+}
+
+fn mesh_size_m(mesh: &TetMesh) -> f64 {
+    let (mut lo, mut hi) = (Point3::origin(), Point3::origin());
+    for (i, p) in mesh.nodes().iter().enumerate() {
+        lo = if i == 0 { *p } else { lo.inf(p) };
+        hi = if i == 0 { *p } else { hi.sup(p) };
+    }
+    (hi - lo).norm()
+}
+
+fn snapped(d: f64, snap_m: f64) -> f64 {
+    if d.abs() <= snap_m { 0.0 } else { d }
+}
+
+/// Whether `face` cuts the whole support of a node: volume on both sides, more than a sliver
+/// on the smaller, and every point where an element of it meets the plane inside the face.
+fn cuts_whole_support(
+    mesh: &TetMesh,
+    face: &CutFace,
+    phi: &[f64],
+    support: &[usize],
+    snap_m: f64,
+) -> bool {
+    let (mut plus, mut minus, mut total) = (0.0, 0.0, 0.0);
+    for &t in support {
+        let tet = mesh.tets()[t];
+        let corners = tet.map(|n| phi[n]);
+        if corners.iter().all(|&d| d > 0.0) || corners.iter().all(|&d| d < 0.0) {
+            let v = mesh.tet_volume(t);
+            total += v;
+            *(if corners[0] > 0.0 {
+                &mut plus
+            } else {
+                &mut minus
+            }) += v;
+            continue;
+        }
+        if !meets_plane_inside(mesh, face, &tet, &corners, snap_m) {
+            return false;
+        }
+        let (p, m) = clip::split(&mesh.tet_points(t), corners);
+        let (vp, vm) = (sum_volume(&p), sum_volume(&m));
+        plus += vp;
+        minus += vm;
+        total += vp + vm;
+    }
+    plus.min(minus) > SLIVER * total
+}
+
+/// Whether every point where the element meets the plane (its corners on the plane, its
+/// edges' crossings) lies inside the face.
+fn meets_plane_inside(
+    mesh: &TetMesh,
+    face: &CutFace,
+    tet: &[usize; 4],
+    phi: &[f64; 4],
+    snap_m: f64,
+) -> bool {
+    let p = |i: usize| mesh.nodes()[tet[i]];
+    let inside = |x: &Point3<f64>| face.covers(x, snap_m);
+    (0..4).all(|i| phi[i] != 0.0 || inside(&p(i)))
+        && (0..4).all(|i| {
+            (i + 1..4).all(|j| {
+                if phi[i] * phi[j] >= 0.0 {
+                    return true;
+                }
+                let t = phi[i] / (phi[i] - phi[j]);
+                inside(&(p(i) + (p(j) - p(i)) * t))
+            })
+        })
+}
+
+fn sum_volume(tets: &[Tet]) -> f64 {
+    tets.iter().map(clip::volume).sum()
+}
+
+/// Per element, the enriched functions at its corners and its pieces, split by each face
+/// they name.
+fn element_cuts(
+    mesh: &TetMesh,
+    faces: &[CutFace],
+    functions: &[Enriched],
+    snap_m: f64,
+) -> Vec<ElementCut> {
+    let mut by_node: Vec<Vec<usize>> = vec![Vec::new(); mesh.node_count()];
+    for (j, f) in functions.iter().enumerate() {
+        by_node[f.node].push(j);
+    }
+    mesh.tets()
+        .iter()
+        .enumerate()
+        .map(|(t, tet)| {
+            let mut cut = ElementCut::default();
+            for (corner, &n) in tet.iter().enumerate() {
+                for &j in &by_node[n] {
+                    cut.functions.push((j, corner));
+                    if !cut.faces.contains(&functions[j].face) {
+                        cut.faces.push(functions[j].face);
+                    }
+                }
+            }
+            if !cut.functions.is_empty() {
+                cut.pieces = pieces(&mesh.tet_points(t), &cut.faces, faces, snap_m);
+            }
+            cut
+        })
+        .collect()
+}
+
+/// The element split by each face's plane in turn, each piece with its side of each.
+fn pieces(tet: &Tet, named: &[usize], faces: &[CutFace], snap_m: f64) -> Vec<Piece> {
+    let mut parts = vec![*tet];
+    for &k in named {
+        parts = parts
+            .iter()
+            .flat_map(|part| {
+                let phi = part.map(|p| snapped(faces[k].signed_distance(&p), snap_m));
+                let (plus, minus) = clip::split(part, phi);
+                plus.into_iter().chain(minus)
+            })
+            .collect();
+    }
+    parts
+        .iter()
+        .map(|part| {
+            let centre = clip::centroid(part);
+            Piece {
+                volume_m3: clip::volume(part),
+                sides: named
+                    .iter()
+                    .map(|&k| {
+                        if faces[k].signed_distance(&centre) >= 0.0 {
+                            1
+                        } else {
+                            -1
+                        }
+                    })
+                    .collect(),
+            }
+        })
+        .filter(|piece| piece.volume_m3 > 0.0)
+        .collect()
+}

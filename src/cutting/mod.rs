@@ -1,0 +1,26 @@
+//! Cutting, plain Rust, no Bevy: incisions as data ([`Incision`]: the faces the blade sweeps),
+//! the Heaviside enrichment they give a mesh ([`Enrichment`]), and the reference solvers every
+//! reduced cut is checked against: the full X-FEM solve ([`xfem::solve`]) and, for a cut along
+//! element faces, plain FEM on the mesh with the cut's nodes doubled
+//! ([`split_mesh::split_along`]). See `docs/cutting.md`.
+
+mod clip;
+mod enrichment;
+mod incision;
+pub mod split_mesh;
+pub mod xfem;
+
+pub use enrichment::{ElementCut, Enriched, Enrichment, Piece, SLIVER};
+pub use incision::{CutFace, Incision, MIN_SEGMENT_M};
+pub use xfem::CutSolution;
+
+/// Why a cut cannot be made or solved.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum CutError {
+    #[error("a degenerate cut: {0}")]
+    Degenerate(String),
+    #[error("the cut detaches a piece of tissue: nothing holds it any more")]
+    Detached,
+    #[error("the cut organ cannot be solved: {0}")]
+    Solve(String),
+}
