@@ -3,5 +3,6 @@
 //! only; the haptic loop's benchmark runs the app's world and lives with it (`app::bench`).
 
 pub mod contact;
+pub mod cutting;
 pub mod fem;
 pub mod vademecum;

@@ -2,16 +2,21 @@
 //! the Heaviside enrichment they give a mesh ([`Enrichment`]), and the reference solvers every
 //! reduced cut is checked against: the full X-FEM solve ([`xfem::solve`]) and, for a cut along
 //! element faces, plain FEM on the mesh with the cut's nodes doubled
-//! ([`split_mesh::split_along`]). See `docs/cutting.md`.
+//! ([`split_mesh::split_along`]); and the cut state online ([`CutState`]), whose condensed
+//! system gains rows and columns as incisions advance. See `docs/cutting.md`.
 
 mod clip;
 mod enrichment;
 mod incision;
+mod response;
 pub mod split_mesh;
+mod state;
 pub mod xfem;
 
 pub use enrichment::{ElementCut, Enriched, Enrichment, Piece, SLIVER};
 pub use incision::{CutFace, Incision, MIN_SEGMENT_M};
+pub use response::{ExactResponse, UncutResponse};
+pub use state::CutState;
 pub use xfem::CutSolution;
 
 /// Why a cut cannot be made or solved.

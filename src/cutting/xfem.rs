@@ -150,7 +150,11 @@ fn assemble(
 
 /// The element's functions: first dof of each and its corner; the four corners' own, then
 /// the enriched ones.
-fn element_functions(tet: &[usize; 4], cut: &ElementCut, nodes: usize) -> Vec<(usize, usize)> {
+pub(super) fn element_functions(
+    tet: &[usize; 4],
+    cut: &ElementCut,
+    nodes: usize,
+) -> Vec<(usize, usize)> {
     (0..4)
         .map(|a| (3 * tet[a], a))
         .chain(cut.functions.iter().map(|&(j, a)| (3 * nodes + 3 * j, a)))
@@ -158,7 +162,7 @@ fn element_functions(tet: &[usize; 4], cut: &ElementCut, nodes: usize) -> Vec<(u
 }
 
 /// `Σ_pieces V_p c_α c_β` for every pair of the element's functions (row-major).
-fn piece_weights(
+pub(super) fn piece_weights(
     cut: &ElementCut,
     functions: &[(usize, usize)],
     enrichment: &Enrichment,

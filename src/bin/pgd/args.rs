@@ -253,6 +253,16 @@ pub enum BenchTarget {
         #[arg(long)]
         json: bool,
     },
+    /// Incisions added online to the cut state, segment by segment, against the full X-FEM
+    /// solve of the same cut after each segment (a 40 × 40 × 10 mm block).
+    Cutting {
+        /// Cubes along x, y, z of the block (six tets each).
+        #[arg(long, num_args = 3, value_names = ["NX", "NY", "NZ"], default_values_t = [16, 16, 4])]
+        cells: Vec<usize>,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Assembly, factorization and solve on a liver-sized mesh (~4,300 nodes, ~21,000 tets).
     Fem {
         /// Print the report as JSON instead of a table.

@@ -133,6 +133,11 @@ fn bench_command(what: BenchTarget) -> ExitCode {
                 json,
             )
         }
+        BenchTarget::Cutting { cells, json } => print_report(
+            "pgd bench cutting",
+            bench::cutting::run([cells[0], cells[1], cells[2]]),
+            json,
+        ),
         BenchTarget::Fem {
             json,
             repeats,
