@@ -10,6 +10,7 @@ use std::time::Instant;
 use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
+use super::fem::median;
 use crate::cutting::{CutError, CutState, Enrichment, ExactResponse, xfem};
 use crate::fem::{Dirichlet, FemModel, Law, Loads, Material, TISSUE_DENSITY_KG_M3};
 use crate::mesh::box_mesh;
@@ -103,11 +104,6 @@ fn relative_l2(a: &[f64], b: &[f64]) -> f64 {
     let diff: f64 = a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum();
     let norm: f64 = b.iter().map(|y| y * y).sum();
     (diff / norm).sqrt()
-}
-
-fn median(mut samples: Vec<f64>) -> f64 {
-    samples.sort_by(f64::total_cmp);
-    samples[samples.len() / 2]
 }
 
 impl std::fmt::Display for CuttingBenchReport {

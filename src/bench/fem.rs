@@ -126,13 +126,19 @@ fn linear_displacement(model: &FemModel, loads: &Loads) -> Result<Vec<f64>, FemE
 }
 
 pub(crate) fn median_ms(repeats: usize, f: &mut dyn FnMut()) -> f64 {
-    let mut samples: Vec<f64> = (0..repeats)
-        .map(|_| {
-            let start = Instant::now();
-            f();
-            start.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
+    median(
+        (0..repeats)
+            .map(|_| {
+                let start = Instant::now();
+                f();
+                start.elapsed().as_secs_f64() * 1e3
+            })
+            .collect(),
+    )
+}
+
+/// The middle sample (the upper of the two middle ones for an even count).
+pub(crate) fn median(mut samples: Vec<f64>) -> f64 {
     samples.sort_by(f64::total_cmp);
     samples[samples.len() / 2]
 }

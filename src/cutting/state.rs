@@ -141,12 +141,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             }
         }
         let order = Enrichment::new(self.model.mesh(), &self.faces);
-        let index: HashMap<(usize, usize), usize> = self
-            .functions
-            .iter()
-            .enumerate()
-            .map(|(j, &key)| (key, j))
-            .collect();
+        let index = self.function_index();
         let mut enriched_m = Vec::with_capacity(q.len());
         for f in &order.functions {
             let j = index.get(&(f.node, f.face));
@@ -158,15 +153,19 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         }
     }
 
-    /// Adds the functions of `enrichment` not yet in the state: their columns of `B`, their
-    /// uncut responses, and their rows of `S`, bordering the factor.
-    fn grow(&mut self, enrichment: &Enrichment) -> Result<(), CutError> {
-        let known: HashMap<(usize, usize), usize> = self
-            .functions
+    /// Each enriched function's place among the unknowns, by `(node, face)`.
+    fn function_index(&self) -> HashMap<(usize, usize), usize> {
+        self.functions
             .iter()
             .enumerate()
             .map(|(j, &key)| (key, j))
-            .collect();
+            .collect()
+    }
+
+    /// Adds the functions of `enrichment` not yet in the state: their columns of `B`, their
+    /// uncut responses, and their rows of `S`, bordering the factor.
+    fn grow(&mut self, enrichment: &Enrichment) -> Result<(), CutError> {
+        let known = self.function_index();
         let held = |n: usize| self.model.dofs().free_index[3 * n] == PRESCRIBED;
         // The enrichment's function index → the state's, old or new; held ones dropped.
         let mut slot = vec![None; enrichment.functions.len()];
