@@ -18,17 +18,39 @@ const SURFACE_MARGIN: f64 = 0.05;
 /// Two segments whose directions differ by less than this (radians) lie on one face.
 const COLLINEAR_RAD: f64 = 1e-6;
 
-/// One planar face of a cut: points `origin + t · along + s · down` for `t ∈ [0, length_m]`,
-/// `s ∈ [−margin_m, depth_m]`, with `normal = along × down`.
+/// One planar face of a cut: the plane through `origin` with unit `normal`, and the part of
+/// it the cut covers.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CutFace {
     pub origin: Point3<f64>,
-    pub along: Unit<Vector3<f64>>,
-    pub down: Unit<Vector3<f64>>,
     pub normal: Unit<Vector3<f64>>,
-    pub length_m: f64,
-    pub depth_m: f64,
-    pub margin_m: f64,
+    pub extent: Extent,
+}
+
+/// Which part of its plane a face covers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Extent {
+    /// Swept by a blade along a straight path: `origin + t · along + s · down` for
+    /// `t ∈ [0, length_m]`, `s ∈ [−margin_m, depth_m]`.
+    Swept {
+        along: Unit<Vector3<f64>>,
+        down: Unit<Vector3<f64>>,
+        length_m: f64,
+        depth_m: f64,
+        margin_m: f64,
+    },
+    /// A radial incision of a spherical shell (the cornea): in the plane through the shell's
+    /// axis, from `from_m` to `to_m` away from the axis along `radial`, and from the anterior
+    /// sphere (centre `centre`, radius `anterior_m`) down to `depth_m` below it.
+    Meridian {
+        radial: Unit<Vector3<f64>>,
+        from_m: f64,
+        to_m: f64,
+        centre: Point3<f64>,
+        anterior_m: f64,
+        depth_m: f64,
+        margin_m: f64,
+    },
 }
 
 impl CutFace {
@@ -49,11 +71,7 @@ impl CutFace {
                 MIN_SEGMENT_M * 1e3
             )));
         }
-        if !(depth_m.is_finite() && depth_m > 0.0) {
-            return Err(CutError::Degenerate(format!(
-                "a depth of {depth_m} m (positive)"
-            )));
-        }
+        check_depth(depth_m)?;
         let along = Unit::new_normalize(path);
         let square = blade - along.into_inner() * blade.dot(&along);
         let finite = blade.iter().all(|c| c.is_finite());
@@ -65,12 +83,60 @@ impl CutFace {
         let down = Unit::new_normalize(square);
         Ok(Self {
             origin: from,
-            along,
-            down,
             normal: Unit::new_normalize(along.cross(&down)),
-            length_m,
-            depth_m,
-            margin_m: SURFACE_MARGIN * depth_m,
+            extent: Extent::Swept {
+                along,
+                down,
+                length_m,
+                depth_m,
+                margin_m: SURFACE_MARGIN * depth_m,
+            },
+        })
+    }
+
+    /// A radial incision of the spherical shell whose anterior sphere has centre `centre` and
+    /// radius `anterior_m`, about the axis through `centre` along `axis`: at `angle_rad` round
+    /// the axis (from the direction `axis × ŷ`, or `axis × x̂` for an axis along y), from
+    /// `from_m` to `to_m` away from the axis, `depth_m` deep below the anterior surface.
+    pub fn meridian(
+        centre: Point3<f64>,
+        anterior_m: f64,
+        axis: Unit<Vector3<f64>>,
+        angle_rad: f64,
+        (from_m, to_m): (f64, f64),
+        depth_m: f64,
+    ) -> Result<Self, CutError> {
+        check_depth(depth_m)?;
+        if !(from_m.is_finite()
+            && to_m.is_finite()
+            && 0.0 <= from_m
+            && from_m + MIN_SEGMENT_M <= to_m)
+        {
+            return Err(CutError::Degenerate(format!(
+                "a radial incision from {:.3} to {:.3} mm off the axis",
+                from_m * 1e3,
+                to_m * 1e3
+            )));
+        }
+        let x = Unit::new_normalize(
+            axis.cross(&Vector3::y())
+                .try_normalize(1e-9)
+                .unwrap_or_else(|| axis.cross(&Vector3::x())),
+        );
+        let y = axis.cross(&x);
+        let radial = Unit::new_normalize(x.into_inner() * angle_rad.cos() + y * angle_rad.sin());
+        Ok(Self {
+            origin: centre,
+            normal: Unit::new_normalize(axis.cross(&radial)),
+            extent: Extent::Meridian {
+                radial,
+                from_m,
+                to_m,
+                centre,
+                anterior_m,
+                depth_m,
+                margin_m: SURFACE_MARGIN * depth_m,
+            },
         })
     }
 
@@ -81,24 +147,74 @@ impl CutFace {
 
     /// Whether `p`, projected on the plane, falls inside the face, `tolerance_m` included.
     pub fn covers(&self, p: &Point3<f64>, tolerance_m: f64) -> bool {
-        let d = p - self.origin;
-        let t = self.along.dot(&d);
-        let s = self.down.dot(&d);
-        (-tolerance_m..=self.length_m + tolerance_m).contains(&t)
-            && (-self.margin_m - tolerance_m..=self.depth_m + tolerance_m).contains(&s)
+        let within = |v: f64, lo: f64, hi: f64| (lo - tolerance_m..=hi + tolerance_m).contains(&v);
+        match self.extent {
+            Extent::Swept {
+                along,
+                down,
+                length_m,
+                depth_m,
+                margin_m,
+            } => {
+                let d = p - self.origin;
+                within(along.dot(&d), 0.0, length_m) && within(down.dot(&d), -margin_m, depth_m)
+            }
+            Extent::Meridian {
+                radial,
+                from_m,
+                to_m,
+                centre,
+                anterior_m,
+                depth_m,
+                margin_m,
+            } => {
+                let below = anterior_m - (p - centre).norm();
+                within(radial.dot(&(p - centre)), from_m, to_m) && within(below, -margin_m, depth_m)
+            }
+        }
+    }
+
+    /// The face's largest dimension (m), for tolerances relative to it.
+    pub fn size_m(&self) -> f64 {
+        match self.extent {
+            Extent::Swept {
+                length_m, depth_m, ..
+            } => length_m.max(depth_m),
+            Extent::Meridian { to_m, depth_m, .. } => to_m.max(depth_m),
+        }
     }
 
     /// The face lengthened along its path to end at `to`, if `to` continues it in a straight
     /// line at the same depth.
-    fn continued(&self, to: Point3<f64>, depth_m: f64) -> Option<Self> {
-        let step = to - (self.origin + self.along.into_inner() * self.length_m);
+    fn continued(&self, to: Point3<f64>, depth: f64) -> Option<Self> {
+        let Extent::Swept {
+            along,
+            length_m,
+            depth_m,
+            ..
+        } = self.extent
+        else {
+            return None;
+        };
+        let step = to - (self.origin + along.into_inner() * length_m);
         let straight = step.norm() >= MIN_SEGMENT_M
-            && step.normalize().dot(&self.along) > COLLINEAR_RAD.cos()
-            && (depth_m - self.depth_m).abs() <= 1e-9 * self.depth_m;
-        straight.then(|| Self {
-            length_m: (to - self.origin).dot(&self.along),
-            ..*self
-        })
+            && step.normalize().dot(&along) > COLLINEAR_RAD.cos()
+            && (depth - depth_m).abs() <= 1e-9 * depth_m;
+        let mut longer = *self;
+        if let Extent::Swept { length_m, .. } = &mut longer.extent {
+            *length_m = (to - self.origin).dot(&along);
+        }
+        straight.then_some(longer)
+    }
+}
+
+fn check_depth(depth_m: f64) -> Result<(), CutError> {
+    if depth_m.is_finite() && depth_m > 0.0 {
+        Ok(())
+    } else {
+        Err(CutError::Degenerate(format!(
+            "a depth of {depth_m} m (positive)"
+        )))
     }
 }
 

@@ -8,13 +8,14 @@
 mod clip;
 mod enrichment;
 mod incision;
+pub mod keratotomy;
 mod response;
 pub mod split_mesh;
 mod state;
 pub mod xfem;
 
 pub use enrichment::{ElementCut, Enriched, Enrichment, Piece, SLIVER};
-pub use incision::{CutFace, Incision, MIN_SEGMENT_M};
+pub use incision::{CutFace, Extent, Incision, MIN_SEGMENT_M};
 pub use response::{ExactResponse, UncutResponse};
 pub use state::CutState;
 pub use xfem::CutSolution;

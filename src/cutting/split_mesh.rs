@@ -12,7 +12,7 @@ use crate::mesh::{Regions, TetMesh};
 /// must run along element faces.
 pub fn split_along(model: &FemModel, face: &CutFace) -> Result<(FemModel, Vec<usize>), CutError> {
     let mesh = model.mesh();
-    let snap_m = 1e-9 * face.length_m.max(face.depth_m);
+    let snap_m = 1e-9 * face.size_m();
     let phi: Vec<f64> = mesh
         .nodes()
         .iter()
@@ -24,7 +24,7 @@ pub fn split_along(model: &FemModel, face: &CutFace) -> Result<(FemModel, Vec<us
             && tet.iter().any(|&n| phi[n] < 0.0)
             && tet
                 .iter()
-                .any(|&n| face.covers(&mesh.nodes()[n], face.depth_m))
+                .any(|&n| face.covers(&mesh.nodes()[n], face.size_m()))
     }) {
         return Err(CutError::Degenerate(format!(
             "element {t} is crossed by the cut: a split mesh needs a cut along element faces"

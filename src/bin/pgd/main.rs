@@ -9,6 +9,7 @@ use args::{BenchTarget, BuildArgs, Cli, Command, ContactBenchArgs, MaterialArgs,
 use clap::Parser;
 use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, default_scene, scene_of};
 use pgd_surgery::cli::{self, fail, print_json, print_report};
+use pgd_surgery::cutting::keratotomy::{Cornea, Keratotomy};
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::organs::Organ;
 use pgd_surgery::pgd::ValidationSettings;
@@ -72,6 +73,29 @@ fn main() -> ExitCode {
                 }
                 Err(e) => fail("pgd validate", &e),
             }
+        }
+        Command::Cut {
+            organ,
+            incisions,
+            optical_zone_mm,
+            depth_fraction,
+            resolution,
+            layers,
+            json,
+        } => {
+            if organ != "cornea" {
+                return fail(
+                    "pgd cut",
+                    &format!("{organ}: radial keratotomy is defined on the cornea only"),
+                );
+            }
+            let plan = Keratotomy {
+                incisions,
+                optical_zone_m: optical_zone_mm * 1e-3,
+                depth_fraction,
+            };
+            let report = Cornea::new(resolution, layers).and_then(|cornea| cornea.cut(&plan));
+            print_report("pgd cut cornea", report, json)
         }
         Command::Bench { what } => bench_command(what),
     }

@@ -292,14 +292,25 @@ fn outer_faces_without(
     organ: Organ,
     nodes: usize,
 ) -> Vec<[usize; 3]> {
-    let mut held = vec![false; nodes];
-    for &n in clamped {
-        held[n] = true;
-    }
     let outer_from = match organ {
         Organ::Gallbladder | Organ::Cornea => nodes / (SHELL_LAYERS + 1) * SHELL_LAYERS,
         _ => 0,
     };
+    faces_from_without(surface, clamped, outer_from, nodes)
+}
+
+/// The surface's faces whose nodes are all numbered from `first` on and none held.
+fn faces_from_without(
+    surface: &Surface,
+    clamped: &[usize],
+    first: usize,
+    nodes: usize,
+) -> Vec<[usize; 3]> {
+    let mut held = vec![false; nodes];
+    for &n in clamped {
+        held[n] = true;
+    }
+    let outer_from = first;
     surface
         .triangles
         .iter()
@@ -310,23 +321,26 @@ fn outer_faces_without(
 
 /// The cornea of paper 001: a thin spherical cap, rim clamped, anterior face accessible.
 fn cornea(settings: &OrganSettings) -> Result<TetMesh, MeshError> {
+    cornea_in_layers(settings, SHELL_LAYERS)
+}
+
+/// The cornea with `layers` elements through its thickness (the organ has two): a cut's depth
+/// is resolved to a `1 / layers` of the thickness. Layer 0 is the posterior face, the last
+/// layer the anterior one; the node count per layer is the organ's at `settings` over three.
+pub fn cornea_in_layers(settings: &OrganSettings, layers: usize) -> Result<TetMesh, MeshError> {
+    let layers = layers.max(1);
     let per_layer = target_nodes(Organ::Cornea, settings) / (SHELL_LAYERS + 1);
     // A hexagonal disc of r rings has 1 + 3r(r + 1) vertices.
     let rings = (((per_layer as f64 / 3.0).sqrt()).round() as usize).max(2);
     let surface = spherical_cap(CORNEA_CURVATURE_M, CORNEA_RIM_M, rings);
-    let mut mesh = extrude(
-        Organ::Cornea.name(),
-        &surface,
-        CORNEA_THICKNESS_M,
-        SHELL_LAYERS,
-    )?;
+    let mut mesh = extrude(Organ::Cornea.name(), &surface, CORNEA_THICKNESS_M, layers)?;
     let n = surface.points.len();
     let first_rim_vertex = 1 + 3 * rings * (rings - 1);
-    let clamped: Vec<usize> = (0..=SHELL_LAYERS)
+    let clamped: Vec<usize> = (0..=layers)
         .flat_map(|k| (first_rim_vertex..n).map(move |v| k * n + v))
         .collect();
     let boundary = Surface::extract(&mesh);
-    let accessible = outer_faces_without(&boundary, &clamped, Organ::Cornea, mesh.node_count());
+    let accessible = faces_from_without(&boundary, &clamped, layers * n, mesh.node_count());
     mesh.set_node_set(region::CLAMPED, clamped)?;
     mesh.set_face_set(region::ACCESSIBLE, accessible)?;
     Ok(mesh)

@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 use super::{MeshError, TetMesh};
 pub use abdomen::{
     Abdomen, CORNEA_CURVATURE_M, CORNEA_RIM_M, CORNEA_THICKNESS_M, GALLBLADDER_WALL_M, GAP_M,
+    cornea_in_layers,
 };
 
 /// Region names stored with generated meshes.

@@ -1,0 +1,248 @@
+//! Radial keratotomy: incisions along meridians of the cornea, from the optical zone's edge
+//! towards the limbus, a fraction of its thickness deep. Under the intraocular pressure the
+//! weakened periphery bulges and the centre flattens; the outcome is the change of the
+//! central corneal power, in dioptres, read from the curvature of the deformed anterior
+//! surface as a keratometer reads it.
+//!
+//! Solved by the full X-FEM of the cut cornea: a reference, not the 1 kHz path.
+
+use nalgebra::{Matrix2, Point3, Unit, Vector2, Vector3};
+use serde::Serialize;
+
+use super::enrichment::Enrichment;
+use super::incision::CutFace;
+use super::{CutError, xfem};
+use crate::fem::{Dirichlet, FemModel, Law, Loads, Material, TISSUE_DENSITY_KG_M3};
+use crate::mesh::organs::{
+    CORNEA_CURVATURE_M, CORNEA_RIM_M, CORNEA_THICKNESS_M, OrganSettings, cornea_in_layers, region,
+};
+use crate::mesh::{Surface, TetMesh};
+
+/// Intraocular pressure: 15 mmHg (Pa).
+pub const IOP_PA: f64 = 15.0 * 133.322;
+
+/// The keratometric index: a keratometer reads power as `(1.3375 − 1) / R`.
+pub const KERATOMETRIC_INDEX: f64 = 1.3375;
+
+/// Young's modulus of the human cornea in vivo, 0.29 ± 0.06 MPa: Pye, "A clinical method for
+/// estimating the modulus of elasticity of the human cornea in vivo", PLoS ONE 15(1),
+/// e0224824 (2020). Nearly incompressible, as soft tissue is.
+pub const CORNEA_YOUNG_PA: f64 = 0.29e6;
+pub const CORNEA_POISSON: f64 = 0.49;
+
+/// The central zone whose curvature a keratometer reads: 3 mm across.
+const CENTRAL_ZONE_M: f64 = 1.5e-3;
+
+/// Incisions stop this far inside the clamped rim (the limbus).
+const LIMBUS_MARGIN_M: f64 = 0.5e-3;
+
+/// One radial keratotomy: how many incisions, evenly spaced, starting at the optical zone's
+/// edge (its diameter), how deep as a fraction of the cornea's thickness.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Keratotomy {
+    pub incisions: usize,
+    pub optical_zone_m: f64,
+    pub depth_fraction: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct KeratotomyReport {
+    pub incisions: usize,
+    pub optical_zone_mm: f64,
+    pub depth_fraction: f64,
+    /// Central power under the intraocular pressure, uncut and cut (D).
+    pub central_power_before_d: f64,
+    pub central_power_after_d: f64,
+    pub central_power_change_d: f64,
+    pub nodes: usize,
+    pub enriched_nodes: usize,
+}
+
+impl std::fmt::Display for KeratotomyReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(
+            f,
+            "radial keratotomy: {} incisions, optical zone {:.1} mm, {:.0} % deep ({} nodes, {} enriched)",
+            self.incisions,
+            self.optical_zone_mm,
+            100.0 * self.depth_fraction,
+            self.nodes,
+            self.enriched_nodes
+        )?;
+        writeln!(
+            f,
+            "central power under 15 mmHg: {:.2} D before, {:.2} D after: change {:+.2} D",
+            self.central_power_before_d, self.central_power_after_d, self.central_power_change_d
+        )
+    }
+}
+
+/// The cornea under intraocular pressure, ready to be cut.
+pub struct Cornea {
+    model: FemModel,
+    loads: Loads,
+    /// Anterior nodes within the central zone.
+    central: Vec<usize>,
+    power_before_d: f64,
+}
+
+impl Cornea {
+    /// The generated cornea (rim clamped) at `resolution` of its nodes per layer, with
+    /// `layers` elements through its thickness, the intraocular pressure on its posterior
+    /// face.
+    pub fn new(resolution: f64, layers: usize) -> Result<Self, CutError> {
+        let settings = OrganSettings {
+            resolution,
+            ..OrganSettings::default()
+        };
+        let solve_error = |e: String| CutError::Solve(e);
+        let mesh = cornea_in_layers(&settings, layers).map_err(|e| solve_error(e.to_string()))?;
+        let per_layer = mesh.node_count() / (layers + 1);
+        let mut loads = Loads::new(mesh.node_count());
+        loads
+            .add_pressure(&mesh, &posterior_faces(&mesh, per_layer), IOP_PA)
+            .map_err(|e| solve_error(e.to_string()))?;
+        let central = (layers * per_layer..mesh.node_count())
+            .filter(|&n| {
+                let p = mesh.nodes()[n];
+                p.x.hypot(p.y) <= CENTRAL_ZONE_M
+            })
+            .collect();
+        let mut dirichlet = Dirichlet::new(mesh.node_count());
+        let rim = mesh
+            .node_set(region::CLAMPED)
+            .map_err(|e| solve_error(e.to_string()))?
+            .to_vec();
+        dirichlet
+            .clamp(&rim)
+            .map_err(|e| solve_error(e.to_string()))?;
+        let material = Material::new(
+            Law::Linear,
+            CORNEA_YOUNG_PA,
+            CORNEA_POISSON,
+            TISSUE_DENSITY_KG_M3,
+        )
+        .map_err(|e| solve_error(e.to_string()))?;
+        let model =
+            FemModel::new(mesh, material, dirichlet).map_err(|e| solve_error(e.to_string()))?;
+        let mut cornea = Self {
+            model,
+            loads,
+            central,
+            power_before_d: 0.0,
+        };
+        let uncut = Enrichment::new(cornea.model.mesh(), &[]);
+        cornea.power_before_d = cornea.central_power_d(&uncut)?;
+        Ok(cornea)
+    }
+
+    pub fn model(&self) -> &FemModel {
+        &self.model
+    }
+
+    /// The faces of a keratotomy's incisions: meridians at even angles.
+    pub fn faces(&self, plan: &Keratotomy) -> Result<Vec<CutFace>, CutError> {
+        if plan.incisions == 0 || !(0.0..=1.0).contains(&plan.depth_fraction) {
+            return Err(CutError::Degenerate(format!(
+                "{} incisions {} deep (at least one, at most the whole thickness)",
+                plan.incisions, plan.depth_fraction
+            )));
+        }
+        let centre = Point3::new(0.0, 0.0, -CORNEA_CURVATURE_M);
+        let anterior_m = CORNEA_CURVATURE_M + CORNEA_THICKNESS_M / 2.0;
+        let reach = (plan.optical_zone_m / 2.0, CORNEA_RIM_M - LIMBUS_MARGIN_M);
+        (0..plan.incisions)
+            .map(|k| {
+                let angle = std::f64::consts::TAU * k as f64 / plan.incisions as f64;
+                CutFace::meridian(
+                    centre,
+                    anterior_m,
+                    Unit::new_unchecked(Vector3::z()),
+                    angle,
+                    reach,
+                    plan.depth_fraction * CORNEA_THICKNESS_M,
+                )
+            })
+            .collect()
+    }
+
+    /// The keratotomy's outcome under the intraocular pressure.
+    pub fn cut(&self, plan: &Keratotomy) -> Result<KeratotomyReport, CutError> {
+        let enrichment = Enrichment::new(self.model.mesh(), &self.faces(plan)?);
+        let after = self.central_power_d(&enrichment)?;
+        let mut enriched: Vec<usize> = enrichment.functions.iter().map(|f| f.node).collect();
+        enriched.sort_unstable();
+        enriched.dedup();
+        Ok(KeratotomyReport {
+            incisions: plan.incisions,
+            optical_zone_mm: plan.optical_zone_m * 1e3,
+            depth_fraction: plan.depth_fraction,
+            central_power_before_d: self.power_before_d,
+            central_power_after_d: after,
+            central_power_change_d: after - self.power_before_d,
+            nodes: self.model.mesh().node_count(),
+            enriched_nodes: enriched.len(),
+        })
+    }
+
+    /// The keratometric power of the deformed anterior centre (D).
+    fn central_power_d(&self, enrichment: &Enrichment) -> Result<f64, CutError> {
+        let solution = xfem::solve(&self.model, enrichment, &self.loads)?;
+        let mesh = self.model.mesh();
+        let deformed: Vec<Point3<f64>> = self
+            .central
+            .iter()
+            .map(|&n| {
+                mesh.nodes()[n] + Vector3::from_column_slice(&solution.nodes_m[3 * n..3 * n + 3])
+            })
+            .collect();
+        Ok((KERATOMETRIC_INDEX - 1.0) / sphere_radius_on_axis(&deformed))
+    }
+}
+
+/// The posterior face: the boundary triangles of layer 0.
+fn posterior_faces(mesh: &TetMesh, per_layer: usize) -> Vec<[usize; 3]> {
+    Surface::extract(mesh)
+        .triangles
+        .into_iter()
+        .filter(|t| t.iter().all(|&n| n < per_layer))
+        .collect()
+}
+
+/// The radius of the sphere centred on the z axis that fits `points` best: the least squares
+/// of `x² + y² + z² = 2 h z + k`, linear in the centre's height `h` and `k = R² − h²`.
+fn sphere_radius_on_axis(points: &[Point3<f64>]) -> f64 {
+    let (mut normal, mut rhs) = (Matrix2::zeros(), Vector2::zeros());
+    for p in points {
+        let row = Vector2::new(2.0 * p.z, 1.0);
+        normal += row * row.transpose();
+        rhs += row * p.coords.norm_squared();
+    }
+    let solution = normal.lu().solve(&rhs).unwrap_or_else(Vector2::zeros);
+    let (h, k) = (solution.x, solution.y);
+    (k + h * h).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points on a sphere of radius 8 mm centred 7.8 mm below the origin, as a cap 3 mm across:
+    /// the fit returns its radius.
+    #[test]
+    fn the_fit_reads_a_sphere_s_radius() {
+        let (radius, centre) = (8.0e-3, Point3::new(0.0, 0.0, -7.8e-3));
+        let points: Vec<Point3<f64>> = (0..50)
+            .map(|i| {
+                let (theta, phi) = (0.18 * (i % 7) as f64 / 7.0, 0.7 * i as f64);
+                centre
+                    + Vector3::new(
+                        theta.sin() * phi.cos(),
+                        theta.sin() * phi.sin(),
+                        theta.cos(),
+                    ) * radius
+            })
+            .collect();
+        assert!((sphere_radius_on_axis(&points) - radius).abs() < 1e-12);
+    }
+}
