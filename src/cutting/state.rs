@@ -17,7 +17,7 @@
 
 use std::collections::HashMap;
 
-use nalgebra::Point3;
+use nalgebra::{Matrix3, Point3, Vector3};
 
 use super::CutError;
 use super::enrichment::Enrichment;
@@ -73,7 +73,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     }
 
     /// Sets a new blade on the surface (see [`Incision::start`]); returns its index.
-    pub fn start(&mut self, at: Point3<f64>, blade: nalgebra::Vector3<f64>, depth_m: f64) -> usize {
+    pub fn start(&mut self, at: Point3<f64>, blade: Vector3<f64>, depth_m: f64) -> usize {
         self.cuts.push(Cut {
             incision: Incision::start(at, blade, depth_m),
             faces: Vec::new(),
@@ -160,6 +160,33 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             .enumerate()
             .map(|(j, &key)| (key, j))
             .collect()
+    }
+
+    /// The force (N) the tool feels for an `indentation_m` of the patch it loads: `patch`
+    /// holds the nodes under the tool and their shares of its load (summing to one). The cut
+    /// patch compliance `C` (3 × 3) is the shares' mean displacement under each unit force;
+    /// the force is `C⁻¹ δ`. `None` where the patch does not resist (held nothing).
+    pub fn felt_force(
+        &self,
+        patch: &[(usize, f64)],
+        indentation_m: Vector3<f64>,
+    ) -> Option<Vector3<f64>> {
+        let nodes = self.model.mesh().node_count();
+        let mut compliance = Matrix3::zeros();
+        for axis in 0..3 {
+            let mut loads = vec![0.0; 3 * nodes];
+            for &(n, share) in patch {
+                loads[3 * n + axis] += share;
+            }
+            let solution = self.solve(&loads);
+            for &(n, share) in patch {
+                let u = Vector3::from_column_slice(&solution.nodes_m[3 * n..3 * n + 3]);
+                compliance.set_column(axis, &(compliance.column(axis) + u * share));
+            }
+        }
+        compliance
+            .try_inverse()
+            .map(|stiffness| stiffness * indentation_m)
     }
 
     /// Adds the functions of `enrichment` not yet in the state: their columns of `B`, their

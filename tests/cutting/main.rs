@@ -260,14 +260,7 @@ fn bad_cuts_are_refused_with_their_reason() {
 /// cut so far, to round-off (the issue asks 5e-3 relative L2).
 #[test]
 fn incisions_added_segment_by_segment_equal_the_full_xfem_solve() {
-    let mesh = box_mesh([40.0 * MM, 40.0 * MM, 10.0 * MM], [16, 16, 4]).unwrap();
-    let clamped = mesh.node_set("x0").unwrap().to_vec();
-    let top = mesh.node_set("z1").unwrap().to_vec();
-    let model = model(mesh, &clamped);
-    let mut loads = Loads::new(model.mesh().node_count());
-    for &n in &top {
-        loads.add_nodal_force(n, [1e-7, 0.0, -2e-7]).unwrap();
-    }
+    let (model, loads) = block_to_cut();
     let response = ExactResponse::new(&model).unwrap();
     let mut state = CutState::new(&model, response);
     let centre = Point3::new(24.0 * MM, 20.0 * MM, 10.0 * MM);
@@ -353,5 +346,78 @@ fn radial_keratotomy_follows_the_clinical_trends() {
     assert!(
         shallower > eight,
         "60 % deep {shallower} D, 90 % deep {eight} D"
+    );
+}
+
+/// The block the online tests cut (40 × 40 × 10 mm, clamped at `x = 0`) and a load spread over
+/// its top.
+fn block_to_cut() -> (FemModel, Loads) {
+    let mesh = box_mesh([40.0 * MM, 40.0 * MM, 10.0 * MM], [16, 16, 4]).unwrap();
+    let clamped = mesh.node_set("x0").unwrap().to_vec();
+    let top = mesh.node_set("z1").unwrap().to_vec();
+    let model = model(mesh, &clamped);
+    let mut loads = Loads::new(model.mesh().node_count());
+    for &n in &top {
+        loads.add_nodal_force(n, [1e-7, 0.0, -2e-7]).unwrap();
+    }
+    (model, loads)
+}
+
+/// The force the tool feels beside two incisions, pressed 1 mm: the cut state's equals the
+/// one from full X-FEM solves of the same cut to round-off, and is softer than the uncut
+/// tissue's.
+#[test]
+fn the_tool_feels_the_cut_tissue_as_full_xfem_does() {
+    let (model, _) = block_to_cut();
+    let mut state = CutState::new(&model, ExactResponse::new(&model).unwrap());
+    for (from, to) in [((14.0, 20.0), (30.0, 20.0)), ((22.0, 12.0), (22.0, 18.0))] {
+        let at = |(x, y): (f64, f64)| Point3::new(x * MM, y * MM, 10.0 * MM);
+        let cut = state.start(at(from), -Vector3::z(), 6.0 * MM);
+        state.advance(cut, at(to)).unwrap();
+    }
+    let tool = Point3::new(24.0 * MM, 21.5 * MM, 10.0 * MM);
+    let radius = 4.0 * MM;
+    let mesh = model.mesh();
+    let mut patch: Vec<(usize, f64)> = mesh
+        .node_set("z1")
+        .unwrap()
+        .iter()
+        .map(|&n| (n, (mesh.nodes()[n] - tool).norm() / radius))
+        .filter(|&(_, d)| d < 1.0)
+        .map(|(n, d)| (n, (1.0 - d * d).powi(2)))
+        .collect();
+    let total: f64 = patch.iter().map(|p| p.1).sum();
+    patch.iter_mut().for_each(|p| p.1 /= total);
+    let press = Vector3::new(0.0, 0.0, -1.0 * MM);
+    let online = state.felt_force(&patch, press).unwrap();
+    let full = |faces: &[pgd_surgery::cutting::CutFace]| {
+        let enrichment = Enrichment::new(mesh, faces);
+        let mut compliance = nalgebra::Matrix3::zeros();
+        for axis in 0..3 {
+            let mut loads = Loads::new(mesh.node_count());
+            for &(n, share) in &patch {
+                let mut force = [0.0; 3];
+                force[axis] = share;
+                loads.add_nodal_force(n, force).unwrap();
+            }
+            let u = xfem::solve(&model, &enrichment, &loads).unwrap();
+            for &(n, share) in &patch {
+                let un = Vector3::from_column_slice(&u.nodes_m[3 * n..3 * n + 3]);
+                compliance.set_column(axis, &(compliance.column(axis) + un * share));
+            }
+        }
+        compliance.try_inverse().unwrap() * press
+    };
+    let (cut, uncut) = (full(state.faces()), full(&[]));
+    eprintln!(
+        "felt force {:.4e} N online, {:.4e} N full X-FEM, {:.4e} N uncut",
+        online.norm(),
+        cut.norm(),
+        uncut.norm()
+    );
+    assert!((online - cut).norm() <= 1e-9 * cut.norm());
+    assert!(
+        cut.norm() < 0.99 * uncut.norm(),
+        "the cut does not soften the tissue"
     );
 }
