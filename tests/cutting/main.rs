@@ -388,7 +388,7 @@ fn the_tool_feels_the_cut_tissue_as_full_xfem_does() {
         .collect();
     let total: f64 = patch.iter().map(|p| p.1).sum();
     patch.iter_mut().for_each(|p| p.1 /= total);
-    let press = Vector3::new(0.0, 0.0, -1.0 * MM);
+    let press = Vector3::new(0.0, 0.0, -MM);
     let online = state.felt_force(&patch, press).unwrap();
     let full = |faces: &[pgd_surgery::cutting::CutFace]| {
         let enrichment = Enrichment::new(mesh, faces);
