@@ -126,20 +126,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     /// side), in the same form as the full X-FEM solve's, enriched amplitudes in the order of
     /// [`Enrichment::new`] over [`Self::faces`].
     pub fn solve(&self, loads_n: &[f64]) -> CutSolution {
-        let mut u0 = loads_n.to_vec();
-        self.response.respond(&mut u0, 1);
-        let rhs: Vec<f64> = self
-            .coupling
-            .iter()
-            .map(|column| -column.iter().map(|&(d, b)| b * u0[d]).sum::<f64>())
-            .collect();
-        let q = self.cholesky_solve(rhs);
-        let mut nodes_m = u0;
-        for (zr, qr) in self.z.iter().zip(&q) {
-            for (u, z) in nodes_m.iter_mut().zip(zr) {
-                *u -= z * qr;
-            }
-        }
+        let (nodes_m, q) = self.condensed(loads_n);
         let order = Enrichment::new(self.model.mesh(), &self.faces);
         let index = self.function_index();
         let mut enriched_m = Vec::with_capacity(q.len());
@@ -151,6 +138,25 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             nodes_m,
             enriched_m,
         }
+    }
+
+    /// The nodes' displacements under `loads_n`, and the enriched amplitudes in the state's
+    /// order: `q = −S⁻¹ Bᵀ K⁻¹ f`, `u = K⁻¹ f − Z q`.
+    fn condensed(&self, loads_n: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let mut u = loads_n.to_vec();
+        self.response.respond(&mut u, 1);
+        let rhs: Vec<f64> = self
+            .coupling
+            .iter()
+            .map(|column| -column.iter().map(|&(d, b)| b * u[d]).sum::<f64>())
+            .collect();
+        let q = self.cholesky_solve(rhs);
+        for (zr, qr) in self.z.iter().zip(&q) {
+            for (ui, z) in u.iter_mut().zip(zr) {
+                *ui -= z * qr;
+            }
+        }
+        (u, q)
     }
 
     /// Each enriched function's place among the unknowns, by `(node, face)`.
@@ -178,9 +184,9 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             for &(n, share) in patch {
                 loads[3 * n + axis] += share;
             }
-            let solution = self.solve(&loads);
+            let (nodes_m, _) = self.condensed(&loads);
             for &(n, share) in patch {
-                let u = Vector3::from_column_slice(&solution.nodes_m[3 * n..3 * n + 3]);
+                let u = Vector3::from_column_slice(&nodes_m[3 * n..3 * n + 3]);
                 compliance.set_column(axis, &(compliance.column(axis) + u * share));
             }
         }
