@@ -218,7 +218,8 @@ fn edge_crack_error(h: f64) -> f64 {
 }
 
 /// Bad cuts get their errors, never a panic or a singular solve: a zero-length step, a blade
-/// along its path, and a cut that frees the loaded end of a bar held at the other.
+/// along its path, and a cut that frees the loaded end of a bar held at the other; a cut that
+/// misses the tissue changes nothing.
 #[test]
 fn bad_cuts_are_refused_with_their_reason() {
     let at = Point3::new(0.0, 0.0, 0.0);
@@ -252,6 +253,22 @@ fn bad_cuts_are_refused_with_their_reason() {
         xfem::solve(&model, &enrichment, &loads),
         Err(CutError::Detached)
     );
+
+    // A cut that misses the tissue, or is shallower than the element it starts in, cuts no
+    // support whole: it enriches nothing, and the organ is solved as uncut.
+    let uncut = xfem::solve(&model, &Enrichment::new(model.mesh(), &[]), &loads).unwrap();
+    for (z_mm, depth_mm) in [(30.0, 5.0), (10.0, 2.0)] {
+        let miss = Incision::straight(
+            Point3::new(20.0 * MM, 2.0 * MM, z_mm * MM),
+            Point3::new(20.0 * MM, 8.0 * MM, z_mm * MM),
+            -Vector3::z(),
+            depth_mm * MM,
+        )
+        .unwrap();
+        let nothing = Enrichment::new(model.mesh(), miss.faces());
+        assert!(nothing.is_empty(), "{z_mm} mm up, {depth_mm} mm deep");
+        assert_eq!(xfem::solve(&model, &nothing, &loads).unwrap(), uncut);
+    }
 }
 
 /// Four incisions at angles drawn at random around a centre, each added online in three
