@@ -8,8 +8,9 @@ use crate::fem::{Dirichlet, FemModel};
 use crate::mesh::{Regions, TetMesh};
 
 /// The model with the nodes strictly inside `face` doubled, and for each copy the node it
-/// copies (copy `k` is node `node_count + k`). Refused when the face crosses an element: it
-/// must run along element faces.
+/// copies (copy `k` is node `node_count + k`). Refused when the face's plane crosses an element
+/// with a corner within one face size of the face (a conservative test: the cut must run
+/// along element faces).
 pub fn split_along(model: &FemModel, face: &CutFace) -> Result<(FemModel, Vec<usize>), CutError> {
     let mesh = model.mesh();
     let snap_m = 1e-9 * face.size_m();
