@@ -62,7 +62,7 @@ pub fn run(cells: [usize; 3]) -> Result<CuttingBenchReport, String> {
                 .map_err(|e: CutError| e.to_string())?;
             add.push(ms(started));
             let started = Instant::now();
-            let fast = state.solve(loads.as_slice());
+            let fast = state.solve(loads.as_slice()).map_err(|e| e.to_string())?;
             online.push(ms(started));
             let started = Instant::now();
             let enrichment = Enrichment::new(model.mesh(), state.faces());

@@ -16,7 +16,7 @@ pub mod xfem;
 
 pub use enrichment::{ElementCut, Enriched, Enrichment, Piece, SLIVER};
 pub use incision::{CutFace, Extent, Incision, MIN_SEGMENT_M};
-pub use response::{ExactResponse, UncutResponse};
+pub use response::{ExactResponse, Response, UncutResponse};
 pub use state::CutState;
 pub use xfem::CutSolution;
 
@@ -27,6 +27,11 @@ pub enum CutError {
     Degenerate(String),
     #[error("the cut detaches a piece of tissue: nothing holds it any more")]
     Detached,
+    #[error(
+        "the cut reaches node {node}, outside the region the cut vademecum covers: rebuild it \
+         with a deeper --cut-depth-mm, or cut nearer the accessible face"
+    )]
+    OutsideRegion { node: usize },
     #[error("the cut organ cannot be solved: {0}")]
     Solve(String),
 }

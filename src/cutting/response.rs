@@ -1,17 +1,33 @@
 //! The uncut organ's response to loads, `K⁻¹ f`: what the cut state condenses the cut onto.
-//! The exact answer is a sparse factorization of the rest stiffness; a vademecum whose load
-//! positions cover the region where cuts are allowed answers the same question from its modes.
+//! The exact answer is a sparse factorization of the rest stiffness; a cut vademecum
+//! ([`RegionResponse`]) answers the same question over the region where cuts are allowed from
+//! its modes and near field, with products only.
 
+use super::CutError;
 use crate::fem::{DirectSolver, Factorization, FemError, FemModel};
+use crate::pgd::{RegionResponse, SparseDofs};
 
-/// Solves the uncut organ for loads given as full nodal vectors (three per node; held dofs
-/// ignored, returned as zero).
+/// `K⁻¹ f` for one sparse load: `X · modal + near`, the modal coefficients of the response's
+/// separated sum (none for an exact response) and the rest as sparse dofs.
+#[derive(Clone, Debug, Default)]
+pub struct Response {
+    pub modal: Vec<f64>,
+    pub near: SparseDofs,
+}
+
+/// Solves the uncut organ for sparse loads over full dofs (three per node; held dofs ignored,
+/// answered as zero).
 pub trait UncutResponse {
     fn node_count(&self) -> usize;
 
-    /// Overwrites each of the `columns` full vectors in `loads` (column-major) with the
-    /// displacement they cause.
-    fn respond(&self, loads: &mut [f64], columns: usize);
+    /// The responses to `loads`; an error names a loaded node the response does not cover.
+    fn respond(&self, loads: &[SparseDofs]) -> Result<Vec<Response>, CutError>;
+
+    /// `Xᵀ v` for a sparse `v`: what `vᵀ` times a response's modal part needs.
+    fn spatial_products(&self, v: &[(usize, f64)]) -> Vec<f64>;
+
+    /// `u += X · modal` over all dofs.
+    fn add_spatial(&self, modal: &[f64], u: &mut [f64]);
 }
 
 /// The exact response: the rest stiffness factorized once.
@@ -38,20 +54,68 @@ impl UncutResponse for ExactResponse {
         self.node_count
     }
 
-    fn respond(&self, loads: &mut [f64], columns: usize) {
-        let (full, free) = (3 * self.node_count, self.free_dofs.len());
-        let mut block = vec![0.0; free * columns];
-        for c in 0..columns {
-            for (i, &d) in self.free_dofs.iter().enumerate() {
-                block[c * free + i] = loads[c * full + d];
+    fn respond(&self, loads: &[SparseDofs]) -> Result<Vec<Response>, CutError> {
+        let free = self.free_dofs.len();
+        let mut index = vec![usize::MAX; 3 * self.node_count];
+        for (i, &d) in self.free_dofs.iter().enumerate() {
+            index[d] = i;
+        }
+        let mut block = vec![0.0; free * loads.len()];
+        for (c, load) in loads.iter().enumerate() {
+            for &(d, v) in load {
+                if index[d] != usize::MAX {
+                    block[c * free + index[d]] += v;
+                }
             }
         }
         self.factor.solve_block_in_place(&mut block, free);
-        loads.fill(0.0);
-        for c in 0..columns {
-            for (i, &d) in self.free_dofs.iter().enumerate() {
-                loads[c * full + d] = block[c * free + i];
-            }
-        }
+        Ok(block
+            .chunks_exact(free.max(1))
+            .take(loads.len())
+            .map(|column| Response {
+                modal: Vec::new(),
+                near: self
+                    .free_dofs
+                    .iter()
+                    .copied()
+                    .zip(column.iter().copied())
+                    .collect(),
+            })
+            .collect())
+    }
+
+    fn spatial_products(&self, _: &[(usize, f64)]) -> Vec<f64> {
+        Vec::new()
+    }
+
+    fn add_spatial(&self, _: &[f64], _: &mut [f64]) {}
+}
+
+impl UncutResponse for RegionResponse {
+    fn node_count(&self) -> usize {
+        RegionResponse::node_count(self)
+    }
+
+    fn respond(&self, loads: &[SparseDofs]) -> Result<Vec<Response>, CutError> {
+        let mut scratch = Vec::new();
+        loads
+            .iter()
+            .map(|load| {
+                Ok(Response {
+                    modal: self
+                        .modal_coefficients(load)
+                        .map_err(|node| CutError::OutsideRegion { node })?,
+                    near: self.near_response(load, &mut scratch),
+                })
+            })
+            .collect()
+    }
+
+    fn spatial_products(&self, v: &[(usize, f64)]) -> Vec<f64> {
+        RegionResponse::spatial_products(self, v)
+    }
+
+    fn add_spatial(&self, modal: &[f64], u: &mut [f64]) {
+        RegionResponse::add_spatial(self, modal, u);
     }
 }

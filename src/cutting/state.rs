@@ -9,7 +9,8 @@
 //! `S q = −Bᵀ K⁻¹ f` with `S = A − Bᵀ K⁻¹ B`, then `u = K⁻¹ f − K⁻¹ B q`.
 //!
 //! `K⁻¹` is the uncut organ's response ([`UncutResponse`]), and `Z = K⁻¹ B` its response to
-//! each enriched function's forces. A segment only ever adds enriched functions (a longer face
+//! each enriched function's forces, kept in the response's own form (modal coefficients and a
+//! sparse near field for a cut vademecum, so that nothing here costs a sparse solve). A segment only ever adds enriched functions (a longer face
 //! enriches the nodes its growth cuts whole; a turn starts a face with its own), and the
 //! entries between the functions already there do not change. So a segment appends columns to
 //! `Z` and rows and columns to `S`, whose Cholesky factor is extended by bordering: `O(n² k)`
@@ -22,7 +23,7 @@ use nalgebra::{Matrix3, Point3, Vector3};
 use super::CutError;
 use super::enrichment::Enrichment;
 use super::incision::{CutFace, Incision};
-use super::response::UncutResponse;
+use super::response::{Response, UncutResponse};
 use super::xfem::{CutSolution, element_functions, piece_weights};
 use crate::fem::{FemModel, PRESCRIBED};
 
@@ -50,8 +51,10 @@ pub struct CutState<'m, R: UncutResponse> {
     functions: Vec<(usize, usize)>,
     /// Per unknown, `B`'s column.
     coupling: Vec<SparseColumn>,
-    /// Per unknown, `K⁻¹` of its column of `B` (full nodal vectors).
-    z: Vec<Vec<f64>>,
+    /// Per unknown, `K⁻¹` of its column of `B`.
+    z: Vec<Response>,
+    /// Per unknown, `Xᵀ` of its column of `B`: its products with any response's modal part.
+    rows: Vec<Vec<f64>>,
     /// The lower Cholesky factor of `S`, row by row (row `i` holds `i + 1` entries).
     factor: Vec<Vec<f64>>,
 }
@@ -68,6 +71,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             functions: Vec::new(),
             coupling: Vec::new(),
             z: Vec::new(),
+            rows: Vec::new(),
             factor: Vec::new(),
         }
     }
@@ -124,9 +128,10 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
 
     /// The cut organ under nodal forces `loads_n` (full vector, each force on its node's own
     /// side), in the same form as the full X-FEM solve's, enriched amplitudes in the order of
-    /// [`Enrichment::new`] over [`Self::faces`].
-    pub fn solve(&self, loads_n: &[f64]) -> CutSolution {
-        let (nodes_m, q) = self.condensed(loads_n);
+    /// [`Enrichment::new`] over [`Self::faces`]. Fails only for a load outside the region a
+    /// cut vademecum covers.
+    pub fn solve(&self, loads_n: &[f64]) -> Result<CutSolution, CutError> {
+        let (nodes_m, q) = self.condensed(loads_n)?;
         let order = Enrichment::new(self.model.mesh(), &self.faces);
         let index = self.function_index();
         let mut enriched_m = Vec::with_capacity(q.len());
@@ -134,29 +139,49 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             let j = index.get(&(f.node, f.face));
             enriched_m.extend((0..3).map(|c| j.map_or(0.0, |&j| q[3 * j + c])));
         }
-        CutSolution {
+        Ok(CutSolution {
             nodes_m,
             enriched_m,
-        }
+        })
     }
 
     /// The nodes' displacements under `loads_n`, and the enriched amplitudes in the state's
     /// order: `q = −S⁻¹ Bᵀ K⁻¹ f`, `u = K⁻¹ f − Z q`.
-    fn condensed(&self, loads_n: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let mut u = loads_n.to_vec();
-        self.response.respond(&mut u, 1);
-        let rhs: Vec<f64> = self
-            .coupling
+    fn condensed(&self, loads_n: &[f64]) -> Result<(Vec<f64>, Vec<f64>), CutError> {
+        let load: Vec<(usize, f64)> = loads_n
             .iter()
-            .map(|column| -column.iter().map(|&(d, b)| b * u[d]).sum::<f64>())
+            .enumerate()
+            .filter(|(_, v)| **v != 0.0)
+            .map(|(d, &v)| (d, v))
+            .collect();
+        let response = self.response.respond(&[load])?.remove(0);
+        let mut u = vec![0.0; loads_n.len()];
+        scatter(&response.near, 1.0, &mut u);
+        let rhs: Vec<f64> = (0..self.z.len())
+            .map(|p| -self.product(p, &response.modal, &u))
             .collect();
         let q = self.cholesky_solve(rhs);
-        for (zr, qr) in self.z.iter().zip(&q) {
-            for (ui, z) in u.iter_mut().zip(zr) {
-                *ui -= z * qr;
-            }
+        let mut modal = response.modal;
+        for (z, &qj) in self.z.iter().zip(&q) {
+            modal
+                .iter_mut()
+                .zip(&z.modal)
+                .for_each(|(m, a)| *m -= qj * a);
+            scatter(&z.near, -qj, &mut u);
         }
-        (u, q)
+        self.response.add_spatial(&modal, &mut u);
+        Ok((u, q))
+    }
+
+    /// `b_pᵀ K⁻¹ f` for unknown `p` and a response given by its modal coefficients and its
+    /// near field scattered over full dofs.
+    fn product(&self, p: usize, modal: &[f64], near: &[f64]) -> f64 {
+        let modal_part: f64 = self.rows[p].iter().zip(modal).map(|(r, m)| r * m).sum();
+        modal_part
+            + self.coupling[p]
+                .iter()
+                .map(|&(d, b)| b * near[d])
+                .sum::<f64>()
     }
 
     /// Each enriched function's place among the unknowns, by `(node, face)`.
@@ -170,29 +195,57 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
 
     /// The force (N) the tool feels for an `indentation_m` of the patch it loads: `patch`
     /// holds the nodes under the tool and their shares of its load (summing to one). The cut
-    /// patch compliance `C` (3 × 3) is the shares' mean displacement under each unit force;
-    /// the force is `C⁻¹ δ`. `None` where the patch does not resist (held nothing).
+    /// patch compliance `C` (3 × 3) is the shares' mean displacement under each unit force,
+    /// `Pᵀ K⁻¹ P + Wᵀ S⁻¹ W` with `W = Bᵀ K⁻¹ P` (`K⁻¹` symmetric); the force is `C⁻¹ δ`.
+    /// `None` where the patch does not resist (held nothing); an error for a patch outside
+    /// the region a cut vademecum covers.
     pub fn felt_force(
         &self,
         patch: &[(usize, f64)],
         indentation_m: Vector3<f64>,
-    ) -> Option<Vector3<f64>> {
-        let nodes = self.model.mesh().node_count();
+    ) -> Result<Option<Vector3<f64>>, CutError> {
+        let loads: Vec<SparseColumn> = (0..3)
+            .map(|axis| {
+                patch
+                    .iter()
+                    .map(|&(n, share)| (3 * n + axis, share))
+                    .collect()
+            })
+            .collect();
+        let responses = self.response.respond(&loads)?;
+        let dofs = 3 * self.model.mesh().node_count();
+        let mut near = vec![0.0; dofs];
         let mut compliance = Matrix3::zeros();
-        for axis in 0..3 {
-            let mut loads = vec![0.0; 3 * nodes];
-            for &(n, share) in patch {
-                loads[3 * n + axis] += share;
+        let mut w = Vec::with_capacity(3);
+        for (axis, response) in responses.iter().enumerate() {
+            scatter(&response.near, 1.0, &mut near);
+            for (row, load) in loads.iter().enumerate() {
+                let modal: f64 = self
+                    .response
+                    .spatial_products(load)
+                    .iter()
+                    .zip(&response.modal)
+                    .map(|(x, m)| x * m)
+                    .sum();
+                let near_part: f64 = load.iter().map(|&(d, s)| s * near[d]).sum();
+                compliance[(row, axis)] = modal + near_part;
             }
-            let (nodes_m, _) = self.condensed(&loads);
-            for &(n, share) in patch {
-                let u = Vector3::from_column_slice(&nodes_m[3 * n..3 * n + 3]);
-                compliance.set_column(axis, &(compliance.column(axis) + u * share));
+            w.push(
+                (0..self.z.len())
+                    .map(|p| self.product(p, &response.modal, &near))
+                    .collect::<Vec<f64>>(),
+            );
+            scatter(&response.near, -1.0, &mut near);
+        }
+        for axis in 0..3 {
+            let y = self.cholesky_solve(w[axis].clone());
+            for row in 0..3 {
+                compliance[(row, axis)] += w[row].iter().zip(&y).map(|(a, b)| a * b).sum::<f64>();
             }
         }
-        compliance
+        Ok(compliance
             .try_inverse()
-            .map(|stiffness| stiffness * indentation_m)
+            .map(|stiffness| stiffness * indentation_m))
     }
 
     /// Adds the functions of `enrichment` not yet in the state: their columns of `B`, their
@@ -229,41 +282,35 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         }
         let first_new = 3 * self.functions.len();
         let (coupling, a) = self.new_blocks(enrichment, &slot, first_new, 3 * added.len());
-        let mut z: Vec<Vec<f64>> = coupling.iter().map(|c| self.nodal(c)).collect();
-        let mut flat: Vec<f64> = z.concat();
-        self.response.respond(&mut flat, z.len());
-        let full = 3 * self.model.mesh().node_count();
-        for (r, column) in z.iter_mut().enumerate() {
-            column.copy_from_slice(&flat[r * full..(r + 1) * full]);
-        }
+        let z = self.response.respond(&coupling)?;
+        let rows: Vec<Vec<f64>> = coupling
+            .iter()
+            .map(|b| self.response.spatial_products(b))
+            .collect();
         // S's new columns: A − Bᵀ Z, against every unknown, old and new.
         let total = first_new + z.len();
+        let mut near = vec![0.0; 3 * self.model.mesh().node_count()];
         let mut columns = vec![vec![0.0; total]; z.len()];
         for (r, column) in columns.iter_mut().enumerate() {
+            scatter(&z[r].near, 1.0, &mut near);
             for (p, entry) in column.iter_mut().enumerate() {
-                let b = if p < first_new {
-                    &self.coupling[p]
+                let (b, row) = if p < first_new {
+                    (&self.coupling[p], &self.rows[p])
                 } else {
-                    &coupling[p - first_new]
+                    (&coupling[p - first_new], &rows[p - first_new])
                 };
-                *entry = a.get(&(p, first_new + r)).copied().unwrap_or(0.0)
-                    - b.iter().map(|&(d, v)| v * z[r][d]).sum::<f64>();
+                let modal: f64 = row.iter().zip(&z[r].modal).map(|(x, m)| x * m).sum();
+                let near_part: f64 = b.iter().map(|&(d, v)| v * near[d]).sum();
+                *entry = a.get(&(p, first_new + r)).copied().unwrap_or(0.0) - modal - near_part;
             }
+            scatter(&z[r].near, -1.0, &mut near);
         }
         self.border(&columns)?;
         self.functions.extend(added);
         self.coupling.extend(coupling);
         self.z.extend(z);
+        self.rows.extend(rows);
         Ok(())
-    }
-
-    /// A sparse column as a full nodal vector.
-    fn nodal(&self, column: &[(usize, f64)]) -> Vec<f64> {
-        let mut out = vec![0.0; 3 * self.model.mesh().node_count()];
-        for &(d, v) in column {
-            out[d] += v;
-        }
-        out
     }
 
     /// `B`'s columns for the new unknowns `first_new..first_new + count`, and the entries of
@@ -365,5 +412,12 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             x[i] = (x[i] - s) / self.factor[i][i];
         }
         x
+    }
+}
+
+/// `u += scale · v` for a sparse `v`.
+fn scatter(v: &[(usize, f64)], scale: f64, u: &mut [f64]) {
+    for &(d, value) in v {
+        u[d] += scale * value;
     }
 }

@@ -198,7 +198,7 @@ pub fn build(
         header,
         positions: patches.positions.iter().map(|&n| n as u32).collect(),
         position_coords_m: coords,
-        position_areas_m2: patches.areas_m2.iter().map(|&a| a as f32).collect(),
+        position_areas_m2: patches.weights.iter().map(|&a| a as f32).collect(),
         position_normals: normals,
         triangles,
         reference_compliance_m_per_n: self_compliances(&steps[0].local),
@@ -314,7 +314,7 @@ fn separated_step(
         progress,
         ..
     } = *context;
-    let weights = patches.weights();
+    let weights = patches.parameter_weights();
     let optimal = optimal_errors(&gram, &weights, settings.pgd.max_modes);
     let brute_force_seconds = clock.elapsed().as_secs_f64();
 

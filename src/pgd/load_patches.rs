@@ -23,8 +23,9 @@ pub trait LoadOperator {
 pub struct LoadPatches {
     /// The accessible surface nodes (volume numbering), one per load position.
     pub positions: Vec<usize>,
-    /// Per position, its lumped surface area (m²): the quadrature weight of the parameter space.
-    pub areas_m2: Vec<f64>,
+    /// Per position, its quadrature weight in the parameter space: the lumped surface area (m²)
+    /// of a tool's position, the lumped volume (m³) of a node a cut may load.
+    pub weights: Vec<f64>,
 }
 
 impl LoadPatches {
@@ -34,7 +35,7 @@ impl LoadPatches {
         kernel: &PatchKernel,
         positions: Vec<usize>,
     ) -> Result<Self, FemError> {
-        let mut areas_m2 = Vec::with_capacity(positions.len());
+        let mut weights = Vec::with_capacity(positions.len());
         for &node in &positions {
             let local = surface.surface_index_of[node];
             if local == NOT_ON_SURFACE {
@@ -44,17 +45,14 @@ impl LoadPatches {
                     problem: "not a surface node",
                 });
             }
-            areas_m2.push(kernel.area_m2(local));
+            weights.push(kernel.area_m2(local));
         }
-        Ok(Self {
-            positions,
-            areas_m2,
-        })
+        Ok(Self { positions, weights })
     }
 
-    /// Quadrature weight of every parameter: its position's area, once per direction.
-    pub fn weights(&self) -> Vec<f64> {
-        self.areas_m2.iter().flat_map(|&a| [a; 3]).collect()
+    /// Quadrature weight of every parameter: its position's, once per direction.
+    pub fn parameter_weights(&self) -> Vec<f64> {
+        self.weights.iter().flat_map(|&a| [a; 3]).collect()
     }
 }
 
