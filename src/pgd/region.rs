@@ -49,7 +49,7 @@ pub struct RegionResponse {
     pub near_offsets: Vec<u32>,
     pub near_nodes: Vec<u32>,
     pub near: Vec<f32>,
-    /// Per volume node, its position, or `u32::MAX` outside the region.
+    /// Per volume node, its position, [`HELD`] where every dof is prescribed, or [`OUTSIDE`].
     slot: Vec<u32>,
 }
 
@@ -71,6 +71,11 @@ pub struct RegionReport {
 /// One position in this many has its compressed response compared with the exact one.
 const ERROR_SAMPLE_STRIDE: usize = 61;
 
+/// The slot of a node outside the region.
+const OUTSIDE: u32 = u32::MAX;
+/// The slot of a held node: a load there moves nothing.
+const HELD: u32 = u32::MAX - 1;
+
 /// Positions solved together (three columns each).
 const BLOCK_POSITIONS: usize = 16;
 
@@ -89,7 +94,7 @@ impl RegionResponse {
         let free = &stiffness.model.dofs().free_index;
         let positions: Vec<usize> = (0..mesh.node_count())
             .into_par_iter()
-            .filter(|&n| free[3 * n] != PRESCRIBED)
+            .filter(|&n| (0..3).any(|c| free[3 * n + c] != PRESCRIBED))
             .filter(|&n| {
                 let p = mesh.nodes()[n];
                 on_faces
@@ -161,7 +166,7 @@ impl RegionResponse {
                 .map(|&v| v as f32)
                 .collect(),
             (near_offsets, near.concat(), near_values),
-            mesh.node_count(),
+            &stiffness.model.dofs().free_index,
         );
         let report = RegionReport {
             positions: region.positions.len(),
@@ -177,15 +182,21 @@ impl RegionResponse {
     }
 
     /// Assembles a response from its arrays (as read from a file): `near` is
-    /// `(offsets, nodes, blocks)`.
+    /// `(offsets, nodes, blocks)`; `free_index` is the model's (three per node).
     pub fn new(
         positions: Vec<u32>,
         spatial: Vec<f32>,
         parametric: Vec<f32>,
         (near_offsets, near_nodes, near): (Vec<u32>, Vec<u32>, Vec<f32>),
-        node_count: usize,
+        free_index: &[usize],
     ) -> Self {
-        let mut slot = vec![u32::MAX; node_count];
+        let mut slot: Vec<u32> = free_index
+            .chunks_exact(3)
+            .map(|dofs| match dofs.iter().all(|&f| f == PRESCRIBED) {
+                true => HELD,
+                false => OUTSIDE,
+            })
+            .collect();
         for (m, &n) in positions.iter().enumerate() {
             slot[n as usize] = m as u32;
         }
@@ -213,16 +224,19 @@ impl RegionResponse {
         self.slot
             .get(node)
             .copied()
-            .filter(|&m| m != u32::MAX)
+            .filter(|&m| m != OUTSIDE && m != HELD)
             .map(|m| m as usize)
     }
 
-    /// `Yᵀ f`: the modal coefficients of the response to the sparse load `load`. `Err(node)`
-    /// names a loaded node outside the region.
+    /// `Yᵀ f`: the modal coefficients of the response to the sparse load `load` (loads on
+    /// held nodes move nothing). `Err(node)` names a loaded node outside the region.
     pub fn modal_coefficients(&self, load: &[(usize, f64)]) -> Result<Vec<f64>, usize> {
         let parameters = 3 * self.positions.len();
         let mut out = vec![0.0; self.modes()];
         for &(dof, value) in load {
+            if self.slot.get(dof / 3) == Some(&HELD) {
+                continue;
+            }
             let m = self.position_of(dof / 3).ok_or(dof / 3)?;
             let p = 3 * m + dof % 3;
             for (k, c) in out.iter_mut().enumerate() {
@@ -323,7 +337,9 @@ fn near_blocks(
     for (j, &node) in chunk.iter().enumerate() {
         for d in 0..3 {
             let f = free_index[3 * node + d];
-            block[(3 * j + d) * rows + f] = 1.0;
+            if f != PRESCRIBED {
+                block[(3 * j + d) * rows + f] = 1.0;
+            }
         }
     }
     stiffness.solve_block(&mut block);
