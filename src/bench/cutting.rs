@@ -2,8 +2,10 @@
 //! the full X-FEM solve of the same cut after each segment, timed in the same run.
 //!
 //! The block is the cut-state test's (40 × 40 × 10 mm, clamped on one side): four incisions
-//! of three segments each around a centre, one turning. Medians over the segments; each
-//! figure also as a ratio to the full X-FEM re-solve.
+//! of four segments each around a centre, one turning, made once over the exact uncut
+//! response (the stiffness factorized) and once over a cut vademecum; the tool's felt force
+//! (the haptic tick's cutting work) timed with 0, 4 and 16 segments present. Medians and p99;
+//! each figure also as a ratio to the full X-FEM re-solve.
 
 use std::time::Instant;
 
@@ -11,11 +13,26 @@ use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
 use super::fem::median;
-use crate::cutting::{CutError, CutState, Enrichment, ExactResponse, xfem};
+use crate::cutting::{CutError, CutState, Enrichment, ExactResponse, UncutResponse, xfem};
 use crate::fem::{Dirichlet, FemModel, Law, Loads, Material, TISSUE_DENSITY_KG_M3};
 use crate::mesh::box_mesh;
+use crate::pgd::{RegionResponse, RegionSettings, RestStiffness, Silent};
 
 const MM: f64 = 1e-3;
+
+/// How one uncut response serves the cut state.
+#[derive(Clone, Debug, Serialize)]
+pub struct ResponseFigures {
+    pub response: &'static str,
+    /// Per segment (ms): the cut state's growth, median and p99.
+    pub add_segment_ms: [f64; 2],
+    /// Per segment (ms): its solve for the whole field, median.
+    pub online_solve_ms: f64,
+    /// The tool's felt force with 0, 4 and 16 segments present (µs): median and p99.
+    pub tick_us: Vec<(usize, [f64; 2])>,
+    /// The largest relative L2 difference from full X-FEM over the segments.
+    pub worst_difference: f64,
+}
 
 #[derive(Clone, Debug, Serialize)]
 pub struct CuttingBenchReport {
@@ -23,34 +40,72 @@ pub struct CuttingBenchReport {
     pub segments: usize,
     /// Enriched unknowns of the condensed system at the end.
     pub unknowns: usize,
-    /// Per segment, medians (ms): the cut state's growth, its solve for the whole field,
-    /// and the full X-FEM solve of the same cut (the baseline).
-    pub add_segment_ms: f64,
-    pub online_solve_ms: f64,
+    /// The full X-FEM solve of the same cut after each segment (the baseline), median (ms).
     pub full_xfem_ms: f64,
-    /// The largest relative L2 difference of the two fields over the segments.
-    pub worst_difference: f64,
+    /// The cut vademecum's build (s): 20 mm deep under the top face, 6 mm near field.
+    pub vademecum_build_s: f64,
+    /// The exact response (the stiffness factorized), then the cut vademecum.
+    pub responses: Vec<ResponseFigures>,
 }
 
-/// Cuts the block `cells` fine (cubes along x, y, z) and times every segment.
+/// Felt-force evaluations timed per figure.
+const TICKS: usize = 500;
+
+/// Cuts the block `cells` fine (cubes along x, y, z) and times every segment, with the exact
+/// uncut response and with a cut vademecum.
 pub fn run(cells: [usize; 3]) -> Result<CuttingBenchReport, String> {
-    let mesh = box_mesh([40.0 * MM, 40.0 * MM, 10.0 * MM], cells).map_err(|e| e.to_string())?;
-    let clamped = mesh.node_set("x0").map_err(|e| e.to_string())?.to_vec();
-    let top = mesh.node_set("z1").map_err(|e| e.to_string())?.to_vec();
+    let text = |e: &dyn std::fmt::Display| e.to_string();
+    let mesh = box_mesh([40.0 * MM, 40.0 * MM, 10.0 * MM], cells).map_err(|e| text(&e))?;
+    let clamped = mesh.node_set("x0").map_err(|e| text(&e))?.to_vec();
+    let top = mesh.node_set("z1").map_err(|e| text(&e))?.to_vec();
+    let top_faces = mesh.face_set("z1").map_err(|e| text(&e))?.to_vec();
     let mut dirichlet = Dirichlet::new(mesh.node_count());
-    dirichlet.clamp(&clamped).map_err(|e| e.to_string())?;
+    dirichlet.clamp(&clamped).map_err(|e| text(&e))?;
     let material =
-        Material::new(Law::Linear, 1.6e3, 0.45, TISSUE_DENSITY_KG_M3).map_err(|e| e.to_string())?;
-    let model = FemModel::new(mesh, material, dirichlet).map_err(|e| e.to_string())?;
+        Material::new(Law::Linear, 1.6e3, 0.45, TISSUE_DENSITY_KG_M3).map_err(|e| text(&e))?;
+    let model = FemModel::new(mesh, material, dirichlet).map_err(|e| text(&e))?;
     let mut loads = Loads::new(model.mesh().node_count());
     for &n in &top {
         loads
             .add_nodal_force(n, [1e-7, 0.0, -2e-7])
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| text(&e))?;
     }
-    let response = ExactResponse::new(&model).map_err(|e| e.to_string())?;
-    let mut state = CutState::new(&model, response);
+    let started = Instant::now();
+    let stiffness = RestStiffness::new(&model).map_err(|e| text(&e))?;
+    let settings = RegionSettings {
+        depth_m: 20.0 * MM,
+        near_radius_m: 6.0 * MM,
+        modes: 40,
+    };
+    let region = RegionResponse::region_nodes(&stiffness, &top_faces, settings.depth_m);
+    let (vademecum, _) =
+        RegionResponse::build(&stiffness, &region, &settings, &Silent).map_err(|e| text(&e))?;
+    let vademecum_build_s = started.elapsed().as_secs_f64();
+    let exact = ExactResponse::new(&model).map_err(|e| text(&e))?;
+    let patch = tool_patch(&model, &top);
+    let (exact, full, unknowns) = cut_with(&model, &loads, &patch, exact, "exact")?;
+    let (vademecum, _, _) = cut_with(&model, &loads, &patch, vademecum, "cut vademecum")?;
+    Ok(CuttingBenchReport {
+        nodes: model.mesh().node_count(),
+        segments: full.len(),
+        unknowns,
+        full_xfem_ms: median(full),
+        vademecum_build_s,
+        responses: vec![exact, vademecum],
+    })
+}
+
+/// The incisions cut with `response`: its figures, the full X-FEM times and the unknowns.
+fn cut_with<R: UncutResponse>(
+    model: &FemModel,
+    loads: &Loads,
+    patch: &[(usize, f64)],
+    response: R,
+    name: &'static str,
+) -> Result<(ResponseFigures, Vec<f64>, usize), String> {
+    let mut state = CutState::new(model, response);
     let (mut add, mut online, mut full) = (vec![], vec![], vec![]);
+    let mut tick_us = vec![(0, time_ticks(&state, patch)?)];
     let mut worst: f64 = 0.0;
     let ms = |since: Instant| since.elapsed().as_secs_f64() * 1e3;
     for (cut, path) in incisions().into_iter().enumerate() {
@@ -66,23 +121,65 @@ pub fn run(cells: [usize; 3]) -> Result<CuttingBenchReport, String> {
             online.push(ms(started));
             let started = Instant::now();
             let enrichment = Enrichment::new(model.mesh(), state.faces());
-            let exact = xfem::solve(&model, &enrichment, &loads).map_err(|e| e.to_string())?;
+            let exact = xfem::solve(model, &enrichment, loads).map_err(|e| e.to_string())?;
             full.push(ms(started));
             worst = worst.max(relative_l2(&fast.nodes_m, &exact.nodes_m));
+            if add.len() == 4 || add.len() == 16 {
+                tick_us.push((add.len(), time_ticks(&state, patch)?));
+            }
         }
     }
-    Ok(CuttingBenchReport {
-        nodes: model.mesh().node_count(),
-        segments: add.len(),
-        unknowns: state.unknowns(),
-        add_segment_ms: median(add),
+    let figures = ResponseFigures {
+        response: name,
+        add_segment_ms: [quantile(&add, 0.5), quantile(&add, 0.99)],
         online_solve_ms: median(online),
-        full_xfem_ms: median(full),
+        tick_us,
         worst_difference: worst,
-    })
+    };
+    Ok((figures, full, state.unknowns()))
 }
 
-/// Four radial incisions from 4 to 13 mm around the block's top centre, three segments each;
+/// The felt force for a 1 mm press, timed `TICKS` times (µs): median and p99.
+fn time_ticks<R: UncutResponse>(
+    state: &CutState<R>,
+    patch: &[(usize, f64)],
+) -> Result<[f64; 2], String> {
+    let mut samples = Vec::with_capacity(TICKS);
+    for _ in 0..TICKS {
+        let started = Instant::now();
+        let force = state
+            .felt_force(patch, Vector3::new(0.0, 0.0, -MM))
+            .map_err(|e| e.to_string())?;
+        samples.push(started.elapsed().as_secs_f64() * 1e6);
+        std::hint::black_box(force);
+    }
+    Ok([quantile(&samples, 0.5), quantile(&samples, 0.99)])
+}
+
+/// The tool's patch: top nodes within 4 mm of a point beside the incisions' centre, weighted
+/// as the trainer's kernel weighs them.
+fn tool_patch(model: &FemModel, top: &[usize]) -> Vec<(usize, f64)> {
+    let tool = Point3::new(24.0 * MM, 21.5 * MM, 10.0 * MM);
+    let nodes = model.mesh().nodes();
+    let mut patch: Vec<(usize, f64)> = top
+        .iter()
+        .map(|&n| (n, (nodes[n] - tool).norm() / (4.0 * MM)))
+        .filter(|&(_, d)| d < 1.0)
+        .map(|(n, d)| (n, (1.0 - d * d).powi(2)))
+        .collect();
+    let total: f64 = patch.iter().map(|p| p.1).sum();
+    patch.iter_mut().for_each(|p| p.1 /= total);
+    patch
+}
+
+/// The `q`-quantile of `samples`.
+fn quantile(samples: &[f64], q: f64) -> f64 {
+    let mut sorted = samples.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    sorted[((q * (sorted.len() - 1) as f64).round() as usize).min(sorted.len() - 1)]
+}
+
+/// Four radial incisions from 4 to 13 mm around the block's top centre, four segments each;
 /// the last turns on its way out.
 fn incisions() -> Vec<Vec<Point3<f64>>> {
     let centre = Point3::new(24.0 * MM, 20.0 * MM, 10.0 * MM);
@@ -92,10 +189,10 @@ fn incisions() -> Vec<Vec<Point3<f64>>> {
             let radial = Vector3::new(theta.cos(), theta.sin(), 0.0);
             let at = |r_mm: f64| centre + radial * (r_mm * MM);
             let last = match k {
-                3 => at(10.0) + Vector3::new(-radial.y, radial.x, 0.0) * (3.0 * MM),
+                3 => at(10.75) + Vector3::new(-radial.y, radial.x, 0.0) * (3.0 * MM),
                 _ => at(13.0),
             };
-            vec![at(4.0), at(7.0), at(10.0), last]
+            vec![at(4.0), at(6.25), at(8.5), at(10.75), last]
         })
         .collect()
 }
@@ -110,21 +207,48 @@ impl std::fmt::Display for CuttingBenchReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(
             f,
-            "cutting benchmark: {} nodes, {} segments, {} enriched unknowns at the end; medians per segment",
-            self.nodes, self.segments, self.unknowns
+            "cutting benchmark: {} nodes, {} segments, {} enriched unknowns at the end; \
+             full X-FEM solve per segment (baseline) {:.1} ms median; cut vademecum built in {:.1} s",
+            self.nodes, self.segments, self.unknowns, self.full_xfem_ms, self.vademecum_build_s
         )?;
-        let ratio = |ms: f64| ms / self.full_xfem_ms;
-        for (name, ms) in [
-            ("add a segment (cut state)", self.add_segment_ms),
-            ("solve the cut field (cut state)", self.online_solve_ms),
-            ("full X-FEM solve (baseline)", self.full_xfem_ms),
-        ] {
-            writeln!(f, "{name:<34} {ms:>10.3} ms {:>8.3} × baseline", ratio(ms))?;
+        writeln!(
+            f,
+            "{:<14} {:>22} {:>16} {:>36} {:>12}",
+            "response",
+            "add a segment (ms)",
+            "cut field (ms)",
+            "felt force, 0 / 4 / 16 segments (µs)",
+            "vs X-FEM"
+        )?;
+        for r in &self.responses {
+            let ticks: Vec<String> = r
+                .tick_us
+                .iter()
+                .map(|(_, [p50, p99])| format!("{p50:.0} (p99 {p99:.0})"))
+                .collect();
+            writeln!(
+                f,
+                "{:<14} {:>8.3} (p99 {:>6.3}) {:>16.3} {:>36} {:>12.1e}",
+                r.response,
+                r.add_segment_ms[0],
+                r.add_segment_ms[1],
+                r.online_solve_ms,
+                ticks.join(" / "),
+                r.worst_difference
+            )?;
         }
         writeln!(
             f,
-            "largest relative L2 difference of the fields: {:.1e}",
-            self.worst_difference
+            "ratios to the baseline: add a segment {}",
+            self.responses
+                .iter()
+                .map(|r| format!(
+                    "{} {:.3}×",
+                    r.response,
+                    r.add_segment_ms[0] / self.full_xfem_ms
+                ))
+                .collect::<Vec<_>>()
+                .join(", ")
         )
     }
 }

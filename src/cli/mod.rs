@@ -11,8 +11,10 @@ mod pgd_validate;
 mod trainer_commands;
 
 pub use output::{fail, print_json, print_report};
-pub use parse::{parse_inclusion, parse_spacing, parse_stiffness_ratio, parse_subdivisions};
+pub use parse::{
+    parse_inclusion, parse_radial, parse_spacing, parse_stiffness_ratio, parse_subdivisions,
+};
 pub use pgd_build::{build_vademecum, print_build_report};
 pub use pgd_mesh::report_mesh;
-pub use pgd_validate::{print_validation, validate_vademecum};
+pub use pgd_validate::{print_cut_validation, print_validation, validate_cuts, validate_vademecum};
 pub use trainer_commands::{debrief, numbered, validate_scenarios};

@@ -48,6 +48,14 @@ pub fn parse_inclusion(text: &str) -> Result<Inclusion, String> {
     Ok(inclusion)
 }
 
+/// A cut pattern of `pgd validate --cuts`: `radial:N`, N radial incisions (N ≥ 1).
+pub fn parse_radial(text: &str) -> Result<usize, String> {
+    text.strip_prefix("radial:")
+        .and_then(|n| n.parse::<usize>().ok())
+        .filter(|&n| n >= 1)
+        .ok_or_else(|| format!("{text}: expected radial:N, N radial incisions (at least 1)"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,6 +4,8 @@
 use std::path::Path;
 
 use super::pgd_build::write_convergence;
+use crate::cutting::keratotomy::Cornea;
+use crate::cutting::{CutValidationReport, CutValidationSettings, validate_keratotomy};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::Organ;
 use crate::pgd::{self, ValidationReport, ValidationSettings};
@@ -53,4 +55,56 @@ pub fn print_validation(report: &ValidationReport) {
             100.0 * s.max
         );
     }
+}
+
+/// Checks the cut section of the vademecum in `file` against full X-FEM on `mesh` (the
+/// cornea's, as it was built): `settings.incisions` radial incisions at random angles.
+pub fn validate_cuts(
+    source: &str,
+    (organ, mesh): (Option<Organ>, TetMesh),
+    file: &Path,
+    settings: &CutValidationSettings,
+) -> Result<CutValidationReport, String> {
+    if organ != Some(Organ::Cornea) {
+        return Err(format!(
+            "{source}: radial incisions are defined on the cornea only"
+        ));
+    }
+    let vademecum = pgd::load(file).map_err(|e| e.to_string())?;
+    vademecum
+        .check_mesh(file, &mesh)
+        .map_err(|e| e.to_string())?;
+    let Some(cuts) = &vademecum.cuts else {
+        return Err(format!(
+            "{}: built without a cut section; rebuild it with `pgd build {source} --cuts` \
+             (and the mesh options it was built with)",
+            file.display()
+        ));
+    };
+    let cornea =
+        Cornea::from_mesh(mesh, vademecum.header.material).map_err(|e| format!("{source}: {e}"))?;
+    validate_keratotomy(&cornea, cuts, settings).map_err(|e| format!("{source}: {e}"))
+}
+
+/// The cut validation as a table.
+pub fn print_cut_validation(report: &CutValidationReport) {
+    println!(
+        "{} random patterns of {} against full X-FEM ({} nodes)   mean       p95       max",
+        report.cases.len(),
+        report.pattern,
+        report.nodes
+    );
+    for (name, s) in [
+        ("displacement under 15 mmHg (rel. L2)", &report.cut_l2_error),
+        ("force felt beside an incision", &report.force_error),
+    ] {
+        println!(
+            "  {name:<52} {:>9.2e} {:>9.2e} {:>9.2e}",
+            s.mean, s.p95, s.max
+        );
+    }
+    println!(
+        "one incision segment online: {:.2} ms median; full X-FEM solve: {:.0} ms median",
+        report.segment_ms.p50, report.full_xfem_ms.p50
+    );
 }

@@ -14,7 +14,7 @@ use super::incision::CutFace;
 use super::{CutError, xfem};
 use crate::fem::{Dirichlet, FemModel, Law, Loads, Material, TISSUE_DENSITY_KG_M3};
 use crate::mesh::organs::{
-    CORNEA_CURVATURE_M, CORNEA_RIM_M, CORNEA_THICKNESS_M, OrganSettings, cornea_in_layers, region,
+    CORNEA_CURVATURE_M, CORNEA_RIM_M, CORNEA_THICKNESS_M, Organ, OrganSettings, generate, region,
 };
 use crate::mesh::{Surface, TetMesh};
 
@@ -93,16 +93,29 @@ impl Cornea {
     pub fn new(resolution: f64, layers: usize) -> Result<Self, CutError> {
         let settings = OrganSettings {
             resolution,
+            cornea_layers: layers,
             ..OrganSettings::default()
         };
-        let solve_error = |e: String| CutError::Solve(e);
-        let mesh = cornea_in_layers(&settings, layers).map_err(|e| solve_error(e.to_string()))?;
-        let per_layer = mesh.node_count() / (layers + 1);
+        let mesh = generate(Organ::Cornea, &settings).map_err(solve_error)?;
+        let material = Material::new(
+            Law::Linear,
+            CORNEA_YOUNG_PA,
+            CORNEA_POISSON,
+            TISSUE_DENSITY_KG_M3,
+        )
+        .map_err(solve_error)?;
+        Self::from_mesh(mesh, material)
+    }
+
+    /// The generated cornea `mesh` (any resolution and layers) of `material`, rim clamped,
+    /// under the intraocular pressure: as a cornea vademecum was built.
+    pub fn from_mesh(mesh: TetMesh, material: Material) -> Result<Self, CutError> {
         let mut loads = Loads::new(mesh.node_count());
         loads
-            .add_pressure(&mesh, &posterior_faces(&mesh, per_layer), IOP_PA)
-            .map_err(|e| solve_error(e.to_string()))?;
-        let central = (layers * per_layer..mesh.node_count())
+            .add_pressure(&mesh, &posterior_faces(&mesh), IOP_PA)
+            .map_err(solve_error)?;
+        let central = anterior_nodes(&mesh)
+            .into_iter()
             .filter(|&n| {
                 let p = mesh.nodes()[n];
                 p.x.hypot(p.y) <= CENTRAL_ZONE_M
@@ -111,20 +124,10 @@ impl Cornea {
         let mut dirichlet = Dirichlet::new(mesh.node_count());
         let rim = mesh
             .node_set(region::CLAMPED)
-            .map_err(|e| solve_error(e.to_string()))?
+            .map_err(solve_error)?
             .to_vec();
-        dirichlet
-            .clamp(&rim)
-            .map_err(|e| solve_error(e.to_string()))?;
-        let material = Material::new(
-            Law::Linear,
-            CORNEA_YOUNG_PA,
-            CORNEA_POISSON,
-            TISSUE_DENSITY_KG_M3,
-        )
-        .map_err(|e| solve_error(e.to_string()))?;
-        let model =
-            FemModel::new(mesh, material, dirichlet).map_err(|e| solve_error(e.to_string()))?;
+        dirichlet.clamp(&rim).map_err(solve_error)?;
+        let model = FemModel::new(mesh, material, dirichlet).map_err(solve_error)?;
         let mut cornea = Self {
             model,
             loads,
@@ -134,6 +137,11 @@ impl Cornea {
         let uncut = Enrichment::new(cornea.model.mesh(), &[]);
         cornea.power_before_d = cornea.central_power_d(&uncut)?;
         Ok(cornea)
+    }
+
+    /// The intraocular pressure's nodal forces (N).
+    pub fn pressure(&self) -> &Loads {
+        &self.loads
     }
 
     pub fn model(&self) -> &FemModel {
@@ -148,20 +156,11 @@ impl Cornea {
                 plan.incisions, plan.depth_fraction
             )));
         }
-        let centre = Point3::new(0.0, 0.0, -CORNEA_CURVATURE_M);
-        let anterior_m = CORNEA_CURVATURE_M + CORNEA_THICKNESS_M / 2.0;
-        let reach = (plan.optical_zone_m / 2.0, CORNEA_RIM_M - LIMBUS_MARGIN_M);
         (0..plan.incisions)
             .map(|k| {
                 let angle = std::f64::consts::TAU * k as f64 / plan.incisions as f64;
-                CutFace::meridian(
-                    centre,
-                    anterior_m,
-                    Unit::new_unchecked(Vector3::z()),
-                    angle,
-                    reach,
-                    plan.depth_fraction * CORNEA_THICKNESS_M,
-                )
+                let reach = (plan.optical_zone_m / 2.0, INCISION_END_M);
+                incision(angle, reach, plan.depth_fraction)
             })
             .collect()
     }
@@ -200,13 +199,58 @@ impl Cornea {
     }
 }
 
-/// The posterior face: the boundary triangles of layer 0.
-fn posterior_faces(mesh: &TetMesh, per_layer: usize) -> Vec<[usize; 3]> {
+/// Where radial incisions end: 0.5 mm inside the limbus (m off the axis).
+pub const INCISION_END_M: f64 = CORNEA_RIM_M - LIMBUS_MARGIN_M;
+
+/// A radial incision at `angle_rad` round the axis, from `reach.0` to `reach.1` off it (m),
+/// `depth_fraction` of the thickness deep.
+pub fn incision(
+    angle_rad: f64,
+    reach: (f64, f64),
+    depth_fraction: f64,
+) -> Result<CutFace, CutError> {
+    CutFace::meridian(
+        Point3::new(0.0, 0.0, -CORNEA_CURVATURE_M),
+        ANTERIOR_RADIUS_M,
+        Unit::new_unchecked(Vector3::z()),
+        angle_rad,
+        reach,
+        depth_fraction * CORNEA_THICKNESS_M,
+    )
+}
+
+/// The anterior and posterior spheres' radii (m), about the cornea's centre of curvature.
+const ANTERIOR_RADIUS_M: f64 = CORNEA_CURVATURE_M + CORNEA_THICKNESS_M / 2.0;
+const POSTERIOR_RADIUS_M: f64 = CORNEA_CURVATURE_M - CORNEA_THICKNESS_M / 2.0;
+
+/// The boundary nodes on the sphere of `radius_m` (within a hundredth of the thickness).
+fn nodes_on_sphere(mesh: &TetMesh, radius_m: f64) -> impl Fn(usize) -> bool + '_ {
+    let centre = Point3::new(0.0, 0.0, -CORNEA_CURVATURE_M);
+    move |n| ((mesh.nodes()[n] - centre).norm() - radius_m).abs() <= CORNEA_THICKNESS_M / 100.0
+}
+
+/// The anterior face's nodes: where the tool presses and the keratometer reads.
+pub fn anterior_nodes(mesh: &TetMesh) -> Vec<usize> {
+    let on = nodes_on_sphere(mesh, ANTERIOR_RADIUS_M);
+    Surface::extract(mesh)
+        .nodes
+        .into_iter()
+        .filter(|&n| on(n))
+        .collect()
+}
+
+/// The posterior face: the boundary triangles on the posterior sphere.
+fn posterior_faces(mesh: &TetMesh) -> Vec<[usize; 3]> {
+    let on = nodes_on_sphere(mesh, POSTERIOR_RADIUS_M);
     Surface::extract(mesh)
         .triangles
         .into_iter()
-        .filter(|t| t.iter().all(|&n| n < per_layer))
+        .filter(|t| t.iter().all(|&n| on(n)))
         .collect()
+}
+
+fn solve_error(e: impl std::fmt::Display) -> CutError {
+    CutError::Solve(e.to_string())
 }
 
 /// The radius of the sphere centred on the z axis that fits `points` best: the least squares

@@ -12,12 +12,14 @@ pub mod keratotomy;
 mod response;
 pub mod split_mesh;
 mod state;
+mod validation;
 pub mod xfem;
 
 pub use enrichment::{ElementCut, Enriched, Enrichment, Piece, SLIVER};
 pub use incision::{CutFace, Extent, Incision, MIN_SEGMENT_M};
 pub use response::{ExactResponse, Response, UncutResponse};
 pub use state::CutState;
+pub use validation::{CutCase, CutValidationReport, CutValidationSettings, validate_keratotomy};
 pub use xfem::CutSolution;
 
 /// Why a cut cannot be made or solved.

@@ -30,6 +30,25 @@ pub trait UncutResponse {
     fn add_spatial(&self, modal: &[f64], u: &mut [f64]);
 }
 
+/// A response lent to several cut states in turn.
+impl<R: UncutResponse> UncutResponse for &R {
+    fn node_count(&self) -> usize {
+        (**self).node_count()
+    }
+
+    fn respond(&self, loads: &[SparseDofs]) -> Result<Vec<Response>, CutError> {
+        (**self).respond(loads)
+    }
+
+    fn spatial_products(&self, v: &[(usize, f64)]) -> Vec<f64> {
+        (**self).spatial_products(v)
+    }
+
+    fn add_spatial(&self, modal: &[f64], u: &mut [f64]) {
+        (**self).add_spatial(modal, u);
+    }
+}
+
 /// The exact response: the rest stiffness factorized once.
 pub struct ExactResponse {
     factor: Factorization,

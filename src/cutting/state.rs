@@ -92,16 +92,42 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         let mut incision = self.cuts[cut].incision.clone();
         incision.advance(to)?;
         let face = *incision.faces().last().expect("advanced");
-        let mut faces = self.faces.clone();
         let turned = incision.faces().len() > self.cuts[cut].faces.len();
-        let id = if turned {
-            faces.push(face);
-            faces.len() - 1
-        } else {
-            let id = *self.cuts[cut].faces.last().expect("a face to lengthen");
-            faces[id] = face;
-            id
+        let id = match turned {
+            true => self.add_face(face)?,
+            false => {
+                let id = *self.cuts[cut].faces.last().expect("a face to lengthen");
+                self.lengthen(id, face)?;
+                id
+            }
         };
+        let entry = &mut self.cuts[cut];
+        entry.incision = incision;
+        if turned {
+            entry.faces.push(id);
+        }
+        Ok(())
+    }
+
+    /// Adds a whole face at once (a keratotomy's meridian incision, say); returns its index.
+    pub fn add_face(&mut self, face: CutFace) -> Result<usize, CutError> {
+        let mut faces = self.faces.clone();
+        faces.push(face);
+        self.apply(faces)?;
+        Ok(self.faces.len() - 1)
+    }
+
+    /// Replaces face `id` by `face`, which must cover it (the same incision, longer or
+    /// deeper): a cut only ever grows.
+    pub fn lengthen(&mut self, id: usize, face: CutFace) -> Result<(), CutError> {
+        let mut faces = self.faces.clone();
+        faces[id] = face;
+        self.apply(faces)
+    }
+
+    /// Takes `faces` as the cut, growing the system by the functions they add; a refused cut
+    /// leaves the state as it was.
+    fn apply(&mut self, faces: Vec<CutFace>) -> Result<(), CutError> {
         let enrichment = Enrichment::new(self.model.mesh(), &faces);
         let held = |n: usize| self.model.dofs().free_index[3 * n] == PRESCRIBED;
         if enrichment.detaches(self.model.mesh(), held) {
@@ -109,11 +135,6 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         }
         self.grow(&enrichment)?;
         self.faces = faces;
-        let entry = &mut self.cuts[cut];
-        entry.incision = incision;
-        if turned {
-            entry.faces.push(id);
-        }
         Ok(())
     }
 
@@ -131,7 +152,20 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     /// [`Enrichment::new`] over [`Self::faces`]. Fails only for a load outside the region a
     /// cut vademecum covers.
     pub fn solve(&self, loads_n: &[f64]) -> Result<CutSolution, CutError> {
-        let (nodes_m, q) = self.condensed(loads_n)?;
+        let load: Vec<(usize, f64)> = loads_n
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| **v != 0.0)
+            .map(|(d, &v)| (d, v))
+            .collect();
+        let uncut = self.response.respond(&[load])?.remove(0);
+        Ok(self.solve_from(uncut))
+    }
+
+    /// The cut organ from its uncut displacement `uncut` (`K⁻¹ f`, however it is known: a
+    /// standing load such as the intraocular pressure has it computed once, exactly).
+    pub fn solve_from(&self, uncut: Response) -> CutSolution {
+        let (nodes_m, q) = self.condensed(uncut);
         let order = Enrichment::new(self.model.mesh(), &self.faces);
         let index = self.function_index();
         let mut enriched_m = Vec::with_capacity(q.len());
@@ -139,23 +173,16 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             let j = index.get(&(f.node, f.face));
             enriched_m.extend((0..3).map(|c| j.map_or(0.0, |&j| q[3 * j + c])));
         }
-        Ok(CutSolution {
+        CutSolution {
             nodes_m,
             enriched_m,
-        })
+        }
     }
 
-    /// The nodes' displacements under `loads_n`, and the enriched amplitudes in the state's
-    /// order: `q = −S⁻¹ Bᵀ K⁻¹ f`, `u = K⁻¹ f − Z q`.
-    fn condensed(&self, loads_n: &[f64]) -> Result<(Vec<f64>, Vec<f64>), CutError> {
-        let load: Vec<(usize, f64)> = loads_n
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| **v != 0.0)
-            .map(|(d, &v)| (d, v))
-            .collect();
-        let response = self.response.respond(&[load])?.remove(0);
-        let mut u = vec![0.0; loads_n.len()];
+    /// The nodes' displacements from the uncut ones `response`, and the enriched amplitudes in
+    /// the state's order: `q = −S⁻¹ Bᵀ K⁻¹ f`, `u = K⁻¹ f − Z q`.
+    fn condensed(&self, response: Response) -> (Vec<f64>, Vec<f64>) {
+        let mut u = vec![0.0; 3 * self.model.mesh().node_count()];
         scatter(&response.near, 1.0, &mut u);
         let rhs: Vec<f64> = (0..self.z.len())
             .map(|p| -self.product(p, &response.modal, &u))
@@ -170,7 +197,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             scatter(&z.near, -qj, &mut u);
         }
         self.response.add_spatial(&modal, &mut u);
-        Ok((u, q))
+        (u, q)
     }
 
     /// `b_pᵀ K⁻¹ f` for unknown `p` and a response given by its modal coefficients and its

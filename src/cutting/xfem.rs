@@ -11,7 +11,7 @@ use faer::Side;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, Triplet};
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 use super::CutError;
 use super::enrichment::{ElementCut, Enrichment};
@@ -47,32 +47,86 @@ pub fn solve(
     enrichment: &Enrichment,
     loads: &Loads,
 ) -> Result<CutSolution, CutError> {
+    Ok(solve_each(model, enrichment, &[loads.as_slice()])?.remove(0))
+}
+
+/// The force (N) a tool feels pressing `patch` (nodes and their shares of its load, summing
+/// to one) by `indentation_m` into the cut organ: the patch compliance from three solves (a
+/// unit force along each axis, spread by the shares), inverted. The reference for
+/// [`super::CutState::felt_force`]; `None` where the patch does not resist.
+pub fn felt_force(
+    model: &FemModel,
+    enrichment: &Enrichment,
+    patch: &[(usize, f64)],
+    indentation_m: Vector3<f64>,
+) -> Result<Option<Vector3<f64>>, CutError> {
+    let dofs = 3 * model.mesh().node_count();
+    let loads: Vec<Vec<f64>> = (0..3)
+        .map(|axis| {
+            let mut f = vec![0.0; dofs];
+            patch
+                .iter()
+                .for_each(|&(n, share)| f[3 * n + axis] += share);
+            f
+        })
+        .collect();
+    let columns: Vec<&[f64]> = loads.iter().map(Vec::as_slice).collect();
+    let solutions = solve_each(model, enrichment, &columns)?;
+    let mut compliance = Matrix3::zeros();
+    for (axis, u) in solutions.iter().enumerate() {
+        for &(n, share) in patch {
+            for row in 0..3 {
+                compliance[(row, axis)] += share * u.nodes_m[3 * n + row];
+            }
+        }
+    }
+    Ok(compliance.try_inverse().map(|k| k * indentation_m))
+}
+
+/// One factorization, a solve per load vector (full dofs).
+fn solve_each(
+    model: &FemModel,
+    enrichment: &Enrichment,
+    loads: &[&[f64]],
+) -> Result<Vec<CutSolution>, CutError> {
     let own = &model.dofs().free_index;
     if enrichment.detaches(model.mesh(), |n| own[3 * n] == PRESCRIBED) {
         return Err(CutError::Detached);
     }
     let dofs = Dofs::new(model, enrichment);
     let matrix = assemble(model, enrichment, &dofs)?;
-    let mut rhs = vec![0.0; dofs.free];
-    for (d, &f) in loads.as_slice().iter().enumerate() {
-        if let Some(i) = dofs.index(d) {
-            rhs[i] += f;
+    let mut rhs = vec![0.0; dofs.free * loads.len()];
+    for (column, load) in rhs.chunks_exact_mut(dofs.free.max(1)).zip(loads) {
+        for (d, &f) in load.iter().enumerate() {
+            if let Some(i) = dofs.index(d) {
+                column[i] += f;
+            }
         }
     }
     let symbolic = SymbolicLlt::try_new(matrix.symbolic(), Side::Lower)
         .map_err(|e| CutError::Solve(format!("{e:?}")))?;
     let llt = Llt::try_new_with_symbolic(symbolic, matrix.as_ref(), Side::Lower)
         .map_err(|_| CutError::Detached)?;
-    llt.solve_in_place(MatMut::from_column_major_slice_mut(&mut rhs, dofs.free, 1));
+    llt.solve_in_place(MatMut::from_column_major_slice_mut(
+        &mut rhs,
+        dofs.free,
+        loads.len(),
+    ));
     if rhs.iter().any(|v| !v.is_finite()) {
         return Err(CutError::Detached);
     }
-    let value = |d: usize| dofs.index(d).map_or(0.0, |i| rhs[i]);
     let nodes = 3 * model.mesh().node_count();
-    Ok(CutSolution {
-        nodes_m: (0..nodes).map(value).collect(),
-        enriched_m: (nodes..dofs.total).map(value).collect(),
-    })
+    Ok(rhs
+        .chunks_exact(dofs.free.max(1))
+        .take(loads.len())
+        .map(|column| {
+            let value = |d: usize| dofs.index(d).map_or(0.0, |i| column[i]);
+            CutSolution {
+                nodes_m: (0..nodes).map(value).collect(),
+                enriched_m: (nodes..dofs.total).map(value).collect(),
+            }
+        })
+        .collect())
 }
 
 /// The numbering of the free unknowns: a node's own dofs are free where the model's are; an

@@ -18,6 +18,7 @@ use super::enrichment::{ModeReport, enrich};
 use super::error_curve::{EnergyError, ErrorCurve, FieldError, optimal_errors};
 use super::load_patches::{LoadOperator, LoadPatches};
 use super::local::{LocalPart, distance_neighbours, near_nodes};
+use super::region::RegionReport;
 use super::responses::{Responses, SecantLoads, SecantReport};
 use super::separated::SeparatedField;
 use super::settings::BuildSettings;
@@ -63,7 +64,12 @@ pub struct BuildReport {
     /// The share of the organ's nodes in a load's near field, on average: near 1, every load
     /// keeps its exact response everywhere (a large file, few modes).
     pub near_field_share: f64,
+    /// The cut section, when one was asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cuts: Option<RegionReport>,
     pub total_seconds: f64,
+    /// The file's size (bytes), once written.
+    pub file_bytes: u64,
 }
 
 /// Above this [`BuildReport::near_field_share`] the build warns that the near field is too
@@ -193,6 +199,7 @@ pub fn build(
         modes_per_step: reports.iter().map(|r| r.modes_kept).collect(),
         convergence: reports.iter().map(|r| r.curve.clone()).collect(),
         build_seconds: started.elapsed().as_secs_f64(),
+        cuts: None,
     };
     let vademecum = Vademecum {
         header,
@@ -203,6 +210,7 @@ pub fn build(
         triangles,
         reference_compliance_m_per_n: self_compliances(&steps[0].local),
         steps,
+        cuts: None,
     };
     let report = BuildReport {
         positions: patches.positions.len(),
@@ -211,7 +219,9 @@ pub fn build(
         steps: reports,
         failed_step,
         near_field_share,
+        cuts: None,
         total_seconds: started.elapsed().as_secs_f64(),
+        file_bytes: 0,
     };
     Ok((vademecum, report))
 }

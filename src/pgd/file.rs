@@ -8,13 +8,14 @@ use std::path::Path;
 use super::container::{self, Kind, Reader, put};
 use super::error::VademecumError;
 use super::local::LocalPart;
+use super::region::RegionResponse;
 use super::settings::BuildSettings;
 use super::vademecum::{Header, Step, Vademecum};
 use crate::fem::{Inclusion, Material};
 use crate::mesh::TetMesh;
 
 /// Bumped on any change of layout or meaning; older files are refused, not misread.
-pub const FORMAT_VERSION: u32 = 4;
+pub const FORMAT_VERSION: u32 = 5;
 const KIND: Kind = Kind {
     magic: b"PGDVADEM",
     version: FORMAT_VERSION,
@@ -149,7 +150,69 @@ fn payload(v: &Vademecum) -> Vec<u8> {
         put(&mut out, &l.correction_nodes);
         put(&mut out, &l.correction);
     }
+    if let Some(cuts) = &v.cuts {
+        put(&mut out, &cuts.positions);
+        put(&mut out, &cuts.held);
+        put(&mut out, &cuts.spatial);
+        put(&mut out, &cuts.parametric);
+        put(&mut out, &cuts.near_offsets);
+        put(&mut out, &cuts.near_nodes);
+        put(&mut out, &cuts.near);
+    }
     out
+}
+
+/// The cut section, present when the header announces it.
+fn read_cuts(r: &mut Reader, header: &Header) -> Result<Option<RegionResponse>, VademecumError> {
+    if header.cuts.is_none() {
+        return Ok(None);
+    }
+    let positions = r.take("cut positions")?;
+    let held = r.take("held nodes")?;
+    let spatial = r.take("cut spatial modes")?;
+    let parametric = r.take("cut parametric modes")?;
+    let near = (
+        r.take("cut near-field offsets")?,
+        r.take("cut near-field nodes")?,
+        r.take("cut near fields")?,
+    );
+    check_cuts(r, header, (&positions, &held, &spatial, &parametric), &near)?;
+    Ok(Some(RegionResponse::new(
+        positions,
+        spatial,
+        parametric,
+        held,
+        near,
+        header.node_count,
+    )))
+}
+
+/// The cut arrays agree with the header and with each other.
+fn check_cuts(
+    r: &Reader,
+    header: &Header,
+    (positions, held, spatial, parametric): (&[u32], &[u32], &[f32], &[f32]),
+    (offsets, nodes, near): &(Vec<u32>, Vec<u32>, Vec<f32>),
+) -> Result<(), VademecumError> {
+    let node_count = header.node_count;
+    let beyond = |list: &[u32]| list.iter().any(|&n| n as usize >= node_count);
+    if beyond(positions) || beyond(held) || beyond(nodes) {
+        return Err(r.malformed("cut section (a node beyond the header's node count)"));
+    }
+    let m = positions.len();
+    let modes = header.cuts.as_ref().map_or(0, |c| c.report.modes);
+    if spatial.len() != modes * 3 * node_count || parametric.len() != modes * 3 * m {
+        return Err(r.malformed("cut modes (sizes differ from the header)"));
+    }
+    let rows_ok = offsets.len() == m + 1
+        && offsets.first() == Some(&0)
+        && offsets.windows(2).all(|w| w[0] <= w[1])
+        && offsets[m] as usize == nodes.len()
+        && near.len() == 9 * nodes.len();
+    if !rows_ok {
+        return Err(r.malformed("cut near fields (rows differ from the positions)"));
+    }
+    Ok(())
 }
 
 fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumError> {
@@ -185,6 +248,7 @@ fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumEr
             },
         });
     }
+    let cuts = read_cuts(r, &header)?;
     r.finish()?;
     Ok(Vademecum {
         header,
@@ -195,6 +259,7 @@ fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumEr
         triangles,
         reference_compliance_m_per_n,
         steps,
+        cuts,
     })
 }
 

@@ -29,7 +29,7 @@ pub use error_curve::{EnergyError, ErrorCurve, optimal_errors};
 pub use file::{FORMAT_VERSION, decode, encode, load, read_header, save};
 pub use load_patches::{LoadOperator, LoadPatches};
 pub use local::LocalPart;
-pub use region::{RegionReport, RegionResponse, RegionSettings, SparseDofs};
+pub use region::{CutHeader, RegionReport, RegionResponse, RegionSettings, SparseDofs, add_cuts};
 pub use responses::{Responses, SecantLoads, SecantReport, SecantSettings};
 pub use separated::SeparatedField;
 pub use settings::{BuildSettings, DEFAULT_LOAD_STEPS_M};

@@ -20,8 +20,10 @@ use super::local::near_nodes;
 use super::separated::SeparatedField;
 use super::statistics::Statistics;
 use super::stiffness::RestStiffness;
-use crate::fem::{FemError, PRESCRIBED};
+use super::vademecum::Vademecum;
+use crate::fem::{FemError, FemModel, PRESCRIBED};
 use crate::mesh::TetMesh;
+use crate::mesh::organs::{CORNEA_THICKNESS_M, Organ};
 
 /// Where cuts may go and how finely their loads' responses are kept.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -34,6 +36,36 @@ pub struct RegionSettings {
     pub modes: usize,
 }
 
+impl RegionSettings {
+    /// Cuts as deep as the organ's surgery takes them. The cornea: its whole thickness (radial
+    /// keratotomy goes to 95 % of it), a near field of 1 mm (two elements of the keratotomy
+    /// mesh). The abdominal organs: 20 mm under the accessible faces, a 8 mm near field.
+    pub fn for_organ(organ: Option<Organ>) -> Self {
+        match organ {
+            Some(Organ::Cornea) => Self {
+                depth_m: 1.5 * CORNEA_THICKNESS_M,
+                near_radius_m: 1e-3,
+                modes: 40,
+            },
+            _ => Self {
+                depth_m: 0.02,
+                near_radius_m: 8e-3,
+                modes: 40,
+            },
+        }
+    }
+}
+
+/// The header's account of a cut vademecum: where cuts may go, how finely their responses
+/// are kept, and how the build went.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CutHeader {
+    /// The face set cuts enter by.
+    pub faces: String,
+    pub settings: RegionSettings,
+    pub report: RegionReport,
+}
+
 /// A sparse load or response over full dofs: `(dof, value)`.
 pub type SparseDofs = Vec<(usize, f64)>;
 
@@ -44,6 +76,8 @@ pub type SparseDofs = Vec<(usize, f64)>;
 pub struct RegionResponse {
     /// Volume node of each load position: the region's free nodes.
     pub positions: Vec<u32>,
+    /// The nodes with every dof held: a load there moves nothing.
+    pub held: Vec<u32>,
     pub spatial: Vec<f32>,
     pub parametric: Vec<f32>,
     pub near_offsets: Vec<u32>,
@@ -54,7 +88,7 @@ pub struct RegionResponse {
 }
 
 /// What a region build did and how close the compressed responses come to the exact ones.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct RegionReport {
     pub positions: usize,
     pub modes: usize,
@@ -78,6 +112,29 @@ const HELD: u32 = u32::MAX - 1;
 
 /// Positions solved together (three columns each).
 const BLOCK_POSITIONS: usize = 16;
+
+/// Adds the cut section to `vademecum`, built for `model` (the model it was built for): the
+/// responses over the nodes within `settings.depth_m` of its accessible faces.
+pub fn add_cuts(
+    vademecum: &mut Vademecum,
+    model: &FemModel,
+    settings: &RegionSettings,
+    progress: &dyn Progress,
+) -> Result<RegionReport, FemError> {
+    let faces = vademecum.header.accessible_region.clone();
+    progress.message("factorizing the stiffness for the cut modes");
+    let stiffness = RestStiffness::new(model)?;
+    let region =
+        RegionResponse::region_nodes(&stiffness, model.mesh().face_set(&faces)?, settings.depth_m);
+    let (response, report) = RegionResponse::build(&stiffness, &region, settings, progress)?;
+    vademecum.header.cuts = Some(CutHeader {
+        faces,
+        settings: *settings,
+        report: report.clone(),
+    });
+    vademecum.cuts = Some(response);
+    Ok(report)
+}
 
 impl RegionResponse {
     /// The free nodes within `depth_m` of any node of `faces`, their lumped volumes (m³)
@@ -165,8 +222,9 @@ impl RegionResponse {
                 .flatten()
                 .map(|&v| v as f32)
                 .collect(),
+            held_nodes(&stiffness.model.dofs().free_index),
             (near_offsets, near.concat(), near_values),
-            &stiffness.model.dofs().free_index,
+            mesh.node_count(),
         );
         let report = RegionReport {
             positions: region.positions.len(),
@@ -181,27 +239,26 @@ impl RegionResponse {
         Ok((response, report))
     }
 
-    /// Assembles a response from its arrays (as read from a file): `near` is
-    /// `(offsets, nodes, blocks)`; `free_index` is the model's (three per node).
+    /// Assembles a response from its arrays (as read from a file, checked there): `near` is
+    /// `(offsets, nodes, blocks)`.
     pub fn new(
         positions: Vec<u32>,
         spatial: Vec<f32>,
         parametric: Vec<f32>,
+        held: Vec<u32>,
         (near_offsets, near_nodes, near): (Vec<u32>, Vec<u32>, Vec<f32>),
-        free_index: &[usize],
+        node_count: usize,
     ) -> Self {
-        let mut slot: Vec<u32> = free_index
-            .chunks_exact(3)
-            .map(|dofs| match dofs.iter().all(|&f| f == PRESCRIBED) {
-                true => HELD,
-                false => OUTSIDE,
-            })
-            .collect();
+        let mut slot = vec![OUTSIDE; node_count];
+        for &n in &held {
+            slot[n as usize] = HELD;
+        }
         for (m, &n) in positions.iter().enumerate() {
             slot[n as usize] = m as u32;
         }
         Self {
             positions,
+            held,
             spatial,
             parametric,
             near_offsets,
@@ -298,16 +355,27 @@ impl RegionResponse {
             };
             for e in self.near_offsets[m] as usize..self.near_offsets[m + 1] as usize {
                 let node = self.near_nodes[e] as usize;
-                for d in 3 * node..3 * node + 3 {
-                    if scratch[d] != 0.0 {
-                        out.push((d, scratch[d]));
-                        scratch[d] = 0.0;
+                for (c, value) in scratch[3 * node..3 * node + 3].iter_mut().enumerate() {
+                    if *value != 0.0 {
+                        out.push((3 * node + c, std::mem::take(value)));
                     }
                 }
             }
         }
         out
     }
+}
+
+/// The nodes whose every dof is prescribed.
+fn held_nodes(free_index: &[usize]) -> Vec<u32> {
+    (0..free_index.len() / 3)
+        .filter(|&n| {
+            free_index[3 * n..3 * n + 3]
+                .iter()
+                .all(|&f| f == PRESCRIBED)
+        })
+        .map(|n| n as u32)
+        .collect()
 }
 
 /// Each node's share of the volume of its elements (m³).
@@ -368,7 +436,7 @@ fn near_blocks(
                 }
             }
         }
-        if m % ERROR_SAMPLE_STRIDE == 0 {
+        if m.is_multiple_of(ERROR_SAMPLE_STRIDE) {
             let kept: std::collections::HashSet<u32> = near[m].iter().copied().collect();
             for d in 0..3 {
                 let (mut diff, mut norm) = (0.0, 0.0);

@@ -1,10 +1,10 @@
 //! The summary of a set of relative errors: mean, median, p95 and largest. Shared by the
 //! build's error curves and by validation against full FEM.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// A set of values summarized; all zero for an empty set.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Statistics {
     pub mean: f64,
     pub p50: f64,

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::error_curve::ErrorCurve;
 use super::local::LocalPart;
+use super::region::{CutHeader, RegionResponse};
 use super::settings::BuildSettings;
 use crate::fem::{Inclusion, Material, on_pressed_side, patch_weight};
 
@@ -37,6 +38,9 @@ pub struct Header {
     /// Per load step, the error against the number of modes (for the convergence plot).
     pub convergence: Vec<ErrorCurve>,
     pub build_seconds: f64,
+    /// The cut section's region and build (none in a vademecum built without cuts).
+    #[serde(default)]
+    pub cuts: Option<CutHeader>,
 }
 
 /// One load step's response per unit force: a separated global part plus the local part.
@@ -111,6 +115,9 @@ pub struct Vademecum {
     pub reference_compliance_m_per_n: Vec<f32>,
     /// Load steps in increasing indentation; one for a linear vademecum.
     pub steps: Vec<Step>,
+    /// The uncut organ's compressed responses to loads anywhere cuts may go: what a cut state
+    /// condenses incisions onto (`docs/cutting.md`).
+    pub cuts: Option<RegionResponse>,
 }
 
 impl Vademecum {

@@ -8,7 +8,9 @@ use crate::fem::{Inclusion, Law, Material};
 use crate::mesh::TetMesh;
 use crate::mesh::io::ImportOptions;
 use crate::mesh::organs::{Organ, OrganSettings, region};
-use crate::pgd::{self, BuildReport, BuildSettings, OrganModel, Vademecum, VademecumError};
+use crate::pgd::{
+    self, BuildReport, BuildSettings, OrganModel, RegionSettings, Vademecum, VademecumError,
+};
 
 use super::{Bar, OrganSource};
 use crate::report;
@@ -93,6 +95,9 @@ impl VademecumSpec {
             if self.mesh.seed != mesh.seed {
                 command += &format!(" --seed {}", self.mesh.seed);
             }
+            if self.mesh.cornea_layers != mesh.cornea_layers {
+                command += &format!(" --cornea-layers {}", self.mesh.cornea_layers);
+            }
         }
         if self.build.tool_tip_radius_m != build.tool_tip_radius_m {
             command += &format!(" --tool-radius-mm {}", self.build.tool_tip_radius_m * 1e3);
@@ -143,6 +148,7 @@ pub fn ensure_vademecum(
         material,
         inclusions: &spec.inclusions,
         settings: spec.build.clone(),
+        cuts: None,
     };
     let (vademecum, _, [csv, png]) = build_and_save(job, &spec.file)?;
     eprintln!(
@@ -162,6 +168,8 @@ pub struct BuildJob<'a> {
     pub material: Material,
     pub inclusions: &'a [Inclusion],
     pub settings: BuildSettings,
+    /// Also build the cut section over this region.
+    pub cuts: Option<RegionSettings>,
 }
 
 /// Builds `job`'s vademecum with progress bars (the organ clamped at its `clamped` region,
@@ -181,9 +189,16 @@ pub fn build_and_save(
         clamped_region: region::CLAMPED.into(),
         accessible_region: region::ACCESSIBLE.into(),
     };
-    let (vademecum, built) = pgd::build(&organ_model, &job.settings, &Bar::default())
+    let (mut vademecum, mut built) = pgd::build(&organ_model, &job.settings, &Bar::default())
         .map_err(|e| format!("{source}: {e}"))?;
+    if let Some(cuts) = &job.cuts {
+        let report = pgd::add_cuts(&mut vademecum, &model, cuts, &Bar::default())
+            .map_err(|e| format!("{source}: cut section: {e}"))?;
+        built.total_seconds += report.total_seconds;
+        built.cuts = Some(report);
+    }
     pgd::save(file, &vademecum).map_err(|e| e.to_string())?;
+    built.file_bytes = std::fs::metadata(file).map_or(0, |m| m.len());
     let curves = report::write_convergence_of(file, &vademecum.header)?;
     Ok((vademecum, built, curves))
 }

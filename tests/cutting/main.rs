@@ -477,3 +477,28 @@ fn a_cut_vademecum_serves_the_cut_state_within_its_error() {
     eprintln!("cut vademecum against full X-FEM: worst relative L2 {worst:.2e}");
     assert!(worst < 5e-3, "{worst}");
 }
+
+/// Radial keratotomies the cut state never saw (random angles, optical zone and depth), each
+/// incision made online in three lengthening segments over the exact uncut response: under
+/// the intraocular pressure the field, and the force a tool feels beside an incision, equal
+/// the full X-FEM solve of the finished pattern to round-off.
+#[test]
+fn random_keratotomies_made_online_equal_full_xfem() {
+    use pgd_surgery::cutting::{CutValidationSettings, validate_keratotomy};
+    let cornea = Cornea::new(0.2, 4).unwrap();
+    let exact = ExactResponse::new(cornea.model()).unwrap();
+    let validation = CutValidationSettings {
+        incisions: 4,
+        samples: 2,
+        seed: 7,
+        segments: 3,
+    };
+    let report = validate_keratotomy(&cornea, &exact, &validation).unwrap();
+    assert_eq!(report.failed, 0, "{report:#?}");
+    assert!(
+        report.cases.iter().all(|c| c.unknowns > 0),
+        "nothing was cut"
+    );
+    assert!(report.cut_l2_error.max < 1e-9, "{:?}", report.cut_l2_error);
+    assert!(report.force_error.max < 1e-9, "{:?}", report.force_error);
+}

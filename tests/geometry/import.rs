@@ -318,6 +318,7 @@ fn an_organ_surface_in_stl_becomes_a_valid_tet_mesh() {
         &OrganSettings {
             resolution: 0.5,
             seed: 1,
+            ..OrganSettings::default()
         },
     )
     .unwrap();

@@ -270,6 +270,7 @@ fn generation_is_deterministic_and_the_seed_changes_the_patient() {
     let settings = OrganSettings {
         resolution: 0.3,
         seed: 7,
+        ..OrganSettings::default()
     };
     let a = organs::generate(Organ::Liver, &settings).unwrap();
     let b = organs::generate(Organ::Liver, &settings).unwrap();
@@ -279,6 +280,7 @@ fn generation_is_deterministic_and_the_seed_changes_the_patient() {
     let coarse = OrganSettings {
         resolution: 0.25,
         seed: 1,
+        ..OrganSettings::default()
     };
     for organ in [
         Organ::Liver,
@@ -311,6 +313,7 @@ fn generation_is_deterministic_and_the_seed_changes_the_patient() {
         &OrganSettings {
             resolution: 0.5,
             seed: 7,
+            ..OrganSettings::default()
         },
     )
     .unwrap();

@@ -28,6 +28,7 @@ pub fn liver() -> &'static Liver {
         let settings = OrganSettings {
             resolution: 0.25,
             seed: 1,
+            ..OrganSettings::default()
         };
         let mesh = generate(Organ::Liver, &settings).unwrap();
         let material = organ::material(Organ::Liver, Law::Linear);

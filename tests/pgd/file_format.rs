@@ -90,3 +90,38 @@ fn a_vademecum_that_would_not_load_back_is_not_written() {
     assert!(err.to_string().contains("unwritable.vdm"), "{err}");
     assert_eq!(std::fs::read(&path).unwrap(), before);
 }
+
+/// A vademecum with a cut section loads back with it, and its compressed responses answer as
+/// before; a header announcing a cut section the payload lacks is refused, naming the file.
+#[test]
+fn a_cut_section_survives_the_round_trip() {
+    use pgd_surgery::pgd::{RegionSettings, Silent, add_cuts};
+    let model = block_model(block_mesh([4, 3, 2]));
+    let mut vademecum = build_block(&model, 2);
+    let settings = RegionSettings {
+        depth_m: 0.02,
+        near_radius_m: 0.01,
+        modes: 3,
+    };
+    let report = add_cuts(&mut vademecum, &model, &settings, &Silent).unwrap();
+    assert!(report.positions > 0 && report.modes > 0, "{report:?}");
+    let path = temp("cuts.vdm");
+    save(&path, &vademecum).unwrap();
+    let back = load(&path).unwrap();
+    assert_eq!(back, vademecum);
+    let cuts = back.cuts.as_ref().unwrap();
+    let node = cuts.positions[0] as usize;
+    let unit = [(3 * node + 2, 1.0)];
+    assert_eq!(
+        cuts.modal_coefficients(&unit),
+        vademecum.cuts.as_ref().unwrap().modal_coefficients(&unit)
+    );
+
+    let mut without_payload = vademecum.clone();
+    without_payload.cuts = None;
+    let lying = temp("lying.vdm");
+    save(&lying, &without_payload).unwrap();
+    let err = load(&lying).unwrap_err();
+    assert!(matches!(err, VademecumError::Malformed { .. }), "{err}");
+    assert!(err.to_string().contains("lying.vdm"), "{err}");
+}

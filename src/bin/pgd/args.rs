@@ -8,8 +8,8 @@ use pgd_surgery::contact::{CouplingSettings, PenaltySettings, PointshellDensity}
 use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
 use pgd_surgery::mesh::TetMesh;
 use pgd_surgery::mesh::io::ImportOptions;
-use pgd_surgery::mesh::organs::{Organ, OrganSettings};
-use pgd_surgery::pgd::{self, BuildSettings, PgdSettings, ValidationSettings};
+use pgd_surgery::mesh::organs::{CORNEA_LAYERS, Organ, OrganSettings};
+use pgd_surgery::pgd::{self, BuildSettings, PgdSettings, RegionSettings, ValidationSettings};
 use pgd_surgery::{bench, cli, store};
 
 #[derive(Parser)]
@@ -69,9 +69,9 @@ pub enum Command {
         /// The vademecum (default: vademecums/<source>.vdm).
         #[arg(long, value_name = "FILE.vdm")]
         vademecum: Option<PathBuf>,
-        /// Number of random loads.
-        #[arg(long, default_value_t = ValidationSettings::default().samples)]
-        samples: usize,
+        /// Number of random loads (default 60), or of cut patterns with --cuts (default 5).
+        #[arg(long)]
+        samples: Option<usize>,
         /// Seed of the random loads.
         #[arg(long, default_value_t = ValidationSettings::default().seed)]
         sample_seed: u64,
@@ -79,6 +79,11 @@ pub enum Command {
         /// organ's tool radius, 20 for the abdominal organs; the smallest is a tenth of it).
         #[arg(long)]
         max_indentation_mm: Option<f64>,
+        /// Check the cut section instead, on cut patterns drawn at random: `radial:N` (the
+        /// cornea), N radial incisions at random angles, optical zones of 3–5 mm and depths
+        /// of 60–95 %, each made in three segments; --samples patterns (default 5 here).
+        #[arg(long, value_name = "radial:N", value_parser = cli::parse_radial)]
+        cuts: Option<usize>,
         /// Print the report as JSON.
         #[arg(long)]
         json: bool,
@@ -127,6 +132,10 @@ pub struct MeshArgs {
     /// Organs: varies proportions deterministically (another patient).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// The cornea: elements through its thickness (a cut's depth is resolved to one of them;
+    /// radial keratotomy wants 8).
+    #[arg(long, default_value_t = CORNEA_LAYERS)]
+    pub cornea_layers: usize,
     /// Files: multiplies coordinates (0.001 for files in millimetres).
     #[arg(long, default_value_t = 1.0)]
     pub scale: f64,
@@ -142,6 +151,7 @@ impl MeshArgs {
             organ: OrganSettings {
                 resolution: self.resolution,
                 seed: self.seed,
+                cornea_layers: self.cornea_layers,
             },
             import: ImportOptions {
                 scale: self.scale,
@@ -226,9 +236,49 @@ pub struct BuildArgs {
     /// millimetres, increasing. The deepest is the range the vademecum is valid over.
     #[arg(long, value_delimiter = ',', default_values_t = pgd::DEFAULT_LOAD_STEPS_M.map(|m| m * 1e3))]
     pub load_steps_mm: Vec<f64>,
+    /// Also build the cut section: the uncut organ's response to a unit force at every node
+    /// within --cut-depth-mm of the accessible faces, which an incision anywhere there is
+    /// condensed onto online (docs/cutting.md).
+    #[arg(long)]
+    pub cuts: bool,
+    /// How deep cuts may go under the accessible faces, in millimetres (default: the
+    /// cornea's whole thickness, 20 for the other organs).
+    #[arg(long, requires = "cuts")]
+    pub cut_depth_mm: Option<f64>,
+    /// Radius of each cut load's exact near field, in millimetres (default: 1 for the
+    /// cornea, 8 for the other organs).
+    #[arg(long, requires = "cuts")]
+    pub cut_near_mm: Option<f64>,
+    /// PGD modes of the cut section's far field.
+    #[arg(long, requires = "cuts")]
+    pub cut_modes: Option<usize>,
 }
 
 impl BuildArgs {
+    /// The cut section's region, if `--cuts` asks for one.
+    pub fn cut_settings(&self, organ: Option<Organ>) -> Result<Option<RegionSettings>, String> {
+        if !self.cuts {
+            return Ok(None);
+        }
+        let defaults = RegionSettings::for_organ(organ);
+        let length = |option: &str, mm: Option<f64>, default_m: f64| match mm {
+            Some(mm) if !(mm.is_finite() && mm > 0.0) => Err(format!(
+                "--{option} {mm}: expected a positive length in millimetres"
+            )),
+            Some(mm) => Ok(mm * 1e-3),
+            None => Ok(default_m),
+        };
+        let modes = self.cut_modes.unwrap_or(defaults.modes);
+        if modes == 0 {
+            return Err("--cut-modes 0: expected at least one mode".into());
+        }
+        Ok(Some(RegionSettings {
+            depth_m: length("cut-depth-mm", self.cut_depth_mm, defaults.depth_m)?,
+            near_radius_m: length("cut-near-mm", self.cut_near_mm, defaults.near_radius_m)?,
+            modes,
+        }))
+    }
+
     pub fn settings(&self, organ: Option<Organ>) -> Result<BuildSettings, String> {
         let defaults = BuildSettings::for_organ(organ);
         let steps = &self.load_steps_mm;
@@ -279,8 +329,9 @@ pub enum BenchTarget {
         #[arg(long)]
         json: bool,
     },
-    /// Incisions added online to the cut state, segment by segment, against the full X-FEM
-    /// solve of the same cut after each segment (a 40 × 40 × 10 mm block).
+    /// Incisions added online to the cut state, segment by segment, over the exact uncut
+    /// response and over a cut vademecum, against the full X-FEM solve of the same cut after
+    /// each segment; the tool's felt force with 0, 4 and 16 segments (a 40 × 40 × 10 mm block).
     Cutting {
         /// Cubes along x, y, z of the block (six tets each).
         #[arg(long, num_args = 3, value_names = ["NX", "NY", "NZ"], default_values_t = [16, 16, 4])]

@@ -3,12 +3,14 @@
 
 mod args;
 
+use std::path::Path;
 use std::process::ExitCode;
 
 use args::{BenchTarget, BuildArgs, Cli, Command, ContactBenchArgs, MaterialArgs, MeshArgs};
 use clap::Parser;
 use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, default_scene, scene_of};
 use pgd_surgery::cli::{self, fail, print_json, print_report};
+use pgd_surgery::cutting::CutValidationSettings;
 use pgd_surgery::cutting::keratotomy::{Cornea, Keratotomy};
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::organs::Organ;
@@ -48,14 +50,25 @@ fn main() -> ExitCode {
             samples,
             sample_seed,
             max_indentation_mm,
+            cuts,
             json,
         } => {
             let file = vademecum.unwrap_or_else(|| args::default_vademecum(&mesh));
-            let settings = |organ| {
-                let defaults = ValidationSettings {
-                    samples,
+            if let Some(incisions) = cuts {
+                let settings = CutValidationSettings {
+                    incisions,
+                    samples: samples.unwrap_or(CutValidationSettings::default().samples),
                     seed: sample_seed,
-                    ..ValidationSettings::for_organ(organ)
+                    ..CutValidationSettings::default()
+                };
+                return validate_cut_section(&mesh, &file, &settings, json);
+            }
+            let settings = |organ| {
+                let defaults = ValidationSettings::for_organ(organ);
+                let defaults = ValidationSettings {
+                    samples: samples.unwrap_or(defaults.samples),
+                    seed: sample_seed,
+                    ..defaults
                 };
                 match max_indentation_mm {
                     Some(mm) => defaults.deepest_indentation(mm * 1e-3),
@@ -101,6 +114,26 @@ fn main() -> ExitCode {
     }
 }
 
+/// `pgd validate --cuts`: the cut section against full X-FEM.
+fn validate_cut_section(
+    mesh: &MeshArgs,
+    file: &Path,
+    settings: &CutValidationSettings,
+    json: bool,
+) -> ExitCode {
+    let validated = mesh
+        .load()
+        .and_then(|loaded| cli::validate_cuts(&mesh.source, loaded, file, settings));
+    match validated {
+        Ok(report) if json => print_json(&report),
+        Ok(report) => {
+            cli::print_cut_validation(&report);
+            ExitCode::SUCCESS
+        }
+        Err(e) => fail("pgd validate --cuts", &e),
+    }
+}
+
 /// The build `pgd build` asks for: the mesh loaded, its material and settings resolved.
 fn job<'a>(
     mesh: &'a MeshArgs,
@@ -114,6 +147,7 @@ fn job<'a>(
         material: material.material(organ)?,
         inclusions: &material.inclusion,
         settings: build.settings(organ)?,
+        cuts: build.cut_settings(organ)?,
     })
 }
 

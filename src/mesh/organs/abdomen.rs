@@ -293,7 +293,7 @@ fn outer_faces_without(
     nodes: usize,
 ) -> Vec<[usize; 3]> {
     let outer_from = match organ {
-        Organ::Gallbladder | Organ::Cornea => nodes / (SHELL_LAYERS + 1) * SHELL_LAYERS,
+        Organ::Gallbladder => nodes / (SHELL_LAYERS + 1) * SHELL_LAYERS,
         _ => 0,
     };
     faces_from_without(surface, clamped, outer_from, nodes)
@@ -319,16 +319,12 @@ fn faces_from_without(
         .collect()
 }
 
-/// The cornea of paper 001: a thin spherical cap, rim clamped, anterior face accessible.
+/// The cornea of paper 001: a thin spherical cap, rim clamped, anterior face accessible, with
+/// `settings.cornea_layers` elements through its thickness (a cut's depth is resolved to one
+/// of them). Layer 0 is the posterior face, the last layer the anterior one; the node count
+/// per layer is the organ's at `settings` over three, whatever the layers.
 fn cornea(settings: &OrganSettings) -> Result<TetMesh, MeshError> {
-    cornea_in_layers(settings, SHELL_LAYERS)
-}
-
-/// The cornea with `layers` elements through its thickness (the organ has two): a cut's depth
-/// is resolved to a `1 / layers` of the thickness. Layer 0 is the posterior face, the last
-/// layer the anterior one; the node count per layer is the organ's at `settings` over three.
-pub fn cornea_in_layers(settings: &OrganSettings, layers: usize) -> Result<TetMesh, MeshError> {
-    let layers = layers.max(1);
+    let layers = settings.cornea_layers.max(1);
     let per_layer = target_nodes(Organ::Cornea, settings) / (SHELL_LAYERS + 1);
     // A hexagonal disc of r rings has 1 + 3r(r + 1) vertices.
     let rings = (((per_layer as f64 / 3.0).sqrt()).round() as usize).max(2);

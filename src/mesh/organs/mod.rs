@@ -17,7 +17,6 @@ use serde::{Deserialize, Serialize};
 use super::{MeshError, TetMesh};
 pub use abdomen::{
     Abdomen, CORNEA_CURVATURE_M, CORNEA_RIM_M, CORNEA_THICKNESS_M, GALLBLADDER_WALL_M, GAP_M,
-    cornea_in_layers,
 };
 
 /// Region names stored with generated meshes.
@@ -92,6 +91,16 @@ pub struct OrganSettings {
     pub resolution: f64,
     /// Varies proportions by a few percent, deterministically: a different patient.
     pub seed: u64,
+    /// Elements through the cornea's thickness: a cut's depth is resolved to one of them.
+    #[serde(default = "default_cornea_layers")]
+    pub cornea_layers: usize,
+}
+
+/// The cornea's elements through its thickness by default: enough for pressing.
+pub const CORNEA_LAYERS: usize = 2;
+
+fn default_cornea_layers() -> usize {
+    CORNEA_LAYERS
 }
 
 impl Default for OrganSettings {
@@ -99,6 +108,7 @@ impl Default for OrganSettings {
         Self {
             resolution: 1.0,
             seed: 1,
+            cornea_layers: CORNEA_LAYERS,
         }
     }
 }
