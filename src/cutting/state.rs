@@ -221,29 +221,26 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     }
 
     /// The force (N) the tool feels for an `indentation_m` of the patch it loads: `patch`
-    /// holds the nodes under the tool and their shares of its load (summing to one). The cut
-    /// patch compliance `C` (3 × 3) is the shares' mean displacement under each unit force,
-    /// `Pᵀ K⁻¹ P + Wᵀ S⁻¹ W` with `W = Bᵀ K⁻¹ P` (`K⁻¹` symmetric); the force is `C⁻¹ δ`.
-    /// `None` where the patch does not resist (held nothing); an error for a patch outside
-    /// the region a cut vademecum covers.
+    /// holds the nodes under the tool and their shares of its load (summing to one). The
+    /// uncut patch compliance `Pᵀ K⁻¹ P` comes from the uncut response (a sparse solve for an
+    /// exact one); the haptic tick, which has it from the tool's vademecum, calls
+    /// [`Self::felt_force_over`]. An error for a patch outside the region a cut vademecum
+    /// covers.
     pub fn felt_force(
         &self,
         patch: &[(usize, f64)],
         indentation_m: Vector3<f64>,
     ) -> Result<Option<Vector3<f64>>, CutError> {
-        let loads: Vec<SparseColumn> = (0..3)
-            .map(|axis| {
-                patch
-                    .iter()
-                    .map(|&(n, share)| (3 * n + axis, share))
-                    .collect()
-            })
-            .collect();
+        let uncut = self.uncut_compliance(patch)?;
+        Ok(self.felt_force_over(patch, uncut, indentation_m))
+    }
+
+    /// The uncut patch compliance `Pᵀ K⁻¹ P` (m/N) from the uncut response.
+    pub fn uncut_compliance(&self, patch: &[(usize, f64)]) -> Result<Matrix3<f64>, CutError> {
+        let loads = axis_loads(patch);
         let responses = self.response.respond(&loads)?;
-        let dofs = 3 * self.model.mesh().node_count();
-        let mut near = vec![0.0; dofs];
-        let mut compliance = Matrix3::zeros();
-        let mut w = Vec::with_capacity(3);
+        let mut near = vec![0.0; 3 * self.model.mesh().node_count()];
+        let mut uncut = Matrix3::zeros();
         for (axis, response) in responses.iter().enumerate() {
             scatter(&response.near, 1.0, &mut near);
             for (row, load) in loads.iter().enumerate() {
@@ -255,24 +252,53 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
                     .map(|(x, m)| x * m)
                     .sum();
                 let near_part: f64 = load.iter().map(|&(d, s)| s * near[d]).sum();
-                compliance[(row, axis)] = modal + near_part;
+                uncut[(row, axis)] = modal + near_part;
             }
-            w.push(
-                (0..self.z.len())
-                    .map(|p| self.product(p, &response.modal, &near))
-                    .collect::<Vec<f64>>(),
-            );
             scatter(&response.near, -1.0, &mut near);
         }
+        Ok(uncut)
+    }
+
+    /// The felt force from the uncut patch compliance `uncut_m_per_n` (3 × 3): the cut one is
+    /// `C = C₀ + Wᵀ S⁻¹ W` with `W = Bᵀ K⁻¹ P = Zᵀ P` (`K⁻¹` symmetric), read from the
+    /// enriched functions' stored responses at the patch's nodes: no solve, `O(n (p + m) + n²)`
+    /// for `n` unknowns, `p` patch nodes and `m` modes. `None` where the patch does not resist.
+    pub fn felt_force_over(
+        &self,
+        patch: &[(usize, f64)],
+        uncut_m_per_n: Matrix3<f64>,
+        indentation_m: Vector3<f64>,
+    ) -> Option<Vector3<f64>> {
+        let loads = axis_loads(patch);
+        let patch_modes: Vec<Vec<f64>> = loads
+            .iter()
+            .map(|load| self.response.spatial_products(load))
+            .collect();
+        let w: Vec<Vec<f64>> = (0..3)
+            .map(|axis| {
+                self.z
+                    .iter()
+                    .map(|z| {
+                        let modal: f64 = patch_modes[axis]
+                            .iter()
+                            .zip(&z.modal)
+                            .map(|(x, m)| x * m)
+                            .sum();
+                        modal + sorted_dot(&z.near, &loads[axis])
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut compliance = uncut_m_per_n;
         for axis in 0..3 {
             let y = self.cholesky_solve(w[axis].clone());
             for row in 0..3 {
                 compliance[(row, axis)] += w[row].iter().zip(&y).map(|(a, b)| a * b).sum::<f64>();
             }
         }
-        Ok(compliance
+        compliance
             .try_inverse()
-            .map(|stiffness| stiffness * indentation_m))
+            .map(|stiffness| stiffness * indentation_m)
     }
 
     /// Adds the functions of `enrichment` not yet in the state: their columns of `B`, their
@@ -309,7 +335,10 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         }
         let first_new = 3 * self.functions.len();
         let (coupling, a) = self.new_blocks(enrichment, &slot, first_new, 3 * added.len());
-        let z = self.response.respond(&coupling)?;
+        let mut z = self.response.respond(&coupling)?;
+        // Sorted, so that the tick reads a response at the patch's dofs by binary search.
+        z.iter_mut()
+            .for_each(|z| z.near.sort_unstable_by_key(|e| e.0));
         let rows: Vec<Vec<f64>> = coupling
             .iter()
             .map(|b| self.response.spatial_products(b))
@@ -440,6 +469,25 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         }
         x
     }
+}
+
+/// The patch's unit loads along x, y and z: each node's share on its dof of that axis.
+fn axis_loads(patch: &[(usize, f64)]) -> Vec<SparseColumn> {
+    (0..3)
+        .map(|axis| {
+            patch
+                .iter()
+                .map(|&(n, share)| (3 * n + axis, share))
+                .collect()
+        })
+        .collect()
+}
+
+/// `vᵀ load` for `v` sorted by dof (binary search per load entry).
+fn sorted_dot(v: &[(usize, f64)], load: &[(usize, f64)]) -> f64 {
+    load.iter()
+        .filter_map(|&(d, s)| v.binary_search_by_key(&d, |e| e.0).ok().map(|i| s * v[i].1))
+        .sum()
 }
 
 /// `u += scale · v` for a sparse `v`.
