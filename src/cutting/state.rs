@@ -51,8 +51,11 @@ pub struct CutState<'m, R: UncutResponse> {
     functions: Vec<(usize, usize)>,
     /// Per unknown, `B`'s column.
     coupling: Vec<SparseColumn>,
-    /// Per unknown, `K⁻¹` of its column of `B`.
-    z: Vec<Response>,
+    /// Per unknown, the modal coefficients of `K⁻¹` of its column of `B` …
+    z_modal: Vec<Vec<f64>>,
+    /// … and per dof, the rest of those responses as `(unknown, value)`: the tick reads the
+    /// few dofs under the tool for every unknown at once.
+    z_near: Vec<Vec<(u32, f64)>>,
     /// Per unknown, `Xᵀ` of its column of `B`: its products with any response's modal part.
     rows: Vec<Vec<f64>>,
     /// The lower Cholesky factor of `S`, row by row (row `i` holds `i + 1` entries).
@@ -70,7 +73,8 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             faces: Vec::new(),
             functions: Vec::new(),
             coupling: Vec::new(),
-            z: Vec::new(),
+            z_modal: Vec::new(),
+            z_near: vec![Vec::new(); 3 * model.mesh().node_count()],
             rows: Vec::new(),
             factor: Vec::new(),
         }
@@ -140,7 +144,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
 
     /// The enriched unknowns so far.
     pub fn unknowns(&self) -> usize {
-        self.z.len()
+        self.z_modal.len()
     }
 
     pub fn faces(&self) -> &[CutFace] {
@@ -184,17 +188,16 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     fn condensed(&self, response: Response) -> (Vec<f64>, Vec<f64>) {
         let mut u = vec![0.0; 3 * self.model.mesh().node_count()];
         scatter(&response.near, 1.0, &mut u);
-        let rhs: Vec<f64> = (0..self.z.len())
+        let rhs: Vec<f64> = (0..self.unknowns())
             .map(|p| -self.product(p, &response.modal, &u))
             .collect();
         let q = self.cholesky_solve(rhs);
         let mut modal = response.modal;
-        for (z, &qj) in self.z.iter().zip(&q) {
-            modal
-                .iter_mut()
-                .zip(&z.modal)
-                .for_each(|(m, a)| *m -= qj * a);
-            scatter(&z.near, -qj, &mut u);
+        for (z, &qj) in self.z_modal.iter().zip(&q) {
+            modal.iter_mut().zip(z).for_each(|(m, a)| *m -= qj * a);
+        }
+        for (ud, entries) in u.iter_mut().zip(&self.z_near) {
+            *ud -= entries.iter().map(|&(p, v)| q[p as usize] * v).sum::<f64>();
         }
         self.response.add_spatial(&modal, &mut u);
         (u, q)
@@ -274,27 +277,25 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             .iter()
             .map(|load| self.response.spatial_products(load))
             .collect();
-        let w: Vec<Vec<f64>> = (0..3)
+        // Wᵀ S⁻¹ W = Yᵀ Y with L Y = W: one forward substitution per axis.
+        let y: Vec<Vec<f64>> = (0..3)
             .map(|axis| {
-                self.z
+                let mut w: Vec<f64> = self
+                    .z_modal
                     .iter()
-                    .map(|z| {
-                        let modal: f64 = patch_modes[axis]
-                            .iter()
-                            .zip(&z.modal)
-                            .map(|(x, m)| x * m)
-                            .sum();
-                        modal + sorted_dot(&z.near, &loads[axis])
-                    })
-                    .collect()
+                    .map(|z| patch_modes[axis].iter().zip(z).map(|(x, m)| x * m).sum())
+                    .collect();
+                for &(d, share) in &loads[axis] {
+                    for &(p, v) in &self.z_near[d] {
+                        w[p as usize] += share * v;
+                    }
+                }
+                self.forward(w)
             })
             .collect();
         let mut compliance = uncut_m_per_n;
-        for axis in 0..3 {
-            let y = self.cholesky_solve(w[axis].clone());
-            for row in 0..3 {
-                compliance[(row, axis)] += w[row].iter().zip(&y).map(|(a, b)| a * b).sum::<f64>();
-            }
+        for (row, axis) in (0..3).flat_map(|r| (0..3).map(move |a| (r, a))) {
+            compliance[(row, axis)] += y[row].iter().zip(&y[axis]).map(|(a, b)| a * b).sum::<f64>();
         }
         compliance
             .try_inverse()
@@ -335,10 +336,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         }
         let first_new = 3 * self.functions.len();
         let (coupling, a) = self.new_blocks(enrichment, &slot, first_new, 3 * added.len());
-        let mut z = self.response.respond(&coupling)?;
-        // Sorted, so that the tick reads a response at the patch's dofs by binary search.
-        z.iter_mut()
-            .for_each(|z| z.near.sort_unstable_by_key(|e| e.0));
+        let z = self.response.respond(&coupling)?;
         let rows: Vec<Vec<f64>> = coupling
             .iter()
             .map(|b| self.response.spatial_products(b))
@@ -364,7 +362,13 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         self.border(&columns)?;
         self.functions.extend(added);
         self.coupling.extend(coupling);
-        self.z.extend(z);
+        for (r, response) in z.into_iter().enumerate() {
+            let p = (first_new + r) as u32;
+            for (d, v) in response.near {
+                self.z_near[d].push((p, v));
+            }
+            self.z_modal.push(response.modal);
+        }
         self.rows.extend(rows);
         Ok(())
     }
@@ -456,13 +460,19 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         Ok(())
     }
 
-    /// `S⁻¹ rhs` through the factor.
-    fn cholesky_solve(&self, mut x: Vec<f64>) -> Vec<f64> {
-        let n = x.len();
-        for i in 0..n {
-            let s: f64 = (0..i).map(|k| self.factor[i][k] * x[k]).sum();
-            x[i] = (x[i] - s) / self.factor[i][i];
+    /// `L⁻¹ x` (forward substitution through the factor's rows).
+    fn forward(&self, mut x: Vec<f64>) -> Vec<f64> {
+        for (i, row) in self.factor.iter().enumerate() {
+            let s: f64 = row[..i].iter().zip(&x[..i]).map(|(l, v)| l * v).sum();
+            x[i] = (x[i] - s) / row[i];
         }
+        x
+    }
+
+    /// `S⁻¹ rhs` through the factor.
+    fn cholesky_solve(&self, x: Vec<f64>) -> Vec<f64> {
+        let mut x = self.forward(x);
+        let n = x.len();
         for i in (0..n).rev() {
             let s: f64 = (i + 1..n).map(|k| self.factor[k][i] * x[k]).sum();
             x[i] = (x[i] - s) / self.factor[i][i];
@@ -481,13 +491,6 @@ fn axis_loads(patch: &[(usize, f64)]) -> Vec<SparseColumn> {
                 .collect()
         })
         .collect()
-}
-
-/// `vᵀ load` for `v` sorted by dof (binary search per load entry).
-fn sorted_dot(v: &[(usize, f64)], load: &[(usize, f64)]) -> f64 {
-    load.iter()
-        .filter_map(|&(d, s)| v.binary_search_by_key(&d, |e| e.0).ok().map(|i| s * v[i].1))
-        .sum()
 }
 
 /// `u += scale · v` for a sparse `v`.
