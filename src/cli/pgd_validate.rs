@@ -5,7 +5,9 @@ use std::path::Path;
 
 use super::pgd_build::write_convergence;
 use crate::cutting::keratotomy::Cornea;
-use crate::cutting::{CutValidationReport, CutValidationSettings, validate_keratotomy};
+use crate::cutting::{
+    CutError, CutValidationReport, CutValidationSettings, ExactResponse, validate_keratotomy,
+};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::Organ;
 use crate::pgd::{self, ValidationReport, ValidationSettings};
@@ -58,12 +60,14 @@ pub fn print_validation(report: &ValidationReport) {
 }
 
 /// Checks the cut section of the vademecum in `file` against full X-FEM on `mesh` (the
-/// cornea's, as it was built): `settings.incisions` radial incisions at random angles.
+/// cornea's, as it was built): `settings.incisions` radial incisions at random angles. With
+/// `exact`, the cut state runs on the factorized stiffness instead (the reference path).
 pub fn validate_cuts(
     source: &str,
     (organ, mesh): (Option<Organ>, TetMesh),
     file: &Path,
     settings: &CutValidationSettings,
+    exact: bool,
 ) -> Result<CutValidationReport, String> {
     if organ != Some(Organ::Cornea) {
         return Err(format!(
@@ -83,7 +87,13 @@ pub fn validate_cuts(
     };
     let cornea =
         Cornea::from_mesh(mesh, vademecum.header.material).map_err(|e| format!("{source}: {e}"))?;
-    validate_keratotomy(&cornea, cuts, settings).map_err(|e| format!("{source}: {e}"))
+    let validated = match exact {
+        true => ExactResponse::new(cornea.model())
+            .map_err(|e| CutError::Solve(e.to_string()))
+            .and_then(|response| validate_keratotomy(&cornea, &response, settings)),
+        false => validate_keratotomy(&cornea, cuts, settings),
+    };
+    validated.map_err(|e| format!("{source}: {e}"))
 }
 
 /// The cut validation as a table.

@@ -18,7 +18,7 @@ use super::enrichment::{ModeReport, enrich};
 use super::error_curve::{EnergyError, ErrorCurve, FieldError, optimal_errors};
 use super::load_patches::{LoadOperator, LoadPatches};
 use super::local::{LocalPart, distance_neighbours, near_nodes};
-use super::region::RegionReport;
+use super::region::{CutHeader, RegionReport, RegionResponse, RegionSettings};
 use super::responses::{Responses, SecantLoads, SecantReport};
 use super::separated::SeparatedField;
 use super::settings::BuildSettings;
@@ -448,4 +448,27 @@ fn self_compliances(local: &LocalPart) -> Vec<f32> {
             block[0].max(block[4]).max(block[8])
         })
         .collect()
+}
+
+/// Adds the cut section to `vademecum`, built for `model` (the model it was built for): the
+/// responses over the nodes within `settings.depth_m` of its accessible faces.
+pub fn add_cuts(
+    vademecum: &mut Vademecum,
+    model: &FemModel,
+    settings: &RegionSettings,
+    progress: &dyn Progress,
+) -> Result<RegionReport, FemError> {
+    let faces = vademecum.header.accessible_region.clone();
+    progress.message("factorizing the stiffness for the cut modes");
+    let stiffness = RestStiffness::new(model)?;
+    let region =
+        RegionResponse::region_nodes(&stiffness, model.mesh().face_set(&faces)?, settings.depth_m);
+    let (response, report) = RegionResponse::build(&stiffness, &region, settings, progress)?;
+    vademecum.header.cuts = Some(CutHeader {
+        faces,
+        settings: *settings,
+        report: report.clone(),
+    });
+    vademecum.cuts = Some(response);
+    Ok(report)
 }

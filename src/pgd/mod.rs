@@ -21,7 +21,7 @@ mod stiffness;
 mod vademecum;
 mod validate;
 
-pub use build::{BuildReport, OrganModel, StepReport, WIDE_NEAR_FIELD_SHARE, build};
+pub use build::{BuildReport, OrganModel, StepReport, WIDE_NEAR_FIELD_SHARE, add_cuts, build};
 pub use deformation::{Deformation, PatchLoad, PointLoad, RigidCarry};
 pub use enrichment::{ModeReport, PgdSettings, enrich};
 pub use error::VademecumError;
@@ -29,7 +29,7 @@ pub use error_curve::{EnergyError, ErrorCurve, optimal_errors};
 pub use file::{FORMAT_VERSION, decode, encode, load, read_header, save};
 pub use load_patches::{LoadOperator, LoadPatches};
 pub use local::LocalPart;
-pub use region::{CutHeader, RegionReport, RegionResponse, RegionSettings, SparseDofs, add_cuts};
+pub use region::{CutHeader, RegionReport, RegionResponse, RegionSettings, SparseDofs};
 pub use responses::{Responses, SecantLoads, SecantReport, SecantSettings};
 pub use separated::SeparatedField;
 pub use settings::{BuildSettings, DEFAULT_LOAD_STEPS_M};

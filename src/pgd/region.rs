@@ -20,8 +20,7 @@ use super::local::near_nodes;
 use super::separated::SeparatedField;
 use super::statistics::Statistics;
 use super::stiffness::RestStiffness;
-use super::vademecum::Vademecum;
-use crate::fem::{FemError, FemModel, PRESCRIBED};
+use crate::fem::{FemError, PRESCRIBED};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::{CORNEA_THICKNESS_M, Organ};
 
@@ -112,29 +111,6 @@ const HELD: u32 = u32::MAX - 1;
 
 /// Positions solved together (three columns each).
 const BLOCK_POSITIONS: usize = 16;
-
-/// Adds the cut section to `vademecum`, built for `model` (the model it was built for): the
-/// responses over the nodes within `settings.depth_m` of its accessible faces.
-pub fn add_cuts(
-    vademecum: &mut Vademecum,
-    model: &FemModel,
-    settings: &RegionSettings,
-    progress: &dyn Progress,
-) -> Result<RegionReport, FemError> {
-    let faces = vademecum.header.accessible_region.clone();
-    progress.message("factorizing the stiffness for the cut modes");
-    let stiffness = RestStiffness::new(model)?;
-    let region =
-        RegionResponse::region_nodes(&stiffness, model.mesh().face_set(&faces)?, settings.depth_m);
-    let (response, report) = RegionResponse::build(&stiffness, &region, settings, progress)?;
-    vademecum.header.cuts = Some(CutHeader {
-        faces,
-        settings: *settings,
-        report: report.clone(),
-    });
-    vademecum.cuts = Some(response);
-    Ok(report)
-}
 
 impl RegionResponse {
     /// The free nodes within `depth_m` of any node of `faces`, their lumped volumes (m³)

@@ -84,6 +84,10 @@ pub enum Command {
         /// of 60–95 %, each made in three segments; --samples patterns (default 5 here).
         #[arg(long, value_name = "radial:N", value_parser = cli::parse_radial)]
         cuts: Option<usize>,
+        /// With --cuts: run the cut state on the factorized stiffness instead of the cut
+        /// section (the reference path; a sparse solve per enriched function).
+        #[arg(long, requires = "cuts")]
+        exact_response: bool,
         /// Print the report as JSON.
         #[arg(long)]
         json: bool,
@@ -109,7 +113,7 @@ pub enum Command {
         resolution: f64,
         /// Elements through the thickness: a cut's depth counts in these.
         #[arg(long, default_value_t = 8)]
-        layers: usize,
+        cornea_layers: usize,
         /// Print the report as JSON.
         #[arg(long)]
         json: bool,

@@ -51,6 +51,7 @@ fn main() -> ExitCode {
             sample_seed,
             max_indentation_mm,
             cuts,
+            exact_response,
             json,
         } => {
             let file = vademecum.unwrap_or_else(|| args::default_vademecum(&mesh));
@@ -61,7 +62,7 @@ fn main() -> ExitCode {
                     seed: sample_seed,
                     ..CutValidationSettings::default()
                 };
-                return validate_cut_section(&mesh, &file, &settings, json);
+                return validate_cut_section(&mesh, &file, (&settings, exact_response), json);
             }
             let settings = |organ| {
                 let defaults = ValidationSettings::for_organ(organ);
@@ -93,7 +94,7 @@ fn main() -> ExitCode {
             optical_zone_mm,
             depth_fraction,
             resolution,
-            layers,
+            cornea_layers,
             json,
         } => {
             if organ != "cornea" {
@@ -107,7 +108,8 @@ fn main() -> ExitCode {
                 optical_zone_m: optical_zone_mm * 1e-3,
                 depth_fraction,
             };
-            let report = Cornea::new(resolution, layers).and_then(|cornea| cornea.cut(&plan));
+            let report =
+                Cornea::new(resolution, cornea_layers).and_then(|cornea| cornea.cut(&plan));
             print_report("pgd cut cornea", report, json)
         }
         Command::Bench { what } => bench_command(what),
@@ -118,12 +120,12 @@ fn main() -> ExitCode {
 fn validate_cut_section(
     mesh: &MeshArgs,
     file: &Path,
-    settings: &CutValidationSettings,
+    (settings, exact): (&CutValidationSettings, bool),
     json: bool,
 ) -> ExitCode {
     let validated = mesh
         .load()
-        .and_then(|loaded| cli::validate_cuts(&mesh.source, loaded, file, settings));
+        .and_then(|loaded| cli::validate_cuts(&mesh.source, loaded, file, settings, exact));
     match validated {
         Ok(report) if json => print_json(&report),
         Ok(report) => {
