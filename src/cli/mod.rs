@@ -12,7 +12,7 @@ mod trainer_commands;
 
 pub use output::{fail, print_json, print_report};
 pub use parse::{
-    parse_inclusion, parse_radial, parse_spacing, parse_stiffness_ratio, parse_subdivisions,
+    parse_cut_pattern, parse_inclusion, parse_spacing, parse_stiffness_ratio, parse_subdivisions,
 };
 pub use pgd_build::{build_vademecum, print_build_report};
 pub use pgd_mesh::report_mesh;

@@ -1,6 +1,7 @@
 //! Parsers of the binaries' option values, with errors that say the range or the form.
 
 use crate::contact::{check_spacing, check_subdivisions};
+use crate::cutting::CutPattern;
 use crate::fem::Inclusion;
 
 /// A `--subdivide` count within [`crate::contact::SUBDIVISIONS`].
@@ -48,12 +49,17 @@ pub fn parse_inclusion(text: &str) -> Result<Inclusion, String> {
     Ok(inclusion)
 }
 
-/// A cut pattern of `pgd validate --cuts`: `radial:N`, N radial incisions (N ≥ 1).
-pub fn parse_radial(text: &str) -> Result<usize, String> {
-    text.strip_prefix("radial:")
-        .and_then(|n| n.parse::<usize>().ok())
-        .filter(|&n| n >= 1)
-        .ok_or_else(|| format!("{text}: expected radial:N, N radial incisions (at least 1)"))
+/// A cut pattern of `pgd validate --cuts`: `radial:N` (the cornea) or `straight:N` (an
+/// organ's accessible face), N incisions (N ≥ 1).
+pub fn parse_cut_pattern(text: &str) -> Result<CutPattern, String> {
+    let count = |n: &str| n.parse::<usize>().ok().filter(|&n| n >= 1);
+    let pattern = match text.split_once(':') {
+        Some(("radial", n)) => count(n).map(CutPattern::Radial),
+        Some(("straight", n)) => count(n).map(CutPattern::Straight),
+        _ => None,
+    };
+    pattern
+        .ok_or_else(|| format!("{text}: expected radial:N or straight:N, N incisions (at least 1)"))
 }
 
 #[cfg(test)]

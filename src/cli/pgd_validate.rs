@@ -6,8 +6,10 @@ use std::path::Path;
 use super::pgd_build::write_convergence;
 use crate::cutting::keratotomy::Cornea;
 use crate::cutting::{
-    CutError, CutValidationReport, CutValidationSettings, ExactResponse, validate_keratotomy,
+    CutPattern, CutValidationReport, CutValidationSettings, ExactResponse, UncutResponse,
+    validate_incisions, validate_keratotomy,
 };
+use crate::fem::FemModel;
 use crate::mesh::TetMesh;
 use crate::mesh::organs::Organ;
 use crate::pgd::{self, ValidationReport, ValidationSettings};
@@ -59,9 +61,11 @@ pub fn print_validation(report: &ValidationReport) {
     }
 }
 
-/// Checks the cut section of the vademecum in `file` against full X-FEM on `mesh` (the
-/// cornea's, as it was built): `settings.incisions` radial incisions at random angles. With
-/// `exact`, the cut state runs on the factorized stiffness instead (the reference path).
+/// Checks the cut section of the vademecum in `file` against full X-FEM on `mesh` (as it was
+/// built), on the random patterns `settings` draws: radial keratotomies of the cornea under the
+/// intraocular pressure, straight incisions into another organ's accessible face under the
+/// tool. With `exact`, the cut state runs on the factorized stiffness instead (the reference
+/// path).
 pub fn validate_cuts(
     source: &str,
     (organ, mesh): (Option<Organ>, TetMesh),
@@ -69,11 +73,6 @@ pub fn validate_cuts(
     settings: &CutValidationSettings,
     exact: bool,
 ) -> Result<CutValidationReport, String> {
-    if organ != Some(Organ::Cornea) {
-        return Err(format!(
-            "{source}: radial incisions are defined on the cornea only"
-        ));
-    }
     let vademecum = pgd::load(file).map_err(|e| e.to_string())?;
     vademecum
         .check_mesh(file, &mesh)
@@ -85,15 +84,47 @@ pub fn validate_cuts(
             file.display()
         ));
     };
-    let cornea =
-        Cornea::from_mesh(mesh, vademecum.header.material).map_err(|e| format!("{source}: {e}"))?;
-    let validated = match exact {
-        true => ExactResponse::new(cornea.model())
-            .map_err(|e| CutError::Solve(e.to_string()))
-            .and_then(|response| validate_keratotomy(&cornea, &response, settings)),
-        false => validate_keratotomy(&cornea, cuts, settings),
+    let in_source = |e: &dyn std::fmt::Display| format!("{source}: {e}");
+    let material = vademecum.header.material;
+    let site = match (settings.pattern, organ) {
+        (CutPattern::Radial(_), Some(Organ::Cornea)) => {
+            Site::Cornea(Cornea::from_mesh(mesh, material).map_err(|e| in_source(&e))?)
+        }
+        (CutPattern::Straight(_), organ) if organ != Some(Organ::Cornea) => Site::Organ(
+            pgd::organ::clamped_model(mesh, material)
+                .and_then(|model| model.with_inclusions(&vademecum.header.inclusions))
+                .map_err(|e| in_source(&e))?,
+        ),
+        (pattern, _) => {
+            return Err(format!(
+                "{source}: {pattern} does not apply (radial:N cuts the cornea, straight:N the \
+                 other organs)"
+            ));
+        }
     };
-    validated.map_err(|e| format!("{source}: {e}"))
+    let model = match &site {
+        Site::Cornea(cornea) => cornea.model(),
+        Site::Organ(model) => model,
+    };
+    let factorized = match exact {
+        true => Some(ExactResponse::new(model).map_err(|e| in_source(&e))?),
+        false => None,
+    };
+    let response: &dyn UncutResponse = match &factorized {
+        Some(exact) => exact,
+        None => cuts,
+    };
+    let validated = match &site {
+        Site::Cornea(cornea) => validate_keratotomy(cornea, &response, settings),
+        Site::Organ(model) => validate_incisions(model, &response, settings),
+    };
+    validated.map_err(|e| in_source(&e))
+}
+
+/// What a cut pattern is validated on.
+enum Site {
+    Cornea(Cornea),
+    Organ(FemModel),
 }
 
 /// The cut validation as a table.

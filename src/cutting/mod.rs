@@ -19,7 +19,10 @@ pub use enrichment::{ElementCut, Enriched, Enrichment, Piece, SLIVER};
 pub use incision::{CutFace, Extent, Incision, MIN_SEGMENT_M};
 pub use response::{ExactResponse, Response, UncutResponse};
 pub use state::CutState;
-pub use validation::{CutCase, CutValidationReport, CutValidationSettings, validate_keratotomy};
+pub use validation::{
+    CutCase, CutPattern, CutValidationReport, CutValidationSettings, validate_incisions,
+    validate_keratotomy,
+};
 pub use xfem::CutSolution;
 
 /// Why a cut cannot be made or solved.

@@ -31,7 +31,7 @@ pub trait UncutResponse {
 }
 
 /// A response lent to several cut states in turn.
-impl<R: UncutResponse> UncutResponse for &R {
+impl<R: UncutResponse + ?Sized> UncutResponse for &R {
     fn node_count(&self) -> usize {
         (**self).node_count()
     }

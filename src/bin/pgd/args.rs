@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, Parser, Subcommand};
 use pgd_surgery::contact::{CouplingSettings, PenaltySettings, PointshellDensity};
+use pgd_surgery::cutting::CutPattern;
 use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
 use pgd_surgery::mesh::TetMesh;
 use pgd_surgery::mesh::io::ImportOptions;
@@ -79,11 +80,13 @@ pub enum Command {
         /// organ's tool radius, 20 for the abdominal organs; the smallest is a tenth of it).
         #[arg(long)]
         max_indentation_mm: Option<f64>,
-        /// Check the cut section instead, on cut patterns drawn at random: `radial:N` (the
-        /// cornea), N radial incisions at random angles, optical zones of 3–5 mm and depths
-        /// of 60–95 %, each made in three segments; --samples patterns (default 5 here).
-        #[arg(long, value_name = "radial:N", value_parser = cli::parse_radial)]
-        cuts: Option<usize>,
+        /// Check the cut section instead, on cut patterns drawn at random, each incision made
+        /// in three segments: `radial:N` (the cornea), N radial incisions at random angles,
+        /// optical zones of 3–5 mm and depths of 60–95 %, under 15 mmHg; `straight:N`, N
+        /// incisions 20 mm long and 10 mm deep into the accessible face, under the tool
+        /// beside the first; --samples patterns (default 5 here).
+        #[arg(long, value_name = "PATTERN", value_parser = cli::parse_cut_pattern)]
+        cuts: Option<CutPattern>,
         /// With --cuts: run the cut state on the factorized stiffness instead of the cut
         /// section (the reference path; a sparse solve per enriched function).
         #[arg(long, requires = "cuts")]

@@ -55,9 +55,9 @@ fn main() -> ExitCode {
             json,
         } => {
             let file = vademecum.unwrap_or_else(|| args::default_vademecum(&mesh));
-            if let Some(incisions) = cuts {
+            if let Some(pattern) = cuts {
                 let settings = CutValidationSettings {
-                    incisions,
+                    pattern,
                     samples: samples.unwrap_or(CutValidationSettings::default().samples),
                     seed: sample_seed,
                     ..CutValidationSettings::default()
