@@ -526,7 +526,10 @@ fn random_liver_incisions_made_online_equal_full_xfem() {
     };
     let report = validate_incisions(&model, &exact, &validation).unwrap();
     assert_eq!(report.failed, 0, "{report:#?}");
-    assert!(report.cases.iter().all(|c| c.unknowns > 0), "nothing was cut");
+    assert!(
+        report.cases.iter().all(|c| c.unknowns > 0),
+        "nothing was cut"
+    );
     assert!(report.cut_l2_error.max < 1e-9, "{:?}", report.cut_l2_error);
     assert!(report.force_error.max < 1e-9, "{:?}", report.force_error);
 }
