@@ -51,10 +51,12 @@ pub struct CutState<'m, R: UncutResponse> {
     functions: Vec<(usize, usize)>,
     /// Per unknown, `B`'s column.
     coupling: Vec<SparseColumn>,
-    /// Per unknown, the modal coefficients of `K⁻¹` of its column of `B` …
+    /// The enriched functions' uncut responses `Z = K⁻¹ B`, kept as `Ẑ = Z L⁻ᵀ` (`L` the
+    /// factor of `S`): per unknown, the modal coefficients …
     z_modal: Vec<Vec<f64>>,
-    /// … and per dof, the rest of those responses as `(unknown, value)`: the tick reads the
-    /// few dofs under the tool for every unknown at once.
+    /// … and per dof, the rest as `(unknown, value)`. With `Ẑ`, the felt compliance's
+    /// `Wᵀ S⁻¹ W` is `(Ẑᵀ P)ᵀ (Ẑᵀ P)`: the tick reads the few dofs under the tool for every
+    /// unknown at once and solves nothing. Bordering leaves `Ẑ`'s old columns as they are.
     z_near: Vec<Vec<(u32, f64)>>,
     /// Per unknown, `Xᵀ` of its column of `B`: its products with any response's modal part.
     rows: Vec<Vec<f64>>,
@@ -184,23 +186,24 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     }
 
     /// The nodes' displacements from the uncut ones `response`, and the enriched amplitudes in
-    /// the state's order: `q = −S⁻¹ Bᵀ K⁻¹ f`, `u = K⁻¹ f − Z q`.
+    /// the state's order: `q = −S⁻¹ Bᵀ K⁻¹ f`, `u = K⁻¹ f − Z q = K⁻¹ f − Ẑ y` with
+    /// `L y = −Bᵀ K⁻¹ f` and `q = L⁻ᵀ y`.
     fn condensed(&self, response: Response) -> (Vec<f64>, Vec<f64>) {
         let mut u = vec![0.0; 3 * self.model.mesh().node_count()];
         scatter(&response.near, 1.0, &mut u);
         let rhs: Vec<f64> = (0..self.unknowns())
             .map(|p| -self.product(p, &response.modal, &u))
             .collect();
-        let q = self.cholesky_solve(rhs);
+        let y = self.forward(rhs);
         let mut modal = response.modal;
-        for (z, &qj) in self.z_modal.iter().zip(&q) {
-            modal.iter_mut().zip(z).for_each(|(m, a)| *m -= qj * a);
+        for (z, &yj) in self.z_modal.iter().zip(&y) {
+            modal.iter_mut().zip(z).for_each(|(m, a)| *m -= yj * a);
         }
         for (ud, entries) in u.iter_mut().zip(&self.z_near) {
-            *ud -= entries.iter().map(|&(p, v)| q[p as usize] * v).sum::<f64>();
+            *ud -= entries.iter().map(|&(p, v)| y[p as usize] * v).sum::<f64>();
         }
         self.response.add_spatial(&modal, &mut u);
-        (u, q)
+        (u, self.backward(y))
     }
 
     /// `b_pᵀ K⁻¹ f` for unknown `p` and a response given by its modal coefficients and its
@@ -277,20 +280,20 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             .iter()
             .map(|load| self.response.spatial_products(load))
             .collect();
-        // Wᵀ S⁻¹ W = Yᵀ Y with L Y = W: one forward substitution per axis.
+        // Wᵀ S⁻¹ W = Yᵀ Y with Y = L⁻¹ W = Ẑᵀ P.
         let y: Vec<Vec<f64>> = (0..3)
             .map(|axis| {
-                let mut w: Vec<f64> = self
+                let mut y: Vec<f64> = self
                     .z_modal
                     .iter()
                     .map(|z| patch_modes[axis].iter().zip(z).map(|(x, m)| x * m).sum())
                     .collect();
                 for &(d, share) in &loads[axis] {
                     for &(p, v) in &self.z_near[d] {
-                        w[p as usize] += share * v;
+                        y[p as usize] += share * v;
                     }
                 }
-                self.forward(w)
+                y
             })
             .collect();
         let mut compliance = uncut_m_per_n;
@@ -362,15 +365,33 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         self.border(&columns)?;
         self.functions.extend(added);
         self.coupling.extend(coupling);
-        for (r, response) in z.into_iter().enumerate() {
-            let p = (first_new + r) as u32;
-            for (d, v) in response.near {
-                self.z_near[d].push((p, v));
-            }
-            self.z_modal.push(response.modal);
+        let mut scratch = vec![0.0; self.z_near.len()];
+        for response in z {
+            self.push_hatted(response, &mut scratch);
         }
         self.rows.extend(rows);
         Ok(())
+    }
+
+    /// Appends the next unknown `p`'s column of `Ẑ`, its factor row `l` in place:
+    /// `ẑ_p = (z_p − Σ_{j<p} ẑ_j l_j) / l_p`, over every dof the sum reaches.
+    fn push_hatted(&mut self, z: Response, scratch: &mut [f64]) {
+        let p = self.z_modal.len();
+        let row = &self.factor[p];
+        let mut modal = z.modal;
+        for (zj, &l) in self.z_modal.iter().zip(row) {
+            modal.iter_mut().zip(zj).for_each(|(m, a)| *m -= l * a);
+        }
+        modal.iter_mut().for_each(|m| *m /= row[p]);
+        scatter(&z.near, 1.0, scratch);
+        for (entries, value) in self.z_near.iter_mut().zip(scratch.iter_mut()) {
+            let reached: f64 = entries.iter().map(|&(j, v)| row[j as usize] * v).sum();
+            let hatted = (std::mem::take(value) - reached) / row[p];
+            if hatted != 0.0 {
+                entries.push((p as u32, hatted));
+            }
+        }
+        self.z_modal.push(modal);
     }
 
     /// `B`'s columns for the new unknowns `first_new..first_new + count`, and the entries of
@@ -469,9 +490,8 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         x
     }
 
-    /// `S⁻¹ rhs` through the factor.
-    fn cholesky_solve(&self, x: Vec<f64>) -> Vec<f64> {
-        let mut x = self.forward(x);
+    /// `L⁻ᵀ y` (backward substitution).
+    fn backward(&self, mut x: Vec<f64>) -> Vec<f64> {
         let n = x.len();
         for i in (0..n).rev() {
             let s: f64 = (i + 1..n).map(|k| self.factor[k][i] * x[k]).sum();
