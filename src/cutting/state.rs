@@ -19,6 +19,7 @@
 use std::collections::HashMap;
 
 use nalgebra::{Matrix3, Point3, Vector3};
+use rayon::prelude::*;
 
 use super::CutError;
 use super::enrichment::Enrichment;
@@ -365,33 +366,50 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         self.border(&columns)?;
         self.functions.extend(added);
         self.coupling.extend(coupling);
-        let mut scratch = vec![0.0; self.z_near.len()];
-        for response in z {
-            self.push_hatted(response, &mut scratch);
-        }
+        self.push_hatted(z);
         self.rows.extend(rows);
         Ok(())
     }
 
-    /// Appends the next unknown `p`'s column of `Ẑ`, its factor row `l` in place:
-    /// `ẑ_p = (z_p − Σ_{j<p} ẑ_j l_j) / l_p`, over every dof the sum reaches.
-    fn push_hatted(&mut self, z: Response, scratch: &mut [f64]) {
-        let p = self.z_modal.len();
-        let row = &self.factor[p];
-        let mut modal = z.modal;
-        for (zj, &l) in self.z_modal.iter().zip(row) {
-            modal.iter_mut().zip(zj).for_each(|(m, a)| *m -= l * a);
-        }
-        modal.iter_mut().for_each(|m| *m /= row[p]);
-        scatter(&z.near, 1.0, scratch);
-        for (entries, value) in self.z_near.iter_mut().zip(scratch.iter_mut()) {
-            let reached: f64 = entries.iter().map(|&(j, v)| row[j as usize] * v).sum();
-            let hatted = (std::mem::take(value) - reached) / row[p];
-            if hatted != 0.0 {
-                entries.push((p as u32, hatted));
+    /// Appends the new unknowns' columns of `Ẑ`, their factor rows `l` in place:
+    /// `ẑ_p = (z_p − Σ_{j<p} ẑ_j l_j) / l_p`. The recurrence runs dof by dof (each dof's
+    /// entries are all it reads), so the dofs go in parallel.
+    fn push_hatted(&mut self, z: Vec<Response>) {
+        let first = self.z_modal.len();
+        let factor = &self.factor;
+        let hatted = |value: f64, entries: &[(u32, f64)], p: usize| {
+            let reached: f64 = entries
+                .iter()
+                .map(|&(j, v)| factor[p][j as usize] * v)
+                .sum();
+            (value - reached) / factor[p][p]
+        };
+        let mut dense = vec![vec![0.0; z.len()]; self.z_near.len()];
+        for (r, response) in z.iter().enumerate() {
+            for &(d, v) in &response.near {
+                dense[d][r] += v;
             }
         }
-        self.z_modal.push(modal);
+        self.z_near
+            .par_iter_mut()
+            .zip(dense)
+            .for_each(|(entries, values)| {
+                for (r, value) in values.into_iter().enumerate() {
+                    let v = hatted(value, entries, first + r);
+                    if v != 0.0 {
+                        entries.push(((first + r) as u32, v));
+                    }
+                }
+            });
+        for (r, response) in z.into_iter().enumerate() {
+            let p = first + r;
+            let mut modal = response.modal;
+            for (zj, &l) in self.z_modal.iter().zip(&factor[p]) {
+                modal.iter_mut().zip(zj).for_each(|(m, a)| *m -= l * a);
+            }
+            modal.iter_mut().for_each(|m| *m /= factor[p][p]);
+            self.z_modal.push(modal);
+        }
     }
 
     /// `B`'s columns for the new unknowns `first_new..first_new + count`, and the entries of
