@@ -36,9 +36,11 @@ pub struct RegionSettings {
 }
 
 impl RegionSettings {
-    /// Cuts as deep as the organ's surgery takes them. The cornea: its whole thickness (radial
-    /// keratotomy goes to 95 % of it), a near field of 1 mm (two elements of the keratotomy
-    /// mesh). The abdominal organs: 20 mm under the accessible faces, a 8 mm near field.
+    /// Cuts as deep as the organ's surgery takes them. The cornea: every node (1.5 times its
+    /// thickness under the anterior face, so that the posterior face, which the intraocular
+    /// pressure loads, is in; radial keratotomy cuts to 95 % of the thickness), a near field
+    /// of 1 mm (two elements of the keratotomy mesh). The abdominal organs: 20 mm under the
+    /// accessible faces, an 8 mm near field.
     pub fn for_organ(organ: Option<Organ>) -> Self {
         match organ {
             Some(Organ::Cornea) => Self {
