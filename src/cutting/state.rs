@@ -30,6 +30,7 @@ use super::incision::{CutFace, Incision};
 use super::response::{Response, UncutResponse};
 use super::xfem::{CutSolution, element_functions, piece_weights};
 use crate::fem::{FemModel, PRESCRIBED};
+use crate::mesh::Surface;
 
 /// A sparse column of `B`: the nodes' own dofs it couples to, with the entries.
 type SparseColumn = Vec<(usize, f64)>;
@@ -55,13 +56,18 @@ pub struct CutState<'m, R: UncutResponse> {
     functions: Vec<(usize, usize)>,
     /// Per unknown, `B`'s column.
     coupling: Vec<SparseColumn>,
-    /// The enriched functions' uncut responses `Z = K⁻¹ B`, kept as `Ẑ = Z L⁻ᵀ` (`L` the
-    /// factor of `S`): per unknown, the modal coefficients …
+    /// The enriched functions' uncut responses `Z = K⁻¹ B`: per unknown, the modal
+    /// coefficients of `Ẑ = Z L⁻ᵀ` (`L` the factor of `S`) …
     z_modal: Vec<Vec<f64>>,
-    /// … and per dof, the rest as `(unknown, value)`. With `Ẑ`, the felt compliance's
-    /// `Wᵀ S⁻¹ W` is `(Ẑᵀ P)ᵀ (Ẑᵀ P)`: the tick reads the few dofs under the tool for every
-    /// unknown at once and solves nothing. Bordering leaves `Ẑ`'s old columns as they are.
+    /// … per dof, the rest of `Z` as `(unknown, value)` …
     z_near: Vec<Vec<(u32, f64)>>,
+    /// … and per dof of a surface node, the rest of `Ẑ`. With `Ẑ`, the felt compliance's
+    /// `Wᵀ S⁻¹ W` is `(Ẑᵀ P)ᵀ (Ẑᵀ P)`: the tick reads the few surface dofs under the tool
+    /// for every unknown at once and solves nothing. Bordering leaves `Ẑ`'s old columns as
+    /// they are.
+    z_hat_surface: Vec<Vec<(u32, f64)>>,
+    /// Per node, its place among the surface nodes, or `u32::MAX` inside.
+    surface_slot: Vec<u32>,
     /// Per unknown, `Xᵀ` of its column of `B`: its products with any response's modal part.
     rows: Vec<Vec<f64>>,
     /// The lower Cholesky factor of `S`, row by row (row `i` holds `i + 1` entries).
@@ -72,6 +78,11 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     /// The uncut organ: `model` gives the mesh, the material and the held nodes, `response`
     /// its uncut solves.
     pub fn new(model: &'m FemModel, response: R) -> Self {
+        let surface = Surface::extract(model.mesh()).nodes;
+        let mut surface_slot = vec![u32::MAX; model.mesh().node_count()];
+        for (k, &n) in surface.iter().enumerate() {
+            surface_slot[n] = k as u32;
+        }
         Self {
             model,
             response,
@@ -81,6 +92,8 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             coupling: Vec::new(),
             z_modal: Vec::new(),
             z_near: vec![Vec::new(); 3 * model.mesh().node_count()],
+            z_hat_surface: vec![Vec::new(); 3 * surface.len()],
+            surface_slot,
             rows: Vec::new(),
             factor: Vec::new(),
         }
@@ -190,8 +203,8 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     }
 
     /// The nodes' displacements from the uncut ones `response`, and the enriched amplitudes in
-    /// the state's order: `q = −S⁻¹ Bᵀ K⁻¹ f`, `u = K⁻¹ f − Z q = K⁻¹ f − Ẑ y` with
-    /// `L y = −Bᵀ K⁻¹ f` and `q = L⁻ᵀ y`.
+    /// the state's order: `q = −S⁻¹ Bᵀ K⁻¹ f`, `u = K⁻¹ f − Z q`, the modal part as `Ẑ y`
+    /// with `L y = −Bᵀ K⁻¹ f` and `q = L⁻ᵀ y`.
     fn condensed(&self, response: Response) -> (Vec<f64>, Vec<f64>) {
         let mut u = vec![0.0; 3 * self.model.mesh().node_count()];
         scatter(&response.near, 1.0, &mut u);
@@ -203,11 +216,12 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         for (z, &yj) in self.z_modal.iter().zip(&y) {
             modal.iter_mut().zip(z).for_each(|(m, a)| *m -= yj * a);
         }
+        let q = self.backward(y);
         for (ud, entries) in u.iter_mut().zip(&self.z_near) {
-            *ud -= entries.iter().map(|&(p, v)| y[p as usize] * v).sum::<f64>();
+            *ud -= entries.iter().map(|&(p, v)| q[p as usize] * v).sum::<f64>();
         }
         self.response.add_spatial(&modal, &mut u);
-        (u, self.backward(y))
+        (u, q)
     }
 
     /// `b_pᵀ K⁻¹ f` for unknown `p` and a response given by its modal coefficients and its
@@ -270,9 +284,10 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     }
 
     /// The felt force from the uncut patch compliance `uncut_m_per_n` (3 × 3): the cut one is
-    /// `C = C₀ + Wᵀ S⁻¹ W` with `W = Bᵀ K⁻¹ P = Zᵀ P` (`K⁻¹` symmetric), read from the
-    /// enriched functions' stored responses at the patch's nodes: no solve, `O(n (p + m) + n²)`
-    /// for `n` unknowns, `p` patch nodes and `m` modes. `None` where the patch does not resist.
+    /// `C = C₀ + Wᵀ S⁻¹ W` with `W = Bᵀ K⁻¹ P = Zᵀ P` (`K⁻¹` symmetric), `Wᵀ S⁻¹ W = Yᵀ Y`
+    /// with `Y = Ẑᵀ P` read at the patch's nodes: no solve, `O(n (p + m))` for `n` unknowns,
+    /// `p` patch nodes and `m` modes. The patch's nodes are surface nodes, as a tool's are (a
+    /// node inside adds nothing). `None` where the patch does not resist.
     pub fn felt_force_over(
         &self,
         patch: &[(usize, f64)],
@@ -293,7 +308,10 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
                     .map(|z| patch_modes[axis].iter().zip(z).map(|(x, m)| x * m).sum())
                     .collect();
                 for &(d, share) in &loads[axis] {
-                    for &(p, v) in &self.z_near[d] {
+                    let Some(entries) = self.surface_entries(d) else {
+                        continue;
+                    };
+                    for &(p, v) in entries {
                         y[p as usize] += share * v;
                     }
                 }
@@ -369,15 +387,16 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         self.border(&columns)?;
         self.functions.extend(added);
         self.coupling.extend(coupling);
-        self.push_hatted(z);
+        self.push_responses(z);
         self.rows.extend(rows);
         Ok(())
     }
 
-    /// Appends the new unknowns' columns of `Ẑ`, their factor rows `l` in place:
-    /// `ẑ_p = (z_p − Σ_{j<p} ẑ_j l_j) / l_p`. The recurrence runs dof by dof (each dof's
-    /// entries are all it reads), so the dofs go in parallel.
-    fn push_hatted(&mut self, z: Vec<Response>) {
+    /// Appends the new unknowns' responses: `Z`'s rest as it is, and `Ẑ`'s modal part and
+    /// surface rest, their factor rows `l` in place: `ẑ_p = (z_p − Σ_{j<p} ẑ_j l_j) / l_p`.
+    /// The recurrence runs dof by dof (each dof's entries are all it reads), so the surface
+    /// dofs go in parallel.
+    fn push_responses(&mut self, z: Vec<Response>) {
         let first = self.z_modal.len();
         let factor = &self.factor;
         let hatted = |value: f64, entries: &[(u32, f64)], p: usize| {
@@ -387,13 +406,16 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
                 .sum();
             (value - reached) / factor[p][p]
         };
-        let mut dense = vec![vec![0.0; z.len()]; self.z_near.len()];
+        let mut dense = vec![vec![0.0; z.len()]; self.z_hat_surface.len()];
         for (r, response) in z.iter().enumerate() {
             for &(d, v) in &response.near {
-                dense[d][r] += v;
+                self.z_near[d].push(((first + r) as u32, v));
+                if let Some(k) = surface_dof(&self.surface_slot, d) {
+                    dense[k][r] += v;
+                }
             }
         }
-        self.z_near
+        self.z_hat_surface
             .par_iter_mut()
             .zip(dense)
             .for_each(|(entries, values)| {
@@ -413,6 +435,11 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             modal.iter_mut().for_each(|m| *m /= factor[p][p]);
             self.z_modal.push(modal);
         }
+    }
+
+    /// `Ẑ`'s rest at dof `d`, if its node is on the surface.
+    fn surface_entries(&self, d: usize) -> Option<&[(u32, f64)]> {
+        surface_dof(&self.surface_slot, d).map(|k| self.z_hat_surface[k].as_slice())
     }
 
     /// `B`'s columns for the new unknowns `first_new..first_new + count`, and the entries of
@@ -519,6 +546,14 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             x[i] = (x[i] - s) / self.factor[i][i];
         }
         x
+    }
+}
+
+/// The place of dof `d` among the surface nodes' dofs, if its node is on the surface.
+fn surface_dof(surface_slot: &[u32], d: usize) -> Option<usize> {
+    match surface_slot[d / 3] {
+        u32::MAX => None,
+        k => Some(3 * k as usize + d % 3),
     }
 }
 
