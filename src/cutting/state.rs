@@ -10,9 +10,9 @@
 //!
 //! `K⁻¹` is the uncut organ's response ([`UncutResponse`]), and `Z = K⁻¹ B` its response to
 //! each enriched function's forces, kept in the response's own form (modal coefficients and a
-//! sparse near field for a cut vademecum, so that nothing here costs a sparse solve) and as
-//! `Ẑ = Z L⁻ᵀ`, `L` the Cholesky factor of `S`, so that the tick's felt force reads it and
-//! solves nothing. A segment only ever adds enriched functions (a longer face enriches the
+//! sparse near field for a cut vademecum, so that nothing here costs a sparse solve) and, at
+//! the surface's dofs, as `Ẑ = Z L⁻ᵀ`, `L` the Cholesky factor of `S`, so that the tick's
+//! felt force reads it and solves nothing. A segment only ever adds enriched functions (a longer face enriches the
 //! nodes its growth cuts whole; a turn starts a face with its own), and the entries between
 //! the functions already there do not change. So a segment appends rows and columns to `S`,
 //! whose factor is extended by bordering (`O(n² k)` for `k` new unknowns on `n`, against
