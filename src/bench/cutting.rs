@@ -13,7 +13,7 @@ use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
 use super::fem::median;
-use crate::cutting::{CutState, Enrichment, ExactResponse, UncutResponse, xfem};
+use crate::cutting::{CutState, Enrichment, ExactResponse, UncutResponse, tool_patch, xfem};
 use crate::fem::{Dirichlet, FemModel, Law, Loads, Material, TISSUE_DENSITY_KG_M3};
 use crate::mesh::box_mesh;
 use crate::pgd::{RegionResponse, RegionSettings, RestStiffness, Silent};
@@ -85,7 +85,7 @@ pub fn run(cells: [usize; 3]) -> Result<CuttingBenchReport, String> {
         RegionResponse::build(&stiffness, &region, &settings, &Silent).map_err(|e| text(&e))?;
     let vademecum_build_s = started.elapsed().as_secs_f64();
     let exact = ExactResponse::new(&model).map_err(|e| text(&e))?;
-    let patch = tool_patch(&model, &top);
+    let patch = beside_the_incisions(&model, &top);
     let (exact, full, unknowns) = cut_with(&model, &loads, &patch, exact, "exact")?;
     let (vademecum, _, _) = cut_with(&model, &loads, &patch, vademecum, "cut vademecum")?;
     Ok(CuttingBenchReport {
@@ -165,18 +165,10 @@ fn time_ticks<R: UncutResponse>(
 
 /// The tool's patch: top nodes within 4 mm of a point beside the incisions' centre, weighted
 /// as the trainer's kernel weighs them.
-fn tool_patch(model: &FemModel, top: &[usize]) -> Vec<(usize, f64)> {
+fn beside_the_incisions(model: &FemModel, top: &[usize]) -> Vec<(usize, f64)> {
+    let positions: Vec<Point3<f64>> = top.iter().map(|&n| model.mesh().nodes()[n]).collect();
     let tool = Point3::new(24.0 * MM, 21.5 * MM, 10.0 * MM);
-    let nodes = model.mesh().nodes();
-    let mut patch: Vec<(usize, f64)> = top
-        .iter()
-        .map(|&n| (n, (nodes[n] - tool).norm() / (4.0 * MM)))
-        .filter(|&(_, d)| d < 1.0)
-        .map(|(n, d)| (n, (1.0 - d * d).powi(2)))
-        .collect();
-    let total: f64 = patch.iter().map(|p| p.1).sum();
-    patch.iter_mut().for_each(|p| p.1 /= total);
-    patch
+    tool_patch(top, &positions, tool, 4.0 * MM)
 }
 
 /// The `q`-quantile of `samples`.

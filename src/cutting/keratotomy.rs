@@ -220,7 +220,7 @@ pub fn incision(
 }
 
 /// The anterior and posterior spheres' radii (m), about the cornea's centre of curvature.
-const ANTERIOR_RADIUS_M: f64 = CORNEA_CURVATURE_M + CORNEA_THICKNESS_M / 2.0;
+pub const ANTERIOR_RADIUS_M: f64 = CORNEA_CURVATURE_M + CORNEA_THICKNESS_M / 2.0;
 const POSTERIOR_RADIUS_M: f64 = CORNEA_CURVATURE_M - CORNEA_THICKNESS_M / 2.0;
 
 /// The boundary nodes on the sphere of `radius_m` (within a hundredth of the thickness).

@@ -20,8 +20,8 @@ pub use incision::{CutFace, Extent, Incision, MIN_SEGMENT_M};
 pub use response::{ExactResponse, Response, UncutResponse};
 pub use state::CutState;
 pub use validation::{
-    CutCase, CutPattern, CutValidationReport, CutValidationSettings, validate_incisions,
-    validate_keratotomy,
+    CutCase, CutPattern, CutValidationReport, CutValidationSettings, tool_patch,
+    validate_incisions, validate_keratotomy,
 };
 pub use xfem::CutSolution;
 

@@ -12,9 +12,9 @@
 //! each enriched function's forces, kept in the response's own form (modal coefficients and a
 //! sparse near field for a cut vademecum, so that nothing here costs a sparse solve) and, at
 //! the surface's dofs, as `Ẑ = Z L⁻ᵀ`, `L` the Cholesky factor of `S`, so that the tick's
-//! felt force reads it and solves nothing. A segment only ever adds enriched functions (a longer face enriches the
-//! nodes its growth cuts whole; a turn starts a face with its own), and the entries between
-//! the functions already there do not change. So a segment appends rows and columns to `S`,
+//! felt force reads it and solves nothing. A segment only ever adds enriched functions (a
+//! longer face enriches the nodes its growth cuts whole; a turn starts a face with its own),
+//! and the entries between the functions already there do not change. So a segment appends rows and columns to `S`,
 //! whose factor is extended by bordering (`O(n² k)` for `k` new unknowns on `n`, against
 //! `O(n³)` for a new factorization), and columns to `Ẑ`, whose old ones bordering leaves as
 //! they are.
@@ -30,7 +30,7 @@ use super::incision::{CutFace, Incision};
 use super::response::{Response, UncutResponse};
 use super::xfem::{CutSolution, element_functions, piece_weights};
 use crate::fem::{FemModel, PRESCRIBED};
-use crate::mesh::Surface;
+use crate::mesh::{NOT_ON_SURFACE, Surface};
 
 /// A sparse column of `B`: the nodes' own dofs it couples to, with the entries.
 type SparseColumn = Vec<(usize, f64)>;
@@ -66,8 +66,8 @@ pub struct CutState<'m, R: UncutResponse> {
     /// for every unknown at once and solves nothing. Bordering leaves `Ẑ`'s old columns as
     /// they are.
     z_hat_surface: Vec<Vec<(u32, f64)>>,
-    /// Per node, its place among the surface nodes, or `u32::MAX` inside.
-    surface_slot: Vec<u32>,
+    /// Per node, its place among the surface nodes, or [`NOT_ON_SURFACE`].
+    surface_index_of: Vec<usize>,
     /// Per unknown, `Xᵀ` of its column of `B`: its products with any response's modal part.
     rows: Vec<Vec<f64>>,
     /// The lower Cholesky factor of `S`, row by row (row `i` holds `i + 1` entries).
@@ -78,11 +78,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     /// The uncut organ: `model` gives the mesh, the material and the held nodes, `response`
     /// its uncut solves.
     pub fn new(model: &'m FemModel, response: R) -> Self {
-        let surface = Surface::extract(model.mesh()).nodes;
-        let mut surface_slot = vec![u32::MAX; model.mesh().node_count()];
-        for (k, &n) in surface.iter().enumerate() {
-            surface_slot[n] = k as u32;
-        }
+        let surface = Surface::extract(model.mesh());
         Self {
             model,
             response,
@@ -92,8 +88,8 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             coupling: Vec::new(),
             z_modal: Vec::new(),
             z_near: vec![Vec::new(); 3 * model.mesh().node_count()],
-            z_hat_surface: vec![Vec::new(); 3 * surface.len()],
-            surface_slot,
+            z_hat_surface: vec![Vec::new(); 3 * surface.nodes.len()],
+            surface_index_of: surface.surface_index_of,
             rows: Vec::new(),
             factor: Vec::new(),
         }
@@ -410,7 +406,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         for (r, response) in z.iter().enumerate() {
             for &(d, v) in &response.near {
                 self.z_near[d].push(((first + r) as u32, v));
-                if let Some(k) = surface_dof(&self.surface_slot, d) {
+                if let Some(k) = surface_dof(&self.surface_index_of, d) {
                     dense[k][r] += v;
                 }
             }
@@ -439,7 +435,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
 
     /// `Ẑ`'s rest at dof `d`, if its node is on the surface.
     fn surface_entries(&self, d: usize) -> Option<&[(u32, f64)]> {
-        surface_dof(&self.surface_slot, d).map(|k| self.z_hat_surface[k].as_slice())
+        surface_dof(&self.surface_index_of, d).map(|k| self.z_hat_surface[k].as_slice())
     }
 
     /// `B`'s columns for the new unknowns `first_new..first_new + count`, and the entries of
@@ -550,10 +546,10 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
 }
 
 /// The place of dof `d` among the surface nodes' dofs, if its node is on the surface.
-fn surface_dof(surface_slot: &[u32], d: usize) -> Option<usize> {
-    match surface_slot[d / 3] {
-        u32::MAX => None,
-        k => Some(3 * k as usize + d % 3),
+fn surface_dof(surface_index_of: &[usize], d: usize) -> Option<usize> {
+    match surface_index_of[d / 3] {
+        NOT_ON_SURFACE => None,
+        k => Some(3 * k + d % 3),
     }
 }
 

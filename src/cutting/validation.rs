@@ -11,12 +11,12 @@ use serde::Serialize;
 
 use super::enrichment::Enrichment;
 use super::incision::CutFace;
-use super::keratotomy::{Cornea, INCISION_END_M, anterior_nodes, incision};
+use super::keratotomy::{ANTERIOR_RADIUS_M, Cornea, INCISION_END_M, anterior_nodes, incision};
 use super::response::{ExactResponse, Response, UncutResponse};
 use super::state::CutState;
 use super::{CutError, xfem};
-use crate::fem::{FemModel, Loads};
-use crate::mesh::organs::{CORNEA_CURVATURE_M, CORNEA_THICKNESS_M, region};
+use crate::fem::{FemModel, Loads, patch_weight};
+use crate::mesh::organs::{CORNEA_CURVATURE_M, region};
 use crate::mesh::{Surface, TetMesh};
 use crate::pgd::Statistics;
 
@@ -311,11 +311,12 @@ fn cornea_tool(cornea: &Cornea, angle_rad: f64, from_m: f64) -> (Vec<(usize, f64
     let (radius_m, offset_m, press_m) = CORNEA_TOOL_M;
     let r = 0.5 * (from_m + INCISION_END_M);
     let turned = angle_rad + offset_m / r;
-    let anterior = CORNEA_CURVATURE_M + CORNEA_THICKNESS_M / 2.0;
-    let z = (anterior * anterior - r * r).sqrt() - CORNEA_CURVATURE_M;
+    let z = (ANTERIOR_RADIUS_M * ANTERIOR_RADIUS_M - r * r).sqrt() - CORNEA_CURVATURE_M;
     let tool = Point3::new(r * turned.cos(), r * turned.sin(), z);
     let centre = Point3::new(0.0, 0.0, -CORNEA_CURVATURE_M);
-    let patch = patch_around(mesh, &anterior_nodes(mesh), tool, radius_m);
+    let nodes = anterior_nodes(mesh);
+    let positions: Vec<Point3<f64>> = nodes.iter().map(|&n| mesh.nodes()[n]).collect();
+    let patch = tool_patch(&nodes, &positions, tool, radius_m);
     (patch, (centre - tool).normalize() * press_m)
 }
 
@@ -390,7 +391,7 @@ impl AccessibleFace {
             ));
         }
         let (centre, normal) = tool.expect("at least one incision");
-        let patch = patch_around_points(&self.nodes, &self.positions, centre, ORGAN_TOOL_M.0);
+        let patch = tool_patch(&self.nodes, &self.positions, centre, ORGAN_TOOL_M.0);
         let mut loads = Loads::new(self.node_count);
         for &(n, share) in &patch {
             let force = -normal * share;
@@ -415,19 +416,10 @@ impl AccessibleFace {
     }
 }
 
-/// The tool's patch: `candidates` within `radius_m` of `centre`, with shares falling smoothly
-/// to zero at the rim (as the trainer's kernel weighs them), summing to one.
-fn patch_around(
-    mesh: &TetMesh,
-    candidates: &[usize],
-    centre: Point3<f64>,
-    radius_m: f64,
-) -> Vec<(usize, f64)> {
-    let positions: Vec<Point3<f64>> = candidates.iter().map(|&n| mesh.nodes()[n]).collect();
-    patch_around_points(candidates, &positions, centre, radius_m)
-}
-
-fn patch_around_points(
+/// A tool's patch: the `nodes` (at `positions`) within `radius_m` of `centre`, with shares
+/// falling smoothly to zero at the rim as the trainer's kernel weighs them
+/// ([`patch_weight`]), summing to one.
+pub fn tool_patch(
     nodes: &[usize],
     positions: &[Point3<f64>],
     centre: Point3<f64>,
@@ -436,9 +428,8 @@ fn patch_around_points(
     let mut patch: Vec<(usize, f64)> = nodes
         .iter()
         .zip(positions)
-        .map(|(&n, p)| (n, (p - centre).norm() / radius_m))
-        .filter(|&(_, d)| d < 1.0)
-        .map(|(n, d)| (n, (1.0 - d * d).powi(2)))
+        .map(|(&n, p)| (n, patch_weight(1.0, (p - centre).norm(), radius_m)))
+        .filter(|&(_, w)| w > 0.0)
         .collect();
     let total: f64 = patch.iter().map(|p| p.1).sum();
     patch.iter_mut().for_each(|p| p.1 /= total);

@@ -493,14 +493,7 @@ fn random_keratotomies_made_online_equal_full_xfem() {
         seed: 7,
         segments: 3,
     };
-    let report = validate_keratotomy(&cornea, &exact, &validation).unwrap();
-    assert_eq!(report.failed, 0, "{report:#?}");
-    assert!(
-        report.cases.iter().all(|c| c.unknowns > 0),
-        "nothing was cut"
-    );
-    assert!(report.cut_l2_error.max < 1e-9, "{:?}", report.cut_l2_error);
-    assert!(report.force_error.max < 1e-9, "{:?}", report.force_error);
+    equals_full_xfem(&validate_keratotomy(&cornea, &exact, &validation).unwrap());
 }
 
 /// Three straight incisions into the liver's anterior face at random places, made online in
@@ -524,7 +517,12 @@ fn random_liver_incisions_made_online_equal_full_xfem() {
         seed: 3,
         segments: 3,
     };
-    let report = validate_incisions(&model, &exact, &validation).unwrap();
+    equals_full_xfem(&validate_incisions(&model, &exact, &validation).unwrap());
+}
+
+/// Every pattern was served and cut something, its field and felt force within 1e-9 of full
+/// X-FEM.
+fn equals_full_xfem(report: &pgd_surgery::cutting::CutValidationReport) {
     assert_eq!(report.failed, 0, "{report:#?}");
     assert!(
         report.cases.iter().all(|c| c.unknowns > 0),
