@@ -48,6 +48,33 @@ impl Dirichlet {
         Ok(())
     }
 
+    /// Prescribes one component (0 = x, 1 = y, 2 = z) of a node's displacement (m), leaving
+    /// the others free: a roller on a plane of symmetry.
+    pub fn prescribe_component(
+        &mut self,
+        node: usize,
+        component: usize,
+        displacement_m: f64,
+    ) -> Result<(), FemError> {
+        let nodes = self.values.len() / 3;
+        if node >= nodes {
+            return Err(FemError::NodeOutOfRange { node, nodes });
+        }
+        if component > 2 || !displacement_m.is_finite() {
+            return Err(FemError::InvalidInput {
+                what: "prescribed displacement component",
+                value: if component > 2 {
+                    component as f64
+                } else {
+                    displacement_m
+                },
+                problem: "not a component 0-2 with a finite value",
+            });
+        }
+        self.values[3 * node + component] = Some(displacement_m);
+        Ok(())
+    }
+
     pub fn value(&self, dof: usize) -> Option<f64> {
         self.values[dof]
     }

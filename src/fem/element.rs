@@ -1,11 +1,15 @@
 //! The linear tetrahedron: constant shape-function gradients, and the element force and
-//! stiffness of both material laws.
+//! stiffness of every material law.
 //!
 //! With `g_a = ∇N_a` and `F = I + Σ_a u_a ⊗ g_a`, the Kirchhoff–Saint Venant element gives
 //! `f_a = V · P g_a`, with `P = F S`, `S = λ tr(E) I + 2μ E`, `E = ½(FᵀF − I)`, and the
 //! consistent tangent block
 //! `K_ab = V [ (g_a·S g_b) I + λ (F g_a)(F g_b)ᵀ + μ (g_a·g_b) F Fᵀ + μ (F g_b)(F g_a)ᵀ ]`.
 //! At `F = I` this is the linear-elastic block `V [λ g_a g_bᵀ + μ g_b g_aᵀ + μ (g_a·g_b) I]`.
+//!
+//! The compressible neo-Hookean element has `P = μ (F − F⁻ᵀ) + λ ln J F⁻ᵀ` and the tangent
+//! `∂P_iJ/∂F_kL = μ δ_ik δ_JL + (μ − λ ln J) F⁻¹_Jk F⁻¹_Li + λ F⁻¹_Ji F⁻¹_Lk`, whose blocks
+//! reduce to the same linear-elastic block at `F = I`.
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
@@ -69,23 +73,21 @@ impl TetGeometry {
                 (k * u, k)
             }
             Law::KirchhoffSaintVenant => self.ksv_force_and_tangent(lambda, mu, u),
+            Law::NeoHookean => self.neo_hookean_force_and_tangent(lambda, mu, u),
         }
     }
 
-    /// Internal force only, for residual evaluations in line searches.
+    /// Internal force only, for residual evaluations in line searches. Non-finite for a
+    /// neo-Hookean element turned inside out (J ≤ 0), where the energy is infinite.
     pub fn force(&self, law: Law, lambda: f64, mu: f64, u: &ElementVector) -> ElementVector {
         match law {
             Law::Linear => self.linear_stiffness(lambda, mu) * u,
-            Law::KirchhoffSaintVenant => {
-                let (f, s) = self.ksv_stress(lambda, mu, u);
-                self.nodal_forces(&(f * s))
-            }
+            _ => self.nodal_forces(&self.first_piola(law, lambda, mu, u)),
         }
     }
 
-    /// The KSV internal force minus the linear one, `f_KSV(u) − K_e u`: the nonlinear terms
-    /// that the load-step scheme of paper 000 moves to the right-hand side. Zero for the
-    /// linear law.
+    /// The internal force minus the linear one, `f(u) − K_e u`: the nonlinear terms that the
+    /// load-step scheme of paper 000 moves to the right-hand side. Zero for the linear law.
     pub fn nonlinear_force(
         &self,
         law: Law,
@@ -93,15 +95,24 @@ impl TetGeometry {
         mu: f64,
         u: &ElementVector,
     ) -> ElementVector {
+        if law == Law::Linear {
+            return ElementVector::zeros();
+        }
+        let h = self.displacement_gradient(u);
+        let strain = (h + h.transpose()) * 0.5;
+        let linear = Matrix3::identity() * (lambda * strain.trace()) + strain * (2.0 * mu);
+        self.nodal_forces(&(self.first_piola(law, lambda, mu, u) - linear))
+    }
+
+    /// First Piola–Kirchhoff stress `P` of a nonlinear law at the element's displacement.
+    fn first_piola(&self, law: Law, lambda: f64, mu: f64, u: &ElementVector) -> Matrix3<f64> {
         match law {
-            Law::Linear => ElementVector::zeros(),
+            Law::Linear => unreachable!("the linear law has no separate stress path"),
             Law::KirchhoffSaintVenant => {
                 let (f, s) = self.ksv_stress(lambda, mu, u);
-                let h = self.displacement_gradient(u);
-                let strain = (h + h.transpose()) * 0.5;
-                let linear = Matrix3::identity() * (lambda * strain.trace()) + strain * (2.0 * mu);
-                self.nodal_forces(&(f * s - linear))
+                f * s
             }
+            Law::NeoHookean => neo_hookean_stress(lambda, mu, &self.displacement_gradient(u)).0,
         }
     }
 
@@ -137,6 +148,30 @@ impl TetGeometry {
         let f = Matrix3::identity() + h;
         let s = Matrix3::identity() * (lambda * e.trace()) + e * (2.0 * mu);
         (f, s)
+    }
+
+    /// The neo-Hookean force and its tangent block
+    /// `K_ab = V [μ (g_a·g_b) I + (μ − λ ln J) c_b c_aᵀ + λ c_a c_bᵀ]`, `c = F⁻ᵀ g`.
+    fn neo_hookean_force_and_tangent(
+        &self,
+        lambda: f64,
+        mu: f64,
+        u: &ElementVector,
+    ) -> (ElementVector, ElementMatrix) {
+        let (p, inverse_t, log_j) = neo_hookean_stress(lambda, mu, &self.displacement_gradient(u));
+        let force = self.nodal_forces(&p);
+        let c: [Vector3<f64>; 4] = self.grads.map(|g| inverse_t * g);
+        let mut k = ElementMatrix::zeros();
+        for a in 0..4 {
+            for b in 0..4 {
+                let block = Matrix3::identity() * (mu * self.grads[a].dot(&self.grads[b]))
+                    + (c[b] * c[a].transpose()) * (mu - lambda * log_j)
+                    + (c[a] * c[b].transpose()) * lambda;
+                k.fixed_view_mut::<3, 3>(3 * a, 3 * b)
+                    .copy_from(&(block * self.volume_m3));
+            }
+        }
+        (force, k)
     }
 
     /// `f_a = V · P g_a` for a first Piola–Kirchhoff stress `P`.
@@ -175,4 +210,25 @@ impl TetGeometry {
         }
         (force, k)
     }
+}
+
+/// Neo-Hookean `P`, `F⁻ᵀ` and `ln J` for the displacement gradient `h`. An element turned
+/// inside out (J ≤ 0) has infinite energy: its stress is NaN, which a line search backs off from.
+///
+/// `F − F⁻ᵀ` and `ln J` are formed from `h` directly (`F⁻¹ − I = −h F⁻¹`, and `J − 1` from the
+/// invariants of `h`): differences of numbers near 1 would cancel catastrophically for small
+/// strains and put a floor under Newton's relative residual.
+fn neo_hookean_stress(lambda: f64, mu: f64, h: &Matrix3<f64>) -> (Matrix3<f64>, Matrix3<f64>, f64) {
+    let f = Matrix3::identity() + h;
+    let trace = h.trace();
+    let j_minus_one = trace + 0.5 * (trace * trace - (h * h).trace()) + h.determinant();
+    let Some(inverse) = f.try_inverse().filter(|_| j_minus_one > -1.0) else {
+        let nan = Matrix3::from_element(f64::NAN);
+        return (nan, nan, f64::NAN);
+    };
+    let log_j = j_minus_one.ln_1p();
+    let inverse_t = inverse.transpose();
+    let f_minus_inverse_t = h + (h * inverse).transpose();
+    let p = f_minus_inverse_t * mu + inverse_t * (lambda * log_j);
+    (p, inverse_t, log_j)
 }

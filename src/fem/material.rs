@@ -13,6 +13,21 @@ pub enum Law {
     /// exact under large rotations. It stiffens under stretch and softens (and finally loses
     /// stability) under strong compression.
     KirchhoffSaintVenant,
+    /// Compressible neo-Hookean, `ψ = μ/2 (I₁ − 3) − μ ln J + λ/2 (ln J)²`: the same small-strain
+    /// limit as the linear law, stable at any compression (the energy grows without bound as
+    /// an element's volume goes to zero) and stiffening as tissue is pressed.
+    NeoHookean,
+}
+
+impl Law {
+    /// The name the command line and reports use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Law::Linear => "linear",
+            Law::KirchhoffSaintVenant => "ksv",
+            Law::NeoHookean => "neo-hookean",
+        }
+    }
 }
 
 /// An isotropic elastic material in SI units.

@@ -1,11 +1,13 @@
-//! The finite-element core: linear tetrahedra, isotropic linear elasticity and
-//! Kirchhoff–Saint Venant, sparse assembly, loads, mass, and static solvers. Plain Rust on
-//! faer and nalgebra, no Bevy: the offline PGD builder and every validation stand on it.
+//! The finite-element core: linear tetrahedra, isotropic linear elasticity, Kirchhoff–Saint
+//! Venant and neo-Hookean tissue, sparse assembly, loads, mass, static solvers, and indentation
+//! by a rigid sphere. Plain Rust on faer and nalgebra, no Bevy: the offline PGD builder and
+//! every validation stand on it.
 
 mod dofs;
 mod element;
 mod error;
 mod inclusion;
+mod indentation;
 mod linear_solver;
 mod loads;
 mod mass;
@@ -18,6 +20,7 @@ pub use dofs::{Dirichlet, DofMap, PRESCRIBED};
 pub use element::{ElementMatrix, ElementVector, TetGeometry};
 pub use error::FemError;
 pub use inclusion::Inclusion;
+pub use indentation::{ForceDepthPoint, Indentation, IndentationSettings, SphereIndenter};
 pub use linear_solver::{DirectSolver, Factorization};
 pub use loads::{Loads, PatchKernel, on_pressed_side, patch_weight};
 pub use mass::{consistent_mass, lumped_mass};

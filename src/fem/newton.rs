@@ -10,6 +10,23 @@ use super::linear_solver::DirectSolver;
 use super::{FemError, FemModel, Loads};
 use crate::dense_sums::dot;
 
+/// Halvings of a Newton step allowed to keep every element's volume positive (2⁻³⁰ ≈ 1e-9).
+const MAX_HALVINGS: usize = 30;
+
+/// A conservative force on the body beside its elastic one, such as a rigid tool's contact.
+/// It is added to the internal force as the body's resistance (a force pushing the body enters
+/// with a minus sign), and its derivative to the tangent over free dofs.
+pub(super) trait ExtraForce {
+    fn add(&self, model: &FemModel, u_m: &[f64], force: &mut [f64], tangent: Option<&mut [f64]>);
+}
+
+/// The plain elastic problem.
+struct NoExtraForce;
+
+impl ExtraForce for NoExtraForce {
+    fn add(&self, _: &FemModel, _: &[f64], _: &mut [f64], _: Option<&mut [f64]>) {}
+}
+
 /// How a static solve proceeds.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NewtonSettings {
@@ -81,7 +98,8 @@ impl FemModel {
         let mut steps = Vec::with_capacity(settings.load_steps);
         for step in 1..=settings.load_steps {
             let factor = step as f64 / settings.load_steps as f64;
-            let report = self.load_step(&mut solver, &mut u, loads, factor, step, settings)?;
+            let this = (step, settings.load_steps);
+            let report = self.load_step(&mut solver, &mut u, loads, factor, this, settings)?;
             steps.push(report);
         }
         Ok(StaticSolution {
@@ -96,7 +114,7 @@ impl FemModel {
         u: &mut [f64],
         loads: &Loads,
         factor: f64,
-        step: usize,
+        step: (usize, usize),
         settings: &NewtonSettings,
     ) -> Result<StepReport, FemError> {
         let f_ext: Vec<f64> = loads.as_slice().iter().map(|f| f * factor).collect();
@@ -104,18 +122,33 @@ impl FemModel {
         for dof in (0..u.len()).filter(|&d| self.dirichlet().value(d).is_some()) {
             u[dof] = prescribed[dof];
         }
+        self.equilibrate(solver, u, &f_ext, &NoExtraForce, step, settings)
+    }
+
+    /// Newton iterations from `u` (prescribed dofs already set) to `f_int(u) + extra(u) = f_ext`.
+    /// `step` is (this load step, all of them), for error messages.
+    pub(super) fn equilibrate(
+        &self,
+        solver: &mut DirectSolver,
+        u: &mut [f64],
+        f_ext: &[f64],
+        extra: &dyn ExtraForce,
+        (step, steps): (usize, usize),
+        settings: &NewtonSettings,
+    ) -> Result<StepReport, FemError> {
         let mut report = StepReport {
             relative_residuals: Vec::new(),
             step_lengths: Vec::new(),
         };
         for iteration in 0..=settings.max_iterations {
-            let (f_int, tangent) = self.force_and_tangent(u);
-            let (residual, relative) = self.residual(&f_ext, &f_int);
+            let (mut f_int, mut tangent) = self.force_and_tangent(u);
+            extra.add(self, u, &mut f_int, Some(&mut tangent));
+            let (residual, relative) = self.residual(f_ext, &f_int);
             report.relative_residuals.push(relative);
             if !relative.is_finite() {
                 return Err(FemError::NonFiniteSolution {
                     step,
-                    steps: settings.load_steps,
+                    steps,
                     iteration,
                 });
             }
@@ -129,12 +162,12 @@ impl FemModel {
             solver
                 .cholesky_or_lu(&self.pattern().matrix(tangent))?
                 .solve_in_place(&mut du);
-            let length = self.line_search(u, &du, &f_ext, &residual, settings);
+            let length = self.line_search(u, &du, (f_ext, extra), &residual, settings);
             report.step_lengths.push(length);
         }
         Err(FemError::NewtonNotConverged {
             step,
-            steps: settings.load_steps,
+            steps,
             iterations: settings.max_iterations,
             relative_residual: *report.relative_residuals.last().unwrap_or(&f64::NAN),
             tolerance: settings.relative_tolerance,
@@ -146,7 +179,7 @@ impl FemModel {
         &self,
         u: &mut [f64],
         du: &[f64],
-        f_ext: &[f64],
+        (f_ext, extra): (&[f64], &dyn ExtraForce),
         r0: &[f64],
         settings: &NewtonSettings,
     ) -> f64 {
@@ -155,12 +188,23 @@ impl FemModel {
             for (free, &dof) in self.dofs().free_dofs.iter().enumerate() {
                 u[dof] = start[dof] + alpha * du[free];
             }
-            let (r, _) = self.residual(f_ext, &self.internal_force(u));
+            let mut f_int = self.internal_force(u);
+            extra.add(self, u, &mut f_int, None);
+            let (r, _) = self.residual(f_ext, &f_int);
             dot(du, &r)
         };
         let g0 = dot(du, r0);
         let mut alpha = 1.0;
         let mut g = slope_at(u, alpha);
+        // A step that turns an element inside out (infinite neo-Hookean energy) is halved until
+        // every element keeps a positive volume.
+        for _ in 0..MAX_HALVINGS {
+            if g.is_finite() {
+                break;
+            }
+            alpha *= 0.5;
+            g = slope_at(u, alpha);
+        }
         // G(0) ≤ 0 means an indefinite tangent gave no descent direction: take the full step.
         for _ in 0..settings.max_line_search_iterations {
             if g0 <= 0.0 || g >= 0.0 || g.abs() <= 0.5 * g0 {

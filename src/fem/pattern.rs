@@ -76,6 +76,28 @@ impl FreePattern {
         }
     }
 
+    /// Adds a 3×3 block coupling node `node` with itself into `values` (a force that acts on
+    /// single nodes, such as a rigid tool's contact), skipping prescribed dofs.
+    pub fn add_node_block(
+        &self,
+        dofs: &DofMap,
+        node: usize,
+        block: &nalgebra::Matrix3<f64>,
+        values: &mut [f64],
+    ) {
+        let (col_ptr, row_idx) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
+        let free: [usize; 3] = std::array::from_fn(|c| dofs.free_index[3 * node + c]);
+        for (j, &col) in free.iter().enumerate().filter(|(_, c)| **c != PRESCRIBED) {
+            let column = &row_idx[col_ptr[col]..col_ptr[col + 1]];
+            for (i, &row) in free.iter().enumerate().filter(|(_, r)| **r != PRESCRIBED) {
+                let offset = column
+                    .binary_search(&row)
+                    .expect("the pattern holds every pair of a node's own dofs");
+                values[col_ptr[col] + offset] += block[(i, j)];
+            }
+        }
+    }
+
     /// Wraps values into a faer matrix (copies the pattern, which is cheap next to a solve).
     pub fn matrix(&self, values: Vec<f64>) -> SparseColMat<usize, f64> {
         SparseColMat::new(self.symbolic.clone(), values)

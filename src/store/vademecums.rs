@@ -76,10 +76,7 @@ impl VademecumSpec {
 
     /// The command a user runs to build it (options left at their defaults are left out).
     pub fn build_command(&self) -> String {
-        let law = match self.law {
-            Law::Linear => "linear",
-            Law::KirchhoffSaintVenant => "ksv",
-        };
+        let law = self.law.name();
         let source = match &self.source {
             OrganSource::Generated(organ) => organ.name().to_owned(),
             OrganSource::File(path) => path.display().to_string(),

@@ -5,7 +5,7 @@ use pgd_surgery::fem::{Law, NewtonSettings};
 use crate::beams::{LENGTH_M, cantilever};
 
 /// A deterministic pseudo-random sequence in [−1, 1] (no rand dependency for tests).
-fn pseudo_random(seed: u64, len: usize) -> Vec<f64> {
+pub fn pseudo_random(seed: u64, len: usize) -> Vec<f64> {
     let mut state = seed;
     (0..len)
         .map(|_| {

@@ -7,5 +7,6 @@ mod cantilever;
 mod inclusion;
 mod ksv;
 mod loads_and_mass;
+mod neo_hookean;
 mod patch;
 mod surface;

@@ -180,8 +180,12 @@ impl MeshArgs {
 pub enum LawArg {
     /// Linear elasticity: one load step.
     Linear,
-    /// Kirchhoff–Saint Venant by load steps: stiffens as the tool presses deeper.
+    /// Kirchhoff–Saint Venant by load steps: exact under large rotations, but it softens and
+    /// loses stability under strong compression.
     Ksv,
+    /// Compressible neo-Hookean by load steps: stable at any compression, stiffens as the
+    /// tool presses deeper.
+    NeoHookean,
 }
 
 impl LawArg {
@@ -189,6 +193,7 @@ impl LawArg {
         match self {
             LawArg::Linear => Law::Linear,
             LawArg::Ksv => Law::KirchhoffSaintVenant,
+            LawArg::NeoHookean => Law::NeoHookean,
         }
     }
 }

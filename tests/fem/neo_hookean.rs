@@ -1,0 +1,196 @@
+//! The compressible neo-Hookean law against exact homogeneous solutions (uniaxial stretch and
+//! compression, simple shear) and its tangent against finite differences.
+
+use nalgebra::Matrix3;
+use pgd_surgery::fem::{Dirichlet, FemModel, Law, Loads, Material, NewtonSettings, PRESCRIBED};
+use pgd_surgery::mesh::{TetMesh, box_mesh};
+
+use crate::beams::cantilever;
+use crate::ksv::pseudo_random;
+
+const SIDE_M: f64 = 0.02;
+const YOUNG_PA: f64 = 4.0e3;
+const POISSON: f64 = 0.45;
+
+fn lame() -> (f64, f64) {
+    let mu = YOUNG_PA / (2.0 * (1.0 + POISSON));
+    let lambda = YOUNG_PA * POISSON / ((1.0 + POISSON) * (1.0 - 2.0 * POISSON));
+    (lambda, mu)
+}
+
+/// `P = μ (F − F⁻ᵀ) + λ ln J F⁻ᵀ`, written out independently of the element code.
+fn first_piola(f: &Matrix3<f64>) -> Matrix3<f64> {
+    let (lambda, mu) = lame();
+    let inverse_t = f.try_inverse().unwrap().transpose();
+    (f - inverse_t) * mu + inverse_t * (lambda * f.determinant().ln())
+}
+
+fn cube() -> TetMesh {
+    box_mesh([SIDE_M; 3], [3, 3, 3]).unwrap()
+}
+
+fn solve(mesh: TetMesh, dirichlet: Dirichlet, load_steps: usize) -> (FemModel, Vec<f64>) {
+    let material = Material::new(Law::NeoHookean, YOUNG_PA, POISSON, 1000.0).unwrap();
+    let model = FemModel::new(mesh, material, dirichlet).unwrap();
+    let settings = NewtonSettings {
+        load_steps,
+        relative_tolerance: 1e-12,
+        ..NewtonSettings::default()
+    };
+    let loads = Loads::new(model.mesh().node_count());
+    let u = model
+        .solve_static(&loads, &settings)
+        .unwrap()
+        .displacement_m;
+    (model, u)
+}
+
+/// Sum of the internal forces over a set of nodes: the reaction the constraints there carry.
+fn reaction(model: &FemModel, u: &[f64], nodes: &[usize]) -> [f64; 3] {
+    let force = model.internal_force(u);
+    [0, 1, 2].map(|c| nodes.iter().map(|&n| force[3 * n + c]).sum())
+}
+
+/// The lateral stretch that leaves the sides of a bar stretched by `axial` free of stress:
+/// `μ (t − 1/t) + λ ln(axial t²) / t = 0`, by bisection (the left side increases with t).
+fn lateral_stretch(axial: f64) -> f64 {
+    let (lambda, mu) = lame();
+    let stress = |t: f64| mu * (t - 1.0 / t) + lambda * (axial * t * t).ln() / t;
+    let (mut low, mut high) = (0.2, 2.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (low + high);
+        if stress(mid) > 0.0 {
+            high = mid;
+        } else {
+            low = mid;
+        }
+    }
+    0.5 * (low + high)
+}
+
+/// A cube on rollers at x = 0, y = 0, z = 0, its face x = L moved to stretch it by `axial`.
+fn uniaxial(axial: f64) {
+    let mesh = cube();
+    let mut dirichlet = Dirichlet::new(mesh.node_count());
+    for (axis, side) in ["x0", "y0", "z0"].into_iter().enumerate() {
+        for &n in mesh.node_set(side).unwrap() {
+            dirichlet.prescribe_component(n, axis, 0.0).unwrap();
+        }
+    }
+    let pulled = mesh.node_set("x1").unwrap().to_vec();
+    for &n in &pulled {
+        dirichlet
+            .prescribe_component(n, 0, (axial - 1.0) * SIDE_M)
+            .unwrap();
+    }
+    let (model, u) = solve(mesh, dirichlet, 4);
+
+    let lateral = lateral_stretch(axial);
+    let mut worst: f64 = 0.0;
+    for (n, x) in model.mesh().nodes().iter().enumerate() {
+        let exact = [
+            (axial - 1.0) * x[0],
+            (lateral - 1.0) * x[1],
+            (lateral - 1.0) * x[2],
+        ];
+        for c in 0..3 {
+            worst = worst.max((u[3 * n + c] - exact[c]).abs());
+        }
+    }
+    let stretch = (lateral - 1.0).abs().max((axial - 1.0).abs()) * SIDE_M;
+    assert!(
+        worst <= 1e-9 * stretch,
+        "stretch {axial}: displacement off the exact field by {worst:e} m"
+    );
+    let f = Matrix3::from_diagonal(&nalgebra::Vector3::new(axial, lateral, lateral));
+    let exact_force = first_piola(&f)[(0, 0)] * SIDE_M * SIDE_M;
+    let force = reaction(&model, &u, &pulled)[0];
+    assert!(
+        (force - exact_force).abs() <= 1e-8 * exact_force.abs(),
+        "stretch {axial}: end force {force} N, exact {exact_force} N"
+    );
+}
+
+#[test]
+fn uniaxial_stretch_matches_the_exact_homogeneous_solution() {
+    uniaxial(1.3);
+}
+
+#[test]
+fn uniaxial_compression_to_sixty_percent_matches_the_exact_solution() {
+    uniaxial(0.6);
+}
+
+#[test]
+fn simple_shear_matches_the_exact_homogeneous_solution() {
+    let gamma = 0.4;
+    let mesh = cube();
+    let surface: Vec<usize> = (0..mesh.node_count())
+        .filter(|&n| {
+            let x = mesh.nodes()[n];
+            (0..3).any(|c| x[c].abs() < 1e-12 || (x[c] - SIDE_M).abs() < 1e-12)
+        })
+        .collect();
+    let mut dirichlet = Dirichlet::new(mesh.node_count());
+    for &n in &surface {
+        let y = mesh.nodes()[n][1];
+        dirichlet.prescribe(n, [gamma * y, 0.0, 0.0]).unwrap();
+    }
+    let top = mesh.node_set("y1").unwrap().to_vec();
+    let (model, u) = solve(mesh, dirichlet, 2);
+
+    for (n, x) in model.mesh().nodes().iter().enumerate() {
+        let error = (u[3 * n] - gamma * x[1]).abs() + u[3 * n + 1].abs() + u[3 * n + 2].abs();
+        assert!(
+            error <= 1e-12,
+            "node {n} off the affine shear by {error:e} m"
+        );
+    }
+    // With J = 1, P e_y = (μγ, 0, 0): the top carries a shear force μγL² and no normal force.
+    let f = Matrix3::new(1.0, gamma, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+    let exact = first_piola(&f) * nalgebra::Vector3::y() * SIDE_M * SIDE_M;
+    let force = reaction(&model, &u, &top);
+    let (_, mu) = lame();
+    for c in 0..3 {
+        assert!(
+            (force[c] - exact[c]).abs() <= 1e-9 * mu * gamma * SIDE_M * SIDE_M,
+            "top reaction {force:?} N, exact {exact:?} N"
+        );
+    }
+}
+
+#[test]
+fn neo_hookean_tangent_matches_finite_differences() {
+    let beam = cantilever(1, Law::NeoHookean, 0.45, 0.0);
+    let model = &beam.model;
+    let dofs = model.dofs();
+    let mut u = pseudo_random(3, 3 * model.mesh().node_count());
+    let mut v = pseudo_random(4, u.len());
+    for d in 0..u.len() {
+        if dofs.free_index[d] == PRESCRIBED {
+            u[d] = 0.0;
+            v[d] = 0.0;
+        }
+        u[d] *= 1e-3;
+    }
+    let (_, tangent) = model.force_and_tangent(&u);
+    let mut kv = vec![0.0; dofs.free_count()];
+    model.pattern().mul(&tangent, &dofs.restrict(&v), &mut kv);
+    let h = 1e-7;
+    let at = |sign: f64| {
+        let w: Vec<f64> = u.iter().zip(&v).map(|(a, b)| a + sign * h * b).collect();
+        dofs.restrict(&model.internal_force(&w))
+    };
+    let (plus, minus) = (at(1.0), at(-1.0));
+    let (mut diff, mut scale) = (0.0, 0.0);
+    for ((k, p), m) in kv.iter().zip(&plus).zip(&minus) {
+        let fd = (p - m) / (2.0 * h);
+        diff += (k - fd) * (k - fd);
+        scale += fd * fd;
+    }
+    let relative = (diff / scale).sqrt();
+    assert!(
+        relative < 1e-7,
+        "tangent vs central differences: {relative:e}"
+    );
+}
