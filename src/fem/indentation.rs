@@ -140,8 +140,19 @@ impl FemModel {
         let mut u = self.dirichlet().scaled_values(1.0);
         let f_ext = vec![0.0; u.len()];
         let mut curve = Vec::with_capacity(depths_m.len());
+        // The last equilibrium, and the step that led to it: the predictor of the next one.
+        let mut converged = (0.0, u.clone());
+        let mut increment: Option<(f64, Vec<f64>)> = None;
         for (index, &depth_m) in depths_m.iter().enumerate() {
             contact.center = indenter.center(depth_m);
+            // Extrapolating the last step starts Newton with the surface near the sphere rather
+            // than deep inside it, where the first iterations would crush the elements there.
+            if let Some((step_m, du)) = &increment {
+                let scale = (depth_m - converged.0) / step_m;
+                for (value, change) in u.iter_mut().zip(du) {
+                    *value += change * scale;
+                }
+            }
             let step = (index + 1, depths_m.len());
             let mut point = ForceDepthPoint {
                 depth_m,
@@ -169,6 +180,9 @@ impl FemModel {
             (point.force_n, point.contact_nodes) =
                 contact.total_push(self, &u, &indenter.direction);
             curve.push(point);
+            let du = u.iter().zip(&converged.1).map(|(a, b)| a - b).collect();
+            increment = Some((depth_m - converged.0, du));
+            converged = (depth_m, u.clone());
         }
         Ok(Indentation {
             curve,

@@ -5,6 +5,7 @@ mod bad_input;
 mod beams;
 mod cantilever;
 mod inclusion;
+mod indentation;
 mod ksv;
 mod loads_and_mass;
 mod neo_hookean;
