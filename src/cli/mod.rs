@@ -1,20 +1,25 @@
 //! What the binaries' commands do and print, apart from parsing their arguments: `pgd build`,
-//! `validate` and `mesh`; `trainer validate` and the end of an attempt; the parsers of option
+//! `validate`, `indent` and `mesh`; `trainer validate` and the end of an attempt; the parsers of option
 //! values, with errors that name the range; how a command ends (JSON or a table, or an error).
 //! The binaries keep their clap option types beside them and call in here.
 
 mod output;
 mod parse;
 mod pgd_build;
+mod pgd_indent;
 mod pgd_mesh;
 mod pgd_validate;
 mod trainer_commands;
 
 pub use output::{fail, print_json, print_report};
 pub use parse::{
-    parse_cut_pattern, parse_inclusion, parse_spacing, parse_stiffness_ratio, parse_subdivisions,
+    parse_cut_pattern, parse_inclusion, parse_point_mm, parse_spacing, parse_stiffness_ratio,
+    parse_subdivisions,
 };
 pub use pgd_build::{build_vademecum, print_build_report};
+pub use pgd_indent::{
+    IndentReport, IndentRequest, LawCurve, indent_organ, plot_indentation, print_indentation,
+};
 pub use pgd_mesh::report_mesh;
 pub use pgd_validate::{print_cut_validation, print_validation, validate_cuts, validate_vademecum};
 pub use trainer_commands::{debrief, numbered, validate_scenarios};

@@ -27,19 +27,16 @@ pub fn parse_stiffness_ratio(text: &str) -> Result<f64, String> {
     }
 }
 
+/// Reads a point `X,Y,Z` in millimetres, as `pgd indent --at` takes it.
+pub fn parse_point_mm(text: &str) -> Result<[f64; 3], String> {
+    let [x, y, z] = comma_numbers(text, "X,Y,Z (millimetres)")?;
+    Ok([x, y, z])
+}
+
 /// Reads `X,Y,Z,RADIUS,RATIO` (lengths in mm) as `pgd build --inclusion` takes it.
 pub fn parse_inclusion(text: &str) -> Result<Inclusion, String> {
-    let numbers: Vec<f64> = text
-        .split(',')
-        .map(|part| part.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("`{text}`: {e}; expected X,Y,Z,RADIUS,RATIO (millimetres, ratio)"))?;
-    let [x, y, z, radius_mm, stiffness_ratio] = numbers[..] else {
-        return Err(format!(
-            "`{text}`: {} numbers; expected five: X,Y,Z,RADIUS,RATIO (millimetres, ratio)",
-            numbers.len()
-        ));
-    };
+    let [x, y, z, radius_mm, stiffness_ratio] =
+        comma_numbers(text, "X,Y,Z,RADIUS,RATIO (millimetres, ratio)")?;
     let inclusion = Inclusion {
         centre_m: [x, y, z].map(|c| c * 1e-3),
         radius_m: radius_mm * 1e-3,
@@ -47,6 +44,23 @@ pub fn parse_inclusion(text: &str) -> Result<Inclusion, String> {
     };
     inclusion.validate().map_err(|e| format!("`{text}`: {e}"))?;
     Ok(inclusion)
+}
+
+/// `N` comma-separated finite numbers, or an error naming the `expected` layout.
+fn comma_numbers<const N: usize>(text: &str, expected: &str) -> Result<[f64; N], String> {
+    let numbers: Vec<f64> = text
+        .split(',')
+        .map(|part| part.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("`{text}`: {e}; expected {expected}"))?;
+    let count = numbers.len();
+    match <[f64; N]>::try_from(numbers) {
+        Ok(values) if values.iter().all(|v| v.is_finite()) => Ok(values),
+        Ok(_) => Err(format!("`{text}`: not all finite; expected {expected}")),
+        Err(_) => Err(format!(
+            "`{text}`: {count} numbers; expected {N}: {expected}"
+        )),
+    }
 }
 
 /// A cut pattern of `pgd validate --cuts`: `radial:N` (the cornea) or `straight:N` (an

@@ -1,13 +1,16 @@
 //! Displacement-controlled indentation by a rigid sphere: the full nonlinear reference for the
 //! force a trainee feels, `F(δ)` at any surface point and depth.
 //!
-//! Contact is frictionless, between the sphere and the surface nodes, enforced by an augmented
-//! Lagrangian: within one Newton solve each node in contact is pushed out along the sphere's
-//! normal by `p = max(0, λ − k g)` (`g` its signed distance to the sphere, `k` a penalty), and
-//! between solves the multipliers take the converged pushes, `λ ← p`, until no node is deeper
-//! inside than the stated tolerance. The penalty alone would leave a penetration of `p / k`;
-//! the multipliers remove it without the ill-conditioning of a huge `k`. The pushes derive from
-//! the potential `Σ p² / 2k`, so Newton's energy line search applies unchanged.
+//! Contact is frictionless, between the sphere and points sampled over the surface triangles
+//! (a few per sphere radius, so that a sphere smaller than the triangles cannot slip between
+//! their nodes), enforced by an augmented Lagrangian: within one Newton solve each point in
+//! contact is pushed out along the sphere's normal by the pressure `p = max(0, λ − κ g)` over
+//! the area it stands for (`g` its signed distance to the sphere, `κ` a penalty), shared among
+//! its triangle's nodes by its barycentric weights; between solves the multipliers take the
+//! converged pressures, `λ ← p`, until no point is deeper inside than the stated tolerance. The
+//! penalty alone would leave a penetration of `p / κ`; the multipliers remove it without the
+//! ill-conditioning of a huge `κ`. The pushes derive from the potential `Σ a p² / 2κ`, so
+//! Newton's energy line search applies unchanged.
 
 use nalgebra::{Matrix3, Point3, Vector3};
 
@@ -64,9 +67,12 @@ impl SphereIndenter {
 /// How an indentation is solved.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IndentationSettings {
-    /// Penalty per node, `k = factor · E · √A` (E the material's Young's modulus, A the node's
-    /// lumped surface area): a node's own stiffness scales as `E h`.
+    /// Penalty `κ = factor · E / h` (Pa/m; E the material's Young's modulus, h the square root
+    /// of the triangle's area): the pressure a layer of tissue one element thick answers a
+    /// unit penetration with, times the factor.
     pub penalty_factor: f64,
+    /// Contact points per sphere radius along a triangle's edges (at least one per triangle).
+    pub samples_per_radius: f64,
     /// Multiplier updates stop once no node is inside the sphere deeper than this fraction of
     /// the depth.
     pub penetration_tolerance: f64,
@@ -79,6 +85,7 @@ impl Default for IndentationSettings {
     fn default() -> Self {
         Self {
             penalty_factor: 10.0,
+            samples_per_radius: 6.0,
             penetration_tolerance: 1e-3,
             max_augmentations: 20,
             newton: NewtonSettings {
@@ -96,9 +103,9 @@ pub struct ForceDepthPoint {
     pub depth_m: f64,
     /// The force the sphere needs along its direction of travel (N).
     pub force_n: f64,
-    /// Nodes pushed by the sphere.
-    pub contact_nodes: usize,
-    /// The deepest node inside the sphere (m), after the last multiplier update.
+    /// Surface points pushed by the sphere.
+    pub contact_points: usize,
+    /// The deepest surface point inside the sphere (m), after the last multiplier update.
     pub penetration_m: f64,
     /// Multiplier updates and Newton iterations it took.
     pub augmentations: usize,
@@ -110,29 +117,37 @@ pub struct ForceDepthPoint {
 pub struct Indentation {
     pub curve: Vec<ForceDepthPoint>,
     pub displacement_m: Vec<f64>,
+    /// The depth (m) where no equilibrium was found, and why: the curve stops before it (a
+    /// law that loses stability under compression, such as Kirchhoff–Saint Venant, does).
+    pub stopped: Option<(f64, FemError)>,
 }
 
 impl FemModel {
     /// Presses `indenter` into the body to each of `depths_m` in turn (increasing, positive),
-    /// against the surface nodes `surface_nodes` with lumped areas `areas_m2`, and reports the
-    /// equilibrium at each depth. The depths are the load steps: space them finely enough for
-    /// Newton (a tenth of the sphere's radius is safe).
+    /// against the surface triangles `triangles` (volume numbering), and reports the
+    /// equilibrium at each depth to `on_depth` and in the result. The depths are the load
+    /// steps: space them finely enough for Newton (a tenth of the sphere's radius is safe).
+    /// Bad input is an error; a depth without equilibrium ends the curve (see
+    /// [`Indentation::stopped`]).
     pub fn indent(
         &self,
-        (surface_nodes, areas_m2): (&[usize], &[f64]),
+        triangles: &[[usize; 3]],
         indenter: &SphereIndenter,
         depths_m: &[f64],
         settings: &IndentationSettings,
+        on_depth: &mut dyn FnMut(&ForceDepthPoint),
     ) -> Result<Indentation, FemError> {
         check_depths(depths_m)?;
+        let spacing_m = indenter.radius_m / settings.samples_per_radius;
+        let samples = sample_triangles(self.mesh(), triangles, spacing_m);
         let young_pa = self.material().young_pa;
         let mut contact = SphereContact {
-            nodes: surface_nodes.to_vec(),
-            penalty: areas_m2
+            penalty_pa_per_m: samples
                 .iter()
-                .map(|a| settings.penalty_factor * young_pa * a.sqrt())
+                .map(|s| settings.penalty_factor * young_pa / s.face_size_m)
                 .collect(),
-            multipliers: vec![0.0; surface_nodes.len()],
+            multipliers_pa: vec![0.0; samples.len()],
+            samples,
             center: indenter.center(0.0),
             radius_m: indenter.radius_m,
         };
@@ -157,7 +172,7 @@ impl FemModel {
             let mut point = ForceDepthPoint {
                 depth_m,
                 force_n: 0.0,
-                contact_nodes: 0,
+                contact_points: 0,
                 penetration_m: f64::INFINITY,
                 augmentations: 0,
                 newton_iterations: 0,
@@ -165,20 +180,31 @@ impl FemModel {
             while point.penetration_m > settings.penetration_tolerance * depth_m
                 && point.augmentations < settings.max_augmentations
             {
-                let report: StepReport = self.equilibrate(
+                let solved = self.equilibrate(
                     &mut solver,
                     &mut u,
                     &f_ext,
                     &contact,
                     step,
                     &settings.newton,
-                )?;
+                );
+                let report: StepReport = match solved {
+                    Ok(report) => report,
+                    Err(error) => {
+                        return Ok(Indentation {
+                            curve,
+                            displacement_m: converged.1,
+                            stopped: Some((depth_m, error)),
+                        });
+                    }
+                };
                 point.newton_iterations += report.step_lengths.len();
                 point.augmentations += 1;
                 point.penetration_m = contact.update_multipliers(self, &u);
             }
-            (point.force_n, point.contact_nodes) =
+            (point.force_n, point.contact_points) =
                 contact.total_push(self, &u, &indenter.direction);
+            on_depth(&point);
             curve.push(point);
             let du = u.iter().zip(&converged.1).map(|(a, b)| a - b).collect();
             increment = Some((depth_m - converged.0, du));
@@ -187,53 +213,107 @@ impl FemModel {
         Ok(Indentation {
             curve,
             displacement_m: u,
+            stopped: None,
         })
     }
 }
 
-/// The sphere's frictionless push on the surface nodes at one depth.
+/// A point of a surface triangle the sphere may push.
+struct Sample {
+    nodes: [usize; 3],
+    /// Barycentric weights of the point in its triangle.
+    weights: [f64; 3],
+    /// The share of the triangle's area the point stands for (m²).
+    area_m2: f64,
+    /// The square root of its triangle's area (m).
+    face_size_m: f64,
+}
+
+/// Points over each triangle, no farther apart than `spacing_m`: the vertices of its regular
+/// subdivision into `m²` triangles, each standing for a third of the small triangles around it.
+/// With `m = 1` these are the triangle's corners with a third of its area each, the lumped
+/// nodal areas; a node shared by several triangles gets a point from each.
+fn sample_triangles(
+    mesh: &crate::mesh::TetMesh,
+    triangles: &[[usize; 3]],
+    spacing_m: f64,
+) -> Vec<Sample> {
+    let mut samples = Vec::new();
+    for &nodes in triangles {
+        let p = nodes.map(|n| mesh.nodes()[n]);
+        let longest = [(0, 1), (1, 2), (2, 0)]
+            .iter()
+            .map(|&(a, b)| (p[a] - p[b]).norm())
+            .fold(0.0, f64::max);
+        let area_m2 = 0.5 * (p[1] - p[0]).cross(&(p[2] - p[0])).norm();
+        let m = (longest / spacing_m).ceil().max(1.0) as usize;
+        let third = area_m2 / (3 * m * m) as f64;
+        for i in 0..=m {
+            for j in 0..=m - i {
+                let on_edges = [i == 0, j == 0, i + j == m].iter().filter(|&&e| e).count();
+                let around = [6, 3, 1][on_edges];
+                let (u, v) = (i as f64 / m as f64, j as f64 / m as f64);
+                samples.push(Sample {
+                    nodes,
+                    weights: [1.0 - u - v, u, v],
+                    area_m2: around as f64 * third,
+                    face_size_m: area_m2.sqrt(),
+                });
+            }
+        }
+    }
+    samples
+}
+
+/// The sphere's frictionless push on the surface points at one depth.
 struct SphereContact {
-    nodes: Vec<usize>,
-    penalty: Vec<f64>,
-    multipliers: Vec<f64>,
+    samples: Vec<Sample>,
+    penalty_pa_per_m: Vec<f64>,
+    multipliers_pa: Vec<f64>,
     center: Point3<f64>,
     radius_m: f64,
 }
 
 impl SphereContact {
-    /// For each node the sphere pushes: its index in `nodes`, the outward normal from the
+    /// For each point the sphere pushes: its index in `samples`, the outward normal from the
     /// centre, its distance from the centre and the push `p > 0` (N).
     fn pushes<'a>(
         &'a self,
         model: &'a FemModel,
         u_m: &'a [f64],
     ) -> impl Iterator<Item = (usize, Vector3<f64>, f64, f64)> + 'a {
-        self.nodes.iter().enumerate().filter_map(move |(i, &n)| {
-            let x =
-                model.mesh().nodes()[n] + Vector3::new(u_m[3 * n], u_m[3 * n + 1], u_m[3 * n + 2]);
-            let offset = x - self.center;
+        let position = |n: usize| {
+            model.mesh().nodes()[n].coords
+                + Vector3::new(u_m[3 * n], u_m[3 * n + 1], u_m[3 * n + 2])
+        };
+        self.samples.iter().enumerate().filter_map(move |(i, s)| {
+            let x: Vector3<f64> = (0..3).map(|k| position(s.nodes[k]) * s.weights[k]).sum();
+            let offset = x - self.center.coords;
             let distance = offset.norm();
-            let push = self.multipliers[i] - self.penalty[i] * (distance - self.radius_m);
-            (push > 0.0 && distance > 0.0).then(|| (i, offset / distance, distance, push))
+            let pressure =
+                self.multipliers_pa[i] - self.penalty_pa_per_m[i] * (distance - self.radius_m);
+            (pressure > 0.0 && distance > 0.0)
+                .then(|| (i, offset / distance, distance, pressure * s.area_m2))
         })
     }
 
-    /// Sets each multiplier to its node's converged push; returns the deepest penetration (m).
+    /// Sets each multiplier to its point's converged pressure; returns the deepest
+    /// penetration (m).
     fn update_multipliers(&mut self, model: &FemModel, u_m: &[f64]) -> f64 {
         let pushes: Vec<(usize, f64, f64)> = self
             .pushes(model, u_m)
             .map(|(i, _, distance, push)| (i, distance, push))
             .collect();
-        self.multipliers.fill(0.0);
+        self.multipliers_pa.fill(0.0);
         let mut deepest: f64 = 0.0;
         for (i, distance, push) in pushes {
-            self.multipliers[i] = push;
+            self.multipliers_pa[i] = push / self.samples[i].area_m2;
             deepest = deepest.max(self.radius_m - distance);
         }
         deepest
     }
 
-    /// The total push along `direction` (N) and the number of nodes pushed.
+    /// The total push along `direction` (N) and the number of points pushed.
     fn total_push(&self, model: &FemModel, u_m: &[f64], direction: &Vector3<f64>) -> (f64, usize) {
         self.pushes(model, u_m)
             .fold((0.0, 0), |(force, count), (_, normal, _, push)| {
@@ -243,9 +323,9 @@ impl SphereContact {
 }
 
 impl ExtraForce for SphereContact {
-    /// The push `p n` on a node resists as `−p n`; its derivative is
-    /// `k n nᵀ − (p / r)(I − n nᵀ)` (the second term: the sphere's surface turns away
-    /// from a node that slides around it).
+    /// The push `p n` at a point resists as `−w_a p n` on its triangle's node `a`; its
+    /// derivative with respect to node `b` is `w_a w_b [a κ n nᵀ − (p / r)(I − n nᵀ)]` (the
+    /// second term: the sphere's surface turns away from a point that slides around it).
     fn add(
         &self,
         model: &FemModel,
@@ -254,17 +334,27 @@ impl ExtraForce for SphereContact {
         mut tangent: Option<&mut [f64]>,
     ) {
         for (i, normal, distance, push) in self.pushes(model, u_m) {
-            let n = self.nodes[i];
-            for c in 0..3 {
-                force[3 * n + c] -= push * normal[c];
+            let sample = &self.samples[i];
+            for (&n, w) in sample.nodes.iter().zip(sample.weights) {
+                for c in 0..3 {
+                    force[3 * n + c] -= w * push * normal[c];
+                }
             }
-            if let Some(values) = tangent.as_deref_mut() {
-                let outer = normal * normal.transpose();
-                let block =
-                    outer * self.penalty[i] - (Matrix3::identity() - outer) * (push / distance);
-                model
-                    .pattern()
-                    .add_node_block(model.dofs(), n, &block, values);
+            let Some(values) = tangent.as_deref_mut() else {
+                continue;
+            };
+            let outer = normal * normal.transpose();
+            let block = outer * (sample.area_m2 * self.penalty_pa_per_m[i])
+                - (Matrix3::identity() - outer) * (push / distance);
+            for (&a, wa) in sample.nodes.iter().zip(sample.weights) {
+                for (&b, wb) in sample.nodes.iter().zip(sample.weights) {
+                    model.pattern().add_node_block(
+                        model.dofs(),
+                        (a, b),
+                        &(block * (wa * wb)),
+                        values,
+                    );
+                }
             }
         }
     }

@@ -76,24 +76,27 @@ impl FreePattern {
         }
     }
 
-    /// Adds a 3×3 block coupling node `node` with itself into `values` (a force that acts on
-    /// single nodes, such as a rigid tool's contact), skipping prescribed dofs.
+    /// Adds a 3×3 block coupling node `row` to node `col` into `values` (a force acting on the
+    /// nodes of one surface triangle, such as a rigid tool's contact), skipping prescribed
+    /// dofs. The two nodes must share a tetrahedron.
     pub fn add_node_block(
         &self,
         dofs: &DofMap,
-        node: usize,
+        (row, col): (usize, usize),
         block: &nalgebra::Matrix3<f64>,
         values: &mut [f64],
     ) {
         let (col_ptr, row_idx) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
-        let free: [usize; 3] = std::array::from_fn(|c| dofs.free_index[3 * node + c]);
-        for (j, &col) in free.iter().enumerate().filter(|(_, c)| **c != PRESCRIBED) {
-            let column = &row_idx[col_ptr[col]..col_ptr[col + 1]];
-            for (i, &row) in free.iter().enumerate().filter(|(_, r)| **r != PRESCRIBED) {
+        let free =
+            |node: usize| -> [usize; 3] { std::array::from_fn(|c| dofs.free_index[3 * node + c]) };
+        let (rows, cols) = (free(row), free(col));
+        for (j, &c) in cols.iter().enumerate().filter(|(_, c)| **c != PRESCRIBED) {
+            let column = &row_idx[col_ptr[c]..col_ptr[c + 1]];
+            for (i, &r) in rows.iter().enumerate().filter(|(_, r)| **r != PRESCRIBED) {
                 let offset = column
-                    .binary_search(&row)
-                    .expect("the pattern holds every pair of a node's own dofs");
-                values[col_ptr[col] + offset] += block[(i, j)];
+                    .binary_search(&r)
+                    .expect("the pattern holds every pair of nodes that share a tetrahedron");
+                values[col_ptr[c] + offset] += block[(i, j)];
             }
         }
     }

@@ -68,8 +68,7 @@ fn quarter_block(cells: usize, fine_m: f64) -> TetMesh {
 
 struct Press {
     model: FemModel,
-    top: Vec<usize>,
-    top_areas_m2: Vec<f64>,
+    top: Vec<[usize; 3]>,
 }
 
 fn press(cells: usize, fine_m: f64, law: Law, poisson: f64) -> Press {
@@ -86,20 +85,15 @@ fn press(cells: usize, fine_m: f64, law: Law, poisson: f64) -> Press {
             }
         }
     }
-    let surface = Surface::extract(&mesh);
-    let areas = surface.vertex_areas(&mesh);
-    let (top, top_areas_m2) = surface
-        .nodes
-        .iter()
-        .zip(&areas)
-        .filter(|&(&n, _)| on(n, 2, DEPTH_M))
-        .map(|(&n, &a)| (n, a))
-        .unzip();
+    let top = Surface::extract(&mesh)
+        .triangles
+        .into_iter()
+        .filter(|face| face.iter().all(|&n| on(n, 2, DEPTH_M)))
+        .collect();
     let material = Material::new(law, YOUNG_PA, poisson, 1000.0).unwrap();
     Press {
         model: FemModel::new(mesh, material, dirichlet).unwrap(),
         top,
-        top_areas_m2,
     }
 }
 
@@ -111,12 +105,14 @@ impl Press {
         let mut indentation = self
             .model
             .indent(
-                (&self.top, &self.top_areas_m2),
+                &self.top,
                 &indenter,
                 depths_m,
                 &IndentationSettings::default(),
+                &mut |_| {},
             )
             .unwrap();
+        assert_eq!(indentation.stopped, None, "no equilibrium found");
         for point in &mut indentation.curve {
             point.force_n *= 4.0;
         }

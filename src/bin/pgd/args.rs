@@ -121,6 +121,36 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Press the organ with its tool (a rigid sphere, frictionless) to a depth, solving full
+    /// nonlinear FEM at every step, and print the force–depth curve of each law: the reference
+    /// a nonlinear vademecum is checked against. Writes the curves side by side as a PNG.
+    Indent {
+        #[command(flatten)]
+        mesh: MeshArgs,
+        /// Young's modulus, Poisson's ratio and inclusions (--law is ignored: see --laws).
+        #[command(flatten)]
+        material: MaterialArgs,
+        /// Material laws to press with, in order.
+        #[arg(long, value_enum, value_delimiter = ',', default_values = ["linear", "ksv", "neo-hookean"])]
+        laws: Vec<LawArg>,
+        /// Press at the accessible surface node nearest this point, `X,Y,Z` in millimetres
+        /// (default: the accessible face's middle).
+        #[arg(long, value_name = "X,Y,Z", value_parser = cli::parse_point_mm)]
+        at: Option<[f64; 3]>,
+        /// Deepest depth in millimetres (default: 25/6 of the tool's radius, 25 mm under the
+        /// abdominal 6 mm tool).
+        #[arg(long)]
+        depth_mm: Option<f64>,
+        /// Equal depth steps from rest to the deepest (each a full Newton solve).
+        #[arg(long, default_value_t = 25)]
+        steps: usize,
+        /// Where to draw the curves (default: <source>-indentation.png in the current folder).
+        #[arg(long, value_name = "FILE.png")]
+        plot: Option<PathBuf>,
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Time the numerical core and print medians (and ratios to a baseline run alongside).
     Bench {
         #[command(subcommand)]

@@ -15,8 +15,47 @@ use pgd_surgery::cutting::keratotomy::{Cornea, Keratotomy};
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::organs::Organ;
 use pgd_surgery::pgd::ValidationSettings;
-use pgd_surgery::store::{BuildJob, OnStale};
+use pgd_surgery::store::{Bar, BuildJob, OnStale};
 use pgd_surgery::{app, bench};
+
+fn indent_command(
+    mesh: &MeshArgs,
+    material: &MaterialArgs,
+    laws: &[args::LawArg],
+    (at_mm, depth_mm, steps): (Option<[f64; 3]>, Option<f64>, usize),
+    plot: Option<std::path::PathBuf>,
+    json: bool,
+) -> ExitCode {
+    let request = cli::IndentRequest {
+        source: &mesh.source,
+        at_mm,
+        depth_mm,
+        steps,
+    };
+    let plot = plot.unwrap_or_else(|| format!("{}-indentation.png", mesh.stem()).into());
+    let report = mesh.load().and_then(|(organ, m)| {
+        let base = material.material(organ)?;
+        let materials: Vec<_> = laws
+            .iter()
+            .map(|law| pgd_surgery::fem::Material {
+                law: law.law(),
+                ..base
+            })
+            .collect();
+        let report = cli::indent_organ((organ, m), &materials, &request, &Bar::default())?;
+        cli::plot_indentation(&report, &plot)?;
+        Ok(report)
+    });
+    match report {
+        Ok(report) if json => print_json(&report),
+        Ok(report) => {
+            cli::print_indentation(&report);
+            println!("curves drawn in {}", plot.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => fail("pgd indent", &e),
+    }
+}
 
 fn main() -> ExitCode {
     match Cli::parse().command {
@@ -112,6 +151,16 @@ fn main() -> ExitCode {
                 Cornea::new(resolution, cornea_layers).and_then(|cornea| cornea.cut(&plan));
             print_report("pgd cut cornea", report, json)
         }
+        Command::Indent {
+            mesh,
+            material,
+            laws,
+            at,
+            depth_mm,
+            steps,
+            plot,
+            json,
+        } => indent_command(&mesh, &material, &laws, (at, depth_mm, steps), plot, json),
         Command::Bench { what } => bench_command(what),
     }
 }
