@@ -15,6 +15,7 @@ mod material;
 mod model;
 mod newton;
 mod pattern;
+mod volumetric;
 
 pub use dofs::{Dirichlet, DofMap, PRESCRIBED};
 pub use element::{ElementMatrix, ElementVector, TetGeometry};

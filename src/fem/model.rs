@@ -6,6 +6,7 @@ use nalgebra::{SMatrix, SymmetricEigen, Vector3};
 use super::element::{ElementVector, TetGeometry};
 use super::inclusion::{Inclusion, modulus_scale};
 use super::pattern::FreePattern;
+use super::volumetric::NodalVolumes;
 use super::{Dirichlet, DofMap, FemError, Law, Material, consistent_mass, lumped_mass};
 use crate::mesh::TetMesh;
 
@@ -21,6 +22,9 @@ pub struct FemModel {
     /// each element (1 for all when there are none).
     inclusions: Vec<Inclusion>,
     modulus_scale: Vec<f64>,
+    /// The neo-Hookean volumetric energy on nodal volumes (see `volumetric.rs`); `None` for
+    /// the other laws, whose elements carry all their energy.
+    volumetric: Option<NodalVolumes>,
     dirichlet: Dirichlet,
     dofs: DofMap,
     pattern: FreePattern,
@@ -41,9 +45,15 @@ impl FemModel {
         check_rigid_modes(&mesh, &dirichlet)?;
         let geometry = TetGeometry::of_mesh(&mesh);
         let dofs = DofMap::new(&dirichlet);
-        let pattern = FreePattern::new(&mesh, &dofs);
+        let modulus_scale = vec![1.0; mesh.tet_count()];
+        let volumetric = nodal_volumes(&mesh, &geometry, &material, &modulus_scale);
+        let pattern = match volumetric {
+            Some(_) => FreePattern::two_ring(&mesh, &dofs),
+            None => FreePattern::new(&mesh, &dofs),
+        };
         Ok(Self {
-            modulus_scale: vec![1.0; mesh.tet_count()],
+            modulus_scale,
+            volumetric,
             inclusions: Vec::new(),
             mesh,
             geometry,
@@ -61,6 +71,12 @@ impl FemModel {
     /// The model with `inclusions` in its tissue (replacing any it had).
     pub fn with_inclusions(mut self, inclusions: &[Inclusion]) -> Result<Self, FemError> {
         self.modulus_scale = modulus_scale(&self.mesh, inclusions)?;
+        self.volumetric = nodal_volumes(
+            &self.mesh,
+            &self.geometry,
+            &self.material,
+            &self.modulus_scale,
+        );
         self.inclusions = inclusions.to_vec();
         Ok(self)
     }
@@ -79,6 +95,16 @@ impl FemModel {
         let (lambda, mu) = self.material.lame();
         let scale = self.modulus_scale[element];
         (scale * lambda, scale * mu)
+    }
+
+    /// The Lamé constants the element itself carries: all of them, except the first when the
+    /// volumetric energy lives on nodal volumes.
+    fn element_lame(&self, element: usize) -> (f64, f64) {
+        let (lambda, mu) = self.lame(element);
+        match self.volumetric {
+            Some(_) => (0.0, mu),
+            None => (lambda, mu),
+        }
     }
 
     pub fn dirichlet(&self) -> &Dirichlet {
@@ -101,10 +127,13 @@ impl FemModel {
     pub fn internal_force(&self, u_m: &[f64]) -> Vec<f64> {
         let mut force = vec![0.0; u_m.len()];
         for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
-            let (lambda, mu) = self.lame(t);
+            let (lambda, mu) = self.element_lame(t);
             let ue = gather(tet, u_m);
             let fe = geo.force(self.material.law, lambda, mu, &ue);
             scatter_vector(tet, &fe, &mut force);
+        }
+        if let Some(volumetric) = &self.volumetric {
+            volumetric.add_force(&self.mesh, &self.geometry, u_m, &mut force);
         }
         force
     }
@@ -116,10 +145,13 @@ impl FemModel {
             return;
         }
         for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
-            let (lambda, mu) = self.lame(t);
+            let (lambda, mu) = self.element_lame(t);
             let ue = gather(tet, u_m);
             let fe = geo.nonlinear_force(self.material.law, lambda, mu, &ue);
             scatter_vector(tet, &fe, out);
+        }
+        if let Some(volumetric) = &self.volumetric {
+            volumetric.add_nonlinear_force(&self.mesh, &self.geometry, u_m, out);
         }
     }
 
@@ -129,11 +161,20 @@ impl FemModel {
         let mut force = vec![0.0; u_m.len()];
         let mut values = self.pattern.zero_values();
         for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
-            let (lambda, mu) = self.lame(t);
+            let (lambda, mu) = self.element_lame(t);
             let ue = gather(tet, u_m);
             let (fe, ke) = geo.force_and_tangent(self.material.law, lambda, mu, &ue);
             scatter_vector(tet, &fe, &mut force);
             self.pattern.scatter(t, &ke, &mut values);
+        }
+        if let Some(volumetric) = &self.volumetric {
+            volumetric.add_force_and_tangent(
+                (&self.mesh, &self.geometry),
+                (&self.pattern, &self.dofs),
+                u_m,
+                &mut force,
+                &mut values,
+            );
         }
         (force, values)
     }
@@ -160,7 +201,22 @@ impl FemModel {
     }
 }
 
-fn gather(tet: &[usize; 4], u: &[f64]) -> ElementVector {
+/// The neo-Hookean law's nodal volumes, with each element's first Lamé constant scaled by
+/// its inclusion; `None` for the other laws.
+fn nodal_volumes(
+    mesh: &TetMesh,
+    geometry: &[TetGeometry],
+    material: &Material,
+    modulus_scale: &[f64],
+) -> Option<NodalVolumes> {
+    (material.law == Law::NeoHookean).then(|| {
+        let (lambda, _) = material.lame();
+        let lambdas: Vec<f64> = modulus_scale.iter().map(|s| s * lambda).collect();
+        NodalVolumes::new(mesh, geometry, &lambdas)
+    })
+}
+
+pub(super) fn gather(tet: &[usize; 4], u: &[f64]) -> ElementVector {
     ElementVector::from_fn(|i, _| u[3 * tet[i / 3] + i % 3])
 }
 

@@ -23,8 +23,30 @@ pub struct FreePattern {
 }
 
 impl FreePattern {
+    /// The pattern of element matrices: nodes that share a tetrahedron.
     pub fn new(mesh: &TetMesh, dofs: &DofMap) -> Self {
-        let neighbours = node_neighbours(mesh);
+        Self::with_neighbours(mesh, dofs, &node_neighbours(mesh))
+    }
+
+    /// The pattern of an energy on nodal volumes: nodes that share a neighbour (two rings).
+    pub fn two_ring(mesh: &TetMesh, dofs: &DofMap) -> Self {
+        let ring = node_neighbours(mesh);
+        let neighbours: Vec<Vec<usize>> = ring
+            .iter()
+            .map(|around| {
+                let mut reach: Vec<usize> = around
+                    .iter()
+                    .flat_map(|&m| ring[m].iter().copied())
+                    .collect();
+                reach.sort_unstable();
+                reach.dedup();
+                reach
+            })
+            .collect();
+        Self::with_neighbours(mesh, dofs, &neighbours)
+    }
+
+    fn with_neighbours(mesh: &TetMesh, dofs: &DofMap, neighbours: &[Vec<usize>]) -> Self {
         let n = dofs.free_count();
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::new();

@@ -19,7 +19,7 @@ const RADIUS_M: f64 = 0.005;
 fn graded_side(length_m: f64, cells: usize, fine: usize, fine_m: f64) -> Vec<f64> {
     let far = (cells - fine) as i32;
     let far_length = |ratio: f64| fine_m * (1..=far).map(|k| ratio.powi(k)).sum::<f64>();
-    let (mut low, mut high) = (1.0, 4.0);
+    let (mut low, mut high) = (1.0, 50.0);
     for _ in 0..100 {
         let mid = 0.5 * (low + high);
         if far_length(mid) > length_m - fine as f64 * fine_m {
@@ -125,30 +125,42 @@ fn hertz_n(depth_m: f64, poisson: f64) -> f64 {
     4.0 / 3.0 * YOUNG_PA / (1.0 - poisson * poisson) * RADIUS_M.sqrt() * depth_m.powf(1.5)
 }
 
-/// At 0.2 mm cells under a 5 mm sphere (five cells across the contact radius at 0.2 mm deep),
-/// the linear tetrahedra are stiffer than the continuum by 7–8 % (5 % at 0.1 mm cells and
-/// 24,000 nodes, two minutes of solving: too slow for a test); the block's finite size adds
-/// under 1 %.
-const HERTZ_TOLERANCE: f64 = 0.09;
+/// The tissue's Poisson's ratio: volumetric locking is the question.
+const TISSUE_POISSON: f64 = 0.48;
+
+/// Under a 5 mm sphere pressed 0.2 mm (contact radius 1 mm) on 0.2 mm cells, the neo-Hookean
+/// tetrahedra with nodal volumes are 3.5 % stiffer than Hertz (4.3 % at 0.1 mm deep, 6 % at
+/// ν = 0.3; the block's finite size adds under 1 %).
+const HERTZ_TOLERANCE: f64 = 0.06;
+
+/// Linear tetrahedra that keep each element's volume are 20 % stiffer than Hertz there.
+const LOCKED_AT_LEAST: f64 = 0.12;
+
+fn force_at_hertz_depth(law: Law) -> (f64, f64) {
+    let depth_m = 0.2e-3;
+    let curve = press(20, 0.2e-3, law, TISSUE_POISSON).curve(&[depth_m]);
+    assert!(
+        curve[0].penetration_m <= 1e-3 * depth_m,
+        "surface {:.1e} m inside the sphere",
+        curve[0].penetration_m
+    );
+    (curve[0].force_n, hertz_n(depth_m, TISSUE_POISSON))
+}
 
 #[test]
-fn small_indentations_follow_hertz() {
-    let poisson = 0.3;
-    let depths = [0.1e-3, 0.2e-3, 0.3e-3];
-    let curve = press(20, 0.2e-3, Law::NeoHookean, poisson).curve(&depths);
-    for point in &curve {
-        let ratio = point.force_n / hertz_n(point.depth_m, poisson);
-        assert!(
-            (ratio - 1.0).abs() <= HERTZ_TOLERANCE,
-            "at {:.2} mm the force is {ratio:.3} of Hertz's",
-            point.depth_m * 1e3
-        );
-        assert!(
-            point.penetration_m <= 1e-3 * point.depth_m,
-            "nodes {:.1e} m inside the sphere",
-            point.penetration_m
-        );
-    }
+fn nodal_volumes_follow_hertz_where_element_volumes_lock() {
+    let (force, hertz) = force_at_hertz_depth(Law::NeoHookean);
+    let ratio = force / hertz;
+    assert!(
+        (ratio - 1.0).abs() <= HERTZ_TOLERANCE,
+        "neo-Hookean with nodal volumes: {ratio:.3} of Hertz's force"
+    );
+    let (locked, _) = force_at_hertz_depth(Law::Linear);
+    assert!(
+        locked / hertz >= 1.0 + LOCKED_AT_LEAST,
+        "linear tetrahedra at ν = 0.48: {:.3} of Hertz's force; expected them to lock",
+        locked / hertz
+    );
 }
 
 /// Force at a depth of 0.4 R on meshes with `cells` per side.
@@ -162,21 +174,20 @@ fn deep_force_n(cells: usize, law: Law) -> f64 {
         .force_n
 }
 
-/// At ν = 0.48 linear tetrahedra lock: the force at 0.4 R converges from above as the mesh is
-/// refined (8, 12, 16 cells per side, 0.5 to 0.25 mm at the contact), and at least at first
-/// order, so each refinement closes the gap by at least the ratio of the cell sizes.
+/// At ν = 0.48 the force at 0.4 R converges from above as the mesh is refined (6, 9 and 12
+/// cells per side, 0.67 to 0.33 mm at the contact; measured 75.7, 55.8 and 50.8 mN), each
+/// refinement closing less of the gap than the one before.
 #[test]
 fn nearly_incompressible_force_converges_under_refinement() {
-    let cells = [8, 12, 16];
+    let cells = [6, 9, 12];
     let forces = cells.map(|cells| deep_force_n(cells, Law::NeoHookean));
     assert!(
         forces[0] > forces[1] && forces[1] > forces[2],
         "forces {forces:?} N do not decrease under refinement"
     );
-    let first_order = (1.0 / 12.0 - 1.0 / 16.0) / (1.0 / 8.0 - 1.0 / 12.0);
-    let ratio = (forces[1] - forces[2]) / (forces[0] - forces[1]);
+    let shrink = (forces[1] - forces[2]) / (forces[0] - forces[1]);
     assert!(
-        ratio < 1.2 * first_order,
-        "forces {forces:?} N: the gap shrinks by {ratio:.2} per refinement, slower than first order ({first_order:.2})"
+        shrink < 1.0,
+        "forces {forces:?} N: the second refinement changed the force more than the first"
     );
 }
