@@ -19,6 +19,11 @@ use crate::mesh::TetMesh;
 pub type ElementMatrix = SMatrix<f64, 12, 12>;
 pub type ElementVector = SVector<f64, 12>;
 
+/// The element displacement of tetrahedron `tet` from the full displacement `u`.
+pub(super) fn gather(tet: &[usize; 4], u: &[f64]) -> ElementVector {
+    ElementVector::from_fn(|i, _| u[3 * tet[i / 3] + i % 3])
+}
+
 /// Per-tetrahedron constants of the reference configuration.
 #[derive(Clone, Copy, Debug)]
 pub struct TetGeometry {

@@ -3,7 +3,7 @@
 
 use nalgebra::{SMatrix, SymmetricEigen, Vector3};
 
-use super::element::{ElementVector, TetGeometry};
+use super::element::{ElementVector, TetGeometry, gather};
 use super::inclusion::{Inclusion, modulus_scale};
 use super::pattern::FreePattern;
 use super::volumetric::NodalVolumes;
@@ -214,10 +214,6 @@ fn nodal_volumes(
         let lambdas: Vec<f64> = modulus_scale.iter().map(|s| s * lambda).collect();
         NodalVolumes::new(mesh, geometry, &lambdas)
     })
-}
-
-pub(super) fn gather(tet: &[usize; 4], u: &[f64]) -> ElementVector {
-    ElementVector::from_fn(|i, _| u[3 * tet[i / 3] + i % 3])
 }
 
 fn scatter_vector(tet: &[usize; 4], fe: &ElementVector, out: &mut [f64]) {

@@ -19,7 +19,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::DofMap;
-use super::element::{ElementMatrix, ElementVector, TetGeometry};
+use super::element::{ElementMatrix, ElementVector, TetGeometry, gather};
 use super::pattern::FreePattern;
 use crate::mesh::TetMesh;
 
@@ -79,7 +79,7 @@ impl NodalVolumes {
             .tets()
             .iter()
             .zip(geometry)
-            .map(|(tet, geo)| element_volume(geo, &super::model::gather(tet, u_m)))
+            .map(|(tet, geo)| element_volume(geo, &gather(tet, u_m)))
             .collect();
         let mut change_m3 = vec![0.0; self.reference_m3.len()];
         for ((tet, geo), element) in mesh.tets().iter().zip(geometry).zip(&elements) {
@@ -193,9 +193,7 @@ impl NodalVolumes {
         let (pressure, _, elements) = self.state(mesh, geometry, u_m);
         let mut linear = vec![0.0; pressure.len()];
         for (tet, geo) in mesh.tets().iter().zip(geometry) {
-            let trace = geo
-                .displacement_gradient(&super::model::gather(tet, u_m))
-                .trace();
+            let trace = geo.displacement_gradient(&gather(tet, u_m)).trace();
             for &node in tet {
                 linear[node] += geo.volume_m3 * trace / 4.0;
             }
