@@ -100,8 +100,9 @@ pub fn print_build_report(report: &BuildReport, out: &Path) {
     }
     if let Some(failed) = &report.failed_step {
         println!(
-            "KSV step {:.1} mm left out: its fixed point did not converge (the law loses \
-             stability under the tool); the vademecum is valid to {:.1} mm",
+            "load step {:.1} mm left out: its fixed point did not converge (the law loses \
+             stability under the tool, or the step is too far from the linear response); the \
+             vademecum is valid to {:.1} mm",
             failed.indentation_m * 1e3,
             report.steps.last().map_or(0.0, |s| s.indentation_m * 1e3)
         );

@@ -240,8 +240,8 @@ struct StepContext<'a> {
 /// The steps built, their reports, and the report of a step left out.
 type LoadSteps = (Vec<Step>, Vec<StepReport>, Option<StepReport>);
 
-/// The linear step, then (KSV) one step per indentation level until the last or the first
-/// whose fixed point fails.
+/// The linear step, then (nonlinear laws) one step per indentation level until the last or
+/// the first whose fixed point fails.
 fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     let (stiffness, patches, progress) = (context.stiffness, context.patches, context.progress);
     let clock = Instant::now();
@@ -257,15 +257,16 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     for &level_m in &context.settings.load_steps_m {
         let clock = Instant::now();
         // Each position's load is sized so that its linear response is `level_m` deep, and
-        // pushes into the organ: KSV answers a push and a pull differently.
+        // pushes into the organ: a nonlinear law answers a push and a pull differently.
         let magnitudes: Vec<f64> = reference
             .iter()
             .flat_map(|&c| [if c > 0.0 { level_m / c as f64 } else { 0.0 }; 3])
             .zip(&context.push_signs)
             .map(|(m, sign)| m * sign)
             .collect();
+        let law = stiffness.model.material().law.name();
         progress.start(
-            &format!("KSV step {:.1} mm", level_m * 1e3),
+            &format!("{law} step {:.1} mm", level_m * 1e3),
             patches.parameter_count() as u64,
         );
         let fixed_point;
@@ -278,7 +279,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         );
         if !fixed_point.acceptable(&context.settings.secant) {
             progress.message(&format!(
-                "KSV step {:.1} mm: the fixed point did not converge for {} of {} loads; \
+                "{law} step {:.1} mm: the fixed point did not converge for {} of {} loads; \
                  the vademecum stops at the step before",
                 level_m * 1e3,
                 fixed_point.unconverged,
