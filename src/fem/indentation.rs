@@ -77,6 +77,8 @@ pub struct IndentationSettings {
     /// the depth.
     pub penetration_tolerance: f64,
     pub max_augmentations: usize,
+    /// Times a depth step without equilibrium is halved before the curve stops there.
+    pub max_bisections: usize,
     /// Newton's settings for each solve (`load_steps` is unused: the depths are the steps).
     pub newton: NewtonSettings,
 }
@@ -88,6 +90,7 @@ impl Default for IndentationSettings {
             samples_per_radius: 6.0,
             penetration_tolerance: 1e-3,
             max_augmentations: 20,
+            max_bisections: 4,
             newton: NewtonSettings {
                 relative_tolerance: 1e-8,
                 max_iterations: 40,
@@ -141,7 +144,7 @@ impl FemModel {
         let spacing_m = indenter.radius_m / settings.samples_per_radius;
         let samples = sample_triangles(self.mesh(), triangles, spacing_m);
         let young_pa = self.material().young_pa;
-        let mut contact = SphereContact {
+        let contact = SphereContact {
             penalty_pa_per_m: samples
                 .iter()
                 .map(|s| settings.penalty_factor * young_pa / s.face_size_m)
@@ -151,70 +154,123 @@ impl FemModel {
             center: indenter.center(0.0),
             radius_m: indenter.radius_m,
         };
-        let mut solver = DirectSolver::new(self.pattern())?;
-        let mut u = self.dirichlet().scaled_values(1.0);
-        let f_ext = vec![0.0; u.len()];
+        let mut press = Press {
+            solver: DirectSolver::new(self.pattern())?,
+            u: self.dirichlet().scaled_values(1.0),
+            contact,
+            settings,
+        };
         let mut curve = Vec::with_capacity(depths_m.len());
-        // The last equilibrium, and the step that led to it: the predictor of the next one.
-        let mut converged = (0.0, u.clone());
+        // The last equilibrium (depth, displacement, multipliers), and the step that led to it:
+        // the predictor of the next one.
+        let mut converged = (0.0, press.u.clone(), press.contact.multipliers_pa.clone());
         let mut increment: Option<(f64, Vec<f64>)> = None;
-        for (index, &depth_m) in depths_m.iter().enumerate() {
-            contact.center = indenter.center(depth_m);
-            // Extrapolating the last step starts Newton with the surface near the sphere rather
-            // than deep inside it, where the first iterations would crush the elements there.
-            if let Some((step_m, du)) = &increment {
-                let scale = (depth_m - converged.0) / step_m;
-                for (value, change) in u.iter_mut().zip(du) {
-                    *value += change * scale;
+        for (index, &target_m) in depths_m.iter().enumerate() {
+            // Depths still to reach on the way to the target, the nearest last: a depth
+            // without equilibrium is retried after one halfway to it.
+            let mut pending = vec![target_m];
+            while let Some(&depth_m) = pending.last() {
+                press.contact.center = indenter.center(depth_m);
+                // Extrapolating the last step starts Newton with the surface near the sphere
+                // rather than deep inside it, where the first iterations would crush the
+                // elements there.
+                if let Some((step_m, du)) = &increment {
+                    let scale = (depth_m - converged.0) / step_m;
+                    for (value, change) in press.u.iter_mut().zip(du) {
+                        *value += change * scale;
+                    }
                 }
-            }
-            let step = (index + 1, depths_m.len());
-            let mut point = ForceDepthPoint {
-                depth_m,
-                force_n: 0.0,
-                contact_points: 0,
-                penetration_m: f64::INFINITY,
-                augmentations: 0,
-                newton_iterations: 0,
-            };
-            while point.penetration_m > settings.penetration_tolerance * depth_m
-                && point.augmentations < settings.max_augmentations
-            {
-                let solved = self.equilibrate(
-                    &mut solver,
-                    &mut u,
-                    &f_ext,
-                    &contact,
-                    step,
-                    &settings.newton,
-                );
-                let report: StepReport = match solved {
-                    Ok(report) => report,
-                    Err(error) => {
+                let step = (index + 1, depths_m.len());
+                match press.settle(self, depth_m, step) {
+                    Ok(mut point) => {
+                        pending.pop();
+                        (point.force_n, point.contact_points) =
+                            press
+                                .contact
+                                .total_push(self, &press.u, &indenter.direction);
+                        let du = press
+                            .u
+                            .iter()
+                            .zip(&converged.1)
+                            .map(|(a, b)| a - b)
+                            .collect();
+                        increment = Some((depth_m - converged.0, du));
+                        converged = (
+                            depth_m,
+                            press.u.clone(),
+                            press.contact.multipliers_pa.clone(),
+                        );
+                        if pending.is_empty() {
+                            on_depth(&point);
+                            curve.push(point);
+                        }
+                    }
+                    Err(error) if pending.len() > settings.max_bisections => {
                         return Ok(Indentation {
                             curve,
                             displacement_m: converged.1,
-                            stopped: Some((depth_m, error)),
+                            stopped: Some((target_m, error)),
                         });
                     }
-                };
-                point.newton_iterations += report.step_lengths.len();
-                point.augmentations += 1;
-                point.penetration_m = contact.update_multipliers(self, &u);
+                    Err(_) => {
+                        press.u.clone_from(&converged.1);
+                        press.contact.multipliers_pa.clone_from(&converged.2);
+                        pending.push(0.5 * (converged.0 + depth_m));
+                    }
+                }
             }
-            (point.force_n, point.contact_points) =
-                contact.total_push(self, &u, &indenter.direction);
-            on_depth(&point);
-            curve.push(point);
-            let du = u.iter().zip(&converged.1).map(|(a, b)| a - b).collect();
-            increment = Some((depth_m - converged.0, du));
-            converged = (depth_m, u.clone());
         }
         Ok(Indentation {
             curve,
-            displacement_m: u,
+            displacement_m: press.u,
             stopped: None,
         })
+    }
+}
+
+/// The state of one indentation between depths.
+struct Press<'a> {
+    solver: DirectSolver,
+    u: Vec<f64>,
+    contact: SphereContact,
+    settings: &'a IndentationSettings,
+}
+
+impl Press<'_> {
+    /// Newton solves and multiplier updates at one depth (the contact's centre already there)
+    /// until no surface point is deeper inside the sphere than the tolerance. The force is
+    /// left for the caller.
+    fn settle(
+        &mut self,
+        model: &FemModel,
+        depth_m: f64,
+        step: (usize, usize),
+    ) -> Result<ForceDepthPoint, FemError> {
+        let f_ext = vec![0.0; self.u.len()];
+        let mut point = ForceDepthPoint {
+            depth_m,
+            force_n: 0.0,
+            contact_points: 0,
+            penetration_m: f64::INFINITY,
+            augmentations: 0,
+            newton_iterations: 0,
+        };
+        while point.penetration_m > self.settings.penetration_tolerance * depth_m
+            && point.augmentations < self.settings.max_augmentations
+        {
+            let report: StepReport = model.equilibrate(
+                &mut self.solver,
+                &mut self.u,
+                &f_ext,
+                &self.contact,
+                step,
+                &self.settings.newton,
+            )?;
+            point.newton_iterations += report.step_lengths.len();
+            point.augmentations += 1;
+            point.penetration_m = self.contact.update_multipliers(model, &self.u);
+        }
+        Ok(point)
     }
 }
 
