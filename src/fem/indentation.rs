@@ -129,9 +129,9 @@ impl FemModel {
     /// Presses `indenter` into the body to each of `depths_m` in turn (increasing, positive),
     /// against the surface triangles `triangles` (volume numbering), and reports the
     /// equilibrium at each depth to `on_depth` and in the result. The depths are the load
-    /// steps: space them finely enough for Newton (a tenth of the sphere's radius is safe).
-    /// Bad input is an error; a depth without equilibrium ends the curve (see
-    /// [`Indentation::stopped`]).
+    /// steps (a tenth of the sphere's radius apart is safe); one without equilibrium is
+    /// reached through halfway depths, up to `max_bisections` halvings, and then ends the
+    /// curve (see [`Indentation::stopped`]). Bad input is an error.
     pub fn indent(
         &self,
         triangles: &[[usize; 3]],
