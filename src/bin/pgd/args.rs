@@ -67,9 +67,12 @@ pub enum Command {
     Validate {
         #[command(flatten)]
         mesh: MeshArgs,
-        /// The vademecum (default: vademecums/<source>.vdm).
+        /// The vademecum (default: vademecums/<source>.vdm, or <source>-<law>.vdm with --law).
         #[arg(long, value_name = "FILE.vdm")]
         vademecum: Option<PathBuf>,
+        /// The law of the default vademecum file (the file's own law is the one checked).
+        #[arg(long, value_enum, default_value = "linear")]
+        law: LawArg,
         /// Number of random loads (default 60), or of cut patterns with --cuts (default 5).
         #[arg(long)]
         samples: Option<usize>,
@@ -473,6 +476,12 @@ impl ContactBenchArgs {
 }
 
 /// Where a vademecum of this source goes by default: `vademecums/<stem>.vdm`.
-pub fn default_vademecum(mesh: &MeshArgs) -> PathBuf {
-    PathBuf::from("vademecums").join(format!("{}.vdm", mesh.stem()))
+/// `vademecums/<source>.vdm` for the linear law (the trainer's), `<source>-<law>.vdm` for the
+/// others, so that building a nonlinear vademecum never replaces the trainer's.
+pub fn default_vademecum(mesh: &MeshArgs, law: Law) -> PathBuf {
+    let name = match law {
+        Law::Linear => mesh.stem(),
+        _ => format!("{}-{}", mesh.stem(), law.name()),
+    };
+    PathBuf::from("vademecums").join(format!("{name}.vdm"))
 }

@@ -71,7 +71,7 @@ fn main() -> ExitCode {
             distance_field,
             json,
         } => {
-            let out = out.unwrap_or_else(|| args::default_vademecum(&mesh));
+            let out = out.unwrap_or_else(|| args::default_vademecum(&mesh, material.law.law()));
             let built = job(&mesh, &material, &build)
                 .and_then(|job| cli::build_vademecum(job, &out, distance_field));
             match built {
@@ -86,6 +86,7 @@ fn main() -> ExitCode {
         Command::Validate {
             mesh,
             vademecum,
+            law,
             samples,
             sample_seed,
             max_indentation_mm,
@@ -93,7 +94,7 @@ fn main() -> ExitCode {
             exact_response,
             json,
         } => {
-            let file = vademecum.unwrap_or_else(|| args::default_vademecum(&mesh));
+            let file = vademecum.unwrap_or_else(|| args::default_vademecum(&mesh, law.law()));
             if let Some(pattern) = cuts {
                 let settings = CutValidationSettings {
                     pattern,
