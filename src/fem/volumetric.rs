@@ -113,12 +113,7 @@ impl NodalVolumes {
     ) {
         let (pressure, _, elements) = self.state(mesh, geometry, u_m);
         for (tet, element) in mesh.tets().iter().zip(&elements) {
-            let mean = tet.iter().map(|&n| pressure[n]).sum::<f64>() / 4.0;
-            for (a, &node) in tet.iter().enumerate() {
-                for c in 0..3 {
-                    force[3 * node + c] += mean * element.d[a][c];
-                }
-            }
+            add_corner_forces(tet, &element.d, corner_mean(tet, &pressure), force);
         }
     }
 
@@ -133,12 +128,10 @@ impl NodalVolumes {
     ) {
         let (pressure, stiffness, elements) = self.state(mesh, geometry, u_m);
         for (t, (tet, element)) in mesh.tets().iter().zip(&elements).enumerate() {
-            let mean = tet.iter().map(|&n| pressure[n]).sum::<f64>() / 4.0;
+            let mean = corner_mean(tet, &pressure);
+            add_corner_forces(tet, &element.d, mean, force);
             let mut k = ElementMatrix::zeros();
             for a in 0..4 {
-                for c in 0..3 {
-                    force[3 * tet[a] + c] += mean * element.d[a][c];
-                }
                 for b in 0..4 {
                     // V J c_a = d_a, so V J (c_a c_bᵀ − c_b c_aᵀ) = d_a c_bᵀ − d_b c_aᵀ.
                     let block = (element.d[a] * element.c[b].transpose()
@@ -207,14 +200,27 @@ impl NodalVolumes {
             };
         }
         for ((tet, geo), element) in mesh.tets().iter().zip(geometry).zip(&elements) {
-            let mean = |values: &[f64]| tet.iter().map(|&n| values[n]).sum::<f64>() / 4.0;
-            let (p, q) = (mean(&pressure), mean(&linear));
+            let (p, q) = (corner_mean(tet, &pressure), corner_mean(tet, &linear));
             for (a, &node) in tet.iter().enumerate() {
                 let f = element.d[a] * p - geo.grads[a] * (q * geo.volume_m3);
                 for c in 0..3 {
                     out[3 * node + c] += f[c];
                 }
             }
+        }
+    }
+}
+
+/// The mean of a nodal quantity over an element's corners.
+fn corner_mean(tet: &[usize; 4], values: &[f64]) -> f64 {
+    tet.iter().map(|&n| values[n]).sum::<f64>() / 4.0
+}
+
+/// Adds `pressure · d_a` to each corner `a` of an element.
+fn add_corner_forces(tet: &[usize; 4], d: &[Vector3<f64>; 4], pressure: f64, force: &mut [f64]) {
+    for (a, &node) in tet.iter().enumerate() {
+        for c in 0..3 {
+            force[3 * node + c] += pressure * d[a][c];
         }
     }
 }
