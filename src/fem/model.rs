@@ -46,11 +46,16 @@ impl FemModel {
         let geometry = TetGeometry::of_mesh(&mesh);
         let dofs = DofMap::new(&dirichlet);
         let modulus_scale = vec![1.0; mesh.tet_count()];
-        let volumetric = nodal_volumes(&mesh, &geometry, &material, &modulus_scale);
-        let pattern = match volumetric {
-            Some(_) => FreePattern::two_ring(&mesh, &dofs),
-            None => FreePattern::new(&mesh, &dofs),
+        let pattern = match material.law {
+            Law::NeoHookean => FreePattern::two_ring(&mesh, &dofs),
+            _ => FreePattern::new(&mesh, &dofs),
         };
+        let volumetric = nodal_volumes(
+            (&mesh, &geometry),
+            &material,
+            &modulus_scale,
+            (&pattern, &dofs),
+        );
         Ok(Self {
             modulus_scale,
             volumetric,
@@ -72,10 +77,10 @@ impl FemModel {
     pub fn with_inclusions(mut self, inclusions: &[Inclusion]) -> Result<Self, FemError> {
         self.modulus_scale = modulus_scale(&self.mesh, inclusions)?;
         self.volumetric = nodal_volumes(
-            &self.mesh,
-            &self.geometry,
+            (&self.mesh, &self.geometry),
             &self.material,
             &self.modulus_scale,
+            (&self.pattern, &self.dofs),
         );
         self.inclusions = inclusions.to_vec();
         Ok(self)
@@ -170,7 +175,7 @@ impl FemModel {
         if let Some(volumetric) = &self.volumetric {
             volumetric.add_force_and_tangent(
                 (&self.mesh, &self.geometry),
-                (&self.pattern, &self.dofs),
+                &self.pattern,
                 u_m,
                 &mut force,
                 &mut values,
@@ -204,15 +209,15 @@ impl FemModel {
 /// The neo-Hookean law's nodal volumes, with each element's first Lamé constant scaled by
 /// its inclusion; `None` for the other laws.
 fn nodal_volumes(
-    mesh: &TetMesh,
-    geometry: &[TetGeometry],
+    (mesh, geometry): (&TetMesh, &[TetGeometry]),
     material: &Material,
     modulus_scale: &[f64],
+    (pattern, dofs): (&FreePattern, &DofMap),
 ) -> Option<NodalVolumes> {
     (material.law == Law::NeoHookean).then(|| {
         let (lambda, _) = material.lame();
         let lambdas: Vec<f64> = modulus_scale.iter().map(|s| s * lambda).collect();
-        NodalVolumes::new(mesh, geometry, &lambdas)
+        NodalVolumes::new((mesh, geometry), &lambdas, (pattern, dofs))
     })
 }
 

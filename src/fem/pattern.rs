@@ -100,27 +100,35 @@ impl FreePattern {
 
     /// Adds a 3×3 block coupling node `row` to node `col` into `values` (a force acting on the
     /// nodes of one surface triangle, such as a rigid tool's contact), skipping prescribed
-    /// dofs. The two nodes must share a tetrahedron.
+    /// dofs. The two nodes must share a tetrahedron (or a neighbour, in a two-ring pattern).
     pub fn add_node_block(
         &self,
         dofs: &DofMap,
-        (row, col): (usize, usize),
+        nodes: (usize, usize),
         block: &nalgebra::Matrix3<f64>,
         values: &mut [f64],
     ) {
+        add_at(&self.block_positions(dofs, nodes), block, values);
+    }
+
+    /// Where each entry `(i, j)` of the 3×3 block coupling node `row` to node `col` lands in
+    /// the values (index `3i + j`), or `SKIP` where a dof is prescribed.
+    pub(super) fn block_positions(&self, dofs: &DofMap, (row, col): (usize, usize)) -> [u32; 9] {
         let (col_ptr, row_idx) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
-        let free =
-            |node: usize| -> [usize; 3] { std::array::from_fn(|c| dofs.free_index[3 * node + c]) };
-        let (rows, cols) = (free(row), free(col));
-        for (j, &c) in cols.iter().enumerate().filter(|(_, c)| **c != PRESCRIBED) {
-            let column = &row_idx[col_ptr[c]..col_ptr[c + 1]];
-            for (i, &r) in rows.iter().enumerate().filter(|(_, r)| **r != PRESCRIBED) {
-                let offset = column
-                    .binary_search(&r)
-                    .expect("the pattern holds every pair of nodes that share a tetrahedron");
-                values[col_ptr[c] + offset] += block[(i, j)];
+        std::array::from_fn(|k| {
+            let (r, c) = (
+                dofs.free_index[3 * row + k / 3],
+                dofs.free_index[3 * col + k % 3],
+            );
+            if r == PRESCRIBED || c == PRESCRIBED {
+                return SKIP;
             }
-        }
+            let column = &row_idx[col_ptr[c]..col_ptr[c + 1]];
+            let offset = column
+                .binary_search(&r)
+                .expect("the pattern holds every pair of nodes the block couples");
+            (col_ptr[c] + offset) as u32
+        })
     }
 
     /// Wraps values into a faer matrix (copies the pattern, which is cheap next to a solve).
@@ -140,6 +148,15 @@ impl FreePattern {
             for p in col_ptr[j]..col_ptr[j + 1] {
                 y[row_idx[p]] += values[p] * xj;
             }
+        }
+    }
+}
+
+/// Adds a 3×3 block at the positions of [`FreePattern::block_positions`].
+pub(super) fn add_at(positions: &[u32], block: &nalgebra::Matrix3<f64>, values: &mut [f64]) {
+    for (k, &pos) in positions.iter().enumerate() {
+        if pos != SKIP {
+            values[pos as usize] += block[(k / 3, k % 3)];
         }
     }
 }

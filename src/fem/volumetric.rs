@@ -20,7 +20,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::DofMap;
 use super::element::{ElementMatrix, ElementVector, TetGeometry, gather};
-use super::pattern::FreePattern;
+use super::pattern::{FreePattern, add_at};
 use crate::mesh::TetMesh;
 
 /// Per-node constants of the averaged volumetric energy.
@@ -31,6 +31,17 @@ pub(super) struct NodalVolumes {
     lambda_pa: Vec<f64>,
     /// The elements around each node.
     node_tets: Vec<Vec<usize>>,
+    /// The nodes around each node, and where their blocks land in the stiffness values.
+    rings: Vec<Ring>,
+}
+
+/// The nodes of the elements around one node, ascending: the support of its volume gradient.
+struct Ring {
+    nodes: Vec<usize>,
+    /// For each element around the node, the place of each of its corners in `nodes`.
+    corner_slots: Vec<[usize; 4]>,
+    /// For each pair `(i, j)` of ring nodes, the positions of their 3×3 block, at `9 (i r + j)`.
+    positions: Vec<u32>,
 }
 
 /// One element's volumetric quantities at the current displacement.
@@ -44,8 +55,13 @@ struct ElementVolume {
 }
 
 impl NodalVolumes {
-    /// `lambda_pa[e]` is element `e`'s first Lamé constant.
-    pub(super) fn new(mesh: &TetMesh, geometry: &[TetGeometry], lambda_pa: &[f64]) -> Self {
+    /// `lambda_pa[e]` is element `e`'s first Lamé constant; `pattern` is the model's two-ring
+    /// pattern.
+    pub(super) fn new(
+        (mesh, geometry): (&TetMesh, &[TetGeometry]),
+        lambda_pa: &[f64],
+        (pattern, dofs): (&FreePattern, &DofMap),
+    ) -> Self {
         let n = mesh.node_count();
         let (mut reference_m3, mut weighted) = (vec![0.0; n], vec![0.0; n]);
         let mut node_tets = vec![Vec::new(); n];
@@ -61,10 +77,15 @@ impl NodalVolumes {
             .zip(&reference_m3)
             .map(|(w, v)| if *v > 0.0 { w / v } else { 0.0 })
             .collect();
+        let rings = node_tets
+            .iter()
+            .map(|tets| Ring::new(mesh, tets, pattern, dofs))
+            .collect();
         Self {
             reference_m3,
             lambda_pa,
             node_tets,
+            rings,
         }
     }
 
@@ -121,7 +142,7 @@ impl NodalVolumes {
     pub(super) fn add_force_and_tangent(
         &self,
         (mesh, geometry): (&TetMesh, &[TetGeometry]),
-        (pattern, dofs): (&FreePattern, &DofMap),
+        pattern: &FreePattern,
         u_m: &[f64],
         force: &mut [f64],
         values: &mut [f64],
@@ -142,35 +163,24 @@ impl NodalVolumes {
             }
             pattern.scatter(t, &k, values);
         }
-        for (n, tets) in self.node_tets.iter().enumerate() {
-            let gradient = self.volume_gradient(mesh, &elements, tets);
-            for &(a, da) in &gradient {
-                for &(b, db) in &gradient {
-                    let block: Matrix3<f64> = da * db.transpose() * stiffness[n];
-                    pattern.add_node_block(dofs, (a, b), &block, values);
+        let mut gradient = Vec::new();
+        for (n, (tets, ring)) in self.node_tets.iter().zip(&self.rings).enumerate() {
+            // b_n = ∂v_n/∂x over the ring: a quarter of each element's volume gradient.
+            gradient.clear();
+            gradient.resize(ring.nodes.len(), Vector3::zeros());
+            for (&t, slots) in tets.iter().zip(&ring.corner_slots) {
+                for (a, &slot) in slots.iter().enumerate() {
+                    gradient[slot] += elements[t].d[a] / 4.0;
+                }
+            }
+            let r = ring.nodes.len();
+            for (i, gi) in gradient.iter().enumerate() {
+                for (j, gj) in gradient.iter().enumerate() {
+                    let block: Matrix3<f64> = gi * gj.transpose() * stiffness[n];
+                    add_at(&ring.positions[9 * (i * r + j)..][..9], &block, values);
                 }
             }
         }
-    }
-
-    /// `b_n = ∂v_n/∂x` as (node, 3-vector) over the nodes around `n`.
-    fn volume_gradient(
-        &self,
-        mesh: &TetMesh,
-        elements: &[ElementVolume],
-        tets: &[usize],
-    ) -> Vec<(usize, Vector3<f64>)> {
-        let mut gradient: Vec<(usize, Vector3<f64>)> = Vec::with_capacity(16);
-        for &t in tets {
-            for (a, &node) in mesh.tets()[t].iter().enumerate() {
-                let share = elements[t].d[a] / 4.0;
-                match gradient.iter_mut().find(|(m, _)| *m == node) {
-                    Some((_, sum)) => *sum += share,
-                    None => gradient.push((node, share)),
-                }
-            }
-        }
-        gradient
     }
 
     /// Adds the volumetric force minus its rest linearization, `f_vol(u) − K₀ u`, on every dof:
@@ -207,6 +217,26 @@ impl NodalVolumes {
                     out[3 * node + c] += f[c];
                 }
             }
+        }
+    }
+}
+
+impl Ring {
+    fn new(mesh: &TetMesh, tets: &[usize], pattern: &FreePattern, dofs: &DofMap) -> Self {
+        let mut nodes: Vec<usize> = tets.iter().flat_map(|&t| mesh.tets()[t]).collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        let slot = |node: usize| nodes.binary_search(&node).expect("listed above");
+        let corner_slots = tets.iter().map(|&t| mesh.tets()[t].map(slot)).collect();
+        let positions = nodes
+            .iter()
+            .flat_map(|&a| nodes.iter().map(move |&b| (a, b)))
+            .flat_map(|pair| pattern.block_positions(dofs, pair))
+            .collect();
+        Self {
+            nodes,
+            corner_slots,
+            positions,
         }
     }
 }
