@@ -133,7 +133,7 @@ const TISSUE_POISSON: f64 = 0.48;
 /// ν = 0.3; the block's finite size adds under 1 %).
 const HERTZ_TOLERANCE: f64 = 0.06;
 
-/// Linear tetrahedra that keep each element's volume are 20 % stiffer than Hertz there.
+/// Linear tetrahedra that keep each element's volume are 17.6 % stiffer than Hertz there.
 const LOCKED_AT_LEAST: f64 = 0.12;
 
 fn force_at_hertz_depth(law: Law) -> (f64, f64) {
