@@ -189,15 +189,14 @@ pub fn print_indentation(report: &IndentReport) {
         header += &format!(" {:>14}", format!("{} N", curve.law));
     }
     println!("{header}");
-    let rows = report
+    // Every curve shares the depths; the longest lists the most of them.
+    let depths = report
         .curves
         .iter()
-        .map(|c| c.depth_m.len())
-        .max()
-        .unwrap_or(0);
-    let longest = report.curves.iter().max_by_key(|c| c.depth_m.len());
-    for row in 0..rows {
-        let depth = longest.map_or(0.0, |c| c.depth_m[row]);
+        .map(|c| &c.depth_m)
+        .max_by_key(|d| d.len())
+        .map_or(&[][..], |d| &d[..]);
+    for (row, depth) in depths.iter().enumerate() {
         let mut line = format!("{:>10.2}", depth * 1e3);
         for curve in &report.curves {
             line += &match curve.force_n.get(row) {

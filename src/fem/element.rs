@@ -224,16 +224,23 @@ impl TetGeometry {
 /// invariants of `h`): differences of numbers near 1 would cancel catastrophically for small
 /// strains and put a floor under Newton's relative residual.
 fn neo_hookean_stress(lambda: f64, mu: f64, h: &Matrix3<f64>) -> (Matrix3<f64>, Matrix3<f64>, f64) {
-    let f = Matrix3::identity() + h;
-    let trace = h.trace();
-    let j_minus_one = trace + 0.5 * (trace * trace - (h * h).trace()) + h.determinant();
-    let Some(inverse) = f.try_inverse().filter(|_| j_minus_one > -1.0) else {
-        let nan = Matrix3::from_element(f64::NAN);
-        return (nan, nan, f64::NAN);
-    };
+    let (j_minus_one, inverse_t) = volume_change(h);
     let log_j = j_minus_one.ln_1p();
-    let inverse_t = inverse.transpose();
-    let f_minus_inverse_t = h + (h * inverse).transpose();
+    // F − F⁻ᵀ = h + (h F⁻¹)ᵀ = h + F⁻ᵀ hᵀ.
+    let f_minus_inverse_t = h + inverse_t * h.transpose();
     let p = f_minus_inverse_t * mu + inverse_t * (lambda * log_j);
     (p, inverse_t, log_j)
+}
+
+/// `J − 1` and `F⁻ᵀ` for the displacement gradient `h`, `F⁻ᵀ` NaN for an element turned inside
+/// out (J ≤ 0). `J − 1 = I₁ + I₂ + I₃` from the invariants of `h`, not `det F − 1`, which
+/// cancels catastrophically for small strains.
+pub(super) fn volume_change(h: &Matrix3<f64>) -> (f64, Matrix3<f64>) {
+    let trace = h.trace();
+    let j_minus_one = trace + 0.5 * (trace * trace - (h * h).trace()) + h.determinant();
+    let inverse_t = match (Matrix3::identity() + h).try_inverse() {
+        Some(inverse) if j_minus_one > -1.0 => inverse.transpose(),
+        _ => Matrix3::from_element(f64::NAN),
+    };
+    (j_minus_one, inverse_t)
 }

@@ -16,7 +16,7 @@ use nalgebra::{Matrix3, Point3, Vector3};
 
 use super::linear_solver::DirectSolver;
 use super::newton::ExtraForce;
-use super::{FemError, FemModel, NewtonSettings, StepReport};
+use super::{FemError, FemModel, NewtonSettings};
 
 /// A rigid sphere pressed into a body along a straight line.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -258,7 +258,7 @@ impl Press<'_> {
         while point.penetration_m > self.settings.penetration_tolerance * depth_m
             && point.augmentations < self.settings.max_augmentations
         {
-            let report: StepReport = model.equilibrate(
+            let report = model.equilibrate(
                 &mut self.solver,
                 &mut self.u,
                 &f_ext,

@@ -28,6 +28,12 @@ impl Law {
             Law::NeoHookean => "neo-hookean",
         }
     }
+
+    /// Whether the law's volumetric energy lives on nodal volumes (see `volumetric.rs`) rather
+    /// than in each element.
+    pub(super) fn has_nodal_volumes(self) -> bool {
+        self == Law::NeoHookean
+    }
 }
 
 /// An isotropic elastic material in SI units.

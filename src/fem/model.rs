@@ -46,9 +46,9 @@ impl FemModel {
         let geometry = TetGeometry::of_mesh(&mesh);
         let dofs = DofMap::new(&dirichlet);
         let modulus_scale = vec![1.0; mesh.tet_count()];
-        let pattern = match material.law {
-            Law::NeoHookean => FreePattern::two_ring(&mesh, &dofs),
-            _ => FreePattern::new(&mesh, &dofs),
+        let pattern = match material.law.has_nodal_volumes() {
+            true => FreePattern::two_ring(&mesh, &dofs),
+            false => FreePattern::new(&mesh, &dofs),
         };
         let volumetric = nodal_volumes(
             (&mesh, &geometry),
@@ -206,15 +206,15 @@ impl FemModel {
     }
 }
 
-/// The neo-Hookean law's nodal volumes, with each element's first Lamé constant scaled by
-/// its inclusion; `None` for the other laws.
+/// The law's nodal volumes, with each element's first Lamé constant scaled by its inclusion;
+/// `None` for a law whose elements carry all their energy.
 fn nodal_volumes(
     (mesh, geometry): (&TetMesh, &[TetGeometry]),
     material: &Material,
     modulus_scale: &[f64],
     (pattern, dofs): (&FreePattern, &DofMap),
 ) -> Option<NodalVolumes> {
-    (material.law == Law::NeoHookean).then(|| {
+    material.law.has_nodal_volumes().then(|| {
         let (lambda, _) = material.lame();
         let lambdas: Vec<f64> = modulus_scale.iter().map(|s| s * lambda).collect();
         NodalVolumes::new((mesh, geometry), &lambdas, (pattern, dofs))

@@ -19,7 +19,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::DofMap;
-use super::element::{ElementMatrix, ElementVector, TetGeometry, gather};
+use super::element::{ElementMatrix, ElementVector, TetGeometry, gather, volume_change};
 use super::pattern::{FreePattern, add_at};
 use crate::mesh::TetMesh;
 
@@ -48,6 +48,8 @@ struct Ring {
 struct ElementVolume {
     /// `J − 1`, formed from the invariants of the displacement gradient.
     j_minus_one: f64,
+    /// `tr(H)`, the linear volumetric strain.
+    trace: f64,
     /// `d_a = V_e cof(F) g_a`, the derivative of the element's volume by its corners.
     d: [Vector3<f64>; 4],
     /// `c_a = F⁻ᵀ g_a`.
@@ -102,26 +104,41 @@ impl NodalVolumes {
             .zip(geometry)
             .map(|(tet, geo)| element_volume(geo, &gather(tet, u_m)))
             .collect();
-        let mut change_m3 = vec![0.0; self.reference_m3.len()];
-        for ((tet, geo), element) in mesh.tets().iter().zip(geometry).zip(&elements) {
-            for &node in tet {
-                change_m3[node] += geo.volume_m3 * element.j_minus_one / 4.0;
-            }
-        }
+        let j_minus_one = self.nodal_mean(mesh, geometry, |t| elements[t].j_minus_one);
         let (mut pressure, mut stiffness) =
-            (vec![0.0; change_m3.len()], vec![0.0; change_m3.len()]);
-        for n in 0..change_m3.len() {
+            (vec![0.0; j_minus_one.len()], vec![0.0; j_minus_one.len()]);
+        for (n, &change) in j_minus_one.iter().enumerate() {
             let volume = self.reference_m3[n];
             if volume <= 0.0 {
                 continue;
             }
-            let j_minus_one = change_m3[n] / volume;
-            let (j, log_j) = (1.0 + j_minus_one, j_minus_one.ln_1p());
+            let (j, log_j) = (1.0 + change, change.ln_1p());
             let lambda = self.lambda_pa[n];
             pressure[n] = lambda * log_j / j;
             stiffness[n] = lambda * (1.0 - log_j) / (j * j * volume);
         }
         (pressure, stiffness, elements)
+    }
+
+    /// The volume-weighted mean over the elements around each node of a per-element quantity
+    /// (`Σ_e V_e x_e / 4V_n`; zero at a node in no element).
+    fn nodal_mean(
+        &self,
+        mesh: &TetMesh,
+        geometry: &[TetGeometry],
+        of_element: impl Fn(usize) -> f64,
+    ) -> Vec<f64> {
+        let mut sum = vec![0.0; self.reference_m3.len()];
+        for (t, (tet, geo)) in mesh.tets().iter().zip(geometry).enumerate() {
+            let share = geo.volume_m3 * of_element(t) / 4.0;
+            for &node in tet {
+                sum[node] += share;
+            }
+        }
+        for (value, &volume) in sum.iter_mut().zip(&self.reference_m3) {
+            *value = if volume > 0.0 { *value / volume } else { 0.0 };
+        }
+        sum
     }
 
     /// Adds the volumetric force (N) on every dof.
@@ -194,21 +211,12 @@ impl NodalVolumes {
         out: &mut [f64],
     ) {
         let (pressure, _, elements) = self.state(mesh, geometry, u_m);
-        let mut linear = vec![0.0; pressure.len()];
-        for (tet, geo) in mesh.tets().iter().zip(geometry) {
-            let trace = geo.displacement_gradient(&gather(tet, u_m)).trace();
-            for &node in tet {
-                linear[node] += geo.volume_m3 * trace / 4.0;
-            }
-        }
-        for (n, value) in linear.iter_mut().enumerate() {
-            let volume = self.reference_m3[n];
-            *value = if volume > 0.0 {
-                self.lambda_pa[n] * *value / volume
-            } else {
-                0.0
-            };
-        }
+        let linear: Vec<f64> = self
+            .nodal_mean(mesh, geometry, |t| elements[t].trace)
+            .iter()
+            .zip(&self.lambda_pa)
+            .map(|(theta, lambda)| lambda * theta)
+            .collect();
         for ((tet, geo), element) in mesh.tets().iter().zip(geometry).zip(&elements) {
             let (p, q) = (corner_mean(tet, &pressure), corner_mean(tet, &linear));
             for (a, &node) in tet.iter().enumerate() {
@@ -255,19 +263,14 @@ fn add_corner_forces(tet: &[usize; 4], d: &[Vector3<f64>; 4], pressure: f64, for
     }
 }
 
-/// `J − 1`, `d_a` and `c_a` of one element; NaN when it is turned inside out (J ≤ 0).
+/// One element's volume terms at its displacement `u`.
 fn element_volume(geo: &TetGeometry, u: &ElementVector) -> ElementVolume {
     let h = geo.displacement_gradient(u);
-    let trace = h.trace();
-    let j_minus_one = trace + 0.5 * (trace * trace - (h * h).trace()) + h.determinant();
-    let f = Matrix3::identity() + h;
-    let inverse_t = match f.try_inverse() {
-        Some(inverse) if j_minus_one > -1.0 => inverse.transpose(),
-        _ => Matrix3::from_element(f64::NAN),
-    };
+    let (j_minus_one, inverse_t) = volume_change(&h);
     let cofactor = inverse_t * (1.0 + j_minus_one);
     ElementVolume {
         j_minus_one,
+        trace: h.trace(),
         d: geo.grads.map(|g| cofactor * g * geo.volume_m3),
         c: geo.grads.map(|g| inverse_t * g),
     }
