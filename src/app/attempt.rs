@@ -10,6 +10,7 @@ use super::haptic::{ExerciseLink, ExerciseRun, HapticLoop, HapticScene, TickCloc
 use super::scene::{Detail, SceneOrgan, scene_of};
 use crate::contact::{ContactSurface, CouplingSettings};
 use crate::devices::{HapticDevice, TICK_S};
+use crate::fem::Law;
 use crate::mesh::organs::Organ;
 use crate::scenario::{
     self, Exercise, Nodule, NoduleSite, OrganEntry, RegionSite, Scenario, Scorecard, Sites, Task,
@@ -73,6 +74,7 @@ fn scene_organ(scenario: &Scenario, entry: &OrganEntry) -> Result<SceneOrgan, St
         young_pa: entry.young_pa.map(|e| e.0),
         poisson: entry.poisson_ratio.map(|nu| nu.0),
         max_modes: entry.max_modes.map(|n| n.0),
+        law: entry.law.unwrap_or(Law::Linear),
         inclusions: scenario
             .nodules
             .iter()

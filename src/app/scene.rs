@@ -14,7 +14,7 @@ use crate::fem::{Inclusion, Law};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::{Organ, OrganSettings, region};
 use crate::pgd::{BuildSettings, Vademecum};
-use crate::store::{OnStale, OrganSource, VademecumSpec, ensure_vademecum};
+use crate::store::{OnStale, OrganSource, VademecumSpec, ensure_vademecum, vademecum_file_name};
 
 pub const SCENE_ORGANS: [Organ; 4] = Organ::ABDOMEN;
 
@@ -86,6 +86,8 @@ pub struct SceneOrgan {
     /// The vademecum's cap on modes when not the builder's.
     pub max_modes: Option<usize>,
     pub inclusions: Vec<Inclusion>,
+    /// The tissue's law, which its vademecum is built under.
+    pub law: Law,
 }
 
 impl From<Organ> for SceneOrgan {
@@ -97,6 +99,7 @@ impl From<Organ> for SceneOrgan {
             poisson: None,
             max_modes: None,
             inclusions: Vec::new(),
+            law: Law::Linear,
         }
     }
 }
@@ -105,14 +108,15 @@ impl SceneOrgan {
     /// Its vademecum at `detail` for a tool tip of `tip_m`, kept under `dir` in a file named
     /// after what differs from the defaults.
     fn vademecum(&self, dir: &Path, detail: Detail, tip_m: f64) -> VademecumSpec {
-        let file = match &self.source {
-            OrganSource::Generated(_) => format!("{}.vdm", self.name),
+        let stem = match &self.source {
+            OrganSource::Generated(_) => self.name.clone(),
             OrganSource::File(path) => {
                 let stem = path.file_stem().unwrap_or_default().to_string_lossy();
-                format!("{}.mesh-{stem}.vdm", self.name)
+                format!("{}.mesh-{stem}", self.name)
             }
         };
-        let spec = VademecumSpec::new(&self.name, self.source.clone(), Law::Linear, dir.join(file));
+        let file = dir.join(vademecum_file_name(&stem, self.law));
+        let spec = VademecumSpec::new(&self.name, self.source.clone(), self.law, file);
         let mut spec = detail.applied(spec);
         let mut tag = |part: String| spec.file = spec.file.with_extension(format!("{part}.vdm"));
         if tip_m != spec.build.tool_tip_radius_m {

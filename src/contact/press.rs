@@ -45,6 +45,9 @@ pub struct ToolContact {
     /// How far the tip reaches below the rest surface, along the normal (m); clamped to the
     /// vademecum's valid range.
     pub depth_m: f64,
+    /// How much deeper than that range the tip reaches (m); zero within it. The force stays
+    /// at the range's edge there, bounded and finite, and the run's report says so.
+    pub beyond_range_m: f64,
     /// The displacement the tool's load adds to the surface under it (m): into the surface by
     /// the depth, and back sideways by what the other loads moved it.
     pub indentation_m: Vector3<f64>,
@@ -147,15 +150,17 @@ where
     if depth_m <= 0.0 {
         return None;
     }
-    let depth_m = match vademecum.steps.len() {
-        1 => depth_m,
-        _ => depth_m.min(vademecum.valid_indentation_m()),
+    let valid_m = match vademecum.steps.len() {
+        1 => f64::INFINITY,
+        _ => vademecum.valid_indentation_m(),
     };
+    let (depth_m, beyond_range_m) = (depth_m.min(valid_m), (depth_m - valid_m).max(0.0));
     let sideways_m = moved_m - hit.normal * moved_m.dot(&hit.normal);
     Some(ToolContact {
         hit,
         moved_m,
         depth_m,
+        beyond_range_m,
         indentation_m: -hit.normal * depth_m - sideways_m,
         stiffness_n_per_m: Matrix3::zeros(),
         force_n: Vector3::zeros(),

@@ -9,6 +9,7 @@ use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 
 use crate::contact::PointshellDensity;
+use crate::fem::Law;
 
 use super::units::{Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, Seconds};
 
@@ -182,6 +183,9 @@ pub struct OrganEntry {
     /// At most this many separated modes in its vademecum, when not the builder's default.
     #[serde(default)]
     pub max_modes: Option<ModeCount>,
+    /// Its tissue's law (`Linear`, `NeoHookean`, `KirchhoffSaintVenant`), when not linear.
+    #[serde(default)]
+    pub law: Option<Law>,
 }
 
 impl OrganEntry {
@@ -193,6 +197,7 @@ impl OrganEntry {
             young_pa: None,
             poisson_ratio: None,
             max_modes: None,
+            law: None,
         }
     }
 }

@@ -9,4 +9,6 @@ mod vademecums;
 
 pub use progress::Bar;
 pub use source::{MeshSource, OrganSource, load_source};
-pub use vademecums::{BuildJob, OnStale, VademecumSpec, build_and_save, ensure_vademecum};
+pub use vademecums::{
+    BuildJob, OnStale, VademecumSpec, build_and_save, ensure_vademecum, vademecum_file_name,
+};

@@ -51,9 +51,10 @@ impl VademecumSpec {
         self.file.with_extension("vdf")
     }
 
-    /// The organ's default vademecum (the papers' mesh, default settings) under `dir`.
+    /// The organ's default vademecum under `law` (the papers' mesh, default settings) under
+    /// `dir`.
     pub fn default_in(dir: &Path, organ: Organ, law: Law) -> Self {
-        let file = dir.join(format!("{}.vdm", organ.name()));
+        let file = dir.join(vademecum_file_name(organ.name(), law));
         Self::new(organ.name(), OrganSource::Generated(organ), law, file)
     }
 
@@ -115,6 +116,16 @@ impl VademecumSpec {
             command += &format!(" --inclusion {}", inclusion_arg(inclusion));
         }
         command + &format!(" --out {}", self.file.display())
+    }
+}
+
+/// The file name of the vademecum of `stem` under `law`: `<stem>.vdm` for the linear law,
+/// `<stem>-<law>.vdm` for the others, so that a nonlinear vademecum never replaces the linear
+/// one beside it.
+pub fn vademecum_file_name(stem: &str, law: Law) -> String {
+    match law {
+        Law::Linear => format!("{stem}.vdm"),
+        _ => format!("{stem}-{}.vdm", law.name()),
     }
 }
 

@@ -6,6 +6,7 @@ mod deformed;
 mod devices;
 mod faults;
 mod press;
+mod range;
 mod replay;
 mod superposition;
 mod workspace;

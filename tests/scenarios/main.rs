@@ -11,6 +11,7 @@ use std::sync::OnceLock;
 use pgd_surgery::app::attempt::{Outcome, run_simulated, scenario_scene};
 use pgd_surgery::app::scene::{Detail, default_scene};
 use pgd_surgery::devices::{Scripted, TICK_S, Trajectory};
+use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::io::write_vtu;
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate};
 use pgd_surgery::report::write_report;
@@ -247,6 +248,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             7,
             "organs[0].stiffness_pa",
             "stiffness_pa",
+        ),
+        (
+            "unknown-law",
+            7,
+            "organs[0].law",
+            "Unexpected variant named `Hookean`",
         ),
     ];
     for (name, line, field, message) in cases {
@@ -520,4 +527,25 @@ fn the_scenario_chooses_the_contact_master() {
         sparse > 0 && sparse < nodes,
         "{sparse} points 15 mm apart against {nodes} nodes"
     );
+}
+
+/// `law` picks the tissue's law per organ: the liver's vademecum is built under the
+/// neo-Hookean law, with its load steps and their range, and kept beside the linear one under
+/// the law's name; the gallbladder beside it stays linear.
+#[test]
+fn the_scenario_picks_the_law_per_organ() {
+    let text = r#"Scenario(title: "Press", briefing: "Press.",
+        organs: [Organ(name: "liver", law: NeoHookean), "gallbladder"],
+        tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3,
+                             hold_s: 1.0, time_limit_s: 5.0)])"#;
+    let scenario = parse(Path::new("law.scenario.ron"), text).unwrap();
+    let scene = scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap();
+    let law = |k: usize| scene.organs[k].1.header.material.law;
+    assert_eq!(law(0), Law::NeoHookean);
+    assert_eq!(law(1), Law::Linear);
+    let liver = &scene.organs[0].1;
+    assert_eq!(liver.steps.len(), 4, "the linear step and three load steps");
+    assert_eq!(liver.valid_indentation_m(), 1.5e-3);
+    assert!(vademecums().join("liver-neo-hookean.coarse.vdm").is_file());
+    assert_eq!(scene.organs[1].1.valid_indentation_m(), 0.0);
 }

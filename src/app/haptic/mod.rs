@@ -16,7 +16,7 @@ use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
 
 pub use components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
-pub use report::{ForceSummary, HeadlessReport, TickTimes};
+pub use report::{ForceSummary, HeadlessReport, RangeSummary, TickTimes};
 pub use resources::{Device, DeviceForce, FaultLog, ForceTrace, OrganCoupling, TickClock, Tool};
 pub use runner::{HapticLoop, HapticScene, SceneError};
 pub use scoring::{ExerciseLink, ExerciseRun};

@@ -58,6 +58,53 @@ impl ForceSummary {
     }
 }
 
+/// How often and how far the tool pressed beyond what an organ's nonlinear vademecum covers
+/// (its deepest load step): there the force is held at the range's edge.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct RangeSummary {
+    pub beyond_ticks: u64,
+    /// The farthest the tip reached beyond the range (mm).
+    pub max_beyond_mm: f64,
+    /// The organs pressed beyond their range, each with its range (mm).
+    pub organs: Vec<(String, f64)>,
+}
+
+impl RangeSummary {
+    /// Records a tick in which the tool pressed `beyond_m` past the range `valid_m` of
+    /// `organ`; ticks within range (`beyond_m` zero) are not recorded.
+    pub(super) fn record(&mut self, organ: &str, beyond_m: f64, valid_m: f64) {
+        if beyond_m <= 0.0 {
+            return;
+        }
+        self.beyond_ticks += 1;
+        self.max_beyond_mm = self.max_beyond_mm.max(beyond_m * 1e3);
+        if !self.organs.iter().any(|(name, _)| name == organ) {
+            self.organs.push((organ.to_owned(), valid_m * 1e3));
+        }
+    }
+}
+
+impl fmt::Display for RangeSummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.beyond_ticks == 0 {
+            return write!(f, "range: the tool stayed within every vademecum's range");
+        }
+        let organs: Vec<String> = self
+            .organs
+            .iter()
+            .map(|(name, valid_mm)| format!("{name} (valid to {valid_mm:.1} mm)"))
+            .collect();
+        write!(
+            f,
+            "range: the tool pressed beyond the vademecum's range for {} ticks, up to {:.1} mm \
+             deeper, on {}; the force was held at the range's edge there",
+            self.beyond_ticks,
+            self.max_beyond_mm,
+            organs.join(", ")
+        )
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct HeadlessReport {
     pub device: String,
@@ -65,6 +112,7 @@ pub struct HeadlessReport {
     pub ticks: u64,
     pub simulated_s: f64,
     pub force: ForceSummary,
+    pub range: RangeSummary,
     /// Wall-clock compute time of each tick.
     pub compute: TickTimes,
     /// Ticks whose compute exceeded the 1 ms period.
@@ -81,7 +129,7 @@ impl HeadlessReport {
         (device, organs): (String, Vec<String>),
         log: &FaultLog,
         ticks: u64,
-        force: ForceSummary,
+        (force, range): (ForceSummary, RangeSummary),
         compute: &Histogram,
     ) -> Self {
         let period = Duration::from_secs_f64(TICK_S);
@@ -94,6 +142,7 @@ impl HeadlessReport {
             ticks,
             simulated_s: ticks as f64 * TICK_S,
             force,
+            range,
             compute: TickTimes::of(compute),
             overruns,
         }
@@ -123,6 +172,7 @@ impl fmt::Display for HeadlessReport {
             "tick compute: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; {} overruns of 1 ms",
             self.compute.p50_us, self.compute.p99_us, self.compute.max_us, self.overruns
         )?;
+        writeln!(f, "{}", self.range)?;
         write!(f, "faults: {} ticks faulted", self.faulted_ticks)?;
         for (tick, fault) in &self.faults {
             write!(f, "\n  tick {tick}: {fault}")?;

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 use bevy::prelude::*;
 
 use super::components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
-use super::report::{ForceSummary, HeadlessReport};
+use super::report::{ForceSummary, HeadlessReport, RangeSummary};
 use super::resources::{
     Device, DeviceForce, FaultLog, ForceTrace, OrganCoupling, Safety, TickClock, Tool,
 };
@@ -161,6 +161,7 @@ impl HapticLoop {
     pub fn run_simulated(&mut self, ticks: u64) -> HeadlessReport {
         let mut compute = Histogram::default();
         let mut forces = ForceSummary::default();
+        let mut range = RangeSummary::default();
         for tick in 0..ticks {
             let time = self.tick(TickClock {
                 tick,
@@ -169,16 +170,24 @@ impl HapticLoop {
             });
             compute.record(time);
             let force = *self.world.resource::<DeviceForce>();
-            let touching = self
+            let mut touching = false;
+            for (body, touch) in self
                 .world
-                .query::<&ToolTouch>()
+                .query::<(&OrganBody, &ToolTouch)>()
                 .iter(&self.world)
-                .any(|t| t.contact.is_some());
+            {
+                let Some(contact) = &touch.contact else {
+                    continue;
+                };
+                touching = true;
+                let valid_m = body.vademecum.valid_indentation_m();
+                range.record(&body.name, contact.beyond_range_m, valid_m);
+            }
             forces.record(&force, touching);
         }
         let names = (self.device_name(), self.organ_names());
         let log = self.world.resource::<FaultLog>();
-        HeadlessReport::new(names, log, ticks, forces, &compute)
+        HeadlessReport::new(names, log, ticks, (forces, range), &compute)
     }
 
     pub(super) fn device_name(&self) -> String {

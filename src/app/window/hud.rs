@@ -6,6 +6,7 @@ use bevy::prelude::*;
 use super::FrameSet;
 use super::bridge::{HapticLink, Snapshot};
 use super::lesson::Lesson;
+use crate::app::haptic::HapticSnapshot;
 
 #[derive(Component)]
 struct Hud;
@@ -76,7 +77,11 @@ fn update_hud(
     } else if touching.is_empty() {
         "no contact".to_owned()
     } else {
-        format!("touching {}", touching.join(", "))
+        format!(
+            "touching {}{}",
+            touching.join(", "),
+            beyond_range(&snapshot.0)
+        )
     };
     let help = if link.virtual_device.is_some() {
         "\nmouse: move the tool | wheel or W/S: push in / pull out\n\
@@ -115,4 +120,22 @@ fn task_line(lesson: &Lesson, snapshot: &Snapshot) -> String {
         progress.task_elapsed_s,
         task.time_limit_s()
     )
+}
+
+/// What the status line adds while the tool presses deeper than a nonlinear vademecum covers:
+/// the trainee should know the force no longer grows there.
+fn beyond_range(snapshot: &HapticSnapshot) -> String {
+    let beyond_m = snapshot
+        .organs
+        .iter()
+        .filter_map(|o| o.contact.map(|c| c.beyond_range_m))
+        .fold(0.0, f64::max);
+    if beyond_m > 0.0 {
+        format!(
+            " | {:.1} mm beyond the model's range: force held",
+            beyond_m * 1e3
+        )
+    } else {
+        String::new()
+    }
 }

@@ -11,6 +11,7 @@ use pgd_surgery::mesh::TetMesh;
 use pgd_surgery::mesh::io::ImportOptions;
 use pgd_surgery::mesh::organs::{CORNEA_LAYERS, Organ, OrganSettings};
 use pgd_surgery::pgd::{self, BuildSettings, PgdSettings, RegionSettings, ValidationSettings};
+use pgd_surgery::store::vademecum_file_name;
 use pgd_surgery::{bench, cli, store};
 
 #[derive(Parser)]
@@ -475,13 +476,8 @@ impl ContactBenchArgs {
     }
 }
 
-/// Where a vademecum of this source goes by default: `vademecums/<stem>.vdm`.
-/// `vademecums/<source>.vdm` for the linear law (the trainer's), `<source>-<law>.vdm` for the
-/// others, so that building a nonlinear vademecum never replaces the trainer's.
+/// Where a vademecum of this source goes by default: `vademecums/<source>.vdm` for the linear
+/// law, `<source>-<law>.vdm` for the others ([`vademecum_file_name`]).
 pub fn default_vademecum(mesh: &MeshArgs, law: Law) -> PathBuf {
-    let name = match law {
-        Law::Linear => mesh.stem(),
-        _ => format!("{}-{}", mesh.stem(), law.name()),
-    };
-    PathBuf::from("vademecums").join(format!("{name}.vdm"))
+    PathBuf::from("vademecums").join(vademecum_file_name(&mesh.stem(), law))
 }

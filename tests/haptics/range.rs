@@ -1,0 +1,108 @@
+//! A nonlinear vademecum pressed deeper than its load steps cover: the force stays finite and
+//! held at what the range's edge gives, and the run's report says how far beyond the range the
+//! tool went; a press within the range reports nothing.
+
+use std::sync::Arc;
+
+use nalgebra::Vector3;
+use pgd_surgery::app::haptic::{ForceTrace, HapticLoop, HapticScene, HeadlessReport};
+use pgd_surgery::contact::Probe;
+use pgd_surgery::devices::{
+    PressMotion, PressTarget, SafetySettings, Scripted, Workspace, press_and_slide,
+};
+use pgd_surgery::fem::{Dirichlet, FemModel, Law, Material};
+use pgd_surgery::mesh::box_mesh;
+use pgd_surgery::pgd::{BuildSettings, OrganModel, Silent, Vademecum, build};
+
+const TIP_RADIUS_M: f64 = 0.012;
+const RANGE_M: f64 = 1.0e-3;
+
+/// A 6 × 4 × 3 cm block of neo-Hookean liver tissue clamped underneath, its vademecum built
+/// with load steps to `RANGE_M`.
+fn block_vademecum() -> Vademecum {
+    let mesh = box_mesh([0.06, 0.04, 0.03], [6, 4, 3]).unwrap();
+    let mut dirichlet = Dirichlet::new(mesh.node_count());
+    dirichlet.clamp(mesh.node_set("z0").unwrap()).unwrap();
+    let model = FemModel::new(mesh, Material::liver(Law::NeoHookean), dirichlet).unwrap();
+    let organ = OrganModel {
+        source: "block".into(),
+        model: &model,
+        clamped_region: "z0".into(),
+        accessible_region: "z1".into(),
+    };
+    let settings = BuildSettings {
+        tool_tip_radius_m: TIP_RADIUS_M,
+        local_radius_m: 0.015,
+        load_steps_m: vec![0.5e-3, RANGE_M],
+        ..BuildSettings::default()
+    };
+    build(&organ, &settings, &Silent).unwrap().0
+}
+
+/// A scripted press `depth_m` deep at the middle of the block's top face, held, no slide:
+/// the report and the force trace.
+fn press(vademecum: &Arc<Vademecum>, depth_m: f64) -> (HeadlessReport, ForceTrace) {
+    let scene = HapticScene {
+        organs: vec![("block".into(), vademecum.clone())],
+        probe: Probe {
+            tip_radius_m: TIP_RADIUS_M,
+        },
+        workspace: Workspace::default(),
+        safety: SafetySettings::default(),
+        coupling: None,
+    };
+    let target = PressTarget {
+        point_m: Vector3::new(0.03, 0.02, 0.03),
+        normal: Vector3::z(),
+    };
+    let motion = PressMotion {
+        tip_radius_m: TIP_RADIUS_M,
+        depth_m,
+        slide_m: 0.0,
+        ..PressMotion::default()
+    };
+    let script = press_and_slide(&[target], &motion);
+    let ticks = (script.duration_s() * 1e3) as u64;
+    let device = Box::new(Scripted::new("deep press", script));
+    let mut haptic = HapticLoop::new(&scene, device).unwrap();
+    haptic.keep_trace();
+    let report = haptic.run_simulated(ticks);
+    let trace = std::mem::take(&mut *haptic.world_mut().resource_mut::<ForceTrace>());
+    (report, trace)
+}
+
+/// Pressed ten times deeper than the range, the force is finite everywhere and no more than
+/// at the range's edge (1e-6 relative: the same depth gives the same force), the report
+/// counts the ticks beyond the range and how far (the 10 mm press held at 1 mm: about 9 mm
+/// beyond, less what the tracked contact point moves); within the range nothing is reported.
+#[test]
+fn a_press_beyond_the_range_is_held_at_its_edge_and_reported() {
+    let vademecum = Arc::new(block_vademecum());
+    assert_eq!(vademecum.valid_indentation_m(), RANGE_M);
+    let (edge, edge_trace) = press(&vademecum, RANGE_M);
+    let (deep, deep_trace) = press(&vademecum, 10.0 * RANGE_M);
+    eprintln!("{edge}\n{deep}");
+    assert_eq!(edge.range.beyond_ticks, 0, "{edge}");
+    assert!(edge.force.max_desired_n > 0.01, "{edge}");
+    assert!(
+        deep_trace
+            .desired_n
+            .iter()
+            .all(|f| f.iter().all(|c| c.is_finite()))
+    );
+    let largest = |trace: &ForceTrace| trace.desired_n.iter().map(|f| f.norm()).fold(0.0, f64::max);
+    let (edge_n, deep_n) = (largest(&edge_trace), largest(&deep_trace));
+    assert!(
+        (deep_n - edge_n).abs() <= 1e-6 * edge_n,
+        "{deep_n} N beyond the range against {edge_n} N at its edge"
+    );
+    // The 0.5 s press spends 90 % of its depth beyond the range, then the hold and the
+    // lift's first part: well over 500 ticks.
+    assert!(deep.range.beyond_ticks > 500, "{deep}");
+    assert!((deep.range.max_beyond_mm - 9.0).abs() < 0.5, "{deep}");
+    assert_eq!(deep.range.organs, vec![("block".to_owned(), RANGE_M * 1e3)]);
+    assert!(
+        deep.to_string().contains("beyond the vademecum's range"),
+        "{deep}"
+    );
+}
