@@ -14,6 +14,7 @@ const LAYERS: [&[&str]; 4] = [
         "pgd",
         "contact",
         "cutting",
+        "dynamics",
         "devices",
         "scenario",
         "dense_sums",

@@ -34,7 +34,6 @@ impl FemModel {
     /// Builds a model, refusing an invalid material and constraints that leave any connected
     /// part of the mesh free to move rigidly (the stiffness would be singular).
     pub fn new(mesh: TetMesh, material: Material, dirichlet: Dirichlet) -> Result<Self, FemError> {
-        material.validate()?;
         if dirichlet.dof_count() != 3 * mesh.node_count() {
             return Err(FemError::InvalidInput {
                 what: "Dirichlet conditions: dof count",
@@ -43,6 +42,23 @@ impl FemModel {
             });
         }
         check_rigid_modes(&mesh, &dirichlet)?;
+        Self::unchecked(mesh, material, dirichlet)
+    }
+
+    /// A body with no boundary condition, free to move as a whole: for dynamics, where the
+    /// mass keeps the problem well posed. Its rest stiffness is singular (the six rigid
+    /// modes), so static solves and vademecums refuse it.
+    pub fn free_body(mesh: TetMesh, material: Material) -> Result<Self, FemError> {
+        let dirichlet = Dirichlet::new(mesh.node_count());
+        Self::unchecked(mesh, material, dirichlet)
+    }
+
+    fn unchecked(
+        mesh: TetMesh,
+        material: Material,
+        dirichlet: Dirichlet,
+    ) -> Result<Self, FemError> {
+        material.validate()?;
         let geometry = TetGeometry::of_mesh(&mesh);
         let dofs = DofMap::new(&dirichlet);
         let modulus_scale = vec![1.0; mesh.tet_count()];

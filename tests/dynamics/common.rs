@@ -1,0 +1,69 @@
+//! Blocks of liver tissue, their full matrices, and reduced models over them.
+
+use nalgebra::DMatrix;
+use pgd_surgery::dynamics::{ModalBasis, ReducedKsv};
+use pgd_surgery::fem::{Dirichlet, FemModel, Law, Material};
+use pgd_surgery::mesh::box_mesh;
+
+/// A 6 × 4 × 3 cm block of `cells`, clamped underneath when `clamped`.
+pub fn block(cells: [usize; 3], material: Material, clamped: bool) -> FemModel {
+    let mesh = box_mesh([0.06, 0.04, 0.03], cells).unwrap();
+    if !clamped {
+        return FemModel::free_body(mesh, material).unwrap();
+    }
+    let mut dirichlet = Dirichlet::new(mesh.node_count());
+    dirichlet.clamp(mesh.node_set("z0").unwrap()).unwrap();
+    FemModel::new(mesh, material, dirichlet).unwrap()
+}
+
+pub fn liver_block(cells: [usize; 3], law: Law) -> FemModel {
+    block(cells, Material::liver(law), true)
+}
+
+/// The identity over all dofs, column-major: the whole space as a subspace.
+pub fn whole_space(model: &FemModel) -> Vec<f64> {
+    let n = 3 * model.mesh().node_count();
+    let mut columns = vec![0.0; n * n];
+    for i in 0..n {
+        columns[i * n + i] = 1.0;
+    }
+    columns
+}
+
+/// The `keep` lowest vibration modes of `model` as a basis, and its reduced model.
+pub fn lowest_modes(model: &FemModel, keep: usize) -> (ModalBasis, ReducedKsv) {
+    let basis = ModalBasis::ritz(model, &whole_space(model), keep).unwrap();
+    let reduced = ReducedKsv::new(model, &basis).unwrap();
+    (basis, reduced)
+}
+
+/// A sparse matrix over free dofs (values of the model's pattern) as a dense one.
+pub fn dense(model: &FemModel, values: &[f64]) -> DMatrix<f64> {
+    let n = model.dofs().free_count();
+    let mut out = DMatrix::zeros(n, n);
+    let mut e = vec![0.0; n];
+    let mut column = vec![0.0; n];
+    for j in 0..n {
+        e[j] = 1.0;
+        column.fill(0.0);
+        model.pattern().mul(values, &e, &mut column);
+        out.set_column(j, &nalgebra::DVector::from_column_slice(&column));
+        e[j] = 0.0;
+    }
+    out
+}
+
+/// A reproducible pseudo-random vector in [-1, 1].
+pub fn pseudo_random(n: usize, seed: u64) -> Vec<f64> {
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (0..n)
+        .map(|_| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        })
+        .collect()
+}
