@@ -4,5 +4,6 @@
 
 pub mod contact;
 pub mod cutting;
+pub mod dynamics;
 pub mod fem;
 pub mod vademecum;

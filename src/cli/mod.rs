@@ -5,6 +5,7 @@
 
 mod output;
 mod parse;
+mod pgd_bench_dynamics;
 mod pgd_build;
 mod pgd_indent;
 mod pgd_mesh;
@@ -16,6 +17,7 @@ pub use parse::{
     parse_cut_pattern, parse_inclusion, parse_point_mm, parse_spacing, parse_stiffness_ratio,
     parse_subdivisions,
 };
+pub use pgd_bench_dynamics::{DynamicsRequest, bench_dynamics, plot_energy};
 pub use pgd_build::{build_vademecum, print_build_report};
 pub use pgd_indent::{
     IndentReport, IndentRequest, LawCurve, indent_organ, plot_indentation, print_indentation,

@@ -5,14 +5,13 @@ use std::path::Path;
 use std::time::Instant;
 
 use nalgebra::Point3;
-use plotters::prelude::*;
 use serde::Serialize;
 
 use crate::fem::{FemModel, IndentationSettings, Material, SphereIndenter};
 use crate::mesh::organs::{Organ, region};
 use crate::mesh::{Surface, TetMesh};
 use crate::pgd::{Progress, organ};
-use crate::report::save_png;
+use crate::report::{LineChart, Series, line_chart};
 
 /// The default depth over the tool's radius: 25 mm under the abdominal 6 mm tool, the deepest
 /// a trainee presses, and the same proportion for the cornea's 0.5 mm spatula.
@@ -215,56 +214,29 @@ pub fn print_indentation(report: &IndentReport) {
 
 /// Draws every law's force against depth on one chart.
 pub fn plot_indentation(report: &IndentReport, path: &Path) -> Result<(), String> {
-    let deepest = report
+    let series = report
         .curves
         .iter()
-        .flat_map(|c| c.depth_m.iter().copied())
-        .fold(0.0, f64::max)
-        * 1e3;
-    let strongest = report
-        .curves
-        .iter()
-        .flat_map(|c| c.force_n.iter().copied())
-        .fold(0.0, f64::max);
-    let colours = [BLUE, RED, GREEN, MAGENTA, CYAN];
-    save_png(path, (900, 600), |root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(
-                format!("{}: force against depth", report.source),
-                ("sans-serif", 24),
-            )
-            .margin(16)
-            .x_label_area_size(44)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0.0..deepest.max(1e-3), 0.0..(1.05 * strongest).max(1e-6))?;
-        chart
-            .configure_mesh()
-            .x_desc("depth (mm)")
-            .y_desc("force (N)")
-            .draw()?;
-        for (curve, colour) in report.curves.iter().zip(colours.iter().cycle()) {
-            let colour = *colour;
-            let points = std::iter::once((0.0, 0.0)).chain(
-                curve
-                    .depth_m
-                    .iter()
-                    .zip(&curve.force_n)
-                    .map(|(d, f)| (d * 1e3, *f)),
-            );
-            chart
-                .draw_series(LineSeries::new(points, colour.stroke_width(2)))?
-                .label(curve.law)
-                .legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()?;
-        Ok(())
-    })
-    .map_err(|e| format!("{}: {e}", path.display()))
+        .map(|curve| Series {
+            name: curve.law.to_owned(),
+            points: std::iter::once((0.0, 0.0))
+                .chain(
+                    curve
+                        .depth_m
+                        .iter()
+                        .zip(&curve.force_n)
+                        .map(|(d, f)| (d * 1e3, *f)),
+                )
+                .collect(),
+        })
+        .collect();
+    line_chart(
+        path,
+        &LineChart {
+            title: format!("{}: force against depth", report.source),
+            x_label: "depth (mm)",
+            y_label: "force (N)",
+            series,
+        },
+    )
 }

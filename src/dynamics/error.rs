@@ -2,8 +2,10 @@
 
 use crate::fem::Law;
 
-#[derive(Debug, thiserror::Error, PartialEq)]
+#[derive(Debug, thiserror::Error)]
 pub enum DynamicsError {
+    #[error("the rest stiffness: {0}")]
+    Stiffness(#[from] crate::fem::FemError),
     #[error("the subspace has no vectors left once its dependent ones are dropped")]
     EmptyBasis,
     #[error(

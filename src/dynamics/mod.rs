@@ -1,8 +1,9 @@
 //! Organs that move: reduced dynamics `M q̈ + C q̇ + f_int(q) = f_ext` in a small basis per
 //! organ, integrated at the haptic tick by an energy–momentum conserving scheme.
 //!
-//! - [`ModalBasis`]: the Ritz vectors of a subspace (the vademecum's spatial modes): mass-
-//!   orthonormal, so the reduced mass is the identity and the rest stiffness is diagonal.
+//! - [`ModalBasis`]: the organ's lowest vibration modes, by subspace iteration from the
+//!   vademecum's spatial modes: mass-orthonormal, so the reduced mass is the identity and
+//!   the rest stiffness is diagonal.
 //! - [`ReducedKsv`]: the Kirchhoff–Saint Venant energy and internal force in that basis, as
 //!   precomputed polynomial coefficients (cost independent of the mesh), and the Simo–Tarnow
 //!   algorithmic force that makes the step conserve energy exactly.

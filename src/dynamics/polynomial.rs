@@ -21,6 +21,7 @@
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::{DynamicsError, ModalBasis};
+use crate::dense_sums::dot;
 use crate::fem::{FemModel, Law};
 
 /// Elements whose coefficient rows are stacked for one matrix product.
@@ -41,6 +42,9 @@ pub struct ReducedKsv {
     stiffness: Vec<f64>,
     /// `A`, `r × P`, row-major; empty for the linear law.
     cubic: Vec<f64>,
+    /// `A` again as `Aₖₘⱼ` laid out `[m][k][j]` (`r³`), so that the force's term
+    /// `2 Σₖⱼ Aₖₘⱼ aₖ aⱼ` runs over contiguous memory.
+    cubic_by_middle: Vec<f64>,
     /// `B`, `P × P`, row-major; empty for the linear law.
     quartic: Vec<f64>,
 }
@@ -64,12 +68,7 @@ impl ReducedKsv {
             Law::NeoHookean => return Err(DynamicsError::unsupported(law)),
         };
         let r = basis.len();
-        let pairs: Vec<(usize, usize)> = (0..r).flat_map(|j| (j..r).map(move |k| (j, k))).collect();
-        let mut pair_of = vec![0; r * r];
-        for (p, &(j, k)) in pairs.iter().enumerate() {
-            pair_of[j * r + k] = p;
-            pair_of[k * r + j] = p;
-        }
+        let (pairs, pair_of) = index_pairs(r);
         let p_count = if nonlinear { pairs.len() } else { 0 };
         let mut k = DMatrix::zeros(r, r);
         let mut a = DMatrix::zeros(r, p_count);
@@ -85,14 +84,45 @@ impl ReducedKsv {
             }
         }
         let row_major = |m: DMatrix<f64>| m.transpose().as_slice().to_vec();
+        let cubic = row_major(a);
+        let cubic_by_middle = match nonlinear {
+            true => (0..r * r * r)
+                .map(|i| {
+                    let (m, k, j) = (i / (r * r), (i / r) % r, i % r);
+                    cubic[k * p_count + pair_of[m * r + j]]
+                })
+                .collect(),
+            false => Vec::new(),
+        };
         Ok(Self {
             r,
             pairs,
             pair_of,
             stiffness: row_major(k),
-            cubic: row_major(a),
+            cubic,
+            cubic_by_middle,
             quartic: row_major(b),
         })
+    }
+
+    /// The linear law's reduced model in a Ritz basis: its stiffness is the diagonal of
+    /// squared frequencies, with no pass over the elements.
+    pub fn linear(basis: &ModalBasis) -> Self {
+        let r = basis.len();
+        let mut stiffness = vec![0.0; r * r];
+        for (k, w2) in basis.omega2.iter().enumerate() {
+            stiffness[k * r + k] = *w2;
+        }
+        let (pairs, pair_of) = index_pairs(r);
+        Self {
+            r,
+            pairs,
+            pair_of,
+            stiffness,
+            cubic: Vec::new(),
+            cubic_by_middle: Vec::new(),
+            quartic: Vec::new(),
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -162,9 +192,9 @@ impl ReducedKsv {
         for (m, o) in out.iter_mut().enumerate() {
             let pairs_of_m = &self.pair_of[m * r..(m + 1) * r];
             let mut f = dot(&self.cubic[m * p..(m + 1) * p], &s.pairs);
-            for (row, &ak) in self.cubic.chunks_exact(p).zip(a) {
-                let inner: f64 = pairs_of_m.iter().zip(a).map(|(&q, &aj)| row[q] * aj).sum();
-                f += 2.0 * ak * inner;
+            let by_middle = &self.cubic_by_middle[m * r * r..(m + 1) * r * r];
+            for (row, &ak) in by_middle.chunks_exact(r).zip(a) {
+                f += 2.0 * ak * dot(row, a);
             }
             let contracted: f64 = pairs_of_m
                 .iter()
@@ -232,12 +262,29 @@ impl ReducedKsv {
         }
     }
 
+    /// The tangent stiffness `∂f/∂q` at `q` into `out` (`r × r`, row-major).
+    pub fn tangent(&self, q: &[f64], out: &mut [f64], s: &mut Scratch) {
+        self.algorithmic_jacobian((q, q), out, s);
+        out.iter_mut().for_each(|k| *k *= 2.0);
+    }
+
     fn k_times(&self, q: &[f64]) -> Vec<f64> {
         self.stiffness
             .chunks_exact(self.r)
             .map(|row| dot(row, q))
             .collect()
     }
+}
+
+/// The index pairs `(j, k)`, `j ≤ k`, of `r` modes, and the pair of every `(j, k)`.
+fn index_pairs(r: usize) -> (Vec<(usize, usize)>, Vec<usize>) {
+    let pairs: Vec<(usize, usize)> = (0..r).flat_map(|j| (j..r).map(move |k| (j, k))).collect();
+    let mut pair_of = vec![0; r * r];
+    for (p, &(j, k)) in pairs.iter().enumerate() {
+        pair_of[j * r + k] = p;
+        pair_of[k * r + j] = p;
+    }
+    (pairs, pair_of)
 }
 
 /// How often the pair `(j, k)` stands for itself in a sum over all `j, k`.
@@ -312,8 +359,4 @@ fn write_row(
         m[(row + c, column)] = shear * v;
     }
     m[(row + 6, column)] = volume * x.trace();
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

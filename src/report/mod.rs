@@ -8,5 +8,5 @@ mod scorecard;
 pub use convergence::{
     StepCurve, write as write_convergence, write_of_header as write_convergence_of,
 };
-pub use plot::save_png;
+pub use plot::{LineChart, Series, line_chart, save_png};
 pub use scorecard::{summary, write_report};

@@ -36,3 +36,67 @@ pub fn save_png(
     encoder.write_header()?.write_image_data(&pixels)?;
     Ok(())
 }
+
+/// One named line of a [`LineChart`].
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// Lines against a common x axis, each in its own colour with a legend; the axes span the
+/// data.
+pub struct LineChart<'a> {
+    pub title: String,
+    pub x_label: &'a str,
+    pub y_label: &'a str,
+    pub series: Vec<Series>,
+}
+
+/// Draws `chart` into a 900 × 600 PNG at `path`; errors name the file.
+pub fn line_chart(path: &Path, chart: &LineChart) -> Result<(), String> {
+    let points = || chart.series.iter().flat_map(|s| s.points.iter().copied());
+    let span = |values: Vec<f64>| {
+        let low = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let high = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let pad = 0.05 * (high - low).max(1e-9 * high.abs().max(1e-12));
+        (low - pad)..(high + pad)
+    };
+    let (xs, ys) = (
+        span(points().map(|p| p.0).collect()),
+        span(points().map(|p| p.1).collect()),
+    );
+    let colours = [BLUE, RED, GREEN, MAGENTA, CYAN];
+    save_png(path, (900, 600), |root| {
+        let mut drawing = ChartBuilder::on(root)
+            .caption(&chart.title, ("sans-serif", 24))
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(70)
+            .build_cartesian_2d(xs, ys)?;
+        drawing
+            .configure_mesh()
+            .x_desc(chart.x_label)
+            .y_desc(chart.y_label)
+            .draw()?;
+        for (series, colour) in chart.series.iter().zip(colours.iter().cycle()) {
+            let colour = *colour;
+            drawing
+                .draw_series(LineSeries::new(
+                    series.points.iter().copied(),
+                    colour.stroke_width(2),
+                ))?
+                .label(series.name.as_str())
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
+        }
+        drawing
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerLeft)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()?;
+        Ok(())
+    })
+    .map_err(|e| format!("{}: {e}", path.display()))
+}

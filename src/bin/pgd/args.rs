@@ -386,6 +386,30 @@ pub enum BenchTarget {
         #[arg(long)]
         json: bool,
     },
+    /// Reduced dynamics of the four organs (KSV, bases from their linear vademecums): step
+    /// time per organ and basis size against the linear law's, the four organs in one tick,
+    /// and the energy of an undamped swing under the energy-momentum step, implicit Euler and
+    /// Newmark.
+    Dynamics {
+        /// Basis sizes timed per organ.
+        #[arg(long, value_delimiter = ',', default_values_t = [8, 12, 16])]
+        modes: Vec<usize>,
+        /// Basis size of the four-organ tick and the energy trace.
+        #[arg(long, default_value_t = 12)]
+        scene_modes: usize,
+        /// Ticks timed per case: a pull for the first half, released for the second.
+        #[arg(long, default_value_t = 2000)]
+        ticks: usize,
+        /// Where the organs' linear vademecums are kept (missing or stale ones are rebuilt).
+        #[arg(long, default_value = "vademecums")]
+        vademecums: PathBuf,
+        /// Also draw the energy against time of each scheme as a PNG.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Assembly, factorization and solve on a liver-sized mesh (~4,300 nodes, ~21,000 tets).
     Fem {
         /// Print the report as JSON instead of a table.

@@ -227,6 +227,30 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             )
         }
         BenchTarget::Contact(options) => bench_contact(&options),
+        BenchTarget::Dynamics {
+            modes,
+            scene_modes,
+            ticks,
+            vademecums,
+            plot,
+            json,
+        } => {
+            let request = cli::DynamicsRequest {
+                organs: &SCENE_ORGANS,
+                modes: &modes,
+                scene_modes,
+                ticks,
+                vademecums: &vademecums,
+            };
+            let result = cli::bench_dynamics(&request).and_then(|report| {
+                if let Some(path) = &plot {
+                    cli::plot_energy(&report, path)?;
+                    eprintln!("wrote {}", path.display());
+                }
+                Ok(report)
+            });
+            print_report("pgd bench dynamics", result, json)
+        }
         BenchTarget::Haptics {
             repeats,
             realtime_seconds,
