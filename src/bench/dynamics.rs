@@ -48,6 +48,8 @@ pub struct OrganFigures {
     /// The basis size: as asked, or all the vademecum's modes where it has fewer.
     pub modes: usize,
     pub lowest_hz: f64,
+    /// The highest kept mode's frequency: what the basis resolves in time.
+    pub highest_hz: f64,
     pub precompute_s: f64,
     pub ksv: StepTimes,
     /// The linear law's step of the same size: the baseline.
@@ -110,7 +112,8 @@ struct Swing {
     step: EnergyMomentum,
     state: ReducedState,
     pull: Vec<f64>,
-    lowest_hz: f64,
+    /// The lowest and highest kept frequencies (Hz).
+    band_hz: (f64, f64),
     precompute_s: f64,
 }
 
@@ -129,7 +132,10 @@ impl Swing {
         Ok(Self {
             pull: pull(organ.model, &basis),
             state: ReducedState::at_rest(basis.len()),
-            lowest_hz: omega(0) / (2.0 * std::f64::consts::PI),
+            band_hz: (
+                omega(0) / (2.0 * std::f64::consts::PI),
+                omega(basis.len() - 1) / (2.0 * std::f64::consts::PI),
+            ),
             reduced,
             step,
             precompute_s,
@@ -172,13 +178,15 @@ fn organ_figures(
 ) -> Result<OrganFigures, DynamicsError> {
     let ksv = Swing::new(organ, modes, Law::KirchhoffSaintVenant)?;
     let linear = Swing::new(organ, modes, Law::Linear)?;
-    let (lowest_hz, precompute_s, kept) = (ksv.lowest_hz, ksv.precompute_s, ksv.reduced.len());
+    let ((lowest_hz, highest_hz), precompute_s) = (ksv.band_hz, ksv.precompute_s);
+    let kept = ksv.reduced.len();
     let ksv = time_together(vec![ksv], ticks)?;
     let linear = time_together(vec![linear], ticks)?;
     Ok(OrganFigures {
         organ: organ.name.to_owned(),
         modes: kept,
         lowest_hz,
+        highest_hz,
         precompute_s,
         ksv_to_linear_p50: ksv.p50_us / linear.p50_us,
         ksv,
@@ -371,10 +379,11 @@ impl std::fmt::Display for DynamicsBenchReport {
         )?;
         writeln!(
             f,
-            "{:<12} {:>5} {:>9} {:>11} {:>9} {:>9} {:>7} {:>10} {:>10} {:>8}",
+            "{:<12} {:>5} {:>9} {:>9} {:>11} {:>9} {:>9} {:>7} {:>10} {:>10} {:>8}",
             "organ",
             "modes",
             "f1 (Hz)",
+            "fr (Hz)",
             "precompute",
             "KSV p50",
             "KSV p99",
@@ -386,10 +395,11 @@ impl std::fmt::Display for DynamicsBenchReport {
         for o in &self.organs {
             writeln!(
                 f,
-                "{:<12} {:>5} {:>9.2} {:>10.2}s {:>9.1} {:>9.1} {:>7.2} {:>10.1} {:>10.1} {:>8.1}",
+                "{:<12} {:>5} {:>9.2} {:>9.2} {:>10.2}s {:>9.1} {:>9.1} {:>7.2} {:>10.1} {:>10.1} {:>8.1}",
                 o.organ,
                 o.modes,
                 o.lowest_hz,
+                o.highest_hz,
                 o.precompute_s,
                 o.ksv.p50_us,
                 o.ksv.p99_us,
