@@ -9,13 +9,17 @@
 //!   algorithmic force that makes the step conserve energy exactly.
 //! - [`EnergyMomentum`]: the implicit midpoint step with that force and a stated Rayleigh
 //!   damping, solved by Newton's method with the rest Jacobian.
+//! - [`GraspedOrgan`]: a grasper on such an organ: a virtual coupling to the hand, slip,
+//!   release that fades the hand's force, damage.
 
 mod basis;
 mod error;
+mod grasp;
 mod integrator;
 mod polynomial;
 
 pub use basis::ModalBasis;
 pub use error::DynamicsError;
+pub use grasp::{GraspPoint, GraspSettings, GraspTick, GraspedOrgan, Jaws};
 pub use integrator::{EnergyMomentum, RayleighDamping, ReducedState, StepReport};
 pub use polynomial::ReducedKsv;

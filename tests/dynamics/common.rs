@@ -4,6 +4,10 @@ use nalgebra::DMatrix;
 use pgd_surgery::dynamics::{ModalBasis, ReducedKsv};
 use pgd_surgery::fem::{Dirichlet, FemModel, Law, Material};
 use pgd_surgery::mesh::box_mesh;
+use pgd_surgery::pgd::{BuildSettings, OrganModel, PgdSettings, Silent, build};
+
+/// The basis size of the tests in the vademecum's basis.
+pub const KEEP: usize = 12;
 
 /// A 6 × 4 × 3 cm block of `cells`, clamped underneath when `clamped`.
 pub fn block(cells: [usize; 3], material: Material, clamped: bool) -> FemModel {
@@ -66,4 +70,29 @@ pub fn pseudo_random(n: usize, seed: u64) -> Vec<f64> {
             ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         })
         .collect()
+}
+
+/// The block's linear vademecum, converged far enough that its spatial modes span the
+/// response to any load of its top face.
+pub fn vademecum_basis(model: &FemModel) -> (ModalBasis, ReducedKsv) {
+    let organ = OrganModel {
+        source: "block".into(),
+        model,
+        clamped_region: "z0".into(),
+        accessible_region: "z1".into(),
+    };
+    let settings = BuildSettings {
+        tool_tip_radius_m: 0.012,
+        local_radius_m: 0.015,
+        target_error: 1e-3,
+        pgd: PgdSettings {
+            max_modes: 40,
+            ..PgdSettings::default()
+        },
+        ..BuildSettings::default()
+    };
+    let vademecum = build(&organ, &settings, &Silent).unwrap().0;
+    let basis = ModalBasis::of_vademecum(model, &vademecum, KEEP).unwrap();
+    let reduced = ReducedKsv::new(model, &basis).unwrap();
+    (basis, reduced)
 }

@@ -4,5 +4,6 @@
 
 mod common;
 mod conservation;
+mod grasp;
 mod modal;
 mod polynomial;

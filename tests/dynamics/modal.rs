@@ -2,41 +2,12 @@
 //! load onto the static answer, and it swings at the organ's lowest eigenfrequency.
 
 use nalgebra::{DVector, SymmetricEigen, Vector3};
-use pgd_surgery::dynamics::{
-    EnergyMomentum, ModalBasis, RayleighDamping, ReducedKsv, ReducedState,
-};
+use pgd_surgery::dynamics::{EnergyMomentum, RayleighDamping, ReducedState};
 use pgd_surgery::fem::{FemModel, Law, Loads, NewtonSettings};
-use pgd_surgery::pgd::{BuildSettings, OrganModel, PgdSettings, Silent, build};
 
-use crate::common::{dense, liver_block};
+use crate::common::{KEEP, dense, liver_block, vademecum_basis};
 
 const TICK_S: f64 = 1e-3;
-const KEEP: usize = 12;
-
-/// The block's linear vademecum, converged far enough that its spatial modes span the
-/// response to any load of its top face.
-fn vademecum_basis(model: &FemModel) -> (ModalBasis, ReducedKsv) {
-    let organ = OrganModel {
-        source: "block".into(),
-        model,
-        clamped_region: "z0".into(),
-        accessible_region: "z1".into(),
-    };
-    let settings = BuildSettings {
-        tool_tip_radius_m: 0.012,
-        local_radius_m: 0.015,
-        target_error: 1e-3,
-        pgd: PgdSettings {
-            max_modes: 40,
-            ..PgdSettings::default()
-        },
-        ..BuildSettings::default()
-    };
-    let vademecum = build(&organ, &settings, &Silent).unwrap().0;
-    let basis = ModalBasis::of_vademecum(model, &vademecum, KEEP).unwrap();
-    let reduced = ReducedKsv::new(model, &basis).unwrap();
-    (basis, reduced)
-}
 
 /// The lowest eigenpair of the full model (`K φ = ω² M φ`, dense, by Cholesky of `M`): ω²
 /// and the mode over free dofs.

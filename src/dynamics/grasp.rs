@@ -1,0 +1,313 @@
+//! A grasper on a dynamic organ: jaws that close on a point of the tissue and hold it, a
+//! virtual coupling between the hand and the jaws, slip, release and damage.
+//!
+//! - **The grasped point** moves with the organ's kept modes and, quasi-statically, with the
+//!   modes left out: `x = X + Φₛ q + R F`, `R` the point's static compliance less the kept
+//!   modes' share (the mode-acceleration remainder). `R` acts as a spring in series with the
+//!   coupling.
+//! - **The coupling** pulls the point towards the hand: `F = k (x_hand + offset − x) + b (v_hand
+//!   − v)`, solved with the series remainder, `F = (I + kR)⁻¹ (k e + b ė)`. It is evaluated
+//!   from the start of the tick and held over the step: explicit, stable while the coupled
+//!   modes' `h √(k φ²)` stays far below 2 (about 0.01 for the organs). The hand feels `−F`:
+//!   tension as well as compression, with the organ's inertia in it.
+//! - **Slip**: the jaws hold up to `slip_force_n`; a pull beyond drags the jaws along the tissue
+//!   (the offset gives way so that the force stays at the limit), and after `escape_m` of
+//!   slip the tissue leaves the jaws.
+//! - **Release**: when the jaws open (or the tissue escapes), the organ is let go at once and
+//!   swings back; the force at the hand fades to zero over `release_s`, so it never jumps.
+//! - **Damage**: a pull above `damage_force_n`, or the grasped point drawn further than
+//!   `damage_stretch_m` from where it was grasped, marks the tissue damaged (reported once).
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::{DynamicsError, EnergyMomentum, ModalBasis, ReducedKsv, ReducedState};
+
+/// The grasper's settings. The defaults are chosen for a hand-held device of about 3 N peak,
+/// not measured on tissue (slip and damage thresholds of real jaws on liver are to be
+/// taken from measurements; `docs/dynamics.md`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GraspSettings {
+    /// Coupling stiffness (N/m): the jaws follow the hand through this spring.
+    pub coupling_n_per_m: f64,
+    /// Coupling damping (N·s/m): above `k h / 2`, the passivity bound of a sampled spring.
+    pub coupling_damping_n_s_per_m: f64,
+    pub slip_force_n: f64,
+    /// Slip along the jaws after which the tissue leaves them (m).
+    pub escape_m: f64,
+    /// Seconds over which the hand's force fades after a release.
+    pub release_s: f64,
+    pub damage_force_n: f64,
+    pub damage_stretch_m: f64,
+}
+
+impl Default for GraspSettings {
+    fn default() -> Self {
+        Self {
+            coupling_n_per_m: 150.0,
+            coupling_damping_n_s_per_m: 0.5,
+            slip_force_n: 2.5,
+            escape_m: 0.01,
+            release_s: 0.05,
+            damage_force_n: 2.0,
+            damage_stretch_m: 0.04,
+        }
+    }
+}
+
+/// A point of the organ the jaws can close on: its rest position, the kept modes there, and
+/// the static compliance of the modes left out.
+#[derive(Clone, Debug)]
+pub struct GraspPoint {
+    pub rest_m: Vector3<f64>,
+    modes: Vec<Vector3<f64>>,
+    remainder_m_per_n: Matrix3<f64>,
+}
+
+impl GraspPoint {
+    /// The point at `node` of `basis`, whose full static compliance (m/N, from the
+    /// vademecum's local part or a FEM solve) is `compliance`.
+    pub fn at_node(
+        basis: &ModalBasis,
+        node: usize,
+        rest_m: Vector3<f64>,
+        compliance: &Matrix3<f64>,
+    ) -> Self {
+        let modes: Vec<Vector3<f64>> = (0..basis.len())
+            .map(|k| Vector3::from_column_slice(&basis.mode(k)[3 * node..3 * node + 3]))
+            .collect();
+        let kept: Matrix3<f64> = modes
+            .iter()
+            .zip(&basis.omega2)
+            .map(|(phi, w2)| phi * phi.transpose() / *w2)
+            .sum();
+        Self {
+            rest_m,
+            modes,
+            remainder_m_per_n: compliance - kept,
+        }
+    }
+
+    /// Where the kept modes put the point, and how fast it moves with them.
+    fn moved(&self, state: &ReducedState) -> (Vector3<f64>, Vector3<f64>) {
+        let mut at = Vector3::zeros();
+        let mut velocity = Vector3::zeros();
+        for (phi, (q, v)) in self.modes.iter().zip(state.q.iter().zip(&state.v)) {
+            at += phi * *q;
+            velocity += phi * *v;
+        }
+        (at, velocity)
+    }
+
+    /// The generalized force of a force `force_n` at the point.
+    fn generalized(&self, force_n: &Vector3<f64>, out: &mut [f64]) {
+        for (o, phi) in out.iter_mut().zip(&self.modes) {
+            *o = phi.dot(force_n);
+        }
+    }
+}
+
+/// What the jaws are doing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Jaws {
+    Open,
+    /// Holding: the hand's target for the point is the hand plus `offset_m`; `slipped_m` is
+    /// how far the jaws have slid along the tissue; `from_m` where the point was grasped.
+    Holding {
+        offset_m: Vector3<f64>,
+        slipped_m: f64,
+        from_m: Vector3<f64>,
+    },
+    /// Let go: the hand's force fades from `force_n` over the release time.
+    Releasing {
+        force_n: Vector3<f64>,
+        elapsed_s: f64,
+    },
+}
+
+/// One tick's outcome at the hand.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GraspTick {
+    /// The force the hand feels (N).
+    pub hand_force_n: Vector3<f64>,
+    /// The grasped point, where the jaws hold it (m); none when not holding.
+    pub point_m: Option<Vector3<f64>>,
+    pub slipping: bool,
+    /// Set on the tick the tissue is first damaged.
+    pub damaged_now: bool,
+}
+
+/// A dynamic organ and a grasper on it.
+pub struct GraspedOrgan {
+    pub reduced: ReducedKsv,
+    pub step: EnergyMomentum,
+    pub state: ReducedState,
+    pub point: GraspPoint,
+    pub settings: GraspSettings,
+    pub jaws: Jaws,
+    pub damaged: bool,
+    previous_hand_m: Option<Vector3<f64>>,
+    load: Vec<f64>,
+}
+
+impl GraspedOrgan {
+    pub fn new(
+        reduced: ReducedKsv,
+        step: EnergyMomentum,
+        point: GraspPoint,
+        settings: GraspSettings,
+    ) -> Self {
+        let r = reduced.len();
+        Self {
+            reduced,
+            step,
+            state: ReducedState::at_rest(r),
+            point,
+            settings,
+            jaws: Jaws::Open,
+            damaged: false,
+            previous_hand_m: None,
+            load: vec![0.0; r],
+        }
+    }
+
+    /// One tick with the hand at `hand_m` and the jaws `closed` or not: the coupling force,
+    /// the organ stepped under it, the state of the jaws.
+    pub fn tick(
+        &mut self,
+        hand_m: &Vector3<f64>,
+        closed: bool,
+    ) -> Result<GraspTick, DynamicsError> {
+        let h = self.step.step_s();
+        let hand_velocity = self
+            .previous_hand_m
+            .map_or(Vector3::zeros(), |p| (hand_m - p) / h);
+        self.previous_hand_m = Some(*hand_m);
+        let (moved, velocity) = self.point.moved(&self.state);
+        let mut tick = GraspTick {
+            hand_force_n: Vector3::zeros(),
+            point_m: None,
+            slipping: false,
+            damaged_now: false,
+        };
+        let force = match (self.jaws, closed) {
+            (Jaws::Open | Jaws::Releasing { .. }, true) => {
+                let at = self.point.rest_m + moved;
+                self.jaws = Jaws::Holding {
+                    offset_m: at - hand_m,
+                    slipped_m: 0.0,
+                    from_m: at,
+                };
+                Vector3::zeros()
+            }
+            (Jaws::Holding { .. }, false) => self.release(),
+            (
+                Jaws::Holding {
+                    offset_m,
+                    slipped_m,
+                    from_m,
+                },
+                true,
+            ) => {
+                let error = hand_m + offset_m - self.point.rest_m - moved;
+                let force = self.coupling(&error, &(hand_velocity - velocity));
+                let (force, escaped) = self.slip(force, (offset_m, slipped_m, from_m), &mut tick);
+                let point_m = self.point.rest_m + moved + self.point.remainder_m_per_n * force;
+                tick.point_m = Some(point_m);
+                self.check_damage(&force, &(point_m - from_m), &mut tick);
+                match escaped {
+                    true => self.release(),
+                    false => force,
+                }
+            }
+            (Jaws::Releasing { force_n, elapsed_s }, false) => {
+                self.jaws = match elapsed_s + h >= self.settings.release_s {
+                    true => Jaws::Open,
+                    false => Jaws::Releasing {
+                        force_n,
+                        elapsed_s: elapsed_s + h,
+                    },
+                };
+                Vector3::zeros()
+            }
+            (Jaws::Open, false) => Vector3::zeros(),
+        };
+        tick.hand_force_n = match self.jaws {
+            Jaws::Holding { .. } => -force,
+            Jaws::Releasing { force_n, elapsed_s } => {
+                -force_n * (1.0 - elapsed_s / self.settings.release_s)
+            }
+            Jaws::Open => Vector3::zeros(),
+        };
+        self.point.generalized(&force, &mut self.load);
+        self.step.step(&self.reduced, &mut self.state, &self.load)?;
+        Ok(tick)
+    }
+
+    /// How far the kept modes have moved the grasp point from rest (m).
+    pub fn point_displacement(&self) -> Vector3<f64> {
+        self.point.moved(&self.state).0
+    }
+
+    /// `F = (I + kR)⁻¹ (k e + b ė)`: the coupling with the remainder's spring in series.
+    fn coupling(&self, error: &Vector3<f64>, rate: &Vector3<f64>) -> Vector3<f64> {
+        let (k, b) = (
+            self.settings.coupling_n_per_m,
+            self.settings.coupling_damping_n_s_per_m,
+        );
+        let series = Matrix3::identity() + self.point.remainder_m_per_n * k;
+        let target = error * k + rate * b;
+        series.lu().solve(&target).unwrap_or(target)
+    }
+
+    /// Caps the force at the slip limit, moving the jaws along the tissue by what the cap takes
+    /// off; whether the tissue has now left the jaws.
+    fn slip(
+        &mut self,
+        force: Vector3<f64>,
+        (offset_m, slipped_m, from_m): (Vector3<f64>, f64, Vector3<f64>),
+        tick: &mut GraspTick,
+    ) -> (Vector3<f64>, bool) {
+        let limit = self.settings.slip_force_n;
+        let size = force.norm();
+        if size <= limit {
+            return (force, false);
+        }
+        let capped = force * (limit / size);
+        let slide = (force - capped) / self.settings.coupling_n_per_m;
+        let slipped_m = slipped_m + slide.norm();
+        tick.slipping = true;
+        self.jaws = Jaws::Holding {
+            offset_m: offset_m - slide,
+            slipped_m,
+            from_m,
+        };
+        (capped, slipped_m > self.settings.escape_m)
+    }
+
+    /// Marks the tissue damaged, once, under a pull of `force` that has drawn the point
+    /// `drawn_m` from where it was grasped.
+    fn check_damage(&mut self, force: &Vector3<f64>, drawn_m: &Vector3<f64>, tick: &mut GraspTick) {
+        let stretched = drawn_m.norm() > self.settings.damage_stretch_m;
+        if !self.damaged && (force.norm() > self.settings.damage_force_n || stretched) {
+            self.damaged = true;
+            tick.damaged_now = true;
+        }
+    }
+
+    /// Lets the tissue go: the organ at once, the hand's force over the release time.
+    fn release(&mut self) -> Vector3<f64> {
+        let (moved, velocity) = self.point.moved(&self.state);
+        let force_n = match self.jaws {
+            Jaws::Holding { offset_m, .. } => {
+                let hand = self.previous_hand_m.unwrap_or(self.point.rest_m);
+                self.coupling(&(hand + offset_m - self.point.rest_m - moved), &(-velocity))
+            }
+            _ => Vector3::zeros(),
+        };
+        self.jaws = Jaws::Releasing {
+            force_n,
+            elapsed_s: 0.0,
+        };
+        Vector3::zeros()
+    }
+}
