@@ -75,6 +75,7 @@ fn scene_organ(scenario: &Scenario, entry: &OrganEntry) -> Result<SceneOrgan, St
         poisson: entry.poisson_ratio.map(|nu| nu.0),
         max_modes: entry.max_modes.map(|n| n.0),
         law: entry.law.unwrap_or(Law::Linear),
+        dynamic: entry.dynamic.unwrap_or(scenario.tool.grasps()),
         inclusions: scenario
             .nodules
             .iter()

@@ -7,10 +7,11 @@ use std::sync::Arc;
 
 use nalgebra::Vector3;
 
-use super::haptic::HapticScene;
+use super::haptic::{HapticScene, SceneDynamics};
 use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, FieldOrigin, Probe};
 use crate::devices::{PressTarget, SafetySettings, Workspace};
-use crate::fem::{Inclusion, Law};
+use crate::dynamics::{DynamicModel, GraspSettings, TRAINER_MODES};
+use crate::fem::{Inclusion, Law, Material};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::{Organ, OrganSettings, region};
 use crate::pgd::{BuildSettings, Vademecum};
@@ -88,6 +89,9 @@ pub struct SceneOrgan {
     pub inclusions: Vec<Inclusion>,
     /// The tissue's law, which its vademecum is built under.
     pub law: Law,
+    /// Whether it moves (reduced dynamics; the grasper pulls it) rather than staying
+    /// quasi-static.
+    pub dynamic: bool,
 }
 
 impl From<Organ> for SceneOrgan {
@@ -100,6 +104,7 @@ impl From<Organ> for SceneOrgan {
             max_modes: None,
             inclusions: Vec::new(),
             law: Law::Linear,
+            dynamic: false,
         }
     }
 }
@@ -169,6 +174,7 @@ pub fn scene_of(
             Ok((organ.name.clone(), Arc::new(vademecum), mesh))
         })
         .collect::<Result<Vec<_>, String>>()?;
+    let dynamics = scene_dynamics(organs, &loaded)?;
     let attachments: Vec<AttachmentSpec> = loaded
         .iter()
         .flat_map(|(name, vademecum, mesh)| attachments_of(name, vademecum, mesh))
@@ -188,7 +194,42 @@ pub fn scene_of(
         workspace: Workspace::default(),
         safety: SafetySettings::default(),
         coupling: (!coupling.is_empty()).then(|| Arc::new(coupling)),
+        dynamics,
     })
+}
+
+/// The dynamic models of the organs that move (their tissue under the KSV law, whose reduced
+/// energy is exact, in [`TRAINER_MODES`] modes from their vademecums); `None` if none does.
+fn scene_dynamics(
+    organs: &[SceneOrgan],
+    loaded: &[(String, Arc<Vademecum>, TetMesh)],
+) -> Result<Option<SceneDynamics>, String> {
+    let mut moving = Vec::new();
+    for (index, (organ, (name, vademecum, mesh))) in organs.iter().zip(loaded).enumerate() {
+        if !organ.dynamic {
+            continue;
+        }
+        let header = &vademecum.header;
+        let material = Material {
+            law: Law::KirchhoffSaintVenant,
+            ..header.material
+        };
+        let model = crate::pgd::organ::clamped_model(mesh.clone(), material)
+            .and_then(|m| m.with_inclusions(&header.inclusions))
+            .map_err(|e| format!("{name}: {e}"))?;
+        let dynamic = DynamicModel::new(&model, vademecum, TRAINER_MODES)
+            .map_err(|e| format!("{name}: dynamics: {e}"))?;
+        let lowest_hz = dynamic.basis.omega2[0].sqrt() / (2.0 * std::f64::consts::PI);
+        eprintln!(
+            "{name} moves: {} modes from {lowest_hz:.2} Hz",
+            dynamic.basis.len()
+        );
+        moving.push((index, Arc::new(dynamic)));
+    }
+    Ok((!moving.is_empty()).then(|| SceneDynamics {
+        organs: moving,
+        grasp: GraspSettings::default(),
+    }))
 }
 
 /// A short tag that tells one set of inclusions from another in a file name.

@@ -46,6 +46,8 @@ pub enum Fault {
     Device(String),
     /// Ticks overran their period this many times in a row.
     Overruns(u32),
+    /// An organ's dynamics could not be stepped.
+    Physics(String),
 }
 
 impl std::fmt::Display for Fault {
@@ -55,6 +57,7 @@ impl std::fmt::Display for Fault {
             Fault::NonFiniteForce => write!(f, "the computed force is not finite"),
             Fault::Device(message) => write!(f, "device error: {message}"),
             Fault::Overruns(n) => write!(f, "{n} ticks in a row overran the 1 ms period"),
+            Fault::Physics(message) => write!(f, "the physics failed: {message}"),
         }
     }
 }

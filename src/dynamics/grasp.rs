@@ -72,8 +72,27 @@ impl GraspPoint {
         rest_m: Vector3<f64>,
         compliance: &Matrix3<f64>,
     ) -> Self {
+        Self::at_patch(basis, &[(node, 1.0)], rest_m, compliance)
+    }
+
+    /// The jaws' patch: mesh nodes with their shares (summing to one), the patch's rest
+    /// centre and its static compliance (m/N).
+    pub fn at_patch(
+        basis: &ModalBasis,
+        shares: &[(usize, f64)],
+        rest_m: Vector3<f64>,
+        compliance: &Matrix3<f64>,
+    ) -> Self {
         let modes: Vec<Vector3<f64>> = (0..basis.len())
-            .map(|k| Vector3::from_column_slice(&basis.mode(k)[3 * node..3 * node + 3]))
+            .map(|k| {
+                let mode = basis.mode(k);
+                shares
+                    .iter()
+                    .map(|&(node, share)| {
+                        Vector3::from_column_slice(&mode[3 * node..3 * node + 3]) * share
+                    })
+                    .sum()
+            })
             .collect();
         let kept: Matrix3<f64> = modes
             .iter()
@@ -147,6 +166,8 @@ pub struct GraspedOrgan {
     pub damaged: bool,
     previous_hand_m: Option<Vector3<f64>>,
     load: Vec<f64>,
+    /// The force the jaws put on the organ this tick (N).
+    applied_n: Vector3<f64>,
 }
 
 impl GraspedOrgan {
@@ -167,6 +188,7 @@ impl GraspedOrgan {
             damaged: false,
             previous_hand_m: None,
             load: vec![0.0; r],
+            applied_n: Vector3::zeros(),
         }
     }
 
@@ -240,7 +262,47 @@ impl GraspedOrgan {
         };
         self.point.generalized(&force, &mut self.load);
         self.step.step(&self.reduced, &mut self.state, &self.load)?;
+        self.applied_n = force;
         Ok(tick)
+    }
+
+    /// Closes the jaws with the hand at `hand_m` while the tool already pushes on the point
+    /// with `force_n` (a press): the coupling starts at that force, so the hand feels no
+    /// jump as the press becomes a grasp.
+    pub fn close(&mut self, hand_m: &Vector3<f64>, force_n: &Vector3<f64>) {
+        let at = self.point.rest_m + self.point.moved(&self.state).0;
+        let k = self.settings.coupling_n_per_m;
+        let stretch = (Matrix3::identity() + self.point.remainder_m_per_n * k) * force_n / k;
+        self.jaws = Jaws::Holding {
+            offset_m: at + stretch - hand_m,
+            slipped_m: 0.0,
+            from_m: at,
+        };
+        self.previous_hand_m = Some(*hand_m);
+    }
+
+    /// The force the jaws put on the organ in the last tick (N).
+    pub fn applied_n(&self) -> Vector3<f64> {
+        self.applied_n
+    }
+
+    /// Whether the jaws hold the tissue.
+    pub fn holding(&self) -> bool {
+        matches!(self.jaws, Jaws::Holding { .. })
+    }
+
+    /// The kept modes' dynamic correction to the static answer of the jaws' load,
+    /// `q − Λ⁻¹ Φₛᵀ F` (mode acceleration), into `out`: the organ's displacement is the
+    /// vademecum's static field for `F` at the point plus `Φ` times this.
+    pub fn correction(&self, omega2: &[f64], out: &mut [f64]) {
+        for (((o, q), phi), w2) in out
+            .iter_mut()
+            .zip(&self.state.q)
+            .zip(&self.point.modes)
+            .zip(omega2)
+        {
+            *o = q - phi.dot(&self.applied_n) / w2;
+        }
     }
 
     /// How far the kept modes have moved the grasp point from rest (m).

@@ -16,10 +16,12 @@ mod basis;
 mod error;
 mod grasp;
 mod integrator;
+mod organ;
 mod polynomial;
 
 pub use basis::ModalBasis;
 pub use error::DynamicsError;
 pub use grasp::{GraspPoint, GraspSettings, GraspTick, GraspedOrgan, Jaws};
 pub use integrator::{EnergyMomentum, RayleighDamping, ReducedState, StepReport};
+pub use organ::{DynamicModel, TISSUE_DAMPING_RATIO, TRAINER_MODES};
 pub use polynomial::ReducedKsv;

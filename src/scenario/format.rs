@@ -65,6 +65,9 @@ impl Difficulty {
 pub enum Tool {
     /// A round-tipped probe.
     Probe { tip_radius_mm: Millimetres },
+    /// A grasper: its closed jaws press like a probe of this radius; the device's button
+    /// closes them on the tissue under them, which then follows the hand (`docs/dynamics.md`).
+    Grasper { tip_radius_mm: Millimetres },
 }
 
 impl Default for Tool {
@@ -78,8 +81,15 @@ impl Default for Tool {
 impl Tool {
     pub fn tip_radius_m(&self) -> f64 {
         match self {
-            Tool::Probe { tip_radius_mm } => tip_radius_mm.metres(),
+            Tool::Probe { tip_radius_mm } | Tool::Grasper { tip_radius_mm } => {
+                tip_radius_mm.metres()
+            }
         }
+    }
+
+    /// Whether the tool grasps (and so the organs move by default).
+    pub fn grasps(&self) -> bool {
+        matches!(self, Tool::Grasper { .. })
     }
 }
 
@@ -186,6 +196,10 @@ pub struct OrganEntry {
     /// Its tissue's law (`Linear`, `NeoHookean`, `KirchhoffSaintVenant`), when not linear.
     #[serde(default)]
     pub law: Option<Law>,
+    /// Whether it moves (reduced dynamics, and the grasper can pull it) or stays
+    /// quasi-static; by default it moves when the tool is a grasper.
+    #[serde(default)]
+    pub dynamic: Option<bool>,
 }
 
 impl OrganEntry {
@@ -198,6 +212,7 @@ impl OrganEntry {
             poisson_ratio: None,
             max_modes: None,
             law: None,
+            dynamic: None,
         }
     }
 }

@@ -55,6 +55,7 @@ pub fn liver() -> &'static Liver {
 pub fn scene(safety: SafetySettings) -> HapticScene {
     HapticScene {
         coupling: None,
+        dynamics: None,
         organs: vec![("liver".into(), liver().vademecum.clone())],
         probe: Probe {
             tip_radius_m: TIP_RADIUS_M,

@@ -5,6 +5,7 @@ mod common;
 mod deformed;
 mod devices;
 mod faults;
+mod grasp;
 mod press;
 mod range;
 mod replay;

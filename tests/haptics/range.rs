@@ -50,6 +50,7 @@ fn press(vademecum: &Arc<Vademecum>, depth_m: f64) -> (HeadlessReport, ForceTrac
         workspace: Workspace::default(),
         safety: SafetySettings::default(),
         coupling: None,
+        dynamics: None,
     };
     let target = PressTarget {
         point_m: Vector3::new(0.03, 0.02, 0.03),

@@ -6,6 +6,8 @@ use std::sync::Arc;
 use bevy::prelude::*;
 
 use crate::contact::{ContactSurface, ToolContact};
+use crate::devices::TICK_S;
+use crate::dynamics::{DynamicModel, GraspSettings, GraspedOrgan};
 use crate::pgd::{Deformation, Patch, PatchLoad, Vademecum};
 
 /// An organ's mechanical model (the vademecum, which carries the regions it was built with in
@@ -37,4 +39,29 @@ pub struct OrganDeformation(pub Deformation);
 
 impl OrganDeformation {
     pub const TOOL: usize = 0;
+}
+
+/// An organ that moves: its dynamic model (shared with the window, which draws its modes),
+/// its state with the grasper's jaws on it, and the kept modes' correction to the static
+/// field of the jaws' load this tick (what the snapshot hands the window).
+#[derive(Component)]
+pub struct OrganMotion {
+    pub model: Arc<DynamicModel>,
+    pub organ: GraspedOrgan,
+    pub correction: Vec<f64>,
+    /// The jaws' patch on the surface while they hold.
+    pub shares: Vec<(usize, f64)>,
+}
+
+impl OrganMotion {
+    pub fn new(model: Arc<DynamicModel>, settings: GraspSettings) -> Self {
+        let organ = model.at_rest(TICK_S, settings);
+        let correction = vec![0.0; model.basis.len()];
+        Self {
+            model,
+            organ,
+            correction,
+            shares: Vec::new(),
+        }
+    }
 }

@@ -15,10 +15,12 @@ mod thread;
 use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
 
-pub use components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
+pub use components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
 pub use report::{ForceSummary, HeadlessReport, RangeSummary, TickTimes};
-pub use resources::{Device, DeviceForce, FaultLog, ForceTrace, OrganCoupling, TickClock, Tool};
-pub use runner::{HapticLoop, HapticScene, SceneError};
+pub use resources::{
+    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, TickClock, Tool,
+};
+pub use runner::{HapticLoop, HapticScene, SceneDynamics, SceneError};
 pub use scoring::{ExerciseLink, ExerciseRun};
 pub use snapshot::{HapticSnapshot, LoopTiming, OrganSnapshot};
 pub use thread::{HapticThread, RealTimeReport, SceneSwap, Scheduling};
@@ -64,7 +66,9 @@ pub fn haptic_schedule() -> Schedule {
     );
     schedule.add_systems((
         systems::read_device.in_set(HapticSet::ReadDevice),
-        systems::tool_contact.in_set(HapticSet::ToolContact),
+        (systems::tool_contact, systems::grasp)
+            .chain()
+            .in_set(HapticSet::ToolContact),
         systems::evaluate_modes.in_set(HapticSet::EvaluateModes),
         systems::organ_contact.in_set(HapticSet::OrganContact),
         systems::compute_force.in_set(HapticSet::ComputeForce),

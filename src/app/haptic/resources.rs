@@ -63,3 +63,8 @@ pub struct ForceTrace {
 /// The organs' contact and attachments, with their state from tick to tick.
 #[derive(Resource, Clone)]
 pub struct OrganCoupling(pub Coupling);
+
+/// The force the grasper's jaws pull the hand with this tick (N): the opposite of what they
+/// pull the organ with, and the release's fade.
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct GraspForce(pub Vector3<f64>);

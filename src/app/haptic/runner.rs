@@ -5,14 +5,15 @@ use std::time::{Duration, Instant};
 
 use bevy::prelude::*;
 
-use super::components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
+use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
 use super::report::{ForceSummary, HeadlessReport, RangeSummary};
 use super::resources::{
-    Device, DeviceForce, FaultLog, ForceTrace, OrganCoupling, Safety, TickClock, Tool,
+    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, Safety, TickClock, Tool,
 };
 use super::snapshot::{HapticSnapshot, OrganSnapshot, SnapshotPublisher};
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
 use crate::devices::{HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S, Workspace};
+use crate::dynamics::{DynamicModel, GraspSettings};
 use crate::pgd::{Deformation, Vademecum};
 
 /// What the haptic world is made of.
@@ -25,6 +26,26 @@ pub struct HapticScene {
     pub safety: SafetySettings,
     /// Organ/organ contact and attachments (set up, at rest); `None` leaves the organs apart.
     pub coupling: Option<Arc<Coupling>>,
+    /// Organs that move, and the grasper that pulls them; `None`: every organ quasi-static and
+    /// the tool a probe.
+    pub dynamics: Option<SceneDynamics>,
+}
+
+/// The moving organs of a scene (by index into its organs) and the grasper's settings.
+#[derive(Clone)]
+pub struct SceneDynamics {
+    pub organs: Vec<(usize, Arc<DynamicModel>)>,
+    pub grasp: GraspSettings,
+}
+
+impl SceneDynamics {
+    /// The dynamic model of organ `index`, if it moves.
+    pub fn model(&self, index: usize) -> Option<&Arc<DynamicModel>> {
+        self.organs
+            .iter()
+            .find(|(i, _)| *i == index)
+            .map(|(_, m)| m)
+    }
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -61,7 +82,7 @@ impl HapticLoop {
     pub fn parked(scene: &HapticScene) -> Result<Self, SceneError> {
         let mut world = World::new();
         for (index, (name, vademecum)) in scene.organs.iter().enumerate() {
-            world.spawn((
+            let mut organ = world.spawn((
                 OrganBody {
                     name: name.clone(),
                     surface: Arc::new(ContactSurface::new(vademecum)?),
@@ -71,7 +92,13 @@ impl HapticLoop {
                 ToolTouch::default(),
                 OrganDeformation(Deformation::new(vademecum, 1)),
             ));
+            if let Some(dynamics) = &scene.dynamics
+                && let Some(model) = dynamics.model(index)
+            {
+                organ.insert(OrganMotion::new(model.clone(), dynamics.grasp));
+            }
         }
+        world.insert_resource(GraspForce::default());
         world.insert_resource(Tool {
             probe: scene.probe,
             workspace: scene.workspace,

@@ -3,13 +3,14 @@
 use bevy::prelude::*;
 use nalgebra::Vector3;
 
-use super::components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
+use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
 use super::resources::{
-    Device, DeviceForce, FaultLog, ForceTrace, OrganCoupling, Safety, TickClock, Tool,
+    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, Safety, TickClock, Tool,
 };
 use super::snapshot::{LoopTiming, SnapshotPublisher};
 use crate::contact::{Target, follow, press};
 use crate::devices::Fault;
+use crate::dynamics::GraspPoint;
 use crate::pgd::SurfacePoint;
 
 /// Reads the device into [`Tool`], mapped onto the scene. A non-finite sample or a device error is a fault and the
@@ -74,6 +75,75 @@ pub fn tool_contact(
     }
 }
 
+/// The grasper on the organs that move: the device's button closes the jaws on the organ the
+/// tool touches (one at a time), and every moving organ is stepped, held or swinging back.
+/// While the jaws hold, the organ's tool load is their pull at their patch (its static field
+/// the vademecum's, the kept modes' motion the correction) and the hand feels the grasp, not
+/// a press.
+pub fn grasp(
+    tool: Res<Tool>,
+    mut grasp_force: ResMut<GraspForce>,
+    mut faults: ResMut<FaultLog>,
+    mut organs: Query<(
+        &OrganBody,
+        &mut ToolTouch,
+        &mut OrganDeformation,
+        &mut OrganMotion,
+    )>,
+) {
+    grasp_force.0 = Vector3::zeros();
+    let Some(sample) = tool.sample else {
+        return;
+    };
+    let closed = sample.buttons & 1 != 0;
+    let mut held_elsewhere = organs.iter().any(|(_, _, _, m)| m.organ.holding());
+    for (body, mut touch, mut deformation, mut motion) in &mut organs {
+        let motion = &mut *motion;
+        let holding = motion.organ.holding();
+        let grasping = closed && !holding && !held_elsewhere && touch.contact.is_some();
+        if grasping {
+            take_hold(body, &touch, motion, &sample.tip_m);
+            held_elsewhere = true;
+        }
+        match motion
+            .organ
+            .tick(&sample.tip_m, closed && (holding || grasping))
+        {
+            Ok(outcome) => grasp_force.0 += outcome.hand_force_n,
+            Err(e) => faults
+                .this_tick
+                .push(Fault::Physics(format!("{}: {e}", body.name))),
+        }
+        motion
+            .organ
+            .correction(&motion.model.basis.omega2, &mut motion.correction);
+        if motion.organ.holding() {
+            touch.contact = None;
+            let load = &mut deformation.0.loads[OrganDeformation::TOOL];
+            load.shares.clone_from(&motion.shares);
+            load.force_n = motion.organ.applied_n();
+        }
+    }
+}
+
+/// Closes the jaws on the patch the tool touches (its shares, its centre and the vademecum's
+/// compliance there), starting from the press's force.
+fn take_hold(body: &OrganBody, touch: &ToolTouch, motion: &mut OrganMotion, hand_m: &Vector3<f64>) {
+    let vademecum = &body.vademecum;
+    let nodes: Vec<(usize, f64)> = touch
+        .patch
+        .shares
+        .iter()
+        .map(|&(position, share)| (vademecum.positions[position] as usize, share))
+        .collect();
+    let compliance = vademecum.compliance(&touch.patch, &Vector3::zeros());
+    let centre = touch.contact.map_or(Vector3::zeros(), |c| c.hit.point_m);
+    motion.organ.point = GraspPoint::at_patch(&motion.model.basis, &nodes, centre, &compliance);
+    motion.shares.clone_from(&touch.patch.shares);
+    let pressing = touch.contact.map_or(Vector3::zeros(), |c| c.force_n);
+    motion.organ.close(hand_m, &pressing);
+}
+
 /// Sums every organ's loads into its modal coefficients.
 pub fn evaluate_modes(mut organs: Query<(&OrganBody, &mut OrganDeformation)>) {
     for (body, mut deformation) in &mut organs {
@@ -112,11 +182,16 @@ pub fn organ_contact(
 }
 
 /// The force on the tool: the opposite of what it applies to the organs.
-pub fn compute_force(touches: Query<&ToolTouch>, mut force: ResMut<DeviceForce>) {
-    force.desired_n = -touches
-        .iter()
-        .filter_map(|t| t.contact.map(|c| c.force_n))
-        .sum::<Vector3<f64>>();
+pub fn compute_force(
+    touches: Query<&ToolTouch>,
+    grasp: Res<GraspForce>,
+    mut force: ResMut<DeviceForce>,
+) {
+    force.desired_n = grasp.0
+        - touches
+            .iter()
+            .filter_map(|t| t.contact.map(|c| c.force_n))
+            .sum::<Vector3<f64>>();
 }
 
 /// Clamps, rate-limits and, on a fault, fades the force; logs each fault as it starts (a fault

@@ -239,6 +239,7 @@ mod tests {
                 ..SafetySettings::default()
             },
             coupling: None,
+            dynamics: None,
         }
     }
 

@@ -16,6 +16,7 @@ pub fn scene_without_organs() -> HapticScene {
         workspace: crate::devices::Workspace::default(),
         safety: crate::devices::SafetySettings::default(),
         coupling: None,
+        dynamics: None,
     }
 }
 

@@ -1,0 +1,54 @@
+//! An organ's dynamic model, made once when its scene is set up: its lowest modes from its
+//! vademecum, its reduced KSV energy in them, and the tissue's damping.
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::{
+    DynamicsError, EnergyMomentum, GraspPoint, GraspSettings, GraspedOrgan, ModalBasis,
+    RayleighDamping, ReducedKsv,
+};
+use crate::fem::FemModel;
+use crate::pgd::Vademecum;
+
+/// Modes kept per organ in the trainer: the four organs step in 21 µs p99 at 8 modes
+/// (`pgd bench dynamics`), beside the rest of the tick.
+pub const TRAINER_MODES: usize = 8;
+
+/// The damping ratio of liver tissue at the kept modes' ends (`docs/dynamics.md`).
+pub const TISSUE_DAMPING_RATIO: f64 = 0.1;
+
+/// What an organ needs to move: shared by its haptic state and the window (which draws the
+/// kept modes on the surface).
+pub struct DynamicModel {
+    pub basis: ModalBasis,
+    pub reduced: ReducedKsv,
+    pub damping: RayleighDamping,
+}
+
+impl DynamicModel {
+    /// The model of `model` (under the KSV law) in the `modes` lowest modes found from
+    /// `vademecum`, damped at [`TISSUE_DAMPING_RATIO`].
+    pub fn new(
+        model: &FemModel,
+        vademecum: &Vademecum,
+        modes: usize,
+    ) -> Result<Self, DynamicsError> {
+        let basis = ModalBasis::of_vademecum(model, vademecum, modes)?;
+        let reduced = ReducedKsv::new(model, &basis)?;
+        let omega = |k: usize| basis.omega2[k].sqrt();
+        let damping =
+            RayleighDamping::with_ratio(TISSUE_DAMPING_RATIO, omega(0), omega(basis.len() - 1));
+        Ok(Self {
+            basis,
+            reduced,
+            damping,
+        })
+    }
+
+    /// The organ at rest with open jaws, stepped at `step_s`.
+    pub fn at_rest(&self, step_s: f64, settings: GraspSettings) -> GraspedOrgan {
+        let step = EnergyMomentum::new(&self.reduced, &self.basis.omega2, step_s, self.damping);
+        let nowhere = GraspPoint::at_patch(&self.basis, &[], Vector3::zeros(), &Matrix3::zeros());
+        GraspedOrgan::new(self.reduced.clone(), step, nowhere, settings)
+    }
+}
