@@ -45,6 +45,20 @@ impl DynamicModel {
         })
     }
 
+    /// Adds the kept modes times `correction` (m) to the surface `positions`, vertex `k` being
+    /// volume node `nodes[k]`: what the organ's motion adds to the vademecum's static field.
+    pub fn add_to_surface(&self, nodes: &[u32], correction: &[f64], positions: &mut [[f32; 3]]) {
+        for (k, &c) in correction.iter().enumerate() {
+            let mode = self.basis.mode(k);
+            for (p, &node) in positions.iter_mut().zip(nodes) {
+                let at = 3 * node as usize;
+                for (axis, v) in p.iter_mut().enumerate() {
+                    *v += (c * mode[at + axis]) as f32;
+                }
+            }
+        }
+    }
+
     /// The organ at rest with open jaws, stepped at `step_s`.
     pub fn at_rest(&self, step_s: f64, settings: GraspSettings) -> GraspedOrgan {
         let step = EnergyMomentum::new(&self.reduced, &self.basis.omega2, step_s, self.damping);

@@ -152,6 +152,7 @@ impl HapticLoop {
                 let organ = OrganSnapshot {
                     deformation: deformation.0.clone(),
                     contact: None,
+                    motion: Vec::new(),
                 };
                 (index.0, organ)
             })

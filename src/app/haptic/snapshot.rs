@@ -13,6 +13,9 @@ use crate::scenario::Progress;
 pub struct OrganSnapshot {
     pub deformation: Deformation,
     pub contact: Option<ToolContact>,
+    /// A moving organ's kept modes' correction to the static field (empty when it does not
+    /// move): the window adds the modes times these to the deformed surface.
+    pub motion: Vec<f64>,
 }
 
 #[derive(Clone, Debug, Default)]

@@ -248,7 +248,12 @@ pub fn publish_snapshot(
     tool: Res<Tool>,
     force: Res<DeviceForce>,
     safety: Res<Safety>,
-    organs: Query<(&OrganIndex, &ToolTouch, &OrganDeformation)>,
+    organs: Query<(
+        &OrganIndex,
+        &ToolTouch,
+        &OrganDeformation,
+        Option<&OrganMotion>,
+    )>,
     timing: Option<Res<LoopTiming>>,
     publisher: Option<ResMut<SnapshotPublisher>>,
 ) {
@@ -262,10 +267,13 @@ pub fn publish_snapshot(
     snapshot.force_n = force.sent_n;
     snapshot.faulted = safety.0.is_faulted();
     snapshot.timing = timing.map_or_else(LoopTiming::default, |t| *t);
-    for (index, touch, deformation) in &organs {
+    for (index, touch, deformation, motion) in &organs {
         let organ = &mut snapshot.organs[index.0];
         organ.contact = touch.contact;
         organ.deformation.clone_from(&deformation.0);
+        if let Some(motion) = motion {
+            organ.motion.clone_from(&motion.correction);
+        }
     }
     publisher.0.publish();
 }

@@ -11,6 +11,7 @@ use bevy::prelude::*;
 use super::bridge::{HapticLink, Snapshot};
 use super::{FrameSet, SceneView, tissue};
 use crate::app::haptic::OrganDeformation;
+use crate::dynamics::DynamicModel;
 use crate::mesh::vertex_normals;
 use crate::pgd::Vademecum;
 
@@ -23,6 +24,8 @@ pub(super) struct OrganView {
     pub(super) triangles: Vec<[usize; 3]>,
     /// Scratch: the whole displacement field (m).
     field: Vec<f64>,
+    /// The organ's dynamic model, when it moves.
+    motion: Option<Arc<DynamicModel>>,
 }
 
 pub(super) fn setup(app: &mut App) {
@@ -67,6 +70,11 @@ fn spawn_organs(
                 field: vec![0.0; vademecum.dof_count()],
                 vademecum: vademecum.clone(),
                 triangles,
+                motion: link
+                    .scene
+                    .dynamics
+                    .as_ref()
+                    .and_then(|d| d.model(index).cloned()),
             },
         ));
     }
@@ -113,6 +121,9 @@ fn deform(
         organ
             .deformation
             .deformed_surface(&view.vademecum, &mut view.field, &mut positions);
+        if let Some(motion) = &view.motion {
+            motion.add_to_surface(&view.vademecum.positions, &organ.motion, &mut positions);
+        }
         let colours = contact_tint(
             positions.len(),
             &organ.deformation.loads[OrganDeformation::TOOL].shares,
