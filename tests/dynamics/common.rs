@@ -59,17 +59,8 @@ pub fn dense(model: &FemModel, values: &[f64]) -> DMatrix<f64> {
 
 /// A reproducible pseudo-random vector in [-1, 1].
 pub fn pseudo_random(n: usize, seed: u64) -> Vec<f64> {
-    let mut state = seed
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    (0..n)
-        .map(|_| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        })
-        .collect()
+    let mut rng = fastrand::Rng::with_seed(seed);
+    (0..n).map(|_| 2.0 * rng.f64() - 1.0).collect()
 }
 
 /// The block's linear vademecum, converged far enough that its spatial modes span the
