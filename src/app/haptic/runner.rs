@@ -153,6 +153,7 @@ impl HapticLoop {
                     deformation: deformation.0.clone(),
                     contact: None,
                     motion: Vec::new(),
+                    grasped: false,
                 };
                 (index.0, organ)
             })

@@ -16,6 +16,8 @@ pub struct OrganSnapshot {
     /// A moving organ's kept modes' correction to the static field (empty when it does not
     /// move): the window adds the modes times these to the deformed surface.
     pub motion: Vec<f64>,
+    /// Whether the grasper's jaws hold it.
+    pub grasped: bool,
 }
 
 #[derive(Clone, Debug, Default)]

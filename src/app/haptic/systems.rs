@@ -273,6 +273,7 @@ pub fn publish_snapshot(
         organ.deformation.clone_from(&deformation.0);
         if let Some(motion) = motion {
             organ.motion.clone_from(&motion.correction);
+            organ.grasped = motion.organ.holding();
         }
     }
     publisher.0.publish();

@@ -72,8 +72,17 @@ fn update_hud(
         .filter(|(o, _)| o.contact.is_some())
         .map(|(_, (name, _))| name.as_str())
         .collect();
+    let grasped = snapshot
+        .0
+        .organs
+        .iter()
+        .zip(&link.scene.organs)
+        .find(|(o, _)| o.grasped)
+        .map(|(_, (name, _))| name.as_str());
     let status = if snapshot.0.faulted {
         "FAULT: force faded to zero (see the log)".to_owned()
+    } else if let Some(name) = grasped {
+        format!("grasping {name}: release the button to let go")
     } else if touching.is_empty() {
         "no contact".to_owned()
     } else {
