@@ -371,6 +371,9 @@ pub enum BenchTarget {
         /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
         #[arg(long, default_value = "vademecums")]
         vademecums: PathBuf,
+        /// Every organ moves (reduced dynamics, stepped every tick), as with a grasper.
+        #[arg(long)]
+        dynamic: bool,
         /// Print the report as JSON instead of a table.
         #[arg(long)]
         json: bool,

@@ -8,8 +8,9 @@ use std::process::ExitCode;
 
 use args::{BenchTarget, BuildArgs, Cli, Command, ContactBenchArgs, MaterialArgs, MeshArgs};
 use clap::Parser;
-use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, default_scene, scene_of};
+use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, scene_of};
 use pgd_surgery::cli::{self, fail, print_json, print_report};
+use pgd_surgery::contact::CouplingSettings;
 use pgd_surgery::cutting::CutValidationSettings;
 use pgd_surgery::cutting::keratotomy::{Cornea, Keratotomy};
 use pgd_surgery::fem::Law;
@@ -255,9 +256,23 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             repeats,
             realtime_seconds,
             vademecums,
+            dynamic,
             json,
         } => {
-            let scene = match default_scene(&vademecums, Detail::Full, OnStale::Rebuild) {
+            let organs = SCENE_ORGANS.map(|organ| SceneOrgan {
+                dynamic,
+                ..SceneOrgan::from(organ)
+            });
+            let coupling = CouplingSettings::default();
+            let built = scene_of(
+                &organs,
+                None,
+                &coupling,
+                &vademecums,
+                Detail::Full,
+                OnStale::Rebuild,
+            );
+            let scene = match built {
                 Ok(scene) => scene,
                 Err(e) => return fail("pgd bench haptics", &e),
             };
