@@ -162,25 +162,20 @@ fn nodule_site(scene: &HapticScene, nodule: &Nodule) -> NoduleSite {
     NoduleSite { centre_m, outward }
 }
 
-/// Where a retraction `task` watches its organ: the accessible surface point nearest the
+/// Where a retraction or grasp `task` watches its organ: the accessible surface point nearest the
 /// scenario's point (`None` for other tasks, or an organ not in the scene, which validation
 /// refuses).
 fn region_site(scene: &HapticScene, task: &Task) -> Option<RegionSite> {
-    let Task::Retraction {
-        organ,
-        at_mm,
-        towards,
-        ..
-    } = task
-    else {
-        return None;
-    };
-    let index = scene.organs.iter().position(|(name, _)| name == organ)?;
+    let watched = task.watched()?;
+    let index = scene
+        .organs
+        .iter()
+        .position(|(name, _)| name == watched.organ)?;
     let surface = ContactSurface::new(&scene.organs[index].1).ok()?;
-    let (x, y, z) = *towards;
+    let (x, y, z) = watched.towards;
     Some(RegionSite {
         organ: index,
-        at: surface.closest(&scenario::metres(*at_mm))?.at,
+        at: surface.closest(&scenario::metres(watched.at_mm))?.at,
         towards: Vector3::new(x, y, z).try_normalize(0.0)?,
     })
 }

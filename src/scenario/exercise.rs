@@ -26,11 +26,19 @@ pub struct Sample {
     /// Retraction: the force (N) on the organs other than the watched region's, from the tool
     /// and from the organs they touch.
     pub surrounding_force_n: f64,
+    /// The organs the grasper's jaws hold: bit `k` for the scenario's `organs[k]`.
+    pub grasping: u64,
+    /// Whether the grasper has damaged any tissue so far.
+    pub damaged: bool,
 }
 
 impl Sample {
     pub fn touches(&self, organ: usize) -> bool {
         organ < 64 && self.touching & (1 << organ) != 0
+    }
+
+    pub fn grasps(&self, organ: usize) -> bool {
+        organ < 64 && self.grasping & (1 << organ) != 0
     }
 }
 
@@ -173,6 +181,8 @@ struct Running {
     last_tip: Option<Vector3<f64>>,
     /// Palpation: whether the button was held on the last tick.
     button_held: bool,
+    /// Grasp: whether the tissue has been damaged.
+    damaged: bool,
 }
 
 /// The tasks of a scenario, run one after another.
@@ -304,12 +314,14 @@ impl Running {
                 max_force_n,
                 ..
             } => (max_force_n.0, targets.len(), None),
-            Task::Palpation { max_force_n, .. } | Task::Retraction { max_force_n, .. } => {
-                (max_force_n.0, 0, None)
-            }
+            Task::Palpation { max_force_n, .. }
+            | Task::Retraction { max_force_n, .. }
+            | Task::Grasp { max_force_n, .. } => (max_force_n.0, 0, None),
         };
         let hold_s = match task {
-            Task::ForceControl { hold_s, .. } | Task::Retraction { hold_s, .. } => Some(hold_s.0),
+            Task::ForceControl { hold_s, .. }
+            | Task::Retraction { hold_s, .. }
+            | Task::Grasp { hold_s, .. } => Some(hold_s.0),
             Task::SafeNavigation { .. } | Task::Palpation { .. } => None,
         };
         let (move_target_mm, surrounding_limit_n) = match task {
@@ -318,6 +330,7 @@ impl Running {
                 max_surrounding_force_n,
                 ..
             } => (Some(move_mm.0), Some(max_surrounding_force_n.0)),
+            Task::Grasp { move_mm, .. } => (Some(move_mm.0), None),
             _ => (None, None),
         };
         Self {
@@ -342,13 +355,14 @@ impl Running {
             },
             force_sum: 0.0,
             organ: match task {
-                Task::ForceControl { organ, .. } | Task::Palpation { organ, .. } => {
-                    organs.iter().position(|o| &o.name == organ)
-                }
+                Task::ForceControl { organ, .. }
+                | Task::Palpation { organ, .. }
+                | Task::Grasp { organ, .. } => organs.iter().position(|o| &o.name == organ),
                 // Retraction watches its organ through its region site.
                 Task::SafeNavigation { .. } | Task::Retraction { .. } => None,
             },
             button_held: false,
+            damaged: false,
             held_since: None,
             over_limit: LimitWatch::default(),
             over_surrounding: LimitWatch::default(),
@@ -363,7 +377,7 @@ impl Running {
         let m = &mut self.metrics;
         let force = sample.force_n;
         m.peak_force_n = m.peak_force_n.max(force);
-        if sample.touching != 0 {
+        if sample.touching != 0 || sample.grasping != 0 {
             m.contact_s += dt;
             self.force_sum += force * dt;
         }
@@ -371,8 +385,12 @@ impl Running {
             .over_limit
             .crossed(force, m.force_limit_n, dt, &mut m.time_over_limit_s)
         {
+            let verb = match m.kind {
+                TaskKind::Grasp => "pulled",
+                _ => "pressed",
+            };
             let error = format!(
-                "{:.2} s: pressed harder than {:.2} N",
+                "{:.2} s: {verb} harder than {:.2} N",
                 sample.time_s, m.force_limit_n
             );
             m.errors.push(error);
@@ -406,12 +424,41 @@ impl Running {
                 ..
             } => {
                 self.load_around(max_surrounding_force_n.0, sample, dt);
-                let m = &mut self.metrics;
-                let moved_mm = sample.region_moved_m * 1e3;
-                m.moved_mm = Some(m.moved_mm.map_or(moved_mm, |most| most.max(moved_mm)));
+                let moved_mm = self.region_moved_mm(sample);
                 self.hold(moved_mm >= move_mm.0, hold_s.0, sample.time_s);
             }
+            Task::Grasp {
+                organ,
+                move_mm,
+                hold_s,
+                ..
+            } => self.grasp(organ, (move_mm.0, hold_s.0), sample),
         }
+    }
+
+    /// Retraction and grasp: how far the region has moved (mm), kept as the farthest yet.
+    fn region_moved_mm(&mut self, sample: &Sample) -> f64 {
+        let m = &mut self.metrics;
+        let moved_mm = sample.region_moved_m * 1e3;
+        m.moved_mm = Some(m.moved_mm.map_or(moved_mm, |most| most.max(moved_mm)));
+        moved_mm
+    }
+
+    /// Grasp: held in the jaws and drawn far enough for the hold, then let go; a damaged
+    /// tissue is an error and the task can no longer be done.
+    fn grasp(&mut self, organ: &str, (move_mm, hold_s): (f64, f64), sample: &Sample) {
+        let grasped = self.organ.is_some_and(|k| sample.grasps(k));
+        if sample.damaged && !self.damaged {
+            self.damaged = true;
+            let error = format!("{:.2} s: tore the {organ}", sample.time_s);
+            self.metrics.errors.push(error);
+        }
+        let moved_mm = self.region_moved_mm(sample);
+        if self.metrics.longest_hold_s < hold_s {
+            self.hold(grasped && moved_mm >= move_mm, hold_s, sample.time_s);
+        }
+        let m = &mut self.metrics;
+        m.completed = m.longest_hold_s >= hold_s && !grasped && !self.damaged;
     }
 
     /// Completes the task once `holding` has been true for `hold_s` without a break.

@@ -337,6 +337,28 @@ pub enum Task {
         max_surrounding_force_n: Newtons,
         time_limit_s: Seconds,
     },
+    /// Take hold of the organ with the grasper and pull it: close the jaws on its `region`
+    /// (the surface nearest `at_mm`), draw it at least `move_mm` along `towards`, keep it
+    /// there for `hold_s`, then open the jaws, pulling no harder than `max_force_n`. Damaging
+    /// the tissue (pulling it harder or further than it bears) fails the task.
+    Grasp {
+        organ: String,
+        region: String,
+        at_mm: (f64, f64, f64),
+        towards: (f64, f64, f64),
+        move_mm: Millimetres,
+        hold_s: Seconds,
+        max_force_n: Newtons,
+        time_limit_s: Seconds,
+    },
+}
+
+/// The region a retraction or grasp task watches: its organ, the point nearest which it
+/// lies (mm) and the direction it is to move in.
+pub struct Watched<'a> {
+    pub organ: &'a str,
+    pub at_mm: (f64, f64, f64),
+    pub towards: (f64, f64, f64),
 }
 
 /// What kind a task is, for its metrics and its score.
@@ -351,6 +373,8 @@ pub enum TaskKind {
     Palpation,
     #[serde(rename = "retraction")]
     Retraction,
+    #[serde(rename = "grasp")]
+    Grasp,
 }
 
 impl std::fmt::Display for TaskKind {
@@ -360,17 +384,42 @@ impl std::fmt::Display for TaskKind {
             TaskKind::SafeNavigation => "safe navigation",
             TaskKind::Palpation => "palpation",
             TaskKind::Retraction => "retraction",
+            TaskKind::Grasp => "grasp",
         })
     }
 }
 
 impl Task {
+    /// The region a retraction or grasp task watches.
+    pub fn watched(&self) -> Option<Watched<'_>> {
+        match self {
+            Task::Retraction {
+                organ,
+                at_mm,
+                towards,
+                ..
+            }
+            | Task::Grasp {
+                organ,
+                at_mm,
+                towards,
+                ..
+            } => Some(Watched {
+                organ,
+                at_mm: *at_mm,
+                towards: *towards,
+            }),
+            _ => None,
+        }
+    }
+
     pub fn kind(&self) -> TaskKind {
         match self {
             Task::ForceControl { .. } => TaskKind::ForceControl,
             Task::SafeNavigation { .. } => TaskKind::SafeNavigation,
             Task::Palpation { .. } => TaskKind::Palpation,
             Task::Retraction { .. } => TaskKind::Retraction,
+            Task::Grasp { .. } => TaskKind::Grasp,
         }
     }
 
@@ -417,6 +466,18 @@ impl Task {
                  loading the organs around under {:.2} N",
                 move_mm.0, hold_s.0, max_force_n.0, max_surrounding_force_n.0
             ),
+            Task::Grasp {
+                organ,
+                region,
+                move_mm,
+                hold_s,
+                max_force_n,
+                ..
+            } => format!(
+                "grasp {region} of the {organ}, draw it {:.0} mm, hold it {} s and let go, \
+                 under {:.2} N and without tearing it",
+                move_mm.0, hold_s.0, max_force_n.0
+            ),
         }
     }
 
@@ -425,7 +486,8 @@ impl Task {
             Task::ForceControl { time_limit_s, .. }
             | Task::SafeNavigation { time_limit_s, .. }
             | Task::Palpation { time_limit_s, .. }
-            | Task::Retraction { time_limit_s, .. } => time_limit_s.0,
+            | Task::Retraction { time_limit_s, .. }
+            | Task::Grasp { time_limit_s, .. } => time_limit_s.0,
         }
     }
 }

@@ -201,7 +201,7 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
             anchors: vec!["tasks".into()],
             message: "the scenario has no tasks".into(),
             hint: format!(
-                "add a ForceControl(…), SafeNavigation(…), Palpation(…) or Retraction(…) task ({REFERENCE})"
+                "add a ForceControl(…), SafeNavigation(…), Palpation(…), Retraction(…) or Grasp(…) task ({REFERENCE})"
             ),
         });
     }
@@ -255,8 +255,23 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
             hold_s,
             time_limit_s,
             ..
+        }
+        | Task::Grasp {
+            organ,
+            towards,
+            hold_s,
+            time_limit_s,
+            ..
         } => {
             problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
+            if matches!(task, Task::Grasp { .. }) && !scenario.tool.grasps() {
+                problems.push(Problem {
+                    field: field("organ"),
+                    anchors: anchors("organ"),
+                    message: "a Grasp task needs a grasper to grasp with".into(),
+                    hint: "set tool: Grasper(tip_radius_mm: 6.0)".into(),
+                });
+            }
             let (x, y, z) = *towards;
             if !(x * x + y * y + z * z).is_normal() {
                 problems.push(Problem {

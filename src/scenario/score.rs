@@ -67,7 +67,10 @@ fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
     // Accuracy weighs only where there is a mark to be accurate about.
     let accuracy_weight = match m.kind {
         TaskKind::Palpation => rubric.accuracy,
-        TaskKind::ForceControl | TaskKind::SafeNavigation | TaskKind::Retraction => 0.0,
+        TaskKind::ForceControl
+        | TaskKind::SafeNavigation
+        | TaskKind::Retraction
+        | TaskKind::Grasp => 0.0,
     };
     let terms = [
         (rubric.completion, completion),
@@ -96,13 +99,16 @@ fn accuracy(m: &TaskMetrics) -> f64 {
 fn force_control(m: &TaskMetrics) -> f64 {
     if m.contact_s <= 0.0 {
         return match m.kind {
-            TaskKind::ForceControl | TaskKind::Palpation | TaskKind::Retraction => 0.0,
+            TaskKind::ForceControl
+            | TaskKind::Palpation
+            | TaskKind::Retraction
+            | TaskKind::Grasp => 0.0,
             TaskKind::SafeNavigation => 1.0,
         };
     }
     let over_s = match m.kind {
         TaskKind::ForceControl => m.contact_s - m.within_band_s,
-        TaskKind::SafeNavigation | TaskKind::Palpation => m.time_over_limit_s,
+        TaskKind::SafeNavigation | TaskKind::Palpation | TaskKind::Grasp => m.time_over_limit_s,
         TaskKind::Retraction => m.time_over_limit_s + m.surrounding_over_limit_s,
     };
     (1.0 - over_s / m.contact_s).clamp(0.0, 1.0)

@@ -61,7 +61,7 @@ fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     run_simulated(scenario, &scene, device, ticks).unwrap()
 }
 
-const SHIPPED: [&str; 7] = [
+const SHIPPED: [&str; 8] = [
     "liver-steady-press",
     "pancreas-palpation",
     "gallbladder-gentle-press",
@@ -69,6 +69,7 @@ const SHIPPED: [&str; 7] = [
     "duodenum-navigation",
     "abdomen-tour",
     "gallbladder-retraction",
+    "gallbladder-grasp-retract",
 ];
 
 #[test]
@@ -254,6 +255,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             7,
             "organs[0].law",
             "Unexpected variant named `Hookean`",
+        ),
+        (
+            "grasp-without-grasper",
+            8,
+            "tasks[0].organ",
+            "needs a grasper",
         ),
     ];
     for (name, line, field, message) in cases {

@@ -12,7 +12,7 @@ use std::sync::{Arc, Mutex};
 
 use bevy::prelude::*;
 
-use super::components::{OrganBody, OrganDeformation, OrganIndex, ToolTouch};
+use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
 use super::resources::{DeviceForce, TickClock, Tool};
 use super::snapshot::SnapshotPublisher;
 use crate::scenario::{Exercise, Progress, RegionSite, Sample};
@@ -23,6 +23,7 @@ type Organ = (
     &'static ToolTouch,
     &'static OrganBody,
     &'static OrganDeformation,
+    Option<&'static OrganMotion>,
 );
 
 /// Between the haptic thread and whoever started the exercise: whether it has begun, the
@@ -188,6 +189,13 @@ pub fn score_tick(
         .iter()
         .filter(|(index, touch, ..)| touch.contact.is_some() && index.0 < 64)
         .fold(0, |bits, (index, ..)| bits | 1 << index.0);
+    let grasping = organs
+        .iter()
+        .filter(|(index, .., motion)| motion.is_some_and(|m| m.organ.holding()) && index.0 < 64)
+        .fold(0, |bits, (index, ..)| bits | 1 << index.0);
+    let damaged = organs
+        .iter()
+        .any(|(.., motion)| motion.is_some_and(|m| m.organ.damaged));
     let (region_moved_m, surrounding_force_n) = exercise
         .watched_region()
         .map_or((0.0, 0.0), |region| watch(region, &organs));
@@ -199,6 +207,8 @@ pub fn score_tick(
         button: tool.sample.is_some_and(|s| s.buttons & 1 != 0),
         region_moved_m,
         surrounding_force_n,
+        grasping,
+        damaged,
     });
     if exercise.finished() {
         let run = &mut *run;
@@ -212,7 +222,7 @@ pub fn score_tick(
 fn watch(region: &RegionSite, organs: &Query<Organ>) -> (f64, f64) {
     let mut moved_m = 0.0;
     let mut surrounding_n = 0.0;
-    for (index, _, body, deformation) in organs {
+    for (index, _, body, deformation, _) in organs {
         let deformation = &deformation.0;
         if index.0 == region.organ {
             moved_m = deformation
