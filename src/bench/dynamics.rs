@@ -112,6 +112,8 @@ struct Swing {
     step: EnergyMomentum,
     state: ReducedState,
     pull: Vec<f64>,
+    /// No load, for the ticks after the release (allocated once, outside the timed ticks).
+    none: Vec<f64>,
     /// The lowest and highest kept frequencies (Hz).
     band_hz: (f64, f64),
     precompute_s: f64,
@@ -131,6 +133,7 @@ impl Swing {
         let step = EnergyMomentum::new(&reduced, &basis.omega2, TICK_S, damping);
         Ok(Self {
             pull: pull(organ.model, &basis),
+            none: vec![0.0; basis.len()],
             state: ReducedState::at_rest(basis.len()),
             band_hz: (
                 omega(0) / (2.0 * std::f64::consts::PI),
@@ -144,8 +147,11 @@ impl Swing {
 
     /// Tick `tick` of `ticks`: pulled for the first half, released for the second.
     fn tick(&mut self, tick: usize, ticks: usize) -> Result<usize, DynamicsError> {
-        let none = vec![0.0; self.pull.len()];
-        let load = if tick < ticks / 2 { &self.pull } else { &none };
+        let load = if tick < ticks / 2 {
+            &self.pull
+        } else {
+            &self.none
+        };
         Ok(self
             .step
             .step(&self.reduced, &mut self.state, load)?
@@ -260,7 +266,7 @@ fn energy_trace(organ: &DynamicsOrgan, modes: usize) -> Result<EnergyTrace, Dyna
             }
             match scheme {
                 Scheme::EnergyMomentum => {
-                    conserving.step(reduced, &mut state, &vec![0.0; modes])?;
+                    conserving.step(reduced, &mut state, &swing.none)?;
                 }
                 Scheme::ImplicitEuler => implicit_euler(reduced, &mut state)?,
                 Scheme::Newmark { gamma, beta } => {

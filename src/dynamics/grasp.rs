@@ -16,7 +16,8 @@
 //! - **Release**: when the jaws open (or the tissue escapes), the organ is let go at once and
 //!   swings back; the force at the hand fades to zero over `release_s`, so it never jumps.
 //! - **Damage**: a pull above `damage_force_n`, or the grasped point drawn further than
-//!   `damage_stretch_m` from where it was grasped, marks the tissue damaged (reported once).
+//!   `damage_stretch_m` from where it was grasped, marks the tissue damaged (reported once per
+//!   grasp).
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -151,7 +152,7 @@ pub struct GraspTick {
     /// The grasped point, where the jaws hold it (m); none when not holding.
     pub point_m: Option<Vector3<f64>>,
     pub slipping: bool,
-    /// Set on the tick the tissue is first damaged.
+    /// Set on the tick the tissue is first damaged in this grasp.
     pub damaged_now: bool,
 }
 
@@ -163,6 +164,7 @@ pub struct GraspedOrgan {
     pub point: GraspPoint,
     pub settings: GraspSettings,
     pub jaws: Jaws,
+    /// Whether the current (or last) grasp has damaged the tissue.
     pub damaged: bool,
     previous_hand_m: Option<Vector3<f64>>,
     load: Vec<f64>,
@@ -192,8 +194,9 @@ impl GraspedOrgan {
         }
     }
 
-    /// One tick with the hand at `hand_m` and the jaws `closed` or not: the coupling force,
-    /// the organ stepped under it, the state of the jaws.
+    /// One tick with the hand at `hand_m`, the jaws kept `closed` or opened: the coupling
+    /// force, the organ stepped under it, the state of the jaws. Closed jaws that hold
+    /// nothing (open, or the tissue escaped) stay empty: [`Self::close`] takes hold.
     pub fn tick(
         &mut self,
         hand_m: &Vector3<f64>,
@@ -212,15 +215,6 @@ impl GraspedOrgan {
             damaged_now: false,
         };
         let force = match (self.jaws, closed) {
-            (Jaws::Open | Jaws::Releasing { .. }, true) => {
-                let at = self.point.rest_m + moved;
-                self.jaws = Jaws::Holding {
-                    offset_m: at - hand_m,
-                    slipped_m: 0.0,
-                    from_m: at,
-                };
-                Vector3::zeros()
-            }
             (Jaws::Holding { .. }, false) => self.release(),
             (
                 Jaws::Holding {
@@ -241,7 +235,7 @@ impl GraspedOrgan {
                     false => force,
                 }
             }
-            (Jaws::Releasing { force_n, elapsed_s }, false) => {
+            (Jaws::Releasing { force_n, elapsed_s }, _) => {
                 self.jaws = match elapsed_s + h >= self.settings.release_s {
                     true => Jaws::Open,
                     false => Jaws::Releasing {
@@ -251,7 +245,7 @@ impl GraspedOrgan {
                 };
                 Vector3::zeros()
             }
-            (Jaws::Open, false) => Vector3::zeros(),
+            (Jaws::Open, _) => Vector3::zeros(),
         };
         tick.hand_force_n = match self.jaws {
             Jaws::Holding { .. } => -force,
@@ -266,9 +260,10 @@ impl GraspedOrgan {
         Ok(tick)
     }
 
-    /// Closes the jaws with the hand at `hand_m` while the tool already pushes on the point
-    /// with `force_n` (a press): the coupling starts at that force, so the hand feels no
-    /// jump as the press becomes a grasp.
+    /// Closes the jaws on the point with the hand at `hand_m` while the tool already pushes on
+    /// it with `force_n` (a press; zero for none): the coupling starts at that force, so the
+    /// hand feels no jump as the press becomes a grasp. A new grasp can damage the tissue
+    /// anew.
     pub fn close(&mut self, hand_m: &Vector3<f64>, force_n: &Vector3<f64>) {
         let at = self.point.rest_m + self.point.moved(&self.state).0;
         let k = self.settings.coupling_n_per_m;
@@ -279,6 +274,7 @@ impl GraspedOrgan {
             from_m: at,
         };
         self.previous_hand_m = Some(*hand_m);
+        self.damaged = false;
     }
 
     /// The force the jaws put on the organ in the last tick (N).

@@ -28,8 +28,9 @@ pub struct Sample {
     pub surrounding_force_n: f64,
     /// The organs the grasper's jaws hold: bit `k` for the scenario's `organs[k]`.
     pub grasping: u64,
-    /// Whether the grasper has damaged any tissue so far.
-    pub damaged: bool,
+    /// Whether the grasper tore tissue this tick (a tear before the task began, in an
+    /// earlier attempt, does not count against it).
+    pub tore: bool,
 }
 
 impl Sample {
@@ -448,7 +449,7 @@ impl Running {
     /// tissue is an error and the task can no longer be done.
     fn grasp(&mut self, organ: &str, (move_mm, hold_s): (f64, f64), sample: &Sample) {
         let grasped = self.organ.is_some_and(|k| sample.grasps(k));
-        if sample.damaged && !self.damaged {
+        if sample.tore && !self.damaged {
             self.damaged = true;
             let error = format!("{:.2} s: tore the {organ}", sample.time_s);
             self.metrics.errors.push(error);

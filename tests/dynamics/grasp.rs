@@ -92,6 +92,9 @@ fn grasped_pulled_held_and_released() {
     for tick in 0..6100 {
         let t = tick as f64 * TICK_S;
         let closed = (0.1..3.1).contains(&t);
+        if tick == 100 {
+            organ.close(&hand(t), &Vector3::zeros());
+        }
         let GraspTick {
             hand_force_n,
             point_m,
@@ -151,7 +154,8 @@ fn grasped_pulled_held_and_released() {
 
 /// Pulled 150 mm: the hand's force never exceeds the slip limit, the jaws slip, the tissue
 /// escapes once they have slid 10 mm (the jaws let go, the force fades), and the tissue is
-/// marked damaged on the way (the 2 N damage pull is below the 2.5 N slip).
+/// marked damaged on the way (the 2 N damage pull is below the 2.5 N slip); the jaws, kept shut,
+/// do not take it again, and a new grasp starts with undamaged tissue.
 #[test]
 fn a_pull_too_far_slips_escapes_and_damages() {
     let settings = GraspSettings::default();
@@ -160,6 +164,9 @@ fn a_pull_too_far_slips_escapes_and_damages() {
     for tick in 0..3000 {
         let t = tick as f64 * TICK_S;
         let hand = rest + Vector3::new(0.0, 0.0, 0.15) * ease((t - 0.1) / 2.0);
+        if tick == 100 {
+            organ.close(&hand, &Vector3::zeros());
+        }
         let outcome = organ.tick(&hand, t >= 0.1).unwrap();
         strongest = strongest.max(outcome.hand_force_n.norm());
         slipped |= outcome.slipping;
@@ -180,4 +187,8 @@ fn a_pull_too_far_slips_escapes_and_damages() {
     assert!(slipped);
     assert!(damaged_at.is_some() && escaped_at.is_some());
     assert!(damaged_at < escaped_at);
+    // The jaws stayed shut on nothing after the escape; a new grasp starts undamaged.
+    assert_eq!(organ.jaws, Jaws::Open);
+    organ.close(&(rest + Vector3::new(0.0, 0.0, 0.15)), &Vector3::zeros());
+    assert!(!organ.damaged);
 }

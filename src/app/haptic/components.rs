@@ -51,6 +51,8 @@ pub struct OrganMotion {
     pub correction: Vec<f64>,
     /// The jaws' patch on the surface while they hold.
     pub shares: Vec<(usize, f64)>,
+    /// Whether the jaws tore the tissue this tick (what the scenario's tasks score).
+    pub tore: bool,
 }
 
 impl OrganMotion {
@@ -62,6 +64,7 @@ impl OrganMotion {
             organ,
             correction,
             shares: Vec::new(),
+            tore: false,
         }
     }
 }

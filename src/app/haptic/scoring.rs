@@ -193,9 +193,9 @@ pub fn score_tick(
         .iter()
         .filter(|(index, .., motion)| motion.is_some_and(|m| m.organ.holding()) && index.0 < 64)
         .fold(0, |bits, (index, ..)| bits | 1 << index.0);
-    let damaged = organs
+    let tore = organs
         .iter()
-        .any(|(.., motion)| motion.is_some_and(|m| m.organ.damaged));
+        .any(|(.., motion)| motion.is_some_and(|m| m.tore));
     let (region_moved_m, surrounding_force_n) = exercise
         .watched_region()
         .map_or((0.0, 0.0), |region| watch(region, &organs));
@@ -208,7 +208,7 @@ pub fn score_tick(
         region_moved_m,
         surrounding_force_n,
         grasping,
-        damaged,
+        tore,
     });
     if exercise.finished() {
         let run = &mut *run;

@@ -75,13 +75,14 @@ pub fn tool_contact(
     }
 }
 
-/// The grasper on the organs that move: the device's button closes the jaws on the organ the
-/// tool touches (one at a time), and every moving organ is stepped, held or swinging back.
+/// The grasper on the organs that move: pressing the device's button closes the jaws on the
+/// organ the tool touches (one at a time), and every moving organ is stepped, held or swinging back.
 /// While the jaws hold, the organ's tool load is their pull at their patch (its static field
 /// the vademecum's, the kept modes' motion the correction) and the hand feels the grasp, not
 /// a press.
 pub fn grasp(
     tool: Res<Tool>,
+    mut was_closed: Local<bool>,
     mut grasp_force: ResMut<GraspForce>,
     mut faults: ResMut<FaultLog>,
     mut organs: Query<(
@@ -96,20 +97,25 @@ pub fn grasp(
         return;
     };
     let closed = sample.buttons & 1 != 0;
+    // Jaws close on tissue when the button goes down, not while it stays down: tissue that
+    // escaped a closed grasper is not taken again until the trainee opens and closes it.
+    let closing = closed && !*was_closed;
+    *was_closed = closed;
     let mut held_elsewhere = organs.iter().any(|(_, _, _, m)| m.organ.holding());
     for (body, mut touch, mut deformation, mut motion) in &mut organs {
         let motion = &mut *motion;
         let holding = motion.organ.holding();
-        let grasping = closed && !holding && !held_elsewhere && touch.contact.is_some();
+        let grasping = closing && !holding && !held_elsewhere && touch.contact.is_some();
         if grasping {
             take_hold(body, &touch, motion, &sample.tip_m);
             held_elsewhere = true;
         }
-        match motion
-            .organ
-            .tick(&sample.tip_m, closed && (holding || grasping))
-        {
-            Ok(outcome) => grasp_force.0 += outcome.hand_force_n,
+        motion.tore = false;
+        match motion.organ.tick(&sample.tip_m, closed) {
+            Ok(outcome) => {
+                grasp_force.0 += outcome.hand_force_n;
+                motion.tore = outcome.damaged_now;
+            }
             Err(e) => faults
                 .this_tick
                 .push(Fault::Physics(format!("{}: {e}", body.name))),
