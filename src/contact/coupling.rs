@@ -165,10 +165,15 @@ impl Coupling {
     }
 
     /// Takes organ `index`'s state for this tick: its coefficients (the coupling of the last
-    /// tick included), and the master's loads for their near-field corrections.
-    pub fn read(&mut self, index: usize, deformation: &Deformation) {
+    /// tick included) plus `moved`, what its motion adds to its first load step's coefficients
+    /// (empty for an organ that does not move), and the master's loads for their near-field
+    /// corrections.
+    pub fn read(&mut self, index: usize, deformation: &Deformation, moved: &[f64]) {
         let organ = &mut self.organs[index];
         concatenate(&deformation.coefficients, &mut organ.alpha);
+        for (a, &m) in organ.alpha.iter_mut().zip(moved) {
+            *a += m as f32;
+        }
         if let Some((_, near)) = self.master.as_mut().filter(|(m, _)| *m == index) {
             near.set_loads(&deformation.loads);
         }

@@ -11,11 +11,14 @@
 //!   damping, solved by Newton's method with the rest Jacobian.
 //! - [`GraspedOrgan`]: a grasper on such an organ: a virtual coupling to the hand, slip,
 //!   release that fades the hand's force, damage.
+//! - [`ModeFit`]: the kept modes in the vademecum's own modes, so that contact and
+//!   attachments, which read an organ through those, see it move.
 
 mod basis;
 mod error;
 mod grasp;
 mod integrator;
+mod mode_fit;
 mod organ;
 mod polynomial;
 
@@ -23,5 +26,6 @@ pub use basis::ModalBasis;
 pub use error::DynamicsError;
 pub use grasp::{GraspPoint, GraspSettings, GraspTick, GraspedOrgan, Jaws};
 pub use integrator::{EnergyMomentum, RayleighDamping, ReducedState, StepReport};
+pub use mode_fit::ModeFit;
 pub use organ::{DynamicModel, TISSUE_DAMPING_RATIO, TRAINER_MODES};
 pub use polynomial::ReducedKsv;

@@ -4,7 +4,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::{
-    DynamicsError, EnergyMomentum, GraspPoint, GraspSettings, GraspedOrgan, ModalBasis,
+    DynamicsError, EnergyMomentum, GraspPoint, GraspSettings, GraspedOrgan, ModalBasis, ModeFit,
     RayleighDamping, ReducedKsv,
 };
 use crate::fem::FemModel;
@@ -23,6 +23,8 @@ pub struct DynamicModel {
     pub basis: ModalBasis,
     pub reduced: ReducedKsv,
     pub damping: RayleighDamping,
+    /// The kept modes in the vademecum's modes: how contact and attachments see the motion.
+    pub fit: ModeFit,
 }
 
 impl DynamicModel {
@@ -38,10 +40,12 @@ impl DynamicModel {
         let omega = |k: usize| basis.omega2[k].sqrt();
         let damping =
             RayleighDamping::with_ratio(TISSUE_DAMPING_RATIO, omega(0), omega(basis.len() - 1));
+        let fit = ModeFit::new(&basis, vademecum);
         Ok(Self {
             basis,
             reduced,
             damping,
+            fit,
         })
     }
 

@@ -68,6 +68,24 @@ pub fn facing_clear_of(name: &str, direction: Vector3<f64>, clear_of: &str) -> P
     target(vademecum, best)
 }
 
+/// A point of the carrier's accessible surface facing +y, `distance_m` from the centre of an
+/// attachment's `interface` (carrier positions).
+pub fn carrier_point_near(
+    carrier: &Vademecum,
+    interface: &[usize],
+    distance_m: f64,
+) -> PressTarget {
+    let at = |m: usize| Vector3::from(carrier.position_coords_m[m].map(f64::from));
+    let centre = interface.iter().map(|&m| at(m)).sum::<Vector3<f64>>() / interface.len() as f64;
+    let normals = carrier.rest_normals();
+    let off = |m: usize| ((at(m) - centre).norm() - distance_m).abs();
+    let nearest = (0..carrier.positions.len())
+        .filter(|&m| normals[m].y > 0.5)
+        .min_by(|&a, &b| off(a).total_cmp(&off(b)))
+        .unwrap();
+    target(carrier, nearest)
+}
+
 /// The tool comes from 5 mm off `target` and pushes `depth_m` into it along its normal over
 /// `push_s`, then holds for `hold_s`.
 pub fn push(target: &PressTarget, depth_m: f64, push_s: f64, hold_s: f64) -> Trajectory {

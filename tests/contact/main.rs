@@ -7,6 +7,7 @@ mod common;
 mod deep_press;
 mod dimples;
 mod field_file;
+mod moving;
 mod near_field;
 
 use common::*;
@@ -478,28 +479,8 @@ fn assert_carried_by_the_duodenum(carried: &str) {
         .find(|a| (a.carrier, a.carried) == (d, g))
         .unwrap();
     let interface = attachment.interface();
-    let centre: Vector3<f64> = interface
-        .iter()
-        .map(|&m| Vector3::from(duodenum.position_coords_m[m].map(f64::from)))
-        .sum::<Vector3<f64>>()
-        / interface.len() as f64;
-    let normals = duodenum.rest_normals();
     // Pressed 3 cm from the interface, whose motion is then mostly the duodenum's bending.
-    let nearest = (0..duodenum.positions.len())
-        .filter(|&m| normals[m].y > 0.5)
-        .min_by(|&a, &b| {
-            let dist = |m: usize| {
-                ((Vector3::from(duodenum.position_coords_m[m].map(f64::from)) - centre).norm()
-                    - 0.03)
-                    .abs()
-            };
-            dist(a).total_cmp(&dist(b))
-        })
-        .unwrap();
-    let target = pgd_surgery::devices::PressTarget {
-        point_m: Vector3::from(duodenum.position_coords_m[nearest].map(f64::from)),
-        normal: normals[nearest],
-    };
+    let target = carrier_point_near(duodenum, interface, 0.03);
     let (_, record) = run(push(&target, 0.008, 1.0, 0.2), 1300);
     let last = record.last().unwrap();
     let mut field = vec![0.0; duodenum.dof_count()];

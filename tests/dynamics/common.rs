@@ -4,7 +4,7 @@ use nalgebra::DMatrix;
 use pgd_surgery::dynamics::{ModalBasis, ReducedKsv};
 use pgd_surgery::fem::{Dirichlet, FemModel, Law, Material};
 use pgd_surgery::mesh::box_mesh;
-use pgd_surgery::pgd::{BuildSettings, OrganModel, PgdSettings, Silent, build};
+use pgd_surgery::pgd::{BuildSettings, OrganModel, PgdSettings, Silent, Vademecum, build};
 
 /// The basis size of the tests in the vademecum's basis.
 pub const KEEP: usize = 12;
@@ -65,7 +65,7 @@ pub fn pseudo_random(n: usize, seed: u64) -> Vec<f64> {
 
 /// The block's linear vademecum, converged far enough that its spatial modes span the
 /// response to any load of its top face.
-pub fn vademecum_basis(model: &FemModel) -> (ModalBasis, ReducedKsv) {
+pub fn block_vademecum(model: &FemModel) -> Vademecum {
     let organ = OrganModel {
         source: "block".into(),
         model,
@@ -82,7 +82,12 @@ pub fn vademecum_basis(model: &FemModel) -> (ModalBasis, ReducedKsv) {
         },
         ..BuildSettings::default()
     };
-    let vademecum = build(&organ, &settings, &Silent).unwrap().0;
+    build(&organ, &settings, &Silent).unwrap().0
+}
+
+/// The [`KEEP`] lowest modes found from [`block_vademecum`], and the reduced model in them.
+pub fn vademecum_basis(model: &FemModel) -> (ModalBasis, ReducedKsv) {
+    let vademecum = block_vademecum(model);
     let basis = ModalBasis::of_vademecum(model, &vademecum, KEEP).unwrap();
     let reduced = ReducedKsv::new(model, &basis).unwrap();
     (basis, reduced)

@@ -6,4 +6,5 @@ mod common;
 mod conservation;
 mod grasp;
 mod modal;
+mod mode_fit;
 mod polynomial;

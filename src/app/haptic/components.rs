@@ -43,12 +43,14 @@ impl OrganDeformation {
 
 /// An organ that moves: its dynamic model (shared with the window, which draws its modes),
 /// its state with the grasper's jaws on it, and the kept modes' correction to the static
-/// field of the jaws' load this tick (what the snapshot hands the window).
+/// field of the jaws' load this tick (what the snapshot hands the window), and that correction
+/// in the vademecum's modes (what organ contact and attachments read).
 #[derive(Component)]
 pub struct OrganMotion {
     pub model: Arc<DynamicModel>,
     pub organ: GraspedOrgan,
     pub correction: Vec<f64>,
+    pub in_vademecum_modes: Vec<f64>,
     /// The jaws' patch on the surface while they hold.
     pub shares: Vec<(usize, f64)>,
     /// Whether the jaws tore the tissue this tick (what the scenario's tasks score).
@@ -59,10 +61,12 @@ impl OrganMotion {
     pub fn new(model: Arc<DynamicModel>, settings: GraspSettings) -> Self {
         let organ = model.at_rest(TICK_S, settings);
         let correction = vec![0.0; model.basis.len()];
+        let in_vademecum_modes = vec![0.0; model.fit.modes()];
         Self {
             model,
             organ,
             correction,
+            in_vademecum_modes,
             shares: Vec::new(),
             tore: false,
         }

@@ -123,6 +123,10 @@ pub fn grasp(
         motion
             .organ
             .correction(&motion.model.basis.omega2, &mut motion.correction);
+        motion
+            .model
+            .fit
+            .coefficients_into(&motion.correction, &mut motion.in_vademecum_modes);
         if motion.organ.holding() {
             touch.contact = None;
             let load = &mut deformation.0.loads[OrganDeformation::TOOL];
@@ -157,26 +161,32 @@ pub fn evaluate_modes(mut organs: Query<(&OrganBody, &mut OrganDeformation)>) {
     }
 }
 
-/// Organ against organ: hands every organ's coefficients and the tool's hold on it to the
-/// coupling, ticks its pairs and attachments, and gives each organ its coupling loads and
-/// carry. The tool's load follows the contact's push in the same tick, so the trainee feels
-/// the organ behind at once.
+/// Organ against organ: hands every organ's coefficients (a moving organ's motion included)
+/// and the tool's hold on it to the coupling, ticks its pairs and attachments, and gives each
+/// organ its coupling loads and carry. The tool's load follows the contact's push in the same
+/// tick, so the trainee feels the organ behind at once.
 pub fn organ_contact(
     coupling: Option<ResMut<OrganCoupling>>,
-    mut organs: Query<(&OrganIndex, &mut ToolTouch, &mut OrganDeformation)>,
+    mut organs: Query<(
+        &OrganIndex,
+        &mut ToolTouch,
+        &mut OrganDeformation,
+        Option<&OrganMotion>,
+    )>,
 ) {
     let Some(mut coupling) = coupling else {
         return;
     };
     let coupling = &mut coupling.0;
-    for (index, touch, deformation) in &organs {
+    for (index, touch, deformation, motion) in &organs {
         let deformation = &deformation.0;
-        coupling.read(index.0, deformation);
+        let moved = motion.map_or(&[][..], |m| &m.in_vademecum_modes);
+        coupling.read(index.0, deformation, moved);
         let load = &deformation.loads[OrganDeformation::TOOL];
         coupling.hold(index.0, touch.contact.as_ref(), load);
     }
     coupling.tick();
-    for (index, mut touch, mut deformation) in &mut organs {
+    for (index, mut touch, mut deformation, _) in &mut organs {
         let deformation = &mut deformation.0;
         coupling.write(index.0, deformation);
         follow(
