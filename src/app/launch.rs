@@ -20,8 +20,8 @@ use super::window::{
     FrameReport, Lesson, Lessons, MenuPlan, Opening, SceneSource, ScreenshotPlan, WindowScene,
 };
 use crate::devices::{
-    DeviceSpec, HapticDevice, PressMotion, Recorder, Scripted, TICK_S, TimerMode, Trajectory,
-    VirtualDevice, press_and_slide,
+    DeviceSpec, HapticDevice, OpenHaptics, PressMotion, Recorder, Scripted, TICK_S, TimerMode,
+    Trajectory, VirtualDevice, press_and_slide,
 };
 use crate::scenario::{Exercise, Scenario};
 use crate::store::OnStale;
@@ -104,6 +104,7 @@ fn print_realtime(report: &RealTimeReport) {
 pub fn run_headless(options: &Options) -> Result<Report, String> {
     let scene = scene(options)?;
     let trajectory = match &options.device {
+        Some(DeviceSpec::OpenHaptics(name)) => return run_hardware_headless(options, &scene, name),
         None => {
             let motion = PressMotion {
                 tip_radius_m: scene.probe.tip_radius_m,
@@ -123,6 +124,22 @@ pub fn run_headless(options: &Options) -> Result<Report, String> {
         None => Report::Simulated(haptic.run_simulated(ticks)),
         Some(timer) => Report::RealTime(run_realtime(haptic, timer, ticks)?),
     })
+}
+
+/// Serves a hardware device without a window, on the real clock, for `--ticks` (ten seconds
+/// when it does not say).
+fn run_hardware_headless(
+    options: &Options,
+    scene: &HapticScene,
+    name: &Option<String>,
+) -> Result<Report, String> {
+    let timer = options
+        .realtime
+        .ok_or("a hardware device runs on the real clock: add --realtime (and --ticks)")?;
+    let device = recorded(openhaptics(name)?, &options.record);
+    let haptic = HapticLoop::new(scene, device).map_err(|e| e.to_string())?;
+    let ticks = options.ticks.unwrap_or(HARDWARE_TICKS);
+    Ok(Report::RealTime(run_realtime(haptic, timer, ticks)?))
 }
 
 /// A scenario for the window: the lesson it opens with, and the scenarios its menu offers.
@@ -158,6 +175,7 @@ pub fn open_window(
             let trajectory = Trajectory::load(path).map_err(|e| e.to_string())?;
             (scripted(&options.device, trajectory), None)
         }
+        Some(DeviceSpec::OpenHaptics(name)) => (openhaptics(name)?, None),
         None | Some(DeviceSpec::Virtual) => {
             let start = press_targets(&scene)
                 .first()
@@ -310,6 +328,15 @@ fn scripted(spec: &Option<DeviceSpec>, trajectory: Trajectory) -> Box<dyn Haptic
         _ => "scripted (built-in press and slide on each organ)".into(),
     };
     Box::new(Scripted::new(name, trajectory))
+}
+
+/// Headless ticks on a hardware device when `--ticks` does not say: ten seconds.
+const HARDWARE_TICKS: u64 = 10_000;
+
+/// The Geomagic device `name` names (the default without one), opened through OpenHaptics.
+fn openhaptics(name: &Option<String>) -> Result<Box<dyn HapticDevice>, String> {
+    let device = OpenHaptics::open(None, name.as_deref()).map_err(|e| e.to_string())?;
+    Ok(Box::new(device))
 }
 
 fn recorded(device: Box<dyn HapticDevice>, record: &Option<PathBuf>) -> Box<dyn HapticDevice> {

@@ -8,7 +8,7 @@ use pgd_surgery::app::launch::WindowLesson;
 use pgd_surgery::app::scene::Detail;
 use pgd_surgery::app::window::{Opening, ScreenshotPlan};
 use pgd_surgery::app::{self, DEFAULT_SCENARIO, launch};
-use pgd_surgery::cli::{debrief, numbered, validate_scenarios};
+use pgd_surgery::cli::{debrief, list_devices, numbered, validate_scenarios};
 use pgd_surgery::devices::{DeviceSpec, TimerMode};
 use pgd_surgery::scenario;
 use pgd_surgery::store::OnStale;
@@ -26,7 +26,9 @@ struct Cli {
     #[arg(long, global = true)]
     headless: bool,
     /// The haptic device: `scripted:FILE` replays a trajectory CSV (time_s,x_m,y_m,z_m,buttons);
-    /// `virtual` is the mouse. Headless default: a built-in press-and-slide on every organ.
+    /// `virtual` is the mouse; `openhaptics[:NAME]` a Geomagic Touch (its HD library loaded at
+    /// run time; `trainer devices` says what is found). Headless default: a built-in
+    /// press-and-slide on every organ.
     #[arg(long, global = true)]
     device: Option<DeviceSpec>,
     /// Record what the device reports to this trajectory file (replayable with scripted:FILE).
@@ -94,6 +96,9 @@ enum Command {
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
+    /// List the haptic device backends, which of them can be used on this machine, and why
+    /// the others cannot.
+    Devices,
 }
 
 fn parse_timer(s: &str) -> Result<TimerMode, String> {
@@ -106,8 +111,10 @@ fn parse_timer(s: &str) -> Result<TimerMode, String> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    if let Some(Command::Validate { files }) = &cli.command {
-        return validate_scenarios(files);
+    match &cli.command {
+        Some(Command::Validate { files }) => return validate_scenarios(files),
+        Some(Command::Devices) => return list_devices(),
+        _ => {}
     }
     if !cli.headless
         && let Some(why) = app::missing_display()

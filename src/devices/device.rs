@@ -31,17 +31,46 @@ impl DeviceSample {
     }
 }
 
-/// What a device can render.
+/// What a device can render. A motor takes a peak force for a moment but heats under a
+/// sustained one: the continuous limit holds for the force's root mean square over the motors'
+/// thermal window, the peak at every tick.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DeviceLimits {
-    /// The largest force (N) it renders continuously.
-    pub max_force_n: f64,
+    /// The largest force (N) it renders at any tick.
+    pub peak_force_n: f64,
+    /// The largest force (N) it renders continuously: the bound on the RMS force over
+    /// `thermal_window_s`.
+    pub continuous_force_n: f64,
+    /// The time constant (s) of the exponential window the RMS force is taken over.
+    pub thermal_window_s: f64,
+}
+
+impl DeviceLimits {
+    /// A device without motors to heat (scripted, virtual): one limit, the peak.
+    pub fn peak_only(peak_force_n: f64) -> Self {
+        Self {
+            peak_force_n,
+            continuous_force_n: peak_force_n,
+            thermal_window_s: 1.0,
+        }
+    }
+
+    /// The Geomagic Touch, the device the papers used: 3.3 N peak, 0.88 N continuous (its
+    /// data sheet). The data sheet gives no thermal window; 2 s is chosen short, so that a
+    /// sustained press falls to the continuous limit well before the motors could heat.
+    pub fn touch() -> Self {
+        Self {
+            peak_force_n: 3.3,
+            continuous_force_n: 0.88,
+            thermal_window_s: 2.0,
+        }
+    }
 }
 
 impl Default for DeviceLimits {
-    /// The Geomagic Touch's continuous force, the device the papers used.
+    /// The Touch's peak force, as the limit of a device without motors.
     fn default() -> Self {
-        Self { max_force_n: 3.3 }
+        Self::peak_only(3.3)
     }
 }
 

@@ -1,11 +1,14 @@
-//! The device layer, free of Bevy: the device trait and its backends, the trajectory
+//! The device layer, free of Bevy: the device trait and its backends (scripted, recorder,
+//! virtual, and OpenHaptics hardware over the servo link and its watchdog), the trajectory
 //! files they replay and record, the map from the device's workspace to the scene, the safety
 //! filter between the physics and the motors, and the clock that paces the 1 kHz loop.
 
 mod device;
+mod openhaptics;
 mod recorder;
 mod safety;
 mod scripted;
+mod servo;
 mod spec;
 mod sweep;
 mod timing;
@@ -14,9 +17,11 @@ mod virtual_device;
 mod workspace;
 
 pub use device::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
+pub use openhaptics::OpenHaptics;
 pub use recorder::Recorder;
 pub use safety::{Fault, SafetyFilter, SafetySettings};
 pub use scripted::Scripted;
+pub use servo::{ServoLink, WATCHDOG_S};
 pub use spec::DeviceSpec;
 pub use sweep::{PressMotion, PressTarget, press_and_slide};
 pub use timing::{Histogram, Metronome, TimerMode};

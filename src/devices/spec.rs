@@ -1,4 +1,5 @@
-//! Which device to serve, as the command line names it: `scripted:FILE` or `virtual`.
+//! Which device to serve, as the command line names it: `scripted:FILE`, `virtual` or
+//! `openhaptics[:NAME]`.
 
 use std::path::PathBuf;
 use std::str::FromStr;
@@ -9,6 +10,9 @@ pub enum DeviceSpec {
     Scripted(PathBuf),
     /// Mouse and keyboard in the trainer window.
     Virtual,
+    /// A Geomagic device through OpenHaptics: the named one (as the vendor's Touch Setup
+    /// names it), or the default.
+    OpenHaptics(Option<String>),
 }
 
 impl FromStr for DeviceSpec {
@@ -18,9 +22,13 @@ impl FromStr for DeviceSpec {
         match s.split_once(':') {
             Some(("scripted", path)) if !path.is_empty() => Ok(Self::Scripted(path.into())),
             None if s == "virtual" => Ok(Self::Virtual),
+            None if s == "openhaptics" => Ok(Self::OpenHaptics(None)),
+            Some(("openhaptics", name)) if !name.is_empty() => {
+                Ok(Self::OpenHaptics(Some(name.into())))
+            }
             _ => Err(format!(
-                "unknown device `{s}`: expected `scripted:FILE` (a trajectory CSV) or `virtual`; \
-                 hardware devices are not supported yet"
+                "unknown device `{s}`: expected `scripted:FILE` (a trajectory CSV), `virtual` \
+                 (the mouse) or `openhaptics[:NAME]` (a Geomagic Touch, Touch X or Phantom)"
             )),
         }
     }

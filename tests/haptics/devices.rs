@@ -5,7 +5,8 @@ use std::time::Duration;
 
 use nalgebra::Vector3;
 use pgd_surgery::devices::{
-    DeviceSpec, Fault, Histogram, SafetyFilter, SafetySettings, Trajectory, TrajectoryError,
+    DeviceLimits, DeviceSpec, Fault, Histogram, SafetyFilter, SafetySettings, TICK_S, Trajectory,
+    TrajectoryError,
 };
 
 fn write(name: &str, text: &str) -> std::path::PathBuf {
@@ -62,7 +63,15 @@ fn device_names_parse() {
         Ok(DeviceSpec::Scripted("a/b.csv".into()))
     );
     assert_eq!("virtual".parse::<DeviceSpec>(), Ok(DeviceSpec::Virtual));
-    for bad in ["scripted:", "touch", "virtual:x"] {
+    assert_eq!(
+        "openhaptics".parse::<DeviceSpec>(),
+        Ok(DeviceSpec::OpenHaptics(None))
+    );
+    assert_eq!(
+        "openhaptics:Left Touch".parse::<DeviceSpec>(),
+        Ok(DeviceSpec::OpenHaptics(Some("Left Touch".into())))
+    );
+    for bad in ["scripted:", "touch", "virtual:x", "openhaptics:"] {
         let e = bad.parse::<DeviceSpec>().unwrap_err();
         assert!(e.contains(bad), "{e}");
     }
@@ -73,7 +82,7 @@ fn device_names_parse() {
 #[test]
 fn the_safety_filter_clamps_and_limits_the_rate() {
     let settings = SafetySettings::default();
-    let mut filter = SafetyFilter::new(settings, 10.0);
+    let mut filter = SafetyFilter::new(settings, DeviceLimits::peak_only(10.0));
     let desired = Vector3::new(0.0, 6.0, 8.0);
     let mut last: Vector3<f64> = Vector3::zeros();
     let mut ticks = 0;
@@ -91,7 +100,57 @@ fn the_safety_filter_clamps_and_limits_the_rate() {
     );
     assert!((last.normalize() - desired.normalize()).norm() < 1e-12);
     // A device weaker than the settings caps the force at its own limit.
-    assert_eq!(SafetyFilter::new(settings, 1.0).max_force_n(), 1.0);
+    assert_eq!(
+        SafetyFilter::new(settings, DeviceLimits::peak_only(1.0)).max_force_n(),
+        1.0
+    );
+}
+
+/// A Touch (3.3 N peak, 0.88 N continuous over a 2 s window) asked for 2 N for 10 s: the force
+/// starts at 2 N with the motors cold, never passes the peak or changes faster than the rate
+/// limit, and settles on the continuous limit; its mean square over the thermal window,
+/// recomputed here from the forces sent, never passes the continuous limit's square. Asked for
+/// 0.5 N, under the continuous limit, it gives 0.5 N throughout.
+#[test]
+fn a_sustained_force_is_held_to_the_continuous_limit() {
+    let settings = SafetySettings::default();
+    let limits = DeviceLimits::touch();
+    let run = |asked_n: f64| {
+        let mut filter = SafetyFilter::new(settings, limits);
+        let desired = Vector3::new(0.0, 0.0, asked_n);
+        (0..10_000)
+            .map(|_| filter.filter(&desired, &[]).norm())
+            .collect::<Vec<f64>>()
+    };
+    let sent = run(2.0);
+    let window = limits.thermal_window_s / TICK_S;
+    let mut heat = 0.0_f64;
+    let mut hottest = 0.0_f64;
+    for f in &sent {
+        heat += (f * f - heat) / window;
+        hottest = hottest.max(heat);
+    }
+    let largest_step = sent
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(0.0, f64::max);
+    let settled = sent.last().unwrap();
+    eprintln!(
+        "2 N asked: {:.3} N at 0.5 s, {:.3} N at 2 s, {settled:.4} N at 10 s; RMS over the window at most {:.4} N",
+        sent[500],
+        sent[2000],
+        hottest.sqrt()
+    );
+    assert!(
+        (sent[200] - 2.0).abs() < 1e-9,
+        "a cold device renders the peak"
+    );
+    assert!(sent.iter().all(|&f| f <= limits.peak_force_n));
+    assert!(largest_step <= settings.max_change_n_per_tick * (1.0 + 1e-12));
+    assert!((settled - limits.continuous_force_n).abs() < 0.01 * limits.continuous_force_n);
+    assert!(hottest.sqrt() <= limits.continuous_force_n * (1.0 + 1e-9));
+    let gentle = run(0.5);
+    assert!(gentle[100..].iter().all(|&f| (f - 0.5).abs() < 1e-12));
 }
 
 /// After a fault the force fades linearly to zero in `fade_ticks`, is held at zero while the
@@ -99,7 +158,7 @@ fn the_safety_filter_clamps_and_limits_the_rate() {
 #[test]
 fn the_safety_filter_fades_holds_and_recovers() {
     let settings = SafetySettings::default();
-    let mut filter = SafetyFilter::new(settings, 3.3);
+    let mut filter = SafetyFilter::new(settings, DeviceLimits::peak_only(3.3));
     let desired = Vector3::new(0.0, 0.0, 0.1);
     for _ in 0..10 {
         filter.filter(&desired, &[]);

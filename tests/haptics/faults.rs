@@ -148,14 +148,14 @@ fn a_streak_of_overruns_fades_the_force() {
 /// clamped on every tick, and reaches the limit.
 #[test]
 fn the_clamp_holds() {
-    let limit = DeviceLimits { max_force_n: 0.05 };
+    let limit = DeviceLimits::peak_only(0.05);
     let motion = PressMotion::default();
     let device = Box::new(Scripted::new("weak device", press(&motion)).with_limits(limit));
     let mut haptic = haptic(device, SafetySettings::default());
     let trace = run(&mut haptic, tick_at(press(&motion).duration_s()));
     let asked = trace.desired_n.iter().map(|f| f.norm()).fold(0.0, f64::max);
     let sent = trace.sent_n.iter().map(|f| f.norm()).fold(0.0, f64::max);
-    assert!(asked > 3.0 * limit.max_force_n, "asked only {asked} N");
-    assert!(sent <= limit.max_force_n * (1.0 + 1e-12), "sent {sent} N");
-    assert!(sent > 0.99 * limit.max_force_n, "sent {sent} N");
+    assert!(asked > 3.0 * limit.peak_force_n, "asked only {asked} N");
+    assert!(sent <= limit.peak_force_n * (1.0 + 1e-12), "sent {sent} N");
+    assert!(sent > 0.99 * limit.peak_force_n, "sent {sent} N");
 }

@@ -6,6 +6,7 @@ mod deformed;
 mod devices;
 mod faults;
 mod grasp;
+mod openhaptics;
 mod press;
 mod range;
 mod replay;

@@ -68,11 +68,11 @@ impl HapticLoop {
     pub fn new(scene: &HapticScene, device: Box<dyn HapticDevice>) -> Result<Self, SceneError> {
         let mut haptic = Self::parked(scene)?;
         haptic.world.remove_resource::<Parked>();
-        let max_force_n = device.limits().max_force_n;
+        let limits = device.limits();
         haptic.world.insert_resource(Device(device));
         haptic
             .world
-            .insert_resource(Safety(SafetyFilter::new(scene.safety, max_force_n)));
+            .insert_resource(Safety(SafetyFilter::new(scene.safety, limits)));
         Ok(haptic)
     }
 
@@ -130,7 +130,7 @@ impl HapticLoop {
         ) else {
             return;
         };
-        safety.0.retune(settings, device.0.limits().max_force_n);
+        safety.0.retune(settings, device.0.limits());
         self.world.remove_resource::<Parked>();
         self.world.insert_resource(device);
         self.world.insert_resource(safety);

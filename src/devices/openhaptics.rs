@@ -1,0 +1,392 @@
+//! The OpenHaptics backend (Geomagic Touch, Touch X, Phantom): the vendor's HD library is
+//! loaded at run time, so the build never needs the SDK and a machine without it gets a clear
+//! message instead of a link error.
+//!
+//! The servo is the HD scheduler's own callback, not a thread of ours: the scheduler runs at
+//! the device's servo rate with the priority the vendor's driver needs, and HD calls outside a
+//! scheduler frame are not allowed for force output. Each frame the callback reads the position
+//! (mm), the transform and the buttons, publishes them to the [`ServoLink`], renders the link's
+//! force (zero once the haptic loop stops commanding: the watchdog), and reports any HD error.
+
+use std::ffi::{CString, c_char, c_int, c_uint, c_ulong, c_ushort, c_void};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use libloading::Library;
+use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+
+use super::servo::ServoLink;
+use super::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
+
+/// The library's name as the dynamic loader finds it, and the environment variable that names
+/// another file.
+pub const LIBRARY: &str = "libHD.so";
+pub const LIBRARY_VARIABLE: &str = "PGD_OPENHAPTICS_LIB";
+
+// Parameters, capabilities and return values of `hdDefines.h`.
+const HD_CURRENT_BUTTONS: c_uint = 0x2000;
+const HD_CURRENT_POSITION: c_uint = 0x2050;
+const HD_CURRENT_TRANSFORM: c_uint = 0x2052;
+const HD_DEVICE_MODEL_TYPE: c_uint = 0x2501;
+const HD_USABLE_WORKSPACE_DIMENSIONS: c_uint = 0x2551;
+const HD_NOMINAL_MAX_FORCE: c_uint = 0x2603;
+const HD_NOMINAL_MAX_CONTINUOUS_FORCE: c_uint = 0x2604;
+const HD_CURRENT_FORCE: c_uint = 0x2700;
+const HD_FORCE_OUTPUT: c_uint = 0x4000;
+const HD_INVALID_HANDLE: c_uint = 0xFFFF_FFFF;
+const HD_CALLBACK_CONTINUE: c_uint = 1;
+const HD_DEFAULT_SCHEDULER_PRIORITY: c_ushort = u16::MAX / 2;
+
+/// `HDErrorInfo`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+struct ErrorInfo {
+    code: c_uint,
+    internal: c_int,
+    handle: c_uint,
+}
+
+type Callback = extern "C" fn(*mut c_void) -> c_uint;
+
+/// The HD functions the backend calls, resolved once from the library, which they keep open.
+struct Hd {
+    init_device: unsafe extern "C" fn(*const c_char) -> c_uint,
+    disable_device: unsafe extern "C" fn(c_uint),
+    make_current: unsafe extern "C" fn(c_uint),
+    get_error: unsafe extern "C" fn() -> ErrorInfo,
+    enable: unsafe extern "C" fn(c_uint),
+    begin_frame: unsafe extern "C" fn(c_uint),
+    end_frame: unsafe extern "C" fn(c_uint),
+    get_doublev: unsafe extern "C" fn(c_uint, *mut f64),
+    get_integerv: unsafe extern "C" fn(c_uint, *mut c_int),
+    get_string: unsafe extern "C" fn(c_uint) -> *const c_char,
+    set_doublev: unsafe extern "C" fn(c_uint, *const f64),
+    start_scheduler: unsafe extern "C" fn(),
+    stop_scheduler: unsafe extern "C" fn(),
+    schedule_asynchronous: unsafe extern "C" fn(Callback, *mut c_void, c_ushort) -> c_ulong,
+    unschedule: unsafe extern "C" fn(c_ulong),
+    _library: Library,
+}
+
+impl Hd {
+    /// Loads the library at `path` (a bare name goes through the dynamic loader's search).
+    fn load(path: &Path) -> Result<Self, DeviceError> {
+        let failed = |message: String| DeviceError::Failed {
+            device: "openhaptics".into(),
+            message,
+        };
+        // SAFETY: loading runs the library's initializers; the HD library is the vendor's.
+        let library = unsafe { Library::new(path) }.map_err(|e| {
+            failed(format!(
+                "cannot load the OpenHaptics HD library `{}` ({e}); install OpenHaptics (the \
+                 Geomagic Touch device drivers and the OpenHaptics Developer Edition for Linux), \
+                 or name the library's file in {LIBRARY_VARIABLE}",
+                path.display()
+            ))
+        })?;
+        macro_rules! resolve {
+            ($name:literal) => {
+                // SAFETY: the symbol's type is the one `hd.h` declares.
+                *unsafe { library.get($name.as_bytes()) }.map_err(|e| {
+                    failed(format!(
+                        "`{}` lacks {} ({e}): not an OpenHaptics HD library",
+                        path.display(),
+                        $name
+                    ))
+                })?
+            };
+        }
+        Ok(Self {
+            init_device: resolve!("hdInitDevice"),
+            disable_device: resolve!("hdDisableDevice"),
+            make_current: resolve!("hdMakeCurrentDevice"),
+            get_error: resolve!("hdGetError"),
+            enable: resolve!("hdEnable"),
+            begin_frame: resolve!("hdBeginFrame"),
+            end_frame: resolve!("hdEndFrame"),
+            get_doublev: resolve!("hdGetDoublev"),
+            get_integerv: resolve!("hdGetIntegerv"),
+            get_string: resolve!("hdGetString"),
+            set_doublev: resolve!("hdSetDoublev"),
+            start_scheduler: resolve!("hdStartScheduler"),
+            stop_scheduler: resolve!("hdStopScheduler"),
+            schedule_asynchronous: resolve!("hdScheduleAsynchronous"),
+            unschedule: resolve!("hdUnschedule"),
+            _library: library,
+        })
+    }
+
+    /// The pending HD error, if any, as `(code, vendor code)`.
+    fn error(&self) -> Option<(u32, u32)> {
+        // SAFETY: `hdGetError` takes no argument and returns the struct by value.
+        let info = unsafe { (self.get_error)() };
+        (info.code != 0).then_some((info.code, info.internal as u32))
+    }
+
+    fn doubles<const N: usize>(&self, parameter: c_uint) -> [f64; N] {
+        let mut values = [0.0; N];
+        // SAFETY: every parameter asked for here writes at most N doubles.
+        unsafe { (self.get_doublev)(parameter, values.as_mut_ptr()) };
+        values
+    }
+}
+
+/// What an HD error code means, for the trainee and for whoever set the device up.
+pub fn error_message(code: u32) -> &'static str {
+    match code {
+        0x0100 => "invalid enumerant (HD_INVALID_ENUM)",
+        0x0101 => "invalid value (HD_INVALID_VALUE)",
+        0x0102 => "operation not allowed now (HD_INVALID_OPERATION)",
+        0x0103 => "wrong input type (HD_INVALID_INPUT_TYPE)",
+        0x0104 => "bad device handle (HD_BAD_HANDLE)",
+        0x0200 => "the motors are too warm: let the device cool down (HD_WARM_MOTORS)",
+        0x0201 => "the force exceeded the device's maximum (HD_EXCEEDED_MAX_FORCE)",
+        0x0202 => "the force changed faster than the device allows (HD_EXCEEDED_MAX_FORCE_IMPULSE)",
+        0x0203 => "the stylus moved faster than the device allows (HD_EXCEEDED_MAX_VELOCITY)",
+        0x0204 => "force error (HD_FORCE_ERROR)",
+        0x0300 => "device fault: check its cable and power (HD_DEVICE_FAULT)",
+        0x0301 => "the device is already initialized (HD_DEVICE_ALREADY_INITIATED)",
+        0x0302 => {
+            "communication error: check the cable and the device's permissions (HD_COMM_ERROR)"
+        }
+        0x0303 => {
+            "communication configuration error: run the vendor's Touch Setup (HD_COMM_CONFIG_ERROR)"
+        }
+        0x0304 => "timer error (HD_TIMER_ERROR)",
+        0x0400 => "a frame was begun twice (HD_ILLEGAL_BEGIN)",
+        0x0401 => "a frame was ended without a begin (HD_ILLEGAL_END)",
+        0x0402 => "frame error (HD_FRAME_ERROR)",
+        0x0500 => "invalid scheduler priority (HD_INVALID_PRIORITY)",
+        0x0501 => "the scheduler is full (HD_SCHEDULER_FULL)",
+        0x0600 => "no valid OpenHaptics license (HD_INVALID_LICENSE)",
+        _ => "unknown HD error",
+    }
+}
+
+/// The device frame (x right, y up, z towards the user, mm) to the scene's (x right, y away
+/// from the user, z up, m), with the device's centre at the scene's origin.
+fn to_scene(device_mm: &Vector3<f64>) -> Vector3<f64> {
+    Vector3::new(device_mm.x, -device_mm.z, device_mm.y) * 1e-3
+}
+
+/// A force in the scene's axes to the device's.
+fn to_device_force(scene_n: &Vector3<f64>) -> Vector3<f64> {
+    Vector3::new(scene_n.x, scene_n.z, -scene_n.y)
+}
+
+/// The device's frame change as a rotation: the orientation of the stylus in the scene.
+fn frame() -> Matrix3<f64> {
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0)
+}
+
+/// What the scheduler callback reaches: the functions, the device and the link.
+struct Servo {
+    hd: Arc<Hd>,
+    handle: c_uint,
+    link: Arc<ServoLink>,
+}
+
+/// One servo frame: read, publish, render, report.
+extern "C" fn servo_frame(data: *mut c_void) -> c_uint {
+    // SAFETY: `data` is the `Servo` the device keeps boxed until the callback is unscheduled.
+    let servo = unsafe { &*(data as *const Servo) };
+    let hd = &servo.hd;
+    // SAFETY: HD calls inside a frame on the scheduler's thread, as the API requires.
+    unsafe { (hd.begin_frame)(servo.handle) };
+    let position: [f64; 3] = hd.doubles(HD_CURRENT_POSITION);
+    let transform: [f64; 16] = hd.doubles(HD_CURRENT_TRANSFORM);
+    let mut buttons: c_int = 0;
+    // SAFETY: the buttons are one integer.
+    unsafe { (hd.get_integerv)(HD_CURRENT_BUTTONS, &mut buttons) };
+    let rotation = Matrix3::from_fn(|r, c| transform[4 * c + r]);
+    let orientation = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix(
+        &(frame() * rotation * frame().transpose()),
+    ));
+    servo.link.publish(&DeviceSample {
+        tip_m: to_scene(&Vector3::from(position)),
+        orientation,
+        buttons: buttons as u32,
+    });
+    let force = to_device_force(&servo.link.force_to_render());
+    // SAFETY: the force is three doubles.
+    unsafe {
+        (hd.set_doublev)(HD_CURRENT_FORCE, force.as_ptr());
+        (hd.end_frame)(servo.handle);
+    }
+    if let Some((code, internal)) = hd.error() {
+        servo.link.report_error(code, internal);
+    }
+    HD_CALLBACK_CONTINUE
+}
+
+/// A Geomagic device served by the HD scheduler.
+pub struct OpenHaptics {
+    name: String,
+    hd: Arc<Hd>,
+    handle: c_uint,
+    scheduled: c_ulong,
+    servo: Box<Servo>,
+    limits: DeviceLimits,
+    /// The usable workspace's box (m, the scene's axes): its lower and upper corners.
+    pub workspace_m: (Vector3<f64>, Vector3<f64>),
+}
+
+impl OpenHaptics {
+    /// Opens the device named `device` (the vendor's default without one) through the HD
+    /// library at `library` (or [`LIBRARY_VARIABLE`]'s, or [`LIBRARY`] through the loader).
+    pub fn open(library: Option<&Path>, device: Option<&str>) -> Result<Self, DeviceError> {
+        let path = library.map_or_else(library_path, Path::to_path_buf);
+        let hd = Arc::new(Hd::load(&path)?);
+        let name = device.unwrap_or("default device").to_owned();
+        let failed = |what: &str, (code, internal): (u32, u32)| DeviceError::Failed {
+            device: format!("OpenHaptics {name}"),
+            message: format!(
+                "{what}: {} (HD error {code:#06x}, vendor code {internal})",
+                error_message(code)
+            ),
+        };
+        let c_name = device
+            .map(|d| CString::new(d).map_err(|_| failed("bad device name", (0x0101, 0))))
+            .transpose()?;
+        // SAFETY: a null name asks for the default device, as `hd.h` documents.
+        let handle =
+            unsafe { (hd.init_device)(c_name.as_ref().map_or(std::ptr::null(), |n| n.as_ptr())) };
+        if let Some(error) = hd.error() {
+            return Err(failed("cannot initialize the device", error));
+        }
+        if handle == HD_INVALID_HANDLE {
+            return Err(failed("cannot initialize the device", (0x0104, 0)));
+        }
+        // SAFETY: the handle was just returned by `hdInitDevice`.
+        unsafe { (hd.make_current)(handle) };
+        let limits = device_limits(&hd);
+        let workspace: [f64; 6] = hd.doubles(HD_USABLE_WORKSPACE_DIMENSIONS);
+        let corners = (
+            to_scene(&Vector3::new(workspace[0], workspace[1], workspace[2])),
+            to_scene(&Vector3::new(workspace[3], workspace[4], workspace[5])),
+        );
+        let workspace_m = (corners.0.inf(&corners.1), corners.0.sup(&corners.1));
+        // SAFETY: a model string is static in the library, or null.
+        let model = unsafe { (hd.get_string)(HD_DEVICE_MODEL_TYPE) };
+        let model = match model.is_null() {
+            true => "Geomagic device".to_owned(),
+            // SAFETY: non-null strings from `hdGetString` are NUL-terminated.
+            false => unsafe { std::ffi::CStr::from_ptr(model) }
+                .to_string_lossy()
+                .into_owned(),
+        };
+        let servo = Box::new(Servo {
+            hd: hd.clone(),
+            handle,
+            link: Arc::new(ServoLink::default()),
+        });
+        // SAFETY: the callback's data outlives its scheduling (unscheduled in `drop` first).
+        let scheduled = unsafe {
+            (hd.enable)(HD_FORCE_OUTPUT);
+            let data = &*servo as *const Servo as *mut c_void;
+            let scheduled =
+                (hd.schedule_asynchronous)(servo_frame, data, HD_DEFAULT_SCHEDULER_PRIORITY);
+            (hd.start_scheduler)();
+            scheduled
+        };
+        let device = Self {
+            name: format!("OpenHaptics {model} ({name})"),
+            hd,
+            handle,
+            scheduled,
+            servo,
+            limits,
+            workspace_m,
+        };
+        match device.hd.error() {
+            Some(error) => Err(failed("cannot start the servo loop", error)),
+            None => Ok(device),
+        }
+    }
+
+    /// The HD library this machine would load, or why there is none (what to install).
+    pub fn find_library() -> Result<PathBuf, DeviceError> {
+        let path = library_path();
+        Hd::load(&path).map(|_| path)
+    }
+
+    /// What the haptic loop and the servo share (for its figures: samples, expired frames).
+    pub fn link(&self) -> &Arc<ServoLink> {
+        &self.servo.link
+    }
+}
+
+/// The library to load: [`LIBRARY_VARIABLE`]'s file, or [`LIBRARY`] through the loader.
+pub fn library_path() -> PathBuf {
+    std::env::var_os(LIBRARY_VARIABLE).map_or_else(|| PathBuf::from(LIBRARY), PathBuf::from)
+}
+
+/// The device's own limits: its nominal peak and continuous forces.
+fn device_limits(hd: &Hd) -> DeviceLimits {
+    let [peak]: [f64; 1] = hd.doubles(HD_NOMINAL_MAX_FORCE);
+    let [continuous]: [f64; 1] = hd.doubles(HD_NOMINAL_MAX_CONTINUOUS_FORCE);
+    let touch = DeviceLimits::touch();
+    let valid = |f: f64| f.is_finite() && f > 0.0;
+    DeviceLimits {
+        peak_force_n: if valid(peak) {
+            peak
+        } else {
+            touch.peak_force_n
+        },
+        continuous_force_n: match valid(continuous) {
+            true => continuous.min(if valid(peak) { peak } else { continuous }),
+            false => touch.continuous_force_n,
+        },
+        thermal_window_s: touch.thermal_window_s,
+    }
+}
+
+impl HapticDevice for OpenHaptics {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn limits(&self) -> DeviceLimits {
+        self.limits
+    }
+
+    fn read(&mut self, _time_s: f64) -> Result<DeviceSample, DeviceError> {
+        let link = &self.servo.link;
+        if let Some((code, internal)) = link.take_error() {
+            return Err(DeviceError::Failed {
+                device: self.name.clone(),
+                message: format!(
+                    "{} (HD error {code:#06x}, vendor code {internal})",
+                    error_message(code)
+                ),
+            });
+        }
+        link.latest().ok_or_else(|| DeviceError::Failed {
+            device: self.name.clone(),
+            message: "the servo loop has not run yet".into(),
+        })
+    }
+
+    fn write_force(&mut self, force_n: &Vector3<f64>) -> Result<(), DeviceError> {
+        self.servo.link.command(force_n);
+        Ok(())
+    }
+}
+
+impl Drop for OpenHaptics {
+    /// Zero force, the servo stopped, the device released: whatever the loop last commanded.
+    fn drop(&mut self) {
+        self.servo.link.command(&Vector3::zeros());
+        // SAFETY: the scheduler stops (no callback runs after it returns) before the callback
+        // is unscheduled and its data freed; the handle is the one initialized.
+        unsafe {
+            (self.hd.stop_scheduler)();
+            (self.hd.unschedule)(self.scheduled);
+            let zero = [0.0f64; 3];
+            (self.hd.begin_frame)(self.handle);
+            (self.hd.set_doublev)(HD_CURRENT_FORCE, zero.as_ptr());
+            (self.hd.end_frame)(self.handle);
+            (self.hd.disable_device)(self.handle);
+        }
+    }
+}

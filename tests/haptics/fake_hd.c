@@ -1,0 +1,152 @@
+/* A fake of the OpenHaptics HD library, for the tests: the functions the trainer's backend
+ * calls, with a scheduler thread that runs the scheduled callback every millisecond, a stylus
+ * the test places, and a record of the forces the callback renders. The `fake_hd_*` functions
+ * are the test's controls. Built by the test with the system C compiler. */
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <string.h>
+#include <time.h>
+
+typedef unsigned int HHD;
+typedef unsigned int (*Callback)(void *);
+typedef struct {
+    unsigned int code;
+    int internal;
+    unsigned int handle;
+} ErrorInfo;
+
+static double position_mm[3];
+static int buttons;
+static double last_force[3];
+static atomic_uint pending_error;
+static atomic_long frames;
+static atomic_int running;
+static int disabled;
+static int initialized;
+static int force_output;
+static int in_frame;
+static pthread_t scheduler;
+static Callback callback;
+static void *callback_data;
+static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
+static unsigned int init_error;
+
+static double nominal_max_force = 3.0;
+static double nominal_continuous_force = 0.75;
+
+HHD hdInitDevice(const char *name) {
+    if (name && strcmp(name, "absent") == 0) {
+        init_error = 0x0303;
+        return 0xFFFFFFFF;
+    }
+    initialized = 1;
+    disabled = 0;
+    return 1;
+}
+
+void hdDisableDevice(HHD handle) { (void)handle; disabled = 1; }
+void hdMakeCurrentDevice(HHD handle) { (void)handle; }
+
+ErrorInfo hdGetError(void) {
+    ErrorInfo info = {0, 0, 1};
+    if (init_error) {
+        info.code = init_error;
+        init_error = 0;
+        return info;
+    }
+    info.code = atomic_exchange(&pending_error, 0);
+    info.internal = info.code ? 42 : 0;
+    return info;
+}
+
+void hdEnable(unsigned int capability) {
+    if (capability == 0x4000) force_output = 1;
+}
+
+void hdBeginFrame(HHD handle) { (void)handle; pthread_mutex_lock(&lock); in_frame = 1; }
+void hdEndFrame(HHD handle) { (void)handle; in_frame = 0; pthread_mutex_unlock(&lock); }
+
+void hdGetDoublev(unsigned int parameter, double *values) {
+    switch (parameter) {
+    case 0x2050: memcpy(values, position_mm, sizeof position_mm); break;
+    case 0x2052: /* identity transform, column-major, translation last */
+        memset(values, 0, 16 * sizeof(double));
+        values[0] = values[5] = values[10] = values[15] = 1.0;
+        memcpy(values + 12, position_mm, sizeof position_mm);
+        break;
+    case 0x2551: {
+        double box[6] = {-80, -60, -35, 80, 60, 35};
+        memcpy(values, box, sizeof box);
+        break;
+    }
+    case 0x2603: values[0] = nominal_max_force; break;
+    case 0x2604: values[0] = nominal_continuous_force; break;
+    default: break;
+    }
+}
+
+void hdGetIntegerv(unsigned int parameter, int *values) {
+    if (parameter == 0x2000) values[0] = buttons;
+}
+
+const char *hdGetString(unsigned int parameter) {
+    return parameter == 0x2501 ? "Fake Touch" : 0;
+}
+
+void hdSetDoublev(unsigned int parameter, const double *values) {
+    if (parameter == 0x2700 && in_frame) memcpy(last_force, values, sizeof last_force);
+}
+
+static void *run_scheduler(void *unused) {
+    (void)unused;
+    struct timespec tick = {0, 1000000};
+    while (atomic_load(&running)) {
+        if (callback) callback(callback_data);
+        atomic_fetch_add(&frames, 1);
+        nanosleep(&tick, 0);
+    }
+    return 0;
+}
+
+unsigned long hdScheduleAsynchronous(Callback cb, void *data, unsigned short priority) {
+    (void)priority;
+    callback = cb;
+    callback_data = data;
+    return 7;
+}
+
+void hdStartScheduler(void) {
+    atomic_store(&running, 1);
+    pthread_create(&scheduler, 0, run_scheduler, 0);
+}
+
+void hdStopScheduler(void) {
+    if (atomic_exchange(&running, 0)) pthread_join(scheduler, 0);
+}
+
+void hdUnschedule(unsigned long handle) {
+    if (handle == 7) callback = 0;
+}
+
+/* The test's controls. */
+void fake_hd_set_stylus(double x_mm, double y_mm, double z_mm, int pressed) {
+    pthread_mutex_lock(&lock);
+    position_mm[0] = x_mm;
+    position_mm[1] = y_mm;
+    position_mm[2] = z_mm;
+    buttons = pressed;
+    pthread_mutex_unlock(&lock);
+}
+
+void fake_hd_last_force(double *out) {
+    pthread_mutex_lock(&lock);
+    memcpy(out, last_force, sizeof last_force);
+    pthread_mutex_unlock(&lock);
+}
+
+void fake_hd_inject_error(unsigned int code) { atomic_store(&pending_error, code); }
+long fake_hd_frames(void) { return atomic_load(&frames); }
+int fake_hd_running(void) { return atomic_load(&running); }
+int fake_hd_disabled(void) { return disabled; }
+int fake_hd_force_output(void) { return force_output; }

@@ -1,0 +1,231 @@
+//! The OpenHaptics backend against a fake HD library (`fake_hd.c`, built here with the system
+//! C compiler): a scheduler thread at 1 kHz, a stylus the test places, the forces the servo
+//! renders recorded. Each test loads its own copy of the fake, so their states stay apart.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use libloading::Library;
+use nalgebra::Vector3;
+use pgd_surgery::app::haptic::{DeviceForce, FaultLog, HapticLoop, TickClock};
+use pgd_surgery::devices::{HapticDevice, OpenHaptics, SafetySettings, TICK_S, WATCHDOG_S};
+
+use crate::common::{TIP_RADIUS_M, scene, target};
+
+/// The fake built once per run.
+fn built() -> &'static PathBuf {
+    static BUILT: OnceLock<PathBuf> = OnceLock::new();
+    BUILT.get_or_init(|| {
+        let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/haptics/fake_hd.c");
+        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("libfakehd.so");
+        let status = std::process::Command::new("cc")
+            .args(["-shared", "-fPIC", "-O1", "-pthread", "-o"])
+            .arg(&out)
+            .arg(&source)
+            .status()
+            .expect("a C compiler (cc) builds the fake HD library");
+        assert!(status.success(), "cc failed on {}", source.display());
+        out
+    })
+}
+
+/// This test's own copy of the fake, and its controls.
+struct Fake {
+    path: PathBuf,
+    library: Library,
+}
+
+impl Fake {
+    fn new(test: &str) -> Self {
+        let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("libfakehd-{test}.so"));
+        std::fs::copy(built(), &path).unwrap();
+        // SAFETY: the fake is ours.
+        let library = unsafe { Library::new(&path) }.unwrap();
+        Self { path, library }
+    }
+
+    fn call<T>(&self, name: &str) -> libloading::Symbol<'_, T> {
+        // SAFETY: the test names each control with its C type.
+        unsafe { self.library.get(name.as_bytes()) }.unwrap()
+    }
+
+    fn set_stylus(&self, mm: [f64; 3], buttons: i32) {
+        let f = self.call::<unsafe extern "C" fn(f64, f64, f64, i32)>("fake_hd_set_stylus");
+        // SAFETY: plain values.
+        unsafe { f(mm[0], mm[1], mm[2], buttons) };
+    }
+
+    fn last_force(&self) -> Vector3<f64> {
+        let f = self.call::<unsafe extern "C" fn(*mut f64)>("fake_hd_last_force");
+        let mut out = [0.0; 3];
+        // SAFETY: three doubles.
+        unsafe { f(out.as_mut_ptr()) };
+        Vector3::from(out)
+    }
+
+    fn flag(&self, name: &str) -> i32 {
+        // SAFETY: a control without arguments returning an int.
+        unsafe { self.call::<unsafe extern "C" fn() -> i32>(name)() }
+    }
+
+    fn frames(&self) -> i64 {
+        // SAFETY: a control without arguments returning a long.
+        unsafe { self.call::<unsafe extern "C" fn() -> i64>("fake_hd_frames")() }
+    }
+
+    fn inject_error(&self, code: u32) {
+        // SAFETY: a plain value.
+        unsafe { self.call::<unsafe extern "C" fn(u32)>("fake_hd_inject_error")(code) };
+    }
+
+    fn open(&self) -> OpenHaptics {
+        OpenHaptics::open(Some(&self.path), None).unwrap()
+    }
+
+    /// Waits until the fake's scheduler has run `frames` more frames.
+    fn wait_frames(&self, frames: i64) {
+        let until = self.frames() + frames;
+        let give_up = Instant::now() + Duration::from_secs(5);
+        while self.frames() < until && Instant::now() < give_up {
+            std::thread::sleep(Duration::from_micros(200));
+        }
+    }
+}
+
+/// A library that is not there: one message naming the file, what to install and the variable
+/// that names another file; no panic.
+#[test]
+fn a_missing_library_is_named_with_how_to_install_it() {
+    let error = OpenHaptics::open(Some(Path::new("/nowhere/libHD.so")), None)
+        .err()
+        .unwrap()
+        .to_string();
+    eprintln!("{error}");
+    assert!(error.contains("/nowhere/libHD.so"), "{error}");
+    assert!(error.contains("install OpenHaptics"), "{error}");
+    assert!(error.contains("PGD_OPENHAPTICS_LIB"), "{error}");
+}
+
+/// A device the library cannot initialize: its HD error, explained.
+#[test]
+fn a_device_that_fails_to_initialize_says_why() {
+    let fake = Fake::new("absent");
+    let error = OpenHaptics::open(Some(&fake.path), Some("absent"))
+        .err()
+        .unwrap()
+        .to_string();
+    eprintln!("{error}");
+    assert!(error.contains("cannot initialize"), "{error}");
+    assert!(error.contains("HD_COMM_CONFIG_ERROR"), "{error}");
+}
+
+/// The stylus at (10, 20, 30) mm in the device's frame (x right, y up, z towards the user) is
+/// the tool at (10, −30, 20) mm in the scene's (z up); a force of (1, 2, 3) N in the scene is
+/// rendered as (1, 3, −2) N in the device's frame; the limits are the device's own (the fake
+/// says 3.0 N peak and 0.75 N continuous).
+#[test]
+fn the_servo_reads_the_stylus_and_renders_the_force_in_the_devices_frame() {
+    let fake = Fake::new("frames");
+    fake.set_stylus([10.0, 20.0, 30.0], 1);
+    let mut device = fake.open();
+    assert_eq!(fake.flag("fake_hd_force_output"), 1);
+    fake.wait_frames(3);
+    let sample = device.read(0.0).unwrap();
+    assert!((sample.tip_m - Vector3::new(0.010, -0.030, 0.020)).norm() < 1e-12);
+    assert_eq!(sample.buttons, 1);
+    assert!(sample.orientation.angle() < 1e-12);
+    let limits = device.limits();
+    assert_eq!(
+        (limits.peak_force_n, limits.continuous_force_n),
+        (3.0, 0.75)
+    );
+    device.write_force(&Vector3::new(1.0, 2.0, 3.0)).unwrap();
+    fake.wait_frames(3);
+    assert_eq!(fake.last_force(), Vector3::new(1.0, 3.0, -2.0));
+}
+
+/// The haptic loop over the fake, its stylus 4 mm into the liver: the trainee is pushed back.
+/// An HD error mid-run is a device fault: the force fades to zero within the filter's 5 ticks,
+/// the log names the HD error, and the fake renders zero.
+#[test]
+fn an_hd_error_mid_run_fades_the_force_to_zero() {
+    let fake = Fake::new("error");
+    let target = target();
+    let tip = target.point_m + target.normal * (TIP_RADIUS_M - 0.004);
+    // The scene's (x, y, z) m is the device's (x, z, −y) mm.
+    fake.set_stylus([tip.x * 1e3, tip.z * 1e3, -tip.y * 1e3], 0);
+    let device = Box::new(fake.open());
+    let mut haptic = HapticLoop::new(&scene(SafetySettings::default()), device).unwrap();
+    let mut sent = Vec::new();
+    let tick = |haptic: &mut HapticLoop, sent: &mut Vec<Vector3<f64>>, n: u64| {
+        haptic.tick(TickClock {
+            tick: n,
+            time_s: n as f64 * TICK_S,
+            overruns_in_a_row: 0,
+        });
+        sent.push(haptic.world().resource::<DeviceForce>().sent_n);
+        fake.wait_frames(1);
+    };
+    for n in 0..400 {
+        tick(&mut haptic, &mut sent, n);
+    }
+    let pressing = *sent.last().unwrap();
+    fake.inject_error(0x0201);
+    fake.wait_frames(2);
+    for n in 400..420 {
+        tick(&mut haptic, &mut sent, n);
+    }
+    let log = &haptic.world().resource::<FaultLog>().log;
+    eprintln!("pressing {:.3} N; faults {log:?}", pressing.norm());
+    assert!(pressing.dot(&target.normal) > 0.05, "{pressing:?}");
+    assert!(sent[405..].iter().all(|f| *f == Vector3::zeros()));
+    assert!(
+        log.iter()
+            .any(|(_, f)| f.to_string().contains("HD_EXCEEDED_MAX_FORCE"))
+    );
+    fake.wait_frames(3);
+    assert_eq!(fake.last_force(), Vector3::zeros());
+}
+
+/// The loop stops commanding (a stall, a panic, a hang): the servo renders zero once the last
+/// command is older than the watchdog's 10 ms; measured from the last command, within the
+/// watchdog and a few of the fake's frames (its scheduler sleeps 1 ms between them).
+#[test]
+fn a_stalled_loop_leaves_the_device_at_zero_force() {
+    let fake = Fake::new("stall");
+    let mut device = fake.open();
+    device.write_force(&Vector3::new(0.0, 0.0, 1.0)).unwrap();
+    fake.wait_frames(2);
+    assert_eq!(fake.last_force(), Vector3::new(0.0, 1.0, 0.0));
+    let commanded = Instant::now();
+    device.write_force(&Vector3::new(0.0, 0.0, 1.0)).unwrap();
+    while fake.last_force() != Vector3::zeros() {
+        assert!(commanded.elapsed() < Duration::from_secs(1), "never zeroed");
+        std::thread::sleep(Duration::from_micros(100));
+    }
+    let zeroed_after = commanded.elapsed().as_secs_f64();
+    eprintln!(
+        "zeroed {:.1} ms after the last command (watchdog {:.0} ms); {} expired frames",
+        zeroed_after * 1e3,
+        WATCHDOG_S * 1e3,
+        device.link().expired_frames()
+    );
+    assert!(zeroed_after >= WATCHDOG_S);
+    assert!(zeroed_after < WATCHDOG_S + 0.025);
+}
+
+/// Dropped (the trainer closing, or unwinding from a panic) while commanding 1 N: the servo is
+/// stopped, the last force written is zero, and the device is released.
+#[test]
+fn closing_leaves_zero_force_and_releases_the_device() {
+    let fake = Fake::new("close");
+    let mut device = fake.open();
+    device.write_force(&Vector3::new(1.0, 0.0, 0.0)).unwrap();
+    fake.wait_frames(3);
+    assert_eq!(fake.last_force(), Vector3::new(1.0, 0.0, 0.0));
+    drop(device);
+    assert_eq!(fake.flag("fake_hd_running"), 0);
+    assert_eq!(fake.flag("fake_hd_disabled"), 1);
+    assert_eq!(fake.last_force(), Vector3::zeros());
+}
