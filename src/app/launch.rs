@@ -102,21 +102,24 @@ fn print_realtime(report: &RealTimeReport) {
 
 /// Runs the haptic loop without a window: on a simulated clock unless `options.realtime`.
 pub fn run_headless(options: &Options) -> Result<Report, String> {
-    let scene = scene(options)?;
-    let trajectory = match &options.device {
-        Some(DeviceSpec::OpenHaptics(name)) => return run_hardware_headless(options, &scene, name),
-        None => {
-            let motion = PressMotion {
-                tip_radius_m: scene.probe.tip_radius_m,
-                ..PressMotion::default()
-            };
-            press_and_slide(&press_targets(&scene), &motion)
+    let script = match &options.device {
+        Some(DeviceSpec::OpenHaptics(name)) => return run_hardware_headless(options, name),
+        Some(DeviceSpec::Scripted(path)) => {
+            Some(Trajectory::load(path).map_err(|e| e.to_string())?)
         }
-        Some(DeviceSpec::Scripted(path)) => Trajectory::load(path).map_err(|e| e.to_string())?,
         Some(DeviceSpec::Virtual) => {
             return Err("the virtual device needs the window: drop --headless".into());
         }
+        None => None,
     };
+    let scene = scene(options)?;
+    let trajectory = script.unwrap_or_else(|| {
+        let motion = PressMotion {
+            tip_radius_m: scene.probe.tip_radius_m,
+            ..PressMotion::default()
+        };
+        press_and_slide(&press_targets(&scene), &motion)
+    });
     let ticks = ticks_for(options, &trajectory);
     let device = recorded(scripted(&options.device, trajectory), &options.record);
     let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
@@ -127,17 +130,15 @@ pub fn run_headless(options: &Options) -> Result<Report, String> {
 }
 
 /// Serves a hardware device without a window, on the real clock, for `--ticks` (ten seconds
-/// when it does not say).
-fn run_hardware_headless(
-    options: &Options,
-    scene: &HapticScene,
-    name: &Option<String>,
-) -> Result<Report, String> {
+/// when it does not say). The device is opened first: a missing one is said before the scene
+/// is loaded.
+fn run_hardware_headless(options: &Options, name: &Option<String>) -> Result<Report, String> {
     let timer = options
         .realtime
         .ok_or("a hardware device runs on the real clock: add --realtime (and --ticks)")?;
     let device = recorded(openhaptics(name)?, &options.record);
-    let haptic = HapticLoop::new(scene, device).map_err(|e| e.to_string())?;
+    let scene = scene(options)?;
+    let haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
     let ticks = options.ticks.unwrap_or(HARDWARE_TICKS);
     Ok(Report::RealTime(run_realtime(haptic, timer, ticks)?))
 }

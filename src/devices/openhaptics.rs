@@ -11,6 +11,7 @@
 use std::ffi::{CString, c_char, c_int, c_uint, c_ulong, c_ushort, c_void};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use libloading::Library;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
@@ -36,6 +37,9 @@ const HD_FORCE_OUTPUT: c_uint = 0x4000;
 const HD_INVALID_HANDLE: c_uint = 0xFFFF_FFFF;
 const HD_CALLBACK_CONTINUE: c_uint = 1;
 const HD_DEFAULT_SCHEDULER_PRIORITY: c_ushort = u16::MAX / 2;
+
+/// How long a started servo may take to run its first frame.
+const FIRST_FRAME_WITHIN: Duration = Duration::from_secs(1);
 
 /// `HDErrorInfo`.
 #[repr(C)]
@@ -298,10 +302,29 @@ impl OpenHaptics {
             limits,
             workspace_m,
         };
-        match device.hd.error() {
-            Some(error) => Err(failed("cannot start the servo loop", error)),
-            None => Ok(device),
+        if let Some(error) = device.hd.error() {
+            return Err(failed("cannot start the servo loop", error));
         }
+        device.await_first_frame()?;
+        Ok(device)
+    }
+
+    /// Waits for the servo's first sample, so that the haptic loop's first read has one.
+    fn await_first_frame(&self) -> Result<(), DeviceError> {
+        let give_up = Instant::now() + FIRST_FRAME_WITHIN;
+        while self.servo.link.samples() == 0 {
+            if Instant::now() > give_up {
+                return Err(DeviceError::Failed {
+                    device: self.name.clone(),
+                    message: format!(
+                        "the servo loop ran no frame within {} s of starting",
+                        FIRST_FRAME_WITHIN.as_secs_f64()
+                    ),
+                });
+            }
+            std::thread::sleep(Duration::from_micros(200));
+        }
+        Ok(())
     }
 
     /// The HD library this machine would load, or why there is none (what to install).

@@ -55,6 +55,15 @@ pub fn summary(card: &Scorecard) -> String {
             m.errors.len(),
             task.score
         );
+        let motion = &m.motion;
+        let economy = motion
+            .economy
+            .map_or(String::new(), |e| format!(" ({e:.2}× the shortest)"));
+        let _ = writeln!(
+            out,
+            "  motion: path {:.0} mm{economy}, {} movements, idle {:.1} s, jerk {:.2} m/s³ rms",
+            motion.path_length_mm, motion.movements, motion.idle_s, motion.rms_jerk_m_per_s3
+        );
         if m.targets > 0 {
             let path = m.path_ratio.map_or(String::new(), |r| {
                 format!(", path {r:.2}× the straight line")

@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use super::format::{OrganEntry, Scenario, Spot, Task, TaskKind, spot_name};
+use super::motion::{MotionMetrics, MotionTracker};
 use crate::pgd::SurfacePoint;
 
 /// What the haptic loop knows of one tick, for scoring.
@@ -160,6 +161,8 @@ pub struct TaskMetrics {
     pub surrounding_over_limit_s: f64,
     /// Each error, with the time it was made.
     pub errors: Vec<String>,
+    /// The tool tip's motion over the task: path, economy, movements, idle time, jerk.
+    pub motion: MotionMetrics,
 }
 
 /// One task's running state.
@@ -184,6 +187,7 @@ struct Running {
     button_held: bool,
     /// Grasp: whether the tissue has been damaged.
     damaged: bool,
+    motion: MotionTracker,
 }
 
 /// The tasks of a scenario, run one after another.
@@ -276,6 +280,7 @@ impl Exercise {
     fn end_task(&mut self, time_s: f64) {
         if let Some(mut running) = self.running.take() {
             running.metrics.time_s = time_s - running.metrics.started_s;
+            running.metrics.motion = running.motion.metrics();
             running.metrics.mean_force_n = if running.metrics.contact_s > 0.0 {
                 running.force_sum / running.metrics.contact_s
             } else {
@@ -371,10 +376,12 @@ impl Running {
             path_m: 0.0,
             first_tip: None,
             last_tip: None,
+            motion: MotionTracker::default(),
         }
     }
 
     fn step(&mut self, task: &Task, sample: &Sample, dt: f64, nodules: Nodules) {
+        self.motion.step(sample.tip_m, dt);
         let m = &mut self.metrics;
         let force = sample.force_n;
         m.peak_force_n = m.peak_force_n.max(force);

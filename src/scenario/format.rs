@@ -510,6 +510,10 @@ pub struct Rubric {
     /// twice `found_within_mm` from it.
     #[serde(default = "default_accuracy")]
     pub accuracy: f64,
+    /// Weight of economy of motion: the shortest path the task needed over the path the tip
+    /// took (1 with no wasted motion). None by default.
+    #[serde(default)]
+    pub motion: f64,
     /// Points lost per error (a forbidden zone entered, a press over the limit).
     #[serde(default = "default_error_penalty")]
     pub error_penalty: f64,
@@ -550,6 +554,7 @@ impl Default for Rubric {
             speed: default_speed(),
             force: default_force(),
             accuracy: default_accuracy(),
+            motion: 0.0,
             error_penalty: default_error_penalty(),
             pass_mark: default_pass_mark(),
             all_tasks_required: true,

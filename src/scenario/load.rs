@@ -387,14 +387,16 @@ fn check_rubric(scenario: &Scenario, problems: &mut Vec<Problem>) {
         rubric.speed,
         rubric.force,
         rubric.accuracy,
+        rubric.motion,
     ];
     if weights.iter().any(|w| !(w.is_finite() && *w >= 0.0)) || weights.iter().sum::<f64>() <= 0.0 {
         problems.push(Problem {
             field: "rubric".into(),
             anchors: vec!["rubric".into()],
             message: format!("the weights {weights:?} are not usable"),
-            hint: "completion, speed, force and accuracy are weights of 0 or more, not all 0"
-                .into(),
+            hint:
+                "completion, speed, force, accuracy and motion are weights of 0 or more, not all 0"
+                    .into(),
         });
     }
     if !(0.0..=100.0).contains(&rubric.pass_mark) {

@@ -1,11 +1,12 @@
 //! Training exercises: the scenario file educators write (`format`, `units`), reading it with
 //! errors that point at the line and field (`load`), its tasks as they run, fed by the haptic
-//! loop one tick at a time (`exercise`), and the rubric's score (`score`). No Bevy here: the
+//! loop one tick at a time (`exercise`), the tool's motion metrics (`motion`), and the rubric's score (`score`). No Bevy here: the
 //! app layer runs an [`Exercise`] inside the haptic schedule.
 
 mod exercise;
 mod format;
 mod load;
+mod motion;
 mod score;
 mod units;
 
@@ -15,5 +16,6 @@ pub use format::{
     metres,
 };
 pub use load::{ScenarioError, load, parse};
+pub use motion::{IDLE_M_PER_S, MOVING_M_PER_S, MotionMetrics, MotionTracker, STRIDE};
 pub use score::{Scorecard, TaskScore, score};
 pub use units::{Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, Seconds};

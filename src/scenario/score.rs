@@ -77,10 +77,17 @@ fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
         (rubric.speed, speed),
         (rubric.force, force_control(m)),
         (accuracy_weight, accuracy(m)),
+        (rubric.motion, economy(m)),
     ];
     let weights: f64 = terms.iter().map(|(w, _)| w).sum();
     let weighted = terms.iter().map(|(w, v)| w * v).sum::<f64>() / weights.max(f64::MIN_POSITIVE);
     (100.0 * weighted - rubric.error_penalty * m.errors.len() as f64).clamp(0.0, 100.0)
+}
+
+/// Economy of motion as a share: the shortest path needed over the path taken (1 when the tip
+/// never left its start: nothing was wasted).
+fn economy(m: &TaskMetrics) -> f64 {
+    m.motion.economy.map_or(1.0, |e| (1.0 / e).clamp(0.0, 1.0))
 }
 
 /// Palpation: 1 for a mark on the nodule, falling linearly to 0 at twice the distance that

@@ -145,8 +145,8 @@ fn the_servo_reads_the_stylus_and_renders_the_force_in_the_devices_frame() {
     assert_eq!(fake.last_force(), Vector3::new(1.0, 3.0, -2.0));
 }
 
-/// The haptic loop over the fake, its stylus 4 mm into the liver: the trainee is pushed back.
-/// An HD error mid-run is a device fault: the force fades to zero within the filter's 5 ticks,
+/// The haptic loop over the fake, its stylus 4 mm into the liver: the trainee is pushed back,
+/// with no fault (the device opens with the servo's first sample in hand). An HD error mid-run is a device fault: the force fades to zero within the filter's 5 ticks,
 /// the log names the HD error, and the fake renders zero.
 #[test]
 fn an_hd_error_mid_run_fades_the_force_to_zero() {
@@ -183,6 +183,10 @@ fn an_hd_error_mid_run_fades_the_force_to_zero() {
     assert!(
         log.iter()
             .any(|(_, f)| f.to_string().contains("HD_EXCEEDED_MAX_FORCE"))
+    );
+    assert!(
+        log.iter().all(|(tick, _)| *tick >= 400),
+        "a fault before the error: {log:?}"
     );
     fake.wait_frames(3);
     assert_eq!(fake.last_force(), Vector3::zeros());
@@ -228,4 +232,56 @@ fn closing_leaves_zero_force_and_releases_the_device() {
     assert_eq!(fake.flag("fake_hd_running"), 0);
     assert_eq!(fake.flag("fake_hd_disabled"), 1);
     assert_eq!(fake.last_force(), Vector3::zeros());
+}
+
+/// The trainer asked for an OpenHaptics device whose library is missing: it says so on its
+/// error stream, with what to install, and exits non-zero without a panic; `trainer devices`
+/// lists the backend as unusable with the same reason, and as usable with the fake's path.
+#[test]
+fn the_trainer_says_what_is_missing_and_lists_what_is_found() {
+    let trainer = env!("CARGO_BIN_EXE_trainer");
+    let run = |library: &Path, args: &[&str]| {
+        std::process::Command::new(trainer)
+            .args(args)
+            .env("PGD_OPENHAPTICS_LIB", library)
+            .output()
+            .unwrap()
+    };
+    let missing = Path::new("/nowhere/libHD.so");
+    let headless = [
+        "--headless",
+        "--realtime",
+        "--ticks",
+        "10",
+        "--device",
+        "openhaptics",
+    ];
+    let out = run(missing, &headless);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    eprintln!("{stderr}");
+    assert!(!out.status.success());
+    assert!(stderr.contains("install OpenHaptics"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let listed = |library: &Path| {
+        let out = run(library, &["devices"]);
+        assert!(out.status.success());
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        stdout
+            .lines()
+            .find(|l| l.starts_with("openhaptics"))
+            .unwrap()
+            .to_owned()
+    };
+    let absent = listed(missing);
+    assert!(
+        absent.contains(" no ") && absent.contains("install OpenHaptics"),
+        "{absent}"
+    );
+    let fake = Fake::new("listed");
+    let found = listed(&fake.path);
+    eprintln!("{absent}\n{found}");
+    assert!(
+        found.contains(" yes ") && found.contains("libfakehd-listed.so"),
+        "{found}"
+    );
 }

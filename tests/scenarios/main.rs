@@ -4,6 +4,8 @@
 //! them; broken files each give their expected error at the right line and field; and the
 //! `trainer` binary validates, runs and reports.
 
+mod motion;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
@@ -121,6 +123,13 @@ fn metrics_say_what_went_wrong() {
     assert!(competent.time_s < 5.0, "{}", competent.time_s);
     assert!(competent.errors.is_empty(), "{:?}", competent.errors);
     assert!((0.15..=0.35).contains(&competent.mean_force_n));
+    // The press is one movement in and a hold: a few centimetres of path, mostly idle.
+    let motion = &competent.motion;
+    assert!(
+        motion.path_length_mm > 5.0 && motion.movements >= 1,
+        "{motion:?}"
+    );
+    assert!(motion.idle_s > 0.5 * competent.time_s, "{motion:?}");
     let careless = &run("liver-steady-press", "careless").card.tasks[0].metrics;
     assert!(!careless.completed);
     assert!(careless.peak_force_n > 0.35);

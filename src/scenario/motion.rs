@@ -1,0 +1,124 @@
+//! The objective motion metrics of laparoscopic trainers, from the tool tip's trajectory as
+//! the haptic loop samples it: path length, economy of motion, number of movements, idle time
+//! and smoothness (jerk).
+//!
+//! The tip is read every tick, but velocity and its derivatives are taken on a 100 Hz
+//! subsample (every [`STRIDE`] ticks): a device's position quantization, differentiated three
+//! times at 1 kHz, would drown the hand's jerk in noise. Everything is kept in fixed-size state:
+//! the real-time thread allocates nothing.
+
+use nalgebra::Vector3;
+use serde::Serialize;
+
+/// Ticks between the samples velocity and jerk are taken on (100 Hz at 1 kHz).
+pub const STRIDE: u64 = 10;
+
+/// Above this tip speed (m/s) the hand is moving: a movement starts...
+pub const MOVING_M_PER_S: f64 = 0.010;
+/// ...and it ends once the speed falls below this one (m/s); below it, the hand is idle.
+pub const IDLE_M_PER_S: f64 = 0.005;
+
+/// The tip has left its start once the shortest path it needs is this long (m).
+const LEFT_START_M: f64 = 0.001;
+
+/// What the tip's motion over a task measured.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct MotionMetrics {
+    /// The length of the tip's path (mm).
+    pub path_length_mm: f64,
+    /// The path over the shortest one that reaches as far from the start and ends where it
+    /// ended (1 = no wasted motion); none when the tip never left its start.
+    pub economy: Option<f64>,
+    /// Movements: spells of the tip's speed above [`MOVING_M_PER_S`], each ended by its fall
+    /// below [`IDLE_M_PER_S`].
+    pub movements: usize,
+    /// Time with the tip slower than [`IDLE_M_PER_S`] (s).
+    pub idle_s: f64,
+    /// The root mean square of the tip's jerk (m/s³): the lower, the smoother.
+    pub rms_jerk_m_per_s3: f64,
+}
+
+/// The running measurement.
+#[derive(Clone, Debug, Default)]
+pub struct MotionTracker {
+    metrics: MotionMetrics,
+    start: Option<Vector3<f64>>,
+    last: Option<Vector3<f64>>,
+    farthest_m: f64,
+    farthest: Vector3<f64>,
+    ticks: u64,
+    /// The last four subsamples (oldest first) and how many there are.
+    recent: [Vector3<f64>; 4],
+    count: usize,
+    moving: bool,
+    jerk_sum: f64,
+    jerk_samples: usize,
+}
+
+impl MotionTracker {
+    /// Takes the tip at one tick (`dt` s after the last); no tip (no device sample) is skipped.
+    pub fn step(&mut self, tip_m: Option<Vector3<f64>>, dt: f64) {
+        let Some(tip) = tip_m else { return };
+        let start = match self.start {
+            Some(start) => start,
+            None => {
+                self.farthest = tip;
+                *self.start.insert(tip)
+            }
+        };
+        if let Some(last) = self.last {
+            self.metrics.path_length_mm += (tip - last).norm() * 1e3;
+        }
+        self.last = Some(tip);
+        let reach = (tip - start).norm();
+        if reach > self.farthest_m {
+            self.farthest_m = reach;
+            self.farthest = tip;
+        }
+        if self.ticks.is_multiple_of(STRIDE) {
+            self.subsample(tip, dt * STRIDE as f64);
+        }
+        self.ticks += 1;
+    }
+
+    /// One 100 Hz subsample, `h` s after the last.
+    fn subsample(&mut self, tip: Vector3<f64>, h: f64) {
+        self.recent.rotate_left(1);
+        self.recent[3] = tip;
+        self.count = (self.count + 1).min(4);
+        if self.count < 2 || h <= 0.0 {
+            return;
+        }
+        let r = &self.recent;
+        let speed = (r[3] - r[2]).norm() / h;
+        if speed < IDLE_M_PER_S {
+            self.metrics.idle_s += h;
+        }
+        match self.moving {
+            false if speed > MOVING_M_PER_S => {
+                self.moving = true;
+                self.metrics.movements += 1;
+            }
+            true if speed < IDLE_M_PER_S => self.moving = false,
+            _ => {}
+        }
+        if self.count == 4 {
+            let jerk = (r[3] - r[2] * 3.0 + r[1] * 3.0 - r[0]) / (h * h * h);
+            self.jerk_sum += jerk.norm_squared();
+            self.jerk_samples += 1;
+        }
+    }
+
+    /// The metrics so far.
+    pub fn metrics(&self) -> MotionMetrics {
+        let mut m = self.metrics.clone();
+        if let Some(end) = self.last {
+            let need_m = self.farthest_m + (end - self.farthest).norm();
+            m.economy = (need_m >= LEFT_START_M).then(|| m.path_length_mm * 1e-3 / need_m);
+        }
+        if self.jerk_samples > 0 {
+            m.rms_jerk_m_per_s3 = (self.jerk_sum / self.jerk_samples as f64).sqrt();
+        }
+        m
+    }
+}
