@@ -8,10 +8,13 @@ use pgd_surgery::app::launch::WindowLesson;
 use pgd_surgery::app::scene::Detail;
 use pgd_surgery::app::window::{Opening, ScreenshotPlan};
 use pgd_surgery::app::{self, DEFAULT_SCENARIO, launch};
-use pgd_surgery::cli::{debrief, list_devices, numbered, validate_scenarios};
+use pgd_surgery::cli::{
+    HistoryRequest, HistoryTarget, debrief, list_devices, numbered, show_history,
+    validate_scenarios,
+};
 use pgd_surgery::devices::{DeviceSpec, TimerMode};
 use pgd_surgery::scenario;
-use pgd_surgery::store::OnStale;
+use pgd_surgery::store::{HistoryFilter, OnStale};
 
 #[derive(Parser)]
 #[command(
@@ -70,6 +73,13 @@ struct Cli {
     /// Fail (with the command to run) instead of rebuilding a missing or stale vademecum.
     #[arg(long, global = true)]
     no_rebuild: bool,
+    /// Who is training: each scored attempt is kept under this name (default: the login
+    /// name); with `history`, only this trainee's attempts are listed.
+    #[arg(long, global = true)]
+    trainee: Option<String>,
+    /// The history database every scored attempt is kept in (SQLite).
+    #[arg(long, global = true, default_value = "reports/history.sqlite")]
+    history: PathBuf,
     /// The window without an exercise: the organs and the tool only (by default the window
     /// opens the menu of scenarios/, the built-in scenarios/liver-steady-press.scenario.ron
     /// chosen).
@@ -99,6 +109,19 @@ enum Command {
     /// List the haptic device backends, which of them can be used on this machine, and why
     /// the others cannot.
     Devices,
+    /// The attempts kept so far (all, or --trainee's), as a table and a learning-curve plot,
+    /// or as CSV.
+    History {
+        /// Only the attempts at this scenario file (as it was given to `run`).
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// Print CSV (one row per attempt) instead of the table and the plot.
+        #[arg(long)]
+        csv: bool,
+        /// Where the learning-curve plot goes.
+        #[arg(long, default_value = "reports/learning-curve.png")]
+        plot: PathBuf,
+    },
 }
 
 fn parse_timer(s: &str) -> Result<TimerMode, String> {
@@ -114,8 +137,27 @@ fn main() -> ExitCode {
     match &cli.command {
         Some(Command::Validate { files }) => return validate_scenarios(files),
         Some(Command::Devices) => return list_devices(),
+        Some(Command::History {
+            scenario,
+            csv,
+            plot,
+        }) => {
+            return show_history(&HistoryRequest {
+                database: &cli.history,
+                filter: HistoryFilter {
+                    trainee: cli.trainee.clone(),
+                    scenario: scenario.as_ref().map(|s| s.display().to_string()),
+                },
+                csv: *csv,
+                plot,
+            });
+        }
         _ => {}
     }
+    let history = HistoryTarget {
+        database: cli.history.clone(),
+        trainee: cli.trainee.clone().unwrap_or_else(login_name),
+    };
     if !cli.headless
         && let Some(why) = app::missing_display()
     {
@@ -173,7 +215,7 @@ fn main() -> ExitCode {
         return match exercise {
             Some((scenario, file, report_dir)) => {
                 let outcome = launch::run_scenario_headless(&options, scenario);
-                debrief(outcome, file, None, report_dir, cli.json)
+                debrief(outcome, file, None, report_dir, cli.json, &history)
             }
             None => finish(launch::run_headless(&options), cli.json),
         };
@@ -206,7 +248,7 @@ fn main() -> ExitCode {
                 let codes: Vec<ExitCode> = numbered(attempts)
                     .into_iter()
                     .map(|(file, attempt, outcome)| {
-                        debrief(Ok(outcome), &file, attempt, &dir, cli.json)
+                        debrief(Ok(outcome), &file, attempt, &dir, cli.json, &history)
                     })
                     .collect();
                 codes
@@ -224,6 +266,14 @@ fn main() -> ExitCode {
         },
         Err(e) => finish(Err(e), cli.json),
     }
+}
+
+/// Whom an attempt is kept under when `--trainee` does not say: the login name.
+fn login_name() -> String {
+    std::env::var("USER")
+        .ok()
+        .filter(|u| !u.is_empty())
+        .unwrap_or_else(|| "trainee".into())
 }
 
 fn finish(result: Result<launch::Report, String>, json: bool) -> ExitCode {

@@ -1,5 +1,5 @@
 //! What the binaries' commands do and print, apart from parsing their arguments: `pgd build`,
-//! `validate`, `indent` and `mesh`; `trainer validate`, `devices` and the end of an attempt; the parsers of option
+//! `validate`, `indent` and `mesh`; `trainer validate`, `devices`, `history` and the end of an attempt (kept in the history); the parsers of option
 //! values, with errors that name the range; how a command ends (JSON or a table, or an error).
 //! The binaries keep their clap option types beside them and call in here.
 
@@ -12,6 +12,7 @@ mod pgd_mesh;
 mod pgd_validate;
 mod trainer_commands;
 mod trainer_devices;
+mod trainer_history;
 
 pub use output::{fail, print_json, print_report};
 pub use parse::{
@@ -27,3 +28,4 @@ pub use pgd_mesh::report_mesh;
 pub use pgd_validate::{print_cut_validation, print_validation, validate_cuts, validate_vademecum};
 pub use trainer_commands::{debrief, numbered, validate_scenarios};
 pub use trainer_devices::list_devices;
+pub use trainer_history::{HistoryRequest, HistoryTarget, keep_scored, show_history};

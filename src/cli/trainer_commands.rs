@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use super::trainer_history::{HistoryTarget, keep_scored};
 use crate::app::attempt::Outcome;
 use crate::app::launch;
 use crate::report;
@@ -50,14 +51,16 @@ pub fn validate_scenarios(files: &[PathBuf]) -> ExitCode {
     }
 }
 
-/// The end of an exercise: its score printed (JSON with `json`) and its report written, named
-/// after the scenario's file (and the attempt, when the trainee retried).
+/// The end of an exercise: its score printed (JSON with `json`), its report written, named
+/// after the scenario's file (and the attempt, when the trainee retried), and the attempt kept
+/// in the history.
 pub fn debrief(
     outcome: Result<Outcome, String>,
     file: &Path,
     attempt: Option<usize>,
     report_dir: &Path,
     json: bool,
+    history: &HistoryTarget,
 ) -> ExitCode {
     let outcome = match outcome {
         Ok(outcome) => outcome,
@@ -84,15 +87,21 @@ pub fn debrief(
     } else {
         print!("{}", report::summary(&outcome.card));
     }
-    match written {
+    let (report, code) = match written {
         Ok(paths) => {
-            let paths: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
-            eprintln!("report: {}", paths.join(", "));
-            ExitCode::SUCCESS
+            let shown: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+            eprintln!("report: {}", shown.join(", "));
+            (Some(paths[0].clone()), ExitCode::SUCCESS)
         }
         Err(e) => {
             eprintln!("trainer: the report was not written: {e}");
-            ExitCode::FAILURE
+            (None, ExitCode::FAILURE)
         }
+    };
+    let kept = keep_scored(history, &outcome.card, file, report.as_deref());
+    if code == ExitCode::SUCCESS {
+        kept
+    } else {
+        code
     }
 }

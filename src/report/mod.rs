@@ -1,12 +1,14 @@
-//! Files written for people to read: an attempt's report (scorecard, summary, force plot) and
-//! a vademecum build's convergence curves (table and plot). No Bevy.
+//! Files written for people to read: an attempt's report (scorecard, summary, force plot), a
+//! trainee's learning curve, and a vademecum build's convergence curves (table and plot). No Bevy.
 
 mod convergence;
+mod learning_curve;
 mod plot;
 mod scorecard;
 
 pub use convergence::{
     StepCurve, write as write_convergence, write_of_header as write_convergence_of,
 };
+pub use learning_curve::learning_curve;
 pub use plot::{LineChart, Series, line_chart, save_png};
 pub use scorecard::{summary, write_report};

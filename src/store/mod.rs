@@ -1,12 +1,16 @@
 //! The organs and vademecums on disk, as the trainer and `pgd` find them: where an organ's
 //! mesh comes from (generated or a file), the vademecum each organ runs on, checked against
-//! its mesh, material and settings and rebuilt with progress shown when missing or stale.
-//! No Bevy: the app and both binaries call it.
+//! its mesh, material and settings and rebuilt with progress shown when missing or stale;
+//! and the history of trainees' attempts (SQLite). No Bevy: the app and both binaries call it.
 
+mod history;
 mod progress;
 mod source;
 mod vademecums;
 
+pub use history::{
+    AttemptRecord, History, HistoryError, HistoryFilter, keep as keep_attempt, now_unix_s,
+};
 pub use progress::Bar;
 pub use source::{MeshSource, OrganSource, load_source};
 pub use vademecums::{

@@ -4,6 +4,7 @@
 //! them; broken files each give their expected error at the right line and field; and the
 //! `trainer` binary validates, runs and reports.
 
+mod history;
 mod motion;
 
 use std::path::{Path, PathBuf};
@@ -337,6 +338,8 @@ fn the_trainer_validates_runs_and_reports() {
         .arg(vademecums())
         .arg("--report-dir")
         .arg(&report_dir)
+        .arg("--history")
+        .arg(report_dir.join("history.sqlite"))
         .current_dir(root())
         .output()
         .unwrap();

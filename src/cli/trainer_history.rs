@@ -1,0 +1,152 @@
+//! `trainer history`: the attempts kept so far, as a table and a learning-curve plot, or as
+//! CSV for an educator; and keeping each new attempt at the end of its debrief.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use crate::report::learning_curve;
+use crate::scenario::Scorecard;
+use crate::store::{AttemptRecord, History, HistoryError, HistoryFilter, keep_attempt, now_unix_s};
+
+/// Where attempts are kept, and whose they are.
+#[derive(Clone, Debug)]
+pub struct HistoryTarget {
+    pub database: PathBuf,
+    pub trainee: String,
+}
+
+/// Keeps a scored attempt in the history; says where it went. Fails only when the attempt
+/// could be kept neither in the database nor beside it.
+pub fn keep_scored(
+    target: &HistoryTarget,
+    card: &Scorecard,
+    scenario: &Path,
+    report: Option<&Path>,
+) -> ExitCode {
+    let record = AttemptRecord::of(card, scenario, &target.trainee, report, now_unix_s());
+    match keep_attempt(&target.database, &record) {
+        Ok(id) => {
+            eprintln!(
+                "history: attempt {id} of {} kept in {}",
+                target.trainee,
+                target.database.display()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e @ HistoryError::SetAside { .. }) => {
+            eprintln!("trainer: {e}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("trainer: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// What `trainer history` is asked.
+pub struct HistoryRequest<'a> {
+    pub database: &'a Path,
+    pub filter: HistoryFilter,
+    /// CSV on standard output instead of the table and the plot.
+    pub csv: bool,
+    pub plot: &'a Path,
+}
+
+/// Lists the attempts the request selects.
+pub fn show_history(request: &HistoryRequest) -> ExitCode {
+    if !request.database.exists() {
+        eprintln!(
+            "trainer: no history at {} yet: attempts are kept there as they are scored",
+            request.database.display()
+        );
+        return ExitCode::FAILURE;
+    }
+    let attempts = match History::open(request.database).and_then(|h| h.attempts(&request.filter)) {
+        Ok(attempts) => attempts,
+        Err(e) => {
+            eprintln!("trainer: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let shown = match request.csv {
+        true => write_csv(&attempts),
+        false => print_table(&attempts, request.plot),
+    };
+    match shown {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("trainer: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn write_csv(attempts: &[AttemptRecord]) -> Result<(), String> {
+    let mut out = csv::Writer::from_writer(std::io::stdout());
+    out.write_record([
+        "id",
+        "trainee",
+        "scenario",
+        "title",
+        "when",
+        "score",
+        "passed",
+        "time_s",
+        "path_mm",
+        "peak_force_n",
+        "errors",
+        "report",
+    ])
+    .map_err(|e| e.to_string())?;
+    for a in attempts {
+        out.write_record([
+            a.id.to_string(),
+            a.trainee.clone(),
+            a.scenario.clone(),
+            a.title.clone(),
+            a.when(),
+            format!("{:.1}", a.score),
+            a.passed.to_string(),
+            format!("{:.2}", a.time_s),
+            format!("{:.1}", a.path_mm),
+            format!("{:.3}", a.peak_force_n),
+            a.errors.to_string(),
+            a.report.clone(),
+        ])
+        .map_err(|e| e.to_string())?;
+    }
+    out.flush().map_err(|e| e.to_string())
+}
+
+fn print_table(attempts: &[AttemptRecord], plot: &Path) -> Result<(), String> {
+    println!(
+        "{:>4}  {:<20}  {:<12}  {:<32}  {:>5}  {:<6}  {:>7}  {:>8}  {:>6}  errors",
+        "id", "when", "trainee", "scenario", "score", "result", "time s", "path mm", "peak N"
+    );
+    for a in attempts {
+        println!(
+            "{:>4}  {:<20}  {:<12}  {:<32}  {:>5.0}  {:<6}  {:>7.1}  {:>8.0}  {:>6.2}  {}",
+            a.id,
+            a.when(),
+            a.trainee,
+            a.title,
+            a.score,
+            if a.passed { "passed" } else { "failed" },
+            a.time_s,
+            a.path_mm,
+            a.peak_force_n,
+            a.errors
+        );
+    }
+    if attempts.is_empty() {
+        println!("(no attempt matches)");
+        return Ok(());
+    }
+    if let Some(folder) = plot.parent().filter(|f| !f.as_os_str().is_empty()) {
+        std::fs::create_dir_all(folder).map_err(|e| format!("{}: {e}", folder.display()))?;
+    }
+    learning_curve(plot, attempts)?;
+    eprintln!("learning curve: {}", plot.display());
+    Ok(())
+}

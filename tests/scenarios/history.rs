@@ -1,0 +1,179 @@
+//! The history of attempts: a record reads back as written, filters select, a corrupt
+//! database is refused untouched and the attempt kept beside it, and the trainer keeps every
+//! scored attempt and lists them as a table, a plot and CSV.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use pgd_surgery::store::{AttemptRecord, History, HistoryError, HistoryFilter, keep_attempt};
+
+use crate::{TRAINER, root, vademecums};
+
+/// A fresh folder of this test's own.
+fn folder(test: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("history-{test}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn record(trainee: &str, scenario: &str, score: f64, at_unix_s: i64) -> AttemptRecord {
+    AttemptRecord {
+        id: 0,
+        trainee: trainee.into(),
+        scenario: scenario.into(),
+        title: format!("{scenario} title"),
+        at_unix_s,
+        score,
+        passed: score >= 70.0,
+        time_s: 12.25,
+        path_mm: 431.5,
+        peak_force_n: 0.3125,
+        errors: 2,
+        report: "reports/x.json".into(),
+    }
+}
+
+/// Written, then read back: the same record, numbered; oldest first; filters by trainee and
+/// by scenario select exactly theirs.
+#[test]
+fn attempts_read_back_as_written_and_filter() {
+    let db = folder("roundtrip").join("history.sqlite");
+    let written = [
+        record("ann", "a.ron", 81.5, 200),
+        record("bob", "a.ron", 40.0, 100),
+        record("ann", "b.ron", 66.0, 300),
+    ];
+    let history = History::open(&db).unwrap();
+    for r in &written {
+        history.record(r).unwrap();
+    }
+    drop(history);
+    let history = History::open(&db).unwrap();
+    let all = history.attempts(&HistoryFilter::default()).unwrap();
+    let by_time: Vec<_> = [1, 0, 2].map(|k| written[k].clone()).into();
+    let ids: Vec<i64> = all.iter().map(|a| a.id).collect();
+    assert_eq!(ids, [2, 1, 3]);
+    for (read, wrote) in all.iter().zip(&by_time) {
+        assert_eq!(
+            AttemptRecord {
+                id: 0,
+                ..read.clone()
+            },
+            *wrote
+        );
+    }
+    let ann = HistoryFilter {
+        trainee: Some("ann".into()),
+        ..HistoryFilter::default()
+    };
+    assert_eq!(history.attempts(&ann).unwrap().len(), 2);
+    let a_by_ann = HistoryFilter {
+        scenario: Some("a.ron".into()),
+        ..ann
+    };
+    let found = history.attempts(&a_by_ann).unwrap();
+    assert_eq!((found.len(), found[0].score), (1, 81.5));
+    assert_eq!(all[0].when(), "1970-01-01T00:01:40Z");
+}
+
+/// A file that is not a history database: refused with its path, left as it was, and the
+/// attempt written beside it, where the error says, reading back as the attempt.
+#[test]
+fn a_corrupt_database_is_refused_and_the_attempt_kept_aside() {
+    let db = folder("corrupt").join("history.sqlite");
+    let junk = b"this is not a database, and it must not be overwritten".repeat(100);
+    std::fs::write(&db, &junk).unwrap();
+    let attempt = record("ann", "a.ron", 75.0, 1234);
+    let error = keep_attempt(&db, &attempt).unwrap_err();
+    eprintln!("{error}");
+    let HistoryError::SetAside { path, aside, .. } = &error else {
+        panic!("{error}");
+    };
+    assert_eq!(path, &db);
+    assert!(
+        error.to_string().contains(&*db.to_string_lossy()),
+        "{error}"
+    );
+    assert_eq!(std::fs::read(&db).unwrap(), junk);
+    let kept: AttemptRecord =
+        serde_json::from_str(&std::fs::read_to_string(aside).unwrap()).unwrap();
+    assert_eq!(kept, attempt);
+}
+
+/// Two scored runs of the steady-press scenario through the trainer land in its history
+/// under the trainee; `trainer history` lists them as CSV (their scores as the runs printed
+/// them) and as a table with a learning-curve plot; another trainee's filter lists none.
+#[test]
+fn the_trainer_keeps_each_scored_attempt_and_lists_them() {
+    let dir = folder("trainer");
+    let db = dir.join("history.sqlite");
+    let run = |script: &str| {
+        let output = Command::new(TRAINER)
+            .args([
+                "run",
+                "scenarios/liver-steady-press.scenario.ron",
+                "--headless",
+                "--coarse",
+                "--no-rebuild",
+                "--json",
+                "--trainee",
+                "ann",
+            ])
+            .arg("--device")
+            .arg(format!(
+                "scripted:{}",
+                root()
+                    .join(format!("tests/scenarios/liver-steady-press.{script}.csv"))
+                    .display()
+            ))
+            .arg("--vademecums")
+            .arg(vademecums())
+            .arg("--report-dir")
+            .arg(&dir)
+            .arg("--history")
+            .arg(&db)
+            .current_dir(root())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(output.status.success(), "{stderr}");
+        assert!(stderr.contains("history: attempt"), "{stderr}");
+        let card: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        card["score"].as_f64().unwrap()
+    };
+    let scores = [run("competent"), run("careless")];
+    let history = |args: &[&str]| {
+        Command::new(TRAINER)
+            .arg("history")
+            .args(args)
+            .arg("--history")
+            .arg(&db)
+            .output()
+            .unwrap()
+    };
+    let csv = history(&["--csv", "--trainee", "ann"]);
+    assert!(csv.status.success());
+    let text = String::from_utf8(csv.stdout).unwrap();
+    let mut rows = csv::Reader::from_reader(text.as_bytes());
+    let listed: Vec<f64> = rows
+        .records()
+        .map(|r| r.unwrap()[5].parse().unwrap())
+        .collect();
+    eprintln!("{text}");
+    assert_eq!(listed.len(), 2);
+    for (listed, scored) in listed.iter().zip(scores) {
+        assert!((listed - scored).abs() < 0.051, "{listed} vs {scored}");
+    }
+    let plot = dir.join("curve.png");
+    let table = history(&["--plot", plot.to_str().unwrap()]);
+    assert!(table.status.success());
+    let table = String::from_utf8(table.stdout).unwrap();
+    assert!(
+        table.contains("passed") && table.contains("failed"),
+        "{table}"
+    );
+    assert_eq!(&std::fs::read(&plot).unwrap()[..8], b"\x89PNG\r\n\x1a\n");
+    let none = history(&["--csv", "--trainee", "bob"]);
+    assert_eq!(String::from_utf8(none.stdout).unwrap().lines().count(), 1);
+}
