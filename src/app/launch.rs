@@ -20,8 +20,8 @@ use super::window::{
     FrameReport, Lesson, Lessons, MenuPlan, Opening, SceneSource, ScreenshotPlan, WindowScene,
 };
 use crate::devices::{
-    DeviceSpec, HapticDevice, OpenHaptics, PressMotion, Recorder, Scripted, TICK_S, TimerMode,
-    Trajectory, VirtualDevice, press_and_slide,
+    DeviceSpec, ForceDimension, HapticDevice, OpenHaptics, PressMotion, Recorder, Scripted, TICK_S,
+    TimerMode, Trajectory, VirtualDevice, press_and_slide,
 };
 use crate::scenario::{Exercise, Scenario};
 use crate::store::OnStale;
@@ -102,15 +102,18 @@ fn print_realtime(report: &RealTimeReport) {
 
 /// Runs the haptic loop without a window: on a simulated clock unless `options.realtime`.
 pub fn run_headless(options: &Options) -> Result<Report, String> {
+    if let Some(device) = open_hardware(&options.device) {
+        return run_hardware_headless(options, device?);
+    }
     let script = match &options.device {
-        Some(DeviceSpec::OpenHaptics(name)) => return run_hardware_headless(options, name),
         Some(DeviceSpec::Scripted(path)) => {
             Some(Trajectory::load(path).map_err(|e| e.to_string())?)
         }
         Some(DeviceSpec::Virtual) => {
             return Err("the virtual device needs the window: drop --headless".into());
         }
-        None => None,
+        // Hardware is served above; no device: the built-in press and slide.
+        _ => None,
     };
     let scene = scene(options)?;
     let trajectory = script.unwrap_or_else(|| {
@@ -132,11 +135,14 @@ pub fn run_headless(options: &Options) -> Result<Report, String> {
 /// Serves a hardware device without a window, on the real clock, for `--ticks` (ten seconds
 /// when it does not say). The device is opened first: a missing one is said before the scene
 /// is loaded.
-fn run_hardware_headless(options: &Options, name: &Option<String>) -> Result<Report, String> {
+fn run_hardware_headless(
+    options: &Options,
+    device: Box<dyn HapticDevice>,
+) -> Result<Report, String> {
     let timer = options
         .realtime
         .ok_or("a hardware device runs on the real clock: add --realtime (and --ticks)")?;
-    let device = recorded(openhaptics(name)?, &options.record);
+    let device = recorded(device, &options.record);
     let scene = scene(options)?;
     let haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
     let ticks = options.ticks.unwrap_or(HARDWARE_TICKS);
@@ -171,13 +177,13 @@ pub fn open_window(
         Some(lesson) => scenario_scene_capped(options, &lesson.scenario)?,
         None => scene(options)?,
     };
-    let (device, virtual_device) = match &options.device {
-        Some(DeviceSpec::Scripted(path)) => {
+    let (device, virtual_device) = match (open_hardware(&options.device), &options.device) {
+        (Some(device), _) => (device?, None),
+        (None, Some(DeviceSpec::Scripted(path))) => {
             let trajectory = Trajectory::load(path).map_err(|e| e.to_string())?;
             (scripted(&options.device, trajectory), None)
         }
-        Some(DeviceSpec::OpenHaptics(name)) => (openhaptics(name)?, None),
-        None | Some(DeviceSpec::Virtual) => {
+        (None, _) => {
             let start = press_targets(&scene)
                 .first()
                 .map_or_else(Vector3::zeros, |t| t.point_m + t.normal * 0.03);
@@ -334,10 +340,19 @@ fn scripted(spec: &Option<DeviceSpec>, trajectory: Trajectory) -> Box<dyn Haptic
 /// Headless ticks on a hardware device when `--ticks` does not say: ten seconds.
 const HARDWARE_TICKS: u64 = 10_000;
 
-/// The Geomagic device `name` names (the default without one), opened through OpenHaptics.
-fn openhaptics(name: &Option<String>) -> Result<Box<dyn HapticDevice>, String> {
-    let device = OpenHaptics::open(None, name.as_deref()).map_err(|e| e.to_string())?;
-    Ok(Box::new(device))
+/// The hardware device `spec` names, opened (`None` when it names none): a Geomagic device
+/// through OpenHaptics, or a Force Dimension one through its SDK.
+fn open_hardware(spec: &Option<DeviceSpec>) -> Option<Result<Box<dyn HapticDevice>, String>> {
+    let opened = match spec {
+        Some(DeviceSpec::OpenHaptics(name)) => {
+            OpenHaptics::open(None, name.as_deref()).map(|d| Box::new(d) as Box<dyn HapticDevice>)
+        }
+        Some(DeviceSpec::ForceDimension) => {
+            ForceDimension::open(None).map(|d| Box::new(d) as Box<dyn HapticDevice>)
+        }
+        _ => return None,
+    };
+    Some(opened.map_err(|e| e.to_string()))
 }
 
 fn recorded(device: Box<dyn HapticDevice>, record: &Option<PathBuf>) -> Box<dyn HapticDevice> {

@@ -3,13 +3,34 @@
 use std::process::ExitCode;
 
 use crate::app::missing_display;
-use crate::devices::OpenHaptics;
+use std::path::PathBuf;
+
+use crate::devices::{DeviceError, ForceDimension, OpenHaptics};
 
 /// One backend: how the command line names it, whether it is usable here, and what to know.
 struct Backend {
     spec: &'static str,
     usable: bool,
     note: String,
+}
+
+/// A backend over a vendor library: usable when the library loads, else why not.
+fn vendor(spec: &'static str, devices: &str, found: Result<PathBuf, DeviceError>) -> Backend {
+    match found {
+        Ok(path) => Backend {
+            spec,
+            usable: true,
+            note: format!(
+                "{devices}: library {} (the device is opened when the trainer starts)",
+                path.display()
+            ),
+        },
+        Err(e) => Backend {
+            spec,
+            usable: false,
+            note: e.to_string(),
+        },
+    }
 }
 
 /// Prints the table of backends; succeeds whatever is found.
@@ -33,26 +54,16 @@ pub fn list_devices() -> ExitCode {
                 note: format!("needs the window: {why}"),
             },
         },
-        match OpenHaptics::find_library() {
-            Ok(path) => Backend {
-                spec: "openhaptics[:NAME]",
-                usable: true,
-                note: format!(
-                    "Geomagic Touch, Touch X, Phantom: HD library {} (the device is opened when the trainer starts)",
-                    path.display()
-                ),
-            },
-            Err(e) => Backend {
-                spec: "openhaptics[:NAME]",
-                usable: false,
-                note: e.to_string(),
-            },
-        },
-        Backend {
-            spec: "forcedimension",
-            usable: false,
-            note: "Force Dimension omega, sigma, delta: not supported yet".into(),
-        },
+        vendor(
+            "openhaptics[:NAME]",
+            "Geomagic Touch, Touch X, Phantom",
+            OpenHaptics::find_library(),
+        ),
+        vendor(
+            "forcedimension",
+            "Force Dimension omega, sigma, delta",
+            ForceDimension::find_library(),
+        ),
         Backend {
             spec: "haply[:PORT]",
             usable: false,

@@ -1,9 +1,11 @@
 //! The device layer, free of Bevy: the device trait and its backends (scripted, recorder,
-//! virtual, and OpenHaptics hardware over the servo link and its watchdog), the trajectory
+//! virtual, and the OpenHaptics and Force Dimension hardware over the servo link and its
+//! watchdog), the trajectory
 //! files they replay and record, the map from the device's workspace to the scene, the safety
 //! filter between the physics and the motors, and the clock that paces the 1 kHz loop.
 
 mod device;
+mod forcedimension;
 mod openhaptics;
 mod recorder;
 mod safety;
@@ -13,10 +15,12 @@ mod spec;
 mod sweep;
 mod timing;
 mod trajectory;
+mod vendor;
 mod virtual_device;
 mod workspace;
 
 pub use device::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
+pub use forcedimension::ForceDimension;
 pub use openhaptics::OpenHaptics;
 pub use recorder::Recorder;
 pub use safety::{Fault, SafetyFilter, SafetySettings};

@@ -17,12 +17,16 @@ use libloading::Library;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 
 use super::servo::ServoLink;
+use super::vendor::VendorLibrary;
 use super::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
 
-/// The library's name as the dynamic loader finds it, and the environment variable that names
-/// another file.
-pub const LIBRARY: &str = "libHD.so";
-pub const LIBRARY_VARIABLE: &str = "PGD_OPENHAPTICS_LIB";
+/// The HD library, and what to install when it is missing.
+pub const LIBRARY: VendorLibrary = VendorLibrary {
+    backend: "openhaptics",
+    file: "libHD.so",
+    variable: "PGD_OPENHAPTICS_LIB",
+    install: "OpenHaptics (the Geomagic Touch device drivers and the OpenHaptics Developer Edition for Linux)",
+};
 
 // Parameters, capabilities and return values of `hdDefines.h`.
 const HD_CURRENT_BUTTONS: c_uint = 0x2000;
@@ -75,29 +79,11 @@ struct Hd {
 impl Hd {
     /// Loads the library at `path` (a bare name goes through the dynamic loader's search).
     fn load(path: &Path) -> Result<Self, DeviceError> {
-        let failed = |message: String| DeviceError::Failed {
-            device: "openhaptics".into(),
-            message,
-        };
-        // SAFETY: loading runs the library's initializers; the HD library is the vendor's.
-        let library = unsafe { Library::new(path) }.map_err(|e| {
-            failed(format!(
-                "cannot load the OpenHaptics HD library `{}` ({e}); install OpenHaptics (the \
-                 Geomagic Touch device drivers and the OpenHaptics Developer Edition for Linux), \
-                 or name the library's file in {LIBRARY_VARIABLE}",
-                path.display()
-            ))
-        })?;
+        let library = LIBRARY.load(path)?;
         macro_rules! resolve {
             ($name:literal) => {
-                // SAFETY: the symbol's type is the one `hd.h` declares.
-                *unsafe { library.get($name.as_bytes()) }.map_err(|e| {
-                    failed(format!(
-                        "`{}` lacks {} ({e}): not an OpenHaptics HD library",
-                        path.display(),
-                        $name
-                    ))
-                })?
+                // SAFETY: the field's type is the one `hd.h` declares for the function.
+                unsafe { LIBRARY.function(&library, path, $name)? }
             };
         }
         Ok(Self {
@@ -237,9 +223,9 @@ pub struct OpenHaptics {
 
 impl OpenHaptics {
     /// Opens the device named `device` (the vendor's default without one) through the HD
-    /// library at `library` (or [`LIBRARY_VARIABLE`]'s, or [`LIBRARY`] through the loader).
+    /// library at `library` (or the one [`LIBRARY`] finds).
     pub fn open(library: Option<&Path>, device: Option<&str>) -> Result<Self, DeviceError> {
-        let path = library.map_or_else(library_path, Path::to_path_buf);
+        let path = library.map_or_else(|| LIBRARY.path(), Path::to_path_buf);
         let hd = Arc::new(Hd::load(&path)?);
         let name = device.unwrap_or("default device").to_owned();
         let failed = |what: &str, (code, internal): (u32, u32)| DeviceError::Failed {
@@ -329,7 +315,7 @@ impl OpenHaptics {
 
     /// The HD library this machine would load, or why there is none (what to install).
     pub fn find_library() -> Result<PathBuf, DeviceError> {
-        let path = library_path();
+        let path = LIBRARY.path();
         Hd::load(&path).map(|_| path)
     }
 
@@ -337,11 +323,6 @@ impl OpenHaptics {
     pub fn link(&self) -> &Arc<ServoLink> {
         &self.servo.link
     }
-}
-
-/// The library to load: [`LIBRARY_VARIABLE`]'s file, or [`LIBRARY`] through the loader.
-pub fn library_path() -> PathBuf {
-    std::env::var_os(LIBRARY_VARIABLE).map_or_else(|| PathBuf::from(LIBRARY), PathBuf::from)
 }
 
 /// The device's own limits: its nominal peak and continuous forces.

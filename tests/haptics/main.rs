@@ -4,7 +4,9 @@
 mod common;
 mod deformed;
 mod devices;
+mod fakes;
 mod faults;
+mod forcedimension;
 mod grasp;
 mod openhaptics;
 mod press;

@@ -1,12 +1,9 @@
-//! The OpenHaptics backend against a fake HD library (`fake_hd.c`, built here with the system
-//! C compiler): a scheduler thread at 1 kHz, a stylus the test places, the forces the servo
-//! renders recorded. Each test loads its own copy of the fake, so their states stay apart.
+//! The OpenHaptics backend against a fake HD library (`fake_hd.c`): a scheduler thread at
+//! 1 kHz, a stylus the test places, the forces the servo renders recorded.
 
-use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::path::Path;
 use std::time::{Duration, Instant};
 
-use libloading::Library;
 use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{
     DeviceForce, FaultLog, HapticLoop, HapticThread, Scheduling, TickClock,
@@ -16,84 +13,51 @@ use pgd_surgery::devices::{
 };
 
 use crate::common::{TIP_RADIUS_M, scene, target};
+use crate::fakes::VendorFake;
 
-/// The fake built once per run.
-fn built() -> &'static PathBuf {
-    static BUILT: OnceLock<PathBuf> = OnceLock::new();
-    BUILT.get_or_init(|| {
-        let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/haptics/fake_hd.c");
-        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("libfakehd.so");
-        let status = std::process::Command::new("cc")
-            .args(["-shared", "-fPIC", "-O1", "-pthread", "-o"])
-            .arg(&out)
-            .arg(&source)
-            .status()
-            .expect("a C compiler (cc) builds the fake HD library");
-        assert!(status.success(), "cc failed on {}", source.display());
-        out
-    })
-}
-
-/// This test's own copy of the fake, and its controls.
-struct Fake {
-    path: PathBuf,
-    library: Library,
-}
+/// This test's own copy of the fake HD library, and its controls.
+struct Fake(VendorFake);
 
 impl Fake {
     fn new(test: &str) -> Self {
-        let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("libfakehd-{test}.so"));
-        std::fs::copy(built(), &path).unwrap();
-        // SAFETY: the fake is ours.
-        let library = unsafe { Library::new(&path) }.unwrap();
-        Self { path, library }
+        Self(VendorFake::new("fake_hd", test))
     }
 
-    fn call<T>(&self, name: &str) -> libloading::Symbol<'_, T> {
-        // SAFETY: the test names each control with its C type.
-        unsafe { self.library.get(name.as_bytes()) }.unwrap()
+    fn path(&self) -> &Path {
+        &self.0.path
     }
 
     fn set_stylus(&self, mm: [f64; 3], buttons: i32) {
-        let f = self.call::<unsafe extern "C" fn(f64, f64, f64, i32)>("fake_hd_set_stylus");
+        let f = self
+            .0
+            .call::<unsafe extern "C" fn(f64, f64, f64, i32)>("fake_hd_set_stylus");
         // SAFETY: plain values.
         unsafe { f(mm[0], mm[1], mm[2], buttons) };
     }
 
     fn last_force(&self) -> Vector3<f64> {
-        let f = self.call::<unsafe extern "C" fn(*mut f64)>("fake_hd_last_force");
-        let mut out = [0.0; 3];
-        // SAFETY: three doubles.
-        unsafe { f(out.as_mut_ptr()) };
-        Vector3::from(out)
+        self.0.vector("fake_hd_last_force")
     }
 
     fn flag(&self, name: &str) -> i32 {
-        // SAFETY: a control without arguments returning an int.
-        unsafe { self.call::<unsafe extern "C" fn() -> i32>(name)() }
-    }
-
-    fn frames(&self) -> i64 {
-        // SAFETY: a control without arguments returning a long.
-        unsafe { self.call::<unsafe extern "C" fn() -> i64>("fake_hd_frames")() }
+        self.0.int(name)
     }
 
     fn inject_error(&self, code: u32) {
         // SAFETY: a plain value.
-        unsafe { self.call::<unsafe extern "C" fn(u32)>("fake_hd_inject_error")(code) };
+        unsafe {
+            self.0
+                .call::<unsafe extern "C" fn(u32)>("fake_hd_inject_error")(code)
+        };
     }
 
     fn open(&self) -> OpenHaptics {
-        OpenHaptics::open(Some(&self.path), None).unwrap()
+        OpenHaptics::open(Some(self.path()), None).unwrap()
     }
 
     /// Waits until the fake's scheduler has run `frames` more frames.
     fn wait_frames(&self, frames: i64) {
-        let until = self.frames() + frames;
-        let give_up = Instant::now() + Duration::from_secs(5);
-        while self.frames() < until && Instant::now() < give_up {
-            std::thread::sleep(Duration::from_micros(200));
-        }
+        self.0.wait("fake_hd_frames", frames);
     }
 }
 
@@ -115,7 +79,7 @@ fn a_missing_library_is_named_with_how_to_install_it() {
 #[test]
 fn a_device_that_fails_to_initialize_says_why() {
     let fake = Fake::new("absent");
-    let error = OpenHaptics::open(Some(&fake.path), Some("absent"))
+    let error = OpenHaptics::open(Some(fake.path()), Some("absent"))
         .err()
         .unwrap()
         .to_string();
@@ -282,10 +246,10 @@ fn the_trainer_says_what_is_missing_and_lists_what_is_found() {
         "{absent}"
     );
     let fake = Fake::new("listed");
-    let found = listed(&fake.path);
+    let found = listed(fake.path());
     eprintln!("{absent}\n{found}");
     assert!(
-        found.contains(" yes ") && found.contains("libfakehd-listed.so"),
+        found.contains(" yes ") && found.contains("libfake_hd-listed.so"),
         "{found}"
     );
 }

@@ -1,0 +1,153 @@
+//! The Force Dimension backend against a fake dhd library (`fake_dhd.c`): our servo thread
+//! reads the end effector the test places and sends the forces the fake records.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use nalgebra::Vector3;
+use pgd_surgery::app::haptic::{DeviceForce, FaultLog, HapticLoop, TickClock};
+use pgd_surgery::devices::{ForceDimension, HapticDevice, SafetySettings, TICK_S, WATCHDOG_S};
+
+use crate::common::{TIP_RADIUS_M, scene, target};
+use crate::fakes::VendorFake;
+
+/// This test's own copy of the fake dhd library, and its controls.
+struct Fake(VendorFake);
+
+impl Fake {
+    fn new(test: &str) -> Self {
+        Self(VendorFake::new("fake_dhd", test))
+    }
+
+    /// Places the end effector at `m` in the device's frame (x towards the user, y right, z up).
+    fn set_effector(&self, m: [f64; 3], buttons: u32) {
+        let f = self
+            .0
+            .call::<unsafe extern "C" fn(f64, f64, f64, u32)>("fake_dhd_set_effector");
+        // SAFETY: plain values.
+        unsafe { f(m[0], m[1], m[2], buttons) };
+    }
+
+    fn last_force(&self) -> Vector3<f64> {
+        self.0.vector("fake_dhd_last_force")
+    }
+
+    fn open(&self) -> Result<ForceDimension, String> {
+        ForceDimension::open(Some(&self.0.path)).map_err(|e| e.to_string())
+    }
+
+    fn wait_frames(&self, frames: i64) {
+        self.0.wait("fake_dhd_frames", frames);
+    }
+}
+
+/// No library, or no device: one message each, naming what is missing.
+#[test]
+fn a_missing_library_or_device_is_named() {
+    let error = ForceDimension::open(Some(Path::new("/nowhere/libdhd.so")))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(error.contains("/nowhere/libdhd.so") && error.contains("Force Dimension SDK"));
+    assert!(error.contains("PGD_FORCEDIMENSION_LIB"), "{error}");
+    let fake = Fake::new("absent");
+    // SAFETY: a plain value.
+    unsafe {
+        fake.0
+            .call::<unsafe extern "C" fn(i32)>("fake_dhd_set_absent")(1)
+    };
+    let error = fake.open().err().unwrap();
+    eprintln!("{error}");
+    assert!(error.contains("no device found"), "{error}");
+}
+
+/// The effector at (10, 20, 30) mm in the device's frame (x towards the user, y right, z up) is
+/// the tool at (20, −10, 30) mm in the scene's; (1, 2, 3) N in the scene is sent as
+/// (−2, 1, 3) N; the peak is the SDK's force limit (the fake's 9.5 N); force output enabled.
+#[test]
+fn the_servo_reads_the_effector_and_sends_the_force_in_the_devices_frame() {
+    let fake = Fake::new("frames");
+    fake.set_effector([0.010, 0.020, 0.030], 2);
+    let mut device = fake.open().unwrap();
+    assert_eq!(fake.0.int("fake_dhd_force_enabled"), 1);
+    fake.wait_frames(3);
+    let sample = device.read(0.0).unwrap();
+    assert!((sample.tip_m - Vector3::new(0.020, -0.010, 0.030)).norm() < 1e-12);
+    assert_eq!(sample.buttons, 2);
+    assert_eq!(device.limits().peak_force_n, 9.5);
+    device.write_force(&Vector3::new(1.0, 2.0, 3.0)).unwrap();
+    fake.wait_frames(3);
+    assert_eq!(fake.last_force(), Vector3::new(-2.0, 1.0, 3.0));
+}
+
+/// The haptic loop over the fake, the effector 4 mm into the liver: pushed back, no fault. An
+/// SDK error mid-run fades the force to zero within 5 ticks, the log gives the SDK's words.
+#[test]
+fn an_sdk_error_mid_run_fades_the_force_to_zero() {
+    let fake = Fake::new("error");
+    let target = target();
+    let tip = target.point_m + target.normal * (TIP_RADIUS_M - 0.004);
+    // The scene's (x, y, z) is the device's (−y, x, z).
+    fake.set_effector([-tip.y, tip.x, tip.z], 0);
+    let device = Box::new(fake.open().unwrap());
+    let mut haptic = HapticLoop::new(&scene(SafetySettings::default()), device).unwrap();
+    let mut sent = Vec::new();
+    let tick = |haptic: &mut HapticLoop, sent: &mut Vec<Vector3<f64>>, n: u64| {
+        haptic.tick(TickClock {
+            tick: n,
+            time_s: n as f64 * TICK_S,
+            overruns_in_a_row: 0,
+        });
+        sent.push(haptic.world().resource::<DeviceForce>().sent_n);
+        fake.wait_frames(1);
+    };
+    for n in 0..400 {
+        tick(&mut haptic, &mut sent, n);
+    }
+    let pressing = *sent.last().unwrap();
+    // SAFETY: a plain value.
+    unsafe {
+        fake.0
+            .call::<unsafe extern "C" fn(i32)>("fake_dhd_inject_error")(7)
+    };
+    fake.wait_frames(2);
+    for n in 400..420 {
+        tick(&mut haptic, &mut sent, n);
+    }
+    let log = &haptic.world().resource::<FaultLog>().log;
+    eprintln!("pressing {:.3} N; faults {log:?}", pressing.norm());
+    assert!(pressing.dot(&target.normal) > 0.05, "{pressing:?}");
+    assert!(sent[405..].iter().all(|f| *f == Vector3::zeros()));
+    assert!(log.iter().all(|(tick, _)| *tick >= 400), "{log:?}");
+    assert!(
+        log.iter()
+            .any(|(_, f)| f.to_string().contains("communication error"))
+    );
+}
+
+/// The loop stops commanding: the servo sends zero once the last command is older than the
+/// watchdog's 10 ms (within the watchdog and 25 ms of scheduling); closed, the device is left at
+/// zero force and closed.
+#[test]
+fn a_stalled_loop_and_closing_leave_zero_force() {
+    let fake = Fake::new("stall");
+    let mut device = fake.open().unwrap();
+    device.write_force(&Vector3::new(0.0, 0.0, 1.0)).unwrap();
+    fake.wait_frames(2);
+    assert_eq!(fake.last_force(), Vector3::new(0.0, 0.0, 1.0));
+    let commanded = Instant::now();
+    device.write_force(&Vector3::new(0.0, 0.0, 1.0)).unwrap();
+    while fake.last_force() != Vector3::zeros() {
+        assert!(commanded.elapsed() < Duration::from_secs(1), "never zeroed");
+        std::thread::sleep(Duration::from_micros(100));
+    }
+    let zeroed_after = commanded.elapsed().as_secs_f64();
+    eprintln!("zeroed {:.1} ms after the last command", zeroed_after * 1e3);
+    assert!((WATCHDOG_S..WATCHDOG_S + 0.025).contains(&zeroed_after));
+    device.write_force(&Vector3::new(1.0, 0.0, 0.0)).unwrap();
+    fake.wait_frames(3);
+    assert_ne!(fake.last_force(), Vector3::zeros());
+    drop(device);
+    assert_eq!(fake.last_force(), Vector3::zeros());
+    assert_eq!(fake.0.int("fake_dhd_closed"), 1);
+}
