@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use libloading::Library;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
@@ -28,9 +28,6 @@ pub const LIBRARY: VendorLibrary = VendorLibrary {
     variable: "PGD_FORCEDIMENSION_LIB",
     install: "the Force Dimension SDK for Linux (its lib/ folder on LD_LIBRARY_PATH)",
 };
-
-/// How long the servo thread may take to run its first frame.
-const FIRST_FRAME_WITHIN: Duration = Duration::from_secs(1);
 
 /// The dhd functions the backend calls, resolved once; the library stays open with them.
 struct Dhd {
@@ -226,7 +223,15 @@ impl ForceDimension {
             servo: Some(servo),
             limits,
         };
-        device.await_first_frame()?;
+        if !device.link.await_first_sample() {
+            let (code, text) = device.dhd.last_error();
+            return Err(DeviceError::Failed {
+                device: device.name.clone(),
+                message: format!(
+                    "the servo read no position within a second: {text} (dhd error {code})"
+                ),
+            });
+        }
         Ok(device)
     }
 
@@ -239,23 +244,6 @@ impl ForceDimension {
     /// What the haptic loop and the servo share.
     pub fn link(&self) -> &Arc<ServoLink> {
         &self.link
-    }
-
-    fn await_first_frame(&self) -> Result<(), DeviceError> {
-        let give_up = Instant::now() + FIRST_FRAME_WITHIN;
-        while self.link.samples() == 0 {
-            if Instant::now() > give_up {
-                let (code, text) = self.dhd.last_error();
-                return Err(DeviceError::Failed {
-                    device: self.name.clone(),
-                    message: format!(
-                        "the servo read no position within 1 s: {text} (dhd error {code})"
-                    ),
-                });
-            }
-            std::thread::sleep(Duration::from_micros(200));
-        }
-        Ok(())
     }
 }
 

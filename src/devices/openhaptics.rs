@@ -11,7 +11,6 @@
 use std::ffi::{CString, c_char, c_int, c_uint, c_ulong, c_ushort, c_void};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
 
 use libloading::Library;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
@@ -41,9 +40,6 @@ const HD_FORCE_OUTPUT: c_uint = 0x4000;
 const HD_INVALID_HANDLE: c_uint = 0xFFFF_FFFF;
 const HD_CALLBACK_CONTINUE: c_uint = 1;
 const HD_DEFAULT_SCHEDULER_PRIORITY: c_ushort = u16::MAX / 2;
-
-/// How long a started servo may take to run its first frame.
-const FIRST_FRAME_WITHIN: Duration = Duration::from_secs(1);
 
 /// `HDErrorInfo`.
 #[repr(C)]
@@ -291,26 +287,13 @@ impl OpenHaptics {
         if let Some(error) = device.hd.error() {
             return Err(failed("cannot start the servo loop", error));
         }
-        device.await_first_frame()?;
-        Ok(device)
-    }
-
-    /// Waits for the servo's first sample, so that the haptic loop's first read has one.
-    fn await_first_frame(&self) -> Result<(), DeviceError> {
-        let give_up = Instant::now() + FIRST_FRAME_WITHIN;
-        while self.servo.link.samples() == 0 {
-            if Instant::now() > give_up {
-                return Err(DeviceError::Failed {
-                    device: self.name.clone(),
-                    message: format!(
-                        "the servo loop ran no frame within {} s of starting",
-                        FIRST_FRAME_WITHIN.as_secs_f64()
-                    ),
-                });
-            }
-            std::thread::sleep(Duration::from_micros(200));
+        match device.servo.link.await_first_sample() {
+            true => Ok(device),
+            false => Err(failed(
+                "the servo loop ran no frame within a second of starting",
+                (0x0402, 0),
+            )),
         }
-        Ok(())
     }
 
     /// The HD library this machine would load, or why there is none (what to install).

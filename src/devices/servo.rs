@@ -21,6 +21,9 @@ use super::DeviceSample;
 /// How long a commanded force stays valid without a new command: ten missed 1 ms ticks.
 pub const WATCHDOG_S: f64 = 0.010;
 
+/// How long a started servo may take to publish its first sample.
+pub const FIRST_SAMPLE_WITHIN: Duration = Duration::from_secs(1);
+
 /// The state a backend's servo and the haptic loop share.
 pub struct ServoLink {
     start: Instant,
@@ -153,6 +156,19 @@ impl ServoLink {
     /// Servo frames so far that rendered zero because the loop's command had expired.
     pub fn expired_frames(&self) -> u64 {
         self.expired_frames.load(Ordering::Relaxed)
+    }
+
+    /// Loop side: waits for the servo's first sample, so that the loop's first read has one;
+    /// whether it came within [`FIRST_SAMPLE_WITHIN`].
+    pub fn await_first_sample(&self) -> bool {
+        let give_up = Instant::now() + FIRST_SAMPLE_WITHIN;
+        while self.samples() == 0 {
+            if Instant::now() > give_up {
+                return false;
+            }
+            std::thread::sleep(Duration::from_micros(200));
+        }
+        true
     }
 
     /// Samples the servo has published so far.

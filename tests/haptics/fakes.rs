@@ -1,6 +1,6 @@
 //! Fakes of vendor haptic libraries (`fake_*.c` here), built once per run with the system C
 //! compiler; each test loads its own copy, so that their states stay apart, and drives it
-//! through the fake's `fake_*` controls.
+//! through the fake's `fake_*` controls. And the run every backend's fault test makes.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -9,6 +9,10 @@ use std::time::{Duration, Instant};
 
 use libloading::{Library, Symbol};
 use nalgebra::Vector3;
+use pgd_surgery::app::haptic::{DeviceForce, FaultLog, HapticLoop, TickClock};
+use pgd_surgery::devices::{HapticDevice, SafetySettings, TICK_S};
+
+use crate::common::{TIP_RADIUS_M, scene, target};
 
 /// The shared library built from `tests/haptics/<source>.c`, once per run.
 fn built(source: &str) -> PathBuf {
@@ -81,4 +85,74 @@ impl VendorFake {
             std::thread::sleep(Duration::from_micros(200));
         }
     }
+}
+
+/// What [`press_then_fault`] saw: the force while pressing, every tick's force, the faults.
+pub struct FaultRun {
+    pub pressing: Vector3<f64>,
+    pub sent: Vec<Vector3<f64>>,
+    pub faults: Vec<(u64, String)>,
+}
+
+/// The haptic loop over `device` on the coarse liver, whose tool the fake holds 4 mm into it:
+/// 400 ticks, then `fault` and 20 ticks more, `frame` waiting for a servo frame after each.
+pub fn press_then_fault(
+    device: Box<dyn HapticDevice>,
+    frame: impl Fn(),
+    fault: impl FnOnce(),
+) -> FaultRun {
+    let mut haptic = HapticLoop::new(&scene(SafetySettings::default()), device).unwrap();
+    let mut sent = Vec::new();
+    let mut tick = |haptic: &mut HapticLoop, n: u64| {
+        haptic.tick(TickClock {
+            tick: n,
+            time_s: n as f64 * TICK_S,
+            overruns_in_a_row: 0,
+        });
+        sent.push(haptic.world().resource::<DeviceForce>().sent_n);
+        frame();
+    };
+    (0..400).for_each(|n| tick(&mut haptic, n));
+    fault();
+    frame();
+    frame();
+    (400..420).for_each(|n| tick(&mut haptic, n));
+    let faults = haptic.world().resource::<FaultLog>().log.iter();
+    FaultRun {
+        pressing: sent[399],
+        faults: faults.map(|(t, f)| (*t, f.to_string())).collect(),
+        sent,
+    }
+}
+
+/// The tool at 4 mm into the liver where the tests press (the scene's frame).
+pub fn pressing_tip_m() -> Vector3<f64> {
+    let target = target();
+    target.point_m + target.normal * (TIP_RADIUS_M - 0.004)
+}
+
+/// The run pushed the trainee back with no fault, then faded the force to zero within the
+/// filter's 5 ticks of the fault, whose log entry `says` what happened.
+pub fn assert_faded(run: &FaultRun, says: &str) {
+    eprintln!(
+        "pressing {:.3} N; faults {:?}",
+        run.pressing.norm(),
+        run.faults
+    );
+    assert!(
+        run.pressing.dot(&target().normal) > 0.05,
+        "{:?}",
+        run.pressing
+    );
+    assert!(run.sent[405..].iter().all(|f| *f == Vector3::zeros()));
+    assert!(
+        run.faults.iter().all(|(tick, _)| *tick >= 400),
+        "{:?}",
+        run.faults
+    );
+    assert!(
+        run.faults.iter().any(|(_, f)| f.contains(says)),
+        "{:?}",
+        run.faults
+    );
 }

@@ -5,11 +5,9 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
-use pgd_surgery::app::haptic::{DeviceForce, FaultLog, HapticLoop, TickClock};
-use pgd_surgery::devices::{ForceDimension, HapticDevice, SafetySettings, TICK_S, WATCHDOG_S};
+use pgd_surgery::devices::{ForceDimension, HapticDevice, WATCHDOG_S};
 
-use crate::common::{TIP_RADIUS_M, scene, target};
-use crate::fakes::VendorFake;
+use crate::fakes::{VendorFake, assert_faded, press_then_fault, pressing_tip_m};
 
 /// This test's own copy of the fake dhd library, and its controls.
 struct Fake(VendorFake);
@@ -85,44 +83,22 @@ fn the_servo_reads_the_effector_and_sends_the_force_in_the_devices_frame() {
 #[test]
 fn an_sdk_error_mid_run_fades_the_force_to_zero() {
     let fake = Fake::new("error");
-    let target = target();
-    let tip = target.point_m + target.normal * (TIP_RADIUS_M - 0.004);
+    let tip = pressing_tip_m();
     // The scene's (x, y, z) is the device's (−y, x, z).
     fake.set_effector([-tip.y, tip.x, tip.z], 0);
-    let device = Box::new(fake.open().unwrap());
-    let mut haptic = HapticLoop::new(&scene(SafetySettings::default()), device).unwrap();
-    let mut sent = Vec::new();
-    let tick = |haptic: &mut HapticLoop, sent: &mut Vec<Vector3<f64>>, n: u64| {
-        haptic.tick(TickClock {
-            tick: n,
-            time_s: n as f64 * TICK_S,
-            overruns_in_a_row: 0,
-        });
-        sent.push(haptic.world().resource::<DeviceForce>().sent_n);
-        fake.wait_frames(1);
+    let inject = || {
+        // SAFETY: a plain value.
+        unsafe {
+            fake.0
+                .call::<unsafe extern "C" fn(i32)>("fake_dhd_inject_error")(7)
+        };
     };
-    for n in 0..400 {
-        tick(&mut haptic, &mut sent, n);
-    }
-    let pressing = *sent.last().unwrap();
-    // SAFETY: a plain value.
-    unsafe {
-        fake.0
-            .call::<unsafe extern "C" fn(i32)>("fake_dhd_inject_error")(7)
-    };
-    fake.wait_frames(2);
-    for n in 400..420 {
-        tick(&mut haptic, &mut sent, n);
-    }
-    let log = &haptic.world().resource::<FaultLog>().log;
-    eprintln!("pressing {:.3} N; faults {log:?}", pressing.norm());
-    assert!(pressing.dot(&target.normal) > 0.05, "{pressing:?}");
-    assert!(sent[405..].iter().all(|f| *f == Vector3::zeros()));
-    assert!(log.iter().all(|(tick, _)| *tick >= 400), "{log:?}");
-    assert!(
-        log.iter()
-            .any(|(_, f)| f.to_string().contains("communication error"))
+    let run = press_then_fault(
+        Box::new(fake.open().unwrap()),
+        || fake.wait_frames(1),
+        inject,
     );
+    assert_faded(&run, "communication error");
 }
 
 /// The loop stops commanding: the servo sends zero once the last command is older than the

@@ -5,15 +5,11 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
-use pgd_surgery::app::haptic::{
-    DeviceForce, FaultLog, HapticLoop, HapticThread, Scheduling, TickClock,
-};
-use pgd_surgery::devices::{
-    HapticDevice, OpenHaptics, SafetySettings, TICK_S, TimerMode, WATCHDOG_S,
-};
+use pgd_surgery::app::haptic::{HapticLoop, HapticThread, Scheduling};
+use pgd_surgery::devices::{HapticDevice, OpenHaptics, SafetySettings, TimerMode, WATCHDOG_S};
 
 use crate::common::{TIP_RADIUS_M, scene, target};
-use crate::fakes::VendorFake;
+use crate::fakes::{VendorFake, assert_faded, press_then_fault, pressing_tip_m};
 
 /// This test's own copy of the fake HD library, and its controls.
 struct Fake(VendorFake);
@@ -114,48 +110,21 @@ fn the_servo_reads_the_stylus_and_renders_the_force_in_the_devices_frame() {
 }
 
 /// The haptic loop over the fake, its stylus 4 mm into the liver: the trainee is pushed back,
-/// with no fault (the device opens with the servo's first sample in hand). An HD error mid-run is a device fault: the force fades to zero within the filter's 5 ticks,
-/// the log names the HD error, and the fake renders zero.
+/// with no fault (the device opens with the servo's first sample in hand). An HD error mid-run
+/// is a device fault: the force fades to zero within the filter's 5 ticks, the log names the
+/// HD error, and the fake renders zero.
 #[test]
 fn an_hd_error_mid_run_fades_the_force_to_zero() {
     let fake = Fake::new("error");
-    let target = target();
-    let tip = target.point_m + target.normal * (TIP_RADIUS_M - 0.004);
+    let tip = pressing_tip_m();
     // The scene's (x, y, z) m is the device's (x, z, −y) mm.
     fake.set_stylus([tip.x * 1e3, tip.z * 1e3, -tip.y * 1e3], 0);
-    let device = Box::new(fake.open());
-    let mut haptic = HapticLoop::new(&scene(SafetySettings::default()), device).unwrap();
-    let mut sent = Vec::new();
-    let tick = |haptic: &mut HapticLoop, sent: &mut Vec<Vector3<f64>>, n: u64| {
-        haptic.tick(TickClock {
-            tick: n,
-            time_s: n as f64 * TICK_S,
-            overruns_in_a_row: 0,
-        });
-        sent.push(haptic.world().resource::<DeviceForce>().sent_n);
-        fake.wait_frames(1);
-    };
-    for n in 0..400 {
-        tick(&mut haptic, &mut sent, n);
-    }
-    let pressing = *sent.last().unwrap();
-    fake.inject_error(0x0201);
-    fake.wait_frames(2);
-    for n in 400..420 {
-        tick(&mut haptic, &mut sent, n);
-    }
-    let log = &haptic.world().resource::<FaultLog>().log;
-    eprintln!("pressing {:.3} N; faults {log:?}", pressing.norm());
-    assert!(pressing.dot(&target.normal) > 0.05, "{pressing:?}");
-    assert!(sent[405..].iter().all(|f| *f == Vector3::zeros()));
-    assert!(
-        log.iter()
-            .any(|(_, f)| f.to_string().contains("HD_EXCEEDED_MAX_FORCE"))
+    let run = press_then_fault(
+        Box::new(fake.open()),
+        || fake.wait_frames(1),
+        || fake.inject_error(0x0201),
     );
-    assert!(
-        log.iter().all(|(tick, _)| *tick >= 400),
-        "a fault before the error: {log:?}"
-    );
+    assert_faded(&run, "HD_EXCEEDED_MAX_FORCE");
     fake.wait_frames(3);
     assert_eq!(fake.last_force(), Vector3::zeros());
 }
