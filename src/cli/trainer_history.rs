@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use crate::report::learning_curve;
+use crate::report::{CurvePoint, learning_curve};
 use crate::scenario::Scorecard;
 use crate::store::{AttemptRecord, History, HistoryError, HistoryFilter, keep_attempt, now_unix_s};
 
@@ -146,7 +146,15 @@ fn print_table(attempts: &[AttemptRecord], plot: &Path) -> Result<(), String> {
     if let Some(folder) = plot.parent().filter(|f| !f.as_os_str().is_empty()) {
         std::fs::create_dir_all(folder).map_err(|e| format!("{}: {e}", folder.display()))?;
     }
-    learning_curve(plot, attempts)?;
+    let points: Vec<CurvePoint> = attempts
+        .iter()
+        .map(|a| CurvePoint {
+            scenario: &a.title,
+            score: a.score,
+            time_s: a.time_s,
+        })
+        .collect();
+    learning_curve(plot, &points)?;
     eprintln!("learning curve: {}", plot.display());
     Ok(())
 }

@@ -6,21 +6,29 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::plot::save_png;
-use crate::store::AttemptRecord;
 
 const SIZE: (u32, u32) = (1000, 700);
 
+/// One attempt on the curve.
+#[derive(Clone, Copy, Debug)]
+pub struct CurvePoint<'a> {
+    /// The scenario's title: one line each.
+    pub scenario: &'a str,
+    pub score: f64,
+    pub time_s: f64,
+}
+
 /// Draws the score (top) and the time taken (bottom) of `attempts` (oldest first) against
 /// the attempt's number within its scenario, one colour per scenario.
-pub fn learning_curve(path: &Path, attempts: &[AttemptRecord]) -> Result<(), String> {
-    let mut scenarios: Vec<&str> = attempts.iter().map(|a| a.title.as_str()).collect();
+pub fn learning_curve(path: &Path, attempts: &[CurvePoint]) -> Result<(), String> {
+    let mut scenarios: Vec<&str> = attempts.iter().map(|a| a.scenario).collect();
     scenarios.dedup();
     scenarios.sort_unstable();
     scenarios.dedup();
-    let series = |title: &str, value: fn(&AttemptRecord) -> f64| -> Vec<(f64, f64)> {
+    let series = |title: &str, value: fn(&CurvePoint) -> f64| -> Vec<(f64, f64)> {
         attempts
             .iter()
-            .filter(|a| a.title == title)
+            .filter(|a| a.scenario == title)
             .enumerate()
             .map(|(k, a)| ((k + 1) as f64, value(a)))
             .collect()
@@ -39,13 +47,13 @@ pub fn learning_curve(path: &Path, attempts: &[AttemptRecord]) -> Result<(), Str
                 "score over attempts",
                 "score (0–100)",
                 0.0..100.0,
-                (|a: &AttemptRecord| a.score) as fn(&AttemptRecord) -> f64,
+                (|a: &CurvePoint| a.score) as fn(&CurvePoint) -> f64,
             ),
             (
                 "time over attempts",
                 "time (s)",
                 0.0..slowest,
-                |a: &AttemptRecord| a.time_s,
+                |a: &CurvePoint| a.time_s,
             ),
         ];
         for (area, (caption, y_desc, range, value)) in panels.iter().zip(panel) {

@@ -9,6 +9,6 @@ mod scorecard;
 pub use convergence::{
     StepCurve, write as write_convergence, write_of_header as write_convergence_of,
 };
-pub use learning_curve::learning_curve;
+pub use learning_curve::{CurvePoint, learning_curve};
 pub use plot::{LineChart, Series, line_chart, save_png};
 pub use scorecard::{summary, write_report};
