@@ -173,15 +173,20 @@ pub fn open_window(
     screenshot: Option<ScreenshotPlan>,
     lesson: Option<WindowLesson>,
 ) -> Result<(Report, Attempts), String> {
+    // `--device` first, else the device the opening scenario is meant for.
+    let spec = options.device.clone().or_else(|| {
+        let lesson = lesson.as_ref()?;
+        lesson.scenario.device.spec()
+    });
     let scene = match &lesson {
         Some(lesson) => scenario_scene_capped(options, &lesson.scenario)?,
         None => scene(options)?,
     };
-    let (device, virtual_device) = match (open_hardware(&options.device), &options.device) {
+    let (device, virtual_device) = match (open_hardware(&spec), &spec) {
         (Some(device), _) => (device?, None),
         (None, Some(DeviceSpec::Scripted(path))) => {
             let trajectory = Trajectory::load(path).map_err(|e| e.to_string())?;
-            (scripted(&options.device, trajectory), None)
+            (scripted(&spec, trajectory), None)
         }
         (None, _) => {
             let start = press_targets(&scene)
@@ -208,7 +213,7 @@ pub fn open_window(
                 file,
                 scene: scene.clone(),
             };
-            if let Some(DeviceSpec::Scripted(_)) = &options.device {
+            if let Some(DeviceSpec::Scripted(_)) = &spec {
                 lesson.link.start();
             }
             (Some((lesson, opening)), folder)

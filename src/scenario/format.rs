@@ -9,6 +9,7 @@ use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 
 use crate::contact::PointshellDensity;
+use crate::devices::DeviceSpec;
 use crate::fem::Law;
 
 use super::units::{Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, Seconds};
@@ -103,6 +104,11 @@ pub struct Device {
     /// scales with it: forces are not scaled).
     #[serde(default = "default_workspace_scale")]
     pub workspace_scale: Scale,
+    /// The haptic device the exercise is meant for, named as `--device` names it
+    /// (`openhaptics`, `openhaptics:NAME`, `forcedimension`, `virtual`); `--device` overrides
+    /// it. None: the mouse in the window.
+    #[serde(default)]
+    pub backend: Option<String>,
 }
 
 fn default_workspace_scale() -> Scale {
@@ -113,11 +119,19 @@ fn default_device_force() -> Newtons {
     Newtons(3.3)
 }
 
+impl Device {
+    /// The device the scenario names, if it names one that reads.
+    pub fn spec(&self) -> Option<DeviceSpec> {
+        self.backend.as_ref()?.parse().ok()
+    }
+}
+
 impl Default for Device {
     fn default() -> Self {
         Self {
             max_force_n: default_device_force(),
             workspace_scale: default_workspace_scale(),
+            backend: None,
         }
     }
 }

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use super::format::{OrganEntry, Scenario, Task};
 use crate::contact::PointshellDensity;
+use crate::devices::DeviceSpec;
 use crate::mesh::organs::{Organ, region};
 
 /// Where every reference of the scenario format is explained.
@@ -209,7 +210,23 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
         check_task(scenario, k, task, &mut problems);
     }
     check_rubric(scenario, &mut problems);
+    check_backend(scenario, &mut problems);
     problems
+}
+
+/// A device the scenario names must be one the trainer knows.
+fn check_backend(scenario: &Scenario, problems: &mut Vec<Problem>) {
+    let Some(backend) = &scenario.device.backend else {
+        return;
+    };
+    if let Err(message) = backend.parse::<DeviceSpec>() {
+        problems.push(Problem {
+            field: "device.backend".into(),
+            anchors: vec!["device".into(), "backend".into()],
+            message,
+            hint: "`trainer devices` lists the devices and which this machine has".into(),
+        });
+    }
 }
 
 fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Problem>) {

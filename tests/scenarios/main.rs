@@ -230,6 +230,7 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "workspace_scale",
             "not a workspace scale",
         ),
+        ("unknown-device", 5, "device.backend", "phantom-omni"),
         (
             "organ-mesh-missing",
             6,
@@ -567,4 +568,28 @@ fn the_scenario_picks_the_law_per_organ() {
     assert_eq!(liver.valid_indentation_m(), 1.5e-3);
     assert!(vademecums().join("liver-neo-hookean.coarse.vdm").is_file());
     assert_eq!(scene.organs[1].1.valid_indentation_m(), 0.0);
+}
+
+/// A scenario may name the device it is meant for, as `--device` names it; the window opens
+/// that one unless `--device` names another.
+#[test]
+fn a_scenario_names_its_device() {
+    let text = |backend: &str| {
+        format!(
+            r#"Scenario(title: "Device", briefing: "", organs: ["liver"], device: Device({backend}),
+               tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3, hold_s: 1.0, time_limit_s: 5.0)])"#
+        )
+    };
+    let named = parse(
+        Path::new("device.ron"),
+        &text(r#"backend: "openhaptics:Left Touch""#),
+    );
+    assert_eq!(
+        named.unwrap().device.spec(),
+        Some(pgd_surgery::devices::DeviceSpec::OpenHaptics(Some(
+            "Left Touch".into()
+        )))
+    );
+    let unnamed = parse(Path::new("device.ron"), &text("max_force_n: 2.0")).unwrap();
+    assert_eq!(unnamed.device.spec(), None);
 }
