@@ -61,8 +61,12 @@ pub fn summary(card: &Scorecard) -> String {
             .map_or(String::new(), |e| format!(" ({e:.2}× the shortest)"));
         let _ = writeln!(
             out,
-            "  motion: path {:.0} mm{economy}, {} movements, idle {:.1} s, jerk {:.2} m/s³ rms",
-            motion.path_length_mm, motion.movements, motion.idle_s, motion.rms_jerk_m_per_s3
+            "  motion: path {:.0} mm{economy}, {} movement{}, idle {:.1} s, jerk {:.2} m/s³ rms",
+            motion.path_length_mm,
+            motion.movements,
+            if motion.movements == 1 { "" } else { "s" },
+            motion.idle_s,
+            motion.rms_jerk_m_per_s3
         );
         if m.targets > 0 {
             let path = m.path_ratio.map_or(String::new(), |r| {
