@@ -42,7 +42,7 @@ fn misses(vademecum: &Vademecum, basis: &ModalBasis) -> Vec<f64> {
 }
 
 /// Ritz vectors of the vademecum's own modes lie in their span: the fit reproduces them to the
-/// modes' single precision (measured 1e-7).
+/// round-off (measured 2e-15: they combine the very single-precision values the fit reads).
 #[test]
 fn modes_in_the_vademecums_span_are_fitted_exactly() {
     let model = liver_block([6, 4, 3], Law::Linear);
@@ -55,7 +55,7 @@ fn modes_in_the_vademecums_span_are_fitted_exactly() {
     let basis = ModalBasis::ritz(&model, &columns, KEEP).unwrap();
     let miss = misses(&vademecum, &basis).into_iter().fold(0.0, f64::max);
     eprintln!("Ritz vectors of the vademecum's modes: largest miss {miss:.2e}");
-    assert!(miss < 1e-5, "{miss}");
+    assert!(miss < 1e-9, "{miss}");
 }
 
 /// The basis the trainer uses, iterated towards the true lowest modes, leaves the span: the
