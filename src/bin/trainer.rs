@@ -31,8 +31,7 @@ struct Cli {
     /// The haptic device: `scripted:FILE` replays a trajectory CSV (time_s,x_m,y_m,z_m,buttons);
     /// `virtual` is the mouse; `openhaptics[:NAME]` a Geomagic Touch, `forcedimension` an omega,
     /// sigma or delta (their vendor libraries loaded at run time; `trainer devices` says what
-    /// is found). Headless default: a built-in
-    /// press-and-slide on every organ.
+    /// is found). Headless default: a built-in press-and-slide on every organ.
     #[arg(long, global = true)]
     device: Option<DeviceSpec>,
     /// Record what the device reports to this trajectory file (replayable with scripted:FILE).

@@ -1,6 +1,6 @@
 //! What the binaries' commands do and print, apart from parsing their arguments: `pgd build`,
-//! `validate`, `indent` and `mesh`; `trainer validate`, `devices`, `history` and the end of an attempt (kept in the history); the parsers of option
-//! values, with errors that name the range; how a command ends (JSON or a table, or an error).
+//! `validate`, `indent` and `mesh`; `trainer validate`, `devices`, `history` and the end of an
+//! attempt (kept in the history); the parsers of option values, with errors that name the range; how a command ends (JSON or a table, or an error).
 //! The binaries keep their clap option types beside them and call in here.
 
 mod output;

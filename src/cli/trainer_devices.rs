@@ -1,10 +1,9 @@
 //! `trainer devices`: every device backend, whether it can be used here, and why not.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use crate::app::missing_display;
-use std::path::PathBuf;
-
 use crate::devices::{DeviceError, ForceDimension, OpenHaptics};
 
 /// One backend: how the command line names it, whether it is usable here, and what to know.

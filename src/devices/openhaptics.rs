@@ -312,18 +312,19 @@ impl OpenHaptics {
 fn device_limits(hd: &Hd) -> DeviceLimits {
     let [peak]: [f64; 1] = hd.doubles(HD_NOMINAL_MAX_FORCE);
     let [continuous]: [f64; 1] = hd.doubles(HD_NOMINAL_MAX_CONTINUOUS_FORCE);
+    // A value the device does not give (zero, negative, not a number) is the Touch's.
     let touch = DeviceLimits::touch();
-    let valid = |f: f64| f.is_finite() && f > 0.0;
-    DeviceLimits {
-        peak_force_n: if valid(peak) {
-            peak
+    let given = |f: f64, otherwise: f64| {
+        if f.is_finite() && f > 0.0 {
+            f
         } else {
-            touch.peak_force_n
-        },
-        continuous_force_n: match valid(continuous) {
-            true => continuous.min(if valid(peak) { peak } else { continuous }),
-            false => touch.continuous_force_n,
-        },
+            otherwise
+        }
+    };
+    let peak_force_n = given(peak, touch.peak_force_n);
+    DeviceLimits {
+        peak_force_n,
+        continuous_force_n: given(continuous, touch.continuous_force_n).min(peak_force_n),
         thermal_window_s: touch.thermal_window_s,
     }
 }

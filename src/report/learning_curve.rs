@@ -22,7 +22,6 @@ pub struct CurvePoint<'a> {
 /// the attempt's number within its scenario, one colour per scenario.
 pub fn learning_curve(path: &Path, attempts: &[CurvePoint]) -> Result<(), String> {
     let mut scenarios: Vec<&str> = attempts.iter().map(|a| a.scenario).collect();
-    scenarios.dedup();
     scenarios.sort_unstable();
     scenarios.dedup();
     let series = |title: &str, value: fn(&CurvePoint) -> f64| -> Vec<(f64, f64)> {
@@ -33,11 +32,8 @@ pub fn learning_curve(path: &Path, attempts: &[CurvePoint]) -> Result<(), String
             .map(|(k, a)| ((k + 1) as f64, value(a)))
             .collect()
     };
-    let most = scenarios
-        .iter()
-        .map(|s| series(s, |a| a.score).len())
-        .max()
-        .unwrap_or(1) as f64;
+    let count = |title: &&str| attempts.iter().filter(|a| a.scenario == *title).count();
+    let most = scenarios.iter().map(count).max().unwrap_or(1) as f64;
     let slowest = attempts.iter().map(|a| a.time_s).fold(1.0, f64::max) * 1.1;
     let colours = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
     save_png(path, SIZE, |root| {

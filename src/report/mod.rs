@@ -1,5 +1,6 @@
 //! Files written for people to read: an attempt's report (scorecard, summary, force plot), a
-//! trainee's learning curve, and a vademecum build's convergence curves (table and plot). No Bevy.
+//! trainee's learning curve, and a vademecum build's convergence curves (table and plot). No
+//! Bevy.
 
 mod convergence;
 mod learning_curve;

@@ -180,9 +180,6 @@ struct Running {
     over_surrounding: LimitWatch,
     /// Safe navigation: the forbidden zone the tip is in, if any.
     inside_zone: Option<usize>,
-    path_m: f64,
-    first_tip: Option<Vector3<f64>>,
-    last_tip: Option<Vector3<f64>>,
     /// Palpation: whether the button was held on the last tick.
     button_held: bool,
     /// Grasp: whether the tissue has been damaged.
@@ -373,9 +370,6 @@ impl Running {
             over_limit: LimitWatch::default(),
             over_surrounding: LimitWatch::default(),
             inside_zone: None,
-            path_m: 0.0,
-            first_tip: None,
-            last_tip: None,
             motion: MotionTracker::default(),
         }
     }
@@ -529,14 +523,11 @@ impl Running {
     }
 
     fn navigate(&mut self, targets: &[Spot], forbidden: &[Spot], sample: &Sample) {
-        let Some(tip) = sample.tip_m else {
+        // The motion tracker has taken this tick's tip: its start and path are the task's.
+        let (Some(tip), Some(first)) = (sample.tip_m, self.motion.start()) else {
             return;
         };
-        if let Some(last) = self.last_tip {
-            self.path_m += (tip - last).norm();
-        }
-        self.last_tip = Some(tip);
-        let first = *self.first_tip.get_or_insert(tip);
+        let path_m = self.motion.path_length_m();
         let m = &mut self.metrics;
         if let Some(target) = targets.get(m.targets_reached)
             && target.contains(&tip)
@@ -544,7 +535,7 @@ impl Running {
             m.targets_reached += 1;
             if m.targets_reached == targets.len() {
                 m.completed = true;
-                m.path_ratio = Some(self.path_m / straight_length_m(first, targets).max(1e-6));
+                m.path_ratio = Some(path_m / straight_length_m(first, targets).max(1e-6));
             }
         }
         match self.inside_zone {

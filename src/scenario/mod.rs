@@ -1,7 +1,7 @@
 //! Training exercises: the scenario file educators write (`format`, `units`), reading it with
 //! errors that point at the line and field (`load`), its tasks as they run, fed by the haptic
-//! loop one tick at a time (`exercise`), the tool's motion metrics (`motion`), and the rubric's score (`score`). No Bevy here: the
-//! app layer runs an [`Exercise`] inside the haptic schedule.
+//! loop one tick at a time (`exercise`), the tool's motion metrics (`motion`), and the rubric's
+//! score (`score`). No Bevy here: the app layer runs an [`Exercise`] inside the haptic schedule.
 
 mod exercise;
 mod format;

@@ -42,6 +42,7 @@ pub struct MotionMetrics {
 #[derive(Clone, Debug, Default)]
 pub struct MotionTracker {
     metrics: MotionMetrics,
+    path_m: f64,
     start: Option<Vector3<f64>>,
     last: Option<Vector3<f64>>,
     farthest_m: f64,
@@ -67,7 +68,7 @@ impl MotionTracker {
             }
         };
         if let Some(last) = self.last {
-            self.metrics.path_length_mm += (tip - last).norm() * 1e3;
+            self.path_m += (tip - last).norm();
         }
         self.last = Some(tip);
         let reach = (tip - start).norm();
@@ -109,12 +110,23 @@ impl MotionTracker {
         }
     }
 
+    /// The length (m) of the tip's path so far.
+    pub fn path_length_m(&self) -> f64 {
+        self.path_m
+    }
+
+    /// Where the tip was first seen.
+    pub fn start(&self) -> Option<Vector3<f64>> {
+        self.start
+    }
+
     /// The metrics so far.
     pub fn metrics(&self) -> MotionMetrics {
         let mut m = self.metrics.clone();
+        m.path_length_mm = self.path_m * 1e3;
         if let Some(end) = self.last {
             let need_m = self.farthest_m + (end - self.farthest).norm();
-            m.economy = (need_m >= LEFT_START_M).then(|| m.path_length_mm * 1e-3 / need_m);
+            m.economy = (need_m >= LEFT_START_M).then(|| self.path_m / need_m);
         }
         if self.jerk_samples > 0 {
             m.rms_jerk_m_per_s3 = (self.jerk_sum / self.jerk_samples as f64).sqrt();

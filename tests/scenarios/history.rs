@@ -7,7 +7,7 @@ use std::process::Command;
 
 use pgd_surgery::store::{AttemptRecord, History, HistoryError, HistoryFilter, keep_attempt};
 
-use crate::{TRAINER, root, vademecums};
+use crate::{TRAINER, run_steady_press};
 
 /// A fresh folder of this test's own.
 fn folder(test: &str) -> PathBuf {
@@ -109,33 +109,7 @@ fn the_trainer_keeps_each_scored_attempt_and_lists_them() {
     let dir = folder("trainer");
     let db = dir.join("history.sqlite");
     let run = |script: &str| {
-        let output = Command::new(TRAINER)
-            .args([
-                "run",
-                "scenarios/liver-steady-press.scenario.ron",
-                "--headless",
-                "--coarse",
-                "--no-rebuild",
-                "--json",
-                "--trainee",
-                "ann",
-            ])
-            .arg("--device")
-            .arg(format!(
-                "scripted:{}",
-                root()
-                    .join(format!("tests/scenarios/liver-steady-press.{script}.csv"))
-                    .display()
-            ))
-            .arg("--vademecums")
-            .arg(vademecums())
-            .arg("--report-dir")
-            .arg(&dir)
-            .arg("--history")
-            .arg(&db)
-            .current_dir(root())
-            .output()
-            .unwrap();
+        let output = run_steady_press(script, &dir, &["--trainee", "ann"]);
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(output.status.success(), "{stderr}");
         assert!(stderr.contains("history: attempt"), "{stderr}");

@@ -303,6 +303,34 @@ fn a_missing_file_is_named() {
     assert!(parse(Path::new("inline"), "").is_err());
 }
 
+/// `trainer run` of the steady press, headless on the coarse organs with the scenario's
+/// `script` (competent or careless), its report and history in `dir`, with `extra` options;
+/// the scorecard as JSON on standard output.
+fn run_steady_press(script: &str, dir: &Path, extra: &[&str]) -> std::process::Output {
+    let trajectory = root().join(format!("tests/scenarios/liver-steady-press.{script}.csv"));
+    Command::new(TRAINER)
+        .args([
+            "run",
+            "scenarios/liver-steady-press.scenario.ron",
+            "--headless",
+            "--coarse",
+            "--no-rebuild",
+            "--json",
+        ])
+        .args(extra)
+        .arg("--device")
+        .arg(format!("scripted:{}", trajectory.display()))
+        .arg("--vademecums")
+        .arg(vademecums())
+        .arg("--report-dir")
+        .arg(dir)
+        .arg("--history")
+        .arg(dir.join("history.sqlite"))
+        .current_dir(root())
+        .output()
+        .unwrap()
+}
+
 #[test]
 fn the_trainer_validates_runs_and_reports() {
     let broken = root().join("tests/scenarios/broken/unknown-organ.scenario.ron");
@@ -319,31 +347,7 @@ fn the_trainer_validates_runs_and_reports() {
     );
 
     let report_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenario-cli-report");
-    let output = Command::new(TRAINER)
-        .args([
-            "run",
-            "scenarios/liver-steady-press.scenario.ron",
-            "--headless",
-            "--coarse",
-            "--no-rebuild",
-            "--json",
-        ])
-        .arg("--device")
-        .arg(format!(
-            "scripted:{}",
-            root()
-                .join("tests/scenarios/liver-steady-press.careless.csv")
-                .display()
-        ))
-        .arg("--vademecums")
-        .arg(vademecums())
-        .arg("--report-dir")
-        .arg(&report_dir)
-        .arg("--history")
-        .arg(report_dir.join("history.sqlite"))
-        .current_dir(root())
-        .output()
-        .unwrap();
+    let output = run_steady_press("careless", &report_dir, &[]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{stderr}");
     let card: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
