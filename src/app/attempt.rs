@@ -6,15 +6,17 @@ use std::sync::Arc;
 
 use nalgebra::Vector3;
 
-use super::haptic::{ExerciseLink, ExerciseRun, HapticLoop, HapticScene, TickClock};
+use super::haptic::{
+    ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SettleCuts, TickClock,
+};
 use super::scene::{Detail, SceneOrgan, scene_of};
 use crate::contact::{ContactSurface, CouplingSettings};
 use crate::devices::{HapticDevice, TICK_S};
 use crate::fem::Law;
 use crate::mesh::organs::Organ;
 use crate::scenario::{
-    self, Exercise, Nodule, NoduleSite, OrganEntry, RegionSite, Scenario, Scorecard, Sites, Task,
-    score,
+    self, CutMade, Exercise, Nodule, NoduleSite, OrganEntry, RegionSite, Scenario, Scorecard,
+    Sites, Task, score,
 };
 use crate::store::{OnStale, OrganSource};
 
@@ -40,6 +42,9 @@ pub fn scenario_scene(
         on_stale,
     )?;
     scene.safety.max_force_n = scenario.device.max_force_n.0;
+    if let (Some(cutting), Some(blade)) = (&mut scene.cutting, scenario.tool.blade()) {
+        cutting.blade = blade;
+    }
     scene.workspace.scale = scenario.device.workspace_scale.0;
     Ok(scene)
 }
@@ -76,6 +81,10 @@ fn scene_organ(scenario: &Scenario, entry: &OrganEntry) -> Result<SceneOrgan, St
         max_modes: entry.max_modes.map(|n| n.0),
         law: entry.law.unwrap_or(Law::Linear),
         dynamic: entry.dynamic.unwrap_or(scenario.tool.grasps()),
+        cut_toughness_j_per_m2: scenario
+            .tool
+            .blade()
+            .and_then(|_| entry.toughness_j_per_m2()),
         inclusions: scenario
             .nodules
             .iter()
@@ -101,6 +110,7 @@ pub fn run_simulated(
     max_ticks: u64,
 ) -> Result<Outcome, String> {
     let mut haptic = HapticLoop::new(scene, device).map_err(|e| e.to_string())?;
+    haptic.world_mut().insert_resource(SettleCuts);
     let sites = sites_on(scene, &scenario);
     prepare(&mut haptic, Exercise::new(scenario, sites)).start();
     for tick in 0..max_ticks {
@@ -184,7 +194,28 @@ fn region_site(scene: &HapticScene, task: &Task) -> Option<RegionSite> {
 /// it), ends it and scores it; `None` if none ran or it was taken already.
 pub fn end(haptic: &mut HapticLoop) -> Option<Outcome> {
     let run = haptic.world_mut().remove_resource::<ExerciseRun>()?;
-    run.into_exercise().map(outcome_of)
+    let mut outcome = run.into_exercise().map(outcome_of)?;
+    outcome.card.cuts = cuts_made(haptic);
+    Some(outcome)
+}
+
+/// The scalpel's strokes on every organ, in the scene's order.
+pub fn cuts_made(haptic: &mut HapticLoop) -> Vec<CutMade> {
+    let world = haptic.world_mut();
+    let mut query = world.query::<(&OrganBody, &OrganCut)>();
+    let mm = |v: [f64; 3]| v.map(|c| c * 1e3);
+    query
+        .iter(world)
+        .flat_map(|(body, cut)| {
+            cut.scalpel.strokes().iter().map(|stroke| CutMade {
+                organ: body.name.clone(),
+                start_mm: mm(stroke.start_m),
+                end_mm: mm(stroke.end_m),
+                length_mm: stroke.length_m * 1e3,
+                max_depth_mm: stroke.max_depth_m * 1e3,
+            })
+        })
+        .collect()
 }
 
 /// Ends `exercise` (unfinished tasks are not completed) and scores it.

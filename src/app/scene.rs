@@ -7,8 +7,9 @@ use std::sync::Arc;
 
 use nalgebra::Vector3;
 
-use super::haptic::{HapticScene, SceneDynamics};
+use super::haptic::{HapticScene, SceneCutting, SceneDynamics};
 use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, FieldOrigin, Probe};
+use crate::cutting::Blade;
 use crate::devices::{PressTarget, SafetySettings, Workspace};
 use crate::dynamics::{DynamicModel, GraspSettings, TRAINER_MODES};
 use crate::fem::{Inclusion, Law, Material};
@@ -92,6 +93,8 @@ pub struct SceneOrgan {
     /// Whether it moves (reduced dynamics; the grasper pulls it) rather than staying
     /// quasi-static.
     pub dynamic: bool,
+    /// Its tissue's toughness under a blade (J/m²) when the scene's scalpel cuts it.
+    pub cut_toughness_j_per_m2: Option<f64>,
 }
 
 impl From<Organ> for SceneOrgan {
@@ -105,6 +108,7 @@ impl From<Organ> for SceneOrgan {
             inclusions: Vec::new(),
             law: Law::Linear,
             dynamic: false,
+            cut_toughness_j_per_m2: None,
         }
     }
 }
@@ -175,6 +179,7 @@ pub fn scene_of(
         })
         .collect::<Result<Vec<_>, String>>()?;
     let dynamics = scene_dynamics(organs, &loaded)?;
+    let cutting = scene_cutting(organs, &loaded)?;
     let attachments: Vec<AttachmentSpec> = loaded
         .iter()
         .flat_map(|(name, vademecum, mesh)| attachments_of(name, vademecum, mesh))
@@ -195,6 +200,7 @@ pub fn scene_of(
         safety: SafetySettings::default(),
         coupling: (!coupling.is_empty()).then(|| Arc::new(coupling)),
         dynamics,
+        cutting,
     })
 }
 
@@ -229,6 +235,33 @@ fn scene_dynamics(
     Ok((!moving.is_empty()).then(|| SceneDynamics {
         organs: moving,
         grasp: GraspSettings::default(),
+    }))
+}
+
+/// The organs a scalpel cuts, each with the linear model of its tissue that its cut state
+/// is solved on (the default blade; a scenario sets its own); `None` if none is cut.
+fn scene_cutting(
+    organs: &[SceneOrgan],
+    loaded: &[(String, Arc<Vademecum>, TetMesh)],
+) -> Result<Option<SceneCutting>, String> {
+    let mut cut = Vec::new();
+    for (index, (organ, (name, vademecum, mesh))) in organs.iter().zip(loaded).enumerate() {
+        let Some(toughness) = organ.cut_toughness_j_per_m2 else {
+            continue;
+        };
+        let header = &vademecum.header;
+        let material = Material {
+            law: Law::Linear,
+            ..header.material
+        };
+        let model = crate::pgd::organ::clamped_model(mesh.clone(), material)
+            .and_then(|m| m.with_inclusions(&header.inclusions))
+            .map_err(|e| format!("{name}: {e}"))?;
+        cut.push((index, Arc::new(model), toughness));
+    }
+    Ok((!cut.is_empty()).then(|| SceneCutting {
+        blade: Blade::default(),
+        organs: cut,
     }))
 }
 

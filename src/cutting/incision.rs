@@ -268,7 +268,37 @@ impl Incision {
         Ok(())
     }
 
+    /// The blade cuts `depth_m` deep from now on, and the face it is sweeping as deep (the
+    /// deeper face covers the shallower one: a cut only grows). Returns that face, or `None`
+    /// when `depth_m` is no deeper than the incision already is or no face is swept yet (the
+    /// next step then sweeps at the new depth).
+    pub fn deepen(&mut self, depth_m: f64) -> Result<Option<CutFace>, CutError> {
+        check_depth(depth_m)?;
+        if depth_m <= self.depth_m {
+            return Ok(None);
+        }
+        self.depth_m = depth_m;
+        let Some(face) = self.faces.last_mut() else {
+            return Ok(None);
+        };
+        if let Extent::Swept {
+            depth_m: depth,
+            margin_m,
+            ..
+        } = &mut face.extent
+        {
+            *depth = depth_m;
+            *margin_m = SURFACE_MARGIN * depth_m;
+        }
+        Ok(Some(*face))
+    }
+
     pub fn faces(&self) -> &[CutFace] {
         &self.faces
+    }
+
+    /// The depth (m) the blade cuts.
+    pub fn depth_m(&self) -> f64 {
+        self.depth_m
     }
 }

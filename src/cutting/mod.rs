@@ -3,26 +3,37 @@
 //! reduced cut is checked against: the full X-FEM solve ([`xfem::solve`]) and, for a cut along
 //! element faces, plain FEM on the mesh with the cut's nodes doubled
 //! ([`split_mesh::split_along`]); and the cut state online ([`CutState`]), whose condensed
-//! system gains rows and columns as incisions advance. See `docs/cutting.md`.
+//! system gains rows and columns as incisions advance, on a worker thread beside the haptic
+//! one ([`CutWorker`]); and the scalpel that makes incisions ([`Scalpel`]). See
+//! `docs/cutting.md`.
 
 mod clip;
 mod enrichment;
 mod incision;
 pub mod keratotomy;
 mod response;
+mod scalpel;
 pub mod split_mesh;
 mod state;
 mod validation;
+mod view;
+mod worker;
 pub mod xfem;
 
 pub use enrichment::{ElementCut, Enriched, Enrichment, Piece, SLIVER};
 pub use incision::{CutFace, Extent, Incision, MIN_SEGMENT_M};
 pub use response::{ExactResponse, Response, UncutResponse};
+pub use scalpel::{
+    Blade, BladeContact, CORNEA_TOUGHNESS_J_PER_M2, CutStep, LIVER_TOUGHNESS_J_PER_M2, Scalpel,
+    Stroke,
+};
 pub use state::CutState;
 pub use validation::{
     CutCase, CutPattern, CutValidationReport, CutValidationSettings, tool_patch,
     validate_incisions, validate_keratotomy,
 };
+pub use view::CutView;
+pub use worker::CutWorker;
 pub use xfem::CutSolution;
 
 /// Why a cut cannot be made or solved.

@@ -28,6 +28,7 @@ use super::CutError;
 use super::enrichment::Enrichment;
 use super::incision::{CutFace, Incision};
 use super::response::{Response, UncutResponse};
+use super::view::CutView;
 use super::xfem::{CutSolution, element_functions, piece_weights};
 use crate::fem::{FemModel, PRESCRIBED};
 use crate::mesh::{NOT_ON_SURFACE, Surface};
@@ -303,24 +304,44 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
                     .iter()
                     .map(|z| patch_modes[axis].iter().zip(z).map(|(x, m)| x * m).sum())
                     .collect();
-                for &(d, share) in &loads[axis] {
-                    let Some(entries) = self.surface_entries(d) else {
-                        continue;
-                    };
-                    for &(p, v) in entries {
-                        y[p as usize] += share * v;
-                    }
-                }
+                add_surface_part(
+                    &self.surface_index_of,
+                    &self.z_hat_surface,
+                    &loads[axis],
+                    &mut y,
+                );
                 y
             })
             .collect();
-        let mut compliance = uncut_m_per_n;
-        for (row, axis) in (0..3).flat_map(|r| (0..3).map(move |a| (r, a))) {
-            compliance[(row, axis)] += y[row].iter().zip(&y[axis]).map(|(a, b)| a * b).sum::<f64>();
-        }
-        compliance
+        (uncut_m_per_n + gram(&y))
             .try_inverse()
             .map(|stiffness| stiffness * indentation_m)
+    }
+
+    /// What the tick needs of the state, to read while the state grows elsewhere: the faces,
+    /// and `Ẑ` at the surface's dofs. Only for an exact uncut response, whose `Ẑ` has no
+    /// modal part: a cut vademecum's would need its modes too.
+    pub fn view(&self) -> CutView {
+        debug_assert!(self.z_modal.iter().all(|z| z.is_empty()));
+        CutView {
+            faces: self.faces.clone(),
+            unknowns: self.unknowns(),
+            surface_index_of: self.surface_index_of.clone(),
+            z_hat_surface: self.z_hat_surface.clone(),
+        }
+    }
+
+    /// Incision `cut` cuts `depth_m` deep from now on, and its last face as deep: a blade
+    /// pressed deeper deepens the face it is sweeping (which then covers the shallower one).
+    /// A depth no deeper than the incision's changes nothing.
+    pub fn deepen(&mut self, cut: usize, depth_m: f64) -> Result<(), CutError> {
+        let mut incision = self.cuts[cut].incision.clone();
+        let deeper = incision.deepen(depth_m)?;
+        if let (Some(face), Some(&id)) = (deeper, self.cuts[cut].faces.last()) {
+            self.lengthen(id, face)?;
+        }
+        self.cuts[cut].incision = incision;
+        Ok(())
     }
 
     /// Adds the functions of `enrichment` not yet in the state: their columns of `B`, their
@@ -433,11 +454,6 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         }
     }
 
-    /// `Ẑ`'s rest at dof `d`, if its node is on the surface.
-    fn surface_entries(&self, d: usize) -> Option<&[(u32, f64)]> {
-        surface_dof(&self.surface_index_of, d).map(|k| self.z_hat_surface[k].as_slice())
-    }
-
     /// `B`'s columns for the new unknowns `first_new..first_new + count`, and the entries of
     /// `A` between any unknown and a new one (keyed `(row, new column)`).
     fn new_blocks(
@@ -543,6 +559,29 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         }
         x
     }
+}
+
+/// `y += Ẑᵀ p` over the surface dofs of the sparse load `p` (`Ẑ` kept per surface dof as
+/// `(unknown, value)`; a dof of a node inside adds nothing).
+pub(super) fn add_surface_part(
+    surface_index_of: &[usize],
+    z_hat_surface: &[Vec<(u32, f64)>],
+    load: &[(usize, f64)],
+    y: &mut [f64],
+) {
+    for &(d, share) in load {
+        let Some(k) = surface_dof(surface_index_of, d) else {
+            continue;
+        };
+        for &(p, v) in &z_hat_surface[k] {
+            y[p as usize] += share * v;
+        }
+    }
+}
+
+/// `Yᵀ Y` for the three rows `y` (one per axis).
+pub(super) fn gram(y: &[Vec<f64>]) -> Matrix3<f64> {
+    Matrix3::from_fn(|row, axis| y[row].iter().zip(&y[axis]).map(|(a, b)| a * b).sum())
 }
 
 /// The place of dof `d` among the surface nodes' dofs, if its node is on the surface.

@@ -6,7 +6,8 @@ use std::mem::take;
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use super::format::{OrganEntry, Scenario, Spot, Task, TaskKind, spot_name};
+use super::format::{OrganEntry, Scenario, Spot, Task, TaskKind, metres, spot_name};
+use super::incision::{BladeSample, IncisionMetrics, IncisionTracker};
 use super::motion::{MotionMetrics, MotionTracker};
 use crate::pgd::SurfacePoint;
 
@@ -32,6 +33,8 @@ pub struct Sample {
     /// Whether the grasper tore tissue this tick (a tear before the task began, in an
     /// earlier attempt, does not count against it).
     pub tore: bool,
+    /// The scalpel's cut under way, if it is cutting.
+    pub blade: Option<BladeSample>,
 }
 
 impl Sample {
@@ -115,6 +118,8 @@ impl<'a> Nodules<'a> {
 
 /// Force recorded for the plot every this many ticks (100 Hz at 1 kHz).
 const PLOT_EVERY: u64 = 10;
+/// The share of an incision's line that must be cut for the task to be done.
+pub const COVERED_TO_FINISH: f64 = 0.9;
 /// Above a limit until the force falls below this share of it: one press is one error.
 const HYSTERESIS: f64 = 0.9;
 
@@ -163,6 +168,9 @@ pub struct TaskMetrics {
     pub errors: Vec<String>,
     /// The tool tip's motion over the task: path, economy, movements, idle time, jerk.
     pub motion: MotionMetrics,
+    /// Incision: the cut against the marked line.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub incision: Option<IncisionMetrics>,
 }
 
 /// One task's running state.
@@ -185,6 +193,10 @@ struct Running {
     /// Grasp: whether the tissue has been damaged.
     damaged: bool,
     motion: MotionTracker,
+    /// Incision: the cut against the line.
+    incision: Option<IncisionTracker>,
+    /// Incision: whether the cut has strayed off the line (one error a task).
+    strayed: bool,
 }
 
 /// The tasks of a scenario, run one after another.
@@ -278,6 +290,7 @@ impl Exercise {
         if let Some(mut running) = self.running.take() {
             running.metrics.time_s = time_s - running.metrics.started_s;
             running.metrics.motion = running.motion.metrics();
+            running.metrics.incision = running.incision.as_ref().map(IncisionTracker::metrics);
             running.metrics.mean_force_n = if running.metrics.contact_s > 0.0 {
                 running.force_sum / running.metrics.contact_s
             } else {
@@ -319,13 +332,14 @@ impl Running {
             } => (max_force_n.0, targets.len(), None),
             Task::Palpation { max_force_n, .. }
             | Task::Retraction { max_force_n, .. }
-            | Task::Grasp { max_force_n, .. } => (max_force_n.0, 0, None),
+            | Task::Grasp { max_force_n, .. }
+            | Task::Incision { max_force_n, .. } => (max_force_n.0, 0, None),
         };
         let hold_s = match task {
             Task::ForceControl { hold_s, .. }
             | Task::Retraction { hold_s, .. }
             | Task::Grasp { hold_s, .. } => Some(hold_s.0),
-            Task::SafeNavigation { .. } | Task::Palpation { .. } => None,
+            Task::SafeNavigation { .. } | Task::Palpation { .. } | Task::Incision { .. } => None,
         };
         let (move_target_mm, surrounding_limit_n) = match task {
             Task::Retraction {
@@ -335,6 +349,29 @@ impl Running {
             } => (Some(move_mm.0), Some(max_surrounding_force_n.0)),
             Task::Grasp { move_mm, .. } => (Some(move_mm.0), None),
             _ => (None, None),
+        };
+        let organ = match task {
+            Task::ForceControl { organ, .. }
+            | Task::Palpation { organ, .. }
+            | Task::Grasp { organ, .. }
+            | Task::Incision { organ, .. } => organs.iter().position(|o| &o.name == organ),
+            // Retraction watches its organ through its region site.
+            Task::SafeNavigation { .. } | Task::Retraction { .. } => None,
+        };
+        let incision = match task {
+            Task::Incision {
+                from_mm,
+                to_mm,
+                depth_mm,
+                tolerance_mm,
+                ..
+            } => Some(IncisionTracker::new(
+                organ,
+                (metres(*from_mm), metres(*to_mm)),
+                tolerance_mm.metres(),
+                depth_mm.metres(),
+            )),
+            _ => None,
         };
         Self {
             metrics: TaskMetrics {
@@ -357,13 +394,9 @@ impl Running {
                 ..TaskMetrics::default()
             },
             force_sum: 0.0,
-            organ: match task {
-                Task::ForceControl { organ, .. }
-                | Task::Palpation { organ, .. }
-                | Task::Grasp { organ, .. } => organs.iter().position(|o| &o.name == organ),
-                // Retraction watches its organ through its region site.
-                Task::SafeNavigation { .. } | Task::Retraction { .. } => None,
-            },
+            organ,
+            incision,
+            strayed: false,
             button_held: false,
             damaged: false,
             held_since: None,
@@ -435,7 +468,30 @@ impl Running {
                 hold_s,
                 ..
             } => self.grasp(organ, (move_mm.0, hold_s.0), sample),
+            Task::Incision { organ, .. } => self.cut(organ, sample),
         }
+    }
+
+    /// Incision: the cut follows the line; the task is done when nine tenths of it are cut
+    /// and the blade is lifted. Straying farther than twice the tolerance off the line is an
+    /// error (once).
+    fn cut(&mut self, organ: &str, sample: &Sample) {
+        let Some(tracker) = self.incision.as_mut() else {
+            return;
+        };
+        tracker.step(sample.blade.as_ref());
+        let limit_m = 2.0 * tracker.metrics().tolerance_mm * 1e-3;
+        if !self.strayed && tracker.strayed(limit_m) {
+            self.strayed = true;
+            let error = format!(
+                "{:.2} s: cut the {organ} more than {:.0} mm off the line",
+                sample.time_s,
+                limit_m * 1e3
+            );
+            self.metrics.errors.push(error);
+        }
+        let lifted = sample.blade.is_none_or(|b| Some(b.organ) != self.organ);
+        self.metrics.completed = lifted && tracker.covered_share() >= COVERED_TO_FINISH;
     }
 
     /// Retraction and grasp: how far the region has moved (mm), kept as the farthest yet.

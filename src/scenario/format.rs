@@ -12,7 +12,9 @@ use crate::contact::PointshellDensity;
 use crate::devices::DeviceSpec;
 use crate::fem::Law;
 
-use super::units::{Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, Seconds};
+use super::units::{
+    Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, Seconds, Toughness,
+};
 
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -69,6 +71,15 @@ pub enum Tool {
     /// A grasper: its closed jaws press like a probe of this radius; the device's button
     /// closes them on the tissue under them, which then follows the hand (`docs/dynamics.md`).
     Grasper { tip_radius_mm: Millimetres },
+    /// A scalpel: it presses like a probe of this radius, and where it presses an organ
+    /// harder than the tissue's toughness times `edge_mm` (the length of edge pressed in,
+    /// 5 mm when left out) the tissue parts and the blade cuts along its edge as deep as it
+    /// is pressed (`docs/cutting.md`).
+    Scalpel {
+        tip_radius_mm: Millimetres,
+        #[serde(default)]
+        edge_mm: Option<Millimetres>,
+    },
 }
 
 impl Default for Tool {
@@ -82,10 +93,22 @@ impl Default for Tool {
 impl Tool {
     pub fn tip_radius_m(&self) -> f64 {
         match self {
-            Tool::Probe { tip_radius_mm } | Tool::Grasper { tip_radius_mm } => {
-                tip_radius_mm.metres()
-            }
+            Tool::Probe { tip_radius_mm }
+            | Tool::Grasper { tip_radius_mm }
+            | Tool::Scalpel { tip_radius_mm, .. } => tip_radius_mm.metres(),
         }
+    }
+
+    /// The blade, if the tool cuts.
+    pub fn blade(&self) -> Option<crate::cutting::Blade> {
+        let Tool::Scalpel { edge_mm, .. } = self else {
+            return None;
+        };
+        let blade = crate::cutting::Blade::default();
+        Some(crate::cutting::Blade {
+            edge_m: edge_mm.map_or(blade.edge_m, Millimetres::metres),
+            ..blade
+        })
     }
 
     /// Whether the tool grasps (and so the organs move by default).
@@ -214,9 +237,25 @@ pub struct OrganEntry {
     /// quasi-static; by default it moves when the tool is a grasper.
     #[serde(default)]
     pub dynamic: Option<bool>,
+    /// Its tissue's fracture toughness under a blade, when not the organ's own (the liver's
+    /// and the cornea's are known; another organ is cut by a scalpel only when given one).
+    #[serde(default)]
+    pub toughness_j_per_m2: Option<Toughness>,
 }
 
 impl OrganEntry {
+    /// Its tissue's toughness under a blade (J/m²): the scenario's, or the organ's own where
+    /// it is known (a generated liver or cornea).
+    pub fn toughness_j_per_m2(&self) -> Option<f64> {
+        use crate::mesh::organs::Organ;
+        let own = match (Organ::from_name(&self.name), &self.mesh) {
+            (Some(Organ::Liver), None) => Some(crate::cutting::LIVER_TOUGHNESS_J_PER_M2),
+            (Some(Organ::Cornea), None) => Some(crate::cutting::CORNEA_TOUGHNESS_J_PER_M2),
+            _ => None,
+        };
+        self.toughness_j_per_m2.map(|t| t.0).or(own)
+    }
+
     /// A generated organ with its own tissue and default vademecum.
     pub fn named(name: &str) -> Self {
         Self {
@@ -227,6 +266,7 @@ impl OrganEntry {
             max_modes: None,
             law: None,
             dynamic: None,
+            toughness_j_per_m2: None,
         }
     }
 }
@@ -365,6 +405,19 @@ pub enum Task {
         max_force_n: Newtons,
         time_limit_s: Seconds,
     },
+    /// Cut along the line marked on the organ's surface from `from_mm` to `to_mm`,
+    /// `depth_mm` deep, with the scalpel. Done when the cut covers nine tenths of the line
+    /// within `tolerance_mm` of it and the blade is lifted. Scored on the deviation from the
+    /// line, the depth against `depth_mm`, the strokes it took, the force and the time.
+    Incision {
+        organ: String,
+        from_mm: (f64, f64, f64),
+        to_mm: (f64, f64, f64),
+        depth_mm: Millimetres,
+        tolerance_mm: Millimetres,
+        max_force_n: Newtons,
+        time_limit_s: Seconds,
+    },
 }
 
 /// The region a retraction or grasp task watches: its organ, the point nearest which it
@@ -389,6 +442,8 @@ pub enum TaskKind {
     Retraction,
     #[serde(rename = "grasp")]
     Grasp,
+    #[serde(rename = "incision")]
+    Incision,
 }
 
 impl std::fmt::Display for TaskKind {
@@ -399,6 +454,7 @@ impl std::fmt::Display for TaskKind {
             TaskKind::Palpation => "palpation",
             TaskKind::Retraction => "retraction",
             TaskKind::Grasp => "grasp",
+            TaskKind::Incision => "incision",
         })
     }
 }
@@ -434,6 +490,7 @@ impl Task {
             Task::Palpation { .. } => TaskKind::Palpation,
             Task::Retraction { .. } => TaskKind::Retraction,
             Task::Grasp { .. } => TaskKind::Grasp,
+            Task::Incision { .. } => TaskKind::Incision,
         }
     }
 
@@ -492,6 +549,19 @@ impl Task {
                  under {:.2} N and without tearing it",
                 move_mm.0, hold_s.0, max_force_n.0
             ),
+            Task::Incision {
+                organ,
+                from_mm,
+                to_mm,
+                depth_mm,
+                max_force_n,
+                ..
+            } => format!(
+                "cut the marked line on the {organ}, {:.0} mm long and {:.0} mm deep, under {:.2} N",
+                (metres(*to_mm) - metres(*from_mm)).norm() * 1e3,
+                depth_mm.0,
+                max_force_n.0
+            ),
         }
     }
 
@@ -501,7 +571,8 @@ impl Task {
             | Task::SafeNavigation { time_limit_s, .. }
             | Task::Palpation { time_limit_s, .. }
             | Task::Retraction { time_limit_s, .. }
-            | Task::Grasp { time_limit_s, .. } => time_limit_s.0,
+            | Task::Grasp { time_limit_s, .. }
+            | Task::Incision { time_limit_s, .. } => time_limit_s.0,
         }
     }
 }
@@ -520,8 +591,10 @@ pub struct Rubric {
     /// force limits.
     #[serde(default = "default_force")]
     pub force: f64,
-    /// Weight of accuracy, in palpation only: 1 for a mark on the nodule, falling to 0 at
-    /// twice `found_within_mm` from it.
+    /// Weight of accuracy, in palpation and incision only. Palpation: 1 for a mark on the
+    /// nodule, falling to 0 at twice `found_within_mm` from it. Incision: the mean of the
+    /// line's accuracy (1 on the line, 0 at twice `tolerance_mm` off it on average) and the
+    /// depth's (1 at `depth_mm`, 0 at half or twice as deep).
     #[serde(default = "default_accuracy")]
     pub accuracy: f64,
     /// Weight of economy of motion: the shortest path the task needed over the path the tip

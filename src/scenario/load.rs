@@ -7,7 +7,7 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use super::format::{OrganEntry, Scenario, Task};
+use super::format::{OrganEntry, Scenario, Task, metres};
 use crate::contact::PointshellDensity;
 use crate::devices::DeviceSpec;
 use crate::mesh::organs::{Organ, region};
@@ -313,6 +313,34 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
                 });
             }
         }
+        Task::Incision {
+            organ,
+            from_mm,
+            to_mm,
+            depth_mm,
+            max_force_n,
+            ..
+        } => {
+            problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
+            problems.extend(check_incision(
+                scenario,
+                organ,
+                (from_mm, to_mm),
+                depth_mm.0,
+                &field,
+            ));
+            if max_force_n.0 > device_limit {
+                problems.push(Problem {
+                    field: field("max_force_n"),
+                    anchors: anchors("max_force_n"),
+                    message: format!(
+                        "{} N is above the device's limit of {device_limit} N",
+                        max_force_n.0
+                    ),
+                    hint: "lower it, or raise device.max_force_n".into(),
+                });
+            }
+        }
         Task::SafeNavigation { targets, .. } => {
             if targets.is_empty() {
                 problems.push(Problem {
@@ -325,6 +353,60 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
         }
     }
 }
+
+/// An incision needs a scalpel, an organ a scalpel can part, a line of some length and a
+/// depth the organs' thickness allows.
+fn check_incision(
+    scenario: &Scenario,
+    organ: &str,
+    (from_mm, to_mm): (&(f64, f64, f64), &(f64, f64, f64)),
+    depth_mm: f64,
+    field: &dyn Fn(&str) -> String,
+) -> Vec<Problem> {
+    let anchors = |name: &str| vec!["tasks".to_owned(), "Incision".into(), name.to_owned()];
+    let mut problems = Vec::new();
+    if scenario.tool.blade().is_none() {
+        problems.push(Problem {
+            field: field("organ"),
+            anchors: anchors("organ"),
+            message: "an Incision task needs a scalpel to cut with".into(),
+            hint: "set tool: Scalpel(tip_radius_mm: 6.0)".into(),
+        });
+    }
+    if let Some(entry) = scenario.organ(organ)
+        && entry.toughness_j_per_m2().is_none()
+    {
+        problems.push(Problem {
+            field: field("organ"),
+            anchors: anchors("organ"),
+            message: format!("the {organ}'s toughness under a blade is not known: it cannot be cut"),
+            hint: format!(
+                "give it one: Organ(name: \"{organ}\", toughness_j_per_m2: 190.0) (the liver's is known)"
+            ),
+        });
+    }
+    let length_mm = (metres(*to_mm) - metres(*from_mm)).norm() * 1e3;
+    if length_mm < 5.0 {
+        problems.push(Problem {
+            field: field("to_mm"),
+            anchors: anchors("to_mm"),
+            message: format!("the line is {length_mm:.1} mm long: too short to cut and score"),
+            hint: "mark a line at least 5 mm long, from_mm to to_mm in the scene's frame".into(),
+        });
+    }
+    if depth_mm > MAX_INCISION_DEPTH_MM {
+        problems.push(Problem {
+            field: field("depth_mm"),
+            anchors: anchors("depth_mm"),
+            message: format!("{depth_mm} mm is deeper than a scalpel's incision goes here"),
+            hint: format!("at most {MAX_INCISION_DEPTH_MM} mm"),
+        });
+    }
+    problems
+}
+
+/// The deepest incision a task may ask for (mm).
+const MAX_INCISION_DEPTH_MM: f64 = 30.0;
 
 fn generated_organs() -> String {
     let names: Vec<&str> = Organ::ABDOMEN.iter().map(|o| o.name()).collect();

@@ -1,21 +1,28 @@
 //! Training exercises: the scenario file educators write (`format`, `units`), reading it with
 //! errors that point at the line and field (`load`), its tasks as they run, fed by the haptic
-//! loop one tick at a time (`exercise`), the tool's motion metrics (`motion`), and the rubric's
+//! loop one tick at a time (`exercise`), the tool's motion metrics (`motion`), the cut against
+//! an incision's line (`incision`), and the rubric's
 //! score (`score`). No Bevy here: the app layer runs an [`Exercise`] inside the haptic schedule.
 
 mod exercise;
 mod format;
+mod incision;
 mod load;
 mod motion;
 mod score;
 mod units;
 
-pub use exercise::{Exercise, NoduleSite, Progress, RegionSite, Sample, Sites, TaskMetrics};
+pub use exercise::{
+    COVERED_TO_FINISH, Exercise, NoduleSite, Progress, RegionSite, Sample, Sites, TaskMetrics,
+};
 pub use format::{
     Contact, Device, Difficulty, Nodule, OrganEntry, Rubric, Scenario, Spot, Task, TaskKind, Tool,
     metres,
 };
+pub use incision::{BladeSample, IncisionMetrics, IncisionTracker};
 pub use load::{ScenarioError, load, parse};
 pub use motion::{IDLE_M_PER_S, MOVING_M_PER_S, MotionMetrics, MotionTracker, STRIDE};
-pub use score::{Scorecard, TaskScore, score};
-pub use units::{Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, Seconds};
+pub use score::{CutMade, Scorecard, TaskScore, score};
+pub use units::{
+    Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, Seconds, Toughness,
+};

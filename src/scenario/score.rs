@@ -3,8 +3,9 @@
 
 use serde::Serialize;
 
-use super::exercise::TaskMetrics;
+use super::exercise::{COVERED_TO_FINISH, TaskMetrics};
 use super::format::{Rubric, Scenario, TaskKind};
+use super::incision::IncisionMetrics;
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TaskScore {
@@ -24,6 +25,20 @@ pub struct Scorecard {
     pub passed: bool,
     /// What went wrong, in words, for the debrief.
     pub feedback: Vec<String>,
+    /// The scalpel's strokes, on every organ, in order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub cuts: Vec<CutMade>,
+}
+
+/// One stroke of the scalpel, as the report lists it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CutMade {
+    pub organ: String,
+    /// Where the tissue parted and where the cut reached (mm, the scene's frame).
+    pub start_mm: [f64; 3],
+    pub end_mm: [f64; 3],
+    pub length_mm: f64,
+    pub max_depth_mm: f64,
 }
 
 /// Scores `tasks` (in the scenario's order) by the scenario's rubric.
@@ -53,6 +68,7 @@ pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
         pass_mark: rubric.pass_mark,
         passed,
         feedback,
+        cuts: Vec::new(),
     }
 }
 
@@ -66,7 +82,7 @@ fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
     };
     // Accuracy weighs only where there is a mark to be accurate about.
     let accuracy_weight = match m.kind {
-        TaskKind::Palpation => rubric.accuracy,
+        TaskKind::Palpation | TaskKind::Incision => rubric.accuracy,
         TaskKind::ForceControl
         | TaskKind::SafeNavigation
         | TaskKind::Retraction
@@ -91,8 +107,18 @@ fn economy(m: &TaskMetrics) -> f64 {
 }
 
 /// Palpation: 1 for a mark on the nodule, falling linearly to 0 at twice the distance that
-/// counts as found; 0 without a mark.
+/// counts as found; 0 without a mark. Incision: the mean of the line's accuracy (1 on it,
+/// falling to 0 at twice the tolerance off it on average) and the depth's (1 at the target,
+/// falling to 0 at half or twice as deep); 0 with nothing cut.
 fn accuracy(m: &TaskMetrics) -> f64 {
+    if let Some(cut) = &m.incision {
+        if cut.covered_mm <= 0.0 {
+            return 0.0;
+        }
+        let line = 1.0 - cut.mean_deviation_mm / (2.0 * cut.tolerance_mm);
+        let depth = 1.0 - (cut.mean_depth_mm / cut.target_depth_mm).ln().abs() / 2f64.ln();
+        return 0.5 * (line.clamp(0.0, 1.0) + depth.clamp(0.0, 1.0));
+    }
     match (m.localization_error_mm, m.found_within_mm) {
         (Some(error), Some(within)) => (1.0 - error / (2.0 * within)).clamp(0.0, 1.0),
         _ => 0.0,
@@ -109,13 +135,16 @@ fn force_control(m: &TaskMetrics) -> f64 {
             TaskKind::ForceControl
             | TaskKind::Palpation
             | TaskKind::Retraction
-            | TaskKind::Grasp => 0.0,
+            | TaskKind::Grasp
+            | TaskKind::Incision => 0.0,
             TaskKind::SafeNavigation => 1.0,
         };
     }
     let over_s = match m.kind {
         TaskKind::ForceControl => m.contact_s - m.within_band_s,
-        TaskKind::SafeNavigation | TaskKind::Palpation | TaskKind::Grasp => m.time_over_limit_s,
+        TaskKind::SafeNavigation | TaskKind::Palpation | TaskKind::Grasp | TaskKind::Incision => {
+            m.time_over_limit_s
+        }
         TaskKind::Retraction => m.time_over_limit_s + m.surrounding_over_limit_s,
     };
     (1.0 - over_s / m.contact_s).clamp(0.0, 1.0)
@@ -162,6 +191,33 @@ fn task_feedback(task: &TaskScore) -> Vec<String> {
             m.kind, m.surrounding_over_limit_s, m.surrounding_peak_n
         ));
     }
+    if let Some(cut) = &m.incision {
+        lines.extend(incision_feedback(m.kind, cut));
+    }
     lines.extend(m.errors.iter().map(|e| format!("{}: {e}", m.kind)));
+    lines
+}
+
+/// What an incision's cut missed: the line, its depth.
+fn incision_feedback(kind: TaskKind, cut: &IncisionMetrics) -> Vec<String> {
+    let mut lines = Vec::new();
+    if cut.covered_mm < COVERED_TO_FINISH * cut.line_length_mm {
+        lines.push(format!(
+            "{kind}: cut {:.0} of the line's {:.0} mm (strokes: {})",
+            cut.covered_mm, cut.line_length_mm, cut.strokes
+        ));
+    }
+    if cut.mean_deviation_mm > cut.tolerance_mm {
+        lines.push(format!(
+            "{kind}: {:.1} mm off the line on average (within {:.0} mm counts)",
+            cut.mean_deviation_mm, cut.tolerance_mm
+        ));
+    }
+    let (depth, target) = (cut.mean_depth_mm, cut.target_depth_mm);
+    if cut.covered_mm > 0.0 && !(0.75 * target..=1.25 * target).contains(&depth) {
+        lines.push(format!(
+            "{kind}: cut {depth:.1} mm deep on average for {target:.0} mm"
+        ));
+    }
     lines
 }

@@ -158,3 +158,21 @@ impl TryFrom<u64> for ModeCount {
         }
     }
 }
+
+/// A tissue's fracture toughness in joules per square metre, from 10 to 100,000 (soft organs
+/// are 10²–10³, skin and cornea 10³–10⁴).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct Toughness(pub f64);
+
+impl TryFrom<f64> for Toughness {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (10.0..=1e5).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v} J/m² is not a tissue's toughness (10 to 100000; the liver's is about 190)"
+            )),
+        }
+    }
+}

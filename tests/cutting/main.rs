@@ -1,10 +1,12 @@
 //! The cutting core against independent references: plain FEM on a mesh with the cut's nodes
 //! doubled, a bar cut through, and the handbook's stress intensity of an edge crack.
 
-use nalgebra::{Point3, Vector3};
+mod scalpel;
+
+use nalgebra::{Matrix3, Point3, Vector3};
 use pgd_surgery::cutting::keratotomy::{Cornea, Keratotomy};
 use pgd_surgery::cutting::{
-    CutError, CutSolution, CutState, Enrichment, ExactResponse, Incision, split_mesh, xfem,
+    CutError, CutFace, CutSolution, CutState, Enrichment, ExactResponse, Incision, split_mesh, xfem,
 };
 use pgd_surgery::fem::{Dirichlet, FemModel, Law, Loads, Material, NewtonSettings};
 use pgd_surgery::mesh::{TetMesh, box_mesh};
@@ -393,37 +395,14 @@ fn the_tool_feels_the_cut_tissue_as_full_xfem_does() {
         state.advance(cut, at(to)).unwrap();
     }
     let tool = Point3::new(24.0 * MM, 21.5 * MM, 10.0 * MM);
-    let radius = 4.0 * MM;
-    let mesh = model.mesh();
-    let mut patch: Vec<(usize, f64)> = mesh
-        .node_set("z1")
-        .unwrap()
-        .iter()
-        .map(|&n| (n, (mesh.nodes()[n] - tool).norm() / radius))
-        .filter(|&(_, d)| d < 1.0)
-        .map(|(n, d)| (n, (1.0 - d * d).powi(2)))
-        .collect();
-    let total: f64 = patch.iter().map(|p| p.1).sum();
-    patch.iter_mut().for_each(|p| p.1 /= total);
+    let patch = top_patch(&model, tool, 4.0 * MM);
     let press = Vector3::new(0.0, 0.0, -MM);
     let online = state.felt_force(&patch, press).unwrap().unwrap();
-    let full = |faces: &[pgd_surgery::cutting::CutFace]| {
-        let enrichment = Enrichment::new(mesh, faces);
-        let mut compliance = nalgebra::Matrix3::zeros();
-        for axis in 0..3 {
-            let mut loads = Loads::new(mesh.node_count());
-            for &(n, share) in &patch {
-                let mut force = [0.0; 3];
-                force[axis] = share;
-                loads.add_nodal_force(n, force).unwrap();
-            }
-            let u = xfem::solve(&model, &enrichment, &loads).unwrap();
-            for &(n, share) in &patch {
-                let un = Vector3::from_column_slice(&u.nodes_m[3 * n..3 * n + 3]);
-                compliance.set_column(axis, &(compliance.column(axis) + un * share));
-            }
-        }
-        compliance.try_inverse().unwrap() * press
+    let full = |faces: &[CutFace]| {
+        full_compliance(&model, faces, &patch)
+            .try_inverse()
+            .unwrap()
+            * press
     };
     let (cut, uncut) = (full(state.faces()), full(&[]));
     eprintln!(
@@ -437,6 +416,44 @@ fn the_tool_feels_the_cut_tissue_as_full_xfem_does() {
         cut.norm() < 0.99 * uncut.norm(),
         "the cut does not soften the tissue"
     );
+}
+
+/// A tool's patch on the block's top: its nodes within `radius_m` of `tool`, weighted as the
+/// trainer's kernel weighs them, the shares summing to one.
+fn top_patch(model: &FemModel, tool: Point3<f64>, radius_m: f64) -> Vec<(usize, f64)> {
+    let mesh = model.mesh();
+    let mut patch: Vec<(usize, f64)> = mesh
+        .node_set("z1")
+        .unwrap()
+        .iter()
+        .map(|&n| (n, (mesh.nodes()[n] - tool).norm() / radius_m))
+        .filter(|&(_, d)| d < 1.0)
+        .map(|(n, d)| (n, (1.0 - d * d).powi(2)))
+        .collect();
+    let total: f64 = patch.iter().map(|p| p.1).sum();
+    patch.iter_mut().for_each(|p| p.1 /= total);
+    patch
+}
+
+/// The patch compliance (m/N) of `model` cut by `faces`, from three full X-FEM solves.
+fn full_compliance(model: &FemModel, faces: &[CutFace], patch: &[(usize, f64)]) -> Matrix3<f64> {
+    let mesh = model.mesh();
+    let enrichment = Enrichment::new(mesh, faces);
+    let mut compliance = Matrix3::zeros();
+    for axis in 0..3 {
+        let mut loads = Loads::new(mesh.node_count());
+        for &(n, share) in patch {
+            let mut force = [0.0; 3];
+            force[axis] = share;
+            loads.add_nodal_force(n, force).unwrap();
+        }
+        let u = xfem::solve(model, &enrichment, &loads).unwrap();
+        for &(n, share) in patch {
+            let un = Vector3::from_column_slice(&u.nodes_m[3 * n..3 * n + 3]);
+            compliance.set_column(axis, &(compliance.column(axis) + un * share));
+        }
+    }
+    compliance
 }
 
 /// The same four incisions as the exact cut state's test, served by a cut vademecum (PGD modes

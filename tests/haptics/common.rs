@@ -56,6 +56,7 @@ pub fn scene(safety: SafetySettings) -> HapticScene {
     HapticScene {
         coupling: None,
         dynamics: None,
+        cutting: None,
         organs: vec![("liver".into(), liver().vademecum.clone())],
         probe: Probe {
             tip_radius_m: TIP_RADIUS_M,

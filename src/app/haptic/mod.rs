@@ -4,6 +4,7 @@
 //! The render side only ever reads the latest [`HapticSnapshot`].
 
 mod components;
+mod cutting;
 mod report;
 mod resources;
 mod runner;
@@ -16,11 +17,12 @@ use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
 
 pub use components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
+pub use cutting::{OrganCut, SettleCuts};
 pub use report::{ForceSummary, HeadlessReport, RangeSummary, TickTimes};
 pub use resources::{
     Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, TickClock, Tool,
 };
-pub use runner::{HapticLoop, HapticScene, SceneDynamics, SceneError};
+pub use runner::{HapticLoop, HapticScene, SceneCutting, SceneDynamics, SceneError};
 pub use scoring::{ExerciseLink, ExerciseRun};
 pub use snapshot::{HapticSnapshot, LoopTiming, OrganSnapshot};
 pub use thread::{HapticThread, RealTimeReport, SceneSwap, Scheduling};
@@ -66,7 +68,7 @@ pub fn haptic_schedule() -> Schedule {
     );
     schedule.add_systems((
         systems::read_device.in_set(HapticSet::ReadDevice),
-        (systems::tool_contact, systems::grasp)
+        (systems::tool_contact, systems::grasp, cutting::cut)
             .chain()
             .in_set(HapticSet::ToolContact),
         systems::evaluate_modes.in_set(HapticSet::EvaluateModes),

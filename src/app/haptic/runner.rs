@@ -6,14 +6,17 @@ use std::time::{Duration, Instant};
 use bevy::prelude::*;
 
 use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
+use super::cutting::{OrganCut, SettleCuts};
 use super::report::{ForceSummary, HeadlessReport, RangeSummary};
 use super::resources::{
     Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, Safety, TickClock, Tool,
 };
 use super::snapshot::{HapticSnapshot, OrganSnapshot, SnapshotPublisher};
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
+use crate::cutting::{Blade, CutError, CutWorker, Scalpel};
 use crate::devices::{HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S, Workspace};
 use crate::dynamics::{DynamicModel, GraspSettings};
+use crate::fem::FemModel;
 use crate::pgd::{Deformation, Vademecum};
 
 /// What the haptic world is made of.
@@ -29,6 +32,17 @@ pub struct HapticScene {
     /// Organs that move, and the grasper that pulls them; `None`: every organ quasi-static and
     /// the tool a probe.
     pub dynamics: Option<SceneDynamics>,
+    /// The organs the tool cuts, when it is a scalpel.
+    pub cutting: Option<SceneCutting>,
+}
+
+/// The scalpel's blade and the organs it cuts (by index into the scene's organs): each
+/// one's linear finite-element model, which its cut state is solved on, and its tissue's
+/// toughness (J/m²).
+#[derive(Clone)]
+pub struct SceneCutting {
+    pub blade: Blade,
+    pub organs: Vec<(usize, Arc<FemModel>, f64)>,
 }
 
 /// The moving organs of a scene (by index into its organs) and the grasper's settings.
@@ -52,6 +66,8 @@ impl SceneDynamics {
 pub enum SceneError {
     #[error(transparent)]
     Contact(#[from] ContactError),
+    #[error(transparent)]
+    Cut(#[from] CutError),
 }
 
 /// The safety settings of a loop that has no device yet.
@@ -96,6 +112,13 @@ impl HapticLoop {
                 && let Some(model) = dynamics.model(index)
             {
                 organ.insert(OrganMotion::new(model.clone(), dynamics.grasp));
+            }
+            if let Some(cutting) = &scene.cutting
+                && let Some((_, model, toughness)) = cutting.organs.iter().find(|o| o.0 == index)
+            {
+                let scalpel = Scalpel::new(cutting.blade, *toughness);
+                let worker = CutWorker::spawn(model.clone(), name)?;
+                organ.insert(OrganCut::new(scalpel, worker));
             }
         }
         world.insert_resource(GraspForce::default());
@@ -188,6 +211,7 @@ impl HapticLoop {
     /// deterministic, whatever the machine is doing. Overruns are counted, not fed to the
     /// safety filter, so that a slow machine does not change the forces.
     pub fn run_simulated(&mut self, ticks: u64) -> HeadlessReport {
+        self.world.insert_resource(SettleCuts);
         let mut compute = Histogram::default();
         let mut forces = ForceSummary::default();
         let mut range = RangeSummary::default();

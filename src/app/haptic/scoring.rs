@@ -13,9 +13,10 @@ use std::sync::{Arc, Mutex};
 use bevy::prelude::*;
 
 use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
+use super::cutting::OrganCut;
 use super::resources::{DeviceForce, TickClock, Tool};
 use super::snapshot::SnapshotPublisher;
-use crate::scenario::{Exercise, Progress, RegionSite, Sample};
+use crate::scenario::{BladeSample, Exercise, Progress, RegionSite, Sample};
 
 /// What scoring reads of an organ entity.
 type Organ = (
@@ -24,6 +25,7 @@ type Organ = (
     &'static OrganBody,
     &'static OrganDeformation,
     Option<&'static OrganMotion>,
+    Option<&'static OrganCut>,
 );
 
 /// Between the haptic thread and whoever started the exercise: whether it has begun, the
@@ -191,11 +193,14 @@ pub fn score_tick(
         .fold(0, |bits, (index, ..)| bits | 1 << index.0);
     let grasping = organs
         .iter()
-        .filter(|(index, .., motion)| motion.is_some_and(|m| m.organ.holding()) && index.0 < 64)
+        .filter(|(index, .., motion, _)| motion.is_some_and(|m| m.organ.holding()) && index.0 < 64)
         .fold(0, |bits, (index, ..)| bits | 1 << index.0);
     let tore = organs
         .iter()
-        .any(|(.., motion)| motion.is_some_and(|m| m.tore));
+        .any(|(.., motion, _)| motion.is_some_and(|m| m.tore));
+    let blade = organs
+        .iter()
+        .find_map(|(index, .., cut)| blade_sample(index, cut?));
     let (region_moved_m, surrounding_force_n) = exercise
         .watched_region()
         .map_or((0.0, 0.0), |region| watch(region, &organs));
@@ -209,6 +214,7 @@ pub fn score_tick(
         surrounding_force_n,
         grasping,
         tore,
+        blade,
     });
     if exercise.finished() {
         let run = &mut *run;
@@ -222,7 +228,7 @@ pub fn score_tick(
 fn watch(region: &RegionSite, organs: &Query<Organ>) -> (f64, f64) {
     let mut moved_m = 0.0;
     let mut surrounding_n = 0.0;
-    for (index, _, body, deformation, _) in organs {
+    for (index, _, body, deformation, ..) in organs {
         let deformation = &deformation.0;
         if index.0 == region.organ {
             moved_m = deformation
@@ -234,6 +240,22 @@ fn watch(region: &RegionSite, organs: &Query<Organ>) -> (f64, f64) {
         }
     }
     (moved_m, surrounding_n)
+}
+
+/// The scalpel's cut under way on the organ, if it is cutting: its front, its depth and its
+/// stroke.
+fn blade_sample(index: &OrganIndex, cut: &OrganCut) -> Option<BladeSample> {
+    if !cut.scalpel.cutting() {
+        return None;
+    }
+    let strokes = cut.scalpel.strokes();
+    let stroke = strokes.last()?;
+    Some(BladeSample {
+        organ: index.0,
+        front_m: stroke.end_m.into(),
+        depth_m: stroke.max_depth_m,
+        stroke: strokes.len() as u32,
+    })
 }
 
 /// Where the exercise stands, into the snapshot about to be published.

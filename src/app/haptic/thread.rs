@@ -240,6 +240,7 @@ mod tests {
             },
             coupling: None,
             dynamics: None,
+            cutting: None,
         }
     }
 

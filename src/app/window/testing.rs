@@ -17,6 +17,7 @@ pub fn scene_without_organs() -> HapticScene {
         safety: crate::devices::SafetySettings::default(),
         coupling: None,
         dynamics: None,
+        cutting: None,
     }
 }
 

@@ -1,0 +1,120 @@
+//! The scalpel inside the tick: the cut softens what the tool feels, and the blade's press
+//! decides whether the tissue parts and where the cut goes. The cut state grows on a worker
+//! thread per organ ([`CutWorker`]); the tick reads its latest view and never waits, except
+//! on a simulated clock ([`SettleCuts`]), where each step is waited for so that a run is
+//! deterministic.
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+use nalgebra::{Point3, Unit, Vector3};
+
+use super::components::{OrganBody, OrganDeformation, ToolTouch};
+use super::resources::Tool;
+use crate::contact::ToolContact;
+use crate::cutting::{BladeContact, CutView, CutWorker, Scalpel};
+use crate::pgd::PatchLoad;
+
+/// An organ a scalpel cuts: the blade on it, its cut state on a worker thread, and the view
+/// of that state the tick last read.
+#[derive(Component)]
+pub struct OrganCut {
+    pub scalpel: Scalpel,
+    pub worker: CutWorker,
+    pub view: Arc<CutView>,
+    /// Scratch space kept from tick to tick: the patch's nodes and shares, and `Y`'s rows.
+    nodes: Vec<(usize, f64)>,
+    y: [Vec<f64>; 3],
+}
+
+impl OrganCut {
+    pub fn new(scalpel: Scalpel, worker: CutWorker) -> Self {
+        Self {
+            scalpel,
+            worker,
+            view: Arc::default(),
+            nodes: Vec::new(),
+            y: Default::default(),
+        }
+    }
+}
+
+/// The loop runs on a simulated clock: each cut step is waited for.
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct SettleCuts;
+
+/// Reads each cut organ's latest cut, softens the tool's press for it, and hands the blade's
+/// step, if any, to the organ's cut state.
+pub fn cut(
+    tool: Res<Tool>,
+    settle: Option<Res<SettleCuts>>,
+    mut organs: Query<(
+        &OrganBody,
+        &mut ToolTouch,
+        &mut OrganDeformation,
+        &mut OrganCut,
+    )>,
+) {
+    for (body, mut touch, mut deformation, mut cut) in &mut organs {
+        let cut = &mut *cut;
+        let view = match settle {
+            Some(_) => cut.worker.settle(),
+            None => cut.worker.poll(),
+        };
+        cut.view.clone_from(view);
+        let touch = &mut *touch;
+        if let Some(contact) = touch.contact.as_mut() {
+            cut.nodes.clear();
+            let positions = &body.vademecum.positions;
+            let shares = touch.patch.shares.iter();
+            cut.nodes
+                .extend(shares.map(|&(m, share)| (positions[m] as usize, share)));
+            let load = &mut deformation.0.loads[OrganDeformation::TOOL];
+            soften(contact, load, &cut.view, (&cut.nodes, &mut cut.y));
+        }
+        let edge = tool
+            .sample
+            .map_or_else(Vector3::x, |s| s.orientation * Vector3::x());
+        let blade = touch.contact.as_ref().map(|c| blade_contact(c, edge));
+        if let Some(step) = cut.scalpel.tick(blade.as_ref()) {
+            cut.worker.submit(step);
+        }
+    }
+}
+
+/// The press as the cut organ answers it: the patch compliance the cut adds
+/// ([`CutView::added_compliance`]) on top of the vademecum's, inverted.
+fn soften(
+    contact: &mut ToolContact,
+    load: &mut PatchLoad,
+    view: &CutView,
+    (nodes, y): (&[(usize, f64)], &mut [Vec<f64>; 3]),
+) {
+    let added = view.added_compliance(nodes, y);
+    if added == nalgebra::Matrix3::zeros() {
+        return;
+    }
+    let Some(stiffness) = contact
+        .stiffness_n_per_m
+        .try_inverse()
+        .and_then(|uncut| (uncut + added).try_inverse())
+    else {
+        return;
+    };
+    contact.stiffness_n_per_m = stiffness;
+    contact.force_n = stiffness * contact.indentation_m;
+    load.force_n = contact.force_n;
+}
+
+/// The blade where the tool presses: the point on the rest surface, into the tissue, the
+/// blade's `edge` (from the device's orientation), how deep and how hard.
+fn blade_contact(contact: &ToolContact, edge: Vector3<f64>) -> BladeContact {
+    let inward = Unit::new_normalize(-contact.hit.normal);
+    BladeContact {
+        point_m: Point3::from(contact.hit.point_m),
+        inward,
+        edge,
+        depth_m: contact.depth_m,
+        pressing_n: contact.force_n.dot(&inward),
+    }
+}

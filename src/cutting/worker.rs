@@ -1,0 +1,145 @@
+//! The cut state off the haptic thread. Growing the cut over the exact uncut response costs
+//! sparse solves (milliseconds to a fraction of a second a segment, `docs/cutting.md`), far
+//! over a tick: a worker thread owns the organ's cut state, takes the scalpel's steps in
+//! order, and publishes a [`CutView`] after each one that cut. The tick reads the latest view
+//! without waiting ([`CutWorker::poll`]); a run on a simulated clock waits for each step
+//! ([`CutWorker::settle`]), so that it stays deterministic.
+
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::{Arc, Mutex};
+use std::thread;
+
+use super::CutError;
+use super::response::ExactResponse;
+use super::scalpel::CutStep;
+use super::state::CutState;
+use super::view::CutView;
+use crate::fem::FemModel;
+
+/// What the worker answers each step with.
+enum Outcome {
+    /// The cut grew: the state as it now stands.
+    Grew(Arc<CutView>),
+    /// Nothing to publish (an incision set on the surface has cut nothing yet).
+    Unchanged,
+    /// The cut state refused the step and stands as it was.
+    Refused(CutError),
+}
+
+/// An organ's cut state on a thread of its own.
+pub struct CutWorker {
+    steps: Sender<CutStep>,
+    /// Behind a mutex only so that the worker's handle may be shared between threads (as an
+    /// ECS component is): its owner reaches it through `get_mut`, never locking.
+    outcomes: Mutex<Receiver<Outcome>>,
+    submitted: u64,
+    answered: u64,
+    view: Arc<CutView>,
+    refused: Vec<CutError>,
+}
+
+impl CutWorker {
+    /// Factorizes `model`'s rest stiffness (here, on the caller's thread) and starts the
+    /// worker that cuts it; `name` names the thread.
+    pub fn spawn(model: Arc<FemModel>, name: &str) -> Result<Self, CutError> {
+        let response = ExactResponse::new(&model).map_err(|e| CutError::Solve(e.to_string()))?;
+        let empty = CutState::new(&model, &response).view();
+        let (steps, step_queue) = channel();
+        let (answers, outcomes) = channel();
+        thread::Builder::new()
+            .name(format!("cut {name}"))
+            .spawn(move || serve(&model, response, step_queue, answers))
+            .map_err(|e| CutError::Solve(format!("no thread for the cut state: {e}")))?;
+        Ok(Self {
+            steps,
+            outcomes: Mutex::new(outcomes),
+            submitted: 0,
+            answered: 0,
+            view: Arc::new(empty),
+            refused: Vec::new(),
+        })
+    }
+
+    /// Hands the worker a step; never waits.
+    pub fn submit(&mut self, step: CutStep) {
+        if self.steps.send(step).is_ok() {
+            self.submitted += 1;
+        }
+    }
+
+    /// The latest view, taking whatever the worker has answered; never waits.
+    pub fn poll(&mut self) -> &Arc<CutView> {
+        while let Ok(outcome) = self.receiver().try_recv() {
+            self.take(outcome);
+        }
+        &self.view
+    }
+
+    /// The view once every step handed over is answered: waits for the worker.
+    pub fn settle(&mut self) -> &Arc<CutView> {
+        while self.answered < self.submitted {
+            match self.receiver().recv() {
+                Ok(outcome) => self.take(outcome),
+                Err(_) => break,
+            }
+        }
+        &self.view
+    }
+
+    /// Steps handed over and not yet answered.
+    pub fn pending(&self) -> u64 {
+        self.submitted - self.answered
+    }
+
+    /// The steps the cut state refused, in order.
+    pub fn refused(&self) -> &[CutError] {
+        &self.refused
+    }
+
+    fn receiver(&mut self) -> &Receiver<Outcome> {
+        match self.outcomes.get_mut() {
+            Ok(receiver) => receiver,
+            Err(poisoned) => poisoned.into_inner(),
+        }
+    }
+
+    fn take(&mut self, outcome: Outcome) {
+        self.answered += 1;
+        match outcome {
+            Outcome::Grew(view) => self.view = view,
+            Outcome::Unchanged => {}
+            Outcome::Refused(error) => self.refused.push(error),
+        }
+    }
+}
+
+/// The worker's loop: each step applied in order and answered, until the haptic side drops
+/// its end.
+fn serve(
+    model: &FemModel,
+    response: ExactResponse,
+    steps: Receiver<CutStep>,
+    answers: Sender<Outcome>,
+) {
+    let mut state = CutState::new(model, response);
+    let mut incision = None;
+    for step in steps {
+        let applied = match (step, incision) {
+            (CutStep::Start { at, blade, depth_m }, _) => {
+                incision = Some(state.start(at, blade, depth_m));
+                Ok(false)
+            }
+            (CutStep::Advance { to }, Some(cut)) => state.advance(cut, to).map(|()| true),
+            (CutStep::Deepen { depth_m }, Some(cut)) => state.deepen(cut, depth_m).map(|()| true),
+            (_, None) => Err(CutError::Degenerate("a step before any incision".into())),
+        };
+        let outcome = match applied {
+            Ok(true) => Outcome::Grew(Arc::new(state.view())),
+            Ok(false) => Outcome::Unchanged,
+            Err(error) => Outcome::Refused(error),
+        };
+        if answers.send(outcome).is_err() {
+            return;
+        }
+    }
+}

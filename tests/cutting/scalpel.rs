@@ -1,0 +1,165 @@
+//! The scalpel: the tissue parts only above its threshold, the cut follows the blade's edge,
+//! and the cut state grown on the worker thread makes the tool feel what full X-FEM does.
+
+use std::sync::Arc;
+
+use nalgebra::{Point3, Unit, Vector3};
+use pgd_surgery::cutting::{
+    Blade, BladeContact, CutError, CutStep, CutWorker, LIVER_TOUGHNESS_J_PER_M2, Scalpel,
+};
+
+use super::{MM, block_to_cut, full_compliance, top_patch};
+
+/// The blade on the block's top at `x` mm along a line at `y = 20 mm`, wobbling 0.4 mm across
+/// it, pressing `pressing_n` at `depth_mm`, its edge along `edge`.
+fn on_top(x: f64, pressing_n: f64, depth_mm: f64, edge: Vector3<f64>) -> BladeContact {
+    let wobble = 0.4 * (x * 1.7).sin();
+    BladeContact {
+        point_m: Point3::new(x * MM, (20.0 + wobble) * MM, 10.0 * MM),
+        inward: Unit::new_normalize(-Vector3::z()),
+        edge,
+        depth_m: depth_mm * MM,
+        pressing_n,
+    }
+}
+
+/// A stroke from 10 to 30 mm along x in 0.05 mm steps; the steps the scalpel takes.
+fn stroke(scalpel: &mut Scalpel, pressing_n: f64, edge: Vector3<f64>) -> Vec<CutStep> {
+    let mut steps = Vec::new();
+    for k in 0..=400 {
+        let x = 10.0 + 0.05 * f64::from(k);
+        steps.extend(scalpel.tick(Some(&on_top(x, pressing_n, 4.0, edge))));
+    }
+    steps.extend(scalpel.tick(None));
+    steps
+}
+
+/// Pressed below the tissue's threshold the blade only presses: nothing is cut, however far
+/// it moves. Above it, the tissue parts where the blade is, and the cut follows the edge
+/// (the hand's wobble across it is not cut) in steps of the blade's length, to within a step
+/// of where the blade stops.
+#[test]
+fn the_scalpel_cuts_only_above_the_threshold_and_along_its_edge() {
+    let blade = Blade::default();
+    let threshold = blade.threshold_n(LIVER_TOUGHNESS_J_PER_M2);
+    assert!((threshold - 187.0 * 0.005).abs() < 1e-12);
+
+    let mut scalpel = Scalpel::new(blade, LIVER_TOUGHNESS_J_PER_M2);
+    assert!(stroke(&mut scalpel, 0.95 * threshold, Vector3::x()).is_empty());
+    assert!(scalpel.strokes().is_empty());
+
+    let steps = stroke(&mut scalpel, 1.05 * threshold, Vector3::x());
+    let Some(CutStep::Start { at, depth_m, .. }) = steps.first() else {
+        panic!("the tissue did not part: {steps:?}");
+    };
+    assert!((at.x - 10.0 * MM).abs() < 1e-12 && (depth_m - 4.0 * MM).abs() < 1e-12);
+    let fronts: Vec<Point3<f64>> = steps[1..]
+        .iter()
+        .map(|step| match step {
+            CutStep::Advance { to } => *to,
+            other => panic!("expected an advance, got {other:?}"),
+        })
+        .collect();
+    for pair in fronts.windows(2) {
+        assert!((pair[1].x - pair[0].x) >= blade.step_m - 1e-12);
+    }
+    for front in &fronts {
+        assert!(
+            (front.y - at.y).abs() < 1e-12,
+            "the cut left the edge's line"
+        );
+    }
+    let last = fronts.last().expect("the cut advanced");
+    assert!(
+        30.0 * MM - last.x < blade.step_m,
+        "stopped short at {} mm",
+        last.x / MM
+    );
+    let made = scalpel.strokes();
+    assert_eq!(made.len(), 1);
+    assert!((made[0].length_m - (last.x - at.x)).abs() < 1e-12);
+    assert!(!scalpel.cutting(), "lifting the blade ends the stroke");
+
+    // The edge across the motion: the tissue parts, but moving across the edge cuts nothing.
+    let mut across = Scalpel::new(blade, LIVER_TOUGHNESS_J_PER_M2);
+    let steps = stroke(&mut across, 1.05 * threshold, Vector3::y());
+    assert!(matches!(steps[..], [CutStep::Start { .. }]), "{steps:?}");
+}
+
+/// A blade pressed deeper than its incision by more than the blade's share deepens it; a
+/// turn of the edge starts a new face from where the cut reached.
+#[test]
+fn pressing_deeper_deepens_and_turning_turns() {
+    let blade = Blade::default();
+    let mut scalpel = Scalpel::new(blade, LIVER_TOUGHNESS_J_PER_M2);
+    let hard = 2.0 * blade.threshold_n(LIVER_TOUGHNESS_J_PER_M2);
+    let start = scalpel.tick(Some(&on_top(10.0, hard, 4.0, Vector3::x())));
+    assert!(matches!(start, Some(CutStep::Start { .. })));
+    let deeper = scalpel.tick(Some(&on_top(10.0, hard, 5.0, Vector3::x())));
+    assert_eq!(deeper, Some(CutStep::Deepen { depth_m: 5.0 * MM }));
+    let slightly = scalpel.tick(Some(&on_top(10.0, hard, 5.2, Vector3::x())));
+    assert_eq!(slightly, None, "within the blade's share: no deepening");
+    let advance = scalpel.tick(Some(&on_top(13.0, hard, 5.0, Vector3::x())));
+    assert!(matches!(advance, Some(CutStep::Advance { .. })));
+    // Turned 45°, the edge cuts on from where the cut reached (13 mm along the first line),
+    // along its new direction.
+    let y0 = on_top(10.0, hard, 4.0, Vector3::x()).point_m.y;
+    let mut turned = on_top(13.0, hard, 5.0, Vector3::new(1.0, 1.0, 0.0));
+    turned.point_m = Point3::new(15.5 * MM, y0 + 2.5 * MM, 10.0 * MM);
+    let Some(CutStep::Advance { to }) = scalpel.tick(Some(&turned)) else {
+        panic!("the turned blade did not cut on");
+    };
+    assert!((to - turned.point_m).norm() < 1e-12, "cut on to {to:?}");
+    assert_eq!(scalpel.strokes()[0].max_depth_m, 5.0 * MM);
+}
+
+/// The cut state on its worker thread, fed a stroke's steps, gives the tick the patch
+/// compliance that full X-FEM solves of the same faces give, to round-off; a step the cut
+/// state refuses is reported and changes nothing.
+#[test]
+fn the_worker_serves_the_felt_compliance_of_full_xfem() {
+    let (model, _) = block_to_cut();
+    let model = Arc::new(model);
+    let mut worker = CutWorker::spawn(model.clone(), "block").unwrap();
+    let at = |x: f64| Point3::new(x * MM, 20.0 * MM, 10.0 * MM);
+    worker.submit(CutStep::Start {
+        at: at(14.0),
+        blade: -Vector3::z(),
+        depth_m: 6.0 * MM,
+    });
+    for x in [18.0, 22.0, 26.0, 30.0] {
+        worker.submit(CutStep::Advance { to: at(x) });
+    }
+    let view = worker.settle().clone();
+    assert_eq!(worker.pending(), 0);
+    assert!(view.unknowns > 0, "the stroke enriched nothing");
+    assert_eq!(view.faces.len(), 1, "a straight stroke is one face");
+
+    let patch = top_patch(
+        &model,
+        Point3::new(24.0 * MM, 21.5 * MM, 10.0 * MM),
+        4.0 * MM,
+    );
+    let uncut = full_compliance(&model, &[], &patch);
+    let cut = full_compliance(&model, &view.faces, &patch);
+    let mut y = Default::default();
+    let served = uncut + view.added_compliance(&patch, &mut y);
+    let error = (served - cut).norm() / cut.norm();
+    eprintln!(
+        "{} unknowns; felt compliance {:.4e} m/N served, {:.4e} full X-FEM, {:.4e} uncut; relative difference {error:.1e}",
+        view.unknowns,
+        served.norm(),
+        cut.norm(),
+        uncut.norm()
+    );
+    assert!(error < 1e-9);
+    assert!(
+        cut.norm() > 1.01 * uncut.norm(),
+        "the cut does not soften the patch"
+    );
+
+    worker.submit(CutStep::Advance { to: at(30.0) });
+    let after = worker.settle().clone();
+    assert!(matches!(worker.refused(), [CutError::Degenerate(_)]));
+    assert_eq!(after.unknowns, view.unknowns);
+}
