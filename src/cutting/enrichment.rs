@@ -5,12 +5,14 @@
 //! every node, so the nodal values stay the displacements, and inside the support it opens the
 //! jump across the face.
 //!
-//! **The cut front.** A node is enriched only when the face cuts its whole support: the
-//! support reaches both sides, and wherever it meets the plane, it meets it inside the face.
-//! The discontinuity therefore ends on the boundary of the last supports it crosses whole: the
-//! front is snapped to element faces, no tip enrichment. A crack is short of its true length
-//! by up to about one element, which converges away as the mesh is refined (the edge-crack
-//! test measures it), and costs no singular functions in the reduced basis. A node whose
+//! **The cut front** ([`Front`]). By default a node is enriched only when the face cuts its
+//! whole support: the support reaches both sides, and wherever it meets the plane, it meets it
+//! inside the face. The discontinuity therefore ends on the boundary of the last supports it
+//! crosses whole: the front is snapped to element faces, no tip enrichment. A crack is short
+//! of its true length by up to about one element, which converges away as the mesh is refined
+//! (the edge-crack test measures it), and costs no singular functions in the reduced basis.
+//! On a mesh whose elements are as large as the cut, that leaves the cut all but unfelt; the
+//! trainer's scalpel snaps the front to the nearest element faces instead. A node whose
 //! support the plane only grazes (less than [`SLIVER`] of its volume on one side) is not
 //! enriched: its enriched function would be all but null, and the system near singular.
 
@@ -21,6 +23,19 @@ use nalgebra::Point3;
 use super::clip::{self, Tet};
 use super::incision::CutFace;
 use crate::mesh::TetMesh;
+
+/// Where a cut's front falls, between element faces.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Front {
+    /// On the boundary of the last supports the face cuts whole: the cut is short of the
+    /// face by up to an element (the reference solvers' choice, validated in `docs/cutting.md`).
+    #[default]
+    Inward,
+    /// On the nearest element faces: a node is enriched when at least half of the points
+    /// where its support meets the plane lie inside the face. The cut then ends within about
+    /// half an element of the face, either way; what the trainer's scalpel uses.
+    Nearest,
+}
 
 /// The smallest share of a support's volume on its smaller side for the node to be enriched.
 pub const SLIVER: f64 = 1e-4;
@@ -65,6 +80,11 @@ pub struct Enrichment {
 
 impl Enrichment {
     pub fn new(mesh: &TetMesh, faces: &[CutFace]) -> Self {
+        Self::with_front(mesh, faces, Front::Inward)
+    }
+
+    /// The enrichment with the cut's front placed as `front` says.
+    pub fn with_front(mesh: &TetMesh, faces: &[CutFace], front: Front) -> Self {
         let snap_m = SNAP * mesh_size_m(mesh);
         let supports = supports(mesh);
         let mut functions = Vec::new();
@@ -75,7 +95,7 @@ impl Enrichment {
                 .map(|p| snapped(face.signed_distance(p), snap_m))
                 .collect();
             for (node, support) in supports.iter().enumerate() {
-                if cuts_whole_support(mesh, face, &phi, support, snap_m) {
+                if cuts_support(mesh, (face, front), &phi, support, snap_m) {
                     functions.push(Enriched {
                         node,
                         face: k,
@@ -203,14 +223,15 @@ fn snapped(d: f64, snap_m: f64) -> f64 {
 
 /// Whether `face` cuts the whole support of a node: volume on both sides, more than a sliver
 /// on the smaller, and every point where an element of it meets the plane inside the face.
-fn cuts_whole_support(
+fn cuts_support(
     mesh: &TetMesh,
-    face: &CutFace,
+    (face, front): (&CutFace, Front),
     phi: &[f64],
     support: &[usize],
     snap_m: f64,
 ) -> bool {
     let (mut plus, mut minus, mut total) = (0.0, 0.0, 0.0);
+    let (mut inside, mut meets) = (0, 0);
     for &t in support {
         let tet = mesh.tets()[t];
         let corners = tet.map(|n| phi[n]);
@@ -224,39 +245,38 @@ fn cuts_whole_support(
             }) += v;
             continue;
         }
-        if !meets_plane_inside(mesh, face, &tet, &corners, snap_m) {
+        let (points_inside, points) = plane_points_inside(mesh, face, &tet, &corners, snap_m);
+        if front == Front::Inward && points_inside < points {
             return false;
         }
+        (inside, meets) = (inside + points_inside, meets + points);
         let (p, m) = clip::split(&mesh.tet_points(t), corners);
         let (vp, vm) = (sum_volume(&p), sum_volume(&m));
         plus += vp;
         minus += vm;
         total += vp + vm;
     }
-    plus.min(minus) > SLIVER * total
+    2 * inside >= meets && plus.min(minus) > SLIVER * total
 }
 
-/// Whether every point where the element meets the plane (its corners on the plane, its
-/// edges' crossings) lies inside the face.
-fn meets_plane_inside(
+/// How many of the points where the element meets the plane (its corners on the plane, its
+/// edges' crossings) lie inside the face, of how many.
+fn plane_points_inside(
     mesh: &TetMesh,
     face: &CutFace,
     tet: &[usize; 4],
     phi: &[f64; 4],
     snap_m: f64,
-) -> bool {
+) -> (usize, usize) {
     let p = |i: usize| mesh.nodes()[tet[i]];
-    let inside = |x: &Point3<f64>| face.covers(x, snap_m);
-    (0..4).all(|i| phi[i] != 0.0 || inside(&p(i)))
-        && (0..4).all(|i| {
-            (i + 1..4).all(|j| {
-                if phi[i] * phi[j] >= 0.0 {
-                    return true;
-                }
-                let t = phi[i] / (phi[i] - phi[j]);
-                inside(&(p(i) + (p(j) - p(i)) * t))
-            })
-        })
+    let on_plane = (0..4).filter(|&i| phi[i] == 0.0).map(p);
+    let crossings = (0..4)
+        .flat_map(|i| (i + 1..4).map(move |j| (i, j)))
+        .filter(|&(i, j)| phi[i] * phi[j] < 0.0)
+        .map(|(i, j)| p(i) + (p(j) - p(i)) * (phi[i] / (phi[i] - phi[j])));
+    let points: Vec<Point3<f64>> = on_plane.chain(crossings).collect();
+    let inside = points.iter().filter(|x| face.covers(x, snap_m)).count();
+    (inside, points.len())
 }
 
 fn sum_volume(tets: &[Tet]) -> f64 {

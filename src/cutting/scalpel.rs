@@ -2,11 +2,13 @@
 //!
 //! The tissue parts when the blade presses into it with the tissue's fracture toughness times
 //! the length of edge pressed in (the work of parting a unit area of tissue, over a unit
-//! advance of the edge: Atkins' energy balance for cutting soft solids). Below that force the
-//! blade only presses, and the trainee feels the tissue's resistance; once it parts, the cut
-//! opens under the blade and the force drops. The blade then cuts along its edge as the hand
-//! moves it, as deep as it is pressed: each step of the edge is a segment of the incision,
-//! which the cut state turns into enriched functions.
+//! advance of the edge: the energy balance of cutting soft solids). Below that force the
+//! blade only presses, and the trainee feels the tissue's resistance. Once it parts, the
+//! tissue above the blade's edge no longer holds it along the normal: the force drops to what
+//! the tissue below the cut answers (the give, as in Mahvash and Hayward's deformation,
+//! rupture and cutting phases, IEEE Computer Graphics and Applications 24(2), 2004). The blade
+//! then cuts along its edge as the hand moves it, and as deep as it is pressed: each step of
+//! the edge is a segment of the incision, which the cut state turns into enriched functions.
 
 use nalgebra::{Point3, Unit, Vector3};
 use serde::Serialize;
@@ -158,6 +160,13 @@ impl Scalpel {
     /// Whether a stroke is under way (the blade is in its cut).
     pub fn cutting(&self) -> bool {
         self.sweep.is_some()
+    }
+
+    /// How deep the tissue has parted under the blade (m), while a stroke is under way: the
+    /// tissue above that depth no longer holds the blade along the normal, only the tissue
+    /// below it does (the give).
+    pub fn parted_depth_m(&self) -> Option<f64> {
+        self.sweep.map(|sweep| sweep.depth_m)
     }
 
     /// The blade this tick, `None` off the tissue: what it does to the cut. Lifting the

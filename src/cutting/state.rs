@@ -25,7 +25,7 @@ use nalgebra::{Matrix3, Point3, Vector3};
 use rayon::prelude::*;
 
 use super::CutError;
-use super::enrichment::Enrichment;
+use super::enrichment::{Enrichment, Front};
 use super::incision::{CutFace, Incision};
 use super::response::{Response, UncutResponse};
 use super::view::CutView;
@@ -73,6 +73,8 @@ pub struct CutState<'m, R: UncutResponse> {
     rows: Vec<Vec<f64>>,
     /// The lower Cholesky factor of `S`, row by row (row `i` holds `i + 1` entries).
     factor: Vec<Vec<f64>>,
+    /// Where the cut's front falls between element faces.
+    front: Front,
 }
 
 impl<'m, R: UncutResponse> CutState<'m, R> {
@@ -93,7 +95,19 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             surface_index_of: surface.surface_index_of,
             rows: Vec::new(),
             factor: Vec::new(),
+            front: Front::Inward,
         }
+    }
+
+    /// The state with the cut's front placed as `front` says (before any cut is made).
+    pub fn with_front(mut self, front: Front) -> Self {
+        self.front = front;
+        self
+    }
+
+    /// Where the cut's front falls between element faces.
+    pub fn front(&self) -> Front {
+        self.front
     }
 
     /// Sets a new blade on the surface (see [`Incision::start`]); returns its index.
@@ -148,7 +162,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     /// Takes `faces` as the cut, growing the system by the functions they add; a refused cut
     /// leaves the state as it was.
     fn apply(&mut self, faces: Vec<CutFace>) -> Result<(), CutError> {
-        let enrichment = Enrichment::new(self.model.mesh(), &faces);
+        let enrichment = Enrichment::with_front(self.model.mesh(), &faces, self.front);
         let held = |n: usize| self.model.dofs().free_index[3 * n] == PRESCRIBED;
         if enrichment.detaches(self.model.mesh(), held) {
             return Err(CutError::Detached);
@@ -186,7 +200,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     /// standing load such as the intraocular pressure has it computed once, exactly).
     pub fn solve_from(&self, uncut: Response) -> CutSolution {
         let (nodes_m, q) = self.condensed(uncut);
-        let order = Enrichment::new(self.model.mesh(), &self.faces);
+        let order = Enrichment::with_front(self.model.mesh(), &self.faces, self.front);
         let index = self.function_index();
         let mut enriched_m = Vec::with_capacity(q.len());
         for f in &order.functions {

@@ -10,6 +10,7 @@ use std::sync::{Arc, Mutex};
 use std::thread;
 
 use super::CutError;
+use super::enrichment::Front;
 use super::response::ExactResponse;
 use super::scalpel::CutStep;
 use super::state::CutState;
@@ -26,7 +27,9 @@ enum Outcome {
     Refused(CutError),
 }
 
-/// An organ's cut state on a thread of its own.
+/// An organ's cut state on a thread of its own, its front snapped to the nearest element
+/// faces ([`Front::Nearest`]): on the trainer's meshes, whose elements are as large as an
+/// incision is deep, a front snapped inward would leave the cut all but unfelt.
 pub struct CutWorker {
     steps: Sender<CutStep>,
     /// Behind a mutex only so that the worker's handle may be shared between threads (as an
@@ -121,7 +124,7 @@ fn serve(
     steps: Receiver<CutStep>,
     answers: Sender<Outcome>,
 ) {
-    let mut state = CutState::new(model, response);
+    let mut state = CutState::new(model, response).with_front(Front::Nearest);
     let mut incision = None;
     for step in steps {
         let applied = match (step, incision) {

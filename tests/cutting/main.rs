@@ -6,7 +6,8 @@ mod scalpel;
 use nalgebra::{Matrix3, Point3, Vector3};
 use pgd_surgery::cutting::keratotomy::{Cornea, Keratotomy};
 use pgd_surgery::cutting::{
-    CutError, CutFace, CutSolution, CutState, Enrichment, ExactResponse, Incision, split_mesh, xfem,
+    CutError, CutFace, CutSolution, CutState, Enrichment, ExactResponse, Front, Incision,
+    split_mesh, xfem,
 };
 use pgd_surgery::fem::{Dirichlet, FemModel, Law, Loads, Material, NewtonSettings};
 use pgd_surgery::mesh::{TetMesh, box_mesh};
@@ -399,7 +400,7 @@ fn the_tool_feels_the_cut_tissue_as_full_xfem_does() {
     let press = Vector3::new(0.0, 0.0, -MM);
     let online = state.felt_force(&patch, press).unwrap().unwrap();
     let full = |faces: &[CutFace]| {
-        full_compliance(&model, faces, &patch)
+        full_compliance(&model, (faces, Front::Inward), &patch)
             .try_inverse()
             .unwrap()
             * press
@@ -435,10 +436,15 @@ fn top_patch(model: &FemModel, tool: Point3<f64>, radius_m: f64) -> Vec<(usize, 
     patch
 }
 
-/// The patch compliance (m/N) of `model` cut by `faces`, from three full X-FEM solves.
-fn full_compliance(model: &FemModel, faces: &[CutFace], patch: &[(usize, f64)]) -> Matrix3<f64> {
+/// The patch compliance (m/N) of `model` cut by `faces` (their front placed as `front` says),
+/// from three full X-FEM solves.
+fn full_compliance(
+    model: &FemModel,
+    (faces, front): (&[CutFace], Front),
+    patch: &[(usize, f64)],
+) -> Matrix3<f64> {
     let mesh = model.mesh();
-    let enrichment = Enrichment::new(mesh, faces);
+    let enrichment = Enrichment::with_front(mesh, faces, front);
     let mut compliance = Matrix3::zeros();
     for axis in 0..3 {
         let mut loads = Loads::new(mesh.node_count());

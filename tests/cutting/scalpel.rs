@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use nalgebra::{Point3, Unit, Vector3};
 use pgd_surgery::cutting::{
-    Blade, BladeContact, CutError, CutStep, CutWorker, LIVER_TOUGHNESS_J_PER_M2, Scalpel,
+    Blade, BladeContact, CutError, CutStep, CutWorker, Front, LIVER_TOUGHNESS_J_PER_M2, Scalpel,
 };
 
 use super::{MM, block_to_cut, full_compliance, top_patch};
@@ -114,8 +114,9 @@ fn pressing_deeper_deepens_and_turning_turns() {
 }
 
 /// The cut state on its worker thread, fed a stroke's steps, gives the tick the patch
-/// compliance that full X-FEM solves of the same faces give, to round-off; a step the cut
-/// state refuses is reported and changes nothing.
+/// compliance that full X-FEM solves of the same faces (the front snapped to the nearest
+/// element faces) give, to round-off; a step the cut state refuses is reported and changes
+/// nothing.
 #[test]
 fn the_worker_serves_the_felt_compliance_of_full_xfem() {
     let (model, _) = block_to_cut();
@@ -140,8 +141,8 @@ fn the_worker_serves_the_felt_compliance_of_full_xfem() {
         Point3::new(24.0 * MM, 21.5 * MM, 10.0 * MM),
         4.0 * MM,
     );
-    let uncut = full_compliance(&model, &[], &patch);
-    let cut = full_compliance(&model, &view.faces, &patch);
+    let uncut = full_compliance(&model, (&[], Front::Nearest), &patch);
+    let cut = full_compliance(&model, (&view.faces, Front::Nearest), &patch);
     let mut y = Default::default();
     let served = uncut + view.added_compliance(&patch, &mut y);
     let error = (served - cut).norm() / cut.norm();

@@ -4,6 +4,7 @@
 //! them; broken files each give their expected error at the right line and field; and the
 //! `trainer` binary validates, runs and reports.
 
+mod cutting;
 mod history;
 mod motion;
 
@@ -64,7 +65,7 @@ fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     run_simulated(scenario, &scene, device, ticks).unwrap()
 }
 
-const SHIPPED: [&str; 8] = [
+const SHIPPED: [&str; 9] = [
     "liver-steady-press",
     "pancreas-palpation",
     "gallbladder-gentle-press",
@@ -73,6 +74,7 @@ const SHIPPED: [&str; 8] = [
     "abdomen-tour",
     "gallbladder-retraction",
     "gallbladder-grasp-retract",
+    "liver-capsule-incision",
 ];
 
 #[test]

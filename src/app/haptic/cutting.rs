@@ -13,7 +13,6 @@ use super::components::{OrganBody, OrganDeformation, ToolTouch};
 use super::resources::Tool;
 use crate::contact::ToolContact;
 use crate::cutting::{BladeContact, CutView, CutWorker, Scalpel};
-use crate::pgd::PatchLoad;
 
 /// An organ a scalpel cuts: the blade on it, its cut state on a worker thread, and the view
 /// of that state the tick last read.
@@ -70,7 +69,12 @@ pub fn cut(
             cut.nodes
                 .extend(shares.map(|&(m, share)| (positions[m] as usize, share)));
             let load = &mut deformation.0.loads[OrganDeformation::TOOL];
-            soften(contact, load, &cut.view, (&cut.nodes, &mut cut.y));
+            soften(contact, &cut.view, (&cut.nodes, &mut cut.y));
+            if let Some(parted_m) = cut.scalpel.parted_depth_m() {
+                give(contact, parted_m);
+            }
+            contact.force_n = contact.stiffness_n_per_m * contact.indentation_m;
+            load.force_n = contact.force_n;
         }
         let edge = tool
             .sample
@@ -82,11 +86,10 @@ pub fn cut(
     }
 }
 
-/// The press as the cut organ answers it: the patch compliance the cut adds
+/// The press's stiffness as the cut organ answers it: the patch compliance the cut adds
 /// ([`CutView::added_compliance`]) on top of the vademecum's, inverted.
 fn soften(
     contact: &mut ToolContact,
-    load: &mut PatchLoad,
     view: &CutView,
     (nodes, y): (&[(usize, f64)], &mut [Vec<f64>; 3]),
 ) {
@@ -102,8 +105,13 @@ fn soften(
         return;
     };
     contact.stiffness_n_per_m = stiffness;
-    contact.force_n = stiffness * contact.indentation_m;
-    load.force_n = contact.force_n;
+}
+
+/// The blade in its cut, the tissue parted `parted_m` deep: along the normal only the depth
+/// beyond the cut's bottom presses the tissue; sideways it still holds the blade.
+fn give(contact: &mut ToolContact, parted_m: f64) {
+    let normal = contact.hit.normal;
+    contact.indentation_m += normal * contact.depth_m.min(parted_m);
 }
 
 /// The blade where the tool presses: the point on the rest surface, into the tissue, the
