@@ -10,7 +10,9 @@ use std::path::{Path, PathBuf};
 use super::format::{OrganEntry, Scenario, Task, metres};
 use crate::contact::PointshellDensity;
 use crate::devices::DeviceSpec;
-use crate::mesh::organs::{Organ, region};
+use crate::mesh::Surface;
+use crate::mesh::organs::{Organ, OrganSettings, region};
+use parry3d::query::PointQuery;
 
 /// Where every reference of the scenario format is explained.
 const REFERENCE: &str = "docs/scenarios.md";
@@ -394,6 +396,20 @@ fn check_incision(
             hint: "mark a line at least 5 mm long, from_mm to to_mm in the scene's frame".into(),
         });
     }
+    if let Some(entry) = scenario.organ(organ)
+        && let Some((end, distance_mm)) = farthest_off_surface(entry, [from_mm, to_mm])
+    {
+        let name = ["from_mm", "to_mm"][end];
+        problems.push(Problem {
+            field: field(name),
+            anchors: anchors(name),
+            message: format!("the line's end is {distance_mm:.0} mm off the {organ}'s surface"),
+            hint: format!(
+                "mark the line on the {organ}'s surface (within {LINE_ON_SURFACE_MM} mm); \
+                 `pgd mesh {organ} --out FILE.vtu` writes its mesh to look at"
+            ),
+        });
+    }
     if depth_mm > MAX_INCISION_DEPTH_MM {
         problems.push(Problem {
             field: field("depth_mm"),
@@ -407,6 +423,51 @@ fn check_incision(
 
 /// The deepest incision a task may ask for (mm).
 const MAX_INCISION_DEPTH_MM: f64 = 30.0;
+
+/// How far (mm) a line's end may lie from the organ's surface as the check meshes it (the
+/// coarse organ, whose surface is within a few millimetres of the full one's).
+const LINE_ON_SURFACE_MM: f64 = 5.0;
+
+/// The end of `points_mm` farthest from the organ's surface (0 or 1) and its distance (mm), if
+/// more than [`LINE_ON_SURFACE_MM`]; `None` also when the organ's mesh cannot be had (its own
+/// check says why).
+fn farthest_off_surface(
+    entry: &OrganEntry,
+    points_mm: [&(f64, f64, f64); 2],
+) -> Option<(usize, f64)> {
+    let mesh = match (&entry.mesh, Organ::from_name(&entry.name)) {
+        (Some(path), _) => crate::mesh::io::load(path, &Default::default()).ok()?,
+        (None, Some(organ)) => {
+            let coarse = OrganSettings {
+                resolution: 0.25,
+                ..OrganSettings::default()
+            };
+            crate::mesh::organs::generate(organ, &coarse).ok()?
+        }
+        (None, None) => return None,
+    };
+    let surface = Surface::extract(&mesh);
+    let positions: Vec<[f32; 3]> = mesh
+        .nodes()
+        .iter()
+        .map(|p| p.cast::<f32>().into())
+        .collect();
+    let triangles: Vec<[u32; 3]> = surface
+        .triangles
+        .iter()
+        .map(|t| t.map(|n| n as u32))
+        .collect();
+    let trimesh = crate::parry_interop::trimesh(&positions, &triangles)?;
+    let distance_mm = |p: &(f64, f64, f64)| {
+        let point = nalgebra::Point3::from(metres(*p));
+        let query = crate::parry_interop::to_parry(&point);
+        let projected = trimesh.project_local_point(query, false).point;
+        (crate::parry_interop::from_parry(projected) - point).norm() * 1e3
+    };
+    let distances = points_mm.map(distance_mm);
+    let end = usize::from(distances[1] > distances[0]);
+    (distances[end] > LINE_ON_SURFACE_MM).then_some((end, distances[end]))
+}
 
 fn generated_organs() -> String {
     let names: Vec<&str> = Organ::ABDOMEN.iter().map(|o| o.name()).collect();

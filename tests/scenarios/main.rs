@@ -246,6 +246,30 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "`liver` is not in this scenario",
         ),
         (
+            "incision-without-scalpel",
+            7,
+            "tasks[0].organ",
+            "needs a scalpel",
+        ),
+        (
+            "incision-uncuttable-organ",
+            8,
+            "tasks[0].organ",
+            "toughness under a blade is not known",
+        ),
+        (
+            "incision-off-the-organ",
+            10,
+            "tasks[0].to_mm",
+            "40 mm off the liver's surface",
+        ),
+        (
+            "toughness-out-of-range",
+            4,
+            "toughness_j_per_m2",
+            "not a tissue's toughness",
+        ),
+        (
             "pointshell-cut-too-fine",
             6,
             "contact.pointshell",
