@@ -5,6 +5,7 @@
 
 pub mod attempt;
 pub mod bench;
+pub mod bench_scalpel;
 pub mod haptic;
 pub mod launch;
 pub mod scene;

@@ -8,6 +8,7 @@
 use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, Mutex};
 use std::thread;
+use std::time::Instant;
 
 use super::CutError;
 use super::enrichment::Front;
@@ -16,6 +17,13 @@ use super::scalpel::CutStep;
 use super::state::CutState;
 use super::view::CutView;
 use crate::fem::FemModel;
+
+/// What the haptic side hands the worker: a step to apply, or a view it no longer reads, to
+/// be freed here rather than on the haptic thread (a view holds megabytes).
+enum Job {
+    Step(CutStep),
+    Retire(Arc<CutView>),
+}
 
 /// What the worker answers each step with.
 enum Outcome {
@@ -31,14 +39,16 @@ enum Outcome {
 /// faces ([`Front::Nearest`]): on the trainer's meshes, whose elements are as large as an
 /// incision is deep, a front snapped inward would leave the cut all but unfelt.
 pub struct CutWorker {
-    steps: Sender<CutStep>,
+    jobs: Sender<Job>,
     /// Behind a mutex only so that the worker's handle may be shared between threads (as an
     /// ECS component is): its owner reaches it through `get_mut`, never locking.
-    outcomes: Mutex<Receiver<Outcome>>,
+    outcomes: Mutex<Receiver<(Outcome, f64)>>,
     submitted: u64,
     answered: u64,
     view: Arc<CutView>,
     refused: Vec<CutError>,
+    /// How long each step took the worker (s), in order.
+    step_seconds: Vec<f64>,
 }
 
 impl CutWorker {
@@ -47,25 +57,26 @@ impl CutWorker {
     pub fn spawn(model: Arc<FemModel>, name: &str) -> Result<Self, CutError> {
         let response = ExactResponse::new(&model).map_err(|e| CutError::Solve(e.to_string()))?;
         let empty = CutState::new(&model, &response).view();
-        let (steps, step_queue) = channel();
+        let (jobs, job_queue) = channel();
         let (answers, outcomes) = channel();
         thread::Builder::new()
             .name(format!("cut {name}"))
-            .spawn(move || serve(&model, response, step_queue, answers))
+            .spawn(move || serve(&model, response, job_queue, answers))
             .map_err(|e| CutError::Solve(format!("no thread for the cut state: {e}")))?;
         Ok(Self {
-            steps,
+            jobs,
             outcomes: Mutex::new(outcomes),
             submitted: 0,
             answered: 0,
             view: Arc::new(empty),
             refused: Vec::new(),
+            step_seconds: Vec::new(),
         })
     }
 
     /// Hands the worker a step; never waits.
     pub fn submit(&mut self, step: CutStep) {
-        if self.steps.send(step).is_ok() {
+        if self.jobs.send(Job::Step(step)).is_ok() {
             self.submitted += 1;
         }
     }
@@ -89,6 +100,11 @@ impl CutWorker {
         &self.view
     }
 
+    /// The latest view taken (by [`Self::poll`] or [`Self::settle`]).
+    pub fn view(&self) -> &Arc<CutView> {
+        &self.view
+    }
+
     /// Steps handed over and not yet answered.
     pub fn pending(&self) -> u64 {
         self.submitted - self.answered
@@ -99,17 +115,27 @@ impl CutWorker {
         &self.refused
     }
 
-    fn receiver(&mut self) -> &Receiver<Outcome> {
+    /// How long each step answered so far took the worker (s), in order.
+    pub fn step_seconds(&self) -> &[f64] {
+        &self.step_seconds
+    }
+
+    fn receiver(&mut self) -> &Receiver<(Outcome, f64)> {
         match self.outcomes.get_mut() {
             Ok(receiver) => receiver,
             Err(poisoned) => poisoned.into_inner(),
         }
     }
 
-    fn take(&mut self, outcome: Outcome) {
+    fn take(&mut self, (outcome, seconds): (Outcome, f64)) {
         self.answered += 1;
+        self.step_seconds.push(seconds);
         match outcome {
-            Outcome::Grew(view) => self.view = view,
+            Outcome::Grew(view) => {
+                let old = std::mem::replace(&mut self.view, view);
+                // Dropped by the worker if it is still there; here only if it has gone.
+                let _ = self.jobs.send(Job::Retire(old));
+            }
             Outcome::Unchanged => {}
             Outcome::Refused(error) => self.refused.push(error),
         }
@@ -121,12 +147,20 @@ impl CutWorker {
 fn serve(
     model: &FemModel,
     response: ExactResponse,
-    steps: Receiver<CutStep>,
-    answers: Sender<Outcome>,
+    jobs: Receiver<Job>,
+    answers: Sender<(Outcome, f64)>,
 ) {
     let mut state = CutState::new(model, response).with_front(Front::Nearest);
     let mut incision = None;
-    for step in steps {
+    for job in jobs {
+        let step = match job {
+            Job::Step(step) => step,
+            Job::Retire(view) => {
+                drop(view);
+                continue;
+            }
+        };
+        let started = Instant::now();
         let applied = match (step, incision) {
             (CutStep::Start { at, blade, depth_m }, _) => {
                 incision = Some(state.start(at, blade, depth_m));
@@ -141,7 +175,10 @@ fn serve(
             Ok(false) => Outcome::Unchanged,
             Err(error) => Outcome::Refused(error),
         };
-        if answers.send(outcome).is_err() {
+        if answers
+            .send((outcome, started.elapsed().as_secs_f64()))
+            .is_err()
+        {
             return;
         }
     }

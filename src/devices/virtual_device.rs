@@ -6,7 +6,7 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 
 use super::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
 
@@ -33,6 +33,9 @@ pub struct VirtualHandle {
     tip_m: AtomicVector,
     force_n: AtomicVector,
     buttons: AtomicU32,
+    /// The handle's turn about the scene's anterior axis (rad, as f64 bits): a scalpel's
+    /// edge, along the handle's x, turns in the plane facing the surgeon.
+    turn_rad: AtomicU64,
 }
 
 impl VirtualHandle {
@@ -47,6 +50,15 @@ impl VirtualHandle {
 
     pub fn set_buttons(&self, buttons: u32) {
         self.buttons.store(buttons, Ordering::Relaxed);
+    }
+
+    /// Turns the handle to `turn_rad` about the scene's anterior axis.
+    pub fn set_turn(&self, turn_rad: f64) {
+        self.turn_rad.store(turn_rad.to_bits(), Ordering::Relaxed);
+    }
+
+    pub fn turn_rad(&self) -> f64 {
+        f64::from_bits(self.turn_rad.load(Ordering::Relaxed))
     }
 
     /// The force (N) the device would render now: shown on screen in place of a motor.
@@ -83,8 +95,10 @@ impl HapticDevice for VirtualDevice {
     }
 
     fn read(&mut self, _time_s: f64) -> Result<DeviceSample, DeviceError> {
+        let turn = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), self.handle.turn_rad());
         Ok(DeviceSample {
             buttons: self.handle.buttons.load(Ordering::Relaxed),
+            orientation: turn,
             ..DeviceSample::at(self.handle.tip_m())
         })
     }

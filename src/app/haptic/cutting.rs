@@ -4,8 +4,6 @@
 //! on a simulated clock ([`SettleCuts`]), where each step is waited for so that a run is
 //! deterministic.
 
-use std::sync::Arc;
-
 use bevy::prelude::*;
 use nalgebra::{Point3, Unit, Vector3};
 
@@ -14,13 +12,13 @@ use super::resources::Tool;
 use crate::contact::ToolContact;
 use crate::cutting::{BladeContact, CutView, CutWorker, Scalpel};
 
-/// An organ a scalpel cuts: the blade on it, its cut state on a worker thread, and the view
-/// of that state the tick last read.
+/// An organ a scalpel cuts: the blade on it, and its cut state on a worker thread (whose
+/// latest view the tick reads; the worker frees the views it replaces, so that the tick never
+/// frees one).
 #[derive(Component)]
 pub struct OrganCut {
     pub scalpel: Scalpel,
     pub worker: CutWorker,
-    pub view: Arc<CutView>,
     /// Scratch space kept from tick to tick: the patch's nodes and shares, and `Y`'s rows.
     nodes: Vec<(usize, f64)>,
     y: [Vec<f64>; 3],
@@ -31,7 +29,6 @@ impl OrganCut {
         Self {
             scalpel,
             worker,
-            view: Arc::default(),
             nodes: Vec::new(),
             y: Default::default(),
         }
@@ -55,33 +52,35 @@ pub fn cut(
     )>,
 ) {
     for (body, mut touch, mut deformation, mut cut) in &mut organs {
-        let cut = &mut *cut;
+        let OrganCut {
+            scalpel,
+            worker,
+            nodes,
+            y,
+        } = &mut *cut;
         let view = match settle {
-            Some(_) => cut.worker.settle(),
-            None => cut.worker.poll(),
+            Some(_) => worker.settle(),
+            None => worker.poll(),
         };
-        cut.view.clone_from(view);
         let touch = &mut *touch;
         if let Some(contact) = touch.contact.as_mut() {
-            cut.nodes.clear();
+            nodes.clear();
             let positions = &body.vademecum.positions;
             let shares = touch.patch.shares.iter();
-            cut.nodes
-                .extend(shares.map(|&(m, share)| (positions[m] as usize, share)));
-            let load = &mut deformation.0.loads[OrganDeformation::TOOL];
-            soften(contact, &cut.view, (&cut.nodes, &mut cut.y));
-            if let Some(parted_m) = cut.scalpel.parted_depth_m() {
+            nodes.extend(shares.map(|&(m, share)| (positions[m] as usize, share)));
+            soften(contact, view, (nodes, y));
+            if let Some(parted_m) = scalpel.parted_depth_m() {
                 give(contact, parted_m);
             }
             contact.force_n = contact.stiffness_n_per_m * contact.indentation_m;
-            load.force_n = contact.force_n;
+            deformation.0.loads[OrganDeformation::TOOL].force_n = contact.force_n;
         }
         let edge = tool
             .sample
             .map_or_else(Vector3::x, |s| s.orientation * Vector3::x());
         let blade = touch.contact.as_ref().map(|c| blade_contact(c, edge));
-        if let Some(step) = cut.scalpel.tick(blade.as_ref()) {
-            cut.worker.submit(step);
+        if let Some(step) = scalpel.tick(blade.as_ref()) {
+            worker.submit(step);
         }
     }
 }

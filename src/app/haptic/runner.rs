@@ -177,6 +177,7 @@ impl HapticLoop {
                     contact: None,
                     motion: Vec::new(),
                     grasped: false,
+                    strokes: Vec::new(),
                 };
                 (index.0, organ)
             })

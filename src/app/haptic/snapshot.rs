@@ -6,6 +6,7 @@ use bevy::prelude::*;
 use nalgebra::Vector3;
 
 use crate::contact::ToolContact;
+use crate::cutting::Stroke;
 use crate::pgd::Deformation;
 use crate::scenario::Progress;
 
@@ -18,6 +19,8 @@ pub struct OrganSnapshot {
     pub motion: Vec<f64>,
     /// Whether the grasper's jaws hold it.
     pub grasped: bool,
+    /// The scalpel's strokes on it, the one under way last.
+    pub strokes: Vec<Stroke>,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -28,6 +31,8 @@ pub struct HapticSnapshot {
     pub tip_m: Option<Vector3<f64>>,
     /// The force sent to the device (N).
     pub force_n: Vector3<f64>,
+    /// The scalpel's edge (unit, the scene's frame) when the tool is a scalpel.
+    pub blade_edge: Option<Vector3<f64>>,
     /// Whether the force is faded or held after a fault.
     pub faulted: bool,
     /// In the scene's organ order.

@@ -4,6 +4,7 @@ use bevy::prelude::*;
 use nalgebra::Vector3;
 
 use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
+use super::cutting::OrganCut;
 use super::resources::{
     Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, Safety, TickClock, Tool,
 };
@@ -258,18 +259,22 @@ pub fn trace_force(force: Res<DeviceForce>, trace: Option<ResMut<ForceTrace>>) {
     }
 }
 
+/// What the snapshot takes of an organ entity.
+type Published = (
+    &'static OrganIndex,
+    &'static ToolTouch,
+    &'static OrganDeformation,
+    Option<&'static OrganMotion>,
+    Option<&'static OrganCut>,
+);
+
 /// Hands the render side the tick's state, when one is listening; never waits.
 pub fn publish_snapshot(
     clock: Res<TickClock>,
     tool: Res<Tool>,
     force: Res<DeviceForce>,
     safety: Res<Safety>,
-    organs: Query<(
-        &OrganIndex,
-        &ToolTouch,
-        &OrganDeformation,
-        Option<&OrganMotion>,
-    )>,
+    organs: Query<Published>,
     timing: Option<Res<LoopTiming>>,
     publisher: Option<ResMut<SnapshotPublisher>>,
 ) {
@@ -283,13 +288,22 @@ pub fn publish_snapshot(
     snapshot.force_n = force.sent_n;
     snapshot.faulted = safety.0.is_faulted();
     snapshot.timing = timing.map_or_else(LoopTiming::default, |t| *t);
-    for (index, touch, deformation, motion) in &organs {
+    let cuts = organs.iter().any(|(.., cut)| cut.is_some());
+    snapshot.blade_edge = tool
+        .sample
+        .filter(|_| cuts)
+        .map(|s| s.orientation * Vector3::x());
+    for (index, touch, deformation, motion, cut) in &organs {
         let organ = &mut snapshot.organs[index.0];
         organ.contact = touch.contact;
         organ.deformation.clone_from(&deformation.0);
         if let Some(motion) = motion {
             organ.motion.clone_from(&motion.correction);
             organ.grasped = motion.organ.holding();
+        }
+        if let Some(cut) = cut {
+            organ.strokes.clear();
+            organ.strokes.extend_from_slice(cut.scalpel.strokes());
         }
     }
     publisher.0.publish();

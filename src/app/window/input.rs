@@ -1,7 +1,8 @@
 //! The virtual device, driven from the window: the tool tip follows the cursor on the plane
 //! facing the camera through the tip, and the wheel (or W/S, ↑/↓) pushes it in and out along
 //! the view. Ctrl + wheel is the camera's zoom; a held right or middle button, its orbit or
-//! pan, during which the tool stays where it is.
+//! pan, during which the tool stays where it is. Q and E turn the handle (a scalpel's edge)
+//! about the axis facing the surgeon.
 
 use bevy::input::mouse::{MouseScrollUnit, MouseWheel};
 use bevy::prelude::*;
@@ -15,6 +16,8 @@ const WHEEL_STEP_M: f32 = 0.002;
 const KEY_SPEED_M_PER_S: f32 = 0.02;
 /// Pixels of a touchpad scroll per wheel notch.
 const PIXELS_PER_NOTCH: f32 = 20.0;
+/// How fast Q/E turn the handle (rad/s).
+const TURN_RAD_PER_S: f64 = std::f64::consts::FRAC_PI_2;
 
 pub(super) fn setup(app: &mut App) {
     app.add_systems(Update, drive_virtual_device.in_set(FrameSet::Input));
@@ -68,6 +71,13 @@ fn drive_virtual_device(
     };
     let push = notches * WHEEL_STEP_M + keyed * KEY_SPEED_M_PER_S * time.delta_secs();
     handle.set_tip(&workspace.to_device(&from_bevy(tip + *forward * push)));
+    let turning = match (keys.pressed(KeyCode::KeyQ), keys.pressed(KeyCode::KeyE)) {
+        (true, false) => 1.0,
+        (false, true) => -1.0,
+        _ => 0.0,
+    };
+    let turn = handle.turn_rad() + turning * TURN_RAD_PER_S * time.delta_secs_f64();
+    handle.set_turn(turn);
     // The left button is the device's first button (a stylus button on hardware).
     handle.set_buttons(u32::from(buttons.pressed(MouseButton::Left)));
 }

@@ -6,6 +6,7 @@ mod bridge;
 mod camera;
 mod frames;
 mod hud;
+mod incision;
 mod input;
 mod legend;
 mod lesson;
@@ -143,6 +144,7 @@ pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
     organs::setup(&mut app);
     camera::setup(&mut app);
     tool::setup(&mut app);
+    incision::setup(&mut app);
     input::setup(&mut app);
     hud::setup(&mut app);
     frames::setup(&mut app, log.clone());

@@ -359,6 +359,23 @@ pub enum BenchTarget {
     /// pressed until at least 400 pointshell nodes push, against parry's brute-force check of
     /// every node against the deformed master surface.
     Contact(ContactBenchArgs),
+    /// A stroke of the scalpel through the liver of the four-organ scene, ticked at 1 kHz on
+    /// the real clock: tick compute time against the same stroke with a probe, and the cut
+    /// state's time per step on its worker thread.
+    Scalpel {
+        /// Runs per figure; the median is reported.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// The coarse organs (the liver at half resolution, as a cut coarse organ is).
+        #[arg(long)]
+        coarse: bool,
+        /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
+        #[arg(long, default_value = "vademecums")]
+        vademecums: PathBuf,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// The haptic loop on the four-organ scene: tick compute time over a scripted sweep (all
     /// organs, then each), the same press by full FEM, and real-time punctuality per timer.
     Haptics {

@@ -282,6 +282,40 @@ fn bench_command(what: BenchTarget) -> ExitCode {
                 json,
             )
         }
+        BenchTarget::Scalpel {
+            repeats,
+            coarse,
+            vademecums,
+            json,
+        } => {
+            let organs = SCENE_ORGANS.map(|organ| SceneOrgan {
+                cut_toughness_j_per_m2: (organ == Organ::Liver)
+                    .then_some(pgd_surgery::cutting::LIVER_TOUGHNESS_J_PER_M2),
+                ..SceneOrgan::from(organ)
+            });
+            let detail = if coarse { Detail::Coarse } else { Detail::Full };
+            let coupling = CouplingSettings::default();
+            let built = scene_of(
+                &organs,
+                None,
+                &coupling,
+                &vademecums,
+                detail,
+                OnStale::Rebuild,
+            );
+            let mut scene = match built {
+                Ok(scene) => scene,
+                Err(e) => return fail("pgd bench scalpel", &e),
+            };
+            if let Some(cutting) = &mut scene.cutting {
+                cutting.blade.edge_m = 0.003;
+            }
+            print_report(
+                "pgd bench scalpel",
+                app::bench_scalpel::run(&scene, repeats),
+                json,
+            )
+        }
         BenchTarget::Cutting { cells, json } => print_report(
             "pgd bench cutting",
             bench::cutting::run([cells[0], cells[1], cells[2]]),
