@@ -59,9 +59,14 @@ impl CutWorker {
         let empty = CutState::new(&model, &response).view();
         let (jobs, job_queue) = channel();
         let (answers, outcomes) = channel();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(worker_threads())
+            .thread_name(|k| format!("cut worker {k}"))
+            .build()
+            .map_err(|e| CutError::Solve(format!("no threads for the cut state: {e}")))?;
         thread::Builder::new()
             .name(format!("cut {name}"))
-            .spawn(move || serve(&model, response, job_queue, answers))
+            .spawn(move || pool.install(|| serve(&model, response, job_queue, answers)))
             .map_err(|e| CutError::Solve(format!("no thread for the cut state: {e}")))?;
         Ok(Self {
             jobs,
@@ -140,6 +145,13 @@ impl CutWorker {
             Outcome::Refused(error) => self.refused.push(error),
         }
     }
+}
+
+/// Threads for the cut state's parallel work: one core fewer than the machine has (at least
+/// one), so that the haptic thread always finds a core.
+fn worker_threads() -> usize {
+    let cores = thread::available_parallelism().map_or(1, |n| n.get());
+    cores.saturating_sub(1).max(1)
 }
 
 /// The worker's loop: each step applied in order and answered, until the haptic side drops
