@@ -28,10 +28,10 @@ use super::CutError;
 use super::enrichment::{Enrichment, Front};
 use super::incision::{CutFace, Incision};
 use super::response::{Response, UncutResponse};
-use super::view::CutView;
+use super::view::{CutView, add_surface_part, gram, surface_dof};
 use super::xfem::{CutSolution, element_functions, piece_weights};
 use crate::fem::{FemModel, PRESCRIBED};
-use crate::mesh::{NOT_ON_SURFACE, Surface};
+use crate::mesh::Surface;
 
 /// A sparse column of `B`: the nodes' own dofs it couples to, with the entries.
 type SparseColumn = Vec<(usize, f64)>;
@@ -67,7 +67,7 @@ pub struct CutState<'m, R: UncutResponse> {
     /// for every unknown at once and solves nothing. Bordering leaves `Ẑ`'s old columns as
     /// they are.
     z_hat_surface: Vec<Vec<(u32, f64)>>,
-    /// Per node, its place among the surface nodes, or [`NOT_ON_SURFACE`].
+    /// Per node, its place among the surface nodes, or [`crate::mesh::NOT_ON_SURFACE`].
     surface_index_of: Vec<usize>,
     /// Per unknown, `Xᵀ` of its column of `B`: its products with any response's modal part.
     rows: Vec<Vec<f64>>,
@@ -572,37 +572,6 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             x[i] = (x[i] - s) / self.factor[i][i];
         }
         x
-    }
-}
-
-/// `y += Ẑᵀ p` over the surface dofs of the sparse load `p` (`Ẑ` kept per surface dof as
-/// `(unknown, value)`; a dof of a node inside adds nothing).
-pub(super) fn add_surface_part(
-    surface_index_of: &[usize],
-    z_hat_surface: &[Vec<(u32, f64)>],
-    load: &[(usize, f64)],
-    y: &mut [f64],
-) {
-    for &(d, share) in load {
-        let Some(k) = surface_dof(surface_index_of, d) else {
-            continue;
-        };
-        for &(p, v) in &z_hat_surface[k] {
-            y[p as usize] += share * v;
-        }
-    }
-}
-
-/// `Yᵀ Y` for the three rows `y` (one per axis).
-pub(super) fn gram(y: &[Vec<f64>]) -> Matrix3<f64> {
-    Matrix3::from_fn(|row, axis| y[row].iter().zip(&y[axis]).map(|(a, b)| a * b).sum())
-}
-
-/// The place of dof `d` among the surface nodes' dofs, if its node is on the surface.
-fn surface_dof(surface_index_of: &[usize], d: usize) -> Option<usize> {
-    match surface_index_of[d / 3] {
-        NOT_ON_SURFACE => None,
-        k => Some(3 * k + d % 3),
     }
 }
 

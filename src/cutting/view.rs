@@ -4,7 +4,7 @@
 use nalgebra::Matrix3;
 
 use super::incision::CutFace;
-use super::state::{add_surface_part, gram};
+use crate::mesh::NOT_ON_SURFACE;
 
 /// A cut state as it stood after some segment: enough to soften the tool's patch compliance
 /// for the cut, `C = C₀ + Yᵀ Y` with `Y = Ẑᵀ P` ([`super::CutState::felt_force_over`]).
@@ -35,5 +35,36 @@ impl CutView {
             }
         }
         gram(y.as_slice())
+    }
+}
+
+/// `y += Ẑᵀ p` over the surface dofs of the sparse load `p` (`Ẑ` kept per surface dof as
+/// `(unknown, value)`; a dof of a node inside adds nothing).
+pub(super) fn add_surface_part(
+    surface_index_of: &[usize],
+    z_hat_surface: &[Vec<(u32, f64)>],
+    load: &[(usize, f64)],
+    y: &mut [f64],
+) {
+    for &(d, share) in load {
+        let Some(k) = surface_dof(surface_index_of, d) else {
+            continue;
+        };
+        for &(p, v) in &z_hat_surface[k] {
+            y[p as usize] += share * v;
+        }
+    }
+}
+
+/// `Yᵀ Y` for the three rows `y` (one per axis).
+pub(super) fn gram(y: &[Vec<f64>]) -> Matrix3<f64> {
+    Matrix3::from_fn(|row, axis| y[row].iter().zip(&y[axis]).map(|(a, b)| a * b).sum())
+}
+
+/// The place of dof `d` among the surface nodes' dofs, if its node is on the surface.
+pub(super) fn surface_dof(surface_index_of: &[usize], d: usize) -> Option<usize> {
+    match surface_index_of[d / 3] {
+        NOT_ON_SURFACE => None,
+        k => Some(3 * k + d % 3),
     }
 }
