@@ -108,3 +108,23 @@ impl HapticDevice for VirtualDevice {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The handle's turn is the device's orientation about the anterior axis: a quarter turn
+    /// brings the handle's x (a scalpel's edge) from the patient's left to the feet (−z), and
+    /// the tip stays where it was.
+    #[test]
+    fn turning_the_handle_turns_the_sample() {
+        let tip = Vector3::new(0.01, 0.02, 0.03);
+        let (mut device, handle) = VirtualDevice::new(&tip);
+        let edge =
+            |device: &mut VirtualDevice| device.read(0.0).unwrap().orientation * Vector3::x();
+        assert!((edge(&mut device) - Vector3::x()).norm() < 1e-15);
+        handle.set_turn(std::f64::consts::FRAC_PI_2);
+        assert!((edge(&mut device) + Vector3::z()).norm() < 1e-15);
+        assert_eq!(device.read(0.0).unwrap().tip_m, tip);
+    }
+}

@@ -93,7 +93,7 @@ fn update_hud(
         )
     };
     let help = if link.virtual_device.is_some() {
-        "\nmouse: move the tool | wheel or W/S: push in / pull out\n\
+        "\nmouse: move the tool | wheel or W/S: push in / pull out | Q/E: turn the handle\n\
          right-drag: orbit | middle-drag: pan | Ctrl+wheel or +/-: zoom"
     } else {
         ""
