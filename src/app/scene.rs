@@ -12,7 +12,7 @@ use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, FieldOrigin, Pr
 use crate::cutting::Blade;
 use crate::devices::{PressTarget, SafetySettings, Workspace};
 use crate::dynamics::{DynamicModel, GraspSettings, TRAINER_MODES};
-use crate::fem::{Inclusion, Law, Material};
+use crate::fem::{FemModel, Inclusion, Law, Material};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::{Organ, OrganSettings, region};
 use crate::pgd::{BuildSettings, Vademecum};
@@ -229,14 +229,7 @@ fn scene_dynamics(
         if !organ.dynamic {
             continue;
         }
-        let header = &vademecum.header;
-        let material = Material {
-            law: Law::KirchhoffSaintVenant,
-            ..header.material
-        };
-        let model = crate::pgd::organ::clamped_model(mesh.clone(), material)
-            .and_then(|m| m.with_inclusions(&header.inclusions))
-            .map_err(|e| format!("{name}: {e}"))?;
+        let model = organ_model(name, vademecum, mesh, Law::KirchhoffSaintVenant)?;
         let dynamic = DynamicModel::new(&model, vademecum, TRAINER_MODES)
             .map_err(|e| format!("{name}: dynamics: {e}"))?;
         let lowest_hz = dynamic.basis.omega2[0].sqrt() / (2.0 * std::f64::consts::PI);
@@ -263,20 +256,31 @@ fn scene_cutting(
         let Some(toughness) = organ.cut_toughness_j_per_m2 else {
             continue;
         };
-        let header = &vademecum.header;
-        let material = Material {
-            law: Law::Linear,
-            ..header.material
-        };
-        let model = crate::pgd::organ::clamped_model(mesh.clone(), material)
-            .and_then(|m| m.with_inclusions(&header.inclusions))
-            .map_err(|e| format!("{name}: {e}"))?;
+        let model = organ_model(name, vademecum, mesh, Law::Linear)?;
         cut.push((index, Arc::new(model), toughness));
     }
     Ok((!cut.is_empty()).then(|| SceneCutting {
         blade: Blade::default(),
         organs: cut,
     }))
+}
+
+/// The organ's finite-element model under `law`: its mesh clamped, its tissue and stiffer
+/// regions as its vademecum was built with.
+fn organ_model(
+    name: &str,
+    vademecum: &Vademecum,
+    mesh: &TetMesh,
+    law: Law,
+) -> Result<FemModel, String> {
+    let header = &vademecum.header;
+    let material = Material {
+        law,
+        ..header.material
+    };
+    crate::pgd::organ::clamped_model(mesh.clone(), material)
+        .and_then(|m| m.with_inclusions(&header.inclusions))
+        .map_err(|e| format!("{name}: {e}"))
 }
 
 /// A short tag that tells one set of inclusions from another in a file name.

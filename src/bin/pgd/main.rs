@@ -263,16 +263,7 @@ fn bench_command(what: BenchTarget) -> ExitCode {
                 dynamic,
                 ..SceneOrgan::from(organ)
             });
-            let coupling = CouplingSettings::default();
-            let built = scene_of(
-                &organs,
-                None,
-                &coupling,
-                &vademecums,
-                Detail::Full,
-                OnStale::Rebuild,
-            );
-            let scene = match built {
+            let scene = match abdomen_scene(&organs, &vademecums, Detail::Full) {
                 Ok(scene) => scene,
                 Err(e) => return fail("pgd bench haptics", &e),
             };
@@ -294,16 +285,7 @@ fn bench_command(what: BenchTarget) -> ExitCode {
                 ..SceneOrgan::from(organ)
             });
             let detail = if coarse { Detail::Coarse } else { Detail::Full };
-            let coupling = CouplingSettings::default();
-            let built = scene_of(
-                &organs,
-                None,
-                &coupling,
-                &vademecums,
-                detail,
-                OnStale::Rebuild,
-            );
-            let mut scene = match built {
+            let mut scene = match abdomen_scene(&organs, &vademecums, detail) {
                 Ok(scene) => scene,
                 Err(e) => return fail("pgd bench scalpel", &e),
             };
@@ -365,5 +347,23 @@ fn bench_contact(options: &ContactBenchArgs) -> ExitCode {
             &options.cases,
         ),
         options.json,
+    )
+}
+
+/// The four-organ scene of `organs` at `detail`, with the default contact, its vademecums
+/// from `vademecums` (missing or stale ones rebuilt).
+fn abdomen_scene(
+    organs: &[SceneOrgan],
+    vademecums: &Path,
+    detail: Detail,
+) -> Result<pgd_surgery::app::haptic::HapticScene, String> {
+    let coupling = CouplingSettings::default();
+    scene_of(
+        organs,
+        None,
+        &coupling,
+        vademecums,
+        detail,
+        OnStale::Rebuild,
     )
 }
