@@ -6,6 +6,7 @@
 
 mod device;
 mod forcedimension;
+mod fulcrum;
 mod openhaptics;
 mod recorder;
 mod safety;
@@ -21,6 +22,7 @@ mod workspace;
 
 pub use device::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
 pub use forcedimension::ForceDimension;
+pub use fulcrum::{Fulcrum, MIN_OUTSIDE_M, Pose};
 pub use openhaptics::OpenHaptics;
 pub use recorder::Recorder;
 pub use safety::{Fault, SafetyFilter, SafetySettings};

@@ -7,6 +7,7 @@ mod devices;
 mod fakes;
 mod faults;
 mod forcedimension;
+mod fulcrum;
 mod grasp;
 mod openhaptics;
 mod press;

@@ -1,0 +1,105 @@
+//! The fulcrum effect against hand-computed cases: the tip moves opposite to the hand across
+//! the shaft, scaled by inside over outside, and one for one along it; the force comes back
+//! through the same lever; and the port makes no energy.
+
+use nalgebra::Vector3;
+use pgd_surgery::devices::{Fulcrum, MIN_OUTSIDE_M};
+
+/// A 300 mm instrument through a port at the origin, pointing down (−y) into the abdomen.
+fn port() -> Fulcrum {
+    Fulcrum {
+        port_m: Vector3::zeros(),
+        shaft_m: 0.3,
+    }
+}
+
+/// The handle 100 mm above the port: 200 mm of shaft inside, the tip 200 mm below it.
+/// Moving the handle 10 mm to +x swings the tip to −x; computed by hand: the shaft from
+/// h = (0.01, 0.1, 0) through the origin, |h| of it outside, ends 0.3 − |h| beyond the port at
+/// −h (0.3 − |h|) / |h|.
+#[test]
+fn the_tip_moves_opposite_to_the_hand_scaled_by_depth() {
+    let fulcrum = port();
+    let straight = fulcrum.pose(&Vector3::new(0.0, 0.1, 0.0)).unwrap();
+    assert!((straight.tip_m - Vector3::new(0.0, -0.2, 0.0)).norm() < 1e-15);
+    assert!((straight.outside_m - 0.1).abs() < 1e-15 && (straight.inside_m - 0.2).abs() < 1e-15);
+
+    let handle = Vector3::new(0.01, 0.1, 0.0);
+    let moved = fulcrum.pose(&handle).unwrap();
+    let by_hand = -handle * ((0.3 - handle.norm()) / handle.norm());
+    assert!((moved.tip_m - by_hand).norm() < 1e-15, "{:?}", moved.tip_m);
+    assert!(moved.tip_m.x < 0.0, "the tip did not move against the hand");
+    // For a small move, the ratio is inside over outside: twice here, once deeper in.
+    let small = 1e-6;
+    let ratio = |outside: f64| {
+        let pose = |x: f64| {
+            fulcrum
+                .pose(&Vector3::new(x, outside, 0.0))
+                .unwrap()
+                .tip_m
+                .x
+        };
+        (pose(small) - pose(0.0)) / small
+    };
+    assert!((ratio(0.1) + 2.0).abs() < 1e-6, "{}", ratio(0.1));
+    assert!((ratio(0.15) + 1.0).abs() < 1e-6, "{}", ratio(0.15));
+    // Along the shaft, one for one: the handle 10 mm nearer the port puts the tip 10 mm deeper.
+    let deeper = fulcrum.pose(&Vector3::new(0.0, 0.09, 0.0)).unwrap();
+    assert!((deeper.tip_m.y + 0.21).abs() < 1e-15);
+}
+
+/// A 1 N sideways push on the tip, 200 mm in and 100 mm out, is 2 N the other way at the hand;
+/// a 1 N push along the shaft is 1 N along it.
+#[test]
+fn the_force_comes_back_through_the_lever() {
+    let pose = port().pose(&Vector3::new(0.0, 0.1, 0.0)).unwrap();
+    let across = Fulcrum::hand_force(&pose, &Vector3::new(1.0, 0.0, 0.0));
+    assert!(
+        (across - Vector3::new(-2.0, 0.0, 0.0)).norm() < 1e-15,
+        "{across:?}"
+    );
+    let along = Fulcrum::hand_force(&pose, &Vector3::new(0.0, 1.0, 0.0));
+    assert!(
+        (along - Vector3::new(0.0, 1.0, 0.0)).norm() < 1e-15,
+        "{along:?}"
+    );
+}
+
+/// For any small motion of the hand, the power the tip's force does at the tip equals the
+/// power the hand's force does at the hand: the port is passive.
+#[test]
+fn the_port_makes_no_energy() {
+    let fulcrum = port();
+    let handle = Vector3::new(0.013, 0.11, -0.021);
+    let pose = fulcrum.pose(&handle).unwrap();
+    let tip_force = Vector3::new(0.4, -1.3, 0.7);
+    let hand_force = Fulcrum::hand_force(&pose, &tip_force);
+    for velocity in [
+        Vector3::x(),
+        Vector3::y(),
+        Vector3::z(),
+        Vector3::new(0.3, -0.5, 0.8),
+    ] {
+        let dt = 1e-7;
+        let moved = fulcrum.pose(&(handle + velocity * dt)).unwrap();
+        let tip_velocity = (moved.tip_m - pose.tip_m) / dt;
+        let (at_tip, at_hand) = (tip_force.dot(&tip_velocity), hand_force.dot(&velocity));
+        assert!(
+            (at_tip - at_hand).abs() < 1e-5 * tip_force.norm(),
+            "{at_tip} vs {at_hand}"
+        );
+    }
+}
+
+/// A handle pulled out beyond the shaft leaves the tip at the port; one pushed onto the port is
+/// held out, so the lever's ratio stays bounded.
+#[test]
+fn the_shaft_stays_in_its_port() {
+    let fulcrum = port();
+    let out = fulcrum.pose(&Vector3::new(0.0, 0.5, 0.0)).unwrap();
+    assert_eq!(out.inside_m, 0.0);
+    assert!(out.tip_m.norm() < 1e-15);
+    let at = fulcrum.pose(&Vector3::new(0.0, 0.001, 0.0)).unwrap();
+    assert_eq!(at.outside_m, MIN_OUTSIDE_M);
+    assert!(fulcrum.pose(&Vector3::zeros()).is_none());
+}
