@@ -42,6 +42,7 @@ pub fn scenario_scene(
         on_stale,
     )?;
     scene.safety.max_force_n = scenario.device.max_force_n.0;
+    scene.port = scenario.port.as_ref().map(|port| port.fulcrum());
     if let (Some(cutting), Some(blade)) = (&mut scene.cutting, scenario.tool.blade()) {
         cutting.blade = blade;
     }

@@ -215,6 +215,7 @@ pub fn scene_of(
         coupling: (!coupling.is_empty()).then(|| Arc::new(coupling)),
         dynamics,
         cutting,
+        port: None,
     })
 }
 

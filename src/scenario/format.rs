@@ -30,6 +30,10 @@ pub struct Scenario {
     pub organs: Vec<OrganEntry>,
     #[serde(default)]
     pub tool: Tool,
+    /// The port the instrument goes through (laparoscopy): the device then moves its handle,
+    /// and the tip pivots about the port. None: the device moves the tip (open surgery).
+    #[serde(default)]
+    pub port: Option<Port>,
     #[serde(default)]
     pub device: Device,
     /// Stiffer lumps hidden in the organs' tissue, such as tumours, for palpation. The
@@ -114,6 +118,27 @@ impl Tool {
     /// Whether the tool grasps (and so the organs move by default).
     pub fn grasps(&self) -> bool {
         matches!(self, Tool::Grasper { .. })
+    }
+}
+
+/// A port (trocar) in the abdominal wall and the instrument through it.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Port {
+    /// Where the shaft crosses the wall, in the scene's frame (mm).
+    pub at_mm: (f64, f64, f64),
+    /// The instrument's length from handle to tip (mm; a laparoscopic instrument's is about
+    /// 300 to 450).
+    pub shaft_mm: Millimetres,
+}
+
+impl Port {
+    /// The port as the haptic loop takes it.
+    pub fn fulcrum(&self) -> crate::devices::Fulcrum {
+        crate::devices::Fulcrum {
+            port_m: metres(self.at_mm),
+            shaft_m: self.shaft_mm.metres(),
+        }
     }
 }
 

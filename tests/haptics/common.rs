@@ -57,6 +57,7 @@ pub fn scene(safety: SafetySettings) -> HapticScene {
         coupling: None,
         dynamics: None,
         cutting: None,
+        port: None,
         organs: vec![("liver".into(), liver().vademecum.clone())],
         probe: Probe {
             tip_radius_m: TIP_RADIUS_M,

@@ -103,3 +103,73 @@ fn the_shaft_stays_in_its_port() {
     assert_eq!(at.outside_m, MIN_OUTSIDE_M);
     assert!(fulcrum.pose(&Vector3::zeros()).is_none());
 }
+
+/// Through a port in the trainer: the device moves the handle, the tip is where the shaft puts
+/// it, and the device is sent the tip's force through the lever. The handle goes down the
+/// port's axis until the tip presses the liver 4 mm, then 10 mm sideways: the tip swings the
+/// other way, and the hand feels the liver's push with its part across the shaft inverted and
+/// scaled.
+#[test]
+fn the_trainer_moves_the_handle_and_sends_the_lever_force() {
+    use crate::common::{TIP_RADIUS_M, run, scene, scripted, target};
+    use pgd_surgery::app::haptic::{DeviceForce, HapticLoop, HapticScene, Tool, ToolTouch};
+    use pgd_surgery::devices::{DeviceSample, SafetySettings, Trajectory, TrajectoryRow};
+
+    let target = target();
+    let n = target.normal;
+    let fulcrum = Fulcrum {
+        port_m: target.point_m + n * 0.12,
+        shaft_m: 0.3,
+    };
+    let pressing = 0.3 - 0.12 + TIP_RADIUS_M - 0.004;
+    let side = n.cross(&Vector3::x()).normalize();
+    let handle = |outside: f64, sideways: f64| fulcrum.port_m + n * outside + side * sideways;
+    let row = |t: f64, at: Vector3<f64>| TrajectoryRow::new(t, &DeviceSample::at(at));
+    let trajectory = Trajectory {
+        rows: vec![
+            row(0.0, handle(pressing + 0.05, 0.0)),
+            row(1.0, handle(pressing, 0.0)),
+            row(1.5, handle(pressing, 0.01)),
+            row(2.0, handle(pressing, 0.01)),
+        ],
+    };
+    let ported = HapticScene {
+        port: Some(fulcrum),
+        ..scene(SafetySettings::default())
+    };
+    let mut haptic = HapticLoop::new(&ported, scripted(trajectory)).unwrap();
+    haptic.keep_trace();
+    run(&mut haptic, 2000);
+    let on_axis = fulcrum.pose(&handle(pressing, 0.0)).unwrap().tip_m;
+    assert!((on_axis - (target.point_m + n * (TIP_RADIUS_M - 0.004))).norm() < 1e-12);
+    let world = haptic.world_mut();
+    let tool = world.resource::<Tool>();
+    let (pose, tip) = (tool.pose.unwrap(), tool.sample.unwrap().tip_m);
+    let expected = fulcrum.pose(&handle(pressing, 0.01)).unwrap();
+    assert!((tip - expected.tip_m).norm() < 1e-12);
+    let swing = (tip - on_axis).dot(&side);
+    let ratio = pose.inside_m / pose.outside_m;
+    assert!(
+        (swing + 0.01 * ratio).abs() < 0.1 * 0.01 * ratio,
+        "the tip swung {swing} m for the hand's 0.01 m, inside/outside {ratio}"
+    );
+    let mut touches = world.query::<&ToolTouch>();
+    let at_tip: Vector3<f64> = -touches
+        .iter(world)
+        .filter_map(|t| t.contact.map(|c| c.force_n))
+        .sum::<Vector3<f64>>();
+    assert!(at_tip.norm() > 0.01, "the tip does not press: {at_tip:?}");
+    let desired = world.resource::<DeviceForce>().desired_n;
+    let lever = Fulcrum::hand_force(&pose, &at_tip);
+    assert!((desired - lever).norm() < 1e-12 * at_tip.norm());
+    let across = at_tip - pose.along * at_tip.dot(&pose.along);
+    assert!(
+        across.norm() > 0.05 * at_tip.norm(),
+        "nothing across the shaft to check"
+    );
+    eprintln!(
+        "tip force {at_tip:?} N, hand force {desired:?} N; {:.0} mm in, {:.0} mm out",
+        pose.inside_m * 1e3,
+        pose.outside_m * 1e3
+    );
+}

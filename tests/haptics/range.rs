@@ -52,6 +52,7 @@ fn press(vademecum: &Arc<Vademecum>, depth_m: f64) -> (HeadlessReport, ForceTrac
         coupling: None,
         dynamics: None,
         cutting: None,
+        port: None,
     };
     let target = PressTarget {
         point_m: Vector3::new(0.03, 0.02, 0.03),

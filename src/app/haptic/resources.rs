@@ -7,7 +7,7 @@ use crate::contact::Coupling;
 use nalgebra::Vector3;
 
 use crate::contact::Probe;
-use crate::devices::{DeviceSample, Fault, HapticDevice, SafetyFilter, Workspace};
+use crate::devices::{DeviceSample, Fault, Fulcrum, HapticDevice, Pose, SafetyFilter, Workspace};
 
 #[derive(Resource)]
 pub struct Device(pub Box<dyn HapticDevice>);
@@ -18,6 +18,10 @@ pub struct Tool {
     pub probe: Probe,
     /// How the device's motion maps onto the scene.
     pub workspace: Workspace,
+    /// The port the instrument goes through, if it does: the device moves its handle.
+    pub port: Option<Fulcrum>,
+    /// Through a port, where the instrument is (its handle the device's position).
+    pub pose: Option<Pose>,
     /// In the scene's frame; none until the device has reported a finite position.
     pub sample: Option<DeviceSample>,
 }

@@ -14,7 +14,9 @@ use super::resources::{
 use super::snapshot::{HapticSnapshot, OrganSnapshot, SnapshotPublisher};
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
 use crate::cutting::{Blade, CutError, CutWorker, Scalpel};
-use crate::devices::{HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S, Workspace};
+use crate::devices::{
+    Fulcrum, HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S, Workspace,
+};
 use crate::dynamics::{DynamicModel, GraspSettings};
 use crate::fem::FemModel;
 use crate::pgd::{Deformation, Vademecum};
@@ -34,6 +36,9 @@ pub struct HapticScene {
     pub dynamics: Option<SceneDynamics>,
     /// The organs the tool cuts, when it is a scalpel.
     pub cutting: Option<SceneCutting>,
+    /// The port the instrument goes through, if it does: the device then moves its handle
+    /// (laparoscopy); otherwise its tip (open surgery).
+    pub port: Option<Fulcrum>,
 }
 
 /// The scalpel's blade and the organs it cuts (by index into the scene's organs): each
@@ -125,6 +130,8 @@ impl HapticLoop {
         world.insert_resource(Tool {
             probe: scene.probe,
             workspace: scene.workspace,
+            port: scene.port,
+            pose: None,
             sample: None,
         });
         world.insert_resource(TickClock::default());

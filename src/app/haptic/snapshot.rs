@@ -29,6 +29,9 @@ pub struct HapticSnapshot {
     pub time_s: f64,
     /// The tool tip (m), once the device has reported one.
     pub tip_m: Option<Vector3<f64>>,
+    /// Through a port, the instrument's handle (m): its shaft runs from there through the
+    /// port to the tip.
+    pub handle_m: Option<Vector3<f64>>,
     /// The force sent to the device (N).
     pub force_n: Vector3<f64>,
     /// The scalpel's edge (unit, the scene's frame) when the tool is a scalpel.

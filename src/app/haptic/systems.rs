@@ -10,7 +10,7 @@ use super::resources::{
 };
 use super::snapshot::{LoopTiming, SnapshotPublisher};
 use crate::contact::{Target, follow, press};
-use crate::devices::Fault;
+use crate::devices::{DeviceSample, Fault, Fulcrum};
 use crate::dynamics::GraspPoint;
 use crate::pgd::SurfacePoint;
 
@@ -27,7 +27,10 @@ pub fn read_device(
     faults.this_tick.clear();
     faults.this_tick.append(&mut faults.next_tick);
     match device.0.read(clock.time_s) {
-        Ok(sample) if sample.is_finite() => tool.sample = Some(tool.workspace.to_scene(sample)),
+        Ok(sample) if sample.is_finite() => {
+            let in_scene = tool.workspace.to_scene(sample);
+            through_port(&mut tool, in_scene);
+        }
         Ok(_) => faults.this_tick.push(Fault::NonFiniteDevice),
         Err(e) => faults.this_tick.push(Fault::Device(e.to_string())),
     }
@@ -36,6 +39,21 @@ pub fn read_device(
             .this_tick
             .push(Fault::Overruns(clock.overruns_in_a_row));
     }
+}
+
+/// The tool for a device `sample` (in the scene): its tip, or through a port, its handle,
+/// the tip then where the shaft through the port puts it (a handle on the port itself keeps
+/// the last pose).
+fn through_port(tool: &mut Tool, mut sample: DeviceSample) {
+    if let Some(port) = tool.port {
+        match port.pose(&sample.tip_m) {
+            Some(pose) => tool.pose = Some(pose),
+            None if tool.pose.is_none() => return,
+            None => {}
+        }
+        sample.tip_m = tool.pose.expect("set above").tip_m;
+    }
+    tool.sample = Some(sample);
 }
 
 /// Presses the tool into every organ it touches, on the surface as the organ's other loads have
@@ -198,17 +216,23 @@ pub fn organ_contact(
     }
 }
 
-/// The force on the tool: the opposite of what it applies to the organs.
+/// The force on the tool: the opposite of what it applies to the organs; through a port, as
+/// the hand feels it through the shaft's lever.
 pub fn compute_force(
+    tool: Res<Tool>,
     touches: Query<&ToolTouch>,
     grasp: Res<GraspForce>,
     mut force: ResMut<DeviceForce>,
 ) {
-    force.desired_n = grasp.0
+    let at_tip = grasp.0
         - touches
             .iter()
             .filter_map(|t| t.contact.map(|c| c.force_n))
             .sum::<Vector3<f64>>();
+    force.desired_n = match &tool.pose {
+        Some(pose) => Fulcrum::hand_force(pose, &at_tip),
+        None => at_tip,
+    };
 }
 
 /// Clamps, rate-limits and, on a fault, fades the force; logs each fault as it starts (a fault
@@ -285,6 +309,10 @@ pub fn publish_snapshot(
     snapshot.tick = clock.tick;
     snapshot.time_s = clock.time_s;
     snapshot.tip_m = tool.sample.map(|s| s.tip_m);
+    snapshot.handle_m = tool
+        .port
+        .zip(tool.pose)
+        .map(|(port, pose)| port.port_m - pose.along * pose.outside_m);
     snapshot.force_n = force.sent_n;
     snapshot.faulted = safety.0.is_faulted();
     snapshot.timing = timing.map_or_else(LoopTiming::default, |t| *t);

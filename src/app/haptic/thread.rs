@@ -241,6 +241,7 @@ mod tests {
             coupling: None,
             dynamics: None,
             cutting: None,
+            port: None,
         }
     }
 

@@ -18,6 +18,7 @@ pub fn scene_without_organs() -> HapticScene {
         coupling: None,
         dynamics: None,
         cutting: None,
+        port: None,
     }
 }
 

@@ -1,5 +1,5 @@
-//! The tool as the trainee sees it: a sphere at the tip the device reports, and an arrow of
-//! the force the device renders.
+//! The tool as the trainee sees it: a sphere at the tip the device reports, its shaft when it
+//! goes through a port, and an arrow of the force the device renders.
 
 use bevy::prelude::*;
 
@@ -15,7 +15,10 @@ const ARROW_M_PER_N: f32 = 0.2;
 
 pub(super) fn setup(app: &mut App) {
     super::spawn_with_scene(app, spawn_tool);
-    app.add_systems(Update, (follow_device, draw_force).in_set(FrameSet::Draw));
+    app.add_systems(
+        Update,
+        (follow_device, draw_force, draw_shaft).in_set(FrameSet::Draw),
+    );
 }
 
 fn spawn_tool(
@@ -52,6 +55,17 @@ fn follow_device(
             *visibility = Visibility::Visible;
         }
         None => *visibility = Visibility::Hidden,
+    }
+}
+
+/// Through a port, the instrument's shaft from its handle to its tip.
+fn draw_shaft(snapshot: Res<Snapshot>, mut gizmos: Gizmos) {
+    if let (Some(handle), Some(tip)) = (snapshot.0.handle_m, snapshot.0.tip_m) {
+        gizmos.line(
+            to_bevy(&handle),
+            to_bevy(&tip),
+            Color::srgb(0.6, 0.62, 0.66),
+        );
     }
 }
 
