@@ -51,6 +51,18 @@ impl Fulcrum {
         })
     }
 
+    /// Where the handle must be for the tip to be at `tip_m` (a mouse places the tip, as a
+    /// trainee's eye leads a hand): the shaft from the tip back through the port. A tip deeper
+    /// than the shaft allows is brought back along it; `None` for a tip on the port.
+    pub fn handle_for(&self, tip_m: &Vector3<f64>) -> Option<Vector3<f64>> {
+        let from_port = tip_m - self.port_m;
+        let along = from_port.try_normalize(1e-9)?;
+        let inside_m = from_port
+            .norm()
+            .min((self.shaft_m - MIN_OUTSIDE_M).max(0.0));
+        Some(self.port_m - along * (self.shaft_m - inside_m))
+    }
+
     /// The force the hand feels (N) for the force `tip_n` the instrument's tip feels, the
     /// instrument at `pose`: along the shaft unchanged, across it inverted and scaled by
     /// `inside / outside`.

@@ -91,6 +91,24 @@ fn the_port_makes_no_energy() {
     }
 }
 
+/// The handle for a tip puts the tip there (what the mouse does through a port).
+#[test]
+fn the_handle_for_a_tip_puts_the_tip_there() {
+    let fulcrum = port();
+    for tip in [
+        Vector3::new(0.0, -0.2, 0.0),
+        Vector3::new(0.03, -0.12, 0.05),
+    ] {
+        let handle = fulcrum.handle_for(&tip).unwrap();
+        let pose = fulcrum.pose(&handle).unwrap();
+        assert!(
+            (pose.tip_m - tip).norm() < 1e-15,
+            "{:?} for {tip:?}",
+            pose.tip_m
+        );
+    }
+}
+
 /// A handle pulled out beyond the shaft leaves the tip at the port; one pushed onto the port is
 /// held out, so the lever's ratio stays bounded.
 #[test]

@@ -2,7 +2,8 @@
 //! facing the camera through the tip, and the wheel (or W/S, ↑/↓) pushes it in and out along
 //! the view. Ctrl + wheel is the camera's zoom; a held right or middle button, its orbit or
 //! pan, during which the tool stays where it is. Q and E turn the handle (a scalpel's edge)
-//! about the axis facing the surgeon.
+//! about the axis facing the surgeon. Through a port the cursor still leads the tip: the
+//! handle goes where the shaft to it must be.
 
 use bevy::input::mouse::{MouseScrollUnit, MouseWheel};
 use bevy::prelude::*;
@@ -39,9 +40,15 @@ fn drive_virtual_device(
         return;
     };
     let forward = eye.forward();
-    // The cursor places the tool in the scene; the device's handle is in its own workspace.
+    // The cursor places the tool's tip in the scene; the device's handle is in its own
+    // workspace and, through a port, where the shaft to that tip puts it.
     let workspace = link.scene.workspace;
-    let mut tip = to_bevy(&workspace.to_scene_m(&handle.tip_m()));
+    let port = link.scene.port;
+    let device_m = workspace.to_scene_m(&handle.tip_m());
+    let tip_m = port
+        .and_then(|p| p.pose(&device_m))
+        .map_or(device_m, |pose| pose.tip_m);
+    let mut tip = to_bevy(&tip_m);
     let steering_camera =
         buttons.pressed(MouseButton::Right) || buttons.pressed(MouseButton::Middle);
     if !steering_camera
@@ -70,7 +77,11 @@ fn drive_virtual_device(
         _ => 0.0,
     };
     let push = notches * WHEEL_STEP_M + keyed * KEY_SPEED_M_PER_S * time.delta_secs();
-    handle.set_tip(&workspace.to_device(&from_bevy(tip + *forward * push)));
+    let tip_m = from_bevy(tip + *forward * push);
+    let device_m = port.map_or(Some(tip_m), |p| p.handle_for(&tip_m));
+    if let Some(device_m) = device_m {
+        handle.set_tip(&workspace.to_device(&device_m));
+    }
     let turning = match (keys.pressed(KeyCode::KeyQ), keys.pressed(KeyCode::KeyE)) {
         (true, false) => 1.0,
         (false, true) => -1.0,
