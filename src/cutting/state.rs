@@ -105,11 +105,6 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         self
     }
 
-    /// Where the cut's front falls between element faces.
-    pub fn front(&self) -> Front {
-        self.front
-    }
-
     /// Sets a new blade on the surface (see [`Incision::start`]); returns its index.
     pub fn start(&mut self, at: Point3<f64>, blade: Vector3<f64>, depth_m: f64) -> usize {
         self.cuts.push(Cut {
