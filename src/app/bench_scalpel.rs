@@ -131,7 +131,7 @@ fn cut_of(mut haptic: HapticLoop) -> (Vec<f64>, (usize, f64, f64)) {
     let made = stroke.map_or((unknowns, 0.0, 0.0), |s| {
         (unknowns, s.length_m, s.max_depth_m)
     });
-    (cut.worker.step_seconds().to_vec(), made)
+    (cut.worker.step_seconds(), made)
 }
 
 fn median_figures(runs: &[TickFigures]) -> TickFigures {

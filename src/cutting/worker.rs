@@ -42,13 +42,14 @@ pub struct CutWorker {
     jobs: Sender<Job>,
     /// Behind a mutex only so that the worker's handle may be shared between threads (as an
     /// ECS component is): its owner reaches it through `get_mut`, never locking.
-    outcomes: Mutex<Receiver<(Outcome, f64)>>,
+    outcomes: Mutex<Receiver<Outcome>>,
     submitted: u64,
     answered: u64,
     view: Arc<CutView>,
     refused: Vec<CutError>,
-    /// How long each step took the worker (s), in order.
-    step_seconds: Vec<f64>,
+    /// How long each step took the worker (s), in order: written by the worker, so that the
+    /// haptic side never grows it.
+    step_seconds: Arc<Mutex<Vec<f64>>>,
 }
 
 impl CutWorker {
@@ -59,6 +60,8 @@ impl CutWorker {
         let empty = CutState::new(&model, &response).view();
         let (jobs, job_queue) = channel();
         let (answers, outcomes) = channel();
+        let step_seconds = Arc::new(Mutex::new(Vec::new()));
+        let timings = step_seconds.clone();
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(worker_threads())
             .thread_name(|k| format!("cut worker {k}"))
@@ -66,7 +69,7 @@ impl CutWorker {
             .map_err(|e| CutError::Solve(format!("no threads for the cut state: {e}")))?;
         thread::Builder::new()
             .name(format!("cut {name}"))
-            .spawn(move || pool.install(|| serve(&model, response, job_queue, answers)))
+            .spawn(move || pool.install(|| serve(&model, response, job_queue, (answers, &timings))))
             .map_err(|e| CutError::Solve(format!("no thread for the cut state: {e}")))?;
         Ok(Self {
             jobs,
@@ -75,7 +78,7 @@ impl CutWorker {
             answered: 0,
             view: Arc::new(empty),
             refused: Vec::new(),
-            step_seconds: Vec::new(),
+            step_seconds,
         })
     }
 
@@ -120,21 +123,23 @@ impl CutWorker {
         &self.refused
     }
 
-    /// How long each step answered so far took the worker (s), in order.
-    pub fn step_seconds(&self) -> &[f64] {
-        &self.step_seconds
+    /// How long each step done so far took the worker (s), in order (a copy: not for the
+    /// haptic thread).
+    pub fn step_seconds(&self) -> Vec<f64> {
+        self.step_seconds
+            .lock()
+            .map_or_else(|e| e.into_inner().clone(), |s| s.clone())
     }
 
-    fn receiver(&mut self) -> &Receiver<(Outcome, f64)> {
+    fn receiver(&mut self) -> &Receiver<Outcome> {
         match self.outcomes.get_mut() {
             Ok(receiver) => receiver,
             Err(poisoned) => poisoned.into_inner(),
         }
     }
 
-    fn take(&mut self, (outcome, seconds): (Outcome, f64)) {
+    fn take(&mut self, outcome: Outcome) {
         self.answered += 1;
-        self.step_seconds.push(seconds);
         match outcome {
             Outcome::Grew(view) => {
                 let old = std::mem::replace(&mut self.view, view);
@@ -160,7 +165,7 @@ fn serve(
     model: &FemModel,
     response: ExactResponse,
     jobs: Receiver<Job>,
-    answers: Sender<(Outcome, f64)>,
+    (answers, timings): (Sender<Outcome>, &Mutex<Vec<f64>>),
 ) {
     let mut state = CutState::new(model, response).with_front(Front::Nearest);
     let mut incision = None;
@@ -187,10 +192,10 @@ fn serve(
             Ok(false) => Outcome::Unchanged,
             Err(error) => Outcome::Refused(error),
         };
-        if answers
-            .send((outcome, started.elapsed().as_secs_f64()))
-            .is_err()
-        {
+        if let Ok(mut timings) = timings.lock() {
+            timings.push(started.elapsed().as_secs_f64());
+        }
+        if answers.send(outcome).is_err() {
             return;
         }
     }

@@ -195,8 +195,6 @@ struct Running {
     motion: MotionTracker,
     /// Incision: the cut against the line.
     incision: Option<IncisionTracker>,
-    /// Incision: whether the cut has strayed off the line (one error a task).
-    strayed: bool,
 }
 
 /// The tasks of a scenario, run one after another.
@@ -396,7 +394,6 @@ impl Running {
             force_sum: 0.0,
             organ,
             incision,
-            strayed: false,
             button_held: false,
             damaged: false,
             held_since: None,
@@ -479,14 +476,13 @@ impl Running {
         let Some(tracker) = self.incision.as_mut() else {
             return;
         };
+        let strayed_before = tracker.strayed();
         tracker.step(sample.blade.as_ref());
-        let limit_m = 2.0 * tracker.metrics().tolerance_mm * 1e-3;
-        if !self.strayed && tracker.strayed(limit_m) {
-            self.strayed = true;
+        if !strayed_before && tracker.strayed() {
             let error = format!(
                 "{:.2} s: cut the {organ} more than {:.0} mm off the line",
                 sample.time_s,
-                limit_m * 1e3
+                tracker.stray_limit_m() * 1e3
             );
             self.metrics.errors.push(error);
         }

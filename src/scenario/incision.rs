@@ -47,6 +47,8 @@ pub struct IncisionTracker {
     tolerance_m: f64,
     target_depth_m: f64,
     covered: Vec<bool>,
+    /// How many of `covered` are.
+    covered_bins: usize,
     /// The last front seen, and its stroke.
     last: Option<(u32, Vector3<f64>)>,
     advance_m: f64,
@@ -76,6 +78,7 @@ impl IncisionTracker {
             tolerance_m,
             target_depth_m,
             covered: vec![false; (length_m / BIN_M).ceil().max(1.0) as usize],
+            covered_bins: 0,
             last: None,
             advance_m: 0.0,
             deviation_sum: 0.0,
@@ -116,13 +119,18 @@ impl IncisionTracker {
 
     /// The share of the line covered.
     pub fn covered_share(&self) -> f64 {
-        let covered = self.covered.iter().filter(|&&c| c).count();
-        covered as f64 / self.covered.len() as f64
+        self.covered_bins as f64 / self.covered.len() as f64
     }
 
-    /// Whether the front has strayed farther than `limit_m` from the line.
-    pub fn strayed(&self, limit_m: f64) -> bool {
-        self.max_deviation_m > limit_m
+    /// How far off the line (m) the front strays before it counts as an error: twice the
+    /// tolerance.
+    pub fn stray_limit_m(&self) -> f64 {
+        2.0 * self.tolerance_m
+    }
+
+    /// Whether the front has ever strayed beyond [`Self::stray_limit_m`].
+    pub fn strayed(&self) -> bool {
+        self.max_deviation_m > self.stray_limit_m()
     }
 
     pub fn metrics(&self) -> IncisionMetrics {
@@ -159,7 +167,10 @@ impl IncisionTracker {
                 continue;
             }
             let bin = ((t / BIN_M) as usize).min(self.covered.len() - 1);
-            self.covered[bin] = true;
+            if !self.covered[bin] {
+                self.covered[bin] = true;
+                self.covered_bins += 1;
+            }
         }
     }
 }
