@@ -7,16 +7,17 @@ use std::sync::Arc;
 use nalgebra::Vector3;
 
 use super::haptic::{
-    ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SettleCuts, TickClock,
+    ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SceneScope,
+    SettleCuts, TickClock,
 };
 use super::scene::{Detail, SceneOrgan, scene_of};
 use crate::contact::{ContactSurface, CouplingSettings};
-use crate::devices::{HapticDevice, TICK_S};
+use crate::devices::{HapticDevice, ScopeHandle, TICK_S};
 use crate::fem::Law;
 use crate::mesh::organs::Organ;
 use crate::scenario::{
-    self, CutMade, Exercise, Nodule, NoduleSite, OrganEntry, RegionSite, Scenario, Scorecard,
-    Sites, Task, score,
+    self, CutMade, Exercise, LaparoscopeEntry, Nodule, NoduleSite, OrganEntry, RegionSite,
+    Scenario, Scorecard, Sites, Task, score,
 };
 use crate::store::{OnStale, OrganSource};
 
@@ -43,11 +44,22 @@ pub fn scenario_scene(
     )?;
     scene.safety.max_force_n = scenario.device.max_force_n.0;
     scene.port = scenario.port.as_ref().map(|port| port.fulcrum());
+    scene.scope = scenario.laparoscope.as_ref().and_then(scene_scope);
     if let (Some(cutting), Some(blade)) = (&mut scene.cutting, scenario.tool.blade()) {
         cutting.blade = blade;
     }
     scene.workspace.scale = scenario.device.workspace_scale.0;
     Ok(scene)
+}
+
+/// The scenario's laparoscope, aimed at its focus (a scenario that loaded has been checked
+/// to aim).
+fn scene_scope(entry: &LaparoscopeEntry) -> Option<SceneScope> {
+    Some(SceneScope {
+        scope: entry.laparoscope(),
+        pose: Arc::new(ScopeHandle::new(entry.start()?)),
+        keep_in_view_m: entry.keep_in_view_mm.map(scenario::metres),
+    })
 }
 
 /// The contact a scenario asks for, the defaults where it says nothing.

@@ -216,6 +216,7 @@ pub fn scene_of(
         dynamics,
         cutting,
         port: None,
+        scope: None,
     })
 }
 

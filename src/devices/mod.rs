@@ -1,12 +1,13 @@
 //! The device layer, free of Bevy: the device trait and its backends (scripted, recorder,
 //! virtual, and the OpenHaptics and Force Dimension hardware over the servo link and its
-//! watchdog), the trajectory
-//! files they replay and record, the map from the device's workspace to the scene, the safety
-//! filter between the physics and the motors, and the clock that paces the 1 kHz loop.
+//! watchdog), the trajectory files they replay and record, the map from the device's workspace
+//! to the scene, the instruments through ports and the laparoscope, the safety filter between
+//! the physics and the motors, and the clock that paces the 1 kHz loop.
 
 mod device;
 mod forcedimension;
 mod fulcrum;
+mod laparoscope;
 mod openhaptics;
 mod recorder;
 mod safety;
@@ -23,6 +24,7 @@ mod workspace;
 pub use device::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
 pub use forcedimension::ForceDimension;
 pub use fulcrum::{Fulcrum, MIN_OUTSIDE_M, Pose};
+pub use laparoscope::{Laparoscope, MIN_INSIDE_M, ScopeHandle, ScopePose, Steer, View};
 pub use openhaptics::OpenHaptics;
 pub use recorder::Recorder;
 pub use safety::{Fault, SafetyFilter, SafetySettings};

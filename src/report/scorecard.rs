@@ -59,15 +59,21 @@ pub fn summary(card: &Scorecard) -> String {
         let economy = motion
             .economy
             .map_or(String::new(), |e| format!(" ({e:.2}× the shortest)"));
+        let view = motion
+            .out_of_view_s
+            .map_or(String::new(), |s| format!(", out of view {s:.1} s"));
         let _ = writeln!(
             out,
-            "  motion: path {:.0} mm{economy}, {} movement{}, idle {:.1} s, jerk {:.2} m/s³ rms",
+            "  motion: path {:.0} mm{economy}, {} movement{}, idle {:.1} s, jerk {:.2} m/s³ rms{view}",
             motion.path_length_mm,
             motion.movements,
             if motion.movements == 1 { "" } else { "s" },
             motion.idle_s,
             motion.rms_jerk_m_per_s3
         );
+        if let Some(out_s) = m.target_out_of_view_s {
+            let _ = writeln!(out, "  the point to keep in view: out of view {out_s:.1} s");
+        }
         if m.targets > 0 {
             let path = m.path_ratio.map_or(String::new(), |r| {
                 format!(", path {r:.2}× the straight line")

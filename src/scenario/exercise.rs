@@ -35,6 +35,10 @@ pub struct Sample {
     pub tore: bool,
     /// The scalpel's cut under way, if it is cutting.
     pub blade: Option<BladeSample>,
+    /// Under a laparoscope: whether the tool's tip is in the camera's view...
+    pub tip_in_view: Option<bool>,
+    /// ...and whether the point the scenario has the trainee keep in view is.
+    pub target_in_view: Option<bool>,
 }
 
 impl Sample {
@@ -171,6 +175,9 @@ pub struct TaskMetrics {
     /// Incision: the cut against the marked line.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub incision: Option<IncisionMetrics>,
+    /// Laparoscopy: the time the point to keep in view was out of the camera's view (s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub target_out_of_view_s: Option<f64>,
 }
 
 /// One task's running state.
@@ -406,7 +413,13 @@ impl Running {
 
     fn step(&mut self, task: &Task, sample: &Sample, dt: f64, nodules: Nodules) {
         self.motion.step(sample.tip_m, dt);
+        if let Some(in_view) = sample.tip_in_view {
+            self.motion.view(in_view, dt);
+        }
         let m = &mut self.metrics;
+        if let Some(in_view) = sample.target_in_view {
+            *m.target_out_of_view_s.get_or_insert(0.0) += if in_view { 0.0 } else { dt };
+        }
         let force = sample.force_n;
         m.peak_force_n = m.peak_force_n.max(force);
         if sample.touching != 0 || sample.grasping != 0 {

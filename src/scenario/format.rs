@@ -13,7 +13,8 @@ use crate::devices::DeviceSpec;
 use crate::fem::Law;
 
 use super::units::{
-    Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, Seconds, Toughness,
+    FieldOfView, Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, ScopeAngle,
+    Seconds, Toughness,
 };
 
 #[derive(Clone, Debug, PartialEq, Deserialize)]
@@ -34,6 +35,10 @@ pub struct Scenario {
     /// and the tip pivots about the port. None: the device moves the tip (open surgery).
     #[serde(default)]
     pub port: Option<Port>,
+    /// The camera through its own port (laparoscopy); none: the desktop view of the open
+    /// abdomen.
+    #[serde(default)]
+    pub laparoscope: Option<LaparoscopeEntry>,
     #[serde(default)]
     pub device: Device,
     /// Stiffer lumps hidden in the organs' tissue, such as tumours, for palpation. The
@@ -139,6 +144,65 @@ impl Port {
             port_m: metres(self.at_mm),
             shaft_m: self.shaft_mm.metres(),
         }
+    }
+}
+
+/// The laparoscope: where its optic enters, what it looks at first, and its optics. The
+/// trainee steers it from there; the instrument's time out of its view is measured.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(rename = "Laparoscope", deny_unknown_fields)]
+pub struct LaparoscopeEntry {
+    /// Where the optic crosses the abdominal wall (mm, the scene's frame).
+    pub port_mm: (f64, f64, f64),
+    /// The point the view is centred on at the start (mm): the focus of the exercise.
+    pub look_at_mm: (f64, f64, f64),
+    /// How far the lens is from that point at the start (mm).
+    #[serde(default = "default_scope_distance")]
+    pub distance_mm: Millimetres,
+    /// The optic's viewing angle to its shaft (degrees; 0 or 30 usually).
+    #[serde(default = "default_scope_angle")]
+    pub angle_deg: ScopeAngle,
+    /// The side an angled optic looks towards at the start, about its shaft (degrees; 0
+    /// towards the head).
+    #[serde(default)]
+    pub roll_deg: f64,
+    /// The field of view across the round image (degrees).
+    #[serde(default = "default_field_of_view")]
+    pub fov_deg: FieldOfView,
+    /// A point the trainee must keep in view while steering the camera (mm); its time out
+    /// of view is measured. None: only the instrument's is.
+    #[serde(default)]
+    pub keep_in_view_mm: Option<(f64, f64, f64)>,
+}
+
+fn default_scope_distance() -> Millimetres {
+    Millimetres(80.0)
+}
+fn default_scope_angle() -> ScopeAngle {
+    ScopeAngle(30.0)
+}
+fn default_field_of_view() -> FieldOfView {
+    FieldOfView(70.0)
+}
+
+impl LaparoscopeEntry {
+    /// The optic as the core takes it.
+    pub fn laparoscope(&self) -> crate::devices::Laparoscope {
+        crate::devices::Laparoscope {
+            port_m: metres(self.port_mm),
+            angle_rad: self.angle_deg.radians(),
+            fov_rad: self.fov_deg.radians(),
+        }
+    }
+
+    /// Where the optic starts: centred on `look_at_mm` from `distance_mm` away; `None` when
+    /// the port is too near that point for it.
+    pub fn start(&self) -> Option<crate::devices::ScopePose> {
+        self.laparoscope().aim(
+            &metres(self.look_at_mm),
+            self.distance_mm.metres(),
+            self.roll_deg.to_radians(),
+        )
     }
 }
 
@@ -626,6 +690,11 @@ pub struct Rubric {
     /// took (1 with no wasted motion). None by default.
     #[serde(default)]
     pub motion: f64,
+    /// Weight of the view (laparoscopy): the share of the task's time the instrument's tip,
+    /// and the point to keep in view if there is one, are in the camera's view. None by
+    /// default.
+    #[serde(default)]
+    pub view: f64,
     /// Points lost per error (a forbidden zone entered, a press over the limit).
     #[serde(default = "default_error_penalty")]
     pub error_penalty: f64,
@@ -667,6 +736,7 @@ impl Default for Rubric {
             force: default_force(),
             accuracy: default_accuracy(),
             motion: 0.0,
+            view: 0.0,
             error_penalty: default_error_penalty(),
             pass_mark: default_pass_mark(),
             all_tasks_required: true,

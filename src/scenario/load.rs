@@ -212,8 +212,33 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
         check_task(scenario, k, task, &mut problems);
     }
     check_rubric(scenario, &mut problems);
+    check_laparoscope(scenario, &mut problems);
     check_backend(scenario, &mut problems);
     problems
+}
+
+/// The laparoscope must be able to look at its focus from where it enters, and a rubric that
+/// weighs the view needs a camera to have one.
+fn check_laparoscope(scenario: &Scenario, problems: &mut Vec<Problem>) {
+    match &scenario.laparoscope {
+        Some(scope) if scope.start().is_none() => problems.push(Problem {
+            field: "laparoscope.look_at_mm".into(),
+            anchors: vec!["laparoscope".into(), "look_at_mm".into()],
+            message: format!(
+                "the optic cannot look at ({}, {}, {}) from {} mm away: the port is too near it",
+                scope.look_at_mm.0, scope.look_at_mm.1, scope.look_at_mm.2, scope.distance_mm.0
+            ),
+            hint: "put the port farther from the point looked at, or shorten distance_mm".into(),
+        }),
+        None if scenario.rubric.view > 0.0 => problems.push(Problem {
+            field: "rubric.view".into(),
+            anchors: vec!["rubric".into(), "view".into()],
+            message: "the rubric weighs the view, but the scenario has no laparoscope".into(),
+            hint: "add `laparoscope: Laparoscope(port_mm: …, look_at_mm: …)`, or drop `view`"
+                .into(),
+        }),
+        _ => {}
+    }
 }
 
 /// A device the scenario names must be one the trainer knows.
@@ -548,6 +573,7 @@ fn check_rubric(scenario: &Scenario, problems: &mut Vec<Problem>) {
         rubric.force,
         rubric.accuracy,
         rubric.motion,
+        rubric.view,
     ];
     if weights.iter().any(|w| !(w.is_finite() && *w >= 0.0)) || weights.iter().sum::<f64>() <= 0.0 {
         problems.push(Problem {
@@ -555,7 +581,7 @@ fn check_rubric(scenario: &Scenario, problems: &mut Vec<Problem>) {
             anchors: vec!["rubric".into()],
             message: format!("the weights {weights:?} are not usable"),
             hint:
-                "completion, speed, force, accuracy and motion are weights of 0 or more, not all 0"
+                "completion, speed, force, accuracy, motion and view are weights of 0 or more, not all 0"
                     .into(),
         });
     }

@@ -16,7 +16,7 @@ pub use exercise::{
     COVERED_TO_FINISH, Exercise, NoduleSite, Progress, RegionSite, Sample, Sites, TaskMetrics,
 };
 pub use format::{
-    Contact, Device, Difficulty, Nodule, OrganEntry, Port, Rubric, Scenario, Spot, Task, TaskKind,
+    Contact, Device, Difficulty, LaparoscopeEntry, Nodule, OrganEntry, Port, Rubric, Scenario, Spot, Task, TaskKind,
     Tool, metres,
 };
 pub use incision::{BladeSample, IncisionMetrics, IncisionTracker};
@@ -24,5 +24,6 @@ pub use load::{ScenarioError, load, parse};
 pub use motion::{IDLE_M_PER_S, MOVING_M_PER_S, MotionMetrics, MotionTracker, STRIDE};
 pub use score::{CutMade, Scorecard, TaskScore, score};
 pub use units::{
-    Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, Seconds, Toughness,
+    FieldOfView, Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, ScopeAngle,
+    Seconds, Toughness,
 };

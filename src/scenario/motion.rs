@@ -1,6 +1,6 @@
 //! The objective motion metrics of laparoscopic trainers, from the tool tip's trajectory as
 //! the haptic loop samples it: path length, economy of motion, number of movements, idle time
-//! and smoothness (jerk).
+//! smoothness (jerk), and, under a laparoscope, the time the tip is out of the camera's view.
 //!
 //! The tip is read every tick, but velocity and its derivatives are taken on a 100 Hz
 //! subsample (every [`STRIDE`] ticks): a device's position quantization, differentiated three
@@ -36,6 +36,9 @@ pub struct MotionMetrics {
     pub idle_s: f64,
     /// The root mean square of the tip's jerk (m/s³): the lower, the smoother.
     pub rms_jerk_m_per_s3: f64,
+    /// Under a laparoscope, the time the tip was out of the camera's view (s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub out_of_view_s: Option<f64>,
 }
 
 /// The running measurement.
@@ -107,6 +110,14 @@ impl MotionTracker {
             let jerk = (r[3] - r[2] * 3.0 + r[1] * 3.0 - r[0]) / (h * h * h);
             self.jerk_sum += jerk.norm_squared();
             self.jerk_samples += 1;
+        }
+    }
+
+    /// Takes whether the tip is in the camera's view at one tick (`dt` s after the last).
+    pub fn view(&mut self, in_view: bool, dt: f64) {
+        let out = self.metrics.out_of_view_s.get_or_insert(0.0);
+        if !in_view {
+            *out += dt;
         }
     }
 

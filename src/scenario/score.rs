@@ -94,6 +94,7 @@ fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
         (rubric.force, force_control(m)),
         (accuracy_weight, accuracy(m)),
         (rubric.motion, economy(m)),
+        (rubric.view, in_view(m)),
     ];
     let weights: f64 = terms.iter().map(|(w, _)| w).sum();
     let weighted = terms.iter().map(|(w, v)| w * v).sum::<f64>() / weights.max(f64::MIN_POSITIVE);
@@ -104,6 +105,20 @@ fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
 /// never left its start: nothing was wasted).
 fn economy(m: &TaskMetrics) -> f64 {
     m.motion.economy.map_or(1.0, |e| (1.0 / e).clamp(0.0, 1.0))
+}
+
+/// The share of the task's time in the camera's view: the mean over the tip and the point to
+/// keep in view (those measured; 1 with neither).
+fn in_view(m: &TaskMetrics) -> f64 {
+    let shares: Vec<f64> = [m.motion.out_of_view_s, m.target_out_of_view_s]
+        .into_iter()
+        .flatten()
+        .map(|out_s| 1.0 - out_s / m.time_s.max(f64::MIN_POSITIVE))
+        .collect();
+    match shares.len() {
+        0 => 1.0,
+        n => (shares.iter().sum::<f64>() / n as f64).clamp(0.0, 1.0),
+    }
 }
 
 /// Palpation: 1 for a mark on the nodule, falling linearly to 0 at twice the distance that
@@ -150,6 +165,9 @@ fn force_control(m: &TaskMetrics) -> f64 {
     (1.0 - over_s / m.contact_s).clamp(0.0, 1.0)
 }
 
+/// Time out of the camera's view the debrief mentions (s): a glance aside is not worth a line.
+const NOTED_OUT_OF_VIEW_S: f64 = 0.5;
+
 fn task_feedback(task: &TaskScore) -> Vec<String> {
     let m = &task.metrics;
     let mut lines = Vec::new();
@@ -181,6 +199,18 @@ fn task_feedback(task: &TaskScore) -> Vec<String> {
         lines.push(format!(
             "{}: {:.1} s above {:.2} N (peak {:.2} N)",
             m.kind, m.time_over_limit_s, m.force_limit_n, m.peak_force_n
+        ));
+    }
+    if let Some(out_s) = m.motion.out_of_view_s.filter(|&s| s >= NOTED_OUT_OF_VIEW_S) {
+        lines.push(format!(
+            "{}: the instrument was out of the camera's view for {out_s:.1} s",
+            m.kind
+        ));
+    }
+    if let Some(out_s) = m.target_out_of_view_s.filter(|&s| s >= NOTED_OUT_OF_VIEW_S) {
+        lines.push(format!(
+            "{}: the point to keep in view left the camera's view for {out_s:.1} s",
+            m.kind
         ));
     }
     if let Some(limit) = m.surrounding_limit_n

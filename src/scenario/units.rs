@@ -176,3 +176,50 @@ impl TryFrom<f64> for Toughness {
         }
     }
 }
+
+/// A laparoscope's viewing angle to its shaft, in degrees: from 0 to 70 (optics are made at
+/// 0°, 30°, 45° and 70°).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct ScopeAngle(pub f64);
+
+impl ScopeAngle {
+    pub fn radians(self) -> f64 {
+        self.0.to_radians()
+    }
+}
+
+impl TryFrom<f64> for ScopeAngle {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (0.0..=70.0).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v}° is not a laparoscope's angle: from 0 to 70 degrees (0 and 30 are the usual optics)"
+            )),
+        }
+    }
+}
+
+/// A laparoscope's field of view across its round image, in degrees: from 30 to 120.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct FieldOfView(pub f64);
+
+impl FieldOfView {
+    pub fn radians(self) -> f64 {
+        self.0.to_radians()
+    }
+}
+
+impl TryFrom<f64> for FieldOfView {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (30.0..=120.0).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v}° is not a laparoscope's field of view: from 30 to 120 degrees (about 70 is usual)"
+            )),
+        }
+    }
+}

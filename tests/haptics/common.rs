@@ -58,6 +58,7 @@ pub fn scene(safety: SafetySettings) -> HapticScene {
         dynamics: None,
         cutting: None,
         port: None,
+        scope: None,
         organs: vec![("liver".into(), liver().vademecum.clone())],
         probe: Probe {
             tip_radius_m: TIP_RADIUS_M,

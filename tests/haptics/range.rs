@@ -53,6 +53,7 @@ fn press(vademecum: &Arc<Vademecum>, depth_m: f64) -> (HeadlessReport, ForceTrac
         dynamics: None,
         cutting: None,
         port: None,
+        scope: None,
     };
     let target = PressTarget {
         point_m: Vector3::new(0.03, 0.02, 0.03),

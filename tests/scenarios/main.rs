@@ -299,6 +299,24 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "tasks[0].organ",
             "needs a grasper",
         ),
+        (
+            "laparoscope-port-on-the-focus",
+            7,
+            "laparoscope.look_at_mm",
+            "the port is too near it",
+        ),
+        (
+            "laparoscope-angle-out-of-range",
+            5,
+            "angle_deg",
+            "not a laparoscope's angle",
+        ),
+        (
+            "view-without-laparoscope",
+            8,
+            "rubric.view",
+            "no laparoscope",
+        ),
     ];
     for (name, line, field, message) in cases {
         let file = root().join(format!("tests/scenarios/broken/{name}.scenario.ron"));

@@ -20,7 +20,8 @@ pub use components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolT
 pub use cutting::{OrganCut, SettleCuts};
 pub use report::{ForceSummary, HeadlessReport, RangeSummary, TickTimes};
 pub use resources::{
-    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, TickClock, Tool,
+    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, SceneScope, Scope,
+    TickClock, Tool,
 };
 pub use runner::{HapticLoop, HapticScene, SceneCutting, SceneDynamics, SceneError};
 pub use scoring::{ExerciseLink, ExerciseRun};

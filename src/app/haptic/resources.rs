@@ -7,7 +7,12 @@ use crate::contact::Coupling;
 use nalgebra::Vector3;
 
 use crate::contact::Probe;
-use crate::devices::{DeviceSample, Fault, Fulcrum, HapticDevice, Pose, SafetyFilter, Workspace};
+use std::sync::Arc;
+
+use crate::devices::{
+    DeviceSample, Fault, Fulcrum, HapticDevice, Laparoscope, Pose, SafetyFilter, ScopeHandle,
+    ScopePose, Workspace,
+};
 
 #[derive(Resource)]
 pub struct Device(pub Box<dyn HapticDevice>);
@@ -72,3 +77,36 @@ pub struct OrganCoupling(pub Coupling);
 /// pull the organ with, and the release's fade.
 #[derive(Resource, Clone, Copy, Debug, Default)]
 pub struct GraspForce(pub Vector3<f64>);
+
+/// A scene's laparoscope: its optic, its pose (shared with the window, which steers it), and
+/// the point the trainee is to keep in view, if any.
+#[derive(Clone, Debug)]
+pub struct SceneScope {
+    pub scope: Laparoscope,
+    pub pose: Arc<ScopeHandle>,
+    pub keep_in_view_m: Option<Vector3<f64>>,
+}
+
+/// The laparoscope inside the haptic world, with the pose it was last read at.
+#[derive(Resource, Debug)]
+pub struct Scope {
+    pub rig: SceneScope,
+    pub pose: ScopePose,
+}
+
+impl Scope {
+    pub fn new(rig: SceneScope) -> Self {
+        let pose = rig.pose.get();
+        Self { rig, pose }
+    }
+
+    /// Reads the pose, or keeps the last one while the window holds it, and says whether the
+    /// tip (if known) and the point to keep in view are in view.
+    pub fn in_view(&mut self, tip_m: Option<&Vector3<f64>>) -> (Option<bool>, Option<bool>) {
+        if let Some(pose) = self.rig.pose.try_get() {
+            self.pose = pose;
+        }
+        let sees = |point: &Vector3<f64>| self.rig.scope.sees(&self.pose, point);
+        (tip_m.map(sees), self.rig.keep_in_view_m.as_ref().map(sees))
+    }
+}

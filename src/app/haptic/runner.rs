@@ -9,7 +9,8 @@ use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, To
 use super::cutting::{OrganCut, SettleCuts};
 use super::report::{ForceSummary, HeadlessReport, RangeSummary};
 use super::resources::{
-    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, Safety, TickClock, Tool,
+    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, Safety, SceneScope,
+    Scope, TickClock, Tool,
 };
 use super::snapshot::{HapticSnapshot, OrganSnapshot, SnapshotPublisher};
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
@@ -39,6 +40,8 @@ pub struct HapticScene {
     /// The port the instrument goes through, if it does: the device then moves its handle
     /// (laparoscopy); otherwise its tip (open surgery).
     pub port: Option<Fulcrum>,
+    /// The laparoscope, if the trainee looks through one.
+    pub scope: Option<SceneScope>,
 }
 
 /// The scalpel's blade and the organs it cuts (by index into the scene's organs): each
@@ -140,6 +143,9 @@ impl HapticLoop {
         world.insert_resource(Parked(scene.safety));
         if let Some(coupling) = &scene.coupling {
             world.insert_resource(OrganCoupling(Coupling::clone(coupling)));
+        }
+        if let Some(scope) = &scene.scope {
+            world.insert_resource(Scope::new(scope.clone()));
         }
         Ok(Self {
             world,

@@ -14,7 +14,7 @@ use bevy::prelude::*;
 
 use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
 use super::cutting::OrganCut;
-use super::resources::{DeviceForce, TickClock, Tool};
+use super::resources::{DeviceForce, Scope, TickClock, Tool};
 use super::snapshot::SnapshotPublisher;
 use crate::scenario::{BladeSample, Exercise, Progress, RegionSite, Sample};
 
@@ -174,6 +174,7 @@ pub fn score_tick(
     force: Res<DeviceForce>,
     organs: Query<Organ>,
     run: Option<ResMut<ExerciseRun>>,
+    scope: Option<ResMut<Scope>>,
 ) {
     let Some(mut run) = run else {
         return;
@@ -204,9 +205,12 @@ pub fn score_tick(
     let (region_moved_m, surrounding_force_n) = exercise
         .watched_region()
         .map_or((0.0, 0.0), |region| watch(region, &organs));
+    let tip_m = tool.sample.map(|s| s.tip_m);
+    let (tip_in_view, target_in_view) =
+        scope.map_or((None, None), |mut scope| scope.in_view(tip_m.as_ref()));
     exercise.step(&Sample {
         time_s: clock.time_s,
-        tip_m: tool.sample.map(|s| s.tip_m),
+        tip_m,
         force_n: force.sent_n.norm(),
         touching,
         button: tool.sample.is_some_and(|s| s.buttons & 1 != 0),
@@ -215,6 +219,8 @@ pub fn score_tick(
         grasping,
         tore,
         blade,
+        tip_in_view,
+        target_in_view,
     });
     if exercise.finished() {
         let run = &mut *run;

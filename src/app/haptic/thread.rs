@@ -242,6 +242,7 @@ mod tests {
             dynamics: None,
             cutting: None,
             port: None,
+            scope: None,
         }
     }
 

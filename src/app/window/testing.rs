@@ -19,6 +19,7 @@ pub fn scene_without_organs() -> HapticScene {
         dynamics: None,
         cutting: None,
         port: None,
+        scope: None,
     }
 }
 
