@@ -6,6 +6,7 @@ use bevy::input::mouse::{AccumulatedMouseMotion, MouseScrollUnit, MouseWheel};
 use bevy::prelude::*;
 
 use super::FrameSet;
+use super::laparoscope::CameraMode;
 
 /// Radians of orbit per pixel dragged.
 const ORBIT_PER_PIXEL: f32 = 0.005;
@@ -44,7 +45,12 @@ impl Orbit {
 }
 
 pub(super) fn setup(app: &mut App) {
-    app.add_systems(Update, orbit.in_set(FrameSet::Input));
+    app.add_systems(
+        Update,
+        orbit
+            .in_set(FrameSet::Input)
+            .run_if(resource_equals(CameraMode::Free)),
+    );
 }
 
 fn orbit(

@@ -39,13 +39,24 @@ const SAMPLES_PER_ORGAN: usize = 24;
 /// from silhouettes where a pixel may show what lies behind.
 const FACING: f32 = 0.6;
 
-/// The legend of the frame `camera` sees: `surfaces` as drawn, and the tool's sphere.
+/// The round image of a laparoscope on the screen (pixels): what lies outside is masked.
+#[derive(Clone, Copy, Debug)]
+pub struct Aperture {
+    pub centre_px: Vec2,
+    pub radius_px: f32,
+}
+
+/// The legend of the frame `camera` sees: `surfaces` as drawn, and the tool's sphere; only
+/// pixels inside the `aperture`, if the view has one.
 pub fn legend(
     camera: (&Camera, &GlobalTransform),
     scale_factor: f32,
     surfaces: &[DrawnSurface],
     tool: Option<(Vec3, f32)>,
+    aperture: Option<Aperture>,
 ) -> Legend {
+    let unmasked =
+        |px: &Vec2| aperture.is_none_or(|a| px.distance(a.centre_px) <= a.radius_px);
     let eye = camera.1.translation();
     let meshes: Vec<_> = surfaces
         .iter()
@@ -57,6 +68,7 @@ pub fn legend(
             .world_to_viewport(camera.1, p)
             .ok()
             .map(|px| px * scale_factor)
+            .filter(unmasked)
     };
     let in_sight = |p: Vec3| {
         let (distance, dir) = ((p - eye).length(), (p - eye).normalize());

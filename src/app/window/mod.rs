@@ -2,12 +2,14 @@
 //! snapshot, the tool and the force it renders, a HUD, and the mouse driving the virtual
 //! device. The haptic loop runs apart; this side only reads its snapshots.
 
+mod abdomen;
 mod bridge;
 mod camera;
 mod frames;
 mod hud;
 mod incision;
 mod input;
+mod laparoscope;
 mod legend;
 mod lesson;
 mod menu;
@@ -142,6 +144,8 @@ pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
     menu::setup(&mut app, window.menu.clone());
     bridge::setup(&mut app, window);
     organs::setup(&mut app);
+    abdomen::setup(&mut app);
+    laparoscope::setup(&mut app);
     camera::setup(&mut app);
     tool::setup(&mut app);
     incision::setup(&mut app);

@@ -52,19 +52,7 @@ fn spawn_organs(
             SceneView,
             Name::new(name.clone()),
             Mesh3d(meshes.add(mesh)),
-            MeshMaterial3d(materials.add(StandardMaterial {
-                base_color_texture: Some(images.add(colour)),
-                metallic_roughness_texture: Some(images.add(roughness)),
-                metallic: 0.0,
-                perceptual_roughness: 1.0,
-                reflectance: 0.5,
-                // Wet tissue: a thin glossy film over the rougher parenchyma.
-                clearcoat: 0.5,
-                clearcoat_perceptual_roughness: 0.2,
-                double_sided: true,
-                cull_mode: None,
-                ..default()
-            })),
+            MeshMaterial3d(materials.add(tissue::wet(images.add(colour), images.add(roughness)))),
             OrganView {
                 index,
                 field: vec![0.0; vademecum.dof_count()],
@@ -98,6 +86,7 @@ fn spawn_camera_and_light(mut commands: Commands, link: Res<HapticLink>) {
     commands.spawn((SceneView, Camera3d::default(), orbit.transform(), orbit));
     commands.spawn((
         SceneView,
+        super::laparoscope::Daylight,
         DirectionalLight {
             illuminance: 9_000.0,
             shadow_maps_enabled: true,

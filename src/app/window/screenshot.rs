@@ -15,7 +15,8 @@ use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy::render::{ExtractSchedule, MainWorld, RenderApp};
 use bevy::window::PrimaryWindow;
 
-use super::legend::{DrawnSurface, Legend, legend};
+use super::laparoscope::CameraMode;
+use super::legend::{Aperture, DrawnSurface, Legend, legend};
 use super::organs::OrganView;
 use super::tool::ToolTip;
 use super::{FrameSet, HapticLink};
@@ -73,6 +74,7 @@ struct Frame<'w, 's> {
     tip: Query<'w, 's, (&'static Transform, &'static Visibility), With<ToolTip>>,
     meshes: Res<'w, Assets<Mesh>>,
     link: Res<'w, HapticLink>,
+    mode: Res<'w, CameraMode>,
 }
 
 /// Where the screenshot stands.
@@ -189,11 +191,18 @@ fn drawn(width: u32, rgb: &[u8], legend: &Legend, background: [u8; 4]) -> bool {
 
 fn frame_legend(frame: &Frame) -> Result<Legend, String> {
     let camera = frame.camera.single().map_err(|e| e.to_string())?;
-    let scale_factor = frame
-        .window
-        .single()
-        .map_err(|e| e.to_string())?
-        .scale_factor();
+    let window = frame.window.single().map_err(|e| e.to_string())?;
+    let scale_factor = window.scale_factor();
+    let aperture = (*frame.mode == CameraMode::Laparoscope).then(|| {
+        let size = Vec2::new(
+            window.physical_width() as f32,
+            window.physical_height() as f32,
+        );
+        Aperture {
+            centre_px: size / 2.0,
+            radius_px: size.y / 2.0,
+        }
+    });
     let drawn: Vec<_> = frame
         .organs
         .iter()
@@ -233,7 +242,7 @@ fn frame_legend(frame: &Frame) -> Result<Legend, String> {
                 frame.link.scene.probe.tip_radius_m as f32,
             )
         });
-    Ok(legend(camera, scale_factor, &surfaces, tool))
+    Ok(legend(camera, scale_factor, &surfaces, tool, aperture))
 }
 
 fn write_legend(path: &Path, legend: &Legend) -> Result<(), String> {

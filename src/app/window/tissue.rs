@@ -65,6 +65,40 @@ pub fn tissue(organ: &str) -> Tissue {
             vessels: 0.8,
             seed: 14,
         },
+        // The cavity around the organs: the parietal peritoneum over the walls, the stomach's
+        // paler serosa, the colon's and small bowel's pink.
+        "peritoneum" => Tissue {
+            base: srgb(0.72, 0.36, 0.34),
+            shade: srgb(0.56, 0.24, 0.24),
+            vessel: srgb(0.50, 0.10, 0.14),
+            lobules: 5,
+            vessels: 1.0,
+            seed: 16,
+        },
+        "stomach" => Tissue {
+            base: srgb(0.80, 0.58, 0.54),
+            shade: srgb(0.64, 0.42, 0.40),
+            vessel: srgb(0.52, 0.16, 0.20),
+            lobules: 7,
+            vessels: 0.9,
+            seed: 17,
+        },
+        "colon" => Tissue {
+            base: srgb(0.78, 0.62, 0.50),
+            shade: srgb(0.62, 0.46, 0.36),
+            vessel: srgb(0.50, 0.22, 0.20),
+            lobules: 6,
+            vessels: 0.6,
+            seed: 18,
+        },
+        "bowel" => Tissue {
+            base: srgb(0.84, 0.54, 0.54),
+            shade: srgb(0.68, 0.40, 0.42),
+            vessel: srgb(0.55, 0.18, 0.26),
+            lobules: 6,
+            vessels: 0.8,
+            seed: 19,
+        },
         _ => Tissue {
             base: srgb(0.78, 0.55, 0.52),
             shade: srgb(0.60, 0.40, 0.38),
@@ -142,6 +176,27 @@ fn image(texels: Vec<u8>, format: TextureFormat) -> Image {
         ..ImageSamplerDescriptor::linear()
     });
     image
+}
+
+/// Living tissue's surface: the tissue's colour and roughness tiles under a thin glossy film
+/// of moisture (clearcoat), whose highlights move as the light and the eye do, and some light
+/// let through from behind, as thin living tissue lets it (diffuse transmission, a cheap
+/// stand-in for subsurface scattering). Seen from both sides: a cut or a thin wall shows its
+/// inside lit.
+pub fn wet(colour: Handle<Image>, roughness: Handle<Image>) -> StandardMaterial {
+    StandardMaterial {
+        base_color_texture: Some(colour),
+        metallic_roughness_texture: Some(roughness),
+        metallic: 0.0,
+        perceptual_roughness: 1.0,
+        reflectance: 0.5,
+        clearcoat: 0.6,
+        clearcoat_perceptual_roughness: 0.15,
+        diffuse_transmission: 0.2,
+        double_sided: true,
+        cull_mode: None,
+        ..default()
+    }
 }
 
 /// Texture coordinates of rest positions: a planar projection along the axis in which the

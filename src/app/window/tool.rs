@@ -1,5 +1,5 @@
-//! The tool as the trainee sees it: a sphere at the tip the device reports, its shaft when it
-//! goes through a port, and an arrow of the force the device renders.
+//! The tool as the trainee sees it: a sphere at the tip the device reports, its steel shaft
+//! when it goes through a port, and an arrow of the force the device renders.
 
 use bevy::prelude::*;
 
@@ -9,6 +9,13 @@ use super::{FrameSet, SceneView, to_bevy};
 /// The sphere drawn at the tool tip.
 #[derive(Component)]
 pub(super) struct ToolTip;
+
+/// The instrument's shaft through a port: a steel rod from its handle to its tip.
+#[derive(Component)]
+pub(super) struct Shaft;
+
+/// A laparoscopic instrument's shaft radius (m): 5 mm instruments.
+const SHAFT_RADIUS_M: f32 = 0.0025;
 
 /// Arrow length per newton (m/N): 0.3 N, a firm press on the liver, draws 6 cm.
 const ARROW_M_PER_N: f32 = 0.2;
@@ -40,6 +47,21 @@ fn spawn_tool(
         Transform::default(),
         Visibility::Hidden,
     ));
+    if link.scene.port.is_some() {
+        commands.spawn((
+            SceneView,
+            Shaft,
+            Mesh3d(meshes.add(Cylinder::new(SHAFT_RADIUS_M, 1.0))),
+            MeshMaterial3d(materials.add(StandardMaterial {
+                base_color: Color::srgb(0.55, 0.57, 0.60),
+                metallic: 0.85,
+                perceptual_roughness: 0.3,
+                ..default()
+            })),
+            Transform::default(),
+            Visibility::Hidden,
+        ));
+    }
 }
 
 fn follow_device(
@@ -58,15 +80,25 @@ fn follow_device(
     }
 }
 
-/// Through a port, the instrument's shaft from its handle to its tip.
-fn draw_shaft(snapshot: Res<Snapshot>, mut gizmos: Gizmos) {
-    if let (Some(handle), Some(tip)) = (snapshot.0.handle_m, snapshot.0.tip_m) {
-        gizmos.line(
-            to_bevy(&handle),
-            to_bevy(&tip),
-            Color::srgb(0.6, 0.62, 0.66),
-        );
-    }
+/// Through a port, the instrument's shaft from its handle to its tip: the unit cylinder
+/// stretched along the line between them.
+fn draw_shaft(
+    snapshot: Res<Snapshot>,
+    mut shaft: Query<(&mut Transform, &mut Visibility), With<Shaft>>,
+) {
+    let Ok((mut transform, mut visibility)) = shaft.single_mut() else {
+        return;
+    };
+    let (Some(handle), Some(tip)) = (snapshot.0.handle_m, snapshot.0.tip_m) else {
+        *visibility = Visibility::Hidden;
+        return;
+    };
+    let (handle, tip) = (to_bevy(&handle), to_bevy(&tip));
+    let along = tip - handle;
+    *transform = Transform::from_translation((handle + tip) / 2.0)
+        .with_rotation(Quat::from_rotation_arc(Vec3::Y, along.normalize_or(Vec3::Y)))
+        .with_scale(Vec3::new(1.0, along.length(), 1.0));
+    *visibility = Visibility::Visible;
 }
 
 fn draw_force(snapshot: Res<Snapshot>, mut gizmos: Gizmos) {
