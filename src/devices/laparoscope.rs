@@ -105,7 +105,12 @@ impl Laparoscope {
     /// target the angle at the lens is π − angle, which fixes how deep the lens is
     /// (`D² = L² + d² + 2 L d cos α`) and how far the shaft turns from the target (`sin β =
     /// d sin α / D`). `None` when the target is within `distance_m` of the port.
-    pub fn aim(&self, target_m: &Vector3<f64>, distance_m: f64, roll_rad: f64) -> Option<ScopePose> {
+    pub fn aim(
+        &self,
+        target_m: &Vector3<f64>,
+        distance_m: f64,
+        roll_rad: f64,
+    ) -> Option<ScopePose> {
         let to_target = target_m - self.port_m;
         let reach_m = to_target.norm();
         let towards = Unit::try_new(to_target, 1e-9)?;

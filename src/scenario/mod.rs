@@ -16,8 +16,8 @@ pub use exercise::{
     COVERED_TO_FINISH, Exercise, NoduleSite, Progress, RegionSite, Sample, Sites, TaskMetrics,
 };
 pub use format::{
-    Contact, Device, Difficulty, LaparoscopeEntry, Nodule, OrganEntry, Port, Rubric, Scenario, Spot, Task, TaskKind,
-    Tool, metres,
+    Contact, Device, Difficulty, LaparoscopeEntry, Nodule, OrganEntry, Port, Rubric, Scenario,
+    Spot, Task, TaskKind, Tool, metres,
 };
 pub use incision::{BladeSample, IncisionMetrics, IncisionTracker};
 pub use load::{ScenarioError, load, parse};

@@ -84,7 +84,9 @@ fn a_target_too_near_the_port_cannot_be_aimed_at() {
 #[test]
 fn the_round_image_holds_half_the_field_of_view_around_the_centre() {
     let scope = optic(FRAC_PI_6);
-    let pose = scope.aim(&Vector3::new(0.02, -0.2, 0.01), 0.08, 0.7).unwrap();
+    let pose = scope
+        .aim(&Vector3::new(0.02, -0.2, 0.01), 0.08, 0.7)
+        .unwrap();
     let view = scope.view(&pose);
     let across = Unit::new_normalize(view.forward.cross(&view.up));
     let at = |degrees: f64, distance: f64| {
@@ -106,7 +108,9 @@ fn the_round_image_holds_half_the_field_of_view_around_the_centre() {
 #[test]
 fn steering_pivots_about_the_port_and_undoes_itself() {
     let scope = optic(FRAC_PI_6);
-    let pose = scope.aim(&Vector3::new(0.0, -0.2, 0.05), 0.08, 0.4).unwrap();
+    let pose = scope
+        .aim(&Vector3::new(0.0, -0.2, 0.05), 0.08, 0.4)
+        .unwrap();
     let view = scope.view(&pose);
     let right = view.forward.cross(&view.up);
     let aside = view.eye_m + (view.forward.into_inner() + right * 0.3) * 0.08;
@@ -133,7 +137,8 @@ fn steering_pivots_about_the_port_and_undoes_itself() {
         let again = scope.steer(&scope.steer(&pose, &steer), &back);
         assert!((again.inside_m - pose.inside_m).abs() < 1e-12);
         let axis = (again.axis.into_inner() - pose.axis.into_inner()).norm();
-        let forward = (scope.forward(&again).into_inner() - scope.forward(&pose).into_inner()).norm();
+        let forward =
+            (scope.forward(&again).into_inner() - scope.forward(&pose).into_inner()).norm();
         axis.max(forward)
     };
     let half = |s: Steer| Steer {
@@ -152,7 +157,10 @@ fn steering_pivots_about_the_port_and_undoes_itself() {
         let size = pivot.right_rad.hypot(pivot.up_rad);
         let (whole, halved) = (round_trip(pivot), round_trip(half(pivot)));
         assert!(whole < size * size, "{whole} for a step of {size} rad");
-        assert!(halved < whole / 3.0, "{halved} against {whole}: not second order");
+        assert!(
+            halved < whole / 3.0,
+            "{halved} against {whole}: not second order"
+        );
     }
     let shaft_only = Steer {
         in_m: 0.02,
@@ -207,9 +215,15 @@ fn the_exercise_times_the_tip_out_of_view() {
     assert_eq!(tasks[0].target_out_of_view_s, Some(0.0));
     let card = pgd_surgery::scenario::score(&scenario, tasks);
     // The view's share: the tip in view 30 % of the time, the target all of it.
-    assert!((card.score - 100.0 * (0.3 + 1.0) / 2.0).abs() < 0.2, "{}", card.score);
     assert!(
-        card.feedback.iter().any(|l| l.contains("out of the camera's view")),
+        (card.score - 100.0 * (0.3 + 1.0) / 2.0).abs() < 0.2,
+        "{}",
+        card.score
+    );
+    assert!(
+        card.feedback
+            .iter()
+            .any(|l| l.contains("out of the camera's view")),
         "{:?}",
         card.feedback
     );

@@ -65,7 +65,7 @@ fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     run_simulated(scenario, &scene, device, ticks).unwrap()
 }
 
-const SHIPPED: [&str; 9] = [
+const SHIPPED: [&str; 10] = [
     "liver-steady-press",
     "pancreas-palpation",
     "gallbladder-gentle-press",
@@ -75,6 +75,7 @@ const SHIPPED: [&str; 9] = [
     "gallbladder-retraction",
     "gallbladder-grasp-retract",
     "liver-capsule-incision",
+    "liver-laparoscopic-press",
 ];
 
 #[test]

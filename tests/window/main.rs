@@ -3,8 +3,10 @@
 //! tool held away, then pressing the liver — are checked against the legends the trainer
 //! writes beside them: the image is not blank, each organ's tissue colour shows where its
 //! surface is in sight, and the pressed frame differs from the rest frame around the tool and
-//! nowhere far from it. A missing display is reported plainly, without a panic.
+//! nowhere far from it. A missing display is reported plainly, without a panic. The
+//! laparoscopic view is checked on its own shipped scenario.
 
+mod laparoscope;
 mod xvfb;
 
 use std::path::{Path, PathBuf};

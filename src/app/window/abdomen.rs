@@ -41,10 +41,13 @@ fn ellipsoid(centre: [f32; 3], semi_axes: [f32; 3]) -> Mesh {
 }
 
 fn capsule(centre: [f32; 3], radius: f32, length: f32, along: Vec3) -> Mesh {
-    Capsule3d::new(radius, length).mesh().build().transformed_by(
-        Transform::from_translation(centre.into())
-            .with_rotation(Quat::from_rotation_arc(Vec3::Y, along.normalize())),
-    )
+    Capsule3d::new(radius, length)
+        .mesh()
+        .build()
+        .transformed_by(
+            Transform::from_translation(centre.into())
+                .with_rotation(Quat::from_rotation_arc(Vec3::Y, along.normalize())),
+        )
 }
 
 fn bowel_loop(centre: [f32; 3], tilt_rad: f32) -> Mesh {

@@ -105,8 +105,7 @@ fn start_distance_m(scope: &Laparoscope, pose: &ScopePose, centre_m: Vec3) -> f6
 
 fn camera_transform(view: &View) -> Transform {
     let eye = to_bevy(&view.eye_m);
-    Transform::from_translation(eye)
-        .looking_to(to_bevy(&view.forward), to_bevy(&view.up))
+    Transform::from_translation(eye).looking_to(to_bevy(&view.forward), to_bevy(&view.up))
 }
 
 /// C switches between the laparoscope and the free camera (only with a laparoscope).
@@ -177,38 +176,33 @@ fn look_through_optic(
     }
 }
 
-/// The tip's light in the laparoscopic view, daylight in the free one.
+/// What shows in one mode only.
+type ModeShown = Or<(With<TipLight>, With<Daylight>, With<Vignette>)>;
+
+/// The tip's light and the round image in the laparoscopic view, daylight in the free one.
 fn light_for_mode(
     mode: Res<CameraMode>,
-    mut tip: Query<&mut Visibility, (With<TipLight>, Without<Daylight>)>,
-    mut day: Query<&mut Visibility, (With<Daylight>, Without<TipLight>)>,
-    mut vignette: Query<
-        &mut Visibility,
-        (With<Vignette>, Without<TipLight>, Without<Daylight>),
-    >,
+    mut shown: Query<(&mut Visibility, Has<Daylight>), ModeShown>,
 ) {
     if !mode.is_changed() {
         return;
     }
     let through_optic = *mode == CameraMode::Laparoscope;
-    let shown = |on: bool| match on {
-        true => Visibility::Inherited,
-        false => Visibility::Hidden,
-    };
-    for mut visibility in &mut tip {
-        *visibility = shown(through_optic);
-    }
-    for mut visibility in &mut day {
-        *visibility = shown(!through_optic);
-    }
-    for mut visibility in &mut vignette {
-        *visibility = shown(through_optic);
+    for (mut visibility, daylight) in &mut shown {
+        *visibility = match through_optic != daylight {
+            true => Visibility::Inherited,
+            false => Visibility::Hidden,
+        };
     }
 }
 
 /// The optic's image is round, inscribed in the window's height: black bars either side and
 /// a square mask, clear inside its circle, between them. Behind the HUD's text.
-fn spawn_vignette(mut commands: Commands, link: Res<HapticLink>, mut images: ResMut<Assets<Image>>) {
+fn spawn_vignette(
+    mut commands: Commands,
+    link: Res<HapticLink>,
+    mut images: ResMut<Assets<Image>>,
+) {
     if link.scene.scope.is_none() {
         return;
     }
@@ -255,7 +249,10 @@ fn round_mask() -> Image {
     let half = MASK_TEXELS as f32 / 2.0;
     let texels: Vec<u8> = (0..MASK_TEXELS * MASK_TEXELS)
         .flat_map(|k| {
-            let (x, y) = ((k % MASK_TEXELS) as f32 + 0.5, (k / MASK_TEXELS) as f32 + 0.5);
+            let (x, y) = (
+                (k % MASK_TEXELS) as f32 + 0.5,
+                (k / MASK_TEXELS) as f32 + 0.5,
+            );
             let r = ((x - half).powi(2) + (y - half).powi(2)).sqrt() / half;
             let alpha = ((r - 0.97) / 0.03).clamp(0.0, 1.0);
             [0, 0, 0, (alpha * 255.0).round() as u8]

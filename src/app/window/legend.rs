@@ -55,8 +55,7 @@ pub fn legend(
     tool: Option<(Vec3, f32)>,
     aperture: Option<Aperture>,
 ) -> Legend {
-    let unmasked =
-        |px: &Vec2| aperture.is_none_or(|a| px.distance(a.centre_px) <= a.radius_px);
+    let unmasked = |px: &Vec2| aperture.is_none_or(|a| px.distance(a.centre_px) <= a.radius_px);
     let eye = camera.1.translation();
     let meshes: Vec<_> = surfaces
         .iter()

@@ -96,7 +96,10 @@ fn draw_shaft(
     let (handle, tip) = (to_bevy(&handle), to_bevy(&tip));
     let along = tip - handle;
     *transform = Transform::from_translation((handle + tip) / 2.0)
-        .with_rotation(Quat::from_rotation_arc(Vec3::Y, along.normalize_or(Vec3::Y)))
+        .with_rotation(Quat::from_rotation_arc(
+            Vec3::Y,
+            along.normalize_or(Vec3::Y),
+        ))
         .with_scale(Vec3::new(1.0, along.length(), 1.0));
     *visibility = Visibility::Visible;
 }
