@@ -59,6 +59,7 @@ fn scene_scope(entry: &LaparoscopeEntry) -> Option<SceneScope> {
         scope: entry.laparoscope(),
         pose: Arc::new(ScopeHandle::new(entry.start()?)),
         keep_in_view_m: entry.keep_in_view_mm.map(scenario::metres),
+        script: entry.script(),
     })
 }
 

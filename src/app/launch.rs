@@ -38,6 +38,8 @@ pub struct Options {
     /// window always ticks on the real clock, with this timer or the default.
     pub realtime: Option<TimerMode>,
     pub max_force_n: f64,
+    /// The window opens a laparoscopic scenario with the free camera, not the laparoscope.
+    pub free_camera: bool,
 }
 
 /// What a headless run reports.
@@ -244,6 +246,7 @@ pub fn open_window(
         lesson,
         lessons: lessons.clone(),
         menu,
+        free_camera: options.free_camera,
     });
     let (report, mut haptic) = haptic.stop();
     let attempts = attempts(&lessons, &mut haptic);

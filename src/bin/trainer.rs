@@ -85,6 +85,10 @@ struct Cli {
     /// chosen).
     #[arg(long)]
     free_play: bool,
+    /// Open a laparoscopic scenario with the free camera instead of the laparoscope (C
+    /// switches between them in the window).
+    #[arg(long, global = true)]
+    free_camera: bool,
 }
 
 const DEFAULT_REPORT_DIR: &str = "reports";
@@ -189,6 +193,7 @@ fn main() -> ExitCode {
         ticks: cli.ticks,
         realtime,
         max_force_n: cli.max_force_n,
+        free_camera: cli.free_camera,
     };
     let exercise = match &cli.command {
         Some(Command::Run { file, report_dir }) => match scenario::load(file) {

@@ -183,6 +183,16 @@ impl ScopeHandle {
         *self.0.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
+    /// Sets the pose, unless someone holds the lock this instant (the haptic loop moving a
+    /// scripted camera: it tries again next tick).
+    pub fn try_set(&self, pose: ScopePose) {
+        match self.0.try_lock() {
+            Ok(mut held) => *held = pose,
+            Err(TryLockError::Poisoned(poisoned)) => *poisoned.into_inner() = pose,
+            Err(TryLockError::WouldBlock) => {}
+        }
+    }
+
     /// The pose, unless someone holds the lock this instant.
     pub fn try_get(&self) -> Option<ScopePose> {
         match self.0.try_lock() {
@@ -190,5 +200,41 @@ impl ScopeHandle {
             Err(TryLockError::Poisoned(poisoned)) => Some(*poisoned.into_inner()),
             Err(TryLockError::WouldBlock) => None,
         }
+    }
+}
+
+/// A camera moved by the scenario rather than the trainee: at each key time the view is
+/// centred on a point from a distance, and between keys both go linearly from one key to the
+/// next (the optic aimed anew each time, at the script's roll). Before the first key the view
+/// is the first's, after the last the last's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScopeScript {
+    /// (time s, point looked at m, distance m), in time order.
+    pub keys: Vec<(f64, Vector3<f64>, f64)>,
+    pub roll_rad: f64,
+}
+
+impl ScopeScript {
+    /// The point looked at and the distance at `time_s`.
+    pub fn look_at(&self, time_s: f64) -> Option<(Vector3<f64>, f64)> {
+        let after = self.keys.iter().position(|k| k.0 > time_s);
+        let (from, to) = match after {
+            Some(0) => (self.keys.first()?, self.keys.first()?),
+            Some(k) => (&self.keys[k - 1], &self.keys[k]),
+            None => (self.keys.last()?, self.keys.last()?),
+        };
+        let span = to.0 - from.0;
+        let t = if span > 0.0 {
+            ((time_s - from.0) / span).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        Some((from.1.lerp(&to.1, t), from.2 + (to.2 - from.2) * t))
+    }
+
+    /// Where `scope` is at `time_s`; `None` when its port is too near the point looked at.
+    pub fn pose_at(&self, scope: &Laparoscope, time_s: f64) -> Option<ScopePose> {
+        let (target, distance_m) = self.look_at(time_s)?;
+        scope.aim(&target, distance_m, self.roll_rad)
     }
 }

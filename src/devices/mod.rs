@@ -24,7 +24,9 @@ mod workspace;
 pub use device::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
 pub use forcedimension::ForceDimension;
 pub use fulcrum::{Fulcrum, MIN_OUTSIDE_M, Pose};
-pub use laparoscope::{Laparoscope, MIN_INSIDE_M, ScopeHandle, ScopePose, Steer, View};
+pub use laparoscope::{
+    Laparoscope, MIN_INSIDE_M, ScopeHandle, ScopePose, ScopeScript, Steer, View,
+};
 pub use openhaptics::OpenHaptics;
 pub use recorder::Recorder;
 pub use safety::{Fault, SafetyFilter, SafetySettings};

@@ -215,6 +215,7 @@ pub struct Exercise {
     current: usize,
     running: Option<Running>,
     done: Vec<TaskMetrics>,
+    first_time_s: Option<f64>,
     last_time_s: Option<f64>,
     ticks: u64,
     /// (time s, force N) at 100 Hz while a task runs, for the report's plot; sized for every
@@ -234,6 +235,7 @@ impl Exercise {
             current: 0,
             running: None,
             done: Vec::new(),
+            first_time_s: None,
             last_time_s: None,
             ticks: 0,
             force_trace: Vec::with_capacity(samples + 1),
@@ -252,6 +254,12 @@ impl Exercise {
         }
     }
 
+    /// Seconds from the exercise's first tick to `time_s` (0 before it has begun).
+    pub fn elapsed_s(&self, time_s: f64) -> f64 {
+        self.first_time_s
+            .map_or(0.0, |first| (time_s - first).max(0.0))
+    }
+
     /// The region the task under way watches (retraction), for the sample to measure.
     pub fn watched_region(&self) -> Option<&RegionSite> {
         self.sites.regions.get(self.current)?.as_ref()
@@ -268,6 +276,7 @@ impl Exercise {
             .last_time_s
             .map_or(0.0, |last| (sample.time_s - last).max(0.0));
         self.last_time_s = Some(sample.time_s);
+        self.first_time_s.get_or_insert(sample.time_s);
         if self.finished() {
             return;
         }

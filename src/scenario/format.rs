@@ -173,6 +173,20 @@ pub struct LaparoscopeEntry {
     /// of view is measured. None: only the instrument's is.
     #[serde(default)]
     pub keep_in_view_mm: Option<(f64, f64, f64)>,
+    /// The camera moved by the scenario, key by key, instead of by the trainee (a guided
+    /// view). Empty: the trainee steers it.
+    #[serde(default)]
+    pub script: Vec<ScopeKey>,
+}
+
+/// A key of a scripted camera: at `at_s` seconds from the exercise's start, the view is
+/// centred on `look_at_mm` from `distance_mm` away.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(rename = "Look", deny_unknown_fields)]
+pub struct ScopeKey {
+    pub at_s: f64,
+    pub look_at_mm: (f64, f64, f64),
+    pub distance_mm: Millimetres,
 }
 
 fn default_scope_distance() -> Millimetres {
@@ -195,14 +209,29 @@ impl LaparoscopeEntry {
         }
     }
 
-    /// Where the optic starts: centred on `look_at_mm` from `distance_mm` away; `None` when
-    /// the port is too near that point for it.
+    /// Where the optic starts: centred on `look_at_mm` from `distance_mm` away (or the
+    /// script's first key); `None` when the port is too near that point for it.
     pub fn start(&self) -> Option<crate::devices::ScopePose> {
-        self.laparoscope().aim(
-            &metres(self.look_at_mm),
-            self.distance_mm.metres(),
-            self.roll_deg.to_radians(),
-        )
+        match self.script() {
+            Some(script) => script.pose_at(&self.laparoscope(), 0.0),
+            None => self.laparoscope().aim(
+                &metres(self.look_at_mm),
+                self.distance_mm.metres(),
+                self.roll_deg.to_radians(),
+            ),
+        }
+    }
+
+    /// The scripted camera, if the scenario moves it.
+    pub fn script(&self) -> Option<crate::devices::ScopeScript> {
+        (!self.script.is_empty()).then(|| crate::devices::ScopeScript {
+            keys: self
+                .script
+                .iter()
+                .map(|k| (k.at_s, metres(k.look_at_mm), k.distance_mm.metres()))
+                .collect(),
+            roll_rad: self.roll_deg.to_radians(),
+        })
     }
 }
 

@@ -7,7 +7,7 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use super::format::{OrganEntry, Scenario, Task, metres};
+use super::format::{LaparoscopeEntry, OrganEntry, Scenario, Task, metres};
 use crate::contact::PointshellDensity;
 use crate::devices::DeviceSpec;
 use crate::mesh::Surface;
@@ -117,7 +117,8 @@ fn hint_for(code: &ron::Error) -> String {
 }
 
 /// A problem found after parsing: the field path, and what to look for in the text to put
-/// the cursor on it (each key or quoted value in turn, from the start of the file).
+/// the cursor on it (each key or quoted value in turn, from the start of the file; the same
+/// anchor twice in a row, the next occurrence).
 struct Problem {
     field: String,
     anchors: Vec<String>,
@@ -128,10 +129,14 @@ struct Problem {
 impl Problem {
     fn locate(self, file: &Path, text: &str) -> ScenarioError {
         let mut at = 0;
+        let mut previous: Option<&String> = None;
         for anchor in &self.anchors {
-            if let Some(found) = text[at..].find(anchor.as_str()) {
-                at += found;
+            // An anchor repeated finds the next occurrence (the k-th item of a list).
+            let from = at + previous.filter(|p| *p == anchor).map_or(0, |p| p.len());
+            if let Some(found) = text.get(from..).and_then(|rest| rest.find(anchor.as_str())) {
+                at = from + found;
             }
+            previous = Some(anchor);
         }
         let line = text[..at].matches('\n').count() + 1;
         let column = at - text[..at].rfind('\n').map_or(0, |n| n + 1) + 1;
@@ -217,6 +222,33 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
     problems
 }
 
+/// A scripted camera's keys run forward in time from 0, each at a point the optic can look at.
+fn check_script(scope: &LaparoscopeEntry) -> Option<Problem> {
+    let optic = scope.laparoscope();
+    scope.script.iter().enumerate().find_map(|(k, key)| {
+        let earlier = k.checked_sub(1).map_or(0.0, |j| scope.script[j].at_s);
+        let message = if !(key.at_s.is_finite() && key.at_s >= earlier) {
+            format!("the key at {} s comes before the one at {earlier} s", key.at_s)
+        } else if optic
+            .aim(&metres(key.look_at_mm), key.distance_mm.metres(), 0.0)
+            .is_none()
+        {
+            "the optic cannot look at this point from its port: the port is too near it".into()
+        } else {
+            return None;
+        };
+        Some(Problem {
+            field: format!("laparoscope.script[{k}]"),
+            anchors: vec!["laparoscope".into(), "script".into(), "Look".into()]
+                .into_iter()
+                .chain(std::iter::repeat_n("Look".to_owned(), k))
+                .collect(),
+            message,
+            hint: "keys in time order from 0 s, each looking at a point farther from the port than distance_mm".into(),
+        })
+    })
+}
+
 /// The laparoscope must be able to look at its focus from where it enters, and a rubric that
 /// weighs the view needs a camera to have one.
 fn check_laparoscope(scenario: &Scenario, problems: &mut Vec<Problem>) {
@@ -230,6 +262,7 @@ fn check_laparoscope(scenario: &Scenario, problems: &mut Vec<Problem>) {
             ),
             hint: "put the port farther from the point looked at, or shorten distance_mm".into(),
         }),
+        Some(scope) => problems.extend(check_script(scope)),
         None if scenario.rubric.view > 0.0 => problems.push(Problem {
             field: "rubric.view".into(),
             anchors: vec!["rubric".into(), "view".into()],

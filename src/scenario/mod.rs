@@ -17,7 +17,7 @@ pub use exercise::{
 };
 pub use format::{
     Contact, Device, Difficulty, LaparoscopeEntry, Nodule, OrganEntry, Port, Rubric, Scenario,
-    Spot, Task, TaskKind, Tool, metres,
+    ScopeKey, Spot, Task, TaskKind, Tool, metres,
 };
 pub use incision::{BladeSample, IncisionMetrics, IncisionTracker};
 pub use load::{ScenarioError, load, parse};

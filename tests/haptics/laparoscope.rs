@@ -7,7 +7,7 @@
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_6, PI};
 
 use nalgebra::{Unit, Vector3};
-use pgd_surgery::devices::{Laparoscope, MIN_INSIDE_M, ScopePose, Steer};
+use pgd_surgery::devices::{Laparoscope, MIN_INSIDE_M, ScopePose, ScopeScript, Steer};
 use pgd_surgery::scenario::{Exercise, Sample, Sites, parse};
 
 /// An optic through a port at the origin, 70° across its image.
@@ -231,4 +231,29 @@ fn the_exercise_times_the_tip_out_of_view() {
 
 fn metres(at_mm: (f64, f64, f64)) -> Vector3<f64> {
     pgd_surgery::scenario::metres(at_mm)
+}
+
+/// A scripted camera: at its keys it is aimed as the keys say; between them the view is
+/// centred on the point between theirs; before the first and after the last it holds.
+#[test]
+fn a_scripted_camera_goes_from_key_to_key() {
+    let scope = optic(FRAC_PI_6);
+    let (a, b) = (
+        Vector3::new(0.0, -0.2, 0.05),
+        Vector3::new(0.06, -0.18, -0.02),
+    );
+    let script = ScopeScript {
+        keys: vec![(1.0, a, 0.08), (3.0, b, 0.1)],
+        roll_rad: PI,
+    };
+    let centre = |time_s: f64, distance: f64| {
+        let view = scope.view(&script.pose_at(&scope, time_s).unwrap());
+        view.eye_m + view.forward.into_inner() * distance
+    };
+    assert_eq!(script.pose_at(&scope, 1.0), scope.aim(&a, 0.08, PI));
+    assert_eq!(script.pose_at(&scope, 3.0), scope.aim(&b, 0.1, PI));
+    assert_eq!(script.pose_at(&scope, 0.0), script.pose_at(&scope, 1.0));
+    assert_eq!(script.pose_at(&scope, 9.0), script.pose_at(&scope, 3.0));
+    assert!((centre(2.0, 0.09) - (a + b) / 2.0).norm() < 1e-12);
+    assert!((centre(1.5, 0.085) - (a * 0.75 + b * 0.25)).norm() < 1e-12);
 }

@@ -313,6 +313,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "not a laparoscope's angle",
         ),
         (
+            "laparoscope-script-backwards",
+            11,
+            "laparoscope.script[2]",
+            "comes before the one at 5 s",
+        ),
+        (
             "view-without-laparoscope",
             8,
             "rubric.view",
@@ -641,4 +647,36 @@ fn a_scenario_names_its_device() {
     );
     let unnamed = parse(Path::new("device.ron"), &text("max_force_n: 2.0")).unwrap();
     assert_eq!(unnamed.device.spec(), None);
+}
+
+/// A scripted laparoscope that turns away from the probe two seconds in: the competent press
+/// is in view until then and out of it from the turn (about 0.1 s long) to the task's end, at
+/// 3.9 s; with the camera left on the liver it never leaves the view.
+#[test]
+fn a_scripted_camera_looking_away_times_the_probe_out_of_view() {
+    let name = "liver-laparoscopic-press";
+    let file = root().join(format!("scenarios/{name}.scenario.ron"));
+    let text = std::fs::read_to_string(&file).unwrap();
+    let scripted = text.replace(
+        "fov_deg: 70.0,",
+        "fov_deg: 70.0,
+        script: [
+            Look(at_s: 0.0, look_at_mm: (36.0, 64.0, 0.0), distance_mm: 110.0),
+            Look(at_s: 2.0, look_at_mm: (36.0, 64.0, 0.0), distance_mm: 110.0),
+            Look(at_s: 2.1, look_at_mm: (-130.0, -5.0, -40.0), distance_mm: 110.0),
+        ],",
+    );
+    assert_ne!(scripted, text);
+    let away = parse(&file, &scripted).unwrap_or_else(|e| panic!("{e}"));
+    let steady = run(name, "competent").card.tasks[0].metrics.clone();
+    let turned = run_scenario(away, name, "competent").card.tasks[0]
+        .metrics
+        .clone();
+    assert_eq!(steady.motion.out_of_view_s, Some(0.0));
+    let out_s = turned.motion.out_of_view_s.unwrap();
+    let after_turn_s = turned.time_s - 2.1;
+    assert!(
+        out_s > after_turn_s - 0.1 && out_s < after_turn_s + 0.1,
+        "{out_s} s out of view; {after_turn_s} s after the turn"
+    );
 }

@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use crate::devices::{
     DeviceSample, Fault, Fulcrum, HapticDevice, Laparoscope, Pose, SafetyFilter, ScopeHandle,
-    ScopePose, Workspace,
+    ScopePose, ScopeScript, Workspace,
 };
 
 #[derive(Resource)]
@@ -85,6 +85,8 @@ pub struct SceneScope {
     pub scope: Laparoscope,
     pub pose: Arc<ScopeHandle>,
     pub keep_in_view_m: Option<Vector3<f64>>,
+    /// The camera moved by the scenario, if the trainee does not steer it.
+    pub script: Option<ScopeScript>,
 }
 
 /// The laparoscope inside the haptic world, with the pose it was last read at.
@@ -100,11 +102,27 @@ impl Scope {
         Self { rig, pose }
     }
 
-    /// Reads the pose, or keeps the last one while the window holds it, and says whether the
-    /// tip (if known) and the point to keep in view are in view.
-    pub fn in_view(&mut self, tip_m: Option<&Vector3<f64>>) -> (Option<bool>, Option<bool>) {
-        if let Some(pose) = self.rig.pose.try_get() {
-            self.pose = pose;
+    /// Moves a scripted camera to where it is `elapsed_s` into the exercise (and tells the
+    /// window), or reads the pose the trainee steered it to (keeping the last one while the
+    /// window holds it); then says whether the tip (if known) and the point to keep in view
+    /// are in view.
+    pub fn in_view(
+        &mut self,
+        tip_m: Option<&Vector3<f64>>,
+        elapsed_s: f64,
+    ) -> (Option<bool>, Option<bool>) {
+        match &self.rig.script {
+            Some(script) => {
+                if let Some(pose) = script.pose_at(&self.rig.scope, elapsed_s) {
+                    self.pose = pose;
+                    self.rig.pose.try_set(pose);
+                }
+            }
+            None => {
+                if let Some(pose) = self.rig.pose.try_get() {
+                    self.pose = pose;
+                }
+            }
         }
         let sees = |point: &Vector3<f64>| self.rig.scope.sees(&self.pose, point);
         (tip_m.map(sees), self.rig.keep_in_view_m.as_ref().map(sees))

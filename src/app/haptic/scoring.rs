@@ -206,8 +206,10 @@ pub fn score_tick(
         .watched_region()
         .map_or((0.0, 0.0), |region| watch(region, &organs));
     let tip_m = tool.sample.map(|s| s.tip_m);
-    let (tip_in_view, target_in_view) =
-        scope.map_or((None, None), |mut scope| scope.in_view(tip_m.as_ref()));
+    let elapsed_s = exercise.elapsed_s(clock.time_s);
+    let (tip_in_view, target_in_view) = scope.map_or((None, None), |mut scope| {
+        scope.in_view(tip_m.as_ref(), elapsed_s)
+    });
     exercise.step(&Sample {
         time_s: clock.time_s,
         tip_m,

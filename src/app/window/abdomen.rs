@@ -170,7 +170,7 @@ fn spawn_trocars(
         .map(|p| p.port_m)
         .into_iter()
         .chain(link.scene.scope.as_ref().map(|s| s.scope.port_m));
-    let centre = super::organs::scene_centre(link);
+    let centre = link.scene_centre();
     let mesh = meshes.add(Cylinder::new(TROCAR_RADIUS_M, TROCAR_LENGTH_M));
     let material = materials.add(StandardMaterial {
         base_color: Color::srgb(0.12, 0.12, 0.13),

@@ -31,6 +31,17 @@ impl HapticLink {
         self.snapshots = Mutex::new(snapshots);
     }
 
+    /// The centre of the scene's organs (m).
+    pub(super) fn scene_centre(&self) -> Vec3 {
+        let points = self
+            .scene
+            .organs
+            .iter()
+            .flat_map(|(_, v)| v.position_coords_m.iter());
+        let (sum, count) = points.fold((Vec3::ZERO, 0), |(s, n), p| (s + Vec3::from(*p), n + 1));
+        sum / count.max(1) as f32
+    }
+
     /// A link without a device, for the window's stages in a headless app.
     #[cfg(test)]
     pub(super) fn headless(

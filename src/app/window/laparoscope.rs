@@ -50,8 +50,13 @@ pub(super) struct Vignette;
 /// Texels across the mask of the round image.
 const MASK_TEXELS: usize = 256;
 
-pub(super) fn setup(app: &mut App) {
-    app.init_resource::<CameraMode>();
+/// Whether the window opens a scene with a laparoscope through it, or with the free camera.
+#[derive(Resource, Clone, Copy, Debug)]
+struct OpenThroughOptic(bool);
+
+pub(super) fn setup(app: &mut App, free_camera: bool) {
+    app.init_resource::<CameraMode>()
+        .insert_resource(OpenThroughOptic(!free_camera));
     super::spawn_with_scene(app, (choose_mode, spawn_tip_light, spawn_vignette));
     app.add_systems(
         Update,
@@ -68,11 +73,11 @@ pub(super) fn setup(app: &mut App) {
     );
 }
 
-/// A scene with a laparoscope opens looking through it.
-fn choose_mode(link: Res<HapticLink>, mut mode: ResMut<CameraMode>) {
-    *mode = match link.scene.scope {
-        Some(_) => CameraMode::Laparoscope,
-        None => CameraMode::Free,
+/// A scene with a laparoscope opens looking through it, unless told otherwise.
+fn choose_mode(link: Res<HapticLink>, open: Res<OpenThroughOptic>, mut mode: ResMut<CameraMode>) {
+    *mode = match link.scene.scope.is_some() && open.0 {
+        true => CameraMode::Laparoscope,
+        false => CameraMode::Free,
     };
 }
 
@@ -81,7 +86,7 @@ fn spawn_tip_light(mut commands: Commands, link: Res<HapticLink>) {
         return;
     };
     let pose = rig.pose.get();
-    let distance_m = start_distance_m(&rig.scope, &pose, super::organs::scene_centre(&link)) as f32;
+    let distance_m = start_distance_m(&rig.scope, &pose, link.scene_centre()) as f32;
     commands.spawn((
         SceneView,
         TipLight,
@@ -123,9 +128,10 @@ fn switch_mode(
     };
 }
 
-/// I/K and J/L pivot the optic about its port, U/O push it in and pull it out, Z/X roll it.
+/// I/K and J/L pivot the optic about its port, U/O push it in and pull it out, Z/X roll it
+/// (unless the scenario moves it).
 fn steer_optic(keys: Res<ButtonInput<KeyCode>>, link: Res<HapticLink>, time: Res<Time>) {
-    let Some(rig) = &link.scene.scope else {
+    let Some(rig) = link.scene.scope.as_ref().filter(|rig| rig.script.is_none()) else {
         return;
     };
     let axis = |plus: KeyCode, minus: KeyCode| {

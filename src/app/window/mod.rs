@@ -53,6 +53,8 @@ pub struct WindowScene {
     pub lessons: Lessons,
     /// The menu of scenarios (none in free play).
     pub menu: Option<MenuPlan>,
+    /// Open a scene with a laparoscope with the free camera all the same.
+    pub free_camera: bool,
 }
 
 /// The haptic side's f64 vectors as Bevy's (the Bevy end of the seam; parry's is `crate::parry_interop`).
@@ -138,6 +140,7 @@ pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
             .run_if(on_message::<SceneChanged>)
             .in_set(FrameSet::Receive),
     );
+    let free_camera = window.free_camera;
     screenshot::setup(&mut app, window.screenshot.clone());
     reload::setup(&mut app, folder.as_deref());
     lesson::setup(&mut app, window.lesson.clone(), window.lessons.clone());
@@ -145,7 +148,7 @@ pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
     bridge::setup(&mut app, window);
     organs::setup(&mut app);
     abdomen::setup(&mut app);
-    laparoscope::setup(&mut app);
+    laparoscope::setup(&mut app, free_camera);
     camera::setup(&mut app);
     tool::setup(&mut app);
     incision::setup(&mut app);

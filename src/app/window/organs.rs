@@ -68,20 +68,9 @@ fn spawn_organs(
     }
 }
 
-/// The centre of the scene's organs (m).
-pub(super) fn scene_centre(link: &HapticLink) -> Vec3 {
-    let points = link
-        .scene
-        .organs
-        .iter()
-        .flat_map(|(_, v)| v.position_coords_m.iter());
-    let (sum, count) = points.fold((Vec3::ZERO, 0), |(s, n), p| (s + Vec3::from(*p), n + 1));
-    sum / count.max(1) as f32
-}
-
 /// The surgeon's view of a supine patient: from above (anterior, +y), head (+z) up the screen.
 fn spawn_camera_and_light(mut commands: Commands, link: Res<HapticLink>) {
-    let centre = scene_centre(&link);
+    let centre = link.scene_centre();
     let orbit = super::camera::Orbit::looking_at(centre, Vec3::new(0.0, 0.32, -0.10));
     commands.spawn((SceneView, Camera3d::default(), orbit.transform(), orbit));
     commands.spawn((
