@@ -3,13 +3,12 @@
 //! lit by the light at the optic's tip (without it only the faint ambient light reaches it).
 
 use std::path::Path;
-use std::process::Command;
 
 use nalgebra::Vector3;
 use pgd_surgery::app::window::tissue::{mean_srgb, tissue};
 use pgd_surgery::scenario::{load, metres};
 
-use super::{Shot, TRAINER, assert_ran, held_at, hue_distance, hue_saturation, read_rgb, xvfb};
+use super::{Shot, held_at, hue_distance, hue_saturation, shot_of};
 
 /// The shipped scenario with a time limit long enough that no debrief covers the view while
 /// software rendering draws its first frames.
@@ -38,40 +37,19 @@ fn laparoscopic_shot() -> (Shot, [f32; 2]) {
     let handle = fulcrum
         .handle_for(&(focus + Vector3::new(0.0, 0.03, 0.0)))
         .unwrap();
-    let script = dir.join("laparoscopic.csv");
-    pgd_surgery::devices::Trajectory {
-        rows: held_at(handle),
-    }
-    .save(&script)
-    .unwrap();
-    let png = dir.join("laparoscopic.png");
-    let server = xvfb::Xvfb::start();
-    let output = Command::new(TRAINER)
-        .arg("run")
-        .arg(&file)
-        .args(["--coarse", "--no-rebuild", "--frames", "6"])
-        .arg("--vademecums")
-        .arg(super::vademecums())
-        .arg("--history")
-        .arg(dir.join("laparoscopic-history.sqlite"))
-        .arg("--device")
-        .arg(format!("scripted:{}", script.display()))
-        .arg("--screenshot")
-        .arg(&png)
-        .env("DISPLAY", &server.display)
-        .output()
-        .unwrap();
-    drop(server);
-    assert_ran(&output);
-    let legend = std::fs::read_to_string(png.with_extension("json")).unwrap();
-    let (width, rgb) = read_rgb(&png);
-    let height = rgb.len() / 3 / width;
-    let shot = Shot {
-        width,
-        rgb,
-        legend: serde_json::from_str(&legend).unwrap(),
-    };
-    (shot, [width as f32 / 2.0, height as f32 / 2.0])
+    let history = dir.join("laparoscopic-history.sqlite");
+    let args = [
+        "run",
+        file.to_str().unwrap(),
+        "--frames",
+        "6",
+        "--history",
+        history.to_str().unwrap(),
+    ];
+    let shot = shot_of("laparoscopic", held_at(handle), &args);
+    let height = shot.rgb.len() / 3 / shot.width;
+    let centre = [shot.width as f32 / 2.0, height as f32 / 2.0];
+    (shot, centre)
 }
 
 #[test]

@@ -65,9 +65,15 @@ impl Shot {
     }
 }
 
-/// Runs the trainer with a scripted device that holds the tool along `path`, and reads back
-/// its screenshot and legend.
+/// Runs the trainer in free play with a scripted device that holds the tool along `rows`, and
+/// reads back its screenshot and legend.
 fn screenshot(name: &str, rows: Vec<TrajectoryRow>) -> Shot {
+    shot_of(name, rows, &["--free-play", "--frames", FRAMES])
+}
+
+/// Runs the trainer with `args` on the coarse organs and a scripted device that holds the tool
+/// along `rows`, and reads back its screenshot (`<name>.png`) and legend.
+fn shot_of(name: &str, rows: Vec<TrajectoryRow>, args: &[&str]) -> Shot {
     let server = xvfb::Xvfb::start();
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("window");
     std::fs::create_dir_all(&dir).unwrap();
@@ -75,13 +81,8 @@ fn screenshot(name: &str, rows: Vec<TrajectoryRow>) -> Shot {
     Trajectory { rows }.save(&script).unwrap();
     let png = dir.join(format!("{name}.png"));
     let output = Command::new(TRAINER)
-        .args([
-            "--coarse",
-            "--no-rebuild",
-            "--free-play",
-            "--frames",
-            FRAMES,
-        ])
+        .args(args)
+        .args(["--coarse", "--no-rebuild"])
         .arg("--vademecums")
         .arg(vademecums())
         .arg("--device")
