@@ -1,10 +1,12 @@
 //! What the trainee reads: the force the device renders against its limit, the haptic rate,
-//! the frame time, faults, and how to drive the virtual tool.
+//! the frame time, faults, how to drive the virtual tool and steer the laparoscope, and a
+//! warning while the instrument is out of the laparoscope's view.
 
 use bevy::prelude::*;
 
 use super::FrameSet;
 use super::bridge::{HapticLink, Snapshot};
+use super::laparoscope::CameraMode;
 use super::lesson::Lesson;
 use crate::app::haptic::HapticSnapshot;
 
@@ -46,6 +48,7 @@ fn update_hud(
     snapshot: Res<Snapshot>,
     time: Res<Time<Real>>,
     lesson: Option<Res<Lesson>>,
+    mode: Res<CameraMode>,
     mut rate: Local<Rate>,
     mut hud: Query<&mut Text, With<Hud>>,
 ) {
@@ -99,10 +102,11 @@ fn update_hud(
         ""
     };
     let task = lesson.map_or_else(String::new, |lesson| task_line(&lesson, &snapshot));
+    let camera = camera_line(&link, &snapshot.0, *mode);
     let timing = &snapshot.0.timing;
     text.0 = format!(
         "{task}device: {}\nforce {force_n:.3} N {gauge} limit {limit_n:.1} N\n{status}\n\
-         haptic {:.0} Hz | tick p99 {:.0} us, late p99 {:.0} us, {} skipped | frame {:.1} ms{help}",
+         haptic {:.0} Hz | tick p99 {:.0} us, late p99 {:.0} us, {} skipped | frame {:.1} ms{help}{camera}",
         link.device_name,
         rate.hz,
         timing.compute_p99_us,
@@ -110,6 +114,30 @@ fn update_hud(
         timing.skipped,
         dt * 1e3
     );
+}
+
+/// With a laparoscope: a warning while the instrument's tip is out of its view (what the
+/// exercise times), and how to steer it.
+fn camera_line(link: &HapticLink, snapshot: &HapticSnapshot, mode: CameraMode) -> String {
+    let Some(rig) = &link.scene.scope else {
+        return String::new();
+    };
+    let pose = rig.pose.get();
+    let out = snapshot
+        .tip_m
+        .is_some_and(|tip| !rig.scope.sees(&pose, &tip));
+    let warning = match out {
+        true => "\nINSTRUMENT OUT OF VIEW",
+        false => "",
+    };
+    let keys = match (mode, rig.script.is_some()) {
+        (CameraMode::Free, _) => "\nfree camera | C: back to the laparoscope",
+        (CameraMode::Laparoscope, true) => "\nlaparoscope (moved by the scenario) | C: free camera",
+        (CameraMode::Laparoscope, false) => {
+            "\nlaparoscope: I/K, J/L steer | U/O in / out | Z/X roll | C: free camera"
+        }
+    };
+    format!("{keys}{warning}")
 }
 
 /// The task under way and its clock, above the rest of the HUD (nothing before the exercise
