@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
-use super::plot::{Area, PlotResult, save_png};
+use super::plot::{Area, PlotResult, legend_stroke, save_png};
 use crate::pgd::{ErrorCurve, Header};
 
 const SIZE: (u32, u32) = (1400, 560);
@@ -131,7 +131,7 @@ fn all_steps(area: &Area, steps: &[StepCurve], floor: f64) -> PlotResult {
         chart
             .draw_series(LineSeries::new(points, colour.stroke_width(2)))?
             .label(label)
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
+            .legend(legend_stroke(colour.stroke_width(2)));
     }
     chart
         .configure_series_labels()
@@ -169,7 +169,7 @@ fn per_step(area: &Area, steps: &[StepCurve], floor: f64) -> PlotResult {
                 colour.stroke_width(2),
             ))?
             .label(label)
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
+            .legend(legend_stroke(colour.stroke_width(2)));
         let optimal = step.curve.optimal.iter().enumerate();
         chart.draw_series(DashedLineSeries::new(
             optimal.map(|(n, e)| (n + 1, e.max(floor))),

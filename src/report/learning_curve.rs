@@ -5,7 +5,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::plot::save_png;
+use super::plot::{legend_stroke, save_png};
 
 const SIZE: (u32, u32) = (1000, 700);
 
@@ -75,7 +75,7 @@ pub fn learning_curve(path: &Path, attempts: &[CurvePoint]) -> Result<(), String
                 chart
                     .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
                     .label(*scenario)
-                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour));
+                    .legend(legend_stroke(colour));
                 chart.draw_series(
                     points
                         .into_iter()

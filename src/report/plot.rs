@@ -13,6 +13,14 @@ pub type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
 pub type PlotResult = Result<(), Box<dyn std::error::Error>>;
 
+/// A line series' mark in the legend: a 20-pixel stroke in the series' style.
+pub fn legend_stroke(
+    style: impl Into<ShapeStyle>,
+) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    let style = style.into();
+    move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style)
+}
+
 /// Draws a `size` plot on white with `draw` (fonts: "sans-serif") and saves it as a PNG.
 pub fn save_png(
     path: &Path,
@@ -86,9 +94,7 @@ pub fn line_chart(path: &Path, chart: &LineChart) -> Result<(), String> {
                     colour.stroke_width(2),
                 ))?
                 .label(series.name.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
+                .legend(legend_stroke(colour.stroke_width(2)));
         }
         drawing
             .configure_series_labels()

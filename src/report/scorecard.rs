@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
-use super::plot::{PlotResult, save_png};
+use super::plot::{PlotResult, legend_stroke, save_png};
 use crate::scenario::Scorecard;
 
 const SIZE: (u32, u32) = (1200, 500);
@@ -131,7 +131,7 @@ fn plot(path: &Path, card: &Scorecard, trace: &[(f64, f64)]) -> PlotResult {
         chart
             .draw_series(LineSeries::new(trace.iter().copied(), BLUE.stroke_width(2)))?
             .label("force sent to the device")
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE.stroke_width(2)));
+            .legend(legend_stroke(BLUE.stroke_width(2)));
         for task in &card.tasks {
             let m = &task.metrics;
             let span = (m.started_s, m.started_s + m.time_s.max(1e-3));
