@@ -6,11 +6,15 @@
 //! other's transpose, so the port neither makes nor loses energy (the tests check the power
 //! balance).
 
-use nalgebra::Vector3;
+use nalgebra::{Unit, UnitQuaternion, Vector3};
 
 /// The handle is kept at least this far out of the port (m): at the port itself the lever's
 /// ratio has no bound.
 pub const MIN_OUTSIDE_M: f64 = 0.02;
+
+/// The axis of a handle, in its own frame, from the hand towards the tip: a handle held
+/// upright over a supine patient points down (−y, posterior), and its x is a blade's edge.
+pub const HANDLE_AXIS: Vector3<f64> = Vector3::new(0.0, -1.0, 0.0);
 
 /// A straight instrument through a port.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,6 +65,25 @@ impl Fulcrum {
             .norm()
             .min((self.shaft_m - MIN_OUTSIDE_M).max(0.0));
         Some(self.port_m - along * (self.shaft_m - inside_m))
+    }
+
+    /// The instrument's orientation through the port for a handle held at `handle`: the
+    /// handle's, turned the least that lays its axis ([`HANDLE_AXIS`]) along the shaft. The
+    /// shaft sets where the instrument points; the hand's roll of the handle about its own axis
+    /// is the instrument's roll about the shaft (a blade's edge, a grasper's jaws).
+    pub fn instrument_orientation(
+        pose: &Pose,
+        handle: &UnitQuaternion<f64>,
+    ) -> UnitQuaternion<f64> {
+        let axis = handle * HANDLE_AXIS;
+        let lay = UnitQuaternion::rotation_between(&axis, &pose.along).unwrap_or_else(|| {
+            // Pointing straight back: half a turn about an axis across it.
+            UnitQuaternion::from_axis_angle(
+                &Unit::new_normalize(handle * Vector3::x()),
+                std::f64::consts::PI,
+            )
+        });
+        lay * handle
     }
 
     /// The force the hand feels (N) for the force `tip_n` the instrument's tip feels, the

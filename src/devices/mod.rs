@@ -23,7 +23,7 @@ mod workspace;
 
 pub use device::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
 pub use forcedimension::ForceDimension;
-pub use fulcrum::{Fulcrum, MIN_OUTSIDE_M, Pose};
+pub use fulcrum::{Fulcrum, HANDLE_AXIS, MIN_OUTSIDE_M, Pose};
 pub use laparoscope::{
     Laparoscope, MIN_INSIDE_M, ScopeHandle, ScopePose, ScopeScript, Steer, View,
 };

@@ -165,6 +165,11 @@ fn the_trainer_moves_the_handle_and_sends_the_lever_force() {
     let (pose, tip) = (tool.pose.unwrap(), tool.sample.unwrap().tip_m);
     let expected = fulcrum.pose(&handle(pressing, 0.01)).unwrap();
     assert!((tip - expected.tip_m).norm() < 1e-12);
+    let pointing = tool.sample.unwrap().orientation * pgd_surgery::devices::HANDLE_AXIS;
+    assert!(
+        (pointing - pose.along).norm() < 1e-12,
+        "the instrument is not along the shaft"
+    );
     let swing = (tip - on_axis).dot(&side);
     let ratio = pose.inside_m / pose.outside_m;
     assert!(
@@ -190,4 +195,39 @@ fn the_trainer_moves_the_handle_and_sends_the_lever_force() {
         pose.inside_m * 1e3,
         pose.outside_m * 1e3
     );
+}
+
+/// Through a port the instrument points along the shaft whatever way the handle is held, and
+/// the hand's roll of the handle about its own axis rolls the instrument (a blade's edge)
+/// about the shaft by as much: the edge stays across the shaft and turns with the hand.
+#[test]
+fn the_instrument_lies_along_the_shaft_and_rolls_with_the_handle() {
+    use nalgebra::UnitQuaternion;
+    use pgd_surgery::devices::HANDLE_AXIS;
+    let fulcrum = port();
+    let pose = fulcrum.pose(&Vector3::new(0.04, 0.09, -0.03)).unwrap();
+    let tilted = UnitQuaternion::from_euler_angles(0.3, -0.2, 0.5);
+    for roll in [0.0, 0.4, 1.3, -2.0] {
+        let handle = tilted * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), roll);
+        let instrument = Fulcrum::instrument_orientation(&pose, &handle);
+        assert!((instrument * HANDLE_AXIS - pose.along).norm() < 1e-12);
+        let edge = instrument * Vector3::x();
+        assert!(
+            edge.dot(&pose.along).abs() < 1e-12,
+            "the edge is not across the shaft"
+        );
+        let unrolled = Fulcrum::instrument_orientation(&pose, &tilted) * Vector3::x();
+        // The roll between the two edges, about the shaft (−y of the handle is the shaft: a
+        // turn by `roll` about +y is one by −roll about the shaft's direction).
+        let turned = unrolled
+            .cross(&edge)
+            .dot(&pose.along)
+            .atan2(unrolled.dot(&edge));
+        let expected =
+            (-roll + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        assert!(
+            (turned - expected).abs() < 1e-12,
+            "rolled {turned}, expected {expected}"
+        );
+    }
 }

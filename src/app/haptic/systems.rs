@@ -42,8 +42,8 @@ pub fn read_device(
 }
 
 /// The tool for a device `sample` (in the scene): its tip, or through a port, its handle,
-/// the tip then where the shaft through the port puts it (a handle on the port itself keeps
-/// the last pose).
+/// the tip then where the shaft through the port puts it and the instrument along the shaft,
+/// rolled as the hand rolls the handle (a handle on the port itself keeps the last pose).
 fn through_port(tool: &mut Tool, mut sample: DeviceSample) {
     if let Some(port) = tool.port {
         match port.pose(&sample.tip_m) {
@@ -51,7 +51,9 @@ fn through_port(tool: &mut Tool, mut sample: DeviceSample) {
             None if tool.pose.is_none() => return,
             None => {}
         }
-        sample.tip_m = tool.pose.expect("set above").tip_m;
+        let pose = tool.pose.expect("set above");
+        sample.tip_m = pose.tip_m;
+        sample.orientation = Fulcrum::instrument_orientation(&pose, &sample.orientation);
     }
     tool.sample = Some(sample);
 }
