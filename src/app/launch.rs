@@ -40,6 +40,8 @@ pub struct Options {
     pub max_force_n: f64,
     /// The window opens a laparoscopic scenario with the free camera, not the laparoscope.
     pub free_camera: bool,
+    /// Render into an image of this size (pixels) instead of a window.
+    pub offscreen: Option<(u32, u32)>,
 }
 
 /// What a headless run reports.
@@ -247,6 +249,7 @@ pub fn open_window(
         lessons: lessons.clone(),
         menu,
         free_camera: options.free_camera,
+        offscreen: options.offscreen,
     });
     let (report, mut haptic) = haptic.stop();
     let attempts = attempts(&lessons, &mut haptic);

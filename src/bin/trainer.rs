@@ -89,6 +89,13 @@ struct Cli {
     /// switches between them in the window).
     #[arg(long, global = true)]
     free_camera: bool,
+    /// Render into an image instead of a window: no X server needed (with --frames and
+    /// --screenshot for a picture, --exit-after-s for the frame time).
+    #[arg(long, global = true)]
+    offscreen: bool,
+    /// The offscreen image's size, WIDTHxHEIGHT in pixels.
+    #[arg(long, global = true, default_value = "1280x720", value_parser = parse_size)]
+    size: (u32, u32),
 }
 
 const DEFAULT_REPORT_DIR: &str = "reports";
@@ -128,6 +135,18 @@ enum Command {
     },
 }
 
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let parsed = s
+        .split_once('x')
+        .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)));
+    match parsed {
+        Some((w, h)) if (16..=8192).contains(&w) && (16..=8192).contains(&h) => Ok((w, h)),
+        _ => Err(format!(
+            "`{s}` is not a size: WIDTHxHEIGHT in pixels, each 16 to 8192 (e.g. 1920x1080)"
+        )),
+    }
+}
+
 fn parse_timer(s: &str) -> Result<TimerMode, String> {
     match s {
         "sleep" => Ok(TimerMode::Sleep),
@@ -163,6 +182,7 @@ fn main() -> ExitCode {
         trainee: cli.trainee.clone().unwrap_or_else(login_name),
     };
     if !cli.headless
+        && !cli.offscreen
         && let Some(why) = app::missing_display()
     {
         eprintln!(
@@ -194,6 +214,7 @@ fn main() -> ExitCode {
         realtime,
         max_force_n: cli.max_force_n,
         free_camera: cli.free_camera,
+        offscreen: cli.offscreen.then_some(cli.size),
     };
     let exercise = match &cli.command {
         Some(Command::Run { file, report_dir }) => match scenario::load(file) {

@@ -13,6 +13,7 @@ mod laparoscope;
 mod legend;
 mod lesson;
 mod menu;
+mod offscreen;
 mod organs;
 mod reload;
 mod screenshot;
@@ -55,6 +56,8 @@ pub struct WindowScene {
     pub menu: Option<MenuPlan>,
     /// Open a scene with a laparoscope with the free camera all the same.
     pub free_camera: bool,
+    /// Draw into an image of this size (pixels) instead of a window.
+    pub offscreen: Option<(u32, u32)>,
 }
 
 /// The haptic side's f64 vectors as Bevy's (the Bevy end of the seam; parry's is `crate::parry_interop`).
@@ -105,42 +108,38 @@ fn spawn_with_scene<M>(
     );
 }
 
-/// Opens the trainer window and returns, when it closes, how it closed and how fast it drew.
+/// Opens the trainer window (or draws into an image, offscreen) and returns, when it closes,
+/// how it closed and how fast it drew.
 pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
     let log = frames::FrameLog::default();
     let mut app = App::new();
     // The scenarios folder is watched: an edit of the lesson's file reloads it.
     let folder = window.menu.as_ref().and_then(|m| m.folder.clone());
-    app.add_plugins(
-        DefaultPlugins
-            .set(WindowPlugin {
-                primary_window: Some(Window {
-                    title: "PGD surgery trainer".into(),
-                    ..default()
-                }),
-                ..default()
-            })
-            .set(reload::asset_plugin(folder.as_deref())),
-    )
-    .insert_resource(ClearColor(Color::srgb(0.05, 0.06, 0.08)))
-    .configure_sets(
-        Update,
-        (
-            FrameSet::Input,
-            FrameSet::Receive,
-            FrameSet::Respawn,
-            FrameSet::Draw,
-        )
-            .chain(),
-    )
-    .add_message::<SceneChanged>()
-    .add_systems(
-        Update,
-        despawn_scene_views
-            .run_if(on_message::<SceneChanged>)
-            .in_set(FrameSet::Receive),
+    offscreen::plugins(
+        &mut app,
+        window.offscreen,
+        reload::asset_plugin(folder.as_deref()),
     );
+    app.insert_resource(ClearColor(Color::srgb(0.05, 0.06, 0.08)))
+        .configure_sets(
+            Update,
+            (
+                FrameSet::Input,
+                FrameSet::Receive,
+                FrameSet::Respawn,
+                FrameSet::Draw,
+            )
+                .chain(),
+        )
+        .add_message::<SceneChanged>()
+        .add_systems(
+            Update,
+            despawn_scene_views
+                .run_if(on_message::<SceneChanged>)
+                .in_set(FrameSet::Receive),
+        );
     let free_camera = window.free_camera;
+    offscreen::setup(&mut app, window.offscreen);
     screenshot::setup(&mut app, window.screenshot.clone());
     reload::setup(&mut app, folder.as_deref());
     lesson::setup(&mut app, window.lesson.clone(), window.lessons.clone());

@@ -1,4 +1,4 @@
-//! `--screenshot FILE`: saves the window after a number of frames, with its legend (what is
+//! `--screenshot FILE`: saves the window (or the offscreen image) after a number of frames, with its legend (what is
 //! where, `FILE` with a `.json` extension), then closes it; a failed save closes it with an
 //! error rather than a silent success. Shaders compile asynchronously, and until a pipeline is
 //! ready Bevy silently skips what it draws (an organ, or the tone mapping of the whole frame):
@@ -17,6 +17,7 @@ use bevy::window::PrimaryWindow;
 
 use super::laparoscope::CameraMode;
 use super::legend::{Aperture, DrawnSurface, Legend, legend};
+use super::offscreen::Offscreen;
 use super::organs::OrganView;
 use super::tool::ToolTip;
 use super::{FrameSet, HapticLink};
@@ -75,6 +76,31 @@ struct Frame<'w, 's> {
     meshes: Res<'w, Assets<Mesh>>,
     link: Res<'w, HapticLink>,
     mode: Res<'w, CameraMode>,
+    offscreen: Option<Res<'w, Offscreen>>,
+}
+
+impl Frame<'_, '_> {
+    /// The frame's size in physical pixels and its scale factor: the window's, or the
+    /// offscreen image's (scale 1).
+    fn size(&self) -> Result<(Vec2, f32), String> {
+        if let Some(offscreen) = &self.offscreen {
+            return Ok((offscreen.size.as_vec2(), 1.0));
+        }
+        let window = self.window.single().map_err(|e| e.to_string())?;
+        let size = Vec2::new(
+            window.physical_width() as f32,
+            window.physical_height() as f32,
+        );
+        Ok((size, window.scale_factor()))
+    }
+
+    /// The screenshot of what is drawn: the window, or the offscreen image.
+    fn screenshot(&self) -> Screenshot {
+        match &self.offscreen {
+            Some(offscreen) => Screenshot::image(offscreen.image.clone()),
+            None => Screenshot::primary_window(),
+        }
+    }
 }
 
 /// Where the screenshot stands.
@@ -118,7 +144,7 @@ fn take_screenshot(
     progress.waiting = true;
     let plan = plan.clone();
     let background = clear.0.to_srgba().to_u8_array();
-    commands.spawn(Screenshot::primary_window()).observe(
+    commands.spawn(frame.screenshot()).observe(
         move |captured: On<ScreenshotCaptured>,
               mut progress: ResMut<Progress>,
               mut exit: MessageWriter<AppExit>| {
@@ -191,17 +217,10 @@ fn drawn(width: u32, rgb: &[u8], legend: &Legend, background: [u8; 4]) -> bool {
 
 fn frame_legend(frame: &Frame) -> Result<Legend, String> {
     let camera = frame.camera.single().map_err(|e| e.to_string())?;
-    let window = frame.window.single().map_err(|e| e.to_string())?;
-    let scale_factor = window.scale_factor();
-    let aperture = (*frame.mode == CameraMode::Laparoscope).then(|| {
-        let size = Vec2::new(
-            window.physical_width() as f32,
-            window.physical_height() as f32,
-        );
-        Aperture {
-            centre_px: size / 2.0,
-            radius_px: size.y / 2.0,
-        }
+    let (size, scale_factor) = frame.size()?;
+    let aperture = (*frame.mode == CameraMode::Laparoscope).then(|| Aperture {
+        centre_px: size / 2.0,
+        radius_px: size.y / 2.0,
     });
     let drawn: Vec<_> = frame
         .organs
