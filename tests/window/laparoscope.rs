@@ -8,7 +8,7 @@ use nalgebra::Vector3;
 use pgd_surgery::app::window::tissue::{mean_srgb, tissue};
 use pgd_surgery::scenario::{load, metres};
 
-use super::{Shot, held_at, hue_distance, hue_saturation, shot_of};
+use super::{Shot, Surface, held_at, hue_distance, hue_saturation, shot_of};
 
 /// The shipped scenario with a time limit long enough that no debrief covers the view while
 /// software rendering draws its first frames.
@@ -46,7 +46,7 @@ fn laparoscopic_shot() -> (Shot, [f32; 2]) {
         "--history",
         history.to_str().unwrap(),
     ];
-    let shot = shot_of("laparoscopic", held_at(handle), &args);
+    let shot = shot_of("laparoscopic", held_at(handle), &args, Surface::Offscreen);
     let height = shot.rgb.len() / 3 / shot.width;
     let centre = [shot.width as f32 / 2.0, height as f32 / 2.0];
     (shot, centre)

@@ -1,10 +1,11 @@
-//! The trainer's window, run as a user runs it: under Xvfb with Mesa's software Vulkan
-//! (`scripts/setup-debian.sh` installs both), on the coarse organs. Two screenshots — the
-//! tool held away, then pressing the liver — are checked against the legends the trainer
-//! writes beside them: the image is not blank, each organ's tissue colour shows where its
-//! surface is in sight, and the pressed frame differs from the rest frame around the tool and
-//! nowhere far from it. A missing display is reported plainly, without a panic. The
-//! laparoscopic view is checked on its own shipped scenario.
+//! The trainer's rendering, run as a user runs it, on the coarse organs with Mesa's software
+//! Vulkan (`scripts/setup-debian.sh` installs it): drawn offscreen (`--offscreen`, no X
+//! server), two screenshots — the tool held away, then pressing the liver — are checked
+//! against the legends the trainer writes beside them: each organ's tissue colour shows where
+//! its surface is in sight, and the pressed frame differs from the rest frame around the tool
+//! and nowhere far from it. The window itself, under Xvfb, is not blank. A missing display is
+//! reported plainly, without a panic. The laparoscopic view is checked on its own shipped
+//! scenario.
 
 mod laparoscope;
 mod xvfb;
@@ -65,22 +66,36 @@ impl Shot {
     }
 }
 
-/// Runs the trainer in free play with a scripted device that holds the tool along `rows`, and
-/// reads back its screenshot and legend.
+/// Runs the trainer offscreen in free play with a scripted device that holds the tool along
+/// `rows`, and reads back its screenshot and legend.
 fn screenshot(name: &str, rows: Vec<TrajectoryRow>) -> Shot {
-    shot_of(name, rows, &["--free-play", "--frames", FRAMES])
+    shot_of(
+        name,
+        rows,
+        &["--free-play", "--frames", FRAMES],
+        Surface::Offscreen,
+    )
+}
+
+/// Where the trainer draws.
+#[derive(Clone, Copy)]
+enum Surface {
+    Offscreen,
+    /// A window on a private Xvfb.
+    Window,
 }
 
 /// Runs the trainer with `args` on the coarse organs and a scripted device that holds the tool
-/// along `rows`, and reads back its screenshot (`<name>.png`) and legend.
-fn shot_of(name: &str, rows: Vec<TrajectoryRow>, args: &[&str]) -> Shot {
-    let server = xvfb::Xvfb::start();
+/// along `rows`, drawing on `surface`, and reads back its screenshot (`<name>.png`) and legend.
+fn shot_of(name: &str, rows: Vec<TrajectoryRow>, args: &[&str], surface: Surface) -> Shot {
+    let server = matches!(surface, Surface::Window).then(xvfb::Xvfb::start);
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("window");
     std::fs::create_dir_all(&dir).unwrap();
     let script = dir.join(format!("{name}.csv"));
     Trajectory { rows }.save(&script).unwrap();
     let png = dir.join(format!("{name}.png"));
-    let output = Command::new(TRAINER)
+    let mut command = Command::new(TRAINER);
+    command
         .args(args)
         .args(["--coarse", "--no-rebuild"])
         .arg("--vademecums")
@@ -88,10 +103,15 @@ fn shot_of(name: &str, rows: Vec<TrajectoryRow>, args: &[&str]) -> Shot {
         .arg("--device")
         .arg(format!("scripted:{}", script.display()))
         .arg("--screenshot")
-        .arg(&png)
-        .env("DISPLAY", &server.display)
-        .output()
-        .unwrap();
+        .arg(&png);
+    match &server {
+        Some(server) => command.env("DISPLAY", &server.display),
+        None => command
+            .arg("--offscreen")
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY"),
+    };
+    let output = command.output().unwrap();
     drop(server);
     assert_ran(&output);
     let legend = std::fs::read_to_string(png.with_extension("json")).unwrap();
@@ -187,8 +207,14 @@ fn clear_of_hud(px: &[f32; 2]) -> bool {
 }
 
 #[test]
-fn the_render_is_not_blank() {
-    let (rest, _) = rest_and_press();
+fn the_window_is_not_blank() {
+    let (point, _) = liver_target();
+    let rest = shot_of(
+        "window",
+        held_at(point + Vector3::new(0.3, 0.0, 0.0)),
+        &["--free-play", "--frames", FRAMES],
+        Surface::Window,
+    );
     let background = rest.colour_at([2.0, rest.rgb.len() as f32 / 3.0 / rest.width as f32 - 3.0]);
     let pixels = rest.rgb.len() / 3;
     let drawn = rest

@@ -77,11 +77,9 @@ fn render_into_image(
     cameras: Query<Entity, Added<Camera3d>>,
 ) {
     for camera in &cameras {
-        commands
-            .entity(camera)
-            .insert((
-                RenderTarget::Image(offscreen.image.clone().into()),
-                IsDefaultUiCamera,
-            ));
+        commands.entity(camera).insert((
+            RenderTarget::Image(offscreen.image.clone().into()),
+            IsDefaultUiCamera,
+        ));
     }
 }
