@@ -72,8 +72,8 @@ impl Report {
                 print_realtime(haptic);
                 match frames {
                     Some(f) => println!(
-                        "window: {} frames after warm-up, frame time p50 {:.1} ms ({:.1} fps), p95 {:.1} ms",
-                        f.frames, f.frame_ms_p50, f.fps_p50, f.frame_ms_p95
+                        "window: {} frames after warm-up, frame time p50 {:.1} ms ({:.1} fps), p95 {:.1} ms, p99 {:.1} ms",
+                        f.frames, f.frame_ms_p50, f.fps_p50, f.frame_ms_p95, f.frame_ms_p99
                     ),
                     None => println!("window: closed before drawing past its warm-up"),
                 }

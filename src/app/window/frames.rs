@@ -20,6 +20,7 @@ pub struct FrameReport {
     pub frames: usize,
     pub frame_ms_p50: f64,
     pub frame_ms_p95: f64,
+    pub frame_ms_p99: f64,
     /// Frames per second at the median frame time.
     pub fps_p50: f64,
 }
@@ -45,6 +46,7 @@ impl FrameLog {
             frames: times.len(),
             frame_ms_p50: p50,
             frame_ms_p95: at(0.95),
+            frame_ms_p99: at(0.99),
             fps_p50: 1e3 / p50.max(1e-9),
         })
     }
