@@ -1,15 +1,20 @@
 //! An attempt's report on disk: the scorecard as JSON, a summary a trainee reads, and
-//! a plot of the force against time with each task's limits drawn over its span.
+//! a plot of the force against time with each task's limits drawn over its span, and for an
+//! incision, the cuts drawn over the marked line.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
-use super::plot::{PlotResult, legend_stroke, save_png};
-use crate::scenario::Scorecard;
+use nalgebra::Vector3;
+
+use super::plot::{Area, PlotResult, legend_stroke, save_png};
+use crate::scenario::{CutMade, IncisionMetrics, Scorecard};
 
 const SIZE: (u32, u32) = (1200, 500);
+/// The plot's size with an incision panel under the force.
+const SIZE_WITH_INCISION: (u32, u32) = (1200, 900);
 
 /// Writes `<stem>.json`, `<stem>.txt` and `<stem>.png` in `dir`; returns their paths.
 pub fn write_report(
@@ -110,50 +115,128 @@ pub fn summary(card: &Scorecard) -> String {
 }
 
 fn plot(path: &Path, card: &Scorecard, trace: &[(f64, f64)]) -> PlotResult {
-    save_png(path, SIZE, |root| {
-        let end_s = trace.last().map_or(1.0, |p| p.0).max(1e-3);
-        let limits = card.tasks.iter().map(|t| t.metrics.force_limit_n);
-        let top_n = trace.iter().map(|p| p.1).chain(limits).fold(0.1, f64::max) * 1.15;
-        let mut chart = ChartBuilder::on(root)
-            .caption(
-                format!("{}: force against time", card.title),
-                ("sans-serif", 22),
-            )
-            .margin(16)
-            .x_label_area_size(44)
-            .y_label_area_size(64)
-            .build_cartesian_2d(0.0..end_s, 0.0..top_n)?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .y_desc("force (N)")
-            .draw()?;
-        chart
-            .draw_series(LineSeries::new(trace.iter().copied(), BLUE.stroke_width(2)))?
-            .label("force sent to the device")
-            .legend(legend_stroke(BLUE.stroke_width(2)));
-        for task in &card.tasks {
-            let m = &task.metrics;
-            let span = (m.started_s, m.started_s + m.time_s.max(1e-3));
-            let mut bounds = vec![m.force_limit_n];
-            bounds.extend(m.band_min_n);
-            for level in bounds {
-                chart.draw_series(LineSeries::new(
-                    [(span.0, level), (span.1, level)],
-                    RED.stroke_width(2),
-                ))?;
-            }
-            chart.draw_series([Text::new(
-                m.kind.to_string(),
-                (span.0, m.force_limit_n),
-                ("sans-serif", 14),
-            )])?;
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()?;
-        Ok(())
+    let incision = card.tasks.iter().find_map(|t| t.metrics.incision.as_ref());
+    let Some(incision) = incision else {
+        return save_png(path, SIZE, |root| force_plot(root, card, trace));
+    };
+    save_png(path, SIZE_WITH_INCISION, |root| {
+        let (top, bottom) = root.split_vertically(SIZE.1);
+        force_plot(&top, card, trace)?;
+        incision_plot(&bottom, incision, &card.cuts)
     })
+}
+
+/// The incision seen square to the marked line: along it (mm from its start) and across it
+/// (mm off it, in the plane of the line and the scene's front-back axis, or its head-feet
+/// axis for a line running front to back), the tolerance band shaded, each stroke from where
+/// the tissue parted to where the cut reached.
+fn incision_plot(area: &Area, incision: &IncisionMetrics, cuts: &[CutMade]) -> PlotResult {
+    let from = Vector3::from(incision.from_mm);
+    let along = (Vector3::from(incision.to_mm) - from).normalize();
+    let facing = match along.y.abs() < 0.9 {
+        true => Vector3::y(),
+        false => Vector3::z(),
+    };
+    let across = along.cross(&facing).normalize();
+    let square = |p: [f64; 3]| {
+        let d = Vector3::from(p) - from;
+        (d.dot(&along), d.dot(&across))
+    };
+    let length = incision.line_length_mm;
+    let reach = cuts
+        .iter()
+        .flat_map(|c| [square(c.start_mm).1, square(c.end_mm).1])
+        .fold(3.0 * incision.tolerance_mm, |m, y| m.max(y.abs() * 1.2));
+    let mut chart = ChartBuilder::on(area)
+        .caption("the cuts over the marked line", ("sans-serif", 20))
+        .margin(16)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d(-0.1 * length..1.1 * length, -reach..reach)?;
+    chart
+        .configure_mesh()
+        .x_desc("along the line (mm)")
+        .y_desc("off the line (mm)")
+        .draw()?;
+    let tolerance = incision.tolerance_mm;
+    chart
+        .draw_series([Rectangle::new(
+            [(0.0, -tolerance), (length, tolerance)],
+            GREEN.mix(0.15).filled(),
+        )])?
+        .label(format!("within {tolerance:.1} mm of the line"))
+        .legend(legend_stroke(GREEN.mix(0.4).stroke_width(8)));
+    chart
+        .draw_series(LineSeries::new(
+            [(0.0, 0.0), (length, 0.0)],
+            GREEN.stroke_width(2),
+        ))?
+        .label("the marked line")
+        .legend(legend_stroke(GREEN.stroke_width(2)));
+    for (k, cut) in cuts.iter().enumerate() {
+        let stroke = chart.draw_series(LineSeries::new(
+            [square(cut.start_mm), square(cut.end_mm)],
+            BLACK.stroke_width(3),
+        ))?;
+        if k == 0 {
+            stroke
+                .label("a stroke: where the tissue parted to where the cut reached")
+                .legend(legend_stroke(BLACK.stroke_width(3)));
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
+}
+
+/// The force sent to the device against time, each task's limits over its span.
+fn force_plot(root: &Area, card: &Scorecard, trace: &[(f64, f64)]) -> PlotResult {
+    let end_s = trace.last().map_or(1.0, |p| p.0).max(1e-3);
+    let limits = card.tasks.iter().map(|t| t.metrics.force_limit_n);
+    let top_n = trace.iter().map(|p| p.1).chain(limits).fold(0.1, f64::max) * 1.15;
+    let mut chart = ChartBuilder::on(root)
+        .caption(
+            format!("{}: force against time", card.title),
+            ("sans-serif", 22),
+        )
+        .margin(16)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d(0.0..end_s, 0.0..top_n)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc("force (N)")
+        .draw()?;
+    chart
+        .draw_series(LineSeries::new(trace.iter().copied(), BLUE.stroke_width(2)))?
+        .label("force sent to the device")
+        .legend(legend_stroke(BLUE.stroke_width(2)));
+    for task in &card.tasks {
+        let m = &task.metrics;
+        let span = (m.started_s, m.started_s + m.time_s.max(1e-3));
+        let mut bounds = vec![m.force_limit_n];
+        bounds.extend(m.band_min_n);
+        for level in bounds {
+            chart.draw_series(LineSeries::new(
+                [(span.0, level), (span.1, level)],
+                RED.stroke_width(2),
+            ))?;
+        }
+        chart.draw_series([Text::new(
+            m.kind.to_string(),
+            (span.0, m.force_limit_n),
+            ("sans-serif", 14),
+        )])?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
 }

@@ -18,6 +18,9 @@ pub struct BladeSample {
 /// The incision task's measures.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct IncisionMetrics {
+    /// The marked line's ends (mm, the scene's frame), for the debrief to draw the cut over.
+    pub from_mm: [f64; 3],
+    pub to_mm: [f64; 3],
     pub line_length_mm: f64,
     /// How much of the line the cut covers, within the tolerance of it (mm).
     pub covered_mm: f64,
@@ -148,6 +151,8 @@ impl IncisionTracker {
             max_depth_mm: self.max_depth_m * 1e3,
             target_depth_mm: self.target_depth_m * 1e3,
             strokes: self.strokes,
+            from_mm: (self.from_m * 1e3).into(),
+            to_mm: ((self.from_m + self.along * self.length_m) * 1e3).into(),
         }
     }
 

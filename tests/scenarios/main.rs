@@ -19,7 +19,7 @@ use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::io::write_vtu;
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate};
 use pgd_surgery::report::write_report;
-use pgd_surgery::scenario::{Scenario, load, parse};
+use pgd_surgery::scenario::{Scenario, Task, load, parse};
 use pgd_surgery::store::OnStale;
 
 const TRAINER: &str = env!("CARGO_BIN_EXE_trainer");
@@ -163,6 +163,29 @@ fn the_report_is_written_as_json_text_and_plot() {
         "{summary}"
     );
     assert_eq!(&std::fs::read(png).unwrap()[..8], b"\x89PNG\r\n\x1a\n");
+}
+
+/// An incision's report draws the cuts over the marked line under the force plot: the line's
+/// ends are the scenario's, and the plot has the panel (it is taller than a plot without).
+#[test]
+fn the_incision_report_draws_the_cuts_over_the_line() {
+    let outcome = run("liver-capsule-incision", "competent");
+    let scenario = load(&root().join("scenarios/liver-capsule-incision.scenario.ron")).unwrap();
+    let Some(Task::Incision { from_mm, to_mm, .. }) = scenario.tasks.first() else {
+        panic!("not an incision");
+    };
+    let incision = outcome.card.tasks[0].metrics.incision.as_ref().unwrap();
+    assert_eq!(incision.from_mm, [from_mm.0, from_mm.1, from_mm.2]);
+    assert_eq!(incision.to_mm, [to_mm.0, to_mm.1, to_mm.2]);
+    assert!(!outcome.card.cuts.is_empty());
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenario-report");
+    let height = |stem: &str, outcome: &Outcome| {
+        let [.., png] = write_report(&dir, stem, &outcome.card, &outcome.force_trace).unwrap();
+        let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(png).unwrap()));
+        decoder.read_info().unwrap().info().height
+    };
+    let plain = run("liver-steady-press", "competent");
+    assert!(height("incision", &outcome) > height("press", &plain));
 }
 
 /// Each broken file gives its error at the line and field it is about, with a hint.
