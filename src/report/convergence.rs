@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
-use super::plot::{Area, PlotResult, legend_stroke, save_png};
+use super::plot::{Area, PlotResult, draw_legend, legend_stroke, save_png};
 use crate::pgd::{ErrorCurve, Header};
 
 const SIZE: (u32, u32) = (1400, 560);
@@ -133,11 +133,7 @@ fn all_steps(area: &Area, steps: &[StepCurve], floor: f64) -> PlotResult {
             .label(label)
             .legend(legend_stroke(colour.stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
     Ok(())
 }
 
@@ -178,11 +174,7 @@ fn per_step(area: &Area, steps: &[StepCurve], floor: f64) -> PlotResult {
             colour.stroke_width(1),
         ))?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
     chart.plotting_area().draw(&Text::new(
         "dashed: optimal rank-n (SVD)",
         (longest.max(2) * 2 / 3, 0.5),

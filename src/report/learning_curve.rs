@@ -5,7 +5,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::plot::{legend_stroke, save_png};
+use super::plot::{draw_legend, legend_stroke, save_png};
 
 const SIZE: (u32, u32) = (1000, 700);
 
@@ -82,11 +82,7 @@ pub fn learning_curve(path: &Path, attempts: &[CurvePoint]) -> Result<(), String
                         .map(|p| Circle::new(p, 4, colour.filled())),
                 )?;
             }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .draw()?;
+            draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
         }
         Ok(())
     })

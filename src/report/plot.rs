@@ -13,6 +13,20 @@ pub type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
 pub type PlotResult = Result<(), Box<dyn std::error::Error>>;
 
+/// Draws the chart's legend at `position`, framed on a veil of white over the plot.
+pub fn draw_legend<'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, BitMapBackend<'a>, CT>,
+    position: SeriesLabelPosition,
+) -> PlotResult {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
+}
+
 /// A line series' mark in the legend: a 20-pixel stroke in the series' style.
 pub fn legend_stroke(
     style: impl Into<ShapeStyle>,
@@ -96,12 +110,7 @@ pub fn line_chart(path: &Path, chart: &LineChart) -> Result<(), String> {
                 .label(series.name.as_str())
                 .legend(legend_stroke(colour.stroke_width(2)));
         }
-        drawing
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()?;
+        draw_legend(&mut drawing, SeriesLabelPosition::LowerLeft)?;
         Ok(())
     })
     .map_err(|e| format!("{}: {e}", path.display()))

@@ -9,7 +9,7 @@ use plotters::prelude::*;
 
 use nalgebra::Vector3;
 
-use super::plot::{Area, PlotResult, legend_stroke, save_png};
+use super::plot::{Area, PlotResult, draw_legend, legend_stroke, save_png};
 use crate::scenario::{CutMade, IncisionMetrics, Scorecard};
 
 const SIZE: (u32, u32) = (1200, 500);
@@ -184,12 +184,7 @@ fn incision_plot(area: &Area, incision: &IncisionMetrics, cuts: &[CutMade]) -> P
                 .legend(legend_stroke(BLACK.stroke_width(3)));
         }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }
 
@@ -233,10 +228,6 @@ fn force_plot(root: &Area, card: &Scorecard, trace: &[(f64, f64)]) -> PlotResult
             ("sans-serif", 14),
         )])?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
     Ok(())
 }

@@ -253,7 +253,8 @@ fn check_script(scope: &LaparoscopeEntry) -> Option<Problem> {
 /// weighs the view needs a camera to have one.
 fn check_laparoscope(scenario: &Scenario, problems: &mut Vec<Problem>) {
     match &scenario.laparoscope {
-        Some(scope) if scope.start().is_none() => problems.push(Problem {
+        // A scripted camera starts at its first key, which `check_script` places the error on.
+        Some(scope) if scope.script.is_empty() && scope.start().is_none() => problems.push(Problem {
             field: "laparoscope.look_at_mm".into(),
             anchors: vec!["laparoscope".into(), "look_at_mm".into()],
             message: format!(
