@@ -16,8 +16,8 @@ use crate::devices::{HapticDevice, ScopeHandle, TICK_S};
 use crate::fem::Law;
 use crate::mesh::organs::Organ;
 use crate::scenario::{
-    self, CutMade, Exercise, LaparoscopeEntry, Nodule, NoduleSite, OrganEntry, RegionSite,
-    Scenario, Scorecard, Sites, Task, score,
+    self, CutMade, Exercise, Keratometer, LaparoscopeEntry, Nodule, NoduleSite, OrganEntry,
+    RegionSite, Scenario, Scorecard, Sites, Task, score,
 };
 use crate::store::{OnStale, OrganSource};
 
@@ -164,7 +164,24 @@ pub fn sites_on(scene: &HapticScene, scenario: &Scenario) -> Sites {
             .iter()
             .map(|task| region_site(scene, task))
             .collect(),
+        keratometers: scenario
+            .tasks
+            .iter()
+            .map(|task| keratometer(scene, scenario, task))
+            .collect(),
     }
+}
+
+/// The cut cornea's model a keratotomy `task` predicts its correction with (`None` for other
+/// tasks, or a cornea the scene does not cut, which validation refuses).
+fn keratometer(scene: &HapticScene, scenario: &Scenario, task: &Task) -> Option<Keratometer> {
+    let Task::RadialKeratotomy { organ, .. } = task else {
+        return None;
+    };
+    let index = scenario.organs.iter().position(|o| &o.name == organ)?;
+    let cutting = scene.cutting.as_ref()?;
+    let (_, keratometer) = cutting.keratometers.iter().find(|(k, _)| *k == index)?;
+    Some(keratometer.clone())
 }
 
 /// Where `nodule` lies under its organ's surface: the outward normal at the accessible point

@@ -3,19 +3,21 @@
 
 use std::collections::BTreeSet;
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use nalgebra::Vector3;
 
 use super::haptic::{HapticScene, SceneCutting, SceneDynamics};
 use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, FieldOrigin, Probe};
-use crate::cutting::Blade;
+use crate::cutting::keratotomy::{Cornea, REFERENCE_MESH};
+use crate::cutting::{Blade, CutError};
 use crate::devices::{PressTarget, SafetySettings, Workspace};
 use crate::dynamics::{DynamicModel, GraspSettings, TRAINER_MODES};
 use crate::fem::{FemModel, Inclusion, Law, Material};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::{Organ, OrganSettings, region};
 use crate::pgd::{BuildSettings, Vademecum};
+use crate::scenario::Keratometer;
 use crate::store::{OnStale, OrganSource, VademecumSpec, ensure_vademecum, vademecum_file_name};
 
 pub const SCENE_ORGANS: [Organ; 4] = Organ::ABDOMEN;
@@ -27,23 +29,41 @@ pub const SCENE_ORGANS: [Organ; 4] = Organ::ABDOMEN;
 /// the liver enriches eight nodes, as many as at full resolution.
 pub const CUT_COARSE_RESOLUTION: f64 = 0.5;
 
+/// The mesh resolution and layers of a cornea a scalpel cuts: a cut's depth counts in
+/// elements through the thickness, so a keratotomy needs more than the two layers that
+/// pressing does (`docs/cutting.md`). Full: the reference cornea's mesh; coarse: half its
+/// depth resolution, to build in seconds. A keratotomy's correction is predicted on the
+/// reference cornea at either detail.
+pub const CUT_CORNEA_FULL: (f64, usize) = REFERENCE_MESH;
+pub const CUT_CORNEA_COARSE: (f64, usize) = (0.3, 4);
+
 /// How finely the scene's organs are meshed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Detail {
-    /// The papers' meshes and the default 6 mm tool (vademecums build in about 3 minutes).
+    /// The papers' meshes and each organ's own tool (vademecums build in about 3 minutes).
     #[default]
     Full,
-    /// A quarter of the nodes and a 12 mm tool, whose patch must span the coarser edges: the
-    /// vademecums build in seconds, for a quick look on a slow machine and for tests.
+    /// A quarter of the nodes and, on the abdominal organs, a 12 mm tool, whose patch must
+    /// span the coarser edges: the vademecums build in seconds, for a quick look on a slow
+    /// machine and for tests. The coarse cornea's edges are still shorter than its own
+    /// 0.5 mm spatula, which it keeps.
     Coarse,
 }
 
 impl Detail {
-    /// The tool tip radius (m) the vademecums at this detail are built for.
+    /// The tool tip radius (m) the abdominal organs' vademecums at this detail are built for.
     pub fn tip_radius_m(self) -> f64 {
-        match self {
-            Detail::Full => BuildSettings::default().tool_tip_radius_m,
-            Detail::Coarse => 0.012,
+        self.smallest_tip_m(None)
+    }
+
+    /// The smallest tool tip (m) whose patch spans `organ`'s edges at this detail (`None`: a
+    /// mesh file, taken as abdominal).
+    fn smallest_tip_m(self, organ: Option<Organ>) -> f64 {
+        match (self, organ) {
+            (Detail::Coarse, Some(Organ::Cornea)) | (Detail::Full, _) => {
+                BuildSettings::for_organ(organ).tool_tip_radius_m
+            }
+            (Detail::Coarse, _) => 0.012,
         }
     }
 
@@ -53,8 +73,9 @@ impl Detail {
     }
 
     /// `full`, the vademecum at full detail, at this detail (a generated organ's mesh
-    /// coarsened; the coarse tool and near field for any).
+    /// coarsened; the coarse tool and near field for the abdominal organs and mesh files).
     fn applied(self, full: VademecumSpec) -> VademecumSpec {
+        let cornea = full.source.organ() == Some(Organ::Cornea);
         match self {
             Detail::Full => full,
             Detail::Coarse => VademecumSpec {
@@ -62,14 +83,33 @@ impl Detail {
                     resolution: 0.25,
                     ..full.mesh
                 },
-                build: BuildSettings {
-                    tool_tip_radius_m: self.tip_radius_m(),
-                    local_radius_m: 0.025,
-                    ..full.build
+                build: match cornea {
+                    true => full.build,
+                    false => BuildSettings {
+                        tool_tip_radius_m: self.tip_radius_m(),
+                        local_radius_m: 0.025,
+                        ..full.build
+                    },
                 },
                 file: full.file.with_extension("coarse.vdm"),
                 ..full
             },
+        }
+    }
+
+    /// The mesh of a generated organ a scalpel cuts, at this detail: finer than a pressed
+    /// one's where the coarse elements would be too large for a cut to enrich any node.
+    fn cut_mesh(self, organ: Organ, mesh: &mut OrganSettings) {
+        match (self, organ) {
+            (_, Organ::Cornea) => {
+                let (resolution, layers) = match self {
+                    Detail::Full => CUT_CORNEA_FULL,
+                    Detail::Coarse => CUT_CORNEA_COARSE,
+                };
+                (mesh.resolution, mesh.cornea_layers) = (resolution, layers);
+            }
+            (Detail::Coarse, _) => mesh.resolution = CUT_COARSE_RESOLUTION,
+            (Detail::Full, _) => {}
         }
     }
 }
@@ -134,12 +174,14 @@ impl SceneOrgan {
         let file = dir.join(vademecum_file_name(&stem, self.law));
         let spec = VademecumSpec::new(&self.name, self.source.clone(), self.law, file);
         let mut spec = detail.applied(spec);
-        if detail == Detail::Coarse
-            && self.cut_toughness_j_per_m2.is_some()
-            && matches!(self.source, OrganSource::Generated(_))
+        if let (Some(_), OrganSource::Generated(organ)) =
+            (self.cut_toughness_j_per_m2, &self.source)
         {
-            spec.mesh.resolution = CUT_COARSE_RESOLUTION;
-            spec.file = spec.file.with_extension("cut.vdm");
+            let uncut = spec.mesh;
+            detail.cut_mesh(*organ, &mut spec.mesh);
+            if spec.mesh != uncut {
+                spec.file = spec.file.with_extension("cut.vdm");
+            }
         }
         let mut tag = |part: String| spec.file = spec.file.with_extension(format!("{part}.vdm"));
         if tip_m != spec.build.tool_tip_radius_m {
@@ -166,8 +208,8 @@ impl SceneOrgan {
     }
 }
 
-/// A scene of `organs` felt through a tool tip of `tip_radius_m` (the detail's own when
-/// `None`; coarse organs always take the coarse tool, which their edges need).
+/// A scene of `organs` felt through a tool tip of `tip_radius_m` (the organs' own when
+/// `None`; on coarse organs no finer than their edges need).
 pub fn scene_of(
     organs: &[SceneOrgan],
     tip_radius_m: Option<f64>,
@@ -176,10 +218,7 @@ pub fn scene_of(
     detail: Detail,
     on_stale: OnStale,
 ) -> Result<HapticScene, String> {
-    let tip = match (detail, tip_radius_m) {
-        (Detail::Full, Some(tip)) => tip,
-        _ => detail.tip_radius_m(),
-    };
+    let tip = scene_tip_m(organs, tip_radius_m, detail);
     let mut field_file = None;
     let loaded = organs
         .iter()
@@ -249,22 +288,54 @@ fn scene_dynamics(
 
 /// The organs a scalpel cuts, each with the linear model of its tissue that its cut state
 /// is solved on (the default blade; a scenario sets its own); `None` if none is cut.
+/// The tool tip (m) of a scene of `organs` at `detail`: the one `asked` for (the organs' own
+/// when `None`), on coarse organs no finer than their edges need.
+fn scene_tip_m(organs: &[SceneOrgan], asked: Option<f64>, detail: Detail) -> f64 {
+    let smallest = |detail: Detail| {
+        let tips = organs
+            .iter()
+            .map(move |o| detail.smallest_tip_m(o.source.organ()));
+        tips.fold(0.0, f64::max)
+    };
+    match detail {
+        Detail::Full => asked.unwrap_or_else(|| smallest(Detail::Full)),
+        Detail::Coarse => smallest(Detail::Coarse).max(asked.unwrap_or(0.0)),
+    }
+}
+
 fn scene_cutting(
     organs: &[SceneOrgan],
     loaded: &[(String, Arc<Vademecum>, TetMesh)],
 ) -> Result<Option<SceneCutting>, String> {
     let mut cut = Vec::new();
+    let mut keratometers = Vec::new();
     for (index, (organ, (name, vademecum, mesh))) in organs.iter().zip(loaded).enumerate() {
         let Some(toughness) = organ.cut_toughness_j_per_m2 else {
             continue;
         };
         let model = organ_model(name, vademecum, mesh, Law::Linear)?;
+        if organ.source == OrganSource::Generated(Organ::Cornea) {
+            let cornea = reference_cornea().map_err(|e| format!("{name}: {e}"))?;
+            keratometers.push((index, Keratometer::new(cornea)));
+        }
         cut.push((index, Arc::new(model), toughness));
     }
     Ok((!cut.is_empty()).then(|| SceneCutting {
         blade: Blade::default(),
         organs: cut,
+        keratometers,
     }))
+}
+
+/// The reference cornea under the intraocular pressure, set up once (an assembly and a
+/// solve of 16,000 nodes) for every scene that cuts a cornea.
+fn reference_cornea() -> Result<Arc<Cornea>, CutError> {
+    static REFERENCE: OnceLock<Arc<Cornea>> = OnceLock::new();
+    if let Some(cornea) = REFERENCE.get() {
+        return Ok(cornea.clone());
+    }
+    let cornea = Arc::new(Cornea::reference()?);
+    Ok(REFERENCE.get_or_init(|| cornea).clone())
 }
 
 /// The organ's finite-element model under `law`: its mesh clamped, its tissue and stiffer

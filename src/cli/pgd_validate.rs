@@ -90,11 +90,11 @@ pub fn validate_cuts(
         (CutPattern::Radial(_), Some(Organ::Cornea)) => {
             Site::Cornea(Cornea::from_mesh(mesh, material).map_err(|e| in_source(&e))?)
         }
-        (CutPattern::Straight(_), organ) if organ != Some(Organ::Cornea) => Site::Organ(
+        (CutPattern::Straight(_), organ) if organ != Some(Organ::Cornea) => Site::Organ(Box::new(
             pgd::organ::clamped_model(mesh, material)
                 .and_then(|model| model.with_inclusions(&vademecum.header.inclusions))
                 .map_err(|e| in_source(&e))?,
-        ),
+        )),
         (pattern, _) => {
             return Err(format!(
                 "{source}: {pattern} does not apply (radial:N cuts the cornea, straight:N the \
@@ -124,7 +124,7 @@ pub fn validate_cuts(
 /// What a cut pattern is validated on.
 enum Site {
     Cornea(Cornea),
-    Organ(FemModel),
+    Organ(Box<FemModel>),
 }
 
 /// The cut validation as a table.

@@ -6,10 +6,12 @@
 //!
 //! Solved by the full X-FEM of the cut cornea: a reference, not the 1 kHz path.
 
+use std::sync::Arc;
+
 use nalgebra::{Matrix2, Point3, Unit, Vector2, Vector3};
 use serde::Serialize;
 
-use super::enrichment::Enrichment;
+use super::enrichment::{Enrichment, Front};
 use super::incision::CutFace;
 use super::{CutError, xfem};
 use crate::fem::{Dirichlet, FemModel, Law, Loads, Material, TISSUE_DENSITY_KG_M3};
@@ -29,6 +31,11 @@ pub const KERATOMETRIC_INDEX: f64 = 1.3375;
 /// e0224824 (2020). Nearly incompressible, as soft tissue is.
 pub const CORNEA_YOUNG_PA: f64 = 0.29e6;
 pub const CORNEA_POISSON: f64 = 0.49;
+
+/// The reference cornea's mesh: its resolution (a multiple of the generator's nodes per
+/// layer) and its elements through the thickness. A keratotomy's correction depends on the
+/// mesh (`docs/cutting.md`, Limits), so every prediction is made on this one.
+pub const REFERENCE_MESH: (f64, usize) = (0.6, 8);
 
 /// The central zone whose curvature a keratometer reads: 3 mm across.
 const CENTRAL_ZONE_M: f64 = 1.5e-3;
@@ -79,7 +86,7 @@ impl std::fmt::Display for KeratotomyReport {
 
 /// The cornea under intraocular pressure, ready to be cut.
 pub struct Cornea {
-    model: FemModel,
+    model: Arc<FemModel>,
     loads: Loads,
     /// Anterior nodes within the central zone.
     central: Vec<usize>,
@@ -107,20 +114,16 @@ impl Cornea {
         Self::from_mesh(mesh, material)
     }
 
+    /// The reference cornea ([`REFERENCE_MESH`]) of the in-vivo modulus: the one `pgd cut
+    /// cornea` cuts by default, and the trainer predicts every keratotomy's correction on,
+    /// whatever detail it runs its organs at.
+    pub fn reference() -> Result<Self, CutError> {
+        Self::new(REFERENCE_MESH.0, REFERENCE_MESH.1)
+    }
+
     /// The generated cornea `mesh` (any resolution and layers) of `material`, rim clamped,
     /// under the intraocular pressure: as a cornea vademecum was built.
     pub fn from_mesh(mesh: TetMesh, material: Material) -> Result<Self, CutError> {
-        let mut loads = Loads::new(mesh.node_count());
-        loads
-            .add_pressure(&mesh, &posterior_faces(&mesh), IOP_PA)
-            .map_err(solve_error)?;
-        let central = anterior_nodes(&mesh)
-            .into_iter()
-            .filter(|&n| {
-                let p = mesh.nodes()[n];
-                p.x.hypot(p.y) <= CENTRAL_ZONE_M
-            })
-            .collect();
         let mut dirichlet = Dirichlet::new(mesh.node_count());
         let rim = mesh
             .node_set(region::CLAMPED)
@@ -128,6 +131,24 @@ impl Cornea {
             .to_vec();
         dirichlet.clamp(&rim).map_err(solve_error)?;
         let model = FemModel::new(mesh, material, dirichlet).map_err(solve_error)?;
+        Self::from_model(Arc::new(model))
+    }
+
+    /// The generated cornea's `model` (its rim clamped, as the trainer's cut cornea is) under
+    /// the intraocular pressure.
+    pub fn from_model(model: Arc<FemModel>) -> Result<Self, CutError> {
+        let mesh = model.mesh();
+        let mut loads = Loads::new(mesh.node_count());
+        loads
+            .add_pressure(mesh, &posterior_faces(mesh), IOP_PA)
+            .map_err(solve_error)?;
+        let central = anterior_nodes(mesh)
+            .into_iter()
+            .filter(|&n| {
+                let p = mesh.nodes()[n];
+                p.x.hypot(p.y) <= CENTRAL_ZONE_M
+            })
+            .collect();
         let mut cornea = Self {
             model,
             loads,
@@ -184,6 +205,13 @@ impl Cornea {
         })
     }
 
+    /// The change of central power (D) that incisions along `faces` make, their fronts
+    /// snapped as `front` says (as the cut state that made them snaps them).
+    pub fn power_change_d(&self, faces: &[CutFace], front: Front) -> Result<f64, CutError> {
+        let enrichment = Enrichment::with_front(self.model.mesh(), faces, front);
+        Ok(self.central_power_d(&enrichment)? - self.power_before_d)
+    }
+
     /// The keratometric power of the deformed anterior centre (D).
     fn central_power_d(&self, enrichment: &Enrichment) -> Result<f64, CutError> {
         let solution = xfem::solve(&self.model, enrichment, &self.loads)?;
@@ -217,6 +245,16 @@ pub fn incision(
         reach,
         depth_fraction * CORNEA_THICKNESS_M,
     )
+}
+
+/// [`incision`] at `azimuth_rad` round the axis from the scene's +x towards +y (where
+/// [`CutFace::meridian`] counts its angle from −x).
+pub fn azimuth_incision(
+    azimuth_rad: f64,
+    reach: (f64, f64),
+    depth_fraction: f64,
+) -> Result<CutFace, CutError> {
+    incision(azimuth_rad + std::f64::consts::PI, reach, depth_fraction)
 }
 
 /// The anterior and posterior spheres' radii (m), about the cornea's centre of curvature.
@@ -270,6 +308,23 @@ fn sphere_radius_on_axis(points: &[Point3<f64>]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An incision at 60° from +x covers the anterior point 3 mm off the axis at 60°, 0.1 mm
+    /// under the surface, and not the one at 240°.
+    #[test]
+    fn an_incision_by_azimuth_lies_at_that_azimuth() {
+        let face = azimuth_incision(60f64.to_radians(), (1.5e-3, 5e-3), 0.8).unwrap();
+        let under = |azimuth_deg: f64| {
+            let a = azimuth_deg.to_radians();
+            let centre = Point3::new(0.0, 0.0, -CORNEA_CURVATURE_M);
+            let direction = Vector3::new(a.cos() * 3e-3, a.sin() * 3e-3, 0.0);
+            let height = (ANTERIOR_RADIUS_M.powi(2) - 9e-6).sqrt();
+            let on_surface = centre + direction + Vector3::z() * height;
+            on_surface - (on_surface - centre).normalize() * 1e-4
+        };
+        assert!(face.covers(&under(60.0), 1e-9));
+        assert!(!face.covers(&under(240.0), 1e-9));
+    }
 
     /// Points on a sphere of radius 8 mm centred 7.8 mm below the origin, as a cap 3 mm across:
     /// the fit returns its radius.

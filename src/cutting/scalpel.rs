@@ -38,6 +38,10 @@ pub struct Blade {
     pub turn_rad: f64,
     /// A blade pressed deeper than the incision by this share of its depth deepens it.
     pub deepen_share: f64,
+    /// Where the surface under the blade has curved away from the face's line by more than
+    /// this share of the cut's depth, the cut follows it and a new face starts (a straight
+    /// face over the cornea's curve would leave its far end uncut, above the surface).
+    pub follow_share: f64,
 }
 
 impl Default for Blade {
@@ -48,6 +52,7 @@ impl Default for Blade {
             step_m: 0.002,
             turn_rad: 15f64.to_radians(),
             deepen_share: 0.15,
+            follow_share: 0.1,
         }
     }
 }
@@ -252,9 +257,19 @@ impl Scalpel {
         }
         stroke.length_m += reach_m - sweep.reach_m;
         sweep.reach_m = reach_m;
-        let to = sweep.face_from + sweep.along.into_inner() * reach_m;
-        stroke.end_m = sweep.front(&contact.point_m).coords.into();
-        Some(CutStep::Advance { to })
+        let front = sweep.front(&contact.point_m);
+        stroke.end_m = front.coords.into();
+        let on_line = sweep.face_from + sweep.along.into_inner() * reach_m;
+        if ((front - on_line).dot(&sweep.down)).abs() <= blade.follow_share * sweep.depth_m {
+            return Some(CutStep::Advance { to: on_line });
+        }
+        // The surface has curved away from the face's line: the cut follows it down (or up)
+        // to the surface under the blade, and the next face starts there, square to it.
+        sweep.face_from = front;
+        sweep.down = contact.inward;
+        sweep.along = tangent(&sweep.along, &contact.inward).unwrap_or(sweep.along);
+        sweep.reach_m = 0.0;
+        Some(CutStep::Advance { to: front })
     }
 }
 

@@ -1,6 +1,7 @@
 //! An attempt's report on disk: the scorecard as JSON, a summary a trainee reads, and
 //! a plot of the force against time with each task's limits drawn over its span, and for an
-//! incision, the cuts drawn over the marked line.
+//! incision, the cuts drawn over the marked line; for a keratotomy, the incisions drawn on
+//! the cornea seen from the front.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -10,10 +11,10 @@ use plotters::prelude::*;
 use nalgebra::Vector3;
 
 use super::plot::{Area, PlotResult, draw_legend, legend_stroke, save_png};
-use crate::scenario::{CutMade, IncisionMetrics, Scorecard};
+use crate::scenario::{CutMade, IncisionMetrics, KeratotomyMetrics, Scorecard};
 
 const SIZE: (u32, u32) = (1200, 500);
-/// The plot's size with an incision panel under the force.
+/// The plot's size with an incision's or a keratotomy's panel under the force.
 const SIZE_WITH_INCISION: (u32, u32) = (1200, 900);
 
 /// Writes `<stem>.json`, `<stem>.txt` and `<stem>.png` in `dir`; returns their paths.
@@ -95,6 +96,23 @@ pub fn summary(card: &Scorecard) -> String {
                 "  mark: {error:.1} mm from the nodule across the surface (found within {within:.0} mm)"
             );
         }
+        if let Some(rk) = &m.keratotomy {
+            let correction = rk
+                .predicted_correction_d
+                .map_or("none predicted".to_owned(), |d| format!("{d:.1} D"));
+            let _ = writeln!(
+                out,
+                "  incisions: {} of {}, spacing off by up to {:.0}°, {:.1} mm into the optical zone, {:.0} % deep on average (target {:.0} %){}; correction {correction} (target {:.1} D)",
+                rk.incisions.len(),
+                rk.planned,
+                rk.spacing_error_deg,
+                rk.zone_intrusion_mm,
+                100.0 * rk.mean_depth_fraction,
+                100.0 * rk.target_depth_fraction,
+                if rk.perforated { ", PERFORATED" } else { "" },
+                rk.target_correction_d
+            );
+        }
         if let (Some(moved), Some(target), Some(limit)) =
             (m.moved_mm, m.move_target_mm, m.surrounding_limit_n)
         {
@@ -116,14 +134,101 @@ pub fn summary(card: &Scorecard) -> String {
 
 fn plot(path: &Path, card: &Scorecard, trace: &[(f64, f64)]) -> PlotResult {
     let incision = card.tasks.iter().find_map(|t| t.metrics.incision.as_ref());
-    let Some(incision) = incision else {
+    let keratotomy = card
+        .tasks
+        .iter()
+        .find_map(|t| t.metrics.keratotomy.as_ref());
+    if incision.is_none() && keratotomy.is_none() {
         return save_png(path, SIZE, |root| force_plot(root, card, trace));
-    };
+    }
     save_png(path, SIZE_WITH_INCISION, |root| {
         let (top, bottom) = root.split_vertically(SIZE.1);
         force_plot(&top, card, trace)?;
-        incision_plot(&bottom, incision, &card.cuts)
+        match (incision, keratotomy) {
+            (Some(incision), _) => incision_plot(&bottom, incision, &card.cuts),
+            (None, Some(keratotomy)) => keratotomy_plot(&bottom, keratotomy),
+            (None, None) => Ok(()),
+        }
     })
+}
+
+/// The cornea seen from the front (mm off its axis): the limbus, the optical zone to keep
+/// clear, the plan's evenly spaced meridians turned to the first incision, and each incision
+/// from its nearest to its farthest reach; the predicted correction in the caption.
+fn keratotomy_plot(area: &Area, rk: &KeratotomyMetrics) -> PlotResult {
+    let limbus_mm = crate::mesh::organs::CORNEA_RIM_M * 1e3;
+    let reach = 1.1 * limbus_mm;
+    let correction = rk
+        .predicted_correction_d
+        .map_or("no correction predicted".to_owned(), |d| {
+            format!(
+                "predicted correction {d:.1} D for {:.1} D",
+                rk.target_correction_d
+            )
+        });
+    let perforated = if rk.perforated { "; PERFORATED" } else { "" };
+    // Square to the cornea, with room on its right for the legend.
+    let (width, height) = area.dim_in_pixel();
+    let wide = (1.8 * f64::from(height)).min(f64::from(width)) as i32;
+    let side = (width as i32 - wide) / 2;
+    let panel = area.margin(0, 0, side, side);
+    let mut chart = ChartBuilder::on(&panel)
+        .caption(
+            format!("the incisions: {correction}{perforated}"),
+            ("sans-serif", 20),
+        )
+        .margin(16)
+        .x_label_area_size(40)
+        .y_label_area_size(48)
+        .build_cartesian_2d(-reach..2.6 * reach, -reach..reach)?;
+    chart
+        .configure_mesh()
+        .x_desc("x (mm)")
+        .y_desc("y (mm)")
+        .draw()?;
+    let circle = |radius: f64| {
+        (0..=120).map(move |k| {
+            let a = std::f64::consts::TAU * f64::from(k) / 120.0;
+            (radius * a.cos(), radius * a.sin())
+        })
+    };
+    chart
+        .draw_series(LineSeries::new(circle(limbus_mm), BLACK.stroke_width(1)))?
+        .label("the limbus")
+        .legend(legend_stroke(BLACK.stroke_width(1)));
+    chart
+        .draw_series([Polygon::new(
+            circle(rk.optical_zone_mm / 2.0).collect::<Vec<_>>(),
+            RED.mix(0.15).filled(),
+        )])?
+        .label(format!(
+            "the {:.1} mm optical zone, uncut",
+            rk.optical_zone_mm
+        ))
+        .legend(legend_stroke(RED.mix(0.4).stroke_width(8)));
+    let turn = rk.incisions.first().map_or(0.0, |c| c.angle_deg);
+    for k in 0..rk.planned {
+        let a = (turn + 360.0 * k as f64 / rk.planned as f64).to_radians();
+        let line = chart.draw_series(LineSeries::new(
+            [0.5, 1.0].map(|r| (r * limbus_mm * a.cos(), r * limbus_mm * a.sin())),
+            GREEN.stroke_width(2),
+        ))?;
+        if k == 0 {
+            line.label("the plan's spacing")
+                .legend(legend_stroke(GREEN.stroke_width(2)));
+        }
+    }
+    for (k, cut) in rk.incisions.iter().enumerate() {
+        let a = cut.angle_deg.to_radians();
+        let ends = [cut.from_mm, cut.to_mm].map(|r| (r * a.cos(), r * a.sin()));
+        let line = chart.draw_series(LineSeries::new(ends, BLACK.stroke_width(3)))?;
+        if k == 0 {
+            line.label("an incision")
+                .legend(legend_stroke(BLACK.stroke_width(3)));
+        }
+    }
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+    Ok(())
 }
 
 /// The incision seen square to the marked line: along it (mm from its start) and across it

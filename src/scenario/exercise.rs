@@ -8,6 +8,7 @@ use serde::Serialize;
 
 use super::format::{OrganEntry, Scenario, Spot, Task, TaskKind, metres, spot_name};
 use super::incision::{BladeSample, IncisionMetrics, IncisionTracker};
+use super::keratotomy::{Keratometer, KeratotomyMetrics, KeratotomyPlan, KeratotomyTracker};
 use super::motion::{MotionMetrics, MotionTracker};
 use crate::pgd::SurfacePoint;
 
@@ -84,6 +85,9 @@ pub struct Sites {
     pub nodules: Vec<NoduleSite>,
     /// One per task, in order: the region a retraction task watches.
     pub regions: Vec<Option<RegionSite>>,
+    /// One per task, in order: the cut cornea's model a keratotomy task predicts its
+    /// correction with.
+    pub keratometers: Vec<Option<Keratometer>>,
 }
 
 /// Where an exercise stands, for the trainee's display.
@@ -178,6 +182,12 @@ pub struct TaskMetrics {
     /// Laparoscopy: the time the point to keep in view was out of the camera's view (s).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub target_out_of_view_s: Option<f64>,
+    /// Radial keratotomy: the incisions against the plan, and the correction they give.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub keratotomy: Option<KeratotomyMetrics>,
+    /// A complication (a perforated eye): the attempt fails whatever its score.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub complication: Option<String>,
 }
 
 /// One task's running state.
@@ -202,6 +212,8 @@ struct Running {
     motion: MotionTracker,
     /// Incision: the cut against the line.
     incision: Option<IncisionTracker>,
+    /// Radial keratotomy: the strokes as incisions.
+    keratotomy: Option<KeratotomyTracker>,
 }
 
 /// The tasks of a scenario, run one after another.
@@ -305,6 +317,7 @@ impl Exercise {
             running.metrics.time_s = time_s - running.metrics.started_s;
             running.metrics.motion = running.motion.metrics();
             running.metrics.incision = running.incision.as_ref().map(IncisionTracker::metrics);
+            running.metrics.keratotomy = running.keratotomy.as_ref().map(|k| k.metrics());
             running.metrics.mean_force_n = if running.metrics.contact_s > 0.0 {
                 running.force_sum / running.metrics.contact_s
             } else {
@@ -326,7 +339,18 @@ impl Exercise {
             });
             self.end_task(now);
         }
+        self.predict_corrections();
         (self.scenario, self.done, self.force_trace)
+    }
+
+    /// Each keratotomy's predicted correction: a full solve of the cut cornea, which is why
+    /// it is made here, when the attempt is scored, and not on the haptic thread.
+    fn predict_corrections(&mut self) {
+        for (metrics, keratometer) in self.done.iter_mut().zip(&self.sites.keratometers) {
+            if let (Some(keratotomy), Some(keratometer)) = (&mut metrics.keratotomy, keratometer) {
+                keratotomy.predicted_correction_d = keratometer.correction_d(keratotomy);
+            }
+        }
     }
 }
 
@@ -347,13 +371,17 @@ impl Running {
             Task::Palpation { max_force_n, .. }
             | Task::Retraction { max_force_n, .. }
             | Task::Grasp { max_force_n, .. }
-            | Task::Incision { max_force_n, .. } => (max_force_n.0, 0, None),
+            | Task::Incision { max_force_n, .. }
+            | Task::RadialKeratotomy { max_force_n, .. } => (max_force_n.0, 0, None),
         };
         let hold_s = match task {
             Task::ForceControl { hold_s, .. }
             | Task::Retraction { hold_s, .. }
             | Task::Grasp { hold_s, .. } => Some(hold_s.0),
-            Task::SafeNavigation { .. } | Task::Palpation { .. } | Task::Incision { .. } => None,
+            Task::SafeNavigation { .. }
+            | Task::Palpation { .. }
+            | Task::Incision { .. }
+            | Task::RadialKeratotomy { .. } => None,
         };
         let (move_target_mm, surrounding_limit_n) = match task {
             Task::Retraction {
@@ -368,7 +396,8 @@ impl Running {
             Task::ForceControl { organ, .. }
             | Task::Palpation { organ, .. }
             | Task::Grasp { organ, .. }
-            | Task::Incision { organ, .. } => organs.iter().position(|o| &o.name == organ),
+            | Task::Incision { organ, .. }
+            | Task::RadialKeratotomy { organ, .. } => organs.iter().position(|o| &o.name == organ),
             // Retraction watches its organ through its region site.
             Task::SafeNavigation { .. } | Task::Retraction { .. } => None,
         };
@@ -384,6 +413,26 @@ impl Running {
                 (metres(*from_mm), metres(*to_mm)),
                 tolerance_mm.metres(),
                 depth_mm.metres(),
+            )),
+            _ => None,
+        };
+        let keratotomy = match task {
+            Task::RadialKeratotomy {
+                incisions,
+                optical_zone_mm,
+                depth_fraction,
+                target_correction_d,
+                correction_tolerance_d,
+                ..
+            } => Some(KeratotomyTracker::new(
+                organ,
+                KeratotomyPlan {
+                    incisions: incisions.0,
+                    optical_zone_m: optical_zone_mm.metres(),
+                    depth_fraction: depth_fraction.0,
+                    target_correction_d: target_correction_d.0,
+                    correction_tolerance_d: correction_tolerance_d.0,
+                },
             )),
             _ => None,
         };
@@ -410,6 +459,7 @@ impl Running {
             force_sum: 0.0,
             organ,
             incision,
+            keratotomy,
             button_held: false,
             damaged: false,
             held_since: None,
@@ -488,7 +538,26 @@ impl Running {
                 ..
             } => self.grasp(organ, (move_mm.0, hold_s.0), sample),
             Task::Incision { organ, .. } => self.cut(organ, sample),
+            Task::RadialKeratotomy { organ, .. } => self.keratotomy(organ, sample),
         }
+    }
+
+    /// Radial keratotomy: the task is done when the plan's incisions are made and the blade
+    /// is lifted. A cut through the whole thickness is a complication: the task cannot be
+    /// done any more and the attempt fails.
+    fn keratotomy(&mut self, organ: &str, sample: &Sample) {
+        let Some(tracker) = self.keratotomy.as_mut() else {
+            return;
+        };
+        if tracker.step(sample.blade.as_ref()) {
+            self.metrics.complication = Some(format!(
+                "{:.2} s: cut through the whole thickness of the {organ}: a perforation",
+                sample.time_s
+            ));
+        }
+        self.metrics.completed = !tracker.cutting()
+            && tracker.made() >= tracker.planned()
+            && self.metrics.complication.is_none();
     }
 
     /// Incision: the cut follows the line; the task is done when nine tenths of it are cut
@@ -591,9 +660,11 @@ impl Running {
         m.completed = error_m <= found_within_m;
     }
 
-    /// Whether the task is over before its time: done, or (palpation) marked, right or wrong.
+    /// Whether the task is over before its time: done, (palpation) marked, right or wrong, or
+    /// ended by a complication.
     fn over(&self) -> bool {
-        self.metrics.completed || self.metrics.localization_error_mm.is_some()
+        let m = &self.metrics;
+        m.completed || m.localization_error_mm.is_some() || m.complication.is_some()
     }
 
     fn navigate(&mut self, targets: &[Spot], forbidden: &[Spot], sample: &Sample) {

@@ -13,8 +13,8 @@ use crate::devices::DeviceSpec;
 use crate::fem::Law;
 
 use super::units::{
-    FieldOfView, Millimetres, ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, ScopeAngle,
-    Seconds, Toughness,
+    DepthFraction, Dioptres, EdgeLength, FieldOfView, IncisionCount, Millimetres, ModeCount,
+    Newtons, Pascals, PoissonRatio, Ratio, Scale, ScopeAngle, Seconds, Toughness,
 };
 
 #[derive(Clone, Debug, PartialEq, Deserialize)]
@@ -82,12 +82,12 @@ pub enum Tool {
     Grasper { tip_radius_mm: Millimetres },
     /// A scalpel: it presses like a probe of this radius, and where it presses an organ
     /// harder than the tissue's toughness times `edge_mm` (the length of edge pressed in,
-    /// 5 mm when left out) the tissue parts and the blade cuts along its edge as deep as it
-    /// is pressed (`docs/cutting.md`).
+    /// 5 mm when left out; a diamond knife's point is a few micrometres) the tissue parts
+    /// and the blade cuts along its edge as deep as it is pressed (`docs/cutting.md`).
     Scalpel {
         tip_radius_mm: Millimetres,
         #[serde(default)]
-        edge_mm: Option<Millimetres>,
+        edge_mm: Option<EdgeLength>,
     },
 }
 
@@ -108,14 +108,20 @@ impl Tool {
         }
     }
 
-    /// The blade, if the tool cuts.
+    /// The blade, if the tool cuts. Its cut advances in steps of a third of its tip's
+    /// radius, from 0.5 mm (the cornea's few-millimetre incisions) to 2 mm.
     pub fn blade(&self) -> Option<crate::cutting::Blade> {
-        let Tool::Scalpel { edge_mm, .. } = self else {
+        let Tool::Scalpel {
+            edge_mm,
+            tip_radius_mm,
+        } = self
+        else {
             return None;
         };
         let blade = crate::cutting::Blade::default();
         Some(crate::cutting::Blade {
-            edge_m: edge_mm.map_or(blade.edge_m, Millimetres::metres),
+            edge_m: edge_mm.map_or(blade.edge_m, EdgeLength::metres),
+            step_m: (tip_radius_mm.metres() / 3.0).clamp(0.5e-3, blade.step_m),
             ..blade
         })
     }
@@ -536,6 +542,29 @@ pub enum Task {
         max_force_n: Newtons,
         time_limit_s: Seconds,
     },
+    /// Radial keratotomy on the cornea: `incisions` radial cuts, evenly spaced round its
+    /// axis, each from the edge of the central optical zone (`optical_zone_mm` across, left
+    /// uncut) out towards the limbus, `depth_fraction` of the thickness deep, to flatten the
+    /// cornea by `target_correction_d` dioptres (the myopia corrected). Done when as many
+    /// incisions are made and the blade is lifted. Scored on symmetry, the optical zone
+    /// respected, depth, and the correction the cut cornea is predicted to give against the
+    /// target (within `correction_tolerance_d`, 1 D when left out); a cut through the whole
+    /// thickness perforates the eye and fails the attempt.
+    RadialKeratotomy {
+        organ: String,
+        incisions: IncisionCount,
+        optical_zone_mm: Millimetres,
+        depth_fraction: DepthFraction,
+        target_correction_d: Dioptres,
+        #[serde(default = "default_correction_tolerance")]
+        correction_tolerance_d: Dioptres,
+        max_force_n: Newtons,
+        time_limit_s: Seconds,
+    },
+}
+
+fn default_correction_tolerance() -> Dioptres {
+    Dioptres(1.0)
 }
 
 /// The region a retraction or grasp task watches: its organ, the point nearest which it
@@ -562,6 +591,8 @@ pub enum TaskKind {
     Grasp,
     #[serde(rename = "incision")]
     Incision,
+    #[serde(rename = "radial keratotomy")]
+    RadialKeratotomy,
 }
 
 impl std::fmt::Display for TaskKind {
@@ -573,6 +604,7 @@ impl std::fmt::Display for TaskKind {
             TaskKind::Retraction => "retraction",
             TaskKind::Grasp => "grasp",
             TaskKind::Incision => "incision",
+            TaskKind::RadialKeratotomy => "radial keratotomy",
         })
     }
 }
@@ -609,6 +641,7 @@ impl Task {
             Task::Retraction { .. } => TaskKind::Retraction,
             Task::Grasp { .. } => TaskKind::Grasp,
             Task::Incision { .. } => TaskKind::Incision,
+            Task::RadialKeratotomy { .. } => TaskKind::RadialKeratotomy,
         }
     }
 
@@ -680,6 +713,23 @@ impl Task {
                 depth_mm.0,
                 max_force_n.0
             ),
+            Task::RadialKeratotomy {
+                organ,
+                incisions,
+                optical_zone_mm,
+                depth_fraction,
+                target_correction_d,
+                max_force_n,
+                ..
+            } => format!(
+                "make {} radial incisions in the {organ} outside a {:.1} mm optical zone, {:.0} % \
+                 deep, for {:.1} D of correction, under {:.2} N",
+                incisions.0,
+                optical_zone_mm.0,
+                100.0 * depth_fraction.0,
+                target_correction_d.0,
+                max_force_n.0
+            ),
         }
     }
 
@@ -690,7 +740,8 @@ impl Task {
             | Task::Palpation { time_limit_s, .. }
             | Task::Retraction { time_limit_s, .. }
             | Task::Grasp { time_limit_s, .. }
-            | Task::Incision { time_limit_s, .. } => time_limit_s.0,
+            | Task::Incision { time_limit_s, .. }
+            | Task::RadialKeratotomy { time_limit_s, .. } => time_limit_s.0,
         }
     }
 }

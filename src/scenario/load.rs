@@ -8,6 +8,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use super::format::{LaparoscopeEntry, OrganEntry, Scenario, Task, metres};
+use super::keratotomy::MIN_INCISION_M;
 use crate::contact::PointshellDensity;
 use crate::devices::DeviceSpec;
 use crate::mesh::Surface;
@@ -390,17 +391,17 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
                 depth_mm.0,
                 &field,
             ));
-            if max_force_n.0 > device_limit {
-                problems.push(Problem {
-                    field: field("max_force_n"),
-                    anchors: anchors("max_force_n"),
-                    message: format!(
-                        "{} N is above the device's limit of {device_limit} N",
-                        max_force_n.0
-                    ),
-                    hint: "lower it, or raise device.max_force_n".into(),
-                });
-            }
+            problems.extend(within_device(max_force_n.0, device_limit, &field));
+        }
+        Task::RadialKeratotomy {
+            organ,
+            optical_zone_mm,
+            max_force_n,
+            ..
+        } => {
+            problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
+            problems.extend(check_keratotomy(scenario, organ, optical_zone_mm.0, &field));
+            problems.extend(within_device(max_force_n.0, device_limit, &field));
         }
         Task::SafeNavigation { targets, .. } => {
             if targets.is_empty() {
@@ -415,6 +416,95 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
     }
 }
 
+/// A task's force limit must be one the device can send.
+fn within_device(
+    max_force_n: f64,
+    device_limit: f64,
+    field: &dyn Fn(&str) -> String,
+) -> Option<Problem> {
+    (max_force_n > device_limit).then(|| Problem {
+        field: field("max_force_n"),
+        anchors: vec!["tasks".into(), "max_force_n".into()],
+        message: format!("{max_force_n} N is above the device's limit of {device_limit} N"),
+        hint: "lower it, or raise device.max_force_n".into(),
+    })
+}
+
+/// A cutting task (`Incision`, `RadialKeratotomy`) needs a scalpel and an organ whose
+/// toughness under a blade is known.
+fn check_blade(
+    scenario: &Scenario,
+    organ: &str,
+    task: &str,
+    field: &dyn Fn(&str) -> String,
+) -> Vec<Problem> {
+    let anchors = || vec!["tasks".to_owned(), task.to_owned(), "organ".into()];
+    let mut problems = Vec::new();
+    if scenario.tool.blade().is_none() {
+        problems.push(Problem {
+            field: field("organ"),
+            anchors: anchors(),
+            message: format!("an {task} task needs a scalpel to cut with"),
+            hint: "set tool: Scalpel(tip_radius_mm: 6.0)".into(),
+        });
+    }
+    if let Some(entry) = scenario.organ(organ)
+        && entry.toughness_j_per_m2().is_none()
+    {
+        problems.push(Problem {
+            field: field("organ"),
+            anchors: anchors(),
+            message: format!("the {organ}'s toughness under a blade is not known: it cannot be cut"),
+            hint: format!(
+                "give it one: Organ(name: \"{organ}\", toughness_j_per_m2: 190.0) (the liver's is known)"
+            ),
+        });
+    }
+    problems
+}
+
+/// A keratotomy cuts the generated cornea, with room for its incisions between the optical
+/// zone and the limbus.
+fn check_keratotomy(
+    scenario: &Scenario,
+    organ: &str,
+    optical_zone_mm: f64,
+    field: &dyn Fn(&str) -> String,
+) -> Vec<Problem> {
+    let mut problems = check_blade(scenario, organ, "RadialKeratotomy", field);
+    let anchors = |name: &str| vec!["tasks".into(), "RadialKeratotomy".into(), name.to_owned()];
+    let cornea = scenario
+        .organ(organ)
+        .is_some_and(|e| e.mesh.is_none() && Organ::from_name(&e.name) == Some(Organ::Cornea));
+    if scenario.organ(organ).is_some() && !cornea {
+        problems.push(Problem {
+            field: field("organ"),
+            anchors: anchors("organ"),
+            message: format!("radial keratotomy cuts the cornea, not the {organ}"),
+            hint: "put \"cornea\" in organs and name it here".into(),
+        });
+    }
+    let outer_mm = crate::cutting::keratotomy::INCISION_END_M * 1e3;
+    let room_mm = outer_mm - optical_zone_mm / 2.0;
+    if room_mm < MIN_INCISION_M * 1e3 {
+        problems.push(Problem {
+            field: field("optical_zone_mm"),
+            anchors: anchors("optical_zone_mm"),
+            message: format!(
+                "a {optical_zone_mm} mm optical zone leaves no room for incisions: they end \
+                 {outer_mm:.2} mm off the axis, {:.1} mm inside the {:.1} mm cornea's limbus",
+                crate::mesh::organs::CORNEA_RIM_M * 1e3 - outer_mm,
+                2.0 * crate::mesh::organs::CORNEA_RIM_M * 1e3,
+            ),
+            hint: format!(
+                "an optical zone is 3 to 4 mm across; at most {:.1} mm here",
+                2.0 * (outer_mm - MIN_INCISION_M * 1e3)
+            ),
+        });
+    }
+    problems
+}
+
 /// An incision needs a scalpel, an organ a scalpel can part, a line of some length and a
 /// depth the organs' thickness allows.
 fn check_incision(
@@ -425,27 +515,7 @@ fn check_incision(
     field: &dyn Fn(&str) -> String,
 ) -> Vec<Problem> {
     let anchors = |name: &str| vec!["tasks".to_owned(), "Incision".into(), name.to_owned()];
-    let mut problems = Vec::new();
-    if scenario.tool.blade().is_none() {
-        problems.push(Problem {
-            field: field("organ"),
-            anchors: anchors("organ"),
-            message: "an Incision task needs a scalpel to cut with".into(),
-            hint: "set tool: Scalpel(tip_radius_mm: 6.0)".into(),
-        });
-    }
-    if let Some(entry) = scenario.organ(organ)
-        && entry.toughness_j_per_m2().is_none()
-    {
-        problems.push(Problem {
-            field: field("organ"),
-            anchors: anchors("organ"),
-            message: format!("the {organ}'s toughness under a blade is not known: it cannot be cut"),
-            hint: format!(
-                "give it one: Organ(name: \"{organ}\", toughness_j_per_m2: 190.0) (the liver's is known)"
-            ),
-        });
-    }
+    let mut problems = check_blade(scenario, organ, "Incision", field);
     let length_mm = (metres(*to_mm) - metres(*from_mm)).norm() * 1e3;
     if length_mm < 5.0 {
         problems.push(Problem {

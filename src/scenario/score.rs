@@ -6,6 +6,7 @@ use serde::Serialize;
 use super::exercise::{COVERED_TO_FINISH, TaskMetrics};
 use super::format::{Rubric, Scenario, TaskKind};
 use super::incision::IncisionMetrics;
+use super::keratotomy::KeratotomyMetrics;
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TaskScore {
@@ -53,7 +54,9 @@ pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
         .collect();
     let score = tasks.iter().map(|t| t.score).sum::<f64>() / tasks.len().max(1) as f64;
     let all_done = tasks.iter().all(|t| t.metrics.completed);
-    let passed = score >= rubric.pass_mark && (all_done || !rubric.all_tasks_required);
+    let complication = tasks.iter().any(|t| t.metrics.complication.is_some());
+    let passed =
+        score >= rubric.pass_mark && (all_done || !rubric.all_tasks_required) && !complication;
     let mut feedback: Vec<String> = tasks.iter().flat_map(task_feedback).collect();
     if score < rubric.pass_mark {
         feedback.push(format!(
@@ -82,7 +85,7 @@ fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
     };
     // Accuracy weighs only where there is a mark to be accurate about.
     let accuracy_weight = match m.kind {
-        TaskKind::Palpation | TaskKind::Incision => rubric.accuracy,
+        TaskKind::Palpation | TaskKind::Incision | TaskKind::RadialKeratotomy => rubric.accuracy,
         TaskKind::ForceControl
         | TaskKind::SafeNavigation
         | TaskKind::Retraction
@@ -125,19 +128,47 @@ fn in_view(m: &TaskMetrics) -> f64 {
 /// counts as found; 0 without a mark. Incision: the mean of the line's accuracy (1 on it,
 /// falling to 0 at twice the tolerance off it on average) and the depth's (1 at the target,
 /// falling to 0 at half or twice as deep); 0 with nothing cut.
+///
+/// Radial keratotomy: the mean of the symmetry (1 evenly spaced, 0 when a gap is off by half
+/// the even spacing), the optical zone (1 clear, 0 cut to the axis), the depth's accuracy (as
+/// an incision's) and the correction's (1 on the target, 0 at twice the tolerance off it, or
+/// when it could not be predicted); 0 with no incision.
 fn accuracy(m: &TaskMetrics) -> f64 {
     if let Some(cut) = &m.incision {
         if cut.covered_mm <= 0.0 {
             return 0.0;
         }
         let line = 1.0 - cut.mean_deviation_mm / (2.0 * cut.tolerance_mm);
-        let depth = 1.0 - (cut.mean_depth_mm / cut.target_depth_mm).ln().abs() / 2f64.ln();
-        return 0.5 * (line.clamp(0.0, 1.0) + depth.clamp(0.0, 1.0));
+        let depth = depth_accuracy(cut.mean_depth_mm / cut.target_depth_mm);
+        return 0.5 * (line.clamp(0.0, 1.0) + depth);
+    }
+    if let Some(rk) = &m.keratotomy {
+        return keratotomy_accuracy(rk);
     }
     match (m.localization_error_mm, m.found_within_mm) {
         (Some(error), Some(within)) => (1.0 - error / (2.0 * within)).clamp(0.0, 1.0),
         _ => 0.0,
     }
+}
+
+/// 1 at the target depth (`ratio` of it 1), falling to 0 at half or twice as deep.
+fn depth_accuracy(ratio: f64) -> f64 {
+    (1.0 - ratio.ln().abs() / 2f64.ln()).clamp(0.0, 1.0)
+}
+
+fn keratotomy_accuracy(rk: &KeratotomyMetrics) -> f64 {
+    let made = rk.incisions.len();
+    if made == 0 {
+        return 0.0;
+    }
+    let symmetry = 1.0 - rk.spacing_error_deg / (180.0 / made as f64);
+    let zone = 1.0 - rk.zone_intrusion_mm / (rk.optical_zone_mm / 2.0);
+    let depth = depth_accuracy(rk.mean_depth_fraction / rk.target_depth_fraction);
+    let correction = rk.predicted_correction_d.map_or(0.0, |d| {
+        1.0 - (d - rk.target_correction_d).abs() / (2.0 * rk.correction_tolerance_d)
+    });
+    let terms = [symmetry, zone, depth, correction];
+    terms.iter().map(|t| t.clamp(0.0, 1.0)).sum::<f64>() / terms.len() as f64
 }
 
 /// The share of the time in contact spent as the task wants: within the band (force control),
@@ -151,15 +182,18 @@ fn force_control(m: &TaskMetrics) -> f64 {
             | TaskKind::Palpation
             | TaskKind::Retraction
             | TaskKind::Grasp
-            | TaskKind::Incision => 0.0,
+            | TaskKind::Incision
+            | TaskKind::RadialKeratotomy => 0.0,
             TaskKind::SafeNavigation => 1.0,
         };
     }
     let over_s = match m.kind {
         TaskKind::ForceControl => m.contact_s - m.within_band_s,
-        TaskKind::SafeNavigation | TaskKind::Palpation | TaskKind::Grasp | TaskKind::Incision => {
-            m.time_over_limit_s
-        }
+        TaskKind::SafeNavigation
+        | TaskKind::Palpation
+        | TaskKind::Grasp
+        | TaskKind::Incision
+        | TaskKind::RadialKeratotomy => m.time_over_limit_s,
         TaskKind::Retraction => m.time_over_limit_s + m.surrounding_over_limit_s,
     };
     (1.0 - over_s / m.contact_s).clamp(0.0, 1.0)
@@ -224,6 +258,15 @@ fn task_feedback(task: &TaskScore) -> Vec<String> {
     if let Some(cut) = &m.incision {
         lines.extend(incision_feedback(m.kind, cut));
     }
+    if let Some(rk) = &m.keratotomy {
+        lines.extend(keratotomy_feedback(m.kind, rk));
+    }
+    if let Some(complication) = &m.complication {
+        lines.push(format!(
+            "{}: complication: {complication}; the attempt fails",
+            m.kind
+        ));
+    }
     lines.extend(m.errors.iter().map(|e| format!("{}: {e}", m.kind)));
     lines
 }
@@ -250,4 +293,85 @@ fn incision_feedback(kind: TaskKind, cut: &IncisionMetrics) -> Vec<String> {
         ));
     }
     lines
+}
+
+/// What a keratotomy got wrong, and always the correction it is predicted to give.
+fn keratotomy_feedback(kind: TaskKind, rk: &KeratotomyMetrics) -> Vec<String> {
+    let mut lines = Vec::new();
+    let made = rk.incisions.len();
+    if made != rk.planned {
+        lines.push(format!("{kind}: {made} incisions made of {}", rk.planned));
+    }
+    if made > 1 && rk.spacing_error_deg > 90.0 / made as f64 {
+        lines.push(format!(
+            "{kind}: unevenly spaced: a gap {:.0}° off the even {:.0}°",
+            rk.spacing_error_deg,
+            360.0 / made as f64
+        ));
+    }
+    if rk.zone_intrusion_mm > 0.0 {
+        lines.push(format!(
+            "{kind}: cut {:.1} mm into the {:.1} mm optical zone",
+            rk.zone_intrusion_mm, rk.optical_zone_mm
+        ));
+    }
+    let (depth, target) = (rk.mean_depth_fraction, rk.target_depth_fraction);
+    if made > 0 && (depth - target).abs() > 0.1 {
+        lines.push(format!(
+            "{kind}: {:.0} % deep on average for {:.0} %",
+            100.0 * depth,
+            100.0 * target
+        ));
+    }
+    let target = rk.target_correction_d;
+    lines.push(match rk.predicted_correction_d {
+        Some(d) => format!(
+            "{kind}: predicted correction {d:.1} D for {target:.1} D (within {:.1} D counts)",
+            rk.correction_tolerance_d
+        ),
+        None if made == 0 => format!("{kind}: no incision, no correction"),
+        None => format!("{kind}: the correction could not be predicted"),
+    });
+    lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::parse;
+
+    /// A finished task with full marks scores high, and passes; the same with a
+    /// complication fails, whatever its score, and the debrief says why.
+    #[test]
+    fn a_complication_fails_the_attempt_whatever_its_score() {
+        let scenario = parse(
+            std::path::Path::new("t.scenario.ron"),
+            r#"Scenario(title: "t", briefing: "b", organs: ["liver"],
+                tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3,
+                                     hold_s: 1.0, time_limit_s: 10.0)])"#,
+        )
+        .unwrap();
+        let metrics = TaskMetrics {
+            completed: true,
+            time_s: 2.0,
+            time_limit_s: 10.0,
+            contact_s: 2.0,
+            within_band_s: 2.0,
+            ..TaskMetrics::default()
+        };
+        let clean = score(&scenario, vec![metrics.clone()]);
+        assert!(clean.passed && clean.score > 80.0, "{clean:?}");
+        let complicated = TaskMetrics {
+            complication: Some("1.00 s: a perforation".into()),
+            ..metrics
+        };
+        let card = score(&scenario, vec![complicated]);
+        assert_eq!(card.score, clean.score);
+        assert!(!card.passed);
+        assert!(
+            card.feedback
+                .iter()
+                .any(|l| l.contains("the attempt fails"))
+        );
+    }
 }

@@ -223,3 +223,81 @@ impl TryFrom<f64> for FieldOfView {
         }
     }
 }
+
+/// The length of a blade's edge in the tissue when it first parts it, in millimetres: from
+/// 0.001 (the point of a diamond knife) to 50.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct EdgeLength(pub f64);
+
+impl EdgeLength {
+    pub fn metres(self) -> f64 {
+        self.0 * 1e-3
+    }
+}
+
+impl TryFrom<f64> for EdgeLength {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (0.001..=50.0).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v} mm is not a blade's edge in the tissue: from 0.001 (a diamond knife's point) \
+                 to 50 mm"
+            )),
+        }
+    }
+}
+
+/// A number of radial incisions: from 1 to 16 (keratotomies make 4 or 8; more adds little).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(try_from = "u64")]
+pub struct IncisionCount(pub usize);
+
+impl TryFrom<u64> for IncisionCount {
+    type Error = String;
+    fn try_from(value: u64) -> Result<Self, String> {
+        match value {
+            1..=16 => Ok(Self(value as usize)),
+            v => Err(format!(
+                "{v} incisions: from 1 to 16 (radial keratotomy makes 4 or 8)"
+            )),
+        }
+    }
+}
+
+/// A depth as a share of a tissue's thickness, strictly between 0 and 1 (1 would cut through).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct DepthFraction(pub f64);
+
+impl TryFrom<f64> for DepthFraction {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && v > 0.0 && v < 1.0 => Ok(Self(v)),
+            v => Err(format!(
+                "{v} is not a depth fraction: more than 0 and less than 1 of the thickness \
+                 (keratotomies cut 0.8 to 0.9 deep; 1 perforates)"
+            )),
+        }
+    }
+}
+
+/// A refractive power in dioptres, more than 0 and at most 20.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct Dioptres(pub f64);
+
+impl TryFrom<f64> for Dioptres {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && v > 0.0 && v <= 20.0 => Ok(Self(v)),
+            v => Err(format!(
+                "{v} D is not a correction: more than 0 and at most 20 dioptres (radial \
+                 keratotomy corrects 2 to 8)"
+            )),
+        }
+    }
+}

@@ -113,6 +113,50 @@ fn pressing_deeper_deepens_and_turning_turns() {
     assert_eq!(scalpel.strokes()[0].max_depth_m, 5.0 * MM);
 }
 
+/// Over a curved surface (a sphere of the cornea's 8 mm radius, cut 0.4 mm deep along a
+/// meridian) the cut follows the surface: every point it advances to lies within the blade's
+/// follow share of the depth of the sphere, where one straight face would have left the
+/// surface by its sag (0.7 mm over 3.4 mm).
+#[test]
+fn the_cut_follows_a_curved_surface() {
+    let blade = Blade {
+        step_m: 0.5 * MM,
+        edge_m: 0.005 * MM,
+        ..Blade::default()
+    };
+    let mut scalpel = Scalpel::new(blade, LIVER_TOUGHNESS_J_PER_M2);
+    let radius = 8.0 * MM;
+    let depth = 0.4 * MM;
+    let at = |angle: f64| {
+        let outward = Vector3::new(angle.sin(), 0.0, angle.cos());
+        BladeContact {
+            point_m: Point3::from(outward * radius),
+            inward: Unit::new_normalize(-outward),
+            edge: Vector3::x(),
+            depth_m: depth,
+            pressing_n: 1.0,
+        }
+    };
+    let mut fronts = Vec::new();
+    for k in 0..=500 {
+        let angle = (0.1 + 0.4 * f64::from(k) / 500.0).to_radians() * 60.0;
+        if let Some(CutStep::Advance { to }) = scalpel.tick(Some(&at(angle))) {
+            fronts.push(to);
+        }
+    }
+    let reach = fronts.last().expect("the cut advanced").x;
+    assert!(reach > 3.0 * MM, "the cut reached only {} mm", reach / MM);
+    for to in &fronts {
+        let off = (to.coords.norm() - radius).abs();
+        assert!(
+            off <= blade.follow_share * depth + 1e-9,
+            "{:.3} mm off the surface at x = {:.2} mm",
+            off / MM,
+            to.x / MM
+        );
+    }
+}
+
 /// The cut state on its worker thread, fed a stroke's steps, gives the tick the patch
 /// compliance that full X-FEM solves of the same faces (the front snapped to the nearest
 /// element faces) give, to round-off; a step the cut state refuses is reported and changes

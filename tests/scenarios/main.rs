@@ -1,6 +1,6 @@
 //! Scenarios: every shipped file validates; each has a competent and a careless scripted run
-//! (`tests/scenarios/<name>.competent.csv`, `.careless.csv`, written for the coarse organs and
-//! their 12 mm tool) — the competent one passes, the careless one fails, and the score orders
+//! (`tests/scenarios/<name>.competent.csv`, `.careless.csv`, written for the coarse organs: the
+//! abdominal ones with their 12 mm tool, the cornea with its 0.5 mm knife) — the competent one passes, the careless one fails, and the score orders
 //! them; broken files each give their expected error at the right line and field; and the
 //! `trainer` binary validates, runs and reports.
 
@@ -14,12 +14,14 @@ use std::sync::OnceLock;
 
 use pgd_surgery::app::attempt::{Outcome, run_simulated, scenario_scene};
 use pgd_surgery::app::scene::{Detail, default_scene};
+use pgd_surgery::cutting::Front;
+use pgd_surgery::cutting::keratotomy::Cornea;
 use pgd_surgery::devices::{Scripted, TICK_S, Trajectory};
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::io::write_vtu;
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate};
 use pgd_surgery::report::write_report;
-use pgd_surgery::scenario::{Scenario, Task, load, parse};
+use pgd_surgery::scenario::{Scenario, Scorecard, Task, load, parse};
 use pgd_surgery::store::OnStale;
 
 const TRAINER: &str = env!("CARGO_BIN_EXE_trainer");
@@ -65,7 +67,7 @@ fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     run_simulated(scenario, &scene, device, ticks).unwrap()
 }
 
-const SHIPPED: [&str; 10] = [
+const SHIPPED: [&str; 11] = [
     "liver-steady-press",
     "pancreas-palpation",
     "gallbladder-gentle-press",
@@ -76,6 +78,7 @@ const SHIPPED: [&str; 10] = [
     "gallbladder-grasp-retract",
     "liver-capsule-incision",
     "liver-laparoscopic-press",
+    "cornea-radial-keratotomy",
 ];
 
 #[test]
@@ -163,6 +166,51 @@ fn the_report_is_written_as_json_text_and_plot() {
         "{summary}"
     );
     assert_eq!(&std::fs::read(png).unwrap()[..8], b"\x89PNG\r\n\x1a\n");
+}
+
+/// Radial keratotomy: the competent run's four incisions are evenly spaced outside the
+/// optical zone, as deep as asked within a tenth, and the correction the score weighs is the
+/// reference solver's for those incisions (solved again here), within the scenario's
+/// tolerance of its target; the careless run cuts through the cornea, which ends and fails
+/// the attempt, and the debrief says so. Both reports draw the incisions.
+#[test]
+fn a_keratotomy_is_scored_on_its_incisions_and_a_perforation_fails_it() {
+    let competent = run("cornea-radial-keratotomy", "competent");
+    let rk = competent.card.tasks[0].metrics.keratotomy.clone().unwrap();
+    assert_eq!(rk.incisions.len(), 4, "{rk:?}");
+    assert!(rk.spacing_error_deg < 2.0, "{rk:?}");
+    assert_eq!(rk.zone_intrusion_mm, 0.0);
+    assert!((rk.mean_depth_fraction - rk.target_depth_fraction).abs() < 0.1);
+    assert!(!rk.perforated);
+    let predicted = rk.predicted_correction_d.expect("a correction");
+    let faces = rk.faces().unwrap();
+    let reference = Cornea::reference().unwrap();
+    let solved = -reference.power_change_d(&faces, Front::Inward).unwrap();
+    assert!((predicted - solved).abs() < 1e-9, "{predicted} vs {solved}");
+    assert!(
+        (predicted - rk.target_correction_d).abs() <= rk.correction_tolerance_d,
+        "{predicted} D"
+    );
+    let said = |card: &Scorecard, words: &[&str]| {
+        card.feedback
+            .iter()
+            .any(|line| words.iter().all(|w| line.contains(w)))
+    };
+    assert!(said(&competent.card, &["predicted correction"]));
+
+    let careless = run("cornea-radial-keratotomy", "careless");
+    let m = &careless.card.tasks[0].metrics;
+    assert!(m.keratotomy.as_ref().unwrap().perforated);
+    assert!(m.complication.is_some() && !m.completed);
+    assert!(!careless.card.passed);
+    assert!(said(&careless.card, &["perforation", "the attempt fails"]));
+
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenario-report");
+    for (stem, outcome) in [("rk-competent", &competent), ("rk-careless", &careless)] {
+        let [.., png] = write_report(&dir, stem, &outcome.card, &outcome.force_trace).unwrap();
+        let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(png).unwrap()));
+        assert_eq!(decoder.read_info().unwrap().info().height, 900, "{stem}");
+    }
 }
 
 /// An incision's report draws the cuts over the marked line under the force plot: the line's
@@ -346,6 +394,24 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             8,
             "rubric.view",
             "no laparoscope",
+        ),
+        (
+            "keratotomy-no-incisions",
+            10,
+            "RadialKeratotomy.incisions",
+            "0 incisions: from 1 to 16",
+        ),
+        (
+            "keratotomy-zone-too-wide",
+            11,
+            "tasks[0].optical_zone_mm",
+            "leaves no room for incisions",
+        ),
+        (
+            "keratotomy-through-and-through",
+            12,
+            "RadialKeratotomy.depth_fraction",
+            "not a depth fraction",
         ),
     ];
     for (name, line, field, message) in cases {

@@ -21,6 +21,7 @@ use crate::devices::{
 use crate::dynamics::{DynamicModel, GraspSettings};
 use crate::fem::FemModel;
 use crate::pgd::{Deformation, Vademecum};
+use crate::scenario::Keratometer;
 
 /// What the haptic world is made of.
 #[derive(Clone)]
@@ -46,11 +47,13 @@ pub struct HapticScene {
 
 /// The scalpel's blade and the organs it cuts (by index into the scene's organs): each
 /// one's linear finite-element model, which its cut state is solved on, and its tissue's
-/// toughness (J/m²).
+/// toughness (J/m²); and a cut cornea's model under the intraocular pressure, which
+/// predicts a keratotomy's correction.
 #[derive(Clone)]
 pub struct SceneCutting {
     pub blade: Blade,
     pub organs: Vec<(usize, Arc<FemModel>, f64)>,
+    pub keratometers: Vec<(usize, Keratometer)>,
 }
 
 /// The moving organs of a scene (by index into its organs) and the grasper's settings.

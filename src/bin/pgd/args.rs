@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use clap::{Args, Parser, Subcommand};
 use pgd_surgery::contact::{CouplingSettings, PenaltySettings, PointshellDensity};
 use pgd_surgery::cutting::CutPattern;
+use pgd_surgery::cutting::keratotomy::REFERENCE_MESH;
 use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
 use pgd_surgery::mesh::TetMesh;
 use pgd_surgery::mesh::io::ImportOptions;
@@ -114,12 +115,12 @@ pub enum Command {
         /// Depth of the incisions as a fraction of the corneal thickness.
         #[arg(long, default_value_t = 0.9)]
         depth_fraction: f64,
-        /// Multiplies the cornea's nodes per layer (1 = 2,800; 0.6 keeps a radial incision
-        /// some twenty elements long).
-        #[arg(long, default_value_t = 0.6)]
+        /// Multiplies the cornea's nodes per layer (1 = 2,800; the reference 0.6 keeps a
+        /// radial incision some twenty elements long, and is what the trainer predicts on).
+        #[arg(long, default_value_t = REFERENCE_MESH.0)]
         resolution: f64,
         /// Elements through the thickness: a cut's depth counts in these.
-        #[arg(long, default_value_t = 8)]
+        #[arg(long, default_value_t = REFERENCE_MESH.1)]
         cornea_layers: usize,
         /// Print the report as JSON.
         #[arg(long)]
