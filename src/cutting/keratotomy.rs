@@ -247,6 +247,14 @@ pub fn incision(
     )
 }
 
+/// The point of the anterior surface `r_m` off the axis at `azimuth_rad` round it (from +x
+/// towards +y), in the generated cornea's frame.
+pub fn anterior_point(azimuth_rad: f64, r_m: f64) -> Point3<f64> {
+    let height = (ANTERIOR_RADIUS_M.powi(2) - r_m.powi(2)).max(0.0).sqrt();
+    let (sin, cos) = azimuth_rad.sin_cos();
+    Point3::new(r_m * cos, r_m * sin, height - CORNEA_CURVATURE_M)
+}
+
 /// [`incision`] at `azimuth_rad` round the axis from the scene's +x towards +y (where
 /// [`CutFace::meridian`] counts its angle from −x).
 pub fn azimuth_incision(
@@ -315,11 +323,9 @@ mod tests {
     fn an_incision_by_azimuth_lies_at_that_azimuth() {
         let face = azimuth_incision(60f64.to_radians(), (1.5e-3, 5e-3), 0.8).unwrap();
         let under = |azimuth_deg: f64| {
-            let a = azimuth_deg.to_radians();
+            let on_surface = anterior_point(azimuth_deg.to_radians(), 3e-3);
             let centre = Point3::new(0.0, 0.0, -CORNEA_CURVATURE_M);
-            let direction = Vector3::new(a.cos() * 3e-3, a.sin() * 3e-3, 0.0);
-            let height = (ANTERIOR_RADIUS_M.powi(2) - 9e-6).sqrt();
-            let on_surface = centre + direction + Vector3::z() * height;
+            assert!(((on_surface - centre).norm() - ANTERIOR_RADIUS_M).abs() < 1e-15);
             on_surface - (on_surface - centre).normalize() * 1e-4
         };
         assert!(face.covers(&under(60.0), 1e-9));

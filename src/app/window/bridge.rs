@@ -8,6 +8,7 @@ use bevy::prelude::*;
 use super::{FrameSet, WindowScene};
 use crate::app::haptic::{HapticScene, HapticSnapshot};
 use crate::devices::VirtualHandle;
+use crate::mesh::organs::Organ;
 
 /// What the window holds of the haptic side.
 #[derive(Resource)]
@@ -40,6 +41,31 @@ impl HapticLink {
             .flat_map(|(_, v)| v.position_coords_m.iter());
         let (sum, count) = points.fold((Vec3::ZERO, 0), |(s, n), p| (s + Vec3::from(*p), n + 1));
         sum / count.max(1) as f32
+    }
+
+    /// How far (m) the scene's organs reach from their centre.
+    pub(super) fn scene_radius(&self) -> f32 {
+        let centre = self.scene_centre();
+        let points = self
+            .scene
+            .organs
+            .iter()
+            .flat_map(|(_, v)| v.position_coords_m.iter());
+        points.fold(0.0, |r, p| r.max(Vec3::from(*p).distance(centre)))
+    }
+
+    /// The direction the surgeon looks at the scene from: its first organ's (anterior, +y,
+    /// for the abdomen and for an organ from a mesh file).
+    pub(super) fn facing(&self) -> Vec3 {
+        let first = self.scene.organs.first().map(|(name, _)| name.as_str());
+        let organ = first.and_then(Organ::from_name).unwrap_or(Organ::Liver);
+        Vec3::from(organ.facing().map(|c| c as f32))
+    }
+
+    /// How far out of an organ's surface (m) the lines drawn on it are lifted, so that it
+    /// does not hide them: a sixth of the tool's radius (1 mm for the abdomen's 6 mm tool).
+    pub(super) fn line_lift_m(&self) -> f64 {
+        self.scene.probe.tip_radius_m / 6.0
     }
 
     /// A link without a device, for the window's stages in a headless app.

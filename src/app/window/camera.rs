@@ -23,6 +23,8 @@ pub(super) struct Orbit {
     azimuth: f32,
     /// Up from the xy-plane towards +z.
     elevation: f32,
+    /// How near and how far it may zoom (m): from a seventh to six times its first distance.
+    zoom_m: (f32, f32),
 }
 
 impl Orbit {
@@ -33,7 +35,13 @@ impl Orbit {
             distance,
             azimuth: offset.x.atan2(offset.y),
             elevation: (offset.z / distance).asin(),
+            zoom_m: (distance / 7.0, distance * 6.0),
         }
+    }
+
+    /// The near clipping plane (m) for the nearest it may zoom to.
+    pub(super) fn near_m(&self) -> f32 {
+        self.zoom_m.0 / 10.0
     }
 
     pub(super) fn transform(&self) -> Transform {
@@ -83,6 +91,7 @@ fn orbit(
         })
         .sum();
     let keyed = f32::from(keys.pressed(KeyCode::Minus)) - f32::from(keys.pressed(KeyCode::Equal));
-    orbit.distance = (orbit.distance * ZOOM_STEP.powf(keyed - notches)).clamp(0.05, 2.0);
+    let (nearest, farthest) = orbit.zoom_m;
+    orbit.distance = (orbit.distance * ZOOM_STEP.powf(keyed - notches)).clamp(nearest, farthest);
     *transform = orbit.transform();
 }

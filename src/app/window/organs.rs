@@ -68,11 +68,23 @@ fn spawn_organs(
     }
 }
 
-/// The surgeon's view of a supine patient: from above (anterior, +y), head (+z) up the screen.
+/// The surgeon's view: of a supine patient from above (anterior, +y), head (+z) up the
+/// screen; of the cornea from high over its axis, as under an operating microscope.
 fn spawn_camera_and_light(mut commands: Commands, link: Res<HapticLink>) {
     let centre = link.scene_centre();
-    let orbit = super::camera::Orbit::looking_at(centre, Vec3::new(0.0, 0.32, -0.10));
-    commands.spawn((SceneView, Camera3d::default(), orbit.transform(), orbit));
+    let (camera, light) = view_of(link.facing(), link.scene_radius());
+    let orbit = super::camera::Orbit::looking_at(centre, camera);
+    let projection = Projection::Perspective(PerspectiveProjection {
+        near: orbit.near_m(),
+        ..default()
+    });
+    commands.spawn((
+        SceneView,
+        Camera3d::default(),
+        projection,
+        orbit.transform(),
+        orbit,
+    ));
     commands.spawn((
         SceneView,
         super::laparoscope::Daylight,
@@ -81,8 +93,20 @@ fn spawn_camera_and_light(mut commands: Commands, link: Res<HapticLink>) {
             shadow_maps_enabled: true,
             ..default()
         },
-        Transform::from_translation(centre + Vec3::new(0.1, 0.5, -0.2)).looking_at(centre, Vec3::Z),
+        Transform::from_translation(centre + light).looking_at(centre, Vec3::Z),
     ));
+}
+
+/// Where the camera and the light stand from the scene's centre, for a scene seen from
+/// `facing` that reaches `radius_m` from its centre.
+fn view_of(facing: Vec3, radius_m: f32) -> (Vec3, Vec3) {
+    if facing == Vec3::Y {
+        return (Vec3::new(0.0, 0.32, -0.10), Vec3::new(0.1, 0.5, -0.2));
+    }
+    // 70° above the plane square to `facing`, four of the scene's radii away.
+    let aside = facing.any_orthonormal_vector();
+    let camera = (facing * 0.94 + aside * 0.34) * 4.0 * radius_m;
+    (camera, facing + aside * 0.3)
 }
 
 fn deform(

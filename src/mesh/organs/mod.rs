@@ -72,6 +72,16 @@ impl Organ {
         Organ::ALL.into_iter().find(|o| o.name() == name)
     }
 
+    /// The direction (a unit vector of the organ's frame) the surgeon looks at it from:
+    /// anterior (+y) for the abdominal organs, which share the patient's frame; along the
+    /// cornea's axis (+z) for the cornea, which stands in a frame of its own.
+    pub fn facing(self) -> [f64; 3] {
+        match self {
+            Organ::Cornea => [0.0, 0.0, 1.0],
+            _ => [0.0, 1.0, 0.0],
+        }
+    }
+
     /// Target node count at resolution 1: the papers' sizes where they give them.
     pub fn default_nodes(self) -> usize {
         match self {
