@@ -322,6 +322,7 @@ fn scene_cutting(
     }
     Ok((!cut.is_empty()).then(|| SceneCutting {
         blade: Blade::default(),
+        drawn: cut.iter().map(|_| Arc::default()).collect(),
         organs: cut,
         keratometers,
     }))

@@ -174,6 +174,21 @@ impl CutFace {
         }
     }
 
+    /// Into the tissue along the face at the surface point `p`, and how deep the face
+    /// reaches below the surface there (m): the blade's direction for a swept face, towards
+    /// the shell's centre for a meridian.
+    pub fn inward_at(&self, p: &Point3<f64>) -> (Unit<Vector3<f64>>, f64) {
+        match self.extent {
+            Extent::Swept { down, depth_m, .. } => (down, depth_m),
+            Extent::Meridian {
+                centre, depth_m, ..
+            } => (
+                Unit::try_new(centre - p, 1e-12).unwrap_or(-self.normal),
+                depth_m,
+            ),
+        }
+    }
+
     /// The face's largest dimension (m), for tolerances relative to it.
     pub fn size_m(&self) -> f64 {
         match self.extent {

@@ -32,8 +32,8 @@ pub use validation::{
     CutCase, CutPattern, CutValidationReport, CutValidationSettings, tool_patch,
     validate_incisions, validate_keratotomy,
 };
-pub use view::CutView;
-pub use worker::CutWorker;
+pub use view::{CutAnswer, CutView};
+pub use worker::{CutWorker, LatestCut};
 pub use xfem::CutSolution;
 
 /// Why a cut cannot be made or solved.

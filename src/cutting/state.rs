@@ -25,7 +25,7 @@ use nalgebra::{Matrix3, Point3, Vector3};
 use rayon::prelude::*;
 
 use super::CutError;
-use super::enrichment::{Enrichment, Front};
+use super::enrichment::{Enriched, Enrichment, Front};
 use super::incision::{CutFace, Incision};
 use super::response::{Response, UncutResponse};
 use super::view::{CutView, add_surface_part, gram, surface_dof};
@@ -55,6 +55,8 @@ pub struct CutState<'m, R: UncutResponse> {
     faces: Vec<CutFace>,
     /// Enriched functions as `(node, face)`, in the order they appeared: unknowns `3j..3j+3`.
     functions: Vec<(usize, usize)>,
+    /// Per enriched function, its node's side of its face (`±1`).
+    node_sides: Vec<i8>,
     /// Per unknown, `B`'s column.
     coupling: Vec<SparseColumn>,
     /// The enriched functions' uncut responses `Z = K⁻¹ B`: per unknown, the modal
@@ -88,6 +90,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             cuts: Vec::new(),
             faces: Vec::new(),
             functions: Vec::new(),
+            node_sides: Vec::new(),
             coupling: Vec::new(),
             z_modal: Vec::new(),
             z_near: vec![Vec::new(); 3 * model.mesh().node_count()],
@@ -327,16 +330,26 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             .map(|stiffness| stiffness * indentation_m)
     }
 
-    /// What the tick needs of the state, to read while the state grows elsewhere: the faces,
-    /// and `Ẑ` at the surface's dofs. Only for an exact uncut response, whose `Ẑ` has no
-    /// modal part: a cut vademecum's would need its modes too.
+    /// What the tick and the window need of the state, to read while the state grows
+    /// elsewhere: the faces, the enriched functions, `Ẑ` at the surface's dofs and the factor
+    /// of `S`. Only for an exact uncut response, whose `Ẑ` has no modal part: a cut
+    /// vademecum's would need its modes too.
     pub fn view(&self) -> CutView {
         debug_assert!(self.z_modal.iter().all(|z| z.is_empty()));
+        let functions = self.functions.iter().zip(&self.node_sides);
         CutView {
             faces: self.faces.clone(),
             unknowns: self.unknowns(),
+            functions: functions
+                .map(|(&(node, face), &node_side)| Enriched {
+                    node,
+                    face,
+                    node_side,
+                })
+                .collect(),
             surface_index_of: self.surface_index_of.clone(),
             z_hat_surface: self.z_hat_surface.clone(),
+            factor: self.factor.clone(),
         }
     }
 
@@ -361,6 +374,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         // The enrichment's function index → the state's, old or new; held ones dropped.
         let mut slot = vec![None; enrichment.functions.len()];
         let mut added = Vec::new();
+        let mut sides = Vec::new();
         for (j, f) in enrichment.functions.iter().enumerate() {
             if held(f.node) {
                 continue;
@@ -369,6 +383,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
                 Some(&old) => old,
                 None => {
                     added.push((f.node, f.face));
+                    sides.push(f.node_side);
                     self.functions.len() + added.len() - 1
                 }
             });
@@ -412,6 +427,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         }
         self.border(&columns)?;
         self.functions.extend(added);
+        self.node_sides.extend(sides);
         self.coupling.extend(coupling);
         self.push_responses(z);
         self.rows.extend(rows);

@@ -1,24 +1,77 @@
-//! What the haptic tick reads of a cut organ while its cut state grows on another thread: a
-//! consistent copy of the faces and of the enriched functions' responses at the surface.
+//! What the haptic tick and the window read of a cut organ while its cut state grows on
+//! another thread: a consistent copy of the faces, the enriched functions, their responses
+//! at the surface and the condensed system's factor.
 
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 
+use super::enrichment::Enriched;
 use super::incision::CutFace;
 use crate::mesh::NOT_ON_SURFACE;
 
 /// A cut state as it stood after some segment: enough to soften the tool's patch compliance
-/// for the cut, `C = C₀ + Yᵀ Y` with `Y = Ẑᵀ P` ([`super::CutState::felt_force_over`]).
+/// for the cut, `C = C₀ + Yᵀ Y` with `Y = Ẑᵀ P` ([`super::CutState::felt_force_over`]), and
+/// to draw the cut organ under a load on its surface: the nodes' displacement beyond the
+/// uncut one, `−Ẑ y` with `y = −Ẑᵀ f`, and the lips' opening, the enriched amplitudes
+/// `q = L⁻ᵀ y` (`docs/cutting.md`).
 #[derive(Clone, Debug, Default)]
 pub struct CutView {
     /// The cut's faces so far.
     pub faces: Vec<CutFace>,
     /// The enriched unknowns so far.
     pub unknowns: usize,
+    /// The enriched functions, in the unknowns' order (function `j`: unknowns `3j..3j+3`).
+    pub functions: Vec<Enriched>,
     pub(super) surface_index_of: Vec<usize>,
     pub(super) z_hat_surface: Vec<Vec<(u32, f64)>>,
+    /// The lower Cholesky factor of the condensed system, row by row.
+    pub(super) factor: Vec<Vec<f64>>,
+}
+
+/// The cut's part of an organ's answer to a load on its surface.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CutAnswer {
+    /// `y = −Ẑᵀ f`.
+    y: Vec<f64>,
+    /// The enriched amplitudes `q = L⁻ᵀ y` (m).
+    q: Vec<f64>,
 }
 
 impl CutView {
+    /// The cut's answer to the nodal forces `load` (`(dof, N)`; dofs of nodes inside add
+    /// nothing).
+    pub fn answer(&self, load: &[(usize, f64)]) -> CutAnswer {
+        let mut y = vec![0.0; self.unknowns];
+        add_surface_part(&self.surface_index_of, &self.z_hat_surface, load, &mut y);
+        y.iter_mut().for_each(|v| *v = -*v);
+        let mut q = y.clone();
+        for i in (0..q.len()).rev() {
+            let s: f64 = (i + 1..q.len()).map(|k| self.factor[k][i] * q[k]).sum();
+            q[i] = (q[i] - s) / self.factor[i][i];
+        }
+        CutAnswer { y, q }
+    }
+
+    /// What the cut adds (m) to the uncut displacement of surface node `node` under the load
+    /// `answer` was made for, on the node's own side; zero for a node inside.
+    pub fn added_displacement(&self, node: usize, answer: &CutAnswer) -> Vector3<f64> {
+        Vector3::from_fn(|axis, _| {
+            surface_dof(&self.surface_index_of, 3 * node + axis).map_or(0.0, |k| {
+                let entries = &self.z_hat_surface[k];
+                -entries
+                    .iter()
+                    .map(|&(p, v)| answer.y[p as usize] * v)
+                    .sum::<f64>()
+            })
+        })
+    }
+
+    /// How far (m) function `j`'s node is from itself seen from the other side of its face:
+    /// `(H_other − H_node) q_j = −2 H_node q_j`, the lips' opening there.
+    pub fn opening(&self, j: usize, answer: &CutAnswer) -> Vector3<f64> {
+        let side = f64::from(self.functions[j].node_side);
+        Vector3::from_column_slice(&answer.q[3 * j..3 * j + 3]) * (-2.0 * side)
+    }
+
     /// What the cut adds to the uncut compliance (m/N) of the patch `patch` (nodes and their
     /// shares of the tool's load): `Yᵀ Y`, zero with nothing cut. `y` is scratch space, kept
     /// from tick to tick so that nothing is allocated once it has grown.

@@ -35,6 +35,28 @@ enum Outcome {
     Refused(CutError),
 }
 
+/// The latest view where a reader off the haptic thread (the window) takes it: the worker
+/// replaces it after each step that cut, and whoever lets go of an old view last frees it,
+/// never the haptic thread, which does not touch this.
+#[derive(Debug, Default)]
+pub struct LatestCut(Mutex<Arc<CutView>>);
+
+impl LatestCut {
+    pub fn get(&self) -> Arc<CutView> {
+        self.0
+            .lock()
+            .map_or_else(|e| e.into_inner().clone(), |v| v.clone())
+    }
+
+    fn set(&self, view: Arc<CutView>) {
+        let old = match self.0.lock() {
+            Ok(mut slot) => std::mem::replace(&mut *slot, view),
+            Err(poisoned) => std::mem::replace(&mut *poisoned.into_inner(), view),
+        };
+        drop(old);
+    }
+}
+
 /// An organ's cut state on a thread of its own, its front snapped to the nearest element
 /// faces ([`Front::Nearest`]): on the trainer's meshes, whose elements are as large as an
 /// incision is deep, a front snapped inward would leave the cut all but unfelt.
@@ -54,8 +76,13 @@ pub struct CutWorker {
 
 impl CutWorker {
     /// Factorizes `model`'s rest stiffness (here, on the caller's thread) and starts the
-    /// worker that cuts it; `name` names the thread.
-    pub fn spawn(model: Arc<FemModel>, name: &str) -> Result<Self, CutError> {
+    /// worker that cuts it; `name` names the thread, and each view is also put in `latest`
+    /// for the window.
+    pub fn spawn(
+        model: Arc<FemModel>,
+        name: &str,
+        latest: Arc<LatestCut>,
+    ) -> Result<Self, CutError> {
         let response = ExactResponse::new(&model).map_err(|e| CutError::Solve(e.to_string()))?;
         let empty = CutState::new(&model, &response).view();
         let (jobs, job_queue) = channel();
@@ -69,7 +96,14 @@ impl CutWorker {
             .map_err(|e| CutError::Solve(format!("no threads for the cut state: {e}")))?;
         thread::Builder::new()
             .name(format!("cut {name}"))
-            .spawn(move || pool.install(|| serve(&model, response, job_queue, (answers, &timings))))
+            .spawn(move || {
+                let replies = Replies {
+                    answers,
+                    timings: &timings,
+                    latest: &latest,
+                };
+                pool.install(|| serve(&model, response, job_queue, replies))
+            })
             .map_err(|e| CutError::Solve(format!("no thread for the cut state: {e}")))?;
         Ok(Self {
             jobs,
@@ -159,14 +193,17 @@ fn worker_threads() -> usize {
     cores.saturating_sub(1).max(1)
 }
 
+/// Where the worker's answers go: to the haptic side, each step's time, and the latest view
+/// for the window.
+struct Replies<'a> {
+    answers: Sender<Outcome>,
+    timings: &'a Mutex<Vec<f64>>,
+    latest: &'a LatestCut,
+}
+
 /// The worker's loop: each step applied in order and answered, until the haptic side drops
 /// its end.
-fn serve(
-    model: &FemModel,
-    response: ExactResponse,
-    jobs: Receiver<Job>,
-    (answers, timings): (Sender<Outcome>, &Mutex<Vec<f64>>),
-) {
+fn serve(model: &FemModel, response: ExactResponse, jobs: Receiver<Job>, replies: Replies) {
     let mut state = CutState::new(model, response).with_front(Front::Nearest);
     let mut incision = None;
     for job in jobs {
@@ -188,14 +225,18 @@ fn serve(
             (_, None) => Err(CutError::Degenerate("a step before any incision".into())),
         };
         let outcome = match applied {
-            Ok(true) => Outcome::Grew(Arc::new(state.view())),
+            Ok(true) => {
+                let view = Arc::new(state.view());
+                replies.latest.set(view.clone());
+                Outcome::Grew(view)
+            }
             Ok(false) => Outcome::Unchanged,
             Err(error) => Outcome::Refused(error),
         };
-        if let Ok(mut timings) = timings.lock() {
+        if let Ok(mut timings) = replies.timings.lock() {
             timings.push(started.elapsed().as_secs_f64());
         }
-        if answers.send(outcome).is_err() {
+        if replies.answers.send(outcome).is_err() {
             return;
         }
     }

@@ -1,12 +1,15 @@
 //! The scalpel: the tissue parts only above its threshold, the cut follows the blade's edge,
-//! and the cut state grown on the worker thread makes the tool feel what full X-FEM does.
+//! and the cut state grown on the worker thread makes the tool feel, and the window draw,
+//! what full X-FEM gives.
 
 use std::sync::Arc;
 
 use nalgebra::{Point3, Unit, Vector3};
 use pgd_surgery::cutting::{
-    Blade, BladeContact, CutError, CutStep, CutWorker, Front, LIVER_TOUGHNESS_J_PER_M2, Scalpel,
+    Blade, BladeContact, CutError, CutStep, CutWorker, Enrichment, Front, LIVER_TOUGHNESS_J_PER_M2,
+    Scalpel, xfem,
 };
+use pgd_surgery::fem::Loads;
 
 use super::{MM, block_to_cut, full_compliance, top_patch};
 
@@ -165,7 +168,7 @@ fn the_cut_follows_a_curved_surface() {
 fn the_worker_serves_the_felt_compliance_of_full_xfem() {
     let (model, _) = block_to_cut();
     let model = Arc::new(model);
-    let mut worker = CutWorker::spawn(model.clone(), "block").unwrap();
+    let mut worker = CutWorker::spawn(model.clone(), "block", Default::default()).unwrap();
     let at = |x: f64| Point3::new(x * MM, 20.0 * MM, 10.0 * MM);
     worker.submit(CutStep::Start {
         at: at(14.0),
@@ -207,4 +210,65 @@ fn the_worker_serves_the_felt_compliance_of_full_xfem() {
     let after = worker.settle().clone();
     assert!(matches!(worker.refused(), [CutError::Degenerate(_)]));
     assert_eq!(after.unknowns, view.unknowns);
+}
+
+/// What the window draws of a cut organ under the tool's load, from the worker's view alone:
+/// every enriched surface node's displacement on its own side (the uncut one plus `−Ẑ y`),
+/// and seen from across its face (plus the opening `−2 H q`), equal the full X-FEM solve of
+/// the same cut under the same load, both sides, to round-off; and the lips do open.
+#[test]
+fn the_view_opens_the_lips_as_full_xfem_does() {
+    let (model, _) = block_to_cut();
+    let model = Arc::new(model);
+    let mut worker = CutWorker::spawn(model.clone(), "block", Default::default()).unwrap();
+    let at = |x: f64| Point3::new(x * MM, 20.0 * MM, 10.0 * MM);
+    worker.submit(CutStep::Start {
+        at: at(14.0),
+        blade: -Vector3::z(),
+        depth_m: 6.0 * MM,
+    });
+    worker.submit(CutStep::Advance { to: at(30.0) });
+    let view = worker.settle().clone();
+    assert!(!view.functions.is_empty(), "the stroke enriched nothing");
+
+    // The tool pressing down and across the cut beside it, 1 N.
+    let patch = top_patch(
+        &model,
+        Point3::new(22.0 * MM, 21.0 * MM, 10.0 * MM),
+        4.0 * MM,
+    );
+    let mesh = model.mesh();
+    let mut loads = Loads::new(mesh.node_count());
+    let mut load = Vec::new();
+    for &(n, share) in &patch {
+        let force = [0.0, 0.5 * share, -share];
+        loads.add_nodal_force(n, force).unwrap();
+        load.extend((0..3).map(|c| (3 * n + c, force[c])));
+    }
+    let uncut = xfem::solve(&model, &Enrichment::new(mesh, &[]), &loads).unwrap();
+    let enrichment = Enrichment::with_front(mesh, &view.faces, Front::Nearest);
+    let full = xfem::solve(&model, &enrichment, &loads).unwrap();
+    let answer = view.answer(&load);
+    let top = mesh.node_set("z1").unwrap();
+    let mut widest: f64 = 0.0;
+    for (j, f) in view.functions.iter().enumerate() {
+        if !top.contains(&f.node) {
+            continue;
+        }
+        let own = Vector3::from_column_slice(&uncut.nodes_m[3 * f.node..3 * f.node + 3])
+            + view.added_displacement(f.node, &answer);
+        let across = own + view.opening(j, &answer);
+        let full_own = full.at_node(&enrichment, f.node, &[f.node_side]);
+        let full_across = full.at_node(&enrichment, f.node, &[-f.node_side]);
+        let scale = full_own.norm().max(1e-12);
+        assert!((own - full_own).norm() < 1e-9 * scale, "node {}", f.node);
+        assert!(
+            (across - full_across).norm() < 1e-9 * scale,
+            "node {}",
+            f.node
+        );
+        widest = widest.max((across - own).norm());
+    }
+    eprintln!("the lips open by up to {:.3} mm", widest / MM);
+    assert!(widest > 1e-3 * MM, "the lips did not open");
 }

@@ -4,9 +4,10 @@
 //! against the legends the trainer writes beside them: each organ's tissue colour shows where
 //! its surface is in sight, and the pressed frame differs from the rest frame around the tool
 //! and nowhere far from it. The window itself, under Xvfb, is not blank. A missing display is
-//! reported plainly, without a panic. The laparoscopic view is checked on its own shipped
-//! scenario.
+//! reported plainly, without a panic. The laparoscopic view and the keratotomy's view of the
+//! cornea are checked on their own shipped scenarios.
 
+mod cornea;
 mod laparoscope;
 mod xvfb;
 

@@ -14,7 +14,7 @@ use super::resources::{
 };
 use super::snapshot::{HapticSnapshot, OrganSnapshot, SnapshotPublisher};
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
-use crate::cutting::{Blade, CutError, CutWorker, Scalpel};
+use crate::cutting::{Blade, CutError, CutView, CutWorker, LatestCut, Scalpel};
 use crate::devices::{
     Fulcrum, HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S, Workspace,
 };
@@ -54,6 +54,16 @@ pub struct SceneCutting {
     pub blade: Blade,
     pub organs: Vec<(usize, Arc<FemModel>, f64)>,
     pub keratometers: Vec<(usize, Keratometer)>,
+    /// Per organ cut (as `organs`), its latest cut for the window to draw.
+    pub drawn: Vec<Arc<LatestCut>>,
+}
+
+impl SceneCutting {
+    /// The latest cut of organ `index` (by the scene's order), if the scalpel cuts it.
+    pub fn drawn(&self, index: usize) -> Option<Arc<CutView>> {
+        let k = self.organs.iter().position(|o| o.0 == index)?;
+        Some(self.drawn[k].get())
+    }
 }
 
 /// The moving organs of a scene (by index into its organs) and the grasper's settings.
@@ -125,10 +135,11 @@ impl HapticLoop {
                 organ.insert(OrganMotion::new(model.clone(), dynamics.grasp));
             }
             if let Some(cutting) = &scene.cutting
-                && let Some((_, model, toughness)) = cutting.organs.iter().find(|o| o.0 == index)
+                && let Some(k) = cutting.organs.iter().position(|o| o.0 == index)
             {
+                let (_, model, toughness) = &cutting.organs[k];
                 let scalpel = Scalpel::new(cutting.blade, *toughness);
-                let worker = CutWorker::spawn(model.clone(), name)?;
+                let worker = CutWorker::spawn(model.clone(), name, cutting.drawn[k].clone())?;
                 organ.insert(OrganCut::new(scalpel, worker));
             }
         }

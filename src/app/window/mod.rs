@@ -5,6 +5,7 @@
 mod abdomen;
 mod bridge;
 mod camera;
+mod cut_surface;
 mod frames;
 mod hud;
 mod incision;

@@ -1,6 +1,7 @@
 //! The organs as the trainee sees them: each organ's accessible surface, moved every frame by
 //! the displacement field of the latest snapshot, with nodal normals recomputed on the
-//! deformed surface so that shading follows the deformation.
+//! deformed surface so that shading follows the deformation; a cut organ's surface split
+//! along its cut, with the cut's walls ([`super::cut_surface`]).
 
 use std::sync::Arc;
 
@@ -9,6 +10,7 @@ use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
 
 use super::bridge::{HapticLink, Snapshot};
+use super::cut_surface::{SplitSurface, walls_mesh};
 use super::{FrameSet, SceneView, tissue};
 use crate::app::haptic::OrganDeformation;
 use crate::dynamics::DynamicModel;
@@ -21,12 +23,32 @@ use crate::pgd::Vademecum;
 pub(super) struct OrganView {
     index: usize,
     vademecum: Arc<Vademecum>,
-    pub(super) triangles: Vec<[usize; 3]>,
+    triangles: Vec<[usize; 3]>,
     /// Scratch: the whole displacement field (m).
     field: Vec<f64>,
     /// The organ's dynamic model, when it moves.
     motion: Option<Arc<DynamicModel>>,
+    /// Its surface split along the scalpel's latest cut, once it is cut.
+    split: Option<SplitSurface>,
 }
+
+impl OrganView {
+    /// The triangles drawn: the surface's, split along the cut once it is cut.
+    pub(super) fn drawn_triangles(&self) -> &[[usize; 3]] {
+        self.split
+            .as_ref()
+            .map_or(&self.triangles, |s| &s.triangles)
+    }
+}
+
+/// The walls of organ `index`'s cut, drawn as the tissue inside.
+#[derive(Component)]
+struct CutWalls {
+    index: usize,
+}
+
+/// The colour of cut tissue's inside (sRGB).
+const INSIDE: Color = Color::srgb(0.45, 0.07, 0.08);
 
 pub(super) fn setup(app: &mut App) {
     super::spawn_with_scene(app, (spawn_organs, spawn_camera_and_light));
@@ -63,8 +85,28 @@ fn spawn_organs(
                     .dynamics
                     .as_ref()
                     .and_then(|d| d.model(index).cloned()),
+                split: None,
             },
         ));
+        if link
+            .scene
+            .cutting
+            .as_ref()
+            .is_some_and(|c| c.drawn(index).is_some())
+        {
+            commands.spawn((
+                SceneView,
+                CutWalls { index },
+                Mesh3d(meshes.add(walls_mesh(Vec::new(), Vec::new()))),
+                MeshMaterial3d(materials.add(StandardMaterial {
+                    base_color: INSIDE,
+                    perceptual_roughness: 0.5,
+                    double_sided: true,
+                    cull_mode: None,
+                    ..default()
+                })),
+            ));
+        }
     }
 }
 
@@ -111,7 +153,9 @@ fn view_of(facing: Vec3, radius_m: f32) -> (Vec3, Vec3) {
 
 fn deform(
     snapshot: Res<Snapshot>,
+    link: Res<HapticLink>,
     mut views: Query<(&mut OrganView, &Mesh3d)>,
+    walls: Query<(&CutWalls, &Mesh3d)>,
     mut meshes: ResMut<Assets<Mesh>>,
 ) {
     for (mut view, mesh) in &mut views {
@@ -126,19 +170,46 @@ fn deform(
         if let Some(motion) = &view.motion {
             motion.add_to_surface(&view.vademecum.positions, &organ.motion, &mut positions);
         }
-        let colours = contact_tint(
-            positions.len(),
-            &organ.deformation.loads[OrganDeformation::TOOL].shares,
-        );
+        let tool = &organ.deformation.loads[OrganDeformation::TOOL];
+        if let Some(rebuilt) = refresh_split(view, &link)
+            && let Some(mut mesh) = meshes.get_mut(&mesh.0)
+        {
+            *mesh = rebuilt;
+        }
+        if let Some(split) = &view.split {
+            split.displace(&view.vademecum, tool, &mut positions);
+            let drawn = walls.iter().find(|(cut, _)| cut.index == view.index);
+            if let Some(mut mesh) = drawn.and_then(|(_, m)| meshes.get_mut(&m.0)) {
+                let (points, indices) = split.walls(&positions);
+                *mesh = walls_mesh(points, indices);
+            }
+        }
+        let triangles = view.drawn_triangles();
+        let colours = contact_tint(positions.len(), &tool.shares);
         if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
             mesh.insert_attribute(
                 Mesh::ATTRIBUTE_NORMAL,
-                vertex_normals(&view.triangles, &positions),
+                vertex_normals(triangles, &positions),
             );
             mesh.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions);
             mesh.insert_attribute(Mesh::ATTRIBUTE_COLOR, colours);
         }
     }
+}
+
+/// Splits the organ's surface anew when the scalpel's cut has grown: the render mesh with
+/// the copies, to replace the organ's (`None` while the split stands or nothing is cut).
+fn refresh_split(view: &mut OrganView, link: &HapticLink) -> Option<Mesh> {
+    let cutting = link.scene.cutting.as_ref()?;
+    let cut = cutting.drawn(view.index).filter(|c| c.unknowns > 0)?;
+    if view.split.as_ref().is_some_and(|s| s.is_of(&cut)) {
+        return None;
+    }
+    let split = SplitSurface::new(cut, &view.vademecum, &view.triangles);
+    let rest = split.with_copies(&view.vademecum.position_coords_m);
+    let mesh = surface_mesh(&split.triangles, &rest);
+    view.split = Some(split);
+    Some(mesh)
 }
 
 /// Vertex colours that light up the tool's contact patch (by each position's share of the

@@ -231,7 +231,11 @@ fn frame_legend(frame: &Frame) -> Result<Legend, String> {
                 Some(VertexAttributeValues::Float32x3(values)) => Some(values),
                 _ => None,
             };
-            let triangles = view.triangles.iter().map(|t| t.map(|i| i as u32)).collect();
+            let triangles = view
+                .drawn_triangles()
+                .iter()
+                .map(|t| t.map(|i| i as u32))
+                .collect();
             let positions = attribute(Mesh::ATTRIBUTE_POSITION)?;
             Some((
                 name,
