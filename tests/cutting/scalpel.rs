@@ -9,7 +9,7 @@ use pgd_surgery::cutting::{
     Blade, BladeContact, CutError, CutStep, CutWorker, Enrichment, Front, LIVER_TOUGHNESS_J_PER_M2,
     Scalpel, xfem,
 };
-use pgd_surgery::fem::Loads;
+use pgd_surgery::fem::{FemModel, Loads};
 
 use super::{MM, block_to_cut, full_compliance, top_patch};
 
@@ -160,24 +160,37 @@ fn the_cut_follows_a_curved_surface() {
     }
 }
 
+/// The block on a worker, handed a stroke along `y = 20 mm` on its top, 6 mm deep, from
+/// `x = 14 mm` on to each of `to_x_mm` in turn.
+fn stroke_on_block(to_x_mm: &[f64]) -> (Arc<FemModel>, CutWorker) {
+    let (model, _) = block_to_cut();
+    let model = Arc::new(model);
+    let mut worker = CutWorker::spawn(model.clone(), "block", Default::default()).unwrap();
+    worker.submit(CutStep::Start {
+        at: on_block_top(14.0),
+        blade: -Vector3::z(),
+        depth_m: 6.0 * MM,
+    });
+    for &x in to_x_mm {
+        worker.submit(CutStep::Advance {
+            to: on_block_top(x),
+        });
+    }
+    (model, worker)
+}
+
+/// The point on the block's top `x_mm` along the stroke's line.
+fn on_block_top(x_mm: f64) -> Point3<f64> {
+    Point3::new(x_mm * MM, 20.0 * MM, 10.0 * MM)
+}
+
 /// The cut state on its worker thread, fed a stroke's steps, gives the tick the patch
 /// compliance that full X-FEM solves of the same faces (the front snapped to the nearest
 /// element faces) give, to round-off; a step the cut state refuses is reported and changes
 /// nothing.
 #[test]
 fn the_worker_serves_the_felt_compliance_of_full_xfem() {
-    let (model, _) = block_to_cut();
-    let model = Arc::new(model);
-    let mut worker = CutWorker::spawn(model.clone(), "block", Default::default()).unwrap();
-    let at = |x: f64| Point3::new(x * MM, 20.0 * MM, 10.0 * MM);
-    worker.submit(CutStep::Start {
-        at: at(14.0),
-        blade: -Vector3::z(),
-        depth_m: 6.0 * MM,
-    });
-    for x in [18.0, 22.0, 26.0, 30.0] {
-        worker.submit(CutStep::Advance { to: at(x) });
-    }
+    let (model, mut worker) = stroke_on_block(&[18.0, 22.0, 26.0, 30.0]);
     let view = worker.settle().clone();
     assert_eq!(worker.pending(), 0);
     assert!(view.unknowns > 0, "the stroke enriched nothing");
@@ -206,7 +219,9 @@ fn the_worker_serves_the_felt_compliance_of_full_xfem() {
         "the cut does not soften the patch"
     );
 
-    worker.submit(CutStep::Advance { to: at(30.0) });
+    worker.submit(CutStep::Advance {
+        to: on_block_top(30.0),
+    });
     let after = worker.settle().clone();
     assert!(matches!(worker.refused(), [CutError::Degenerate(_)]));
     assert_eq!(after.unknowns, view.unknowns);
@@ -218,16 +233,7 @@ fn the_worker_serves_the_felt_compliance_of_full_xfem() {
 /// the same cut under the same load, both sides, to round-off; and the lips do open.
 #[test]
 fn the_view_opens_the_lips_as_full_xfem_does() {
-    let (model, _) = block_to_cut();
-    let model = Arc::new(model);
-    let mut worker = CutWorker::spawn(model.clone(), "block", Default::default()).unwrap();
-    let at = |x: f64| Point3::new(x * MM, 20.0 * MM, 10.0 * MM);
-    worker.submit(CutStep::Start {
-        at: at(14.0),
-        blade: -Vector3::z(),
-        depth_m: 6.0 * MM,
-    });
-    worker.submit(CutStep::Advance { to: at(30.0) });
+    let (model, mut worker) = stroke_on_block(&[30.0]);
     let view = worker.settle().clone();
     assert!(!view.functions.is_empty(), "the stroke enriched nothing");
 

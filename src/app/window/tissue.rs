@@ -65,6 +65,16 @@ pub fn tissue(organ: &str) -> Tissue {
             vessels: 0.8,
             seed: 14,
         },
+        // The cornea is clear: what shows through it is the iris, here a grey-blue one, with
+        // no vessels (the cornea has none).
+        "cornea" => Tissue {
+            base: srgb(0.46, 0.54, 0.62),
+            shade: srgb(0.28, 0.34, 0.42),
+            vessel: srgb(0.28, 0.34, 0.42),
+            lobules: 24,
+            vessels: 0.0,
+            seed: 20,
+        },
         // The cavity around the organs: the parietal peritoneum over the walls, the stomach's
         // paler serosa, the colon's and small bowel's pink.
         "peritoneum" => Tissue {
