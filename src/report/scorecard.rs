@@ -172,6 +172,9 @@ fn keratotomy_plot(area: &Area, rk: &KeratotomyMetrics) -> PlotResult {
     let wide = (1.8 * f64::from(height)).min(f64::from(width)) as i32;
     let side = (width as i32 - wide) / 2;
     let panel = area.margin(0, 0, side, side);
+    // The plotting area's width over its height, less the labels, margins and caption, so
+    // that a millimetre is as long across as up.
+    let aspect = f64::from(wide - 16 * 2 - 48) / f64::from(height as i32 - 16 * 2 - 40 - 30);
     let mut chart = ChartBuilder::on(&panel)
         .caption(
             format!("the incisions: {correction}{perforated}"),
@@ -180,7 +183,7 @@ fn keratotomy_plot(area: &Area, rk: &KeratotomyMetrics) -> PlotResult {
         .margin(16)
         .x_label_area_size(40)
         .y_label_area_size(48)
-        .build_cartesian_2d(-reach..2.6 * reach, -reach..reach)?;
+        .build_cartesian_2d(-reach..reach * (2.0 * aspect - 1.0), -reach..reach)?;
     chart
         .configure_mesh()
         .x_desc("x (mm)")
