@@ -5,10 +5,12 @@
 //! its surface is in sight, and the pressed frame differs from the rest frame around the tool
 //! and nowhere far from it. The window itself, under Xvfb, is not blank. A missing display is
 //! reported plainly, without a panic. The laparoscopic view and the keratotomy's view of the
-//! cornea are checked on their own shipped scenarios.
+//! cornea are checked on their own shipped scenarios, and every shipped scenario's start shows
+//! its organs.
 
 mod cornea;
 mod laparoscope;
+mod scenarios;
 mod xvfb;
 
 use std::path::{Path, PathBuf};
