@@ -27,7 +27,11 @@ fn every_shipped_scenario_opens_on_its_organs() {
     for file in files {
         let scenario = load(&file).unwrap();
         scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap();
-        let name = file.file_stem().unwrap().to_string_lossy().replace(".scenario", "");
+        let name = file
+            .file_stem()
+            .unwrap()
+            .to_string_lossy()
+            .replace(".scenario", "");
         let history = dir.join(format!("{name}-history.sqlite"));
         let args = [
             "run",
@@ -54,7 +58,10 @@ fn every_shipped_scenario_opens_on_its_organs() {
             Some(_) => 1,
             None => scenario.organs.len(),
         };
-        assert!(seen >= needed, "{name}: {seen} organs in sight, {needed} needed");
+        assert!(
+            seen >= needed,
+            "{name}: {seen} organs in sight, {needed} needed"
+        );
         let first = [0, 1, 2].map(|c| f32::from(shot.rgb[c]));
         let differ = shot
             .rgb
