@@ -179,9 +179,7 @@ fn keratometer(scene: &HapticScene, scenario: &Scenario, task: &Task) -> Option<
         return None;
     };
     let index = scenario.organs.iter().position(|o| &o.name == organ)?;
-    let cutting = scene.cutting.as_ref()?;
-    let (_, keratometer) = cutting.keratometers.iter().find(|(k, _)| *k == index)?;
-    Some(keratometer.clone())
+    scene.cutting.as_ref()?.organ(index)?.keratometer.clone()
 }
 
 /// Where `nodule` lies under its organ's surface: the outward normal at the accessible point

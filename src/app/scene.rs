@@ -7,7 +7,7 @@ use std::sync::{Arc, OnceLock};
 
 use nalgebra::Vector3;
 
-use super::haptic::{HapticScene, SceneCutting, SceneDynamics};
+use super::haptic::{CutOrgan, HapticScene, SceneCutting, SceneDynamics};
 use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, FieldOrigin, Probe};
 use crate::cutting::keratotomy::{Cornea, REFERENCE_MESH};
 use crate::cutting::{Blade, CutError};
@@ -286,8 +286,6 @@ fn scene_dynamics(
     }))
 }
 
-/// The organs a scalpel cuts, each with the linear model of its tissue that its cut state
-/// is solved on (the default blade; a scenario sets its own); `None` if none is cut.
 /// The tool tip (m) of a scene of `organs` at `detail`: the one `asked` for (the organs' own
 /// when `None`), on coarse organs no finer than their edges need.
 fn scene_tip_m(organs: &[SceneOrgan], asked: Option<f64>, detail: Detail) -> f64 {
@@ -303,28 +301,36 @@ fn scene_tip_m(organs: &[SceneOrgan], asked: Option<f64>, detail: Detail) -> f64
     }
 }
 
+/// The organs a scalpel cuts, each with the linear model of its tissue that its cut state
+/// is solved on (the default blade; a scenario sets its own); `None` if none is cut.
 fn scene_cutting(
     organs: &[SceneOrgan],
     loaded: &[(String, Arc<Vademecum>, TetMesh)],
 ) -> Result<Option<SceneCutting>, String> {
     let mut cut = Vec::new();
-    let mut keratometers = Vec::new();
     for (index, (organ, (name, vademecum, mesh))) in organs.iter().zip(loaded).enumerate() {
-        let Some(toughness) = organ.cut_toughness_j_per_m2 else {
+        let Some(toughness_j_per_m2) = organ.cut_toughness_j_per_m2 else {
             continue;
         };
         let model = organ_model(name, vademecum, mesh, Law::Linear)?;
-        if organ.source == OrganSource::Generated(Organ::Cornea) {
-            let cornea = reference_cornea().map_err(|e| format!("{name}: {e}"))?;
-            keratometers.push((index, Keratometer::new(cornea)));
-        }
-        cut.push((index, Arc::new(model), toughness));
+        let keratometer = match organ.source == OrganSource::Generated(Organ::Cornea) {
+            true => {
+                let cornea = reference_cornea().map_err(|e| format!("{name}: {e}"))?;
+                Some(Keratometer::new(cornea))
+            }
+            false => None,
+        };
+        cut.push(CutOrgan {
+            index,
+            model: Arc::new(model),
+            toughness_j_per_m2,
+            drawn: Arc::default(),
+            keratometer,
+        });
     }
     Ok((!cut.is_empty()).then(|| SceneCutting {
         blade: Blade::default(),
-        drawn: cut.iter().map(|_| Arc::default()).collect(),
         organs: cut,
-        keratometers,
     }))
 }
 

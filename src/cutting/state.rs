@@ -28,7 +28,7 @@ use super::CutError;
 use super::enrichment::{Enriched, Enrichment, Front};
 use super::incision::{CutFace, Incision};
 use super::response::{Response, UncutResponse};
-use super::view::{CutView, add_surface_part, gram, surface_dof};
+use super::view::{CutView, add_surface_part, backward, gram, surface_dof};
 use super::xfem::{CutSolution, element_functions, piece_weights};
 use crate::fem::{FemModel, PRESCRIBED};
 use crate::mesh::Surface;
@@ -53,10 +53,8 @@ pub struct CutState<'m, R: UncutResponse> {
     response: R,
     cuts: Vec<Cut>,
     faces: Vec<CutFace>,
-    /// Enriched functions as `(node, face)`, in the order they appeared: unknowns `3j..3j+3`.
-    functions: Vec<(usize, usize)>,
-    /// Per enriched function, its node's side of its face (`±1`).
-    node_sides: Vec<i8>,
+    /// Enriched functions in the order they appeared: unknowns `3j..3j+3`.
+    functions: Vec<Enriched>,
     /// Per unknown, `B`'s column.
     coupling: Vec<SparseColumn>,
     /// The enriched functions' uncut responses `Z = K⁻¹ B`: per unknown, the modal
@@ -90,7 +88,6 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             cuts: Vec::new(),
             faces: Vec::new(),
             functions: Vec::new(),
-            node_sides: Vec::new(),
             coupling: Vec::new(),
             z_modal: Vec::new(),
             z_near: vec![Vec::new(); 3 * model.mesh().node_count()],
@@ -249,7 +246,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         self.functions
             .iter()
             .enumerate()
-            .map(|(j, &key)| (key, j))
+            .map(|(j, f)| ((f.node, f.face), j))
             .collect()
     }
 
@@ -336,17 +333,10 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     /// vademecum's would need its modes too.
     pub fn view(&self) -> CutView {
         debug_assert!(self.z_modal.iter().all(|z| z.is_empty()));
-        let functions = self.functions.iter().zip(&self.node_sides);
         CutView {
             faces: self.faces.clone(),
             unknowns: self.unknowns(),
-            functions: functions
-                .map(|(&(node, face), &node_side)| Enriched {
-                    node,
-                    face,
-                    node_side,
-                })
-                .collect(),
+            functions: self.functions.clone(),
             surface_index_of: self.surface_index_of.clone(),
             z_hat_surface: self.z_hat_surface.clone(),
             factor: self.factor.clone(),
@@ -374,7 +364,6 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         // The enrichment's function index → the state's, old or new; held ones dropped.
         let mut slot = vec![None; enrichment.functions.len()];
         let mut added = Vec::new();
-        let mut sides = Vec::new();
         for (j, f) in enrichment.functions.iter().enumerate() {
             if held(f.node) {
                 continue;
@@ -382,8 +371,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             slot[j] = Some(match known.get(&(f.node, f.face)) {
                 Some(&old) => old,
                 None => {
-                    added.push((f.node, f.face));
-                    sides.push(f.node_side);
+                    added.push(*f);
                     self.functions.len() + added.len() - 1
                 }
             });
@@ -427,7 +415,6 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         }
         self.border(&columns)?;
         self.functions.extend(added);
-        self.node_sides.extend(sides);
         self.coupling.extend(coupling);
         self.push_responses(z);
         self.rows.extend(rows);
@@ -576,13 +563,8 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     }
 
     /// `L⁻ᵀ y` (backward substitution).
-    fn backward(&self, mut x: Vec<f64>) -> Vec<f64> {
-        let n = x.len();
-        for i in (0..n).rev() {
-            let s: f64 = (i + 1..n).map(|k| self.factor[k][i] * x[k]).sum();
-            x[i] = (x[i] - s) / self.factor[i][i];
-        }
-        x
+    fn backward(&self, x: Vec<f64>) -> Vec<f64> {
+        backward(&self.factor, x)
     }
 }
 

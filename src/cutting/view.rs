@@ -43,11 +43,7 @@ impl CutView {
         let mut y = vec![0.0; self.unknowns];
         add_surface_part(&self.surface_index_of, &self.z_hat_surface, load, &mut y);
         y.iter_mut().for_each(|v| *v = -*v);
-        let mut q = y.clone();
-        for i in (0..q.len()).rev() {
-            let s: f64 = (i + 1..q.len()).map(|k| self.factor[k][i] * q[k]).sum();
-            q[i] = (q[i] - s) / self.factor[i][i];
-        }
+        let q = backward(&self.factor, y.clone());
         CutAnswer { y, q }
     }
 
@@ -107,6 +103,16 @@ pub(super) fn add_surface_part(
             y[p as usize] += share * v;
         }
     }
+}
+
+/// `L⁻ᵀ x` for the lower Cholesky factor `factor` given row by row (backward substitution).
+pub(super) fn backward(factor: &[Vec<f64>], mut x: Vec<f64>) -> Vec<f64> {
+    let n = x.len();
+    for i in (0..n).rev() {
+        let s: f64 = (i + 1..n).map(|k| factor[k][i] * x[k]).sum();
+        x[i] = (x[i] - s) / factor[i][i];
+    }
+    x
 }
 
 /// `Yᵀ Y` for the three rows `y` (one per axis).

@@ -6,7 +6,7 @@
 //! ([`CutWorker::settle`]), so that it stays deterministic.
 
 use std::sync::mpsc::{Receiver, Sender, channel};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, PoisonError};
 use std::thread;
 use std::time::Instant;
 
@@ -45,14 +45,15 @@ impl LatestCut {
     pub fn get(&self) -> Arc<CutView> {
         self.0
             .lock()
-            .map_or_else(|e| e.into_inner().clone(), |v| v.clone())
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
     }
 
+    /// Puts `view` in the slot; the view it replaces is let go after the lock is.
     fn set(&self, view: Arc<CutView>) {
-        let old = match self.0.lock() {
-            Ok(mut slot) => std::mem::replace(&mut *slot, view),
-            Err(poisoned) => std::mem::replace(&mut *poisoned.into_inner(), view),
-        };
+        let mut slot = self.0.lock().unwrap_or_else(PoisonError::into_inner);
+        let old = std::mem::replace(&mut *slot, view);
+        drop(slot);
         drop(old);
     }
 }

@@ -101,11 +101,14 @@ pub struct KeratotomyPlan {
 
 impl KeratotomyTracker {
     /// The `plan` on the scenario's `organ`-th organ, a generated cornea in its own frame
-    /// (`None`: not in the scene, nothing is counted).
+    /// (`None`: not in the scene, nothing is counted). Room is made for four times the
+    /// plan's incisions up front, so that the haptic thread, which steps it, allocates
+    /// nothing as incisions are made.
     pub fn new(organ: Option<usize>, plan: KeratotomyPlan) -> Self {
         Self {
             organ,
             metrics: KeratotomyMetrics {
+                incisions: Vec::with_capacity(4 * plan.incisions),
                 planned: plan.incisions,
                 optical_zone_mm: plan.optical_zone_m * 1e3,
                 target_depth_fraction: plan.depth_fraction,

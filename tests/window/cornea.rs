@@ -5,42 +5,16 @@
 use std::path::Path;
 
 use nalgebra::Vector3;
-use pgd_surgery::app::attempt::scenario_scene;
-use pgd_surgery::app::scene::Detail;
-use pgd_surgery::scenario::load;
-use pgd_surgery::store::OnStale;
 
-use super::{Surface, held_at, hue_saturation, shot_of, vademecums};
+use super::{held_at, hue_saturation, scenario_shot};
 
 #[test]
 fn the_keratotomy_looks_down_on_the_cornea() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("window");
-    std::fs::create_dir_all(&dir).unwrap();
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("scenarios/cornea-radial-keratotomy.scenario.ron");
-    scenario_scene(
-        &load(&shipped).unwrap(),
-        vademecums(),
-        Detail::Coarse,
-        OnStale::Rebuild,
-    )
-    .unwrap();
-    let history = dir.join("cornea-history.sqlite");
-    let args = [
-        "run",
-        shipped.to_str().unwrap(),
-        "--frames",
-        "4",
-        "--history",
-        history.to_str().unwrap(),
-    ];
-    // The knife held 3 mm above the apex, off to the side.
-    let shot = shot_of(
-        "cornea",
-        held_at(Vector3::new(0.004, 0.0, 0.003) / 0.1),
-        &args,
-        Surface::Offscreen,
-    );
+    // The knife held 3 mm above the apex, off to the side (the hand moves ten times as far).
+    let held = held_at(Vector3::new(0.004, 0.0, 0.003) / 0.1);
+    let shot = scenario_shot("cornea", &shipped, 4, held);
     let height = (shot.rgb.len() / 3 / shot.width) as f32;
     let width = shot.width as f32;
     let cornea = shot

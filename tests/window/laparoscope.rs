@@ -8,7 +8,7 @@ use nalgebra::Vector3;
 use pgd_surgery::app::window::tissue::{mean_srgb, tissue};
 use pgd_surgery::scenario::{load, metres};
 
-use super::{Shot, Surface, held_at, hue_distance, hue_saturation, shot_of};
+use super::{Shot, held_at, hue_distance, hue_saturation, scenario_shot};
 
 /// The shipped scenario with a time limit long enough that no debrief covers the view while
 /// software rendering draws its first frames.
@@ -37,16 +37,7 @@ fn laparoscopic_shot() -> (Shot, [f32; 2]) {
     let handle = fulcrum
         .handle_for(&(focus + Vector3::new(0.0, 0.03, 0.0)))
         .unwrap();
-    let history = dir.join("laparoscopic-history.sqlite");
-    let args = [
-        "run",
-        file.to_str().unwrap(),
-        "--frames",
-        "6",
-        "--history",
-        history.to_str().unwrap(),
-    ];
-    let shot = shot_of("laparoscopic", held_at(handle), &args, Surface::Offscreen);
+    let shot = scenario_shot("laparoscopic", &file, 6, held_at(handle));
     let height = shot.rgb.len() / 3 / shot.width;
     let centre = [shot.width as f32 / 2.0, height as f32 / 2.0];
     (shot, centre)

@@ -18,10 +18,12 @@ use std::process::{Command, Output};
 use std::sync::OnceLock;
 
 use nalgebra::Vector3;
+use pgd_surgery::app::attempt::scenario_scene;
 use pgd_surgery::app::scene::{Detail, default_scene, press_targets};
 use pgd_surgery::app::window::Legend;
 use pgd_surgery::app::window::tissue::{mean_srgb, tissue};
 use pgd_surgery::devices::{DeviceSample, Trajectory, TrajectoryRow};
+use pgd_surgery::scenario::load;
 use pgd_surgery::store::OnStale;
 
 const TRAINER: &str = env!("CARGO_BIN_EXE_trainer");
@@ -124,6 +126,27 @@ fn shot_of(name: &str, rows: Vec<TrajectoryRow>, args: &[&str], surface: Surface
         rgb,
         legend: serde_json::from_str(&legend).unwrap(),
     }
+}
+
+/// Runs the scenario in `file` offscreen for `frames` frames (its coarse vademecums built
+/// first) with a scripted device held along `rows`, its attempts kept in a history of their
+/// own, and reads back its screenshot.
+fn scenario_shot(name: &str, file: &Path, frames: u32, rows: Vec<TrajectoryRow>) -> Shot {
+    let scenario = load(file).unwrap();
+    scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap();
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("window");
+    std::fs::create_dir_all(&dir).unwrap();
+    let history = dir.join(format!("{name}-history.sqlite"));
+    let frames = frames.to_string();
+    let args = [
+        "run",
+        file.to_str().unwrap(),
+        "--frames",
+        &frames,
+        "--history",
+        history.to_str().unwrap(),
+    ];
+    shot_of(name, rows, &args, Surface::Offscreen)
 }
 
 fn assert_ran(output: &Output) {

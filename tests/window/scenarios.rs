@@ -5,17 +5,12 @@
 use std::path::Path;
 
 use nalgebra::Vector3;
-use pgd_surgery::app::attempt::scenario_scene;
-use pgd_surgery::app::scene::Detail;
 use pgd_surgery::scenario::load;
-use pgd_surgery::store::OnStale;
 
-use super::{Surface, distance, held_at, shot_of, vademecums};
+use super::{distance, held_at, scenario_shot};
 
 #[test]
 fn every_shipped_scenario_opens_on_its_organs() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("window");
-    std::fs::create_dir_all(&dir).unwrap();
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
     let mut files: Vec<_> = std::fs::read_dir(&shipped)
         .unwrap()
@@ -26,28 +21,14 @@ fn every_shipped_scenario_opens_on_its_organs() {
     assert!(files.len() >= 11, "{} scenarios", files.len());
     for file in files {
         let scenario = load(&file).unwrap();
-        scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap();
         let name = file
             .file_stem()
             .unwrap()
             .to_string_lossy()
             .replace(".scenario", "");
-        let history = dir.join(format!("{name}-history.sqlite"));
-        let args = [
-            "run",
-            file.to_str().unwrap(),
-            "--frames",
-            "2",
-            "--history",
-            history.to_str().unwrap(),
-        ];
         // The device's handle half a metre up, scaled as the scenario scales it.
-        let shot = shot_of(
-            &format!("start-{name}"),
-            held_at(Vector3::new(0.0, 0.5, 0.0)),
-            &args,
-            Surface::Offscreen,
-        );
+        let held = held_at(Vector3::new(0.0, 0.5, 0.0));
+        let shot = scenario_shot(&format!("start-{name}"), &file, 2, held);
         // Through a laparoscope, what the optic is aimed at; otherwise every organ.
         let in_sight = |organ: &str| {
             let drawn = shot.legend.organs.iter().find(|o| o.name == organ);

@@ -23,7 +23,7 @@ pub use resources::{
     Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, SceneScope, Scope,
     TickClock, Tool,
 };
-pub use runner::{HapticLoop, HapticScene, SceneCutting, SceneDynamics, SceneError};
+pub use runner::{CutOrgan, HapticLoop, HapticScene, SceneCutting, SceneDynamics, SceneError};
 pub use scoring::{ExerciseLink, ExerciseRun};
 pub use snapshot::{HapticSnapshot, LoopTiming, OrganSnapshot};
 pub use thread::{HapticThread, RealTimeReport, SceneSwap, Scheduling};

@@ -14,7 +14,7 @@ use super::resources::{
 };
 use super::snapshot::{HapticSnapshot, OrganSnapshot, SnapshotPublisher};
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
-use crate::cutting::{Blade, CutError, CutView, CutWorker, LatestCut, Scalpel};
+use crate::cutting::{Blade, CutError, CutWorker, LatestCut, Scalpel};
 use crate::devices::{
     Fulcrum, HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S, Workspace,
 };
@@ -45,24 +45,32 @@ pub struct HapticScene {
     pub scope: Option<SceneScope>,
 }
 
-/// The scalpel's blade and the organs it cuts (by index into the scene's organs): each
-/// one's linear finite-element model, which its cut state is solved on, and its tissue's
-/// toughness (J/m²); and a cut cornea's model under the intraocular pressure, which
-/// predicts a keratotomy's correction.
+/// The scalpel's blade and the organs it cuts.
 #[derive(Clone)]
 pub struct SceneCutting {
     pub blade: Blade,
-    pub organs: Vec<(usize, Arc<FemModel>, f64)>,
-    pub keratometers: Vec<(usize, Keratometer)>,
-    /// Per organ cut (as `organs`), its latest cut for the window to draw.
-    pub drawn: Vec<Arc<LatestCut>>,
+    pub organs: Vec<CutOrgan>,
+}
+
+/// An organ the scalpel cuts.
+#[derive(Clone)]
+pub struct CutOrgan {
+    /// Its place among the scene's organs.
+    pub index: usize,
+    /// Its linear finite-element model, which its cut state is solved on.
+    pub model: Arc<FemModel>,
+    pub toughness_j_per_m2: f64,
+    /// Its latest cut, for the window to draw (the haptic thread never touches it).
+    pub drawn: Arc<LatestCut>,
+    /// A cornea's model under the intraocular pressure, which predicts a keratotomy's
+    /// correction.
+    pub keratometer: Option<Keratometer>,
 }
 
 impl SceneCutting {
-    /// The latest cut of organ `index` (by the scene's order), if the scalpel cuts it.
-    pub fn drawn(&self, index: usize) -> Option<Arc<CutView>> {
-        let k = self.organs.iter().position(|o| o.0 == index)?;
-        Some(self.drawn[k].get())
+    /// Organ `index` (by the scene's order), if the scalpel cuts it.
+    pub fn organ(&self, index: usize) -> Option<&CutOrgan> {
+        self.organs.iter().find(|o| o.index == index)
     }
 }
 
@@ -135,11 +143,10 @@ impl HapticLoop {
                 organ.insert(OrganMotion::new(model.clone(), dynamics.grasp));
             }
             if let Some(cutting) = &scene.cutting
-                && let Some(k) = cutting.organs.iter().position(|o| o.0 == index)
+                && let Some(cut) = cutting.organ(index)
             {
-                let (_, model, toughness) = &cutting.organs[k];
-                let scalpel = Scalpel::new(cutting.blade, *toughness);
-                let worker = CutWorker::spawn(model.clone(), name, cutting.drawn[k].clone())?;
+                let scalpel = Scalpel::new(cutting.blade, cut.toughness_j_per_m2);
+                let worker = CutWorker::spawn(cut.model.clone(), name, cut.drawn.clone())?;
                 organ.insert(OrganCut::new(scalpel, worker));
             }
         }

@@ -6,6 +6,8 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
+use bevy::asset::RenderAssetUsages;
+use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
 use nalgebra::{Point3, Vector3};
 
@@ -204,8 +206,6 @@ fn add(position: [f32; 3], by_m: &Vector3<f64>) -> [f32; 3] {
 
 /// The walls' render mesh.
 pub(super) fn walls_mesh(points: Vec<[f32; 3]>, indices: Vec<u32>) -> Mesh {
-    use bevy::asset::RenderAssetUsages;
-    use bevy::mesh::{Indices, PrimitiveTopology};
     let triangles: Vec<[usize; 3]> = indices
         .chunks_exact(3)
         .map(|t| [t[0] as usize, t[1] as usize, t[2] as usize])

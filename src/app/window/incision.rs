@@ -1,7 +1,7 @@
 //! Cutting as the trainee sees it: the lines an incision task asks for, a keratotomy's
 //! optical zone (as the surgeon's marker inks it), the cuts the scalpel has made (in the
-//! colour of cut tissue's shadow), and the scalpel's edge at the tool tip. Drawn as lines
-//! over the organs: the surface itself is not split along a cut (`docs/cutting.md`, Limits).
+//! colour of cut tissue's shadow), and the scalpel's edge at the tool tip, drawn as lines
+//! over the organs (the surface split along a cut is [`super::cut_surface`]'s).
 
 use bevy::prelude::*;
 use nalgebra::Vector3;

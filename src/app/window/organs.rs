@@ -92,7 +92,7 @@ fn spawn_organs(
             .scene
             .cutting
             .as_ref()
-            .is_some_and(|c| c.drawn(index).is_some())
+            .is_some_and(|c| c.organ(index).is_some())
         {
             commands.spawn((
                 SceneView,
@@ -201,8 +201,8 @@ fn deform(
 /// the copies, to replace the organ's (`None` while the split stands or nothing is cut).
 fn refresh_split(view: &mut OrganView, link: &HapticLink) -> Option<Mesh> {
     let cutting = link.scene.cutting.as_ref()?;
-    let cut = cutting.drawn(view.index).filter(|c| c.unknowns > 0)?;
-    if view.split.as_ref().is_some_and(|s| s.is_of(&cut)) {
+    let cut = cutting.organ(view.index)?.drawn.get();
+    if cut.unknowns == 0 || view.split.as_ref().is_some_and(|s| s.is_of(&cut)) {
         return None;
     }
     let split = SplitSurface::new(cut, &view.vademecum, &view.triangles);
