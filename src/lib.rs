@@ -12,6 +12,7 @@
 
 pub mod app;
 pub mod bench;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod cli;
 pub mod contact;
 pub mod cutting;

@@ -230,10 +230,10 @@ pub fn open_window(
         HapticThread::spawn(haptic, timer, Scheduling::RealTime).map_err(|e| e.to_string())?;
     let menu = lesson.is_some().then(|| MenuPlan {
         folder,
-        built_in: (
+        built_in: vec![(
             PathBuf::from(super::DEFAULT_SCENARIO.0),
             super::DEFAULT_SCENARIO.1,
-        ),
+        )],
         scenes: scene_source(options),
         swap: haptic.swap(),
     });
@@ -250,6 +250,7 @@ pub fn open_window(
         menu,
         free_camera: options.free_camera,
         offscreen: options.offscreen,
+        paced: None,
     });
     let (report, mut haptic) = haptic.stop();
     let attempts = attempts(&lessons, &mut haptic);
@@ -268,7 +269,10 @@ pub fn open_window(
 /// How the window's menu builds the scene of the scenario chosen.
 fn scene_source(options: &Options) -> SceneSource {
     let options = options.clone();
-    std::sync::Arc::new(move |scenario: &Scenario| scenario_scene_capped(&options, scenario))
+    std::sync::Arc::new(move |scenario: &Scenario| {
+        let (options, scenario) = (options.clone(), scenario.clone());
+        Box::pin(async move { scenario_scene_capped(&options, &scenario) })
+    })
 }
 
 /// Every attempt begun under the window's lessons, in order, scored: the ended ones from each

@@ -4,9 +4,12 @@
 //! ([`window`]) and the benchmark of the whole loop ([`bench`]).
 
 pub mod attempt;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod bench;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod bench_scalpel;
 pub mod haptic;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod launch;
 pub mod scene;
 pub mod window;
@@ -21,6 +24,7 @@ pub const DEFAULT_SCENARIO: (&str, &str) = (
 
 /// Why a window cannot be opened here, if that is known before trying: no `DISPLAY`, or a
 /// local X display whose server does not answer (winit would panic on either).
+#[cfg(not(target_arch = "wasm32"))]
 pub fn missing_display() -> Option<String> {
     if !cfg!(target_os = "linux") {
         return None;
@@ -40,6 +44,7 @@ pub fn missing_display() -> Option<String> {
 }
 
 /// The socket of a local display (`:N`, `:N.S`, `unix:N`); `None` for a remote one.
+#[cfg(not(target_arch = "wasm32"))]
 fn local_x_socket(display: &str) -> Option<std::path::PathBuf> {
     let number = display
         .strip_prefix(':')

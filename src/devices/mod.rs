@@ -5,9 +5,11 @@
 //! the physics and the motors, and the clock that paces the 1 kHz loop.
 
 mod device;
+#[cfg(not(target_arch = "wasm32"))]
 mod forcedimension;
 mod fulcrum;
 mod laparoscope;
+#[cfg(not(target_arch = "wasm32"))]
 mod openhaptics;
 mod recorder;
 mod safety;
@@ -17,16 +19,19 @@ mod spec;
 mod sweep;
 mod timing;
 mod trajectory;
+#[cfg(not(target_arch = "wasm32"))]
 mod vendor;
 mod virtual_device;
 mod workspace;
 
 pub use device::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
+#[cfg(not(target_arch = "wasm32"))]
 pub use forcedimension::ForceDimension;
 pub use fulcrum::{Fulcrum, HANDLE_AXIS, MIN_OUTSIDE_M, Pose};
 pub use laparoscope::{
     Laparoscope, MIN_INSIDE_M, ScopeHandle, ScopePose, ScopeScript, Steer, View,
 };
+#[cfg(not(target_arch = "wasm32"))]
 pub use openhaptics::OpenHaptics;
 pub use recorder::Recorder;
 pub use safety::{Fault, SafetyFilter, SafetySettings};

@@ -95,6 +95,12 @@ impl Trajectory {
             path: path.to_owned(),
             source,
         })?;
+        Self::read(path, file)
+    }
+
+    /// Reads a trajectory from `file`'s text (fetched by a web page, say), named `path` in
+    /// errors; the same checks as [`Trajectory::load`].
+    pub fn read(path: &Path, file: impl std::io::Read) -> Result<Self, TrajectoryError> {
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .from_reader(file);

@@ -6,9 +6,14 @@
 //! each prefixed by its length), and a BLAKE3 checksum of everything before it. Saving writes
 //! a temporary file and renames it, so a failed save never leaves half a file, and two
 //! processes saving the same file never mix their bytes.
+//!
+//! A web page has no file system: it fetches the files its scene needs and [`provide`]s them
+//! here, where [`read`] finds them before looking on disk.
 
-use std::path::Path;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 
 use super::error::VademecumError;
 
@@ -98,11 +103,38 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), VademecumError>
     std::fs::rename(&temporary, path).map_err(io)
 }
 
+/// The bytes of the file at `path`: the ones [`provide`]d for it, else the file's.
 pub fn read(path: &Path) -> Result<Vec<u8>, VademecumError> {
+    if let Some(bytes) = provided(path) {
+        return Ok(bytes.to_vec());
+    }
     std::fs::read(path).map_err(|source| VademecumError::Io {
         file: path.to_path_buf(),
         source,
     })
+}
+
+type Provided = Mutex<BTreeMap<PathBuf, Arc<[u8]>>>;
+
+fn provided_files() -> &'static Provided {
+    static FILES: std::sync::OnceLock<Provided> = std::sync::OnceLock::new();
+    FILES.get_or_init(Provided::default)
+}
+
+/// Makes `bytes` the content of the file at `path` for [`read`] (a page's fetched files).
+pub fn provide(path: &Path, bytes: Arc<[u8]>) {
+    if let Ok(mut files) = provided_files().lock() {
+        files.insert(path.to_path_buf(), bytes);
+    }
+}
+
+/// Whether [`read`] would find `path` among the provided files.
+pub fn is_provided(path: &Path) -> bool {
+    provided(path).is_some()
+}
+
+fn provided(path: &Path) -> Option<Arc<[u8]>> {
+    provided_files().lock().ok()?.get(path).cloned()
 }
 
 /// Four-byte little-endian values: the payloads' only element types.

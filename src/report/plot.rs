@@ -41,6 +41,8 @@ pub fn save_png(
     size: (u32, u32),
     draw: impl FnOnce(&Area) -> PlotResult,
 ) -> PlotResult {
+    // Plotters draws text with a registered font only off the web; the page draws no plots.
+    #[cfg(not(target_arch = "wasm32"))]
     plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
         .map_err(|_| "the embedded font could not be read")?;
     let (width, height) = size;

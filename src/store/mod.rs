@@ -3,11 +3,13 @@
 //! its mesh, material and settings and rebuilt with progress shown when missing or stale;
 //! and the history of trainees' attempts (SQLite). No Bevy: the app and both binaries call it.
 
+#[cfg(not(target_arch = "wasm32"))]
 mod history;
 mod progress;
 mod source;
 mod vademecums;
 
+#[cfg(not(target_arch = "wasm32"))]
 pub use history::{
     AttemptRecord, History, HistoryError, HistoryFilter, keep as keep_attempt, now_unix_s,
 };

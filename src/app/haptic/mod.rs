@@ -5,12 +5,15 @@
 
 mod components;
 mod cutting;
+mod frame_paced;
 mod report;
 mod resources;
 mod runner;
 mod scoring;
 mod snapshot;
+mod swap;
 mod systems;
+#[cfg(not(target_arch = "wasm32"))]
 mod thread;
 
 use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
@@ -18,6 +21,7 @@ use bevy::prelude::*;
 
 pub use components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
 pub use cutting::{OrganCut, SettleCuts};
+pub use frame_paced::{FramePaced, MAX_BURST};
 pub use report::{ForceSummary, HeadlessReport, RangeSummary, TickTimes};
 pub use resources::{
     Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, SceneScope, Scope,
@@ -26,7 +30,9 @@ pub use resources::{
 pub use runner::{CutOrgan, HapticLoop, HapticScene, SceneCutting, SceneDynamics, SceneError};
 pub use scoring::{ExerciseLink, ExerciseRun};
 pub use snapshot::{HapticSnapshot, LoopTiming, OrganSnapshot};
-pub use thread::{HapticThread, RealTimeReport, SceneSwap, Scheduling};
+pub use swap::SceneSwap;
+#[cfg(not(target_arch = "wasm32"))]
+pub use thread::{HapticThread, RealTimeReport, Scheduling};
 
 /// The schedule run once per haptic tick.
 #[derive(ScheduleLabel, Clone, Debug, PartialEq, Eq, Hash)]

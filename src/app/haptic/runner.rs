@@ -1,7 +1,10 @@
 //! The haptic world and its schedule, and the simulated-clock run behind `--headless`.
 
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+// The browser's clock in a web page (std's has none there), the OS's elsewhere.
+use bevy::platform::time::Instant;
 
 use bevy::prelude::*;
 
@@ -43,6 +46,26 @@ pub struct HapticScene {
     pub port: Option<Fulcrum>,
     /// The laparoscope, if the trainee looks through one.
     pub scope: Option<SceneScope>,
+}
+
+#[cfg(test)]
+impl HapticScene {
+    /// A 6 mm probe over no organ, with the default workspace and safety.
+    pub fn without_organs() -> Self {
+        Self {
+            organs: Vec::new(),
+            probe: Probe {
+                tip_radius_m: 0.006,
+            },
+            workspace: Workspace::default(),
+            safety: SafetySettings::default(),
+            coupling: None,
+            dynamics: None,
+            cutting: None,
+            port: None,
+            scope: None,
+        }
+    }
 }
 
 /// The scalpel's blade and the organs it cuts.

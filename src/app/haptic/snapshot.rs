@@ -46,6 +46,10 @@ pub struct HapticSnapshot {
     pub exercise: Option<Progress>,
 }
 
+/// How often the loop hands its timing to the snapshots: quantiles scan the histogram (tens of
+/// µs), so once a second.
+pub(super) const TIMING_EVERY_TICKS: u64 = 1000;
+
 /// The real-time loop's timing so far, for the HUD (µs).
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
 pub struct LoopTiming {

@@ -1,8 +1,8 @@
 //! The haptic loop on a thread of its own, paced by absolute deadlines: render frames can
 //! neither bunch its ticks nor delay them.
 
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -11,7 +11,8 @@ use serde::Serialize;
 use super::report::TickTimes;
 use super::resources::TickClock;
 use super::runner::HapticLoop;
-use super::snapshot::LoopTiming;
+use super::snapshot::{LoopTiming, TIMING_EVERY_TICKS};
+use super::swap::SceneSwap;
 use crate::devices::{Histogram, Metronome, TICK_S, TimerMode};
 
 /// How well the thread kept time.
@@ -45,46 +46,6 @@ pub struct HapticThread {
     handle: JoinHandle<(RealTimeReport, HapticLoop)>,
 }
 
-/// Another scene for the running thread: a parked loop (see [`HapticLoop::parked`]) offered
-/// here is taken at the start of the next tick, with the running loop's device; the loop it
-/// replaces is kept here, to be dropped away from the haptic thread.
-#[derive(Clone, Default)]
-pub struct SceneSwap(Arc<Mutex<Swap>>);
-
-#[derive(Default)]
-struct Swap {
-    incoming: Option<HapticLoop>,
-    retired: Option<HapticLoop>,
-}
-
-impl SceneSwap {
-    /// Offers `next` to the haptic thread (replacing one offered and not yet taken).
-    pub fn offer(&self, next: HapticLoop) {
-        let retired = self.0.lock().ok().and_then(|mut swap| {
-            swap.incoming = Some(next);
-            swap.retired.take()
-        });
-        // Dropped here, outside the lock, on the caller's thread.
-        drop(retired);
-    }
-
-    /// Whether a loop offered has not been taken yet.
-    pub fn pending(&self) -> bool {
-        self.0.lock().is_ok_and(|swap| swap.incoming.is_some())
-    }
-
-    /// On the haptic thread: runs the offered loop from now on, if there is one and the lock
-    /// is free (never waits).
-    fn take(&self, running: &mut HapticLoop) {
-        if let Ok(mut swap) = self.0.try_lock()
-            && let Some(mut next) = swap.incoming.take()
-        {
-            next.take_device(running);
-            swap.retired = Some(std::mem::replace(running, next));
-        }
-    }
-}
-
 impl HapticThread {
     /// Starts ticking `haptic` every millisecond of real time.
     pub fn spawn(
@@ -115,10 +76,6 @@ impl HapticThread {
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
     }
 }
-
-/// How often the loop hands its timing to the snapshots: quantiles scan the histogram (tens of
-/// µs), so once a second.
-const TIMING_EVERY_TICKS: u64 = 1000;
 
 fn run(
     mut haptic: HapticLoop,
@@ -214,54 +171,4 @@ fn raise_priority() -> Result<(), String> {
 fn raise_priority() -> Result<(), String> {
     thread_priority::set_current_thread_priority(thread_priority::ThreadPriority::Max)
         .map_err(|e| format!("{e:?}"))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::app::haptic::HapticScene;
-    use crate::app::haptic::resources::{Device, Safety};
-    use crate::contact::Probe;
-    use crate::devices::{
-        DeviceSample, SafetySettings, Scripted, Trajectory, TrajectoryRow, Workspace,
-    };
-    use nalgebra::Vector3;
-
-    fn scene(max_force_n: f64) -> HapticScene {
-        HapticScene {
-            organs: Vec::new(),
-            probe: Probe {
-                tip_radius_m: 0.006,
-            },
-            workspace: Workspace::default(),
-            safety: SafetySettings {
-                max_force_n,
-                ..SafetySettings::default()
-            },
-            coupling: None,
-            dynamics: None,
-            cutting: None,
-            port: None,
-            scope: None,
-        }
-    }
-
-    /// The offered world runs from the next tick with the running one's device, under its own
-    /// force limit; the world it replaced is kept for the other side to drop, without a device.
-    #[test]
-    fn a_swapped_scene_takes_over_the_device() {
-        let rows = vec![TrajectoryRow::new(0.0, &DeviceSample::at(Vector3::zeros()))];
-        let device = Box::new(Scripted::new("the hand", Trajectory { rows }));
-        let mut running = HapticLoop::new(&scene(3.3), device).unwrap();
-        let swap = SceneSwap::default();
-        swap.offer(HapticLoop::parked(&scene(1.0)).unwrap());
-        assert!(swap.pending());
-        swap.take(&mut running);
-        assert!(!swap.pending());
-        assert_eq!(running.device_name(), "the hand");
-        assert_eq!(running.world().resource::<Safety>().0.max_force_n(), 1.0);
-        running.tick(TickClock::default());
-        let retired = swap.0.lock().unwrap().retired.take().unwrap();
-        assert!(!retired.world().contains_resource::<Device>());
-    }
 }

@@ -1,14 +1,15 @@
 //! The menu of scenarios: every `*.scenario.ron` in the scenarios folder (and the built-in
 //! one, when the folder lacks it), each with its title, difficulty and organs; a file that
 //! does not validate is listed with its error and cannot be chosen. The chosen scenario's
-//! scene is read away from the window (its vademecums loaded, or built when missing), handed
-//! to the haptic thread, and the window redrawn on it; then its briefing opens.
+//! scene is read as a task away from the frames (its vademecums loaded, fetched first in a web
+//! page, or built when missing), handed to the haptic loop, and the window redrawn on it; then
+//! its briefing opens.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::thread::JoinHandle;
 
 use bevy::prelude::*;
+use bevy::tasks::{AsyncComputeTaskPool, BoxedFuture, Task, block_on, poll_once};
 
 use super::bridge::HapticLink;
 use super::lesson::{Lesson, Lessons, Stage, spawn_panel};
@@ -17,16 +18,19 @@ use crate::app::attempt::{prepare, sites_on};
 use crate::app::haptic::{ExerciseLink, HapticLoop, HapticScene, HapticSnapshot, SceneSwap};
 use crate::scenario::{self, Exercise, Scenario};
 
-/// Builds a scenario's scene: its organs' vademecums read, or built when missing or stale.
-pub type SceneSource = Arc<dyn Fn(&Scenario) -> Result<HapticScene, String> + Send + Sync>;
+/// Builds a scenario's scene: its organs' vademecums read (in a web page, fetched first), or
+/// built when missing or stale.
+pub type SceneSource =
+    Arc<dyn Fn(&Scenario) -> BoxedFuture<'static, Result<HapticScene, String>> + Send + Sync>;
 
 /// What the menu offers and how it changes the scene.
 #[derive(Resource, Clone)]
 pub struct MenuPlan {
-    /// The folder whose scenarios are offered (none: the built-in one only).
+    /// The folder whose scenarios are offered (none: the built-in ones only).
     pub folder: Option<PathBuf>,
-    /// The built-in scenario's file name and text.
-    pub built_in: (PathBuf, &'static str),
+    /// The scenarios built into the program (file names and texts), offered where the folder
+    /// lacks them.
+    pub built_in: Vec<(PathBuf, &'static str)>,
     pub scenes: SceneSource,
     /// Where the haptic thread takes the chosen scenario's world.
     pub swap: SceneSwap,
@@ -50,11 +54,11 @@ struct Menu {
 #[derive(Component)]
 struct MenuText;
 
-/// The chosen scenario on its way: a thread reading its scene and building its haptic world.
+/// The chosen scenario on its way: a task reading its scene and building its haptic world.
 #[derive(Resource)]
 struct Loading {
     title: String,
-    task: Option<JoinHandle<Result<Prepared, String>>>,
+    task: Task<Result<Prepared, String>>,
 }
 
 /// A lesson ready to run: its haptic world (parked, with its exercise offered) and the end of
@@ -104,20 +108,20 @@ fn entries(plan: &MenuPlan) -> Vec<Entry> {
             file,
         })
         .collect();
-    let (built_in, text) = &plan.built_in;
-    if !entries
+    let missing: Vec<Entry> = plan
+        .built_in
         .iter()
-        .any(|e| e.file.file_name() == built_in.file_name())
-    {
-        let scenario = scenario::parse(built_in, text).map_err(|e| e.to_string());
-        entries.insert(
-            0,
-            Entry {
-                file: built_in.clone(),
-                scenario,
-            },
-        );
-    }
+        .filter(|(file, _)| {
+            !entries
+                .iter()
+                .any(|e| e.file.file_name() == file.file_name())
+        })
+        .map(|(file, text)| Entry {
+            scenario: scenario::parse(file, text).map_err(|e| e.to_string()),
+            file: file.clone(),
+        })
+        .collect();
+    entries.splice(0..0, missing);
     entries
 }
 
@@ -194,7 +198,7 @@ fn move_selection(
     text.0 = menu_text(&menu);
 }
 
-/// Enter on a scenario that reads: its scene is loaded on a thread of its own.
+/// Enter on a scenario that reads: its scene is loaded as a task.
 fn choose_on_enter(
     mut commands: Commands,
     keys: Res<ButtonInput<KeyCode>>,
@@ -214,36 +218,23 @@ fn choose_on_enter(
         return;
     };
     // The same scene needs no vademecum read again.
-    let scene = super::reload::same_scene(&lesson.scenario, scenario).then(|| lesson.scene.clone());
-    let (file, scenario, scenes) = (file.clone(), scenario.clone(), plan.scenes.clone());
+    let same = super::reload::same_scene(&lesson.scenario, scenario).then(|| lesson.scene.clone());
+    let (file, scenario) = (file.clone(), scenario.clone());
+    let scene: BoxedFuture<'static, _> = match same {
+        Some(scene) => Box::pin(std::future::ready(Ok(scene))),
+        None => (plan.scenes)(&scenario),
+    };
     let title = scenario.title.clone();
-    let task = std::thread::Builder::new()
-        .name("scenario loader".into())
-        .spawn(move || prepared(file, scenario, scene, &scenes));
-    match task {
-        Ok(task) => {
-            commands.insert_resource(Loading {
-                title,
-                task: Some(task),
-            });
-            next.set(Stage::Loading);
-        }
-        Err(e) => bevy::log::error!("could not start loading the scenario: {e}"),
-    }
+    let task = AsyncComputeTaskPool::get().spawn(async move {
+        let scene = scene.await?;
+        prepared(file, scenario, scene)
+    });
+    commands.insert_resource(Loading { title, task });
+    next.set(Stage::Loading);
 }
 
-/// The lesson of `scenario` on `scene` (built from `scenes` when not given), with its parked
-/// haptic world.
-fn prepared(
-    file: PathBuf,
-    scenario: Scenario,
-    scene: Option<HapticScene>,
-    scenes: &SceneSource,
-) -> Result<Prepared, String> {
-    let scene = match scene {
-        Some(scene) => scene,
-        None => scenes(&scenario)?,
-    };
+/// The lesson of `scenario` on `scene`, with its parked haptic world.
+fn prepared(file: PathBuf, scenario: Scenario, scene: HapticScene) -> Result<Prepared, String> {
     let mut haptic = HapticLoop::parked(&scene).map_err(|e| format!("{}: {e}", file.display()))?;
     let exercise = Exercise::new(scenario.clone(), sites_on(&scene, &scenario));
     let link: Arc<ExerciseLink> = prepare(&mut haptic, exercise);
@@ -266,7 +257,7 @@ fn show_loading(mut commands: Commands, loading: Res<Loading>) {
         Stage::Loading,
         format!(
             "Loading {}: reading its organs' vademecums (one that is missing is built first; \
-             its progress shows in the terminal).",
+             its progress shows in the terminal or the browser's console).",
             loading.title
         ),
     );
@@ -285,16 +276,12 @@ fn finish_loading(
     mut changed: MessageWriter<SceneChanged>,
     mut next: ResMut<NextState<Stage>>,
 ) {
-    if !loading.task.as_ref().is_some_and(JoinHandle::is_finished) {
+    let Some(result) = block_on(poll_once(&mut loading.task)) else {
         return;
-    }
-    let result = loading.task.take().map(|t| {
-        t.join()
-            .unwrap_or_else(|_| Err("the loader panicked".into()))
-    });
+    };
     commands.remove_resource::<Loading>();
     match result {
-        Some(Ok(prepared)) => {
+        Ok(prepared) => {
             plan.swap.offer(prepared.haptic);
             // This frame's snapshot is read from the new scene's end, after this stage.
             link.change_scene(prepared.lesson.scene.clone(), prepared.snapshots);
@@ -304,11 +291,10 @@ fn finish_loading(
             changed.write(SceneChanged);
             next.set(Stage::Briefing);
         }
-        Some(Err(problem)) => {
+        Err(problem) => {
             menu.problem = Some(problem);
             next.set(Stage::Menu);
         }
-        None => next.set(Stage::Menu),
     }
 }
 
@@ -366,10 +352,10 @@ mod tests {
         let swap = SceneSwap::default();
         let plan = MenuPlan {
             folder: Some(folder.clone()),
-            built_in: (PathBuf::from("scenarios/built-in.scenario.ron"), "unused"),
+            built_in: vec![(PathBuf::from("scenarios/built-in.scenario.ron"), "unused")],
             scenes: Arc::new(move |_: &Scenario| {
                 counter.fetch_add(1, Ordering::SeqCst);
-                Ok(scene_without_organs())
+                Box::pin(std::future::ready(Ok(scene_without_organs())))
             }),
             swap: swap.clone(),
         };

@@ -16,6 +16,7 @@ mod lesson;
 mod menu;
 mod offscreen;
 mod organs;
+mod paced;
 mod reload;
 mod screenshot;
 #[cfg(test)]
@@ -34,7 +35,7 @@ pub use lesson::{Lesson, Lessons, Opening};
 pub use menu::{MenuPlan, SceneSource};
 pub use screenshot::ScreenshotPlan;
 
-use super::haptic::{HapticScene, HapticSnapshot};
+use super::haptic::{FramePaced, HapticScene, HapticSnapshot};
 use crate::devices::VirtualHandle;
 
 /// Everything the window needs from the haptic side.
@@ -59,6 +60,9 @@ pub struct WindowScene {
     pub free_camera: bool,
     /// Draw into an image of this size (pixels) instead of a window.
     pub offscreen: Option<(u32, u32)>,
+    /// The haptic loop, when the frames tick it (a web page, which has no thread for it);
+    /// `None` when it runs on a thread of its own.
+    pub paced: Option<FramePaced>,
 }
 
 /// The haptic side's f64 vectors as Bevy's (the Bevy end of the seam; parry's is `crate::parry_interop`).
@@ -111,7 +115,7 @@ fn spawn_with_scene<M>(
 
 /// Opens the trainer window (or draws into an image, offscreen) and returns, when it closes,
 /// how it closed and how fast it drew.
-pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
+pub fn run(mut window: WindowScene) -> (AppExit, Option<FrameReport>) {
     let log = frames::FrameLog::default();
     let mut app = App::new();
     // The scenarios folder is watched: an edit of the lesson's file reloads it.
@@ -145,6 +149,7 @@ pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
     reload::setup(&mut app, folder.as_deref());
     lesson::setup(&mut app, window.lesson.clone(), window.lessons.clone());
     menu::setup(&mut app, window.menu.clone());
+    paced::setup(&mut app, window.paced.take());
     bridge::setup(&mut app, window);
     organs::setup(&mut app);
     abdomen::setup(&mut app);

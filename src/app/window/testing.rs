@@ -8,19 +8,7 @@ use crate::app::haptic::HapticScene;
 
 /// A scene without organs, for the window's stages in a headless app.
 pub fn scene_without_organs() -> HapticScene {
-    HapticScene {
-        organs: Vec::new(),
-        probe: crate::contact::Probe {
-            tip_radius_m: 0.006,
-        },
-        workspace: crate::devices::Workspace::default(),
-        safety: crate::devices::SafetySettings::default(),
-        coupling: None,
-        dynamics: None,
-        cutting: None,
-        port: None,
-        scope: None,
-    }
+    HapticScene::without_organs()
 }
 
 /// Presses `key` for one frame, then lets it go for another.
