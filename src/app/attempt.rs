@@ -1,7 +1,7 @@
 //! One attempt at a scenario: its scene (organs, tool, device limit), its exercise inside
 //! the haptic world, and the scorecard when every task has ended or the device's script has.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use nalgebra::Vector3;
@@ -10,7 +10,7 @@ use super::haptic::{
     ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SceneScope,
     SettleCuts, TickClock,
 };
-use super::scene::{Detail, SceneOrgan, scene_of};
+use super::scene::{Detail, SceneOrgan, scene_files, scene_of};
 use crate::contact::{ContactSurface, CouplingSettings};
 use crate::devices::{HapticDevice, ScopeHandle, TICK_S};
 use crate::fem::Law;
@@ -28,11 +28,7 @@ pub fn scenario_scene(
     detail: Detail,
     on_stale: OnStale,
 ) -> Result<HapticScene, String> {
-    let organs: Vec<SceneOrgan> = scenario
-        .organs
-        .iter()
-        .map(|entry| scene_organ(scenario, entry))
-        .collect::<Result<_, String>>()?;
+    let organs = scenario_organs(scenario)?;
     let tip = scenario.tool.tip_radius_m();
     let mut scene = scene_of(
         &organs,
@@ -50,6 +46,31 @@ pub fn scenario_scene(
     }
     scene.workspace.scale = scenario.device.workspace_scale.0;
     Ok(scene)
+}
+
+/// The files [`scenario_scene`] reads from `dir` (see [`scene_files`]).
+pub fn scenario_files(
+    scenario: &Scenario,
+    dir: &Path,
+    detail: Detail,
+) -> Result<Vec<PathBuf>, String> {
+    let organs = scenario_organs(scenario)?;
+    let tip = Some(scenario.tool.tip_radius_m());
+    Ok(scene_files(
+        &organs,
+        tip,
+        &coupling_of(scenario),
+        dir,
+        detail,
+    ))
+}
+
+fn scenario_organs(scenario: &Scenario) -> Result<Vec<SceneOrgan>, String> {
+    scenario
+        .organs
+        .iter()
+        .map(|entry| scene_organ(scenario, entry))
+        .collect()
 }
 
 /// The scenario's laparoscope, aimed at its focus (a scenario that loaded has been checked

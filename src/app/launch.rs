@@ -8,22 +8,21 @@ use std::time::Duration;
 use serde::Serialize;
 
 use bevy::app::AppExit;
-use nalgebra::Vector3;
 
-use super::attempt::{Outcome, outcome_of, prepare, run_simulated, scenario_scene, sites_on};
+use super::attempt::{Outcome, outcome_of, run_simulated, scenario_scene};
 use super::haptic::ExerciseRun;
 use super::haptic::{
     HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport, Scheduling,
 };
-use super::scene::{Detail, default_scene, press_targets};
+use super::scene::{Detail, default_scene, mouse_device, press_targets};
 use super::window::{
     FrameReport, Lesson, Lessons, MenuPlan, Opening, SceneSource, ScreenshotPlan, WindowScene,
 };
 use crate::devices::{
     DeviceSpec, ForceDimension, HapticDevice, OpenHaptics, PressMotion, Recorder, Scripted, TICK_S,
-    TimerMode, Trajectory, VirtualDevice, press_and_slide,
+    TimerMode, Trajectory, press_and_slide,
 };
-use crate::scenario::{Exercise, Scenario};
+use crate::scenario::Scenario;
 use crate::store::OnStale;
 
 #[derive(Clone)]
@@ -193,11 +192,8 @@ pub fn open_window(
             (scripted(&spec, trajectory), None)
         }
         (None, _) => {
-            let start = press_targets(&scene)
-                .first()
-                .map_or_else(Vector3::zeros, |t| t.point_m + t.normal * 0.03);
-            let (device, handle) = VirtualDevice::new(&scene.workspace.to_device(&start));
-            (Box::new(device) as Box<dyn HapticDevice>, Some(handle))
+            let (device, handle) = mouse_device(&scene);
+            (device, Some(handle))
         }
     };
     let device = recorded(device, &options.record);
@@ -210,13 +206,7 @@ pub fn open_window(
             opening,
             folder,
         }) => {
-            let exercise = Exercise::new(scenario.clone(), sites_on(&scene, &scenario));
-            let lesson = Lesson {
-                link: prepare(&mut haptic, exercise),
-                scenario,
-                file,
-                scene: scene.clone(),
-            };
+            let lesson = Lesson::prepare(&mut haptic, scenario, file, scene.clone());
             if let Some(DeviceSpec::Scripted(_)) = &spec {
                 lesson.link.start();
             }
@@ -230,10 +220,10 @@ pub fn open_window(
         HapticThread::spawn(haptic, timer, Scheduling::RealTime).map_err(|e| e.to_string())?;
     let menu = lesson.is_some().then(|| MenuPlan {
         folder,
-        built_in: vec![(
-            PathBuf::from(super::DEFAULT_SCENARIO.0),
-            super::DEFAULT_SCENARIO.1,
-        )],
+        built_in: super::SHIPPED_SCENARIOS
+            .iter()
+            .map(|&(file, text)| (PathBuf::from(file), text))
+            .collect(),
         scenes: scene_source(options),
         swap: haptic.swap(),
     });

@@ -12,15 +12,16 @@ pub mod haptic;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod launch;
 pub mod scene;
+pub mod shipped;
+#[cfg(target_arch = "wasm32")]
+pub mod web;
 pub mod window;
 
-/// The trainer's built-in scenario (its shipped file and its text): the window's default
-/// exercise, built into the binary so that it runs from any directory; the same file ships in
-/// `scenarios/` for educators to copy.
-pub const DEFAULT_SCENARIO: (&str, &str) = (
-    "scenarios/liver-steady-press.scenario.ron",
-    include_str!("../../scenarios/liver-steady-press.scenario.ron"),
-);
+pub use shipped::SHIPPED_SCENARIOS;
+
+/// The trainer's default exercise (its shipped file and its text), built in like every
+/// shipped scenario so that it runs from any directory.
+pub const DEFAULT_SCENARIO: (&str, &str) = SHIPPED_SCENARIOS[0];
 
 /// Why a window cannot be opened here, if that is known before trying: no `DISPLAY`, or a
 /// local X display whose server does not answer (winit would panic on either).

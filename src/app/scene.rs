@@ -2,7 +2,7 @@
 //! generator builds them in one frame), each with its vademecum from `vademecums/`.
 
 use std::collections::BTreeSet;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 
 use nalgebra::Vector3;
@@ -11,7 +11,9 @@ use super::haptic::{CutOrgan, HapticScene, SceneCutting, SceneDynamics};
 use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, FieldOrigin, Probe};
 use crate::cutting::keratotomy::{Cornea, REFERENCE_MESH};
 use crate::cutting::{Blade, CutError};
-use crate::devices::{PressTarget, SafetySettings, Workspace};
+use crate::devices::{
+    HapticDevice, PressTarget, SafetySettings, VirtualDevice, VirtualHandle, Workspace,
+};
 use crate::dynamics::{DynamicModel, GraspSettings, TRAINER_MODES};
 use crate::fem::{FemModel, Inclusion, Law, Material};
 use crate::mesh::TetMesh;
@@ -208,6 +210,28 @@ impl SceneOrgan {
     }
 }
 
+/// The files [`scene_of`] reads for the same arguments: each organ's vademecum, and the
+/// distance field of the organ the others touch (which it builds when missing). A web page
+/// fetches them first.
+pub fn scene_files(
+    organs: &[SceneOrgan],
+    tip_radius_m: Option<f64>,
+    coupling: &CouplingSettings,
+    dir: &Path,
+    detail: Detail,
+) -> Vec<PathBuf> {
+    let tip = scene_tip_m(organs, tip_radius_m, detail);
+    let mut files = Vec::new();
+    for organ in organs {
+        let spec = organ.vademecum(dir, detail, tip);
+        if organ.name == coupling.master {
+            files.push(spec.field_file());
+        }
+        files.push(spec.file);
+    }
+    files
+}
+
 /// A scene of `organs` felt through a tool tip of `tip_radius_m` (the organs' own when
 /// `None`; on coarse organs no finer than their edges need).
 pub fn scene_of(
@@ -398,6 +422,16 @@ fn attachments_of(organ: &str, vademecum: &Vademecum, mesh: &TetMesh) -> Vec<Att
             })
         })
         .collect()
+}
+
+/// The mouse's device for `scene`, its tool starting 3 cm in front of the first organ's press
+/// target, and the handle the window moves it by.
+pub fn mouse_device(scene: &HapticScene) -> (Box<dyn HapticDevice>, Arc<VirtualHandle>) {
+    let start = press_targets(scene)
+        .first()
+        .map_or_else(Vector3::zeros, |t| t.point_m + t.normal * 0.03);
+    let (device, handle) = VirtualDevice::new(&scene.workspace.to_device(&start));
+    (Box::new(device), handle)
 }
 
 /// Per organ, the accessible point that faces the surgeon most (the largest anterior

@@ -9,8 +9,8 @@ use pgd_surgery::app::scene::Detail;
 use pgd_surgery::app::window::{Opening, ScreenshotPlan};
 use pgd_surgery::app::{self, DEFAULT_SCENARIO, launch};
 use pgd_surgery::cli::{
-    HistoryRequest, HistoryTarget, debrief, list_devices, numbered, show_history,
-    validate_scenarios,
+    HistoryRequest, HistoryTarget, debrief, list_devices, numbered, prepare_scenarios,
+    show_history, validate_scenarios,
 };
 use pgd_surgery::devices::{DeviceSpec, TimerMode};
 use pgd_surgery::scenario;
@@ -117,6 +117,13 @@ enum Command {
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
+    /// Build the vademecums (and distance fields) the scenario files need, where missing or
+    /// stale, and list their files: for a class, or for the web page's site
+    /// (`scripts/web-build.sh` copies them).
+    Prepare {
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+    },
     /// List the haptic device backends, which of them can be used on this machine, and why
     /// the others cannot.
     Devices,
@@ -133,6 +140,13 @@ enum Command {
         #[arg(long, default_value = "reports/learning-curve.png")]
         plot: PathBuf,
     },
+}
+
+fn detail_of(cli: &Cli) -> Detail {
+    match cli.coarse {
+        true => Detail::Coarse,
+        false => Detail::Full,
+    }
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -159,6 +173,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match &cli.command {
         Some(Command::Validate { files }) => return validate_scenarios(files),
+        Some(Command::Prepare { files }) => {
+            return prepare_scenarios(files, &cli.vademecums, detail_of(&cli));
+        }
         Some(Command::Devices) => return list_devices(),
         Some(Command::History {
             scenario,
@@ -203,10 +220,7 @@ fn main() -> ExitCode {
     };
     let options = launch::Options {
         vademecums: cli.vademecums.clone(),
-        detail: match cli.coarse {
-            true => Detail::Coarse,
-            false => Detail::Full,
-        },
+        detail: detail_of(&cli),
         on_stale,
         device: cli.device.clone(),
         record: cli.record.clone(),

@@ -26,6 +26,6 @@ pub use pgd_indent::{
 };
 pub use pgd_mesh::report_mesh;
 pub use pgd_validate::{print_cut_validation, print_validation, validate_cuts, validate_vademecum};
-pub use trainer_commands::{debrief, numbered, validate_scenarios};
+pub use trainer_commands::{debrief, numbered, prepare_scenarios, validate_scenarios};
 pub use trainer_devices::list_devices;
 pub use trainer_history::{HistoryRequest, HistoryTarget, keep_scored, show_history};

@@ -1,14 +1,17 @@
-//! What the trainer prints and writes: `trainer validate`'s verdict on scenario files, and the
-//! end of an attempt (its score printed, its report written).
+//! What the trainer prints and writes: `trainer validate`'s verdict on scenario files,
+//! `trainer prepare`'s vademecums, and the end of an attempt (its score printed, its report
+//! written).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use super::trainer_history::{HistoryTarget, keep_scored};
-use crate::app::attempt::Outcome;
+use crate::app::attempt::{Outcome, scenario_files, scenario_scene};
 use crate::app::launch;
+use crate::app::scene::Detail;
 use crate::report;
 use crate::scenario;
+use crate::store::OnStale;
 
 /// Each attempt with its number among its scenario's attempts, when there were several.
 pub fn numbered(attempts: launch::Attempts) -> Vec<(PathBuf, Option<usize>, Outcome)> {
@@ -43,6 +46,39 @@ pub fn validate_scenarios(files: &[PathBuf]) -> ExitCode {
                 failed = true;
             }
         }
+    }
+    if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// `trainer prepare`: the vademecums and distance fields the scenario files need, built under
+/// `dir` where missing or stale, then listed one per line (what a class, or the web page's
+/// site, must have). Fails if any file does not read or any scene cannot be built.
+pub fn prepare_scenarios(files: &[PathBuf], dir: &Path, detail: Detail) -> ExitCode {
+    let mut failed = false;
+    let mut listed: Vec<PathBuf> = Vec::new();
+    for file in files {
+        let prepared = scenario::load(file)
+            .map_err(|e| e.to_string())
+            .and_then(|s| {
+                scenario_scene(&s, dir, detail, OnStale::Rebuild)?;
+                scenario_files(&s, dir, detail)
+            });
+        match prepared {
+            Ok(needed) => listed.extend(needed.into_iter().filter(|f| f.is_file())),
+            Err(e) => {
+                eprintln!("{}: {e}", file.display());
+                failed = true;
+            }
+        }
+    }
+    listed.sort();
+    listed.dedup();
+    for file in &listed {
+        println!("{}", file.display());
     }
     if failed {
         ExitCode::FAILURE

@@ -6,6 +6,7 @@ use std::path::Path;
 use plotters::prelude::*;
 
 /// The plots' font, shipped with the crate so that plots need nothing from the system.
+#[cfg(not(target_arch = "wasm32"))]
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// A whole plot's drawing area.

@@ -12,8 +12,8 @@ use bevy::prelude::*;
 
 use super::FrameSet;
 use super::bridge::Snapshot;
-use crate::app::attempt::{outcome_of, sites_on};
-use crate::app::haptic::{ExerciseLink, HapticScene};
+use crate::app::attempt::{outcome_of, prepare, sites_on};
+use crate::app::haptic::{ExerciseLink, HapticLoop, HapticScene};
 use crate::report;
 use crate::scenario::{Exercise, Scenario};
 
@@ -45,6 +45,22 @@ pub struct Lesson {
 }
 
 impl Lesson {
+    /// `scenario` (read from `file`) on `scene`, its exercise prepared in `haptic`'s world.
+    pub fn prepare(
+        haptic: &mut HapticLoop,
+        scenario: Scenario,
+        file: PathBuf,
+        scene: HapticScene,
+    ) -> Self {
+        let exercise = Exercise::new(scenario.clone(), sites_on(&scene, &scenario));
+        Self {
+            link: prepare(haptic, exercise),
+            scenario,
+            file,
+            scene,
+        }
+    }
+
     /// A fresh exercise of the scenario, for another attempt.
     pub(super) fn fresh_exercise(&self) -> Exercise {
         Exercise::new(self.scenario.clone(), sites_on(&self.scene, &self.scenario))
@@ -206,9 +222,15 @@ fn debrief_when_done(snapshot: Res<Snapshot>, mut next: ResMut<NextState<Stage>>
 
 /// Scores a copy of the ended exercise for the screen; the attempt scores the exercise itself
 /// for the report when the window closes.
-fn show_debrief(mut commands: Commands, lesson: Res<Lesson>) {
+pub(super) fn show_debrief(mut commands: Commands, lesson: Res<Lesson>) {
     let text = match lesson.link.ended_copy() {
-        Some(exercise) => report::summary(&outcome_of(exercise).card),
+        Some(exercise) => {
+            let card = outcome_of(exercise).card;
+            let text = report::summary(&card);
+            #[cfg(target_arch = "wasm32")]
+            commands.insert_resource(super::web_page::Debriefed(card));
+            text
+        }
         None => "The exercise has ended.".to_owned(),
     };
     let text = format!(

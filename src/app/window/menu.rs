@@ -14,9 +14,8 @@ use bevy::tasks::{AsyncComputeTaskPool, BoxedFuture, Task, block_on, poll_once};
 use super::bridge::HapticLink;
 use super::lesson::{Lesson, Lessons, Stage, spawn_panel};
 use super::{FrameSet, SceneChanged};
-use crate::app::attempt::{prepare, sites_on};
-use crate::app::haptic::{ExerciseLink, HapticLoop, HapticScene, HapticSnapshot, SceneSwap};
-use crate::scenario::{self, Exercise, Scenario};
+use crate::app::haptic::{HapticLoop, HapticScene, HapticSnapshot, SceneSwap};
+use crate::scenario::{self, Scenario};
 
 /// Builds a scenario's scene: its organs' vademecums read (in a web page, fetched first), or
 /// built when missing or stale.
@@ -236,16 +235,10 @@ fn choose_on_enter(
 /// The lesson of `scenario` on `scene`, with its parked haptic world.
 fn prepared(file: PathBuf, scenario: Scenario, scene: HapticScene) -> Result<Prepared, String> {
     let mut haptic = HapticLoop::parked(&scene).map_err(|e| format!("{}: {e}", file.display()))?;
-    let exercise = Exercise::new(scenario.clone(), sites_on(&scene, &scenario));
-    let link: Arc<ExerciseLink> = prepare(&mut haptic, exercise);
+    let lesson = Lesson::prepare(&mut haptic, scenario, file, scene);
     let snapshots = haptic.publish();
     Ok(Prepared {
-        lesson: Lesson {
-            scenario,
-            file,
-            scene,
-            link,
-        },
+        lesson,
         haptic,
         snapshots,
     })
@@ -309,6 +302,7 @@ mod tests {
     use super::super::lesson::{self, Opening};
     use super::super::testing::{scene_without_organs, stage, tap, texts};
     use super::*;
+    use crate::app::haptic::ExerciseLink;
 
     fn scenario_text(title: &str, organ: &str) -> String {
         format!(

@@ -23,6 +23,8 @@ mod screenshot;
 mod testing;
 pub mod tissue;
 mod tool;
+#[cfg(target_arch = "wasm32")]
+mod web_page;
 
 use std::sync::Arc;
 
@@ -160,6 +162,8 @@ pub fn run(mut window: WindowScene) -> (AppExit, Option<FrameReport>) {
     input::setup(&mut app);
     hud::setup(&mut app);
     frames::setup(&mut app, log.clone());
+    #[cfg(target_arch = "wasm32")]
+    web_page::setup(&mut app);
     let exit = app.run();
     (exit, log.report())
 }

@@ -25,6 +25,11 @@ pub(super) fn plugins(app: &mut App, size: Option<(u32, u32)>, assets: AssetPlug
     let window = WindowPlugin {
         primary_window: Some(Window {
             title: "PGD surgery trainer".into(),
+            // In a web page: its canvas, sized by the page.
+            #[cfg(target_arch = "wasm32")]
+            canvas: Some("#trainer".into()),
+            #[cfg(target_arch = "wasm32")]
+            fit_canvas_to_parent: true,
             ..default()
         }),
         ..default()

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Builds the trainer as a static web page in web/dist/: the trainer compiled for
+# wasm32-unknown-unknown (WebGL2), bound to JavaScript by wasm-bindgen-cli (the version
+# Cargo.lock pins, installed from the crate registry when missing), the page, and the
+# vademecums every shipped scenario needs (built natively first when missing).
+#   scripts/web-build.sh            coarse organs (the page's default)
+#   WEB_DETAIL=full scripts/web-build.sh   the papers' meshes too (open the page with ?detail=full)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/pgd-surgery/target}"
+tools="${PGD_TOOLS:-$HOME/.cache/pgd-surgery/tools}"
+dist=web/dist
+detail="${WEB_DETAIL:-coarse}"
+
+bindgen_version=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/version = |"/, ""); print }' Cargo.lock)
+if ! rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown; then
+  echo "web-build: adding the wasm32-unknown-unknown target"
+  rustup target add wasm32-unknown-unknown
+fi
+if [ "$("$tools/bin/wasm-bindgen" --version 2>/dev/null)" != "wasm-bindgen $bindgen_version" ]; then
+  echo "web-build: installing wasm-bindgen-cli $bindgen_version into $tools"
+  CARGO_TARGET_DIR="$HOME/.cache/pgd-surgery/tools-build" \
+    cargo install wasm-bindgen-cli --version "=$bindgen_version" --root "$tools" --force
+fi
+
+echo "web-build: compiling the trainer for the browser"
+cargo build --release --target wasm32-unknown-unknown --bin trainer-web
+rm -rf "$dist"
+mkdir -p "$dist/vademecums" "$dist/tests"
+"$tools/bin/wasm-bindgen" --target web --no-typescript --out-dir "$dist" --out-name trainer \
+  "$CARGO_TARGET_DIR/wasm32-unknown-unknown/release/trainer-web.wasm"
+cp web/index.html "$dist/"
+# The scripted runs, for the browser test and for replaying an exercise in the page.
+cp -r tests/scenarios "$dist/tests/"
+
+echo "web-build: the vademecums of every shipped scenario ($detail organs)"
+detail_flag=()
+[ "$detail" = coarse ] && detail_flag=(--coarse)
+cargo build --release --bin trainer
+"$CARGO_TARGET_DIR/release/trainer" prepare "${detail_flag[@]}" scenarios/*.scenario.ron >"$dist/files.txt"
+while read -r file; do
+  cp "$file" "$dist/vademecums/"
+done <"$dist/files.txt"
+rm "$dist/files.txt"
+du -sh "$dist" "$dist/vademecums" "$dist/trainer_bg.wasm"
+echo "web-build: done; serve it with scripts/web-serve.sh"

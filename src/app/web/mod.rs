@@ -1,0 +1,145 @@
+//! The trainer in a web page (wasm32): the window drawn into the page's canvas, the mouse
+//! driving the tool, the menu offering every shipped scenario, each exercise scored with its
+//! debrief. The page has no file system and no threads: a scenario's vademecums are fetched
+//! from the site (`vademecums/`) before its scene is built, and the frames tick the haptic
+//! loop at its fixed 1 ms step ([`FramePaced`]).
+
+mod fetch;
+mod page;
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use super::attempt::{scenario_files, scenario_scene};
+use super::haptic::{FramePaced, HapticLoop, HapticScene, SceneSwap};
+use super::scene::{Detail, mouse_device};
+use super::window::{self, Lesson, Lessons, MenuPlan, Opening, WindowScene};
+use super::{DEFAULT_SCENARIO, SHIPPED_SCENARIOS};
+use crate::devices::{HapticDevice, Scripted, Trajectory, VirtualHandle};
+use crate::pgd::container;
+use crate::scenario::{self, Scenario};
+use crate::store::OnStale;
+
+pub use page::publish;
+
+/// Where the site keeps the vademecums (relative to the page).
+const VADEMECUMS: &str = "vademecums";
+
+/// Starts the trainer in the page; what goes wrong is shown there and logged as an error.
+pub fn start() {
+    wasm_bindgen_futures::spawn_local(async {
+        if let Err(why) = run(page::Query::read()).await {
+            page::fail(&why);
+        }
+    });
+}
+
+async fn run(query: page::Query) -> Result<(), String> {
+    let (file, scenario) = opening_scenario(query.scenario.as_deref())?;
+    let scene = fetched_scene(scenario.clone(), query.detail).await?;
+    let (device, virtual_device) = match &query.script {
+        Some(url) => (scripted(url).await?, None),
+        None => {
+            let (device, handle) = mouse_device(&scene);
+            (device, Some(handle))
+        }
+    };
+    page::status("ready");
+    window::run(window_scene(
+        scene,
+        scenario,
+        file,
+        device,
+        virtual_device,
+        query.detail,
+    )?);
+    Ok(())
+}
+
+/// The shipped scenario `stem` names (the default one when none is named), parsed.
+fn opening_scenario(stem: Option<&str>) -> Result<(PathBuf, Scenario), String> {
+    let (file, text) = match stem {
+        None => DEFAULT_SCENARIO,
+        Some(stem) => *SHIPPED_SCENARIOS
+            .iter()
+            .find(|(file, _)| {
+                Path::new(file).file_name() == Some(format!("{stem}.scenario.ron").as_ref())
+            })
+            .ok_or_else(|| format!("no shipped scenario is called {stem}"))?,
+    };
+    let scenario = scenario::parse(Path::new(file), text).map_err(|e| e.to_string())?;
+    Ok((PathBuf::from(file), scenario))
+}
+
+/// The scene of `scenario`, its files fetched first (those already fetched are kept).
+async fn fetched_scene(scenario: Scenario, detail: Detail) -> Result<HapticScene, String> {
+    let dir = Path::new(VADEMECUMS);
+    for file in scenario_files(&scenario, dir, detail)? {
+        if container::is_provided(&file) {
+            continue;
+        }
+        let url = file.to_string_lossy();
+        page::status(&format!("{}: fetching {url}", scenario.title));
+        if let Some(bytes) = fetch::bytes(&url).await? {
+            container::provide(&file, bytes.into());
+        }
+    }
+    page::status(&format!("{}: building its scene", scenario.title));
+    scenario_scene(&scenario, dir, detail, OnStale::Refuse)
+}
+
+/// A scripted device replaying the trajectory CSV at `url`.
+async fn scripted(url: &str) -> Result<Box<dyn HapticDevice>, String> {
+    let text = fetch::text(url).await?;
+    let trajectory =
+        Trajectory::read(Path::new(url), text.as_bytes()).map_err(|e| e.to_string())?;
+    Ok(Box::new(Scripted::new(
+        format!("scripted ({url})"),
+        trajectory,
+    )))
+}
+
+/// The window over `scene`, on `scenario`'s lesson, its haptic loop ticked by the frames; the
+/// menu builds the other scenarios' scenes from fetched files.
+fn window_scene(
+    scene: HapticScene,
+    scenario: Scenario,
+    file: PathBuf,
+    device: Box<dyn HapticDevice>,
+    virtual_device: Option<Arc<VirtualHandle>>,
+    detail: Detail,
+) -> Result<WindowScene, String> {
+    let device_name = device.name().to_owned();
+    let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
+    let lesson = Lesson::prepare(&mut haptic, scenario, file, scene.clone());
+    if virtual_device.is_none() {
+        lesson.link.start();
+    }
+    let snapshots = haptic.publish();
+    let swap = SceneSwap::default();
+    let menu = MenuPlan {
+        folder: None,
+        built_in: SHIPPED_SCENARIOS
+            .iter()
+            .map(|&(file, text)| (PathBuf::from(file), text))
+            .collect(),
+        scenes: Arc::new(move |scenario: &Scenario| {
+            Box::pin(fetched_scene(scenario.clone(), detail))
+        }),
+        swap: swap.clone(),
+    };
+    Ok(WindowScene {
+        scene,
+        snapshots,
+        virtual_device,
+        device_name,
+        exit_after_s: None,
+        screenshot: None,
+        lesson: Some((lesson, Opening::Lesson)),
+        lessons: Lessons::default(),
+        menu: Some(menu),
+        free_camera: false,
+        offscreen: None,
+        paced: Some(FramePaced::new(haptic, swap)),
+    })
+}
