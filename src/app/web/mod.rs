@@ -20,8 +20,6 @@ use crate::pgd::container;
 use crate::scenario::{self, Scenario};
 use crate::store::OnStale;
 
-pub use page::publish;
-
 /// Where the site keeps the vademecums (relative to the page).
 const VADEMECUMS: &str = "vademecums";
 

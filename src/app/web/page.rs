@@ -4,6 +4,7 @@
 use wasm_bindgen::JsValue;
 
 use crate::app::scene::Detail;
+use crate::app::window::publish;
 
 /// What the page's address asks for: `?scenario=STEM&script=URL&detail=full`.
 pub struct Query {
@@ -47,23 +48,6 @@ pub fn fail(why: &str) {
         line.set_text_content(Some(&format!("The trainer could not start: {why}")));
     }
     publish("error", &JsValue::from_str(why));
-}
-
-/// Sets `window.trainer[key]` (creating `window.trainer`): what a script driving the page
-/// reads (`stage`, `scorecard` as JSON, `error`).
-pub fn publish(key: &str, value: &JsValue) {
-    let Some(window) = web_sys::window() else {
-        return;
-    };
-    let trainer = js_sys::Reflect::get(&window, &JsValue::from_str("trainer"))
-        .ok()
-        .filter(JsValue::is_object)
-        .unwrap_or_else(|| {
-            let object = js_sys::Object::new().into();
-            let _ = js_sys::Reflect::set(&window, &JsValue::from_str("trainer"), &object);
-            object
-        });
-    let _ = js_sys::Reflect::set(&trainer, &JsValue::from_str(key), value);
 }
 
 fn element(id: &str) -> Option<web_sys::Element> {

@@ -220,6 +220,11 @@ fn debrief_when_done(snapshot: Res<Snapshot>, mut next: ResMut<NextState<Stage>>
     }
 }
 
+/// The scorecard the debrief shows, for the web page around the window.
+#[cfg(target_arch = "wasm32")]
+#[derive(Resource, Clone, Debug)]
+pub(super) struct Debriefed(pub crate::scenario::Scorecard);
+
 /// Scores a copy of the ended exercise for the screen; the attempt scores the exercise itself
 /// for the report when the window closes.
 pub(super) fn show_debrief(mut commands: Commands, lesson: Res<Lesson>) {
@@ -228,7 +233,7 @@ pub(super) fn show_debrief(mut commands: Commands, lesson: Res<Lesson>) {
             let card = outcome_of(exercise).card;
             let text = report::summary(&card);
             #[cfg(target_arch = "wasm32")]
-            commands.insert_resource(super::web_page::Debriefed(card));
+            commands.insert_resource(Debriefed(card));
             text
         }
         None => "The exercise has ended.".to_owned(),

@@ -36,6 +36,8 @@ pub use legend::{Legend, OrganLegend, ToolLegend};
 pub use lesson::{Lesson, Lessons, Opening};
 pub use menu::{MenuPlan, SceneSource};
 pub use screenshot::ScreenshotPlan;
+#[cfg(target_arch = "wasm32")]
+pub use web_page::publish;
 
 use super::haptic::{FramePaced, HapticScene, HapticSnapshot};
 use crate::devices::VirtualHandle;

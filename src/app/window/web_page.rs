@@ -1,17 +1,11 @@
 //! What the window tells the web page around it: the stage the trainee is at and, on each
 //! debrief, the scorecard as JSON (`window.trainer.stage`, `window.trainer.scorecard`), for
-//! the page's scripts and the browser test.
+//! the page's scripts and the browser test, through [`publish`].
 
 use bevy::prelude::*;
 use wasm_bindgen::JsValue;
 
-use super::lesson::{Stage, show_debrief};
-use crate::app::web::publish;
-use crate::scenario::Scorecard;
-
-/// The scorecard the debrief shows.
-#[derive(Resource, Clone, Debug)]
-pub(super) struct Debriefed(pub Scorecard);
+use super::lesson::{Debriefed, Stage, show_debrief};
 
 pub(super) fn setup(app: &mut App) {
     app.add_systems(Update, publish_stage.run_if(state_changed::<Stage>))
@@ -33,4 +27,21 @@ fn publish_scorecard(card: Option<Res<Debriefed>>) {
         Ok(json) => publish("scorecard", &JsValue::from_str(&json)),
         Err(e) => bevy::log::error!("the scorecard could not be written as JSON: {e}"),
     }
+}
+
+/// Sets `window.trainer[key]` (creating `window.trainer`): what a script driving the page
+/// reads (`stage`, `scorecard` as JSON, `error`).
+pub fn publish(key: &str, value: &JsValue) {
+    let Some(window) = web_sys::window() else {
+        return;
+    };
+    let trainer = js_sys::Reflect::get(&window, &JsValue::from_str("trainer"))
+        .ok()
+        .filter(JsValue::is_object)
+        .unwrap_or_else(|| {
+            let object = js_sys::Object::new().into();
+            let _ = js_sys::Reflect::set(&window, &JsValue::from_str("trainer"), &object);
+            object
+        });
+    let _ = js_sys::Reflect::set(&trainer, &JsValue::from_str(key), value);
 }
