@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Builds the trainer as a static web page in web/dist/: the trainer compiled for
 # wasm32-unknown-unknown (WebGL2), bound to JavaScript by wasm-bindgen-cli (the version
-# Cargo.lock pins, installed from the crate registry when missing), the page, and the
-# vademecums every shipped scenario needs (built natively first when missing).
+# Cargo.lock pins, installed from the crate registry when missing), the page, and the web
+# forms of the vademecums every shipped scenario needs (built natively first when missing).
 #   scripts/web-build.sh            coarse organs (the page's default)
 #   WEB_DETAIL=full scripts/web-build.sh   the papers' meshes too (open the page with ?detail=full)
 set -euo pipefail
@@ -37,10 +37,7 @@ echo "web-build: the vademecums of every shipped scenario ($detail organs)"
 detail_flag=()
 [ "$detail" = coarse ] && detail_flag=(--coarse)
 cargo build --release --bin trainer
-"$CARGO_TARGET_DIR/release/trainer" prepare "${detail_flag[@]}" scenarios/*.scenario.ron >"$dist/files.txt"
-while read -r file; do
-  cp "$file" "$dist/vademecums/"
-done <"$dist/files.txt"
-rm "$dist/files.txt"
+"$CARGO_TARGET_DIR/release/trainer" prepare "${detail_flag[@]}" --web "$dist/vademecums" \
+  scenarios/*.scenario.ron
 du -sh "$dist" "$dist/vademecums" "$dist/trainer_bg.wasm"
 echo "web-build: done; serve it with scripts/web-serve.sh"

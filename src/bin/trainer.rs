@@ -123,6 +123,10 @@ enum Command {
     Prepare {
         #[arg(required = true)]
         files: Vec<PathBuf>,
+        /// Also write their web forms (`<file>.web`: response values rounded, deflated) into
+        /// this folder, with their sizes and how much the felt force changes.
+        #[arg(long)]
+        web: Option<PathBuf>,
     },
     /// List the haptic device backends, which of them can be used on this machine, and why
     /// the others cannot.
@@ -173,8 +177,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match &cli.command {
         Some(Command::Validate { files }) => return validate_scenarios(files),
-        Some(Command::Prepare { files }) => {
-            return prepare_scenarios(files, &cli.vademecums, detail_of(&cli));
+        Some(Command::Prepare { files, web }) => {
+            return prepare_scenarios(files, &cli.vademecums, detail_of(&cli), web.as_deref());
         }
         Some(Command::Devices) => return list_devices(),
         Some(Command::History {

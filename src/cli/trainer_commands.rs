@@ -9,6 +9,7 @@ use super::trainer_history::{HistoryTarget, keep_scored};
 use crate::app::attempt::{Outcome, scenario_files, scenario_scene};
 use crate::app::launch;
 use crate::app::scene::Detail;
+use crate::pgd::{self, Statistics, web_form};
 use crate::report;
 use crate::scenario;
 use crate::store::OnStale;
@@ -56,8 +57,14 @@ pub fn validate_scenarios(files: &[PathBuf]) -> ExitCode {
 
 /// `trainer prepare`: the vademecums and distance fields the scenario files need, built under
 /// `dir` where missing or stale, then listed one per line (what a class, or the web page's
-/// site, must have). Fails if any file does not read or any scene cannot be built.
-pub fn prepare_scenarios(files: &[PathBuf], dir: &Path, detail: Detail) -> ExitCode {
+/// site, must have), and with `web` their web forms written there, with their sizes and how
+/// much the felt force changes. Fails if any file does not read or any scene cannot be built.
+pub fn prepare_scenarios(
+    files: &[PathBuf],
+    dir: &Path,
+    detail: Detail,
+    web: Option<&Path>,
+) -> ExitCode {
     let mut failed = false;
     let mut listed: Vec<PathBuf> = Vec::new();
     for file in files {
@@ -80,11 +87,66 @@ pub fn prepare_scenarios(files: &[PathBuf], dir: &Path, detail: Detail) -> ExitC
     for file in &listed {
         println!("{}", file.display());
     }
+    if let Some(web) = web
+        && let Err(e) = write_web_forms(&listed, web)
+    {
+        eprintln!("{e}");
+        failed = true;
+    }
     if failed {
         ExitCode::FAILURE
     } else {
         ExitCode::SUCCESS
     }
+}
+
+/// Each file's web form in `dir` (named `<file name>.web`), and a table of sizes and, for
+/// vademecums, the felt force's change (p95 and max over the surface triangles).
+fn write_web_forms(files: &[PathBuf], dir: &Path) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    println!("web form                                     file MB  web MB  felt force p95   max");
+    let (mut total, mut total_web) = (0, 0);
+    for file in files {
+        let bytes = std::fs::read(file).map_err(|e| format!("{}: {e}", file.display()))?;
+        let is_vademecum = file.extension().is_some_and(|e| e == "vdm");
+        let (web, changes) = if is_vademecum {
+            let full = pgd::decode(file, &bytes).map_err(|e| e.to_string())?;
+            let web = web_form::vademecum(&full);
+            let expanded = web_form::expand(file, &web).map_err(|e| e.to_string())?;
+            let back = pgd::decode(file, &expanded).map_err(|e| e.to_string())?;
+            (web, web_form::felt_force_changes(&full, &back))
+        } else {
+            (web_form::deflated(&bytes), Vec::new())
+        };
+        let name = format!(
+            "{}.{}",
+            file.file_name().unwrap_or_default().to_string_lossy(),
+            web_form::EXTENSION
+        );
+        let out = dir.join(&name);
+        std::fs::write(&out, &web).map_err(|e| format!("{}: {e}", out.display()))?;
+        let mb = |n: usize| n as f64 / 1e6;
+        let force = match changes.is_empty() {
+            true => "(kept exactly)".to_owned(),
+            false => {
+                let change = Statistics::of(changes.iter().copied());
+                format!("{:.4} %   {:.4} %", 100.0 * change.p95, 100.0 * change.max)
+            }
+        };
+        println!(
+            "{name:<44} {:>7.2} {:>7.2}  {force}",
+            mb(bytes.len()),
+            mb(web.len())
+        );
+        (total, total_web) = (total + bytes.len(), total_web + web.len());
+    }
+    println!(
+        "{:<44} {:>7.2} {:>7.2}",
+        "all",
+        total as f64 / 1e6,
+        total_web as f64 / 1e6
+    );
+    Ok(())
 }
 
 /// The end of an exercise: its score printed (JSON with `json`), its report written, named

@@ -43,6 +43,18 @@ pub fn encode(kind: &Kind, header: &[u8], payload: &[u8]) -> Vec<u8> {
     bytes
 }
 
+/// Where the payload of a file's `bytes` starts (past the prefix and the header; the whole
+/// length if they are shorter): the values from there on are four-byte words.
+pub fn payload_start(bytes: &[u8]) -> usize {
+    let header_len = bytes
+        .get(12..20)
+        .map_or(0, |b| u64::from_le_bytes(b.try_into().expect("8 bytes")));
+    usize::try_from(header_len)
+        .ok()
+        .and_then(|h| h.checked_add(PREFIX_BYTES))
+        .map_or(bytes.len(), |start| start.min(bytes.len()))
+}
+
 /// Checks magic, version, length and checksum; returns the header and the payload bytes.
 pub fn checked_parts<'a>(
     kind: &Kind,

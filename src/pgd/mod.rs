@@ -20,6 +20,7 @@ mod statistics;
 mod stiffness;
 mod vademecum;
 mod validate;
+pub mod web_form;
 
 pub use build::{BuildReport, OrganModel, StepReport, WIDE_NEAR_FIELD_SHARE, add_cuts, build};
 pub use deformation::{Deformation, PatchLoad, PointLoad, RigidCarry};

@@ -125,3 +125,29 @@ fn a_cut_section_survives_the_round_trip() {
     assert!(matches!(err, VademecumError::Malformed { .. }), "{err}");
     assert!(err.to_string().contains("lying.vdm"), "{err}");
 }
+
+/// The web form expands to a vademecum of the same mesh and header whose felt force is within
+/// 0.2 % of the full file's at every triangle (each value is rounded by at most 2^-11 of
+/// itself); deflated, it is at most half the file.
+#[test]
+fn the_web_form_is_smaller_and_feels_the_same() {
+    use pgd_surgery::pgd::{decode, encode, web_form};
+    let model = block_model(block_mesh([6, 4, 3]));
+    let vademecum = build_block(&model, 6);
+    let path = std::path::Path::new("block.vdm.web");
+    let web = web_form::vademecum(&vademecum);
+    let back = decode(path, &web_form::expand(path, &web).unwrap()).unwrap();
+    assert_eq!(back.header, vademecum.header);
+    assert_eq!(back.position_coords_m, vademecum.position_coords_m);
+    back.check_mesh(path, model.mesh()).unwrap();
+    let changes = web_form::felt_force_changes(&vademecum, &back);
+    assert_eq!(changes.len(), vademecum.triangles.len());
+    let worst = changes.iter().copied().fold(0.0, f64::max);
+    assert!(worst > 0.0 && worst < 2e-3, "felt force changed by {worst}");
+    let full = encode(&vademecum).len();
+    assert!(
+        2 * web.len() <= full,
+        "web form {} bytes of {full}",
+        web.len()
+    );
+}

@@ -16,7 +16,7 @@ use super::scene::{Detail, mouse_device};
 use super::window::{self, Lesson, Lessons, MenuPlan, Opening, WindowScene};
 use super::{DEFAULT_SCENARIO, SHIPPED_SCENARIOS};
 use crate::devices::{HapticDevice, Scripted, Trajectory, VirtualHandle};
-use crate::pgd::container;
+use crate::pgd::{container, web_form};
 use crate::scenario::{self, Scenario};
 use crate::store::OnStale;
 
@@ -76,14 +76,25 @@ async fn fetched_scene(scenario: Scenario, detail: Detail) -> Result<HapticScene
         if container::is_provided(&file) {
             continue;
         }
-        let url = file.to_string_lossy();
-        page::status(&format!("{}: fetching {url}", scenario.title));
-        if let Some(bytes) = fetch::bytes(&url).await? {
+        page::status(&format!("{}: fetching {}", scenario.title, file.display()));
+        if let Some(bytes) = fetched_file(&file).await? {
             container::provide(&file, bytes.into());
         }
     }
     page::status(&format!("{}: building its scene", scenario.title));
     scenario_scene(&scenario, dir, detail, OnStale::Refuse)
+}
+
+/// The file at `file` on the site: its web form expanded, or the file itself where the site
+/// has no web form of it; `None` if it has neither.
+async fn fetched_file(file: &Path) -> Result<Option<Vec<u8>>, String> {
+    let url = file.to_string_lossy();
+    match fetch::bytes(&format!("{url}.{}", web_form::EXTENSION)).await? {
+        Some(web) => web_form::expand(file, &web)
+            .map(Some)
+            .map_err(|e| e.to_string()),
+        None => fetch::bytes(&url).await,
+    }
 }
 
 /// A scripted device replaying the trajectory CSV at `url`.
