@@ -27,8 +27,11 @@ echo "web-build: compiling the trainer for the browser"
 cargo build --release --target wasm32-unknown-unknown --bin trainer-web
 rm -rf "$dist"
 mkdir -p "$dist/vademecums" "$dist/tests"
-"$tools/bin/wasm-bindgen" --target web --no-typescript --out-dir "$dist" --out-name trainer \
+"$tools/bin/wasm-bindgen" --target web --no-typescript --remove-name-section \
+  --remove-producers-section --out-dir "$dist" --out-name trainer \
   "$CARGO_TARGET_DIR/wasm32-unknown-unknown/release/trainer-web.wasm"
+# Compressed twins, which scripts/web_serve.py (as any static host) sends to browsers.
+gzip -9 --keep --force "$dist/trainer_bg.wasm" "$dist/trainer.js"
 cp web/index.html "$dist/"
 # The scripted runs, for the browser test and for replaying an exercise in the page.
 cp -r tests/scenarios "$dist/tests/"
@@ -39,5 +42,5 @@ detail_flag=()
 cargo build --release --bin trainer
 "$CARGO_TARGET_DIR/release/trainer" prepare "${detail_flag[@]}" --web "$dist/vademecums" \
   scenarios/*.scenario.ron
-du -sh "$dist" "$dist/vademecums" "$dist/trainer_bg.wasm"
+du -sh "$dist/trainer_bg.wasm" "$dist/trainer_bg.wasm.gz" "$dist/vademecums"
 echo "web-build: done; serve it with scripts/web-serve.sh"

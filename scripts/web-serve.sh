@@ -1,7 +1,5 @@
 #!/usr/bin/env bash
 # Serves the page scripts/web-build.sh built (web/dist/) on http://localhost:${PORT:-8080}/.
 set -euo pipefail
-cd "$(dirname "$0")/../web/dist"
-port="${PORT:-8080}"
-echo "the trainer: http://localhost:$port/ (?scenario=STEM picks a shipped scenario)"
-exec python3 -m http.server "$port" --bind 127.0.0.1
+cd "$(dirname "$0")/.."
+exec python3 scripts/web_serve.py "${PORT:-8080}" web/dist

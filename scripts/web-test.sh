@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 scripts/web-build.sh
 (cd web && npm ci --no-audit --no-fund --loglevel=error)
 port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-python3 -m http.server "$port" --bind 127.0.0.1 --directory web/dist >/dev/null 2>&1 &
+python3 scripts/web_serve.py "$port" web/dist >/dev/null 2>&1 &
 server=$!
 trap 'kill $server' EXIT
 for _ in $(seq 50); do

@@ -79,7 +79,7 @@ pub fn revolution(
         let r = radius_m(t);
         points.extend((0..segments).map(|j| {
             let phi = 2.0 * PI * j as f64 / segments as f64;
-            centre + (u * phi.cos() + v * phi.sin()) * r
+            centre + (u * libm::cos(phi) + v * libm::sin(phi)) * r
         }));
     }
     points.push(end);
@@ -107,7 +107,7 @@ fn arc_length_stations(radius: &dyn Fn(f64) -> f64, length: f64, rings: usize) -
     let mut cumulative = vec![0.0; SAMPLES + 1];
     for k in 1..=SAMPLES {
         let (t0, t1) = ((k - 1) as f64 / SAMPLES as f64, k as f64 / SAMPLES as f64);
-        let step = ((t1 - t0) * length).hypot(radius(t1) - radius(t0));
+        let step = libm::hypot((t1 - t0) * length, radius(t1) - radius(t0));
         cumulative[k] = cumulative[k - 1] + step;
     }
     let total = cumulative[SAMPLES];
@@ -140,7 +140,7 @@ pub fn spherical_cap(curvature_m: f64, rim_m: f64, rings: usize) -> MidSurface {
         let r = rim_m * i as f64 / rings as f64;
         points.extend((0..6 * i).map(|j| {
             let phi = 2.0 * PI * j as f64 / (6 * i) as f64;
-            on_sphere(r * phi.cos(), r * phi.sin())
+            on_sphere(r * libm::cos(phi), r * libm::sin(phi))
         }));
     }
     // Vertex j of ring i (indices wrap around the ring); ring 0 is the apex.

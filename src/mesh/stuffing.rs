@@ -62,9 +62,9 @@ pub fn stuff_to_node_count(
     target: usize,
 ) -> Result<TetMesh, MeshError> {
     let extent = solid.max - solid.min;
-    let guess = (extent.x * extent.y * extent.z * 0.6 / target as f64).cbrt();
+    let guess = libm::cbrt(extent.x * extent.y * extent.z * 0.6 / target as f64);
     let first = stuff(name, solid, guess)?;
-    let spacing = guess * (first.node_count() as f64 / target as f64).cbrt();
+    let spacing = guess * libm::cbrt(first.node_count() as f64 / target as f64);
     stuff(name, solid, spacing)
 }
 

@@ -52,9 +52,10 @@ try {
     null,
     { timeout: timeoutMs, polling: 500 },
   );
-  const { scorecard, error } = await page.evaluate(() => ({
+  const { scorecard, error, frames } = await page.evaluate(() => ({
     scorecard: window.trainer.scorecard,
     error: window.trainer.error,
+    frames: window.trainer.frames,
   }));
   if (error !== undefined) throw new Error(`the page failed: ${error}`);
   const card = JSON.parse(scorecard);
@@ -63,6 +64,7 @@ try {
       `after ${((Date.now() - started) / 1000).toFixed(0)} s`,
   );
   if (!card.passed) problems.push(`the competent run did not pass: ${scorecard}`);
+  if (frames !== undefined) console.log(`frames: ${frames}`);
 
   const shot = await page.locator("#trainer").screenshot();
   if (screenshotPath) writeFileSync(screenshotPath, shot);

@@ -220,6 +220,12 @@ fn debrief_when_done(snapshot: Res<Snapshot>, mut next: ResMut<NextState<Stage>>
     }
 }
 
+/// What the debrief's keys do. A web page has no reports to write, and nothing to close.
+#[cfg(not(target_arch = "wasm32"))]
+const DEBRIEF_KEYS: &str = "Press R to try again, M for the menu of scenarios, or Esc to close; the reports are written then.";
+#[cfg(target_arch = "wasm32")]
+const DEBRIEF_KEYS: &str = "Press R to try again, or M for the menu of scenarios.";
+
 /// The scorecard the debrief shows, for the web page around the window.
 #[cfg(target_arch = "wasm32")]
 #[derive(Resource, Clone, Debug)]
@@ -238,11 +244,11 @@ pub(super) fn show_debrief(mut commands: Commands, lesson: Res<Lesson>) {
         }
         None => "The exercise has ended.".to_owned(),
     };
-    let text = format!(
-        "{text}\nPress R to try again, M for the menu of scenarios, or Esc to close; the reports \
-         are written then."
+    spawn_panel(
+        &mut commands,
+        Stage::Debrief,
+        format!("{text}\n{DEBRIEF_KEYS}"),
     );
-    spawn_panel(&mut commands, Stage::Debrief, text);
 }
 
 /// Another attempt at the same exercise: back to the briefing, scored from Space as before.
@@ -271,8 +277,9 @@ fn menu_on_m(
     }
 }
 
+/// Esc closes the window; a web page's trainer stays (the page is closed as any other).
 fn close_on_escape(keys: Res<ButtonInput<KeyCode>>, mut exit: MessageWriter<AppExit>) {
-    if keys.just_pressed(KeyCode::Escape) {
+    if !cfg!(target_arch = "wasm32") && keys.just_pressed(KeyCode::Escape) {
         exit.write(AppExit::Success);
     }
 }

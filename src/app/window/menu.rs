@@ -167,8 +167,14 @@ fn menu_text(menu: &Menu) -> String {
         Some(problem) => format!("\n\nThe last choice could not be loaded:\n{problem}"),
         None => String::new(),
     };
+    // A web page's trainer is not closed by a key.
+    let close = if cfg!(target_arch = "wasm32") {
+        ""
+    } else {
+        " (Esc closes the trainer)"
+    };
     format!(
-        "Choose a scenario: Up and Down, then Enter (Esc closes the trainer).\n\n{}{problem}",
+        "Choose a scenario: Up and Down, then Enter{close}.\n\n{}{problem}",
         lines.join("\n")
     )
 }

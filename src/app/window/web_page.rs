@@ -1,10 +1,12 @@
 //! What the window tells the web page around it: the stage the trainee is at and, on each
-//! debrief, the scorecard as JSON (`window.trainer.stage`, `window.trainer.scorecard`), for
-//! the page's scripts and the browser test, through [`publish`].
+//! debrief, the scorecard and the frame times so far as JSON (`window.trainer.stage`,
+//! `.scorecard`, `.frames`), for the page's scripts and the browser test, through
+//! [`publish`].
 
 use bevy::prelude::*;
 use wasm_bindgen::JsValue;
 
+use super::frames::FrameLog;
 use super::lesson::{Debriefed, Stage, show_debrief};
 
 pub(super) fn setup(app: &mut App) {
@@ -19,13 +21,19 @@ fn publish_stage(stage: Res<State<Stage>>) {
     publish("stage", &JsValue::from_str(&format!("{:?}", stage.get())));
 }
 
-fn publish_scorecard(card: Option<Res<Debriefed>>) {
-    let Some(card) = card else {
-        return;
-    };
-    match serde_json::to_string(&card.0) {
-        Ok(json) => publish("scorecard", &JsValue::from_str(&json)),
-        Err(e) => bevy::log::error!("the scorecard could not be written as JSON: {e}"),
+fn publish_scorecard(card: Option<Res<Debriefed>>, frames: Res<FrameLog>) {
+    if let Some(report) = frames.report() {
+        publish_json("frames", &report);
+    }
+    if let Some(card) = card {
+        publish_json("scorecard", &card.0);
+    }
+}
+
+fn publish_json(key: &str, value: &impl serde::Serialize) {
+    match serde_json::to_string(value) {
+        Ok(json) => publish(key, &JsValue::from_str(&json)),
+        Err(e) => bevy::log::error!("{key} could not be written as JSON: {e}"),
     }
 }
 

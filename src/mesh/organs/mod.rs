@@ -7,7 +7,9 @@
 //! thin-walled ones (gallbladder, cornea) are extruded shells. Organs are built in a fixed order
 //! and each later organ yields to the earlier ones — its shape minus theirs grown by a small gap —
 //! so neighbours touch along a shared interface without overlapping, and that interface is
-//! where attachments are tagged.
+//! where attachments are tagged. The same organ comes out bit for bit on every platform (its
+//! trigonometry and roots are `libm`'s, not the C library's): the web page regenerates it and
+//! must match the mesh hash of the vademecum built for it natively.
 
 mod abdomen;
 mod shapes;

@@ -50,11 +50,11 @@ impl ArcTube {
     /// Angle of `p` about the arc's centre, in (−π, π].
     pub fn angle(&self, p: &Point3<f64>) -> f64 {
         let q = p - self.centre;
-        q.dot(&self.w).atan2(q.dot(&self.u))
+        libm::atan2(q.dot(&self.w), q.dot(&self.u))
     }
 
     pub fn point_at(&self, angle: f64) -> Point3<f64> {
-        self.centre + (self.u * angle.cos() + self.w * angle.sin()) * self.arc_radius
+        self.centre + (self.u * libm::cos(angle) + self.w * libm::sin(angle)) * self.arc_radius
     }
 
     pub fn value(&self, p: &Point3<f64>) -> f64 {
