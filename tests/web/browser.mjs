@@ -1,7 +1,8 @@
 // The trainer's web page in headless Chromium: it loads, runs a shipped scenario from a
-// scripted trajectory (the page's `script` parameter), and scores it. Fails on any console
-// error or uncaught exception, on a scorecard that does not pass, and on a canvas that shows
-// a single colour.
+// scripted trajectory (the page's `script` parameter), and scores it; then M opens the menu
+// and the next scenario loads to its briefing. Fails on any console error or uncaught
+// exception, on a scorecard that does not pass, on a canvas that shows nearly one colour, and
+// on a menu that does not load the scenario chosen.
 //   node tests/web/browser.mjs http://127.0.0.1:8080/ [SCREENSHOT.png]
 import { writeFileSync } from "node:fs";
 import { createRequire } from "node:module";
@@ -86,6 +87,18 @@ try {
   }, shot.toString("base64"));
   console.log(`the canvas shows ${colours} colours`);
   if (colours < 50) problems.push(`the canvas is nearly one colour (${colours} colours)`);
+
+  const stage = () => page.evaluate(() => window.trainer.stage);
+  const until = (wanted) =>
+    page.waitForFunction((s) => window.trainer.stage === s, wanted, { timeout: timeoutMs });
+  await page.focus("#trainer");
+  await page.keyboard.press("KeyM");
+  await until("Menu");
+  await page.keyboard.press("ArrowDown");
+  await page.keyboard.press("Enter");
+  await page.waitForFunction(() => window.trainer.stage !== "Menu", null, { timeout: timeoutMs });
+  await until("Briefing");
+  console.log(`the menu loaded the next scenario: ${await stage()}`);
 } catch (e) {
   problems.push(String(e));
 } finally {
