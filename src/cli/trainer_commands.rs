@@ -48,11 +48,7 @@ pub fn validate_scenarios(files: &[PathBuf]) -> ExitCode {
             }
         }
     }
-    if failed {
-        ExitCode::FAILURE
-    } else {
-        ExitCode::SUCCESS
-    }
+    verdict(failed)
 }
 
 /// `trainer prepare`: the vademecums and distance fields the scenario files need, built under
@@ -93,6 +89,10 @@ pub fn prepare_scenarios(
         eprintln!("{e}");
         failed = true;
     }
+    verdict(failed)
+}
+
+fn verdict(failed: bool) -> ExitCode {
     if failed {
         ExitCode::FAILURE
     } else {
