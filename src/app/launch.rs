@@ -220,10 +220,7 @@ pub fn open_window(
         HapticThread::spawn(haptic, timer, Scheduling::RealTime).map_err(|e| e.to_string())?;
     let menu = lesson.is_some().then(|| MenuPlan {
         folder,
-        built_in: super::SHIPPED_SCENARIOS
-            .iter()
-            .map(|&(file, text)| (PathBuf::from(file), text))
-            .collect(),
+        built_in: super::SHIPPED_SCENARIOS,
         scenes: scene_source(options),
         swap: haptic.swap(),
     });

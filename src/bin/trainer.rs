@@ -118,8 +118,7 @@ enum Command {
         files: Vec<PathBuf>,
     },
     /// Build the vademecums (and distance fields) the scenario files need, where missing or
-    /// stale, and list their files: for a class, or for the web page's site
-    /// (`scripts/web-build.sh` copies them).
+    /// stale, and list their files: for a class, or (with --web) for the web page's site.
     Prepare {
         #[arg(required = true)]
         files: Vec<PathBuf>,

@@ -105,6 +105,7 @@ fn verdict(failed: bool) -> ExitCode {
 fn write_web_forms(files: &[PathBuf], dir: &Path) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     println!("web form                                     file MB  web MB  felt force p95   max");
+    let mb = |n: usize| n as f64 / 1e6;
     let (mut total, mut total_web) = (0, 0);
     for file in files {
         let bytes = std::fs::read(file).map_err(|e| format!("{}: {e}", file.display()))?;
@@ -125,7 +126,6 @@ fn write_web_forms(files: &[PathBuf], dir: &Path) -> Result<(), String> {
         );
         let out = dir.join(&name);
         std::fs::write(&out, &web).map_err(|e| format!("{}: {e}", out.display()))?;
-        let mb = |n: usize| n as f64 / 1e6;
         let force = match changes.is_empty() {
             true => "(kept exactly)".to_owned(),
             false => {
@@ -140,12 +140,7 @@ fn write_web_forms(files: &[PathBuf], dir: &Path) -> Result<(), String> {
         );
         (total, total_web) = (total + bytes.len(), total_web + web.len());
     }
-    println!(
-        "{:<44} {:>7.2} {:>7.2}",
-        "all",
-        total as f64 / 1e6,
-        total_web as f64 / 1e6
-    );
+    println!("{:<44} {:>7.2} {:>7.2}", "all", mb(total), mb(total_web));
     Ok(())
 }
 

@@ -73,15 +73,6 @@ impl FramePaced {
             skipped: self.skipped,
         });
     }
-
-    /// Ticks run and ticks skipped so far.
-    pub fn counts(&self) -> (u64, u64) {
-        (self.ticks, self.skipped)
-    }
-
-    pub fn haptic_mut(&mut self) -> &mut HapticLoop {
-        &mut self.haptic
-    }
 }
 
 #[cfg(test)]
@@ -113,7 +104,7 @@ mod tests {
             ran.push(paced.advance(Duration::from_secs_f64(frame as f64 / 60.0)));
         }
         assert_eq!(ran, [16, 17, 17, 16, 17, 17]);
-        assert_eq!(paced.counts(), (100, 0));
+        assert_eq!((paced.ticks, paced.skipped), (100, 0));
         assert_eq!(clock(&paced).tick, 99);
         assert!((clock(&paced).time_s - 0.099).abs() < 1e-12);
     }
@@ -124,7 +115,7 @@ mod tests {
     fn a_late_frame_runs_a_bounded_burst_and_drops_the_rest() {
         let mut paced = paced();
         assert_eq!(paced.advance(Duration::from_millis(1500)), MAX_BURST);
-        assert_eq!(paced.counts(), (MAX_BURST, 1500 - MAX_BURST));
+        assert_eq!((paced.ticks, paced.skipped), (MAX_BURST, 1500 - MAX_BURST));
         assert_eq!(paced.advance(Duration::from_millis(1510)), 10);
         assert_eq!(clock(&paced).tick, MAX_BURST + 9);
         assert!((clock(&paced).time_s - (MAX_BURST + 9) as f64 * TICK_S).abs() < 1e-12);

@@ -21,7 +21,7 @@ use bevy::prelude::*;
 
 pub use components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
 pub use cutting::{OrganCut, SettleCuts};
-pub use frame_paced::{FramePaced, MAX_BURST};
+pub use frame_paced::FramePaced;
 pub use report::{ForceSummary, HeadlessReport, RangeSummary, TickTimes};
 pub use resources::{
     Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, SceneScope, Scope,

@@ -128,10 +128,7 @@ fn window_scene(
     let swap = SceneSwap::default();
     let menu = MenuPlan {
         folder: None,
-        built_in: SHIPPED_SCENARIOS
-            .iter()
-            .map(|&(file, text)| (PathBuf::from(file), text))
-            .collect(),
+        built_in: SHIPPED_SCENARIOS,
         scenes: Arc::new(move |scenario: &Scenario| {
             Box::pin(fetched_scene(scenario.clone(), detail))
         }),

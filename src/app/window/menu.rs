@@ -27,9 +27,10 @@ pub type SceneSource =
 pub struct MenuPlan {
     /// The folder whose scenarios are offered (none: the built-in ones only).
     pub folder: Option<PathBuf>,
-    /// The scenarios built into the program (file names and texts), offered where the folder
-    /// lacks them.
-    pub built_in: Vec<(PathBuf, &'static str)>,
+    /// The scenarios built into the program (file names and texts, as
+    /// [`SHIPPED_SCENARIOS`](crate::app::SHIPPED_SCENARIOS)), offered where the folder lacks
+    /// them.
+    pub built_in: &'static [(&'static str, &'static str)],
     pub scenes: SceneSource,
     /// Where the haptic thread takes the chosen scenario's world.
     pub swap: SceneSwap,
@@ -113,11 +114,11 @@ fn entries(plan: &MenuPlan) -> Vec<Entry> {
         .filter(|(file, _)| {
             !entries
                 .iter()
-                .any(|e| e.file.file_name() == file.file_name())
+                .any(|e| e.file.file_name() == Path::new(file).file_name())
         })
-        .map(|(file, text)| Entry {
-            scenario: scenario::parse(file, text).map_err(|e| e.to_string()),
-            file: file.clone(),
+        .map(|&(file, text)| Entry {
+            scenario: scenario::parse(Path::new(file), text).map_err(|e| e.to_string()),
+            file: PathBuf::from(file),
         })
         .collect();
     entries.splice(0..0, missing);
@@ -352,7 +353,7 @@ mod tests {
         let swap = SceneSwap::default();
         let plan = MenuPlan {
             folder: Some(folder.clone()),
-            built_in: vec![(PathBuf::from("scenarios/built-in.scenario.ron"), "unused")],
+            built_in: &[("scenarios/built-in.scenario.ron", "unused")],
             scenes: Arc::new(move |_: &Scenario| {
                 counter.fetch_add(1, Ordering::SeqCst);
                 Box::pin(std::future::ready(Ok(scene_without_organs())))

@@ -38,7 +38,7 @@ fn publish_json(key: &str, value: &impl serde::Serialize) {
 }
 
 /// Sets `window.trainer[key]` (creating `window.trainer`): what a script driving the page
-/// reads (`stage`, `scorecard` as JSON, `error`).
+/// reads (`stage`; `scorecard` and `frames` as JSON; `error`).
 pub fn publish(key: &str, value: &JsValue) {
     let Some(window) = web_sys::window() else {
         return;
