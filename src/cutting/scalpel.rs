@@ -152,6 +152,12 @@ impl Scalpel {
         }
     }
 
+    /// The blade on uncut tissue again: no stroke made, none under way.
+    pub fn heal(&mut self) {
+        self.sweep = None;
+        self.strokes.clear();
+    }
+
     /// The force (N) into the tissue at which it parts.
     pub fn threshold_n(&self) -> f64 {
         self.threshold_n

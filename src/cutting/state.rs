@@ -105,6 +105,13 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         self
     }
 
+    /// The organ uncut again, its front placed as before: every incision undone, the uncut
+    /// response (its factorization) kept.
+    pub fn heal(self) -> Self {
+        let front = self.front;
+        Self::new(self.model, self.response).with_front(front)
+    }
+
     /// Sets a new blade on the surface (see [`Incision::start`]); returns its index.
     pub fn start(&mut self, at: Point3<f64>, blade: Vector3<f64>, depth_m: f64) -> usize {
         self.cuts.push(Cut {

@@ -22,13 +22,15 @@ use crate::fem::FemModel;
 /// be freed here rather than on the haptic thread (a view holds megabytes).
 enum Job {
     Step(CutStep),
+    /// Undo every incision (a new attempt at the exercise starts on uncut tissue).
+    Heal,
     Retire(Arc<CutView>),
 }
 
 /// What the worker answers each step with.
 enum Outcome {
-    /// The cut grew: the state as it now stands.
-    Grew(Arc<CutView>),
+    /// The cut grew, or was healed: the state as it now stands.
+    Changed(Arc<CutView>),
     /// Nothing to publish (an incision set on the surface has cut nothing yet).
     Unchanged,
     /// The cut state refused the step and stands as it was.
@@ -70,7 +72,7 @@ pub struct CutWorker {
     answered: u64,
     view: Arc<CutView>,
     refused: Vec<CutError>,
-    /// How long each step took the worker (s), in order: written by the worker, so that the
+    /// How long each job (a step, or a heal) took the worker (s), in order: written by the worker, so that the
     /// haptic side never grows it.
     step_seconds: Arc<Mutex<Vec<f64>>>,
 }
@@ -120,6 +122,14 @@ impl CutWorker {
     /// Hands the worker a step; never waits.
     pub fn submit(&mut self, step: CutStep) {
         if self.jobs.send(Job::Step(step)).is_ok() {
+            self.submitted += 1;
+        }
+    }
+
+    /// Has the worker undo every incision, after the steps already handed over; never waits.
+    /// The view that follows is of the uncut organ.
+    pub fn heal(&mut self) {
+        if self.jobs.send(Job::Heal).is_ok() {
             self.submitted += 1;
         }
     }
@@ -176,7 +186,7 @@ impl CutWorker {
     fn take(&mut self, outcome: Outcome) {
         self.answered += 1;
         match outcome {
-            Outcome::Grew(view) => {
+            Outcome::Changed(view) => {
                 let old = std::mem::replace(&mut self.view, view);
                 // Dropped by the worker if it is still there; here only if it has gone.
                 let _ = self.jobs.send(Job::Retire(old));
@@ -208,14 +218,24 @@ fn serve(model: &FemModel, response: ExactResponse, jobs: Receiver<Job>, replies
     let mut state = CutState::new(model, response).with_front(Front::Nearest);
     let mut incision = None;
     for job in jobs {
+        let started = Instant::now();
         let step = match job {
             Job::Step(step) => step,
+            Job::Heal => {
+                state = state.heal();
+                incision = None;
+                let view = Arc::new(state.view());
+                replies.latest.set(view.clone());
+                if !replies.answer(Outcome::Changed(view), started) {
+                    return;
+                }
+                continue;
+            }
             Job::Retire(view) => {
                 drop(view);
                 continue;
             }
         };
-        let started = Instant::now();
         let applied = match (step, incision) {
             (CutStep::Start { at, blade, depth_m }, _) => {
                 incision = Some(state.start(at, blade, depth_m));
@@ -229,16 +249,23 @@ fn serve(model: &FemModel, response: ExactResponse, jobs: Receiver<Job>, replies
             Ok(true) => {
                 let view = Arc::new(state.view());
                 replies.latest.set(view.clone());
-                Outcome::Grew(view)
+                Outcome::Changed(view)
             }
             Ok(false) => Outcome::Unchanged,
             Err(error) => Outcome::Refused(error),
         };
-        if let Ok(mut timings) = replies.timings.lock() {
-            timings.push(started.elapsed().as_secs_f64());
-        }
-        if replies.answers.send(outcome).is_err() {
+        if !replies.answer(outcome, started) {
             return;
         }
+    }
+}
+
+impl Replies<'_> {
+    /// Records the job's time and answers it; false once the haptic side has gone.
+    fn answer(&self, outcome: Outcome, started: Instant) -> bool {
+        if let Ok(mut timings) = self.timings.lock() {
+            timings.push(started.elapsed().as_secs_f64());
+        }
+        self.answers.send(outcome).is_ok()
     }
 }

@@ -9,6 +9,7 @@ use nalgebra::{Point3, Unit, Vector3};
 
 use super::components::{OrganBody, OrganDeformation, ToolTouch};
 use super::resources::Tool;
+use super::scoring::ExerciseRun;
 use crate::contact::ToolContact;
 use crate::cutting::{BladeContact, CutView, CutWorker, Scalpel};
 
@@ -22,6 +23,8 @@ pub struct OrganCut {
     /// Scratch space kept from tick to tick: the patch's nodes and shares, and `Y`'s rows.
     nodes: Vec<(usize, f64)>,
     y: [Vec<f64>; 3],
+    /// The exercise's attempt the tissue was cut in (0 before the first).
+    attempt: u32,
 }
 
 impl OrganCut {
@@ -31,6 +34,7 @@ impl OrganCut {
             worker,
             nodes: Vec::new(),
             y: Default::default(),
+            attempt: 0,
         }
     }
 }
@@ -38,6 +42,24 @@ impl OrganCut {
 /// The loop runs on a simulated clock: each cut step is waited for.
 #[derive(Resource, Clone, Copy, Debug, Default)]
 pub struct SettleCuts;
+
+/// A new attempt at the exercise starts on uncut tissue: once the run has taken its next
+/// attempt, each cut organ's worker undoes its incisions and its scalpel forgets its strokes.
+pub fn heal_on_retry(run: Option<Res<ExerciseRun>>, mut organs: Query<&mut OrganCut>) {
+    let Some(attempts) = run.map(|r| r.attempts()) else {
+        return;
+    };
+    for mut cut in &mut organs {
+        if cut.attempt == attempts {
+            continue;
+        }
+        if cut.attempt > 0 {
+            cut.scalpel.heal();
+            cut.worker.heal();
+        }
+        cut.attempt = attempts;
+    }
+}
 
 /// Reads each cut organ's latest cut, softens the tool's press for it, and hands the blade's
 /// step, if any, to the organ's cut state.
@@ -57,6 +79,7 @@ pub fn cut(
             worker,
             nodes,
             y,
+            ..
         } = &mut *cut;
         let view = match settle {
             Some(_) => worker.settle(),

@@ -120,6 +120,8 @@ pub struct ExerciseRun {
     /// The attempt taken last has ended and been handed over.
     ended: bool,
     tasks: usize,
+    /// Attempts taken so far (the one under way counted).
+    attempts: u32,
 }
 
 impl ExerciseRun {
@@ -130,7 +132,13 @@ impl ExerciseRun {
             link,
             ended: false,
             tasks: 0,
+            attempts: 0,
         }
+    }
+
+    /// Attempts taken so far, the one under way counted: a retry makes it two.
+    pub fn attempts(&self) -> u32 {
+        self.attempts
     }
 
     /// Takes the offered exercise, if there is one (none is offered between an attempt's end
@@ -140,6 +148,7 @@ impl ExerciseRun {
         if let Some(exercise) = &self.exercise {
             self.tasks = exercise.progress().tasks;
             self.ended = false;
+            self.attempts += 1;
         }
     }
 
@@ -345,5 +354,93 @@ mod tests {
         assert!(progress(&world).is_some_and(|p| p.finished()));
         assert_eq!(link.take_earlier().len(), 1);
         assert!(link.take_ended().is_some());
+    }
+
+    /// The steps of a stroke 6 mm deep along 16 mm of a 1 cm thick block's top.
+    fn stroke() -> [crate::cutting::CutStep; 2] {
+        use crate::cutting::CutStep;
+        use nalgebra::{Point3, Vector3};
+        let top = |x_mm: f64| Point3::new(x_mm, 20.0, 10.0) * 1e-3;
+        [
+            CutStep::Start {
+                at: top(12.0),
+                blade: -Vector3::z(),
+                depth_m: 6e-3,
+            },
+            CutStep::Advance { to: top(28.0) },
+        ]
+    }
+
+    /// A block of liver tissue 4 × 4 × 1 cm clamped underneath, cut by [`stroke`] on its
+    /// worker: settled, the cut has enriched unknowns.
+    fn cut_block() -> OrganCut {
+        use crate::cutting::{Blade, CutWorker, LIVER_TOUGHNESS_J_PER_M2, Scalpel};
+        use crate::fem::{Dirichlet, FemModel, Law, Material};
+        let mesh = crate::mesh::box_mesh([0.04, 0.04, 0.01], [8, 8, 2]).unwrap();
+        let mut dirichlet = Dirichlet::new(mesh.node_count());
+        dirichlet.clamp(mesh.node_set("z0").unwrap()).unwrap();
+        let model = FemModel::new(mesh, Material::liver(Law::Linear), dirichlet).unwrap();
+        let mut worker = CutWorker::spawn(Arc::new(model), "block", Default::default()).unwrap();
+        stroke().into_iter().for_each(|step| worker.submit(step));
+        assert!(worker.settle().unknowns > 0, "the stroke cut nothing");
+        OrganCut::new(
+            Scalpel::new(Blade::default(), LIVER_TOUGHNESS_J_PER_M2),
+            worker,
+        )
+    }
+
+    /// The first attempt keeps the tissue as it is; once a retry is started, the cut organs
+    /// are whole again (no enriched unknown left) and cut as before by the same stroke.
+    #[test]
+    fn a_retry_heals_the_cut_organs() {
+        let link = Arc::new(ExerciseLink::default());
+        let mut world = world(&link);
+        let organ = world.spawn(cut_block()).id();
+        let tick = |world: &mut World, from: u64, ticks: u64| {
+            for t in from..from + ticks {
+                world.resource_mut::<TickClock>().time_s = t as f64 * 1e-3;
+                world.run_system_once(score_tick).unwrap();
+                world
+                    .run_system_once(super::super::cutting::heal_on_retry)
+                    .unwrap();
+            }
+        };
+        let unknowns = |world: &mut World| {
+            let mut cut = world.get_mut::<OrganCut>(organ).unwrap();
+            cut.worker.settle().unknowns
+        };
+        let cut_before = unknowns(&mut world);
+        link.offer(exercise());
+        link.start();
+        tick(&mut world, 0, 15);
+        assert_eq!(world.resource::<ExerciseRun>().attempts(), 1);
+        assert_eq!(
+            unknowns(&mut world),
+            cut_before,
+            "healed on the first attempt"
+        );
+
+        assert!(link.retry(exercise()));
+        link.start();
+        tick(&mut world, 15, 2);
+        assert_eq!(world.resource::<ExerciseRun>().attempts(), 2);
+        assert_eq!(unknowns(&mut world), 0, "the retry starts on cut tissue");
+        assert!(
+            world
+                .get::<OrganCut>(organ)
+                .unwrap()
+                .scalpel
+                .strokes()
+                .is_empty()
+        );
+        let mut cut = world.get_mut::<OrganCut>(organ).unwrap();
+        stroke()
+            .into_iter()
+            .for_each(|step| cut.worker.submit(step));
+        assert_eq!(
+            unknowns(&mut world),
+            cut_before,
+            "the same stroke cuts otherwise"
+        );
     }
 }

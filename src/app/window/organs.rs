@@ -171,10 +171,16 @@ fn deform(
             motion.add_to_surface(&view.vademecum.positions, &organ.motion, &mut positions);
         }
         let tool = &organ.deformation.loads[OrganDeformation::TOOL];
-        if let Some(rebuilt) = refresh_split(view, &link)
-            && let Some(mut mesh) = meshes.get_mut(&mesh.0)
-        {
-            *mesh = rebuilt;
+        if let Some(rebuilt) = refresh_split(view, &link) {
+            if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
+                *mesh = rebuilt;
+            }
+            let drawn = walls.iter().find(|(cut, _)| cut.index == view.index);
+            if view.split.is_none()
+                && let Some(mut walls) = drawn.and_then(|(_, m)| meshes.get_mut(&m.0))
+            {
+                *walls = walls_mesh(Vec::new(), Vec::new());
+            }
         }
         if let Some(split) = &view.split {
             split.displace(&view.vademecum, tool, &mut positions);
@@ -197,12 +203,20 @@ fn deform(
     }
 }
 
-/// Splits the organ's surface anew when the scalpel's cut has grown: the render mesh with
-/// the copies, to replace the organ's (`None` while the split stands or nothing is cut).
+/// Splits the organ's surface anew when the scalpel's cut has grown, or makes it whole again
+/// when the cut is healed (a new attempt): the render mesh to replace the organ's (`None`
+/// while the split, or the whole surface, stands).
 fn refresh_split(view: &mut OrganView, link: &HapticLink) -> Option<Mesh> {
     let cutting = link.scene.cutting.as_ref()?;
     let cut = cutting.organ(view.index)?.drawn.get();
-    if cut.unknowns == 0 || view.split.as_ref().is_some_and(|s| s.is_of(&cut)) {
+    if cut.unknowns == 0 {
+        view.split.take()?;
+        return Some(surface_mesh(
+            &view.triangles,
+            &view.vademecum.position_coords_m,
+        ));
+    }
+    if view.split.as_ref().is_some_and(|s| s.is_of(&cut)) {
         return None;
     }
     let split = SplitSurface::new(cut, &view.vademecum, &view.triangles);
