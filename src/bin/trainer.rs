@@ -63,6 +63,10 @@ struct Cli {
     /// Frames to draw before the screenshot.
     #[arg(long, global = true, default_value_t = 30)]
     frames: u32,
+    /// Nor take the screenshot before the haptic loop has run this many seconds (a scripted
+    /// device's trajectory played that far, however fast the frames come).
+    #[arg(long, global = true, default_value_t = 0.0)]
+    screenshot_after_s: f64,
     /// Where the organs' vademecums are kept.
     #[arg(long, global = true, default_value = "vademecums")]
     vademecums: PathBuf,
@@ -266,6 +270,7 @@ fn main() -> ExitCode {
     let screenshot = cli.screenshot.clone().map(|path| ScreenshotPlan {
         path,
         after_frames: cli.frames.max(1),
+        after_haptic_s: cli.screenshot_after_s,
     });
     // `trainer run FILE` opens FILE's briefing, its menu offering FILE's folder; the plain
     // trainer opens the menu of `scenarios/`, the built-in scenario chosen.

@@ -4,11 +4,12 @@
 //! against the legends the trainer writes beside them: each organ's tissue colour shows where
 //! its surface is in sight, and the pressed frame differs from the rest frame around the tool
 //! and nowhere far from it. The window itself, under Xvfb, is not blank. A missing display is
-//! reported plainly, without a panic. The laparoscopic view and the keratotomy's view of the
-//! cornea are checked on their own shipped scenarios, and every shipped scenario's start shows
-//! its organs.
+//! reported plainly, without a panic. The laparoscopic view, the keratotomy's view of the
+//! cornea and an open incision are checked on their own shipped scenarios, and every shipped
+//! scenario's start shows its organs.
 
 mod cornea;
+mod incision;
 mod laparoscope;
 mod scenarios;
 mod xvfb;
@@ -132,17 +133,29 @@ fn shot_of(name: &str, rows: Vec<TrajectoryRow>, args: &[&str], surface: Surface
 /// first) with a scripted device held along `rows`, its attempts kept in a history of their
 /// own, and reads back its screenshot.
 fn scenario_shot(name: &str, file: &Path, frames: u32, rows: Vec<TrajectoryRow>) -> Shot {
+    scenario_shot_after(name, file, (frames, 0.0), rows)
+}
+
+/// [`scenario_shot`] taken no sooner than `after_s` seconds into the scripted trajectory.
+fn scenario_shot_after(
+    name: &str,
+    file: &Path,
+    (frames, after_s): (u32, f64),
+    rows: Vec<TrajectoryRow>,
+) -> Shot {
     let scenario = load(file).unwrap();
     scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap();
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("window");
     std::fs::create_dir_all(&dir).unwrap();
     let history = dir.join(format!("{name}-history.sqlite"));
-    let frames = frames.to_string();
+    let (frames, after_s) = (frames.to_string(), after_s.to_string());
     let args = [
         "run",
         file.to_str().unwrap(),
         "--frames",
         &frames,
+        "--screenshot-after-s",
+        &after_s,
         "--history",
         history.to_str().unwrap(),
     ];

@@ -73,6 +73,15 @@ impl SplitSurface {
         Arc::ptr_eq(&self.view, view)
     }
 
+    /// Each split vertex with its copy (vertex numbers of the split surface, whose first
+    /// `vertices` are the surface's own).
+    pub(super) fn lips(&self, vertices: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.copies
+            .iter()
+            .enumerate()
+            .map(move |(k, &(v, _))| (v, vertices + k))
+    }
+
     /// The copies' rest positions, after the vertices' own (`rest`).
     pub(super) fn with_copies(&self, rest: &[[f32; 3]]) -> Vec<[f32; 3]> {
         let copies = self.copies.iter().map(|&(v, _)| rest[v]);

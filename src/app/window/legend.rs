@@ -10,6 +10,18 @@ use serde::{Deserialize, Serialize};
 pub struct Legend {
     pub organs: Vec<OrganLegend>,
     pub tool: Option<ToolLegend>,
+    /// Each vertex split by a cut and its copy across the cut, where they are drawn: the two
+    /// lips of an incision (none uncut).
+    #[serde(default)]
+    pub lips: Vec<LipLegend>,
+}
+
+/// One split vertex of a cut organ's surface: its own lip and the copy on the other.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct LipLegend {
+    pub organ: String,
+    pub own_px: [f32; 2],
+    pub across_px: [f32; 2],
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -108,7 +120,11 @@ pub fn legend(
             radius_px: centre_px.distance(rim_px),
         })
     });
-    Legend { organs, tool }
+    Legend {
+        organs,
+        tool,
+        lips: Vec::new(),
+    }
 }
 
 /// Distance along a unit ray to its first hit on a sphere, if any ahead.

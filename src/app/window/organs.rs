@@ -33,6 +33,15 @@ pub(super) struct OrganView {
 }
 
 impl OrganView {
+    /// Each vertex split by the cut with its copy across it, as drawn-mesh vertex numbers
+    /// (none uncut).
+    pub(super) fn lips(&self) -> Vec<(usize, usize)> {
+        let vertices = self.vademecum.positions.len();
+        self.split
+            .as_ref()
+            .map_or_else(Vec::new, |s| s.lips(vertices).collect())
+    }
+
     /// The triangles drawn: the surface's, split along the cut once it is cut.
     pub(super) fn drawn_triangles(&self) -> &[[usize; 3]] {
         self.split

@@ -15,8 +15,9 @@ use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy::render::{ExtractSchedule, MainWorld, RenderApp};
 use bevy::window::PrimaryWindow;
 
+use super::bridge::Snapshot;
 use super::laparoscope::CameraMode;
-use super::legend::{Aperture, DrawnSurface, Legend, legend};
+use super::legend::{Aperture, DrawnSurface, Legend, LipLegend, legend};
 use super::offscreen::Offscreen;
 use super::organs::OrganView;
 use super::tool::ToolTip;
@@ -27,6 +28,9 @@ use super::{FrameSet, HapticLink};
 pub struct ScreenshotPlan {
     pub path: PathBuf,
     pub after_frames: u32,
+    /// Nor before the haptic loop's clock has reached this (s): a scripted device's
+    /// trajectory run that far, however fast the frames come.
+    pub after_haptic_s: f64,
 }
 
 impl ScreenshotPlan {
@@ -120,13 +124,16 @@ const MAX_RETRIES: u32 = 30;
 
 fn take_screenshot(
     mut commands: Commands,
-    plan: Res<ScreenshotPlan>,
+    (plan, snapshot): (Res<ScreenshotPlan>, Res<Snapshot>),
     mut progress: ResMut<Progress>,
     frame: Frame,
     clear: Res<ClearColor>,
     ready: Res<PipelinesReady>,
     mut exit: MessageWriter<AppExit>,
 ) {
+    if snapshot.0.time_s < plan.after_haptic_s {
+        return;
+    }
     progress.frames += 1;
     let due = plan.after_frames + progress.retries * RETRY_FRAMES;
     let compiled = ready.0 >= READY_FRAMES || progress.frames >= due + MAX_COMPILE_FRAMES;
@@ -265,7 +272,43 @@ fn frame_legend(frame: &Frame) -> Result<Legend, String> {
                 frame.link.scene.probe.tip_radius_m as f32,
             )
         });
-    Ok(legend(camera, scale_factor, &surfaces, tool, aperture))
+    let mut legend = legend(camera, scale_factor, &surfaces, tool, aperture);
+    legend.lips = lips(frame, camera, scale_factor);
+    Ok(legend)
+}
+
+/// Where each split vertex of a cut organ and its copy across the cut are drawn.
+fn lips(frame: &Frame, camera: (&Camera, &GlobalTransform), scale_factor: f32) -> Vec<LipLegend> {
+    let project = |p: [f32; 3]| {
+        let px = camera
+            .0
+            .world_to_viewport(camera.1, Vec3::from_array(p))
+            .ok()?;
+        Some((px * scale_factor).to_array())
+    };
+    let mut lips = Vec::new();
+    for (name, view, mesh) in &frame.organs {
+        let Some(VertexAttributeValues::Float32x3(positions)) = frame
+            .meshes
+            .get(&mesh.0)
+            .and_then(|m| m.attribute(Mesh::ATTRIBUTE_POSITION))
+        else {
+            continue;
+        };
+        for (own, across) in view.lips() {
+            let (Some(&a), Some(&b)) = (positions.get(own), positions.get(across)) else {
+                continue;
+            };
+            if let (Some(own_px), Some(across_px)) = (project(a), project(b)) {
+                lips.push(LipLegend {
+                    organ: name.to_string(),
+                    own_px,
+                    across_px,
+                });
+            }
+        }
+    }
+    lips
 }
 
 fn write_legend(path: &Path, legend: &Legend) -> Result<(), String> {
@@ -286,6 +329,7 @@ mod tests {
                 visible_px: vec![[1.0, 0.0], [2.0, 0.0]],
             }],
             tool: None,
+            lips: Vec::new(),
         }
     }
 
