@@ -9,19 +9,16 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use super::haptic::{
-    HapticLoop, HapticScene, HapticThread, OrganDeformation, RealTimeReport, Scheduling, TickTimes,
-};
+use super::haptic::{HapticLoop, HapticScene, HapticThread, RealTimeReport, Scheduling, TickTimes};
 use super::scene::press_targets;
 use crate::bench::fem::median_ms;
-use crate::contact::ContactSurface;
 use crate::devices::{
     HapticDevice, PressMotion, PressTarget, Scripted, TICK_S, TimerMode, press_and_slide,
 };
 use crate::fem::{FemError, Law, Loads, NewtonSettings};
+use crate::mesh::Surface;
 use crate::mesh::organs::{self, Organ, OrganSettings};
-use crate::mesh::{Surface, vertex_normals};
-use crate::pgd::{self, Deformation, PatchLoad};
+use crate::pgd::{self, SurfaceModes};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct SweepFigures {
@@ -162,47 +159,22 @@ fn fem_contact(
     })
 }
 
-/// What the window does on the CPU per frame, timed: each organ deformed by a 0.2 N press at
-/// its target, its surface formed and its normals recomputed.
+/// What the window does on the CPU per frame, timed: each organ pressed by 0.2 N at its
+/// press target, its surface vertices formed and their normals ([`crate::bench::frame`]).
 fn render_cpu(scene: &HapticScene, targets: &[PressTarget], repeats: usize) -> f64 {
-    let mut organs: Vec<_> = scene
+    let organs: Vec<_> = scene
         .organs
         .iter()
         .zip(targets)
-        .map(|((_, vademecum), target)| {
-            let surface = ContactSurface::new(vademecum).expect("scene was built");
-            let mut deformation = Deformation::new(vademecum, 1);
-            if let Some(hit) = surface.closest(&target.point_m) {
-                deformation.loads[OrganDeformation::TOOL] = PatchLoad {
-                    shares: vademecum.patch(&hit.at).shares,
-                    force_n: -target.normal * 0.2,
-                };
-            }
-            deformation.evaluate(vademecum);
-            let triangles: Vec<[usize; 3]> = vademecum
-                .triangles
-                .iter()
-                .map(|t| t.map(|m| m as usize))
-                .collect();
-            (
-                vademecum,
-                deformation,
-                triangles,
-                vec![0.0; vademecum.dof_count()],
-            )
-        })
+        .map(|((name, v), t)| (name.clone(), v.as_ref(), t.point_m, t.normal))
         .collect();
-    let mut positions = Vec::new();
-    median_ms(repeats.max(1) * 4, &mut || {
-        for (vademecum, deformation, triangles, field) in &mut organs {
-            deformation.deformed_surface(vademecum, field, &mut positions);
-            std::hint::black_box(vertex_normals(triangles, &positions));
-        }
-    })
+    crate::bench::frame::run(&organs, 0.2, repeats.max(1) * 4)
+        .surface_only
+        .p50_ms
 }
 
 /// The real-time loop for `seconds` with `timer`, while this thread does what a renderer does
-/// on the CPU each 60 Hz frame: read the latest snapshot and form every organ's whole field.
+/// on the CPU each 60 Hz frame: read the latest snapshot and form every organ's surface.
 fn realtime(
     scene: &HapticScene,
     targets: &[PressTarget],
@@ -213,10 +185,10 @@ fn realtime(
     let mut haptic = HapticLoop::new(scene, device(targets)).expect("scene was built");
     let mut snapshots = haptic.publish();
     let thread = HapticThread::spawn(haptic, timer, scheduling).expect("a thread can be spawned");
-    let mut fields: Vec<Vec<f64>> = scene
+    let mut surfaces: Vec<(SurfaceModes, Vec<f64>)> = scene
         .organs
         .iter()
-        .map(|(_, v)| vec![0.0; v.dof_count()])
+        .map(|(_, v)| (SurfaceModes::new(v), vec![0.0; 3 * v.positions.len()]))
         .collect();
     let mut positions = Vec::new();
     let frame = Duration::from_secs_f64(1.0 / 60.0);
@@ -224,12 +196,12 @@ fn realtime(
     while Instant::now() < end {
         let started = Instant::now();
         let snapshot = snapshots.read();
-        for ((organ, (_, vademecum)), u) in
-            snapshot.organs.iter().zip(&scene.organs).zip(&mut fields)
+        for ((organ, (_, vademecum)), (surface, u)) in
+            snapshot.organs.iter().zip(&scene.organs).zip(&mut surfaces)
         {
             organ
                 .deformation
-                .deformed_surface(vademecum, u, &mut positions);
+                .deformed_surface(vademecum, (surface, u), &mut positions);
         }
         std::hint::black_box(&positions);
         std::thread::sleep(frame.saturating_sub(started.elapsed()));

@@ -6,4 +6,5 @@ pub mod contact;
 pub mod cutting;
 pub mod dynamics;
 pub mod fem;
+pub mod frame;
 pub mod vademecum;

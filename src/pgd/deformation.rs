@@ -4,7 +4,7 @@
 
 use nalgebra::Vector3;
 
-use super::{SurfacePoint, Vademecum};
+use super::{SurfaceModes, SurfacePoint, Vademecum};
 
 /// A force on a tool-sized patch of the accessible surface.
 #[derive(Debug, Default, PartialEq)]
@@ -165,24 +165,40 @@ impl Deformation {
         }
     }
 
+    /// The displacement (m) at the load positions (`3 × positions`) into `u`: what
+    /// [`Self::field_into`] gives at their nodes, from the modes and corrections there only.
+    pub fn surface_into(&self, vademecum: &Vademecum, surface: &SurfaceModes, u: &mut [f64]) {
+        u.fill(0.0);
+        for (step, coefficients) in self.coefficients.iter().enumerate() {
+            surface.add_modes(step, coefficients, u);
+            for load in self.loads.iter().filter(|l| l.is_active()) {
+                let load = (load.shares.as_slice(), &load.force_n);
+                vademecum.add_surface_corrections(step, load, surface, u);
+            }
+            for point in &self.coupling_points {
+                let load = (&point.shares()[..], &point.force_n);
+                vademecum.add_surface_corrections(step, load, surface, u);
+            }
+        }
+    }
+
     /// The accessible surface's vertices, deformed, into `positions` (f32, ready to draw):
     /// the visual model mapped from the mechanical one through the load positions' nodes.
-    /// `field` is scratch space for the whole displacement field (`3 × nodes`).
+    /// `u` is scratch space for the displacement there (`3 × positions`).
     pub fn deformed_surface(
         &self,
         vademecum: &Vademecum,
-        field: &mut [f64],
+        (surface, u): (&SurfaceModes, &mut [f64]),
         positions: &mut Vec<[f32; 3]>,
     ) {
-        self.field_into(vademecum, field);
+        self.surface_into(vademecum, surface, u);
         positions.clear();
         positions.extend(
             vademecum
-                .positions
+                .position_coords_m
                 .iter()
-                .zip(&vademecum.position_coords_m)
-                .map(|(&node, rest)| {
-                    let u = &field[3 * node as usize..3 * node as usize + 3];
+                .zip(u.chunks_exact(3))
+                .map(|(rest, u)| {
                     let carried = self.carry.at(&Vector3::from(rest.map(f64::from)));
                     [0, 1, 2].map(|c| rest[c] + (u[c] + carried[c]) as f32)
                 }),

@@ -18,6 +18,7 @@ mod separated;
 mod settings;
 mod statistics;
 mod stiffness;
+mod surface_modes;
 mod vademecum;
 mod validate;
 pub mod web_form;
@@ -36,6 +37,7 @@ pub use separated::SeparatedField;
 pub use settings::{BuildSettings, DEFAULT_LOAD_STEPS_M};
 pub use statistics::Statistics;
 pub use stiffness::RestStiffness;
+pub use surface_modes::SurfaceModes;
 pub use vademecum::{Header, Patch, Step, SurfacePoint, Vademecum};
 pub use validate::{Sample, ValidationReport, ValidationSettings, validate};
 

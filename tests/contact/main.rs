@@ -19,6 +19,7 @@ use pgd_surgery::contact::{
 };
 use pgd_surgery::devices::Scripted;
 use pgd_surgery::parry_interop::{from_parry, to_parry};
+use pgd_surgery::pgd::SurfaceModes;
 
 /// 12 mm up into the gallbladder's underside over 2 s, held for half a second.
 const PUSH_S: f64 = 2.0;
@@ -340,11 +341,12 @@ fn deformed_gallbladder(modes_only: bool) -> Vec<[f32; 3]> {
     let (g, gallbladder) = organ("gallbladder");
     let mut deformation = last.organs[g].clone();
     deformation.coupling_points.clear();
-    let mut field = vec![0.0; gallbladder.dof_count()];
+    let surface = SurfaceModes::new(gallbladder);
+    let mut at_vertices = vec![0.0; 3 * gallbladder.positions.len()];
     let mut positions = Vec::new();
-    deformation.deformed_surface(gallbladder, &mut field, &mut positions);
+    deformation.deformed_surface(gallbladder, (&surface, &mut at_vertices), &mut positions);
     if modes_only {
-        field.fill(0.0);
+        let mut field = vec![0.0; gallbladder.dof_count()];
         for (step, coefficients) in deformation.coefficients.iter().enumerate() {
             gallbladder.add_modes(step, coefficients, &mut field);
         }

@@ -8,3 +8,4 @@ mod inclusion;
 mod nonlinear;
 mod option_values;
 mod outputs;
+mod surface;

@@ -1,5 +1,6 @@
 //! The organs as the trainee sees them: each organ's accessible surface, moved every frame by
-//! the displacement field of the latest snapshot, with nodal normals recomputed on the
+//! the latest snapshot's displacement at its vertices (formed there only, from the modes at
+//! the surface, [`SurfaceModes`]), with nodal normals recomputed on the
 //! deformed surface so that shading follows the deformation; a cut organ's surface split
 //! along its cut, with the cut's walls ([`super::cut_surface`]).
 
@@ -15,7 +16,7 @@ use super::{FrameSet, SceneView, tissue};
 use crate::app::haptic::OrganDeformation;
 use crate::dynamics::DynamicModel;
 use crate::mesh::vertex_normals;
-use crate::pgd::Vademecum;
+use crate::pgd::{SurfaceModes, Vademecum};
 
 /// An organ's visual model, mapped to its vademecum through the load positions (surface
 /// vertex `k` is volume node `positions[k]`).
@@ -24,8 +25,10 @@ pub(super) struct OrganView {
     index: usize,
     vademecum: Arc<Vademecum>,
     triangles: Vec<[usize; 3]>,
-    /// Scratch: the whole displacement field (m).
-    field: Vec<f64>,
+    /// Its modes at the surface vertices, which each frame forms the surface from.
+    surface: SurfaceModes,
+    /// Scratch: the displacement at the surface vertices (m).
+    at_vertices: Vec<f64>,
     /// The organ's dynamic model, when it moves.
     motion: Option<Arc<DynamicModel>>,
     /// Its surface split along the scalpel's latest cut, once it is cut.
@@ -86,7 +89,8 @@ fn spawn_organs(
             MeshMaterial3d(materials.add(tissue::wet(images.add(colour), images.add(roughness)))),
             OrganView {
                 index,
-                field: vec![0.0; vademecum.dof_count()],
+                surface: SurfaceModes::new(vademecum),
+                at_vertices: vec![0.0; 3 * vademecum.positions.len()],
                 vademecum: vademecum.clone(),
                 triangles,
                 motion: link
@@ -173,9 +177,11 @@ fn deform(
         };
         let view = &mut *view;
         let mut positions = Vec::with_capacity(view.vademecum.positions.len());
-        organ
-            .deformation
-            .deformed_surface(&view.vademecum, &mut view.field, &mut positions);
+        organ.deformation.deformed_surface(
+            &view.vademecum,
+            (&view.surface, &mut view.at_vertices),
+            &mut positions,
+        );
         if let Some(motion) = &view.motion {
             motion.add_to_surface(&view.vademecum.positions, &organ.motion, &mut positions);
         }

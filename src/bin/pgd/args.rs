@@ -377,6 +377,24 @@ pub enum BenchTarget {
         #[arg(long)]
         json: bool,
     },
+    /// The render side's CPU work per frame on the four-organ scene, each organ pressed by
+    /// the tool: the surface vertices formed from the modes there (the trainer's path)
+    /// against the whole field formed and the surface picked from it (the baseline), with
+    /// normals, p50 and p99 of each.
+    Frame {
+        /// Frames timed each way.
+        #[arg(long, default_value_t = 400)]
+        frames: usize,
+        /// The coarse organs.
+        #[arg(long)]
+        coarse: bool,
+        /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
+        #[arg(long, default_value = "vademecums")]
+        vademecums: PathBuf,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// The haptic loop on the four-organ scene: tick compute time over a scripted sweep (all
     /// organs, then each), the same press by full FEM, and real-time punctuality per timer.
     Haptics {

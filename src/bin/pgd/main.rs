@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use args::{BenchTarget, BuildArgs, Cli, Command, ContactBenchArgs, MaterialArgs, MeshArgs};
 use clap::Parser;
-use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, scene_of};
+use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, press_targets, scene_of};
 use pgd_surgery::cli::{self, fail, print_json, print_report};
 use pgd_surgery::contact::CouplingSettings;
 use pgd_surgery::cutting::CutValidationSettings;
@@ -252,6 +252,27 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             });
             print_report("pgd bench dynamics", result, json)
         }
+        BenchTarget::Frame {
+            frames,
+            coarse,
+            vademecums,
+            json,
+        } => {
+            let detail = if coarse { Detail::Coarse } else { Detail::Full };
+            let organs = SCENE_ORGANS.map(SceneOrgan::from);
+            let scene = match abdomen_scene(&organs, &vademecums, detail) {
+                Ok(scene) => scene,
+                Err(e) => return fail("pgd bench frame", &e),
+            };
+            let pressed: Vec<_> = scene
+                .organs
+                .iter()
+                .zip(press_targets(&scene))
+                .map(|((name, v), t)| (name.clone(), v.as_ref(), t.point_m, t.normal))
+                .collect();
+            let report = bench::frame::run(&pressed, FRAME_BENCH_PRESS_N, frames);
+            print_report("pgd bench frame", Ok::<_, String>(report), json)
+        }
         BenchTarget::Haptics {
             repeats,
             realtime_seconds,
@@ -315,6 +336,9 @@ fn bench_command(what: BenchTarget) -> ExitCode {
 }
 
 /// `pgd bench contact`: the scene's organs and coupling set up as asked, then timed.
+/// The press on each organ in `pgd bench frame` (N): the haptic benchmark's.
+const FRAME_BENCH_PRESS_N: f64 = 0.2;
+
 fn bench_contact(options: &ContactBenchArgs) -> ExitCode {
     let detail = if options.coarse {
         Detail::Coarse
