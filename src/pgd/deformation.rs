@@ -173,11 +173,11 @@ impl Deformation {
             surface.add_modes(step, coefficients, u);
             for load in self.loads.iter().filter(|l| l.is_active()) {
                 let load = (load.shares.as_slice(), &load.force_n);
-                vademecum.add_surface_corrections(step, load, surface, u);
+                surface.add_corrections(vademecum, step, load, u);
             }
             for point in &self.coupling_points {
                 let load = (&point.shares()[..], &point.force_n);
-                vademecum.add_surface_corrections(step, load, surface, u);
+                surface.add_corrections(vademecum, step, load, u);
             }
         }
     }

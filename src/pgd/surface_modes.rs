@@ -3,6 +3,8 @@
 //! the whole field. On the liver the surface is a third of the nodes, and the interior nodes
 //! of each load's near field are skipped as well.
 
+use nalgebra::Vector3;
+
 use super::Vademecum;
 
 /// A vademecum's spatial modes restricted to its load positions, and where each volume node
@@ -50,6 +52,33 @@ impl SurfaceModes {
         match self.position_of_node[node] {
             NOT_ON_SURFACE => None,
             m => Some(m as usize),
+        }
+    }
+
+    /// Adds `vademecum`'s near-field correction of load step `step` for a force on `shares`
+    /// at the positions to `u` (`3 × positions`): the entries at interior nodes are skipped.
+    pub fn add_corrections(
+        &self,
+        vademecum: &Vademecum,
+        step: usize,
+        (shares, force_n): (&[(usize, f64)], &Vector3<f64>),
+        u: &mut [f64],
+    ) {
+        let local = &vademecum.steps[step].local;
+        for &(i, l) in shares {
+            let l = vademecum.step_share(step, i, l, force_n);
+            if l == 0.0 {
+                continue;
+            }
+            for e in local.corrections_of(i) {
+                let Some(m) = self.position_of(local.correction_nodes[e] as usize) else {
+                    continue;
+                };
+                let value = local.residual(e, force_n);
+                for c in 0..3 {
+                    u[3 * m + c] += l * value[c];
+                }
+            }
         }
     }
 

@@ -9,7 +9,6 @@ use super::error_curve::ErrorCurve;
 use super::local::LocalPart;
 use super::region::{CutHeader, RegionResponse};
 use super::settings::BuildSettings;
-use super::surface_modes::SurfaceModes;
 use crate::fem::{Inclusion, Material, on_pressed_side, patch_weight};
 
 /// What the vademecum was built from and how: enough to refuse a stale file and to say how it
@@ -454,34 +453,6 @@ impl Vademecum {
             if c != 0.0 {
                 for (ui, &xi) in u.iter_mut().zip(x) {
                     *ui += c * xi as f64;
-                }
-            }
-        }
-    }
-
-    /// Adds the near-field correction of load step `step` for a force on `shares` at the load
-    /// positions to `u` (`3 × positions`, positions numbered as `surface` numbers them): the
-    /// entries at interior nodes are skipped.
-    pub fn add_surface_corrections(
-        &self,
-        step: usize,
-        (shares, force_n): (&[(usize, f64)], &Vector3<f64>),
-        surface: &SurfaceModes,
-        u: &mut [f64],
-    ) {
-        let local = &self.steps[step].local;
-        for &(i, l) in shares {
-            let l = self.step_share(step, i, l, force_n);
-            if l == 0.0 {
-                continue;
-            }
-            for e in local.corrections_of(i) {
-                let Some(m) = surface.position_of(local.correction_nodes[e] as usize) else {
-                    continue;
-                };
-                let value = local.residual(e, force_n);
-                for c in 0..3 {
-                    u[3 * m + c] += l * value[c];
                 }
             }
         }

@@ -9,7 +9,6 @@ use nalgebra::{Point3, Unit, Vector3};
 
 use super::components::{OrganBody, OrganDeformation, ToolTouch};
 use super::resources::Tool;
-use super::scoring::ExerciseRun;
 use crate::contact::ToolContact;
 use crate::cutting::{BladeContact, CutView, CutWorker, Scalpel};
 
@@ -24,7 +23,7 @@ pub struct OrganCut {
     nodes: Vec<(usize, f64)>,
     y: [Vec<f64>; 3],
     /// The exercise's attempt the tissue was cut in (0 before the first).
-    attempt: u32,
+    pub(super) attempt: u32,
 }
 
 impl OrganCut {
@@ -42,24 +41,6 @@ impl OrganCut {
 /// The loop runs on a simulated clock: each cut step is waited for.
 #[derive(Resource, Clone, Copy, Debug, Default)]
 pub struct SettleCuts;
-
-/// A new attempt at the exercise starts on uncut tissue: once the run has taken its next
-/// attempt, each cut organ's worker undoes its incisions and its scalpel forgets its strokes.
-pub fn heal_on_retry(run: Option<Res<ExerciseRun>>, mut organs: Query<&mut OrganCut>) {
-    let Some(attempts) = run.map(|r| r.attempts()) else {
-        return;
-    };
-    for mut cut in &mut organs {
-        if cut.attempt == attempts {
-            continue;
-        }
-        if cut.attempt > 0 {
-            cut.scalpel.heal();
-            cut.worker.heal();
-        }
-        cut.attempt = attempts;
-    }
-}
 
 /// Reads each cut organ's latest cut, softens the tool's press for it, and hands the blade's
 /// step, if any, to the organ's cut state.

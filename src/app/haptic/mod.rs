@@ -83,7 +83,7 @@ pub fn haptic_schedule() -> Schedule {
         systems::compute_force.in_set(HapticSet::ComputeForce),
         systems::apply_safety.in_set(HapticSet::Safety),
         systems::write_device.in_set(HapticSet::WriteDevice),
-        (scoring::score_tick, cutting::heal_on_retry)
+        (scoring::score_tick, scoring::heal_on_retry)
             .chain()
             .in_set(HapticSet::Score),
         (

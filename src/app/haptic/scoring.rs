@@ -285,6 +285,24 @@ pub fn publish_progress(
     }
 }
 
+/// A new attempt at the exercise starts on uncut tissue: once the run has taken its next
+/// attempt, each cut organ's worker undoes its incisions and its scalpel forgets its strokes.
+pub fn heal_on_retry(run: Option<Res<ExerciseRun>>, mut organs: Query<&mut OrganCut>) {
+    let Some(attempts) = run.map(|r| r.attempts()) else {
+        return;
+    };
+    for mut cut in &mut organs {
+        if cut.attempt == attempts {
+            continue;
+        }
+        if cut.attempt > 0 {
+            cut.scalpel.heal();
+            cut.worker.heal();
+        }
+        cut.attempt = attempts;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use std::path::Path;
@@ -400,9 +418,7 @@ mod tests {
             for t in from..from + ticks {
                 world.resource_mut::<TickClock>().time_s = t as f64 * 1e-3;
                 world.run_system_once(score_tick).unwrap();
-                world
-                    .run_system_once(super::super::cutting::heal_on_retry)
-                    .unwrap();
+                world.run_system_once(heal_on_retry).unwrap();
             }
         };
         let unknowns = |world: &mut World| {
