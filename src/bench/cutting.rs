@@ -148,7 +148,7 @@ fn cut_with<R: UncutResponse>(
 /// The felt force for a 1 mm press as the tick computes it, timed `TICKS` times (µs): median
 /// and p99.
 fn time_ticks<R: UncutResponse>(
-    state: &CutState<R>,
+    state: &CutState<&FemModel, R>,
     patch: &[(usize, f64)],
 ) -> Result<[f64; 2], String> {
     // The tick has the uncut compliance from the tool's vademecum: computed once here.

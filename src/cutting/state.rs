@@ -19,6 +19,7 @@
 //! `O(n³)` for a new factorization), and columns to `Ẑ`, whose old ones bordering leaves as
 //! they are.
 
+use std::borrow::Borrow;
 use std::collections::HashMap;
 
 use nalgebra::{Matrix3, Point3, Vector3};
@@ -48,8 +49,10 @@ struct Cut {
 
 /// The cut organ as incisions come: the enriched functions in the order they appeared, the
 /// uncut response to each, and the growing condensed system.
-pub struct CutState<'m, R: UncutResponse> {
-    model: &'m FemModel,
+pub struct CutState<M: Borrow<FemModel>, R: UncutResponse> {
+    /// The organ's model, borrowed or owned (a cut state applied where there are no threads
+    /// keeps its own).
+    model: M,
     response: R,
     cuts: Vec<Cut>,
     faces: Vec<CutFace>,
@@ -77,11 +80,12 @@ pub struct CutState<'m, R: UncutResponse> {
     front: Front,
 }
 
-impl<'m, R: UncutResponse> CutState<'m, R> {
+impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
     /// The uncut organ: `model` gives the mesh, the material and the held nodes, `response`
     /// its uncut solves.
-    pub fn new(model: &'m FemModel, response: R) -> Self {
-        let surface = Surface::extract(model.mesh());
+    pub fn new(model: M, response: R) -> Self {
+        let surface = Surface::extract(model.borrow().mesh());
+        let nodes = model.borrow().mesh().node_count();
         Self {
             model,
             response,
@@ -90,13 +94,17 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             functions: Vec::new(),
             coupling: Vec::new(),
             z_modal: Vec::new(),
-            z_near: vec![Vec::new(); 3 * model.mesh().node_count()],
+            z_near: vec![Vec::new(); 3 * nodes],
             z_hat_surface: vec![Vec::new(); 3 * surface.nodes.len()],
             surface_index_of: surface.surface_index_of,
             rows: Vec::new(),
             factor: Vec::new(),
             front: Front::Inward,
         }
+    }
+
+    fn model(&self) -> &FemModel {
+        self.model.borrow()
     }
 
     /// The state with the cut's front placed as `front` says (before any cut is made).
@@ -164,9 +172,9 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     /// Takes `faces` as the cut, growing the system by the functions they add; a refused cut
     /// leaves the state as it was.
     fn apply(&mut self, faces: Vec<CutFace>) -> Result<(), CutError> {
-        let enrichment = Enrichment::with_front(self.model.mesh(), &faces, self.front);
-        let held = |n: usize| self.model.dofs().free_index[3 * n] == PRESCRIBED;
-        if enrichment.detaches(self.model.mesh(), held) {
+        let enrichment = Enrichment::with_front(self.model().mesh(), &faces, self.front);
+        let held = |n: usize| self.model().dofs().free_index[3 * n] == PRESCRIBED;
+        if enrichment.detaches(self.model().mesh(), held) {
             return Err(CutError::Detached);
         }
         self.grow(&enrichment)?;
@@ -202,7 +210,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     /// standing load such as the intraocular pressure has it computed once, exactly).
     pub fn solve_from(&self, uncut: Response) -> CutSolution {
         let (nodes_m, q) = self.condensed(uncut);
-        let order = Enrichment::with_front(self.model.mesh(), &self.faces, self.front);
+        let order = Enrichment::with_front(self.model().mesh(), &self.faces, self.front);
         let index = self.function_index();
         let mut enriched_m = Vec::with_capacity(q.len());
         for f in &order.functions {
@@ -219,7 +227,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     /// the state's order: `q = −S⁻¹ Bᵀ K⁻¹ f`, `u = K⁻¹ f − Z q`, the modal part as `Ẑ y`
     /// with `L y = −Bᵀ K⁻¹ f` and `q = L⁻ᵀ y`.
     fn condensed(&self, response: Response) -> (Vec<f64>, Vec<f64>) {
-        let mut u = vec![0.0; 3 * self.model.mesh().node_count()];
+        let mut u = vec![0.0; 3 * self.model().mesh().node_count()];
         scatter(&response.near, 1.0, &mut u);
         let rhs: Vec<f64> = (0..self.unknowns())
             .map(|p| -self.product(p, &response.modal, &u))
@@ -276,7 +284,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     pub fn uncut_compliance(&self, patch: &[(usize, f64)]) -> Result<Matrix3<f64>, CutError> {
         let loads = axis_loads(patch);
         let responses = self.response.respond(&loads)?;
-        let mut near = vec![0.0; 3 * self.model.mesh().node_count()];
+        let mut near = vec![0.0; 3 * self.model().mesh().node_count()];
         let mut uncut = Matrix3::zeros();
         for (axis, response) in responses.iter().enumerate() {
             scatter(&response.near, 1.0, &mut near);
@@ -367,7 +375,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
     /// uncut responses, and their rows of `S`, bordering the factor.
     fn grow(&mut self, enrichment: &Enrichment) -> Result<(), CutError> {
         let known = self.function_index();
-        let held = |n: usize| self.model.dofs().free_index[3 * n] == PRESCRIBED;
+        let held = |n: usize| self.model().dofs().free_index[3 * n] == PRESCRIBED;
         // The enrichment's function index → the state's, old or new; held ones dropped.
         let mut slot = vec![None; enrichment.functions.len()];
         let mut added = Vec::new();
@@ -404,7 +412,7 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             .collect();
         // S's new columns: A − Bᵀ Z, against every unknown, old and new.
         let total = first_new + z.len();
-        let mut near = vec![0.0; 3 * self.model.mesh().node_count()];
+        let mut near = vec![0.0; 3 * self.model().mesh().node_count()];
         let mut columns = vec![vec![0.0; total]; z.len()];
         for (r, column) in columns.iter_mut().enumerate() {
             scatter(&z[r].near, 1.0, &mut near);
@@ -482,9 +490,9 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
         first_new: usize,
         count: usize,
     ) -> (Vec<SparseColumn>, Entries) {
-        let mesh = self.model.mesh();
+        let mesh = self.model().mesh();
         let nodes = mesh.node_count();
-        let free = &self.model.dofs().free_index;
+        let free = &self.model().dofs().free_index;
         let mut coupling = vec![Vec::new(); count];
         let mut a = HashMap::new();
         // A function's first unknown in the state, or its node's first dof (own functions).
@@ -503,8 +511,8 @@ impl<'m, R: UncutResponse> CutState<'m, R> {
             if !touches_new {
                 continue;
             }
-            let geometry = &self.model.geometry()[t];
-            let (lambda, mu) = self.model.lame(t);
+            let geometry = &self.model().geometry()[t];
+            let (lambda, mu) = self.model().lame(t);
             let functions = element_functions(tet, cut, nodes);
             let weights = piece_weights(cut, &functions, enrichment, geometry.volume_m3);
             let n = functions.len();

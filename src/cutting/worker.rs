@@ -1,14 +1,25 @@
-//! The cut state off the haptic thread. Growing the cut over the exact uncut response costs
+//! The cut state off the haptic tick. Growing the cut over the exact uncut response costs
 //! sparse solves (milliseconds to a fraction of a second a segment, `docs/cutting.md`), far
-//! over a tick: a worker thread owns the organ's cut state, takes the scalpel's steps in
-//! order, and publishes a [`CutView`] after each one that cut. The tick reads the latest view
-//! without waiting ([`CutWorker::poll`]); a run on a simulated clock waits for each step
+//! over a tick: a worker owns the organ's cut state, takes the scalpel's steps in order, and
+//! publishes a [`CutView`] after each one that cut. The tick reads the latest view without
+//! waiting ([`CutWorker::poll`]); a run on a simulated clock waits for each step
 //! ([`CutWorker::settle`]), so that it stays deterministic.
+//!
+//! Where there are threads the worker is a thread of its own ([`threaded`]); in a web page,
+//! which has none, each step is applied where it is handed over ([`inline`]), and the frame
+//! that hands it over takes the step's time.
 
-use std::sync::mpsc::{Receiver, Sender, channel};
+#[cfg(target_arch = "wasm32")]
+mod inline;
+#[cfg(not(target_arch = "wasm32"))]
+mod threaded;
+
 use std::sync::{Arc, Mutex, PoisonError};
-use std::thread;
-use std::time::Instant;
+
+#[cfg(target_arch = "wasm32")]
+use inline::Backend;
+#[cfg(not(target_arch = "wasm32"))]
+use threaded::Backend;
 
 use super::CutError;
 use super::enrichment::Front;
@@ -19,7 +30,7 @@ use super::view::CutView;
 use crate::fem::FemModel;
 
 /// What the haptic side hands the worker: a step to apply, or a view it no longer reads, to
-/// be freed here rather than on the haptic thread (a view holds megabytes).
+/// be freed by the worker rather than on the haptic thread (a view holds megabytes).
 enum Job {
     Step(CutStep),
     /// Undo every incision (a new attempt at the exercise starts on uncut tissue).
@@ -27,7 +38,7 @@ enum Job {
     Retire(Arc<CutView>),
 }
 
-/// What the worker answers each step with.
+/// What the worker answers a step or a heal with.
 enum Outcome {
     /// The cut grew, or was healed: the state as it now stands.
     Changed(Arc<CutView>),
@@ -60,83 +71,107 @@ impl LatestCut {
     }
 }
 
-/// An organ's cut state on a thread of its own, its front snapped to the nearest element
+/// The organ's cut state as the worker keeps it, its front snapped to the nearest element
 /// faces ([`Front::Nearest`]): on the trainer's meshes, whose elements are as large as an
-/// incision is deep, a front snapped inward would leave the cut all but unfelt.
+/// incision is deep, a front snapped inward would leave the cut all but unfelt. `M` is how
+/// it holds the organ's model (borrowed on a thread that owns it, owned otherwise).
+struct Cutter<M: std::borrow::Borrow<FemModel>> {
+    state: CutState<M, ExactResponse>,
+    /// The incision under way.
+    incision: Option<usize>,
+}
+
+impl<M: std::borrow::Borrow<FemModel>> Cutter<M> {
+    fn new(model: M, response: ExactResponse) -> Self {
+        Self {
+            state: CutState::new(model, response).with_front(Front::Nearest),
+            incision: None,
+        }
+    }
+
+    /// Does `job`, publishing each changed view in `latest` too; what to answer, if anything.
+    fn work(self, job: Job, latest: &LatestCut) -> (Self, Option<Outcome>) {
+        let mut cutter = self;
+        let applied = match job {
+            Job::Step(step) => cutter.step(step),
+            Job::Heal => {
+                cutter = Self {
+                    state: cutter.state.heal(),
+                    incision: None,
+                };
+                Ok(true)
+            }
+            Job::Retire(view) => {
+                drop(view);
+                return (cutter, None);
+            }
+        };
+        let outcome = match applied {
+            Ok(true) => {
+                let view = Arc::new(cutter.state.view());
+                latest.set(view.clone());
+                Outcome::Changed(view)
+            }
+            Ok(false) => Outcome::Unchanged,
+            Err(error) => Outcome::Refused(error),
+        };
+        (cutter, Some(outcome))
+    }
+
+    /// Applies a scalpel's step: whether the cut grew.
+    fn step(&mut self, step: CutStep) -> Result<bool, CutError> {
+        let state = &mut self.state;
+        match (step, self.incision) {
+            (CutStep::Start { at, blade, depth_m }, _) => {
+                self.incision = Some(state.start(at, blade, depth_m));
+                Ok(false)
+            }
+            (CutStep::Advance { to }, Some(cut)) => state.advance(cut, to).map(|()| true),
+            (CutStep::Deepen { depth_m }, Some(cut)) => state.deepen(cut, depth_m).map(|()| true),
+            (_, None) => Err(CutError::Degenerate("a step before any incision".into())),
+        }
+    }
+}
+
+/// An organ's cut state on its worker.
 pub struct CutWorker {
-    jobs: Sender<Job>,
-    /// Behind a mutex only so that the worker's handle may be shared between threads (as an
-    /// ECS component is): its owner reaches it through `get_mut`, never locking.
-    outcomes: Mutex<Receiver<Outcome>>,
-    submitted: u64,
-    answered: u64,
+    backend: Backend,
     view: Arc<CutView>,
     refused: Vec<CutError>,
-    /// How long each job (a step, or a heal) took the worker (s), in order: written by the worker, so that the
-    /// haptic side never grows it.
-    step_seconds: Arc<Mutex<Vec<f64>>>,
 }
 
 impl CutWorker {
     /// Factorizes `model`'s rest stiffness (here, on the caller's thread) and starts the
-    /// worker that cuts it; `name` names the thread, and each view is also put in `latest`
-    /// for the window.
+    /// worker that cuts it; `name` names the worker's thread, and each view is also put in
+    /// `latest` for the window.
     pub fn spawn(
         model: Arc<FemModel>,
         name: &str,
         latest: Arc<LatestCut>,
     ) -> Result<Self, CutError> {
         let response = ExactResponse::new(&model).map_err(|e| CutError::Solve(e.to_string()))?;
-        let empty = CutState::new(&model, &response).view();
-        let (jobs, job_queue) = channel();
-        let (answers, outcomes) = channel();
-        let step_seconds = Arc::new(Mutex::new(Vec::new()));
-        let timings = step_seconds.clone();
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(worker_threads())
-            .thread_name(|k| format!("cut worker {k}"))
-            .build()
-            .map_err(|e| CutError::Solve(format!("no threads for the cut state: {e}")))?;
-        thread::Builder::new()
-            .name(format!("cut {name}"))
-            .spawn(move || {
-                let replies = Replies {
-                    answers,
-                    timings: &timings,
-                    latest: &latest,
-                };
-                pool.install(|| serve(&model, response, job_queue, replies))
-            })
-            .map_err(|e| CutError::Solve(format!("no thread for the cut state: {e}")))?;
+        let empty = CutState::new(model.as_ref(), &response).view();
         Ok(Self {
-            jobs,
-            outcomes: Mutex::new(outcomes),
-            submitted: 0,
-            answered: 0,
+            backend: Backend::start(model, response, name, latest)?,
             view: Arc::new(empty),
             refused: Vec::new(),
-            step_seconds,
         })
     }
 
-    /// Hands the worker a step; never waits.
+    /// Hands the worker a step.
     pub fn submit(&mut self, step: CutStep) {
-        if self.jobs.send(Job::Step(step)).is_ok() {
-            self.submitted += 1;
-        }
+        self.backend.send(Job::Step(step));
     }
 
-    /// Has the worker undo every incision, after the steps already handed over; never waits.
-    /// The view that follows is of the uncut organ.
+    /// Has the worker undo every incision, after the steps already handed over. The view
+    /// that follows is of the uncut organ.
     pub fn heal(&mut self) {
-        if self.jobs.send(Job::Heal).is_ok() {
-            self.submitted += 1;
-        }
+        self.backend.send(Job::Heal);
     }
 
     /// The latest view, taking whatever the worker has answered; never waits.
     pub fn poll(&mut self) -> &Arc<CutView> {
-        while let Ok(outcome) = self.receiver().try_recv() {
+        while let Some(outcome) = self.backend.answered() {
             self.take(outcome);
         }
         &self.view
@@ -144,11 +179,8 @@ impl CutWorker {
 
     /// The view once every step handed over is answered: waits for the worker.
     pub fn settle(&mut self) -> &Arc<CutView> {
-        while self.answered < self.submitted {
-            match self.receiver().recv() {
-                Ok(outcome) => self.take(outcome),
-                Err(_) => break,
-            }
+        while let Some(outcome) = self.backend.next_answer() {
+            self.take(outcome);
         }
         &self.view
     }
@@ -160,7 +192,7 @@ impl CutWorker {
 
     /// Steps handed over and not yet answered.
     pub fn pending(&self) -> u64 {
-        self.submitted - self.answered
+        self.backend.pending()
     }
 
     /// The steps the cut state refused, in order.
@@ -168,104 +200,20 @@ impl CutWorker {
         &self.refused
     }
 
-    /// How long each step done so far took the worker (s), in order (a copy: not for the
-    /// haptic thread).
+    /// How long each job done so far (a step, or a heal) took the worker (s), in order (a
+    /// copy: not for the haptic thread).
     pub fn step_seconds(&self) -> Vec<f64> {
-        self.step_seconds
-            .lock()
-            .map_or_else(|e| e.into_inner().clone(), |s| s.clone())
-    }
-
-    fn receiver(&mut self) -> &Receiver<Outcome> {
-        match self.outcomes.get_mut() {
-            Ok(receiver) => receiver,
-            Err(poisoned) => poisoned.into_inner(),
-        }
+        self.backend.step_seconds()
     }
 
     fn take(&mut self, outcome: Outcome) {
-        self.answered += 1;
         match outcome {
             Outcome::Changed(view) => {
                 let old = std::mem::replace(&mut self.view, view);
-                // Dropped by the worker if it is still there; here only if it has gone.
-                let _ = self.jobs.send(Job::Retire(old));
+                self.backend.send(Job::Retire(old));
             }
             Outcome::Unchanged => {}
             Outcome::Refused(error) => self.refused.push(error),
         }
-    }
-}
-
-/// Threads for the cut state's parallel work: one core fewer than the machine has (at least
-/// one), so that the haptic thread always finds a core.
-fn worker_threads() -> usize {
-    let cores = thread::available_parallelism().map_or(1, |n| n.get());
-    cores.saturating_sub(1).max(1)
-}
-
-/// Where the worker's answers go: to the haptic side, each step's time, and the latest view
-/// for the window.
-struct Replies<'a> {
-    answers: Sender<Outcome>,
-    timings: &'a Mutex<Vec<f64>>,
-    latest: &'a LatestCut,
-}
-
-/// The worker's loop: each step applied in order and answered, until the haptic side drops
-/// its end.
-fn serve(model: &FemModel, response: ExactResponse, jobs: Receiver<Job>, replies: Replies) {
-    let mut state = CutState::new(model, response).with_front(Front::Nearest);
-    let mut incision = None;
-    for job in jobs {
-        let started = Instant::now();
-        let step = match job {
-            Job::Step(step) => step,
-            Job::Heal => {
-                state = state.heal();
-                incision = None;
-                let view = Arc::new(state.view());
-                replies.latest.set(view.clone());
-                if !replies.answer(Outcome::Changed(view), started) {
-                    return;
-                }
-                continue;
-            }
-            Job::Retire(view) => {
-                drop(view);
-                continue;
-            }
-        };
-        let applied = match (step, incision) {
-            (CutStep::Start { at, blade, depth_m }, _) => {
-                incision = Some(state.start(at, blade, depth_m));
-                Ok(false)
-            }
-            (CutStep::Advance { to }, Some(cut)) => state.advance(cut, to).map(|()| true),
-            (CutStep::Deepen { depth_m }, Some(cut)) => state.deepen(cut, depth_m).map(|()| true),
-            (_, None) => Err(CutError::Degenerate("a step before any incision".into())),
-        };
-        let outcome = match applied {
-            Ok(true) => {
-                let view = Arc::new(state.view());
-                replies.latest.set(view.clone());
-                Outcome::Changed(view)
-            }
-            Ok(false) => Outcome::Unchanged,
-            Err(error) => Outcome::Refused(error),
-        };
-        if !replies.answer(outcome, started) {
-            return;
-        }
-    }
-}
-
-impl Replies<'_> {
-    /// Records the job's time and answers it; false once the haptic side has gone.
-    fn answer(&self, outcome: Outcome, started: Instant) -> bool {
-        if let Ok(mut timings) = self.timings.lock() {
-            timings.push(started.elapsed().as_secs_f64());
-        }
-        self.answers.send(outcome).is_ok()
     }
 }

@@ -1,8 +1,9 @@
 // The trainer's web page in headless Chromium: it loads, runs a shipped scenario from a
 // scripted trajectory (the page's `script` parameter), and scores it; then M opens the menu
-// and the next scenario loads to its briefing. Fails on any console error or uncaught
-// exception, on a scorecard that does not pass, on a canvas that shows nearly one colour, and
-// on a menu that does not load the scenario chosen.
+// and the next scenario loads to its briefing; then the liver incision, cut by the scalpel,
+// is scored as well. Fails on any console error or uncaught exception, on a scorecard that
+// does not pass, on a canvas that shows nearly one colour, and on a menu that does not load
+// the scenario chosen.
 //   node tests/web/browser.mjs http://127.0.0.1:8080/ [SCREENSHOT.png]
 import { writeFileSync } from "node:fs";
 import { createRequire } from "node:module";
@@ -13,7 +14,8 @@ const { chromium } = require("playwright-core");
 const base = process.argv[2] ?? "http://127.0.0.1:8080/";
 const screenshotPath = process.argv[3];
 const scenario = "liver-steady-press";
-const script = `tests/scenarios/${scenario}.competent.csv`;
+// A scenario whose scalpel cuts: the cut state grows where the page hands it each step.
+const cutting = "liver-capsule-incision";
 // Software WebGL renders a frame in about a second, so the physics, paced by the frames, runs
 // slower than real time: the 5.5 s script takes minutes.
 const timeoutMs = 8 * 60 * 1000;
@@ -46,26 +48,30 @@ try {
       problems.push(`uncaught: ${error}`);
     }
   });
-  const started = Date.now();
-  await page.goto(`${base}?scenario=${scenario}&script=${script}`);
-  await page.waitForFunction(
-    () => window.trainer?.scorecard !== undefined || window.trainer?.error !== undefined,
-    null,
-    { timeout: timeoutMs, polling: 500 },
-  );
-  const { scorecard, error, frames } = await page.evaluate(() => ({
-    scorecard: window.trainer.scorecard,
-    error: window.trainer.error,
-    frames: window.trainer.frames,
-  }));
-  if (error !== undefined) throw new Error(`the page failed: ${error}`);
-  const card = JSON.parse(scorecard);
-  console.log(
-    `scored ${card.score.toFixed(1)} (pass mark ${card.pass_mark}, passed ${card.passed}) ` +
-      `after ${((Date.now() - started) / 1000).toFixed(0)} s`,
-  );
-  if (!card.passed) problems.push(`the competent run did not pass: ${scorecard}`);
-  if (frames !== undefined) console.log(`frames: ${frames}`);
+  // Loads `name` with its competent script and requires the scorecard to pass.
+  const scoredRun = async (name) => {
+    const started = Date.now();
+    await page.goto(`${base}?scenario=${name}&script=tests/scenarios/${name}.competent.csv`);
+    await page.waitForFunction(
+      () => window.trainer?.scorecard !== undefined || window.trainer?.error !== undefined,
+      null,
+      { timeout: timeoutMs, polling: 500 },
+    );
+    const { scorecard, error, frames } = await page.evaluate(() => ({
+      scorecard: window.trainer.scorecard,
+      error: window.trainer.error,
+      frames: window.trainer.frames,
+    }));
+    if (error !== undefined) throw new Error(`the page failed on ${name}: ${error}`);
+    const card = JSON.parse(scorecard);
+    console.log(
+      `${name}: scored ${card.score.toFixed(1)} (pass mark ${card.pass_mark}, passed ` +
+        `${card.passed}) after ${((Date.now() - started) / 1000).toFixed(0)} s`,
+    );
+    if (!card.passed) problems.push(`the competent run of ${name} did not pass: ${scorecard}`);
+    if (frames !== undefined) console.log(`frames: ${frames}`);
+  };
+  await scoredRun(scenario);
 
   const shot = await page.locator("#trainer").screenshot();
   if (screenshotPath) writeFileSync(screenshotPath, shot);
@@ -99,6 +105,8 @@ try {
   await page.waitForFunction(() => window.trainer.stage !== "Menu", null, { timeout: timeoutMs });
   await until("Briefing");
   console.log(`the menu loaded the next scenario: ${await stage()}`);
+
+  await scoredRun(cutting);
 } catch (e) {
   problems.push(String(e));
 } finally {
