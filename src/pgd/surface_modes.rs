@@ -61,25 +61,10 @@ impl SurfaceModes {
         &self,
         vademecum: &Vademecum,
         step: usize,
-        (shares, force_n): (&[(usize, f64)], &Vector3<f64>),
+        load: (&[(usize, f64)], &Vector3<f64>),
         u: &mut [f64],
     ) {
-        let local = &vademecum.steps[step].local;
-        for &(i, l) in shares {
-            let l = vademecum.step_share(step, i, l, force_n);
-            if l == 0.0 {
-                continue;
-            }
-            for e in local.corrections_of(i) {
-                let Some(m) = self.position_of(local.correction_nodes[e] as usize) else {
-                    continue;
-                };
-                let value = local.residual(e, force_n);
-                for c in 0..3 {
-                    u[3 * m + c] += l * value[c];
-                }
-            }
-        }
+        vademecum.add_corrections_at(step, load, |node| self.position_of(node), u);
     }
 
     /// Adds `Σ_k c_k X^k` of load step `step` at the positions to `u` (`3 × positions`).

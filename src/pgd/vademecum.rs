@@ -466,6 +466,18 @@ impl Vademecum {
         force_n: &Vector3<f64>,
         u: &mut [f64],
     ) {
+        self.add_corrections_at(step, (shares, force_n), Some, u);
+    }
+
+    /// [`Self::add_corrections`] into `u` numbered by `slot` (a node's place in `u`, or
+    /// `None` to leave it out, before its correction is computed).
+    pub(crate) fn add_corrections_at(
+        &self,
+        step: usize,
+        (shares, force_n): (&[(usize, f64)], &Vector3<f64>),
+        slot: impl Fn(usize) -> Option<usize>,
+        u: &mut [f64],
+    ) {
         let local = &self.steps[step].local;
         for &(i, l) in shares {
             let l = self.step_share(step, i, l, force_n);
@@ -473,10 +485,12 @@ impl Vademecum {
                 continue;
             }
             for e in local.corrections_of(i) {
-                let node = local.correction_nodes[e] as usize;
+                let Some(at) = slot(local.correction_nodes[e] as usize) else {
+                    continue;
+                };
                 let value = local.residual(e, force_n);
                 for c in 0..3 {
-                    u[3 * node + c] += l * value[c];
+                    u[3 * at + c] += l * value[c];
                 }
             }
         }
