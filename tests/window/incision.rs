@@ -9,8 +9,9 @@ use nalgebra::Vector3;
 use super::{Shot, distance, row, scenario_shot_after};
 
 /// The blade set down at the line's start, pressed to a tip height of `stroke_y_mm` and
-/// drawn along it (the stroke of `tests/scenarios/cutting.rs`: 57.8 mm cuts, 62 mm does not),
-/// lifted, then pressed 14 mm beside the line's middle, lightly enough not to cut, and held.
+/// drawn along it (the stroke of `tests/scenarios/cutting.rs`: 57.8 mm cuts; 62 mm peaks at
+/// 0.49 N of the 0.56 N that parts the liver, so the uncut run stays higher still), lifted,
+/// then pressed 14 mm beside the line's middle, lightly enough not to cut, and held.
 fn stroke_then_press_beside(stroke_y_mm: f64) -> Vec<super::TrajectoryRow> {
     let at = |t: f64, x: f64, y: f64, z: f64| row(t, Vector3::new(x, y, z) * 1e-3);
     vec![
@@ -61,7 +62,7 @@ fn shot(name: &str, stroke_y_mm: f64) -> Shot {
 #[test]
 fn an_incision_opens_on_screen() {
     let cut = shot("incision-cut", 57.8);
-    let uncut = shot("incision-uncut", 62.0);
+    let uncut = shot("incision-uncut", 63.5);
     assert!(uncut.legend.lips.is_empty(), "the light stroke cut");
     let lips: Vec<_> = cut
         .legend
