@@ -88,9 +88,7 @@ impl<'a> Organ<'a> {
                 .iter()
                 .zip(&v.position_coords_m)
                 .map(|(&n, rest)| {
-                    let u = &self.field[3 * n as usize..3 * n as usize + 3];
-                    let carried = d.carry.at(&Vector3::from(rest.map(f64::from)));
-                    [0, 1, 2].map(|c| rest[c] + (u[c] + carried[c]) as f32)
+                    d.drawn_vertex(rest, &self.field[3 * n as usize..3 * n as usize + 3])
                 }),
         );
     }

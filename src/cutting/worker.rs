@@ -14,6 +14,7 @@ mod inline;
 #[cfg(not(target_arch = "wasm32"))]
 mod threaded;
 
+use std::borrow::Borrow;
 use std::sync::{Arc, Mutex, PoisonError};
 
 #[cfg(target_arch = "wasm32")]
@@ -75,13 +76,13 @@ impl LatestCut {
 /// faces ([`Front::Nearest`]): on the trainer's meshes, whose elements are as large as an
 /// incision is deep, a front snapped inward would leave the cut all but unfelt. `M` is how
 /// it holds the organ's model (borrowed on a thread that owns it, owned otherwise).
-struct Cutter<M: std::borrow::Borrow<FemModel>> {
+struct Cutter<M: Borrow<FemModel>> {
     state: CutState<M, ExactResponse>,
     /// The incision under way.
     incision: Option<usize>,
 }
 
-impl<M: std::borrow::Borrow<FemModel>> Cutter<M> {
+impl<M: Borrow<FemModel>> Cutter<M> {
     fn new(model: M, response: ExactResponse) -> Self {
         Self {
             state: CutState::new(model, response).with_front(Front::Nearest),

@@ -153,33 +153,47 @@ impl Deformation {
     /// The whole displacement field (m, `3 × nodes`) into `u`: the modes with the current
     /// coefficients plus each load's near-field correction, the contact loads' included.
     pub fn field_into(&self, vademecum: &Vademecum, u: &mut [f64]) {
-        u.fill(0.0);
-        for (step, coefficients) in self.coefficients.iter().enumerate() {
-            vademecum.add_modes(step, coefficients, u);
-            for load in self.loads.iter().filter(|l| l.is_active()) {
-                vademecum.add_corrections(step, &load.shares, &load.force_n, u);
-            }
-            for point in &self.coupling_points {
-                vademecum.add_corrections(step, &point.shares(), &point.force_n, u);
-            }
-        }
+        self.sum_into(
+            u,
+            |step, c, u| vademecum.add_modes(step, c, u),
+            |step, (shares, force_n), u| vademecum.add_corrections(step, shares, force_n, u),
+        );
     }
 
     /// The displacement (m) at the load positions (`3 × positions`) into `u`: what
     /// [`Self::field_into`] gives at their nodes, from the modes and corrections there only.
     pub fn surface_into(&self, vademecum: &Vademecum, surface: &SurfaceModes, u: &mut [f64]) {
+        self.sum_into(
+            u,
+            |step, c, u| surface.add_modes(step, c, u),
+            |step, load, u| surface.add_corrections(vademecum, step, load, u),
+        );
+    }
+
+    /// `u` anew: per load step, the modes with the current coefficients, then the near-field
+    /// correction of each active load and contact point, each added by the given function.
+    fn sum_into(
+        &self,
+        u: &mut [f64],
+        add_modes: impl Fn(usize, &[f64], &mut [f64]),
+        add_corrections: impl Fn(usize, (&[(usize, f64)], &Vector3<f64>), &mut [f64]),
+    ) {
         u.fill(0.0);
         for (step, coefficients) in self.coefficients.iter().enumerate() {
-            surface.add_modes(step, coefficients, u);
+            add_modes(step, coefficients, u);
             for load in self.loads.iter().filter(|l| l.is_active()) {
-                let load = (load.shares.as_slice(), &load.force_n);
-                surface.add_corrections(vademecum, step, load, u);
+                add_corrections(step, (&load.shares, &load.force_n), u);
             }
             for point in &self.coupling_points {
-                let load = (&point.shares()[..], &point.force_n);
-                surface.add_corrections(vademecum, step, load, u);
+                add_corrections(step, (&point.shares(), &point.force_n), u);
             }
         }
+    }
+
+    /// Surface vertex at rest `rest` moved by `u` (m) and by the carry, ready to draw.
+    pub fn drawn_vertex(&self, rest: &[f32; 3], u: &[f64]) -> [f32; 3] {
+        let carried = self.carry.at(&Vector3::from(rest.map(f64::from)));
+        [0, 1, 2].map(|c| rest[c] + (u[c] + carried[c]) as f32)
     }
 
     /// The accessible surface's vertices, deformed, into `positions` (f32, ready to draw):
@@ -198,10 +212,7 @@ impl Deformation {
                 .position_coords_m
                 .iter()
                 .zip(u.chunks_exact(3))
-                .map(|(rest, u)| {
-                    let carried = self.carry.at(&Vector3::from(rest.map(f64::from)));
-                    [0, 1, 2].map(|c| rest[c] + (u[c] + carried[c]) as f32)
-                }),
+                .map(|(rest, u)| self.drawn_vertex(rest, u)),
         );
     }
 

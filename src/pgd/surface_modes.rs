@@ -6,6 +6,7 @@
 use nalgebra::Vector3;
 
 use super::Vademecum;
+use super::vademecum::add_scaled_modes;
 
 /// A vademecum's spatial modes restricted to its load positions, and where each volume node
 /// sits among them.
@@ -69,12 +70,6 @@ impl SurfaceModes {
 
     /// Adds `Σ_k c_k X^k` of load step `step` at the positions to `u` (`3 × positions`).
     pub fn add_modes(&self, step: usize, coefficients: &[f64], u: &mut [f64]) {
-        for (x, &c) in self.steps[step].chunks_exact(u.len()).zip(coefficients) {
-            if c != 0.0 {
-                for (ui, &xi) in u.iter_mut().zip(x) {
-                    *ui += c * xi as f64;
-                }
-            }
-        }
+        add_scaled_modes(&self.steps[step], coefficients, u);
     }
 }

@@ -448,14 +448,8 @@ impl Vademecum {
 
     /// Adds `Σ_k c_k X^k` of load step `step` to `u`.
     pub fn add_modes(&self, step: usize, coefficients: &[f64], u: &mut [f64]) {
-        let spatial = self.steps[step].spatial.chunks_exact(self.dof_count());
-        for (x, &c) in spatial.zip(coefficients) {
-            if c != 0.0 {
-                for (ui, &xi) in u.iter_mut().zip(x) {
-                    *ui += c * xi as f64;
-                }
-            }
-        }
+        debug_assert_eq!(u.len(), self.dof_count());
+        add_scaled_modes(&self.steps[step].spatial, coefficients, u);
     }
 
     /// Adds the near-field correction of load step `step` for a force on `shares` to `u`.
@@ -564,3 +558,15 @@ impl Vademecum {
 
 /// Secant iterations of [`Vademecum::force_for_indentation`] over load steps.
 const SECANT_ITERATIONS: usize = 8;
+
+/// Adds `Σ_k c_k X^k` to `u`, the modes `X^k` one after another in `modes`, each as long as
+/// `u`; a mode whose coefficient is zero is skipped.
+pub(crate) fn add_scaled_modes(modes: &[f32], coefficients: &[f64], u: &mut [f64]) {
+    for (x, &c) in modes.chunks_exact(u.len()).zip(coefficients) {
+        if c != 0.0 {
+            for (ui, &xi) in u.iter_mut().zip(x) {
+                *ui += c * xi as f64;
+            }
+        }
+    }
+}

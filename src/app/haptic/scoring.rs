@@ -440,7 +440,7 @@ mod tests {
         link.start();
         tick(&mut world, 15, 2);
         assert_eq!(world.resource::<ExerciseRun>().attempts(), 2);
-        assert_eq!(unknowns(&mut world), 0, "the retry starts on cut tissue");
+        assert_eq!(unknowns(&mut world), 0, "still cut after the retry");
         assert!(
             world
                 .get::<OrganCut>(organ)

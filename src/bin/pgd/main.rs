@@ -335,10 +335,10 @@ fn bench_command(what: BenchTarget) -> ExitCode {
     }
 }
 
-/// `pgd bench contact`: the scene's organs and coupling set up as asked, then timed.
 /// The press on each organ in `pgd bench frame` (N): the haptic benchmark's.
 const FRAME_BENCH_PRESS_N: f64 = 0.2;
 
+/// `pgd bench contact`: the scene's organs and coupling set up as asked, then timed.
 fn bench_contact(options: &ContactBenchArgs) -> ExitCode {
     let detail = if options.coarse {
         Detail::Coarse
