@@ -12,11 +12,11 @@ use super::haptic::{
 };
 use super::scene::{Detail, SceneOrgan, scene_files, scene_of};
 use crate::contact::{ContactSurface, CouplingSettings};
-use crate::devices::{HapticDevice, ScopeHandle, TICK_S};
+use crate::devices::{HapticDevice, Instrument, ScopeHandle, TICK_S};
 use crate::fem::Law;
 use crate::mesh::organs::Organ;
 use crate::scenario::{
-    self, CutMade, Exercise, Keratometer, LaparoscopeEntry, Nodule, NoduleSite, OrganEntry,
+    self, CutMade, Exercise, Keratometer, LaparoscopeEntry, Nodule, NoduleSite, OrganEntry, Port,
     RegionSite, Scenario, Scorecard, Sites, Task, score,
 };
 use crate::store::{OnStale, OrganSource};
@@ -29,7 +29,7 @@ pub fn scenario_scene(
     on_stale: OnStale,
 ) -> Result<HapticScene, String> {
     let organs = scenario_organs(scenario)?;
-    let tip = scenario.tool.tip_radius_m();
+    let tip = scenario.tip_radius_m();
     let mut scene = scene_of(
         &organs,
         Some(tip),
@@ -39,9 +39,14 @@ pub fn scenario_scene(
         on_stale,
     )?;
     scene.safety.max_force_n = scenario.device.max_force_n.0;
-    scene.port = scenario.port.as_ref().map(|port| port.fulcrum());
+    scene.instruments = (scenario.instruments_in_hand().iter())
+        .map(|(tool, port)| Instrument {
+            action: tool.action(),
+            port: port.as_ref().map(Port::fulcrum),
+        })
+        .collect();
     scene.scope = scenario.laparoscope.as_ref().and_then(scene_scope);
-    if let (Some(cutting), Some(blade)) = (&mut scene.cutting, scenario.tool.blade()) {
+    if let (Some(cutting), Some(blade)) = (&mut scene.cutting, scenario.blade()) {
         cutting.blade = blade;
     }
     scene.workspace.scale = scenario.device.workspace_scale.0;
@@ -55,7 +60,7 @@ pub fn scenario_files(
     detail: Detail,
 ) -> Result<Vec<PathBuf>, String> {
     let organs = scenario_organs(scenario)?;
-    let tip = Some(scenario.tool.tip_radius_m());
+    let tip = Some(scenario.tip_radius_m());
     Ok(scene_files(
         &organs,
         tip,
@@ -115,11 +120,8 @@ fn scene_organ(scenario: &Scenario, entry: &OrganEntry) -> Result<SceneOrgan, St
         poisson: entry.poisson_ratio.map(|nu| nu.0),
         max_modes: entry.max_modes.map(|n| n.0),
         law: entry.law.unwrap_or(Law::Linear),
-        dynamic: entry.dynamic.unwrap_or(scenario.tool.grasps()),
-        cut_toughness_j_per_m2: scenario
-            .tool
-            .blade()
-            .and_then(|_| entry.toughness_j_per_m2()),
+        dynamic: entry.dynamic.unwrap_or(scenario.grasps()),
+        cut_toughness_j_per_m2: scenario.blade().and_then(|_| entry.toughness_j_per_m2()),
         inclusions: scenario
             .nodules
             .iter()

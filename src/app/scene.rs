@@ -12,7 +12,7 @@ use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, FieldOrigin, Pr
 use crate::cutting::keratotomy::{Cornea, REFERENCE_MESH};
 use crate::cutting::{Blade, CutError};
 use crate::devices::{
-    HapticDevice, PressTarget, SafetySettings, VirtualDevice, VirtualHandle, Workspace,
+    HapticDevice, Instrument, PressTarget, SafetySettings, VirtualDevice, VirtualHandle, Workspace,
 };
 use crate::dynamics::{DynamicModel, GraspSettings, TRAINER_MODES};
 use crate::fem::{FemModel, Inclusion, Law, Material};
@@ -278,7 +278,7 @@ pub fn scene_of(
         coupling: (!coupling.is_empty()).then(|| Arc::new(coupling)),
         dynamics,
         cutting,
-        port: None,
+        instruments: vec![Instrument::default()],
         scope: None,
     })
 }

@@ -1,7 +1,7 @@
 //! The device layer, free of Bevy: the device trait and its backends (scripted, recorder,
 //! virtual, and the OpenHaptics and Force Dimension hardware over the servo link and its
 //! watchdog), the trajectory files they replay and record, the map from the device's workspace
-//! to the scene, the instruments through ports and the laparoscope, the safety filter between
+//! to the scene, the instruments through ports (one in hand at a time) and the laparoscope, the safety filter between
 //! the physics and the motors, and the clock that paces the 1 kHz loop.
 
 mod device;
@@ -11,6 +11,7 @@ mod fulcrum;
 mod laparoscope;
 #[cfg(not(target_arch = "wasm32"))]
 mod openhaptics;
+mod rack;
 mod recorder;
 mod safety;
 mod scripted;
@@ -33,6 +34,7 @@ pub use laparoscope::{
 };
 #[cfg(not(target_arch = "wasm32"))]
 pub use openhaptics::OpenHaptics;
+pub use rack::{Action, CHANGE_BUTTON, Instrument, MAX_INSTRUMENTS, Rack};
 pub use recorder::Recorder;
 pub use safety::{Fault, SafetyFilter, SafetySettings};
 pub use scripted::Scripted;

@@ -77,6 +77,18 @@ pub fn summary(card: &Scorecard) -> String {
             motion.idle_s,
             motion.rms_jerk_m_per_s3
         );
+        if let Some(changes) = motion.instrument_changes {
+            let paths: Vec<String> = (motion.path_length_by_instrument_mm.iter())
+                .enumerate()
+                .map(|(k, mm)| format!("{} {mm:.0} mm", k + 1))
+                .collect();
+            let _ = writeln!(
+                out,
+                "  instruments changed {changes} time{}; path by instrument: {}",
+                if changes == 1 { "" } else { "s" },
+                paths.join(", ")
+            );
+        }
         if let Some(out_s) = m.target_out_of_view_s {
             let _ = writeln!(out, "  the point to keep in view: out of view {out_s:.1} s");
         }

@@ -23,6 +23,8 @@ pub struct Sample {
     pub touching: u64,
     /// Whether the device's first button is held (the mark in palpation).
     pub button: bool,
+    /// The instrument in hand, in the scenario's order (0 with one).
+    pub instrument: usize,
     /// Retraction: how far (m) the watched region ([`Exercise::watched_region`]) has moved
     /// along its direction; 0 when nothing is watched.
     pub region_moved_m: f64,
@@ -471,6 +473,7 @@ impl Running {
     }
 
     fn step(&mut self, task: &Task, sample: &Sample, dt: f64, nodules: Nodules) {
+        self.motion.in_hand(sample.instrument);
         self.motion.step(sample.tip_m, dt);
         if let Some(in_view) = sample.tip_in_view {
             self.motion.view(in_view, dt);

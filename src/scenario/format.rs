@@ -29,12 +29,17 @@ pub struct Scenario {
     /// duodenum), or `Organ(…)` for a mesh file or a tissue or vademecum of its own.
     #[serde(deserialize_with = "organ_list")]
     pub organs: Vec<OrganEntry>,
+    /// The instrument in the trainee's hand (a 6 mm probe when left out).
     #[serde(default)]
-    pub tool: Tool,
+    pub tool: Option<Tool>,
     /// The port the instrument goes through (laparoscopy): the device then moves its handle,
     /// and the tip pivots about the port. None: the device moves the tip (open surgery).
     #[serde(default)]
     pub port: Option<Port>,
+    /// Instead of `tool` and `port`: several instruments, each through its own port. The
+    /// device drives one at a time, and its second button changes to the next (docs).
+    #[serde(default)]
+    pub instruments: Vec<Instrument>,
     /// The camera through its own port (laparoscopy); none: the desktop view of the open
     /// abdomen.
     #[serde(default)]
@@ -130,6 +135,23 @@ impl Tool {
     pub fn grasps(&self) -> bool {
         matches!(self, Tool::Grasper { .. })
     }
+
+    /// What the tool does besides pressing, as the haptic loop takes it.
+    pub fn action(&self) -> crate::devices::Action {
+        match self {
+            Tool::Probe { .. } => crate::devices::Action::Press,
+            Tool::Grasper { .. } => crate::devices::Action::Grasp,
+            Tool::Scalpel { .. } => crate::devices::Action::Cut,
+        }
+    }
+}
+
+/// An instrument through its port, one of a scenario's `instruments`.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Instrument {
+    pub tool: Tool,
+    pub port: Port,
 }
 
 /// A port (trocar) in the abdominal wall and the instrument through it.
@@ -450,6 +472,39 @@ impl Scenario {
     pub fn organ_names(&self) -> String {
         let names: Vec<&str> = self.organs.iter().map(|o| o.name.as_str()).collect();
         names.join(", ")
+    }
+
+    /// The instruments the trainee works with, in the order the device's second button goes
+    /// through them: the listed `instruments`, or else the one `tool` through its `port`
+    /// (none: open surgery).
+    pub fn instruments_in_hand(&self) -> Vec<(Tool, Option<Port>)> {
+        if self.instruments.is_empty() {
+            let tool = self.tool.clone().unwrap_or_default();
+            return vec![(tool, self.port.clone())];
+        }
+        let listed = self.instruments.iter();
+        listed
+            .map(|i| (i.tool.clone(), Some(i.port.clone())))
+            .collect()
+    }
+
+    /// The tip (m) every instrument presses with: the first's (a loaded scenario's
+    /// instruments all have its radius).
+    pub fn tip_radius_m(&self) -> f64 {
+        self.instruments_in_hand()[0].0.tip_radius_m()
+    }
+
+    /// The blade of the first instrument that cuts, if one does.
+    pub fn blade(&self) -> Option<crate::cutting::Blade> {
+        let instruments = self.instruments_in_hand();
+        instruments.iter().find_map(|(tool, _)| tool.blade())
+    }
+
+    /// Whether an instrument grasps (and so the organs move by default).
+    pub fn grasps(&self) -> bool {
+        self.instruments_in_hand()
+            .iter()
+            .any(|(tool, _)| tool.grasps())
     }
 }
 

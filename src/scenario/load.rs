@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use super::format::{LaparoscopeEntry, OrganEntry, Scenario, Task, metres};
 use super::keratotomy::MIN_INCISION_M;
 use crate::contact::PointshellDensity;
-use crate::devices::DeviceSpec;
+use crate::devices::{DeviceSpec, MAX_INSTRUMENTS};
 use crate::mesh::Surface;
 use crate::mesh::organs::{Organ, OrganSettings, region};
 use parry3d::query::PointQuery;
@@ -219,6 +219,7 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
     }
     check_rubric(scenario, &mut problems);
     check_laparoscope(scenario, &mut problems);
+    check_instruments(scenario, &mut problems);
     check_backend(scenario, &mut problems);
     problems
 }
@@ -273,6 +274,64 @@ fn check_laparoscope(scenario: &Scenario, problems: &mut Vec<Problem>) {
                 .into(),
         }),
         _ => {}
+    }
+}
+
+/// A list of instruments replaces `tool` and `port`, holds at most [`MAX_INSTRUMENTS`], and
+/// presses with one tip: the organs' vademecums are built for one tool radius.
+fn check_instruments(scenario: &Scenario, problems: &mut Vec<Problem>) {
+    let Some(first) = scenario.instruments.first() else {
+        return;
+    };
+    let problem = |field: String, anchors: Vec<String>, message: String, hint: &str| Problem {
+        field,
+        anchors,
+        message,
+        hint: hint.into(),
+    };
+    for (name, given) in [
+        ("tool", scenario.tool.is_some()),
+        ("port", scenario.port.is_some()),
+    ] {
+        if given {
+            problems.push(problem(
+                name.into(),
+                vec![format!("{name}:")],
+                format!("`{name}` and `instruments` both say what the trainee holds"),
+                "give each instrument its tool and port inside `instruments`, and drop `tool` and `port`",
+            ));
+        }
+    }
+    if scenario.instruments.len() > MAX_INSTRUMENTS {
+        problems.push(problem(
+            "instruments".into(),
+            vec!["instruments".into()],
+            format!(
+                "{} instruments: the trainee can change between {MAX_INSTRUMENTS} at most",
+                scenario.instruments.len()
+            ),
+            "keep the instruments the exercise needs",
+        ));
+    }
+    let tip_m = first.tool.tip_radius_m();
+    for (k, instrument) in scenario.instruments.iter().enumerate().skip(1) {
+        let other_m = instrument.tool.tip_radius_m();
+        if (other_m - tip_m).abs() > 1e-9 {
+            // The k-th instrument's tip: the anchor repeated steps through the list.
+            let mut anchors = vec!["instruments".to_owned()];
+            anchors.extend(std::iter::repeat_n("Instrument(".to_owned(), k + 1));
+            anchors.push("tip_radius_mm".into());
+            problems.push(problem(
+                format!("instruments[{k}].tool.tip_radius_mm"),
+                anchors,
+                format!(
+                    "its tip is {} mm, the first instrument's {} mm: the organs are built for one tip",
+                    other_m * 1e3,
+                    tip_m * 1e3
+                ),
+                "give every instrument the first one's tip_radius_mm",
+            ));
+        }
     }
 }
 
@@ -343,7 +402,7 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
             ..
         } => {
             problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
-            if matches!(task, Task::Grasp { .. }) && !scenario.tool.grasps() {
+            if matches!(task, Task::Grasp { .. }) && !scenario.grasps() {
                 problems.push(Problem {
                     field: field("organ"),
                     anchors: anchors("organ"),
@@ -440,7 +499,7 @@ fn check_blade(
 ) -> Vec<Problem> {
     let anchors = || vec!["tasks".to_owned(), task.to_owned(), "organ".into()];
     let mut problems = Vec::new();
-    if scenario.tool.blade().is_none() {
+    if scenario.blade().is_none() {
         problems.push(Problem {
             field: field("organ"),
             anchors: anchors(),

@@ -18,8 +18,8 @@ pub use exercise::{
     COVERED_TO_FINISH, Exercise, NoduleSite, Progress, RegionSite, Sample, Sites, TaskMetrics,
 };
 pub use format::{
-    Contact, Device, Difficulty, LaparoscopeEntry, Nodule, OrganEntry, Port, Rubric, Scenario,
-    ScopeKey, Spot, Task, TaskKind, Tool, metres,
+    Contact, Device, Difficulty, Instrument, LaparoscopeEntry, Nodule, OrganEntry, Port, Rubric,
+    Scenario, ScopeKey, Spot, Task, TaskKind, Tool, metres,
 };
 pub use incision::{BladeSample, IncisionMetrics, IncisionTracker};
 pub use keratotomy::{

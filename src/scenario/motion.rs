@@ -10,6 +10,8 @@
 use nalgebra::Vector3;
 use serde::Serialize;
 
+use crate::devices::MAX_INSTRUMENTS;
+
 /// Ticks between the samples velocity and jerk are taken on (100 Hz at 1 kHz).
 pub const STRIDE: u64 = 10;
 
@@ -27,7 +29,8 @@ pub struct MotionMetrics {
     /// The length of the tip's path (mm).
     pub path_length_mm: f64,
     /// The path over the shortest one that reaches as far from the start and ends where it
-    /// ended (1 = no wasted motion); none when the tip never left its start.
+    /// ended (1 = no wasted motion); none when the tip never left its start. With several
+    /// instruments, the shortest path is summed over the spells between changes.
     pub economy: Option<f64>,
     /// Movements: spells of the tip's speed above [`MOVING_M_PER_S`], each ended by its fall
     /// below [`IDLE_M_PER_S`].
@@ -39,6 +42,14 @@ pub struct MotionMetrics {
     /// Under a laparoscope, the time the tip was out of the camera's view (s).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub out_of_view_s: Option<f64>,
+    /// When the trainee changed instruments: how many times...
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub instrument_changes: Option<usize>,
+    /// ...and each instrument's tip path (mm), in the scenario's order, to the last one used.
+    /// The tip's path above is their sum: the jump from one instrument's tip to the next's is
+    /// no motion of the hand.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub path_length_by_instrument_mm: Vec<f64>,
 }
 
 /// The running measurement.
@@ -48,8 +59,12 @@ pub struct MotionTracker {
     path_m: f64,
     start: Option<Vector3<f64>>,
     last: Option<Vector3<f64>>,
+    /// Where the path since the last change of instrument started, and its farthest point
+    /// from there; the shortest path the segments before needed (m).
+    segment_start: Option<Vector3<f64>>,
     farthest_m: f64,
     farthest: Vector3<f64>,
+    need_before_m: f64,
     ticks: u64,
     /// The last four subsamples (oldest first) and how many there are.
     recent: [Vector3<f64>; 4],
@@ -57,21 +72,32 @@ pub struct MotionTracker {
     moving: bool,
     jerk_sum: f64,
     jerk_samples: usize,
+    /// The instrument in hand, once known, how many changes, how many instruments were
+    /// used (the last one's place, plus one), and each one's path (m).
+    instrument: Option<usize>,
+    changes: usize,
+    used: usize,
+    path_by_instrument_m: [f64; MAX_INSTRUMENTS],
 }
 
 impl MotionTracker {
     /// Takes the tip at one tick (`dt` s after the last); no tip (no device sample) is skipped.
     pub fn step(&mut self, tip_m: Option<Vector3<f64>>, dt: f64) {
         let Some(tip) = tip_m else { return };
-        let start = match self.start {
+        self.start.get_or_insert(tip);
+        let start = match self.segment_start {
             Some(start) => start,
             None => {
                 self.farthest = tip;
-                *self.start.insert(tip)
+                self.farthest_m = 0.0;
+                *self.segment_start.insert(tip)
             }
         };
         if let Some(last) = self.last {
-            self.path_m += (tip - last).norm();
+            let step_m = (tip - last).norm();
+            self.path_m += step_m;
+            let instrument = self.instrument.unwrap_or(0).min(MAX_INSTRUMENTS - 1);
+            self.path_by_instrument_m[instrument] += step_m;
         }
         self.last = Some(tip);
         let reach = (tip - start).norm();
@@ -113,6 +139,24 @@ impl MotionTracker {
         }
     }
 
+    /// Takes the instrument in hand (its place in the scenario's list) before a tick's
+    /// [`step`](Self::step). A change starts the tip's path afresh at the new instrument's tip:
+    /// neither the jump between tips nor its speed counts as motion.
+    pub fn in_hand(&mut self, instrument: usize) {
+        self.used = self.used.max(instrument + 1);
+        match self.instrument.replace(instrument) {
+            Some(before) if before != instrument => {
+                self.changes += 1;
+                self.need_before_m += self.segment_need_m();
+                self.segment_start = None;
+                self.last = None;
+                self.count = 0;
+                self.moving = false;
+            }
+            _ => {}
+        }
+    }
+
     /// Takes whether the tip is in the camera's view at one tick (`dt` s after the last).
     pub fn view(&mut self, in_view: bool, dt: f64) {
         let out = self.metrics.out_of_view_s.get_or_insert(0.0);
@@ -135,13 +179,26 @@ impl MotionTracker {
     pub fn metrics(&self) -> MotionMetrics {
         let mut m = self.metrics.clone();
         m.path_length_mm = self.path_m * 1e3;
-        if let Some(end) = self.last {
-            let need_m = self.farthest_m + (end - self.farthest).norm();
+        let need_m = self.need_before_m + self.segment_need_m();
+        if self.start.is_some() {
             m.economy = (need_m >= LEFT_START_M).then(|| self.path_m / need_m);
         }
         if self.jerk_samples > 0 {
             m.rms_jerk_m_per_s3 = (self.jerk_sum / self.jerk_samples as f64).sqrt();
         }
+        if self.changes > 0 {
+            // Allocates, once a task, only when instruments were changed.
+            let paths = &self.path_by_instrument_m[..self.used.min(MAX_INSTRUMENTS)];
+            m.instrument_changes = Some(self.changes);
+            m.path_length_by_instrument_mm = paths.iter().map(|p| p * 1e3).collect();
+        }
         m
+    }
+
+    /// The shortest path (m) the tip's path since the last change needed: out to its farthest
+    /// point from where it started, then to where it is.
+    fn segment_need_m(&self) -> f64 {
+        self.last
+            .map_or(0.0, |end| self.farthest_m + (end - self.farthest).norm())
     }
 }

@@ -8,8 +8,8 @@ use pgd_surgery::app::haptic::{ForceTrace, HapticLoop, HapticScene};
 use pgd_surgery::app::scene::press_targets;
 use pgd_surgery::contact::Probe;
 use pgd_surgery::devices::{
-    HapticDevice, PressMotion, PressTarget, SafetySettings, Scripted, Trajectory, Workspace,
-    press_and_slide,
+    HapticDevice, Instrument, PressMotion, PressTarget, SafetySettings, Scripted, Trajectory,
+    Workspace, press_and_slide,
 };
 use pgd_surgery::fem::{FemModel, Law};
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate, region};
@@ -57,7 +57,7 @@ pub fn scene(safety: SafetySettings) -> HapticScene {
         coupling: None,
         dynamics: None,
         cutting: None,
-        port: None,
+        instruments: vec![Instrument::default()],
         scope: None,
         organs: vec![("liver".into(), liver().vademecum.clone())],
         probe: Probe {

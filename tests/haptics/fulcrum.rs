@@ -3,7 +3,7 @@
 //! through the same lever; and the port makes no energy.
 
 use nalgebra::Vector3;
-use pgd_surgery::devices::{Fulcrum, MIN_OUTSIDE_M};
+use pgd_surgery::devices::{Fulcrum, Instrument, MIN_OUTSIDE_M};
 
 /// A 300 mm instrument through a port at the origin, pointing down (−y) into the abdomen.
 fn port() -> Fulcrum {
@@ -152,7 +152,10 @@ fn the_trainer_moves_the_handle_and_sends_the_lever_force() {
         ],
     };
     let ported = HapticScene {
-        port: Some(fulcrum),
+        instruments: vec![Instrument {
+            port: Some(fulcrum),
+            ..Instrument::default()
+        }],
         ..scene(SafetySettings::default())
     };
     let mut haptic = HapticLoop::new(&ported, scripted(trajectory)).unwrap();

@@ -9,6 +9,7 @@ mod faults;
 mod forcedimension;
 mod fulcrum;
 mod grasp;
+mod instruments;
 mod laparoscope;
 mod openhaptics;
 mod press;

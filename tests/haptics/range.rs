@@ -8,7 +8,7 @@ use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{ForceTrace, HapticLoop, HapticScene, HeadlessReport};
 use pgd_surgery::contact::Probe;
 use pgd_surgery::devices::{
-    PressMotion, PressTarget, SafetySettings, Scripted, Workspace, press_and_slide,
+    Instrument, PressMotion, PressTarget, SafetySettings, Scripted, Workspace, press_and_slide,
 };
 use pgd_surgery::fem::{Dirichlet, FemModel, Law, Material};
 use pgd_surgery::mesh::box_mesh;
@@ -52,7 +52,7 @@ fn press(vademecum: &Arc<Vademecum>, depth_m: f64) -> (HeadlessReport, ForceTrac
         coupling: None,
         dynamics: None,
         cutting: None,
-        port: None,
+        instruments: vec![Instrument::default()],
         scope: None,
     };
     let target = PressTarget {

@@ -372,6 +372,18 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "needs a grasper",
         ),
         (
+            "instruments-different-tips",
+            8,
+            "instruments[1].tool.tip_radius_mm",
+            "the organs are built for one tip",
+        ),
+        (
+            "instruments-and-tool",
+            5,
+            "tool",
+            "`tool` and `instruments` both say what the trainee holds",
+        ),
+        (
             "laparoscope-port-on-the-focus",
             7,
             "laparoscope.look_at_mm",
@@ -768,4 +780,76 @@ fn a_scripted_camera_looking_away_times_the_probe_out_of_view() {
         out_s > after_turn_s - 0.1 && out_s < after_turn_s + 0.1,
         "{out_s} s out of view; {after_turn_s} s after the turn"
     );
+}
+
+/// The laparoscopic press with a second probe through a port 60 mm to the left: the
+/// competent script, held still for its first second while the change button is pressed
+/// twice (to the second probe and back), presses as the same script held still without the
+/// button. The first probe is taken up again where it was put down, so the press is the same:
+/// the same peak force, path and economy, a pass, and two changes in the task's motion
+/// metrics (and its debrief). Only the time out of the laparoscope's view may differ: the
+/// second probe's tip, just in from its port, is out of it.
+#[test]
+fn two_instruments_changed_and_changed_back_press_as_one() {
+    use pgd_surgery::devices::{CHANGE_BUTTON, TrajectoryRow};
+    use pgd_surgery::report::summary;
+    use pgd_surgery::scenario::Instrument;
+
+    let name = "liver-laparoscopic-press";
+    let mut scenario = load(&root().join(format!("scenarios/{name}.scenario.ron"))).unwrap();
+    let port = scenario.port.take().expect("a laparoscopic scenario");
+    let tool = scenario.tool.take().unwrap_or_default();
+    let mut left = port.clone();
+    left.at_mm.0 -= 60.0;
+    scenario.instruments = vec![
+        Instrument {
+            tool: tool.clone(),
+            port,
+        },
+        Instrument { tool, port: left },
+    ];
+    let script = root().join(format!("tests/scenarios/{name}.competent.csv"));
+    let held_still = |presses: &[f64]| {
+        let mut trajectory = Trajectory::load(&script).unwrap();
+        let start = trajectory.rows[0];
+        for row in &mut trajectory.rows {
+            row.time_s += 1.0;
+        }
+        let mut held = vec![start];
+        for &at_s in presses {
+            for (t, buttons) in [(at_s, CHANGE_BUTTON), (at_s + 0.1, 0)] {
+                held.push(TrajectoryRow {
+                    time_s: t,
+                    buttons,
+                    ..start
+                });
+            }
+        }
+        held.append(&mut trajectory.rows);
+        Trajectory { rows: held }
+    };
+    let run = |trajectory: Trajectory| {
+        let scene =
+            scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Refuse).unwrap();
+        let ticks = ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64;
+        let device = Box::new(Scripted::new("test", trajectory));
+        run_simulated(scenario.clone(), &scene, device, ticks).unwrap()
+    };
+    let plain = run(held_still(&[])).card;
+    let changed = run(held_still(&[0.2, 0.6])).card;
+    let (p, c) = (&plain.tasks[0].metrics, &changed.tasks[0].metrics);
+    eprintln!("{}", summary(&changed));
+    assert!(changed.passed, "{changed:#?}");
+    assert_eq!(c.motion.instrument_changes, Some(2));
+    assert_eq!(p.motion.instrument_changes, None);
+    assert!(
+        (c.peak_force_n - p.peak_force_n).abs() < 1e-9,
+        "{} N vs {} N",
+        c.peak_force_n,
+        p.peak_force_n
+    );
+    let (cm, pm) = (&c.motion, &p.motion);
+    assert!((cm.path_length_mm - pm.path_length_mm).abs() < 1e-6);
+    assert!((cm.economy.unwrap() - pm.economy.unwrap()).abs() < 1e-6);
+    assert!(summary(&changed).contains("instruments changed 2 times"));
 }

@@ -80,3 +80,52 @@ fn a_still_tip_is_idle() {
     // The third difference of equal positions is zero but for round-off, over h³ = 1e-6 s³.
     assert!(m.rms_jerk_m_per_s3 < 1e-9, "{}", m.rms_jerk_m_per_s3);
 }
+
+/// Two instruments: the first's tip moves 10 mm at 10 mm/s and is put down; the second's,
+/// taken up 100 mm away, moves 20 mm and is put down; the first's, taken up again where it
+/// was left, moves 5 mm. The path is their 35 mm (not the 200 mm of jumps between tips), 15 mm
+/// and 20 mm by instrument, two changes, three movements (a jump is no movement), and no
+/// wasted motion.
+#[test]
+fn each_instrument_keeps_its_own_path_and_a_change_is_no_motion() {
+    let x = |mm: f64| Vector3::new(mm * 1e-3, 0.0, 0.0);
+    let far = Vector3::new(0.0, 0.1, 0.0);
+    let mut tracker = MotionTracker::default();
+    let mut feed = |instrument: usize, from: Vector3<f64>, to: Vector3<f64>, speed: f64| {
+        let ticks = ((to - from).norm() / speed / TICK_S).round() as u64;
+        // Held still for a second before and after: each movement ends.
+        for k in 0..=(ticks + 2000) {
+            let t = (k.saturating_sub(1000) as f64 / ticks as f64).min(1.0);
+            tracker.in_hand(instrument);
+            tracker.step(Some(from.lerp(&to, t)), TICK_S);
+        }
+    };
+    feed(0, x(0.0), x(10.0), 0.010);
+    feed(1, far, far + x(20.0), 0.010);
+    feed(0, x(10.0), x(15.0), 0.010);
+    let m = tracker.metrics();
+    eprintln!("{m:?}");
+    assert!(
+        (m.path_length_mm - 35.0).abs() < 1e-9,
+        "{}",
+        m.path_length_mm
+    );
+    assert_eq!(m.instrument_changes, Some(2));
+    let by = &m.path_length_by_instrument_mm;
+    assert_eq!(by.len(), 2);
+    assert!(
+        (by[0] - 15.0).abs() < 1e-9 && (by[1] - 20.0).abs() < 1e-9,
+        "{by:?}"
+    );
+    assert_eq!(m.movements, 3);
+    // Each spell went straight: no wasted motion, the jumps between tips not counted.
+    assert!((m.economy.unwrap() - 1.0).abs() < 1e-9, "{:?}", m.economy);
+}
+
+/// One instrument throughout: nothing about changes in the metrics.
+#[test]
+fn one_instrument_reports_no_changes() {
+    let m = measure(1.0, |t| Vector3::new(0.01 * t, 0.0, 0.0));
+    assert_eq!(m.instrument_changes, None);
+    assert!(m.path_length_by_instrument_mm.is_empty());
+}

@@ -11,6 +11,7 @@ use super::components::{OrganBody, OrganDeformation, ToolTouch};
 use super::resources::Tool;
 use crate::contact::ToolContact;
 use crate::cutting::{BladeContact, CutView, CutWorker, Scalpel};
+use crate::devices::Action;
 
 /// An organ a scalpel cuts: the blade on it, and its cut state on a worker thread (whose
 /// latest view the tick reads; the worker frees the views it replaces, so that the tick never
@@ -54,6 +55,7 @@ pub fn cut(
         &mut OrganCut,
     )>,
 ) {
+    let cuts = tool.action() == Action::Cut;
     for (body, mut touch, mut deformation, mut cut) in &mut organs {
         let OrganCut {
             scalpel,
@@ -73,7 +75,7 @@ pub fn cut(
             let shares = touch.patch.shares.iter();
             nodes.extend(shares.map(|&(m, share)| (positions[m] as usize, share)));
             soften(contact, view, (nodes, y));
-            if let Some(parted_m) = scalpel.parted_depth_m() {
+            if let Some(parted_m) = scalpel.parted_depth_m().filter(|_| cuts) {
                 give(contact, parted_m);
             }
             contact.force_n = contact.stiffness_n_per_m * contact.indentation_m;
@@ -82,7 +84,10 @@ pub fn cut(
         let edge = tool
             .sample
             .map_or_else(Vector3::x, |s| s.orientation * Vector3::x());
-        let blade = touch.contact.as_ref().map(|c| blade_contact(c, edge));
+        // The cut organ answers any instrument softer, but only a blade parts it.
+        let blade = (touch.contact.as_ref())
+            .filter(|_| cuts)
+            .map(|c| blade_contact(c, edge));
         if let Some(step) = scalpel.tick(blade.as_ref()) {
             worker.submit(step);
         }

@@ -74,7 +74,13 @@ pub fn haptic_schedule() -> Schedule {
             .chain(),
     );
     schedule.add_systems((
-        systems::read_device.in_set(HapticSet::ReadDevice),
+        (
+            systems::read_device,
+            systems::change_instrument,
+            systems::place_instrument,
+        )
+            .chain()
+            .in_set(HapticSet::ReadDevice),
         (systems::tool_contact, systems::grasp, cutting::cut)
             .chain()
             .in_set(HapticSet::ToolContact),

@@ -10,8 +10,8 @@ use crate::contact::Probe;
 use std::sync::Arc;
 
 use crate::devices::{
-    DeviceSample, Fault, Fulcrum, HapticDevice, Laparoscope, Pose, SafetyFilter, ScopeHandle,
-    ScopePose, ScopeScript, Workspace,
+    Action, DeviceSample, Fault, Fulcrum, HapticDevice, Laparoscope, Pose, Rack, SafetyFilter,
+    ScopeHandle, ScopePose, ScopeScript, Workspace,
 };
 
 #[derive(Resource)]
@@ -23,12 +23,27 @@ pub struct Tool {
     pub probe: Probe,
     /// How the device's motion maps onto the scene.
     pub workspace: Workspace,
-    /// The port the instrument goes through, if it does: the device moves its handle.
-    pub port: Option<Fulcrum>,
-    /// Through a port, where the instrument is (its handle the device's position).
+    /// The instruments, one in hand; through a port the device moves its handle.
+    pub rack: Rack,
+    /// The device's last good sample, in the scene's frame.
+    pub hand: Option<DeviceSample>,
+    /// Through a port, where the instrument in hand is.
     pub pose: Option<Pose>,
-    /// In the scene's frame; none until the device has reported a finite position.
+    /// The instrument's tip, in the scene's frame; none until the device has reported a finite
+    /// position.
     pub sample: Option<DeviceSample>,
+}
+
+impl Tool {
+    /// What the instrument in hand does besides pressing.
+    pub fn action(&self) -> Action {
+        self.rack.in_hand().1.action
+    }
+
+    /// The port of the instrument in hand, if it goes through one.
+    pub fn port(&self) -> Option<Fulcrum> {
+        self.rack.in_hand().1.port
+    }
 }
 
 /// The tick being run, set by the runner before each run of the schedule.

@@ -19,7 +19,8 @@ use super::snapshot::{HapticSnapshot, OrganSnapshot, SnapshotPublisher};
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
 use crate::cutting::{Blade, CutError, CutWorker, LatestCut, Scalpel};
 use crate::devices::{
-    Fulcrum, HapticDevice, Histogram, SafetyFilter, SafetySettings, TICK_S, Workspace,
+    Fulcrum, HapticDevice, Histogram, Instrument, Rack, SafetyFilter, SafetySettings, TICK_S,
+    Workspace,
 };
 use crate::dynamics::{DynamicModel, GraspSettings};
 use crate::fem::FemModel;
@@ -41,9 +42,9 @@ pub struct HapticScene {
     pub dynamics: Option<SceneDynamics>,
     /// The organs the tool cuts, when it is a scalpel.
     pub cutting: Option<SceneCutting>,
-    /// The port the instrument goes through, if it does: the device then moves its handle
-    /// (laparoscopy); otherwise its tip (open surgery).
-    pub port: Option<Fulcrum>,
+    /// The instruments, the first in hand at the start: through a port the device moves its
+    /// handle (laparoscopy); otherwise its tip (open surgery).
+    pub instruments: Vec<Instrument>,
     /// The laparoscope, if the trainee looks through one.
     pub scope: Option<SceneScope>,
 }
@@ -62,9 +63,16 @@ impl HapticScene {
             coupling: None,
             dynamics: None,
             cutting: None,
-            port: None,
+            instruments: vec![Instrument::default()],
             scope: None,
         }
+    }
+}
+
+impl HapticScene {
+    /// The ports of the instruments that go through one.
+    pub fn ports(&self) -> impl Iterator<Item = Fulcrum> + '_ {
+        self.instruments.iter().filter_map(|i| i.port)
     }
 }
 
@@ -177,7 +185,8 @@ impl HapticLoop {
         world.insert_resource(Tool {
             probe: scene.probe,
             workspace: scene.workspace,
-            port: scene.port,
+            rack: Rack::new(&scene.instruments),
+            hand: None,
             pose: None,
             sample: None,
         });

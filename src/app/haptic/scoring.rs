@@ -225,6 +225,7 @@ pub fn score_tick(
         force_n: force.sent_n.norm(),
         touching,
         button: tool.sample.is_some_and(|s| s.buttons & 1 != 0),
+        instrument: tool.rack.in_hand().0,
         region_moved_m,
         surrounding_force_n,
         grasping,

@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 
 use crate::contact::ToolContact;
 use crate::cutting::Stroke;
+use crate::devices::{MAX_INSTRUMENTS, Rack};
 use crate::pgd::Deformation;
 use crate::scenario::Progress;
 
@@ -32,6 +33,8 @@ pub struct HapticSnapshot {
     /// Through a port, the instrument's handle (m): its shaft runs from there through the
     /// port to the tip.
     pub handle_m: Option<Vector3<f64>>,
+    /// Which instrument is in hand, and where the others were put down.
+    pub instruments: InstrumentsView,
     /// The force sent to the device (N).
     pub force_n: Vector3<f64>,
     /// The scalpel's edge (unit, the scene's frame) when the tool is a scalpel.
@@ -44,6 +47,28 @@ pub struct HapticSnapshot {
     pub timing: LoopTiming,
     /// Where the scenario's exercise stands, once started.
     pub exercise: Option<Progress>,
+}
+
+/// The instruments as the window draws and drives them (fixed-size: the loop allocates nothing).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct InstrumentsView {
+    /// The instrument in hand, in the scenario's order.
+    pub in_hand: usize,
+    /// Added to the device's position to place the handle in hand (m); the mouse, which places
+    /// the tip, takes it off again.
+    pub offset_m: Vector3<f64>,
+    /// Where each instrument not in hand was put down (its handle, m).
+    pub put_down: [Option<Vector3<f64>>; MAX_INSTRUMENTS],
+}
+
+impl InstrumentsView {
+    pub fn of(rack: &Rack) -> Self {
+        Self {
+            in_hand: rack.in_hand().0,
+            offset_m: rack.offset_m(),
+            put_down: std::array::from_fn(|index| rack.put_down(index)),
+        }
+    }
 }
 
 /// How often the loop hands its timing to the snapshots: quantiles scan the histogram (tens of

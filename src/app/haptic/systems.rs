@@ -8,14 +8,15 @@ use super::cutting::OrganCut;
 use super::resources::{
     Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, Safety, TickClock, Tool,
 };
-use super::snapshot::{LoopTiming, SnapshotPublisher};
+use super::snapshot::{InstrumentsView, LoopTiming, SnapshotPublisher};
 use crate::contact::{Target, follow, press};
-use crate::devices::{DeviceSample, Fault, Fulcrum};
+use crate::devices::{Action, Fault, Fulcrum};
 use crate::dynamics::GraspPoint;
 use crate::pgd::SurfacePoint;
 
-/// Reads the device into [`Tool`], mapped onto the scene. A non-finite sample or a device error is a fault and the
-/// tool keeps its last good position; so is a streak of overrun ticks.
+/// Reads the device into [`Tool::hand`], mapped onto the scene. A non-finite sample or a
+/// device error is a fault and the tool keeps its last good position; so is a streak of
+/// overrun ticks.
 pub fn read_device(
     clock: Res<TickClock>,
     safety: Res<Safety>,
@@ -27,10 +28,7 @@ pub fn read_device(
     faults.this_tick.clear();
     faults.this_tick.append(&mut faults.next_tick);
     match device.0.read(clock.time_s) {
-        Ok(sample) if sample.is_finite() => {
-            let in_scene = tool.workspace.to_scene(sample);
-            through_port(&mut tool, in_scene);
-        }
+        Ok(sample) if sample.is_finite() => tool.hand = Some(tool.workspace.to_scene(sample)),
         Ok(_) => faults.this_tick.push(Fault::NonFiniteDevice),
         Err(e) => faults.this_tick.push(Fault::Device(e.to_string())),
     }
@@ -41,11 +39,33 @@ pub fn read_device(
     }
 }
 
-/// The tool for a device `sample` (in the scene): its tip, or through a port, its handle,
-/// the tip then where the shaft through the port puts it and the instrument along the shaft,
-/// rolled as the hand rolls the handle (a handle on the port itself keeps the last pose).
-fn through_port(tool: &mut Tool, mut sample: DeviceSample) {
-    if let Some(port) = tool.port {
+/// The device's change button puts the instrument in hand down and takes up the next, while
+/// the one in hand touches and holds nothing (so the hand feels no step of force).
+pub fn change_instrument(
+    mut tool: ResMut<Tool>,
+    touches: Query<&ToolTouch>,
+    motions: Query<&OrganMotion>,
+) {
+    let Some(hand) = tool.hand else {
+        return;
+    };
+    let free =
+        touches.iter().all(|t| t.contact.is_none()) && motions.iter().all(|m| !m.organ.holding());
+    let tip = tool.sample.map_or(hand.tip_m, |s| s.tip_m);
+    if tool.rack.take(hand.buttons, &hand.tip_m, &tip, free) {
+        tool.pose = None;
+    }
+}
+
+/// Places the instrument in hand for the device's sample: its tip, or through a port, its
+/// handle, the tip then where the shaft through the port puts it and the instrument along the
+/// shaft, rolled as the hand rolls the handle (a handle on the port itself keeps the last pose).
+pub fn place_instrument(mut tool: ResMut<Tool>) {
+    let Some(mut sample) = tool.hand else {
+        return;
+    };
+    sample.tip_m = tool.rack.handle_m(&sample.tip_m);
+    if let Some(port) = tool.port() {
         match port.pose(&sample.tip_m) {
             Some(pose) => tool.pose = Some(pose),
             None if tool.pose.is_none() => return,
@@ -117,7 +137,8 @@ pub fn grasp(
     let Some(sample) = tool.sample else {
         return;
     };
-    let closed = sample.buttons & 1 != 0;
+    // Only a grasper's jaws close; an organ let go swings back whatever is in hand.
+    let closed = sample.buttons & 1 != 0 && tool.action() == Action::Grasp;
     // Jaws close on tissue when the button goes down, not while it stays down: tissue that
     // escaped a closed grasper is not taken again until the trainee opens and closes it.
     let closing = closed && !*was_closed;
@@ -312,13 +333,14 @@ pub fn publish_snapshot(
     snapshot.time_s = clock.time_s;
     snapshot.tip_m = tool.sample.map(|s| s.tip_m);
     snapshot.handle_m = tool
-        .port
+        .port()
         .zip(tool.pose)
         .map(|(port, pose)| port.port_m - pose.along * pose.outside_m);
+    snapshot.instruments = InstrumentsView::of(&tool.rack);
     snapshot.force_n = force.sent_n;
     snapshot.faulted = safety.0.is_faulted();
     snapshot.timing = timing.map_or_else(LoopTiming::default, |t| *t);
-    let cuts = organs.iter().any(|(.., cut)| cut.is_some());
+    let cuts = organs.iter().any(|(.., cut)| cut.is_some()) && tool.action() == Action::Cut;
     snapshot.blade_edge = tool
         .sample
         .filter(|_| cuts)

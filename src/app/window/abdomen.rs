@@ -114,7 +114,7 @@ pub(super) fn setup(app: &mut App) {
 }
 
 fn laparoscopic(link: &HapticLink) -> bool {
-    link.scene.scope.is_some() || link.scene.port.is_some()
+    link.scene.scope.is_some() || link.scene.ports().next().is_some()
 }
 
 fn spawn_abdomen(
@@ -164,11 +164,7 @@ fn spawn_trocars(
     meshes: &mut Assets<Mesh>,
     materials: &mut Assets<StandardMaterial>,
 ) {
-    let ports = link
-        .scene
-        .port
-        .map(|p| p.port_m)
-        .into_iter()
+    let ports = (link.scene.ports().map(|p| p.port_m))
         .chain(link.scene.scope.as_ref().map(|s| s.scope.port_m));
     let centre = link.scene_centre();
     let mesh = meshes.add(Cylinder::new(TROCAR_RADIUS_M, TROCAR_LENGTH_M));

@@ -9,6 +9,7 @@ use super::bridge::{HapticLink, Snapshot};
 use super::laparoscope::CameraMode;
 use super::lesson::Lesson;
 use crate::app::haptic::HapticSnapshot;
+use crate::devices::Action;
 
 #[derive(Component)]
 struct Hud;
@@ -103,10 +104,11 @@ fn update_hud(
     };
     let task = lesson.map_or_else(String::new, |lesson| task_line(&lesson, &snapshot));
     let camera = camera_line(&link, &snapshot.0, *mode);
+    let instruments = instrument_line(&link, &snapshot.0);
     let timing = &snapshot.0.timing;
     text.0 = format!(
         "{task}device: {}\nforce {force_n:.3} N {gauge} limit {limit_n:.1} N\n{status}\n\
-         haptic {:.0} Hz | tick p99 {:.0} us, late p99 {:.0} us, {} skipped | frame {:.1} ms{help}{camera}",
+         haptic {:.0} Hz | tick p99 {:.0} us, late p99 {:.0} us, {} skipped | frame {:.1} ms{help}{instruments}{camera}",
         link.device_name,
         rate.hz,
         timing.compute_p99_us,
@@ -114,6 +116,25 @@ fn update_hud(
         timing.skipped,
         dt * 1e3
     );
+}
+
+/// With several instruments: the one in hand, and how to change it.
+fn instrument_line(link: &HapticLink, snapshot: &HapticSnapshot) -> String {
+    let instruments = &link.scene.instruments;
+    if instruments.len() < 2 {
+        return String::new();
+    }
+    let in_hand = snapshot.instruments.in_hand;
+    let name = match instruments[in_hand].action {
+        Action::Press => "probe",
+        Action::Grasp => "grasper",
+        Action::Cut => "scalpel",
+    };
+    format!(
+        "\nin hand: {name}, instrument {} of {} | Tab (the device's second button): change it, off the tissue",
+        in_hand + 1,
+        instruments.len()
+    )
 }
 
 /// With a laparoscope: a warning while the instrument's tip is out of its view (what the

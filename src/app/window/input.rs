@@ -3,13 +3,15 @@
 //! the view. Ctrl + wheel is the camera's zoom; a held right or middle button, its orbit or
 //! pan, during which the tool stays where it is. Q and E turn the handle (a scalpel's edge)
 //! about the axis facing the surgeon. Through a port the cursor still leads the tip: the
-//! handle goes where the shaft to it must be.
+//! handle goes where the shaft to it must be. Tab is the device's second button: it changes
+//! the instrument in hand, where a scenario gives several.
 
 use bevy::input::mouse::{MouseScrollUnit, MouseWheel};
 use bevy::prelude::*;
 
-use super::bridge::HapticLink;
+use super::bridge::{HapticLink, Snapshot};
 use super::{FrameSet, from_bevy, to_bevy};
+use crate::devices::CHANGE_BUTTON;
 
 /// How far one wheel notch moves the tip along the view (m).
 const WHEEL_STEP_M: f32 = 0.002;
@@ -21,11 +23,14 @@ const PIXELS_PER_NOTCH: f32 = 20.0;
 const TURN_RAD_PER_S: f64 = std::f64::consts::FRAC_PI_2;
 
 pub(super) fn setup(app: &mut App) {
-    app.add_systems(Update, drive_virtual_device.in_set(FrameSet::Input));
+    app.add_systems(
+        Update,
+        (drive_virtual_device, turn_and_press).in_set(FrameSet::Input),
+    );
 }
 
 fn drive_virtual_device(
-    link: Res<HapticLink>,
+    (link, snapshot): (Res<HapticLink>, Res<Snapshot>),
     windows: Query<&Window>,
     cameras: Query<(&Camera, &GlobalTransform)>,
     mut wheel: MessageReader<MouseWheel>,
@@ -42,12 +47,15 @@ fn drive_virtual_device(
     let forward = eye.forward();
     // The cursor places the tool's tip in the scene; the device's handle is in its own
     // workspace and, through a port, where the shaft to that tip puts it.
+    // The instrument in hand: its port, and the offset its handle is indexed by.
     let workspace = link.scene.workspace;
-    let port = link.scene.port;
-    let device_m = workspace.to_scene_m(&handle.tip_m());
+    let instruments = &snapshot.0.instruments;
+    let port = (link.scene.instruments.get(instruments.in_hand)).and_then(|i| i.port);
+    let offset_m = instruments.offset_m;
+    let handle_m = workspace.to_scene_m(&handle.tip_m()) + offset_m;
     let tip_m = port
-        .and_then(|p| p.pose(&device_m))
-        .map_or(device_m, |pose| pose.tip_m);
+        .and_then(|p| p.pose(&handle_m))
+        .map_or(handle_m, |pose| pose.tip_m);
     let mut tip = to_bevy(&tip_m);
     let steering_camera =
         buttons.pressed(MouseButton::Right) || buttons.pressed(MouseButton::Middle);
@@ -78,10 +86,23 @@ fn drive_virtual_device(
     };
     let push = notches * WHEEL_STEP_M + keyed * KEY_SPEED_M_PER_S * time.delta_secs();
     let tip_m = from_bevy(tip + *forward * push);
-    let device_m = port.map_or(Some(tip_m), |p| p.handle_for(&tip_m));
-    if let Some(device_m) = device_m {
-        handle.set_tip(&workspace.to_device(&device_m));
+    let handle_m = port.map_or(Some(tip_m), |p| p.handle_for(&tip_m));
+    if let Some(handle_m) = handle_m {
+        handle.set_tip(&workspace.to_device(&(handle_m - offset_m)));
     }
+}
+
+/// Q and E turn the handle; the left button is the device's first button (a stylus button on
+/// hardware), Tab its second.
+fn turn_and_press(
+    link: Res<HapticLink>,
+    keys: Res<ButtonInput<KeyCode>>,
+    buttons: Res<ButtonInput<MouseButton>>,
+    time: Res<Time>,
+) {
+    let Some(handle) = &link.virtual_device else {
+        return;
+    };
     let turning = match (keys.pressed(KeyCode::KeyQ), keys.pressed(KeyCode::KeyE)) {
         (true, false) => 1.0,
         (false, true) => -1.0,
@@ -89,6 +110,10 @@ fn drive_virtual_device(
     };
     let turn = handle.turn_rad() + turning * TURN_RAD_PER_S * time.delta_secs_f64();
     handle.set_turn(turn);
-    // The left button is the device's first button (a stylus button on hardware).
-    handle.set_buttons(u32::from(buttons.pressed(MouseButton::Left)));
+    let change = if keys.pressed(KeyCode::Tab) {
+        CHANGE_BUTTON
+    } else {
+        0
+    };
+    handle.set_buttons(u32::from(buttons.pressed(MouseButton::Left)) | change);
 }

@@ -182,7 +182,10 @@ fn apply_edits(
 
 /// Whether two scenarios run on the same haptic scene.
 pub(super) fn same_scene(a: &Scenario, b: &Scenario) -> bool {
-    a.organs == b.organs && a.nodules == b.nodules && a.tool == b.tool && a.device == b.device
+    a.organs == b.organs
+        && a.nodules == b.nodules
+        && a.instruments_in_hand() == b.instruments_in_hand()
+        && a.device == b.device
 }
 
 /// A saved edit that does not read: its error, with file, line and field, on screen.

@@ -1,5 +1,6 @@
-//! The tool as the trainee sees it: a sphere at the tip the device reports, its steel shaft
-//! when it goes through a port, and an arrow of the force the device renders.
+//! The tool as the trainee sees it: a sphere at the tip the device reports, the steel shaft
+//! of each instrument through a port (the one in hand, and those put down where they were
+//! left), and an arrow of the force the device renders.
 
 use bevy::prelude::*;
 
@@ -10,9 +11,10 @@ use super::{FrameSet, SceneView, to_bevy};
 #[derive(Component)]
 pub(super) struct ToolTip;
 
-/// The instrument's shaft through a port: a steel rod from its handle to its tip.
+/// An instrument's shaft through its port (the scenario's instrument this is): a steel rod
+/// from its handle to its tip.
 #[derive(Component)]
-pub(super) struct Shaft;
+pub(super) struct Shaft(usize);
 
 /// A laparoscopic instrument's shaft radius (m): 5 mm instruments.
 const SHAFT_RADIUS_M: f32 = 0.0025;
@@ -47,20 +49,24 @@ fn spawn_tool(
         Transform::default(),
         Visibility::Hidden,
     ));
-    if link.scene.port.is_some() {
-        commands.spawn((
-            SceneView,
-            Shaft,
-            Mesh3d(meshes.add(Cylinder::new(SHAFT_RADIUS_M, 1.0))),
-            MeshMaterial3d(materials.add(StandardMaterial {
-                base_color: Color::srgb(0.55, 0.57, 0.60),
-                metallic: 0.85,
-                perceptual_roughness: 0.3,
-                ..default()
-            })),
-            Transform::default(),
-            Visibility::Hidden,
-        ));
+    let shaft = meshes.add(Cylinder::new(SHAFT_RADIUS_M, 1.0));
+    let steel = materials.add(StandardMaterial {
+        base_color: Color::srgb(0.55, 0.57, 0.60),
+        metallic: 0.85,
+        perceptual_roughness: 0.3,
+        ..default()
+    });
+    for (index, instrument) in link.scene.instruments.iter().enumerate() {
+        if instrument.port.is_some() {
+            commands.spawn((
+                SceneView,
+                Shaft(index),
+                Mesh3d(shaft.clone()),
+                MeshMaterial3d(steel.clone()),
+                Transform::default(),
+                Visibility::Hidden,
+            ));
+        }
     }
 }
 
@@ -80,28 +86,37 @@ fn follow_device(
     }
 }
 
-/// Through a port, the instrument's shaft from its handle to its tip: the unit cylinder
-/// stretched along the line between them.
+/// Each instrument's shaft from its handle to its tip (the unit cylinder stretched along the
+/// line between them): the one in hand where the device holds it, the others where they were
+/// put down; one never taken up is not drawn.
 fn draw_shaft(
+    link: Res<HapticLink>,
     snapshot: Res<Snapshot>,
-    mut shaft: Query<(&mut Transform, &mut Visibility), With<Shaft>>,
+    mut shafts: Query<(&Shaft, &mut Transform, &mut Visibility)>,
 ) {
-    let Ok((mut transform, mut visibility)) = shaft.single_mut() else {
-        return;
-    };
-    let (Some(handle), Some(tip)) = (snapshot.0.handle_m, snapshot.0.tip_m) else {
-        *visibility = Visibility::Hidden;
-        return;
-    };
-    let (handle, tip) = (to_bevy(&handle), to_bevy(&tip));
-    let along = tip - handle;
-    *transform = Transform::from_translation((handle + tip) / 2.0)
-        .with_rotation(Quat::from_rotation_arc(
-            Vec3::Y,
-            along.normalize_or(Vec3::Y),
-        ))
-        .with_scale(Vec3::new(1.0, along.length(), 1.0));
-    *visibility = Visibility::Visible;
+    let instruments = &snapshot.0.instruments;
+    for (shaft, mut transform, mut visibility) in &mut shafts {
+        let ends = if shaft.0 == instruments.in_hand {
+            snapshot.0.handle_m.zip(snapshot.0.tip_m)
+        } else {
+            let port = link.scene.instruments[shaft.0].port;
+            (instruments.put_down[shaft.0].zip(port))
+                .and_then(|(handle, port)| Some((handle, port.pose(&handle)?.tip_m)))
+        };
+        let Some((handle, tip)) = ends else {
+            *visibility = Visibility::Hidden;
+            continue;
+        };
+        let (handle, tip) = (to_bevy(&handle), to_bevy(&tip));
+        let along = tip - handle;
+        *transform = Transform::from_translation((handle + tip) / 2.0)
+            .with_rotation(Quat::from_rotation_arc(
+                Vec3::Y,
+                along.normalize_or(Vec3::Y),
+            ))
+            .with_scale(Vec3::new(1.0, along.length(), 1.0));
+        *visibility = Visibility::Visible;
+    }
 }
 
 fn draw_force(snapshot: Res<Snapshot>, mut gizmos: Gizmos) {
