@@ -3,6 +3,8 @@
 # libraries its window loads, Mesa's Vulkan drivers (software rendering where there is no GPU
 # driver), and Xvfb, the virtual X server the window tests draw into. Building needs nothing
 # beyond the Rust toolchain and a C compiler.
+#   scripts/setup-debian.sh --web   also what the browser test needs: Chromium, and Node.js
+#                                   where the machine has none
 set -euo pipefail
 packages=(
   pkg-config
@@ -10,6 +12,14 @@ packages=(
   libvulkan1 mesa-vulkan-drivers
   xvfb
 )
+case "${1:-}" in
+  "") ;;
+  --web)
+    packages+=(chromium)
+    command -v node >/dev/null && command -v npm >/dev/null || packages+=(nodejs npm)
+    ;;
+  *) echo "setup: unknown option \`$1\` (the one option is --web)" >&2; exit 2 ;;
+esac
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The browser test: builds the page (scripts/web-build.sh), serves it on a free local port,
 # and runs tests/web/browser.mjs in headless Chromium (/usr/bin/chromium, or $CHROMIUM), which
-# scores a shipped scenario's scripted run in the page. The canvas lands in web/dist/shot.png.
+# scores shipped scenarios' scripted runs in the page, drawn by each renderer built
+# (WEB_RENDERERS, both by default). The canvases land in web/dist/shot-<renderer>.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/web-build.sh
@@ -14,4 +15,4 @@ for _ in $(seq 50); do
   python3 -c "import urllib.request; urllib.request.urlopen('http://127.0.0.1:$port/')" 2>/dev/null && break
   sleep 0.1
 done
-node tests/web/browser.mjs "http://127.0.0.1:$port/" web/dist/shot.png
+node tests/web/browser.mjs "http://127.0.0.1:$port/" web/dist "${WEB_RENDERERS:-webgl2 webgpu}"

@@ -213,8 +213,14 @@ fn add(position: [f32; 3], by_m: &Vector3<f64>) -> [f32; 3] {
     (Vector3::from(position) + by_m.cast::<f32>()).into()
 }
 
-/// The walls' render mesh.
-pub(super) fn walls_mesh(points: Vec<[f32; 3]>, indices: Vec<u32>) -> Mesh {
+/// The walls' render mesh. No walls are one degenerate triangle, which draws nothing: Bevy
+/// allocates no GPU room for a mesh without vertices, and then logs an error at each of its
+/// uploads.
+pub(super) fn walls_mesh(mut points: Vec<[f32; 3]>, mut indices: Vec<u32>) -> Mesh {
+    if points.is_empty() || indices.is_empty() {
+        points = vec![[0.0; 3]; 3];
+        indices = vec![0, 1, 2];
+    }
     let triangles: Vec<[usize; 3]> = indices
         .chunks_exact(3)
         .map(|t| [t[0] as usize, t[1] as usize, t[2] as usize])
