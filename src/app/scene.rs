@@ -12,7 +12,8 @@ use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, FieldOrigin, Pr
 use crate::cutting::keratotomy::{Cornea, REFERENCE_MESH};
 use crate::cutting::{Blade, CutError};
 use crate::devices::{
-    HapticDevice, Instrument, PressTarget, SafetySettings, VirtualDevice, VirtualHandle, Workspace,
+    Action, HapticDevice, Instrument, PressTarget, SafetySettings, VirtualDevice, VirtualHandle,
+    Workspace,
 };
 use crate::dynamics::{DynamicModel, GraspSettings, TRAINER_MODES};
 use crate::fem::{FemModel, Inclusion, Law, Material};
@@ -270,6 +271,13 @@ pub fn scene_of(
     if let Some(origin @ FieldOrigin::Built { .. }) = origin {
         eprintln!("distance field: {origin}");
     }
+    // One instrument, in the open: a scalpel where an organ is cut, a grasper where one
+    // moves, a probe otherwise (a scenario sets its own).
+    let action = match (&cutting, &dynamics) {
+        (Some(_), _) => Action::Cut,
+        (None, Some(_)) => Action::Grasp,
+        (None, None) => Action::Press,
+    };
     Ok(HapticScene {
         organs,
         probe: Probe { tip_radius_m: tip },
@@ -278,7 +286,7 @@ pub fn scene_of(
         coupling: (!coupling.is_empty()).then(|| Arc::new(coupling)),
         dynamics,
         cutting,
-        instruments: vec![Instrument::default()],
+        instruments: vec![Instrument { action, port: None }],
         scope: None,
     })
 }

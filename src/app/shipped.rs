@@ -20,6 +20,7 @@ pub const SHIPPED_SCENARIOS: &[(&str, &str)] = shipped!(
     "duodenum-navigation",
     "gallbladder-gentle-press",
     "gallbladder-grasp-retract",
+    "gallbladder-liver-two-ports",
     "gallbladder-retraction",
     "liver-capsule-incision",
     "liver-laparoscopic-press",

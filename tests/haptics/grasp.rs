@@ -10,7 +10,7 @@ use pgd_surgery::app::haptic::{
     FaultLog, ForceTrace, HapticLoop, HapticScene, OrganMotion, SceneDynamics, TickClock,
 };
 use pgd_surgery::devices::{
-    DeviceSample, SafetySettings, Scripted, TICK_S, Trajectory, TrajectoryRow,
+    Action, DeviceSample, Instrument, SafetySettings, Scripted, TICK_S, Trajectory, TrajectoryRow,
 };
 use pgd_surgery::dynamics::{DynamicModel, GraspSettings, TRAINER_MODES};
 use pgd_surgery::fem::Law;
@@ -34,6 +34,10 @@ fn moving_scene() -> HapticScene {
             organs: vec![(0, Arc::new(dynamic))],
             grasp: GraspSettings::default(),
         }),
+        instruments: vec![Instrument {
+            action: Action::Grasp,
+            port: None,
+        }],
         ..scene(SafetySettings::default())
     }
 }

@@ -67,7 +67,7 @@ fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     run_simulated(scenario, &scene, device, ticks).unwrap()
 }
 
-const SHIPPED: [&str; 11] = [
+const SHIPPED: [&str; 12] = [
     "liver-steady-press",
     "pancreas-palpation",
     "gallbladder-gentle-press",
@@ -78,6 +78,7 @@ const SHIPPED: [&str; 11] = [
     "gallbladder-grasp-retract",
     "liver-capsule-incision",
     "liver-laparoscopic-press",
+    "gallbladder-liver-two-ports",
     "cornea-radial-keratotomy",
 ];
 
