@@ -1,8 +1,9 @@
 //! The device layer, free of Bevy: the device trait and its backends (scripted, recorder,
 //! virtual, and the OpenHaptics and Force Dimension hardware over the servo link and its
 //! watchdog), the trajectory files they replay and record, the map from the device's workspace
-//! to the scene, the instruments through ports (one in hand at a time) and the laparoscope, the safety filter between
-//! the physics and the motors, and the clock that paces the 1 kHz loop.
+//! to the scene, the instruments through ports (one in hand at a time) and the laparoscope,
+//! the safety filter between the physics and the motors, and the clock that paces the 1 kHz
+//! loop.
 
 mod device;
 #[cfg(not(target_arch = "wasm32"))]

@@ -77,10 +77,6 @@ impl Rack {
         }
     }
 
-    pub fn instruments(&self) -> &[Instrument] {
-        &self.instruments
-    }
-
     /// The instrument in hand, and its place in the list.
     pub fn in_hand(&self) -> (usize, &Instrument) {
         (self.in_hand, &self.instruments[self.in_hand])
@@ -103,19 +99,20 @@ impl Rack {
     }
 
     /// Takes the device's buttons and position (in the scene) at one tick. When the change
-    /// button goes down while the instrument in hand is `free` (touching and holding nothing),
-    /// puts it down where its handle is and takes up the next, whose tip aims from its port at
-    /// `tip_m` (the one put down) the first time. Returns whether the instrument changed.
+    /// button goes down while the instrument in hand is `free` (touching and holding nothing;
+    /// asked only then), puts it down where its handle is and takes up the next, whose tip aims
+    /// from its port at `tip_m` (the one put down) the first time. Returns whether the
+    /// instrument changed.
     pub fn take(
         &mut self,
         buttons: u32,
         device_m: &Vector3<f64>,
         tip_m: &Vector3<f64>,
-        free: bool,
+        free: impl FnOnce() -> bool,
     ) -> bool {
         let pressed = buttons & CHANGE_BUTTON != 0 && self.buttons & CHANGE_BUTTON == 0;
         self.buttons = buttons;
-        if !pressed || !free || self.instruments.len() < 2 {
+        if !pressed || self.instruments.len() < 2 || !free() {
             return false;
         }
         self.put_down[self.in_hand] = Some(self.handle_m(device_m));

@@ -35,12 +35,12 @@ fn the_change_button_takes_up_the_next_instrument_where_it_was_put_down() {
     assert!((tip_a - Vector3::new(0.0, -0.2, 0.0)).norm() < 1e-15);
 
     // Pressing something: the button does nothing.
-    assert!(!rack.take(CHANGE_BUTTON, &hand, &tip_a, false));
+    assert!(!rack.take(CHANGE_BUTTON, &hand, &tip_a, || false));
     assert_eq!(rack.in_hand().0, 0);
     // Held down while the tip comes free: still nothing, the button must go down again.
-    assert!(!rack.take(CHANGE_BUTTON, &hand, &tip_a, true));
-    assert!(!rack.take(0, &hand, &tip_a, true));
-    assert!(rack.take(CHANGE_BUTTON, &hand, &tip_a, true));
+    assert!(!rack.take(CHANGE_BUTTON, &hand, &tip_a, || true));
+    assert!(!rack.take(0, &hand, &tip_a, || true));
+    assert!(rack.take(CHANGE_BUTTON, &hand, &tip_a, || true));
     assert_eq!(rack.in_hand().0, 1);
     assert_eq!(rack.put_down(0), Some(hand));
 
@@ -59,8 +59,8 @@ fn the_change_button_takes_up_the_next_instrument_where_it_was_put_down() {
 
     // Back to A, the device wherever it now is: A's handle is where it was put down, and B's
     // where the device left it.
-    assert!(!rack.take(0, &moved, &tip_b, true));
-    assert!(rack.take(CHANGE_BUTTON, &moved, &tip_b, true));
+    assert!(!rack.take(0, &moved, &tip_b, || true));
+    assert!(rack.take(CHANGE_BUTTON, &moved, &tip_b, || true));
     assert_eq!(rack.in_hand().0, 0);
     assert!((rack.handle_m(&moved) - hand).norm() < 1e-15);
     assert!((tip(&rack, &moved) - tip_a).norm() < 1e-15);
@@ -76,7 +76,7 @@ fn the_change_button_takes_up_the_next_instrument_where_it_was_put_down() {
 fn one_instrument_is_never_changed() {
     let mut rack = Rack::new(&two_probes()[..1]);
     let hand = Vector3::new(0.0, 0.1, 0.0);
-    assert!(!rack.take(CHANGE_BUTTON, &hand, &Vector3::zeros(), true));
+    assert!(!rack.take(CHANGE_BUTTON, &hand, &Vector3::zeros(), || true));
     assert_eq!(rack.in_hand().0, 0);
     assert_eq!(rack.handle_m(&hand), hand);
 }

@@ -49,8 +49,9 @@ pub fn change_instrument(
     let Some(hand) = tool.hand else {
         return;
     };
-    let free =
-        touches.iter().all(|t| t.contact.is_none()) && motions.iter().all(|m| !m.organ.holding());
+    let free = || {
+        touches.iter().all(|t| t.contact.is_none()) && motions.iter().all(|m| !m.organ.holding())
+    };
     let tip = tool.sample.map_or(hand.tip_m, |s| s.tip_m);
     if tool.rack.take(hand.buttons, &hand.tip_m, &tip, free) {
         tool.pose = None;

@@ -45,9 +45,9 @@ fn drive_virtual_device(
         return;
     };
     let forward = eye.forward();
-    // The cursor places the tool's tip in the scene; the device's handle is in its own
-    // workspace and, through a port, where the shaft to that tip puts it.
-    // The instrument in hand: its port, and the offset its handle is indexed by.
+    // The cursor places the tip of the instrument in hand in the scene; the device's handle
+    // is in its own workspace, offset by the instrument's indexing and, through its port,
+    // where the shaft to that tip puts it.
     let workspace = link.scene.workspace;
     let instruments = &snapshot.0.instruments;
     let port = (link.scene.instruments.get(instruments.in_hand)).and_then(|i| i.port);
