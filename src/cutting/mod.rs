@@ -11,6 +11,7 @@ mod clip;
 mod enrichment;
 mod incision;
 pub mod keratotomy;
+mod local;
 mod response;
 mod scalpel;
 pub mod split_mesh;

@@ -20,6 +20,14 @@ pub struct Response {
 pub trait UncutResponse {
     fn node_count(&self) -> usize;
 
+    /// The global modes of the response's separated sum: none for an exact response, whose
+    /// enriched functions' responses are exact; with modes, the cut state solves a patch
+    /// around each new segment instead (`local.rs`).
+    fn modes(&self) -> usize;
+
+    /// Whether a load at `node` is in the region the response answers for.
+    fn covers(&self, node: usize) -> bool;
+
     /// The responses to `loads`; an error names a loaded node the response does not cover.
     fn respond(&self, loads: &[SparseDofs]) -> Result<Vec<Response>, CutError>;
 
@@ -34,6 +42,14 @@ pub trait UncutResponse {
 impl<R: UncutResponse + ?Sized> UncutResponse for &R {
     fn node_count(&self) -> usize {
         (**self).node_count()
+    }
+
+    fn modes(&self) -> usize {
+        (**self).modes()
+    }
+
+    fn covers(&self, node: usize) -> bool {
+        (**self).covers(node)
     }
 
     fn respond(&self, loads: &[SparseDofs]) -> Result<Vec<Response>, CutError> {
@@ -71,6 +87,14 @@ impl ExactResponse {
 impl UncutResponse for ExactResponse {
     fn node_count(&self) -> usize {
         self.node_count
+    }
+
+    fn modes(&self) -> usize {
+        0
+    }
+
+    fn covers(&self, _: usize) -> bool {
+        true
     }
 
     fn respond(&self, loads: &[SparseDofs]) -> Result<Vec<Response>, CutError> {
@@ -113,6 +137,14 @@ impl UncutResponse for ExactResponse {
 impl UncutResponse for RegionResponse {
     fn node_count(&self) -> usize {
         RegionResponse::node_count(self)
+    }
+
+    fn modes(&self) -> usize {
+        RegionResponse::modes(self)
+    }
+
+    fn covers(&self, node: usize) -> bool {
+        RegionResponse::covers(self, node)
     }
 
     fn respond(&self, loads: &[SparseDofs]) -> Result<Vec<Response>, CutError> {

@@ -28,6 +28,7 @@ use rayon::prelude::*;
 use super::CutError;
 use super::enrichment::{Enriched, Enrichment, Front};
 use super::incision::{CutFace, Incision};
+use super::local::{LocalResponse, PatchSolver};
 use super::response::{Response, UncutResponse};
 use super::view::{CutView, add_surface_part, backward, gram, surface_dof};
 use super::xfem::{CutSolution, element_functions, piece_weights};
@@ -74,6 +75,11 @@ pub struct CutState<M: Borrow<FemModel>, R: UncutResponse> {
     surface_index_of: Vec<usize>,
     /// Per unknown, `Xᵀ` of its column of `B`: its products with any response's modal part.
     rows: Vec<Vec<f64>>,
+    /// Per unknown, `Xᵀ ρ` of its patch response's residual (empty for an exact response).
+    residual_modes: Vec<Vec<f64>>,
+    /// The patch solves behind a compressed response's enriched functions; `None` for an
+    /// exact response.
+    local: Option<PatchSolver>,
     /// The lower Cholesky factor of `S`, row by row (row `i` holds `i + 1` entries).
     factor: Vec<Vec<f64>>,
     /// Where the cut's front falls between element faces.
@@ -84,6 +90,14 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
     /// The uncut organ: `model` gives the mesh, the material and the held nodes, `response`
     /// its uncut solves.
     pub fn new(model: M, response: R) -> Self {
+        let local = (response.modes() > 0).then(|| {
+            let radius_m = PATCH_EDGES * mean_edge_m(model.borrow());
+            PatchSolver::new(model.borrow(), &response, radius_m)
+        });
+        Self::with_local(model, response, local)
+    }
+
+    fn with_local(model: M, response: R, local: Option<PatchSolver>) -> Self {
         let surface = Surface::extract(model.borrow().mesh());
         let nodes = model.borrow().mesh().node_count();
         Self {
@@ -98,9 +112,20 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
             z_hat_surface: vec![Vec::new(); 3 * surface.nodes.len()],
             surface_index_of: surface.surface_index_of,
             rows: Vec::new(),
+            residual_modes: Vec::new(),
+            local,
             factor: Vec::new(),
             front: Front::Inward,
         }
+    }
+
+    /// The state with a compressed response's patches reaching `radius_m` from the loaded
+    /// nodes (before any cut is made); an exact response solves no patch.
+    pub fn with_patch_radius(mut self, radius_m: f64) -> Self {
+        if let Some(local) = &mut self.local {
+            local.set_radius(radius_m);
+        }
+        self
     }
 
     fn model(&self) -> &FemModel {
@@ -117,7 +142,7 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
     /// response (its factorization) kept.
     pub fn heal(self) -> Self {
         let front = self.front;
-        Self::new(self.model, self.response).with_front(front)
+        Self::with_local(self.model, self.response, self.local).with_front(front)
     }
 
     /// Sets a new blade on the surface (see [`Incision::start`]); returns its index.
@@ -233,7 +258,9 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
             .map(|p| -self.product(p, &response.modal, &u))
             .collect();
         let y = self.forward(rhs);
+        // An uncut field known exactly has no modal part; `Z`'s may still have one.
         let mut modal = response.modal;
+        modal.resize(self.response.modes(), 0.0);
         for (z, &yj) in self.z_modal.iter().zip(&y) {
             modal.iter_mut().zip(z).for_each(|(m, a)| *m -= yj * a);
         }
@@ -405,35 +432,95 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
         }
         let first_new = 3 * self.functions.len();
         let (coupling, a) = self.new_blocks(enrichment, &slot, first_new, 3 * added.len());
-        let z = self.response.respond(&coupling)?;
+        let local = match &self.local {
+            None => self
+                .response
+                .respond(&coupling)?
+                .into_iter()
+                .map(|response| LocalResponse {
+                    response,
+                    ..LocalResponse::default()
+                })
+                .collect(),
+            Some(solver) => solver.respond(&coupling, &self.response)?,
+        };
         let rows: Vec<Vec<f64>> = coupling
             .iter()
             .map(|b| self.response.spatial_products(b))
             .collect();
-        // S's new columns: A − Bᵀ Z, against every unknown, old and new.
-        let total = first_new + z.len();
-        let mut near = vec![0.0; 3 * self.model().mesh().node_count()];
-        let mut columns = vec![vec![0.0; total]; z.len()];
-        for (r, column) in columns.iter_mut().enumerate() {
-            scatter(&z[r].near, 1.0, &mut near);
-            for (p, entry) in column.iter_mut().enumerate() {
-                let (b, row) = if p < first_new {
-                    (&self.coupling[p], &self.rows[p])
-                } else {
-                    (&coupling[p - first_new], &rows[p - first_new])
-                };
-                let modal: f64 = row.iter().zip(&z[r].modal).map(|(x, m)| x * m).sum();
-                let near_part: f64 = b.iter().map(|&(d, v)| v * near[d]).sum();
-                *entry = a.get(&(p, first_new + r)).copied().unwrap_or(0.0) - modal - near_part;
-            }
-            scatter(&z[r].near, -1.0, &mut near);
-        }
+        let columns = self.condensed_columns(&coupling, &a, &local);
         self.border(&columns)?;
         self.functions.extend(added);
         self.coupling.extend(coupling);
+        let mut z = Vec::with_capacity(local.len());
+        for response in local {
+            self.residual_modes.push(response.residual_modes);
+            z.push(response.response);
+        }
         self.push_responses(z);
         self.rows.extend(rows);
         Ok(())
+    }
+
+    /// The condensed matrix's new columns, against every unknown, old then new:
+    /// `S̃_pr = A_pr − b_pᵀ r_r + r_pᵀ ρ_r + (Xᵀ ρ_p) · c_r` (`local.rs`; with an exact
+    /// response `ρ = 0` and this is `A − Bᵀ K⁻¹ B`).
+    fn condensed_columns(
+        &self,
+        coupling: &[SparseColumn],
+        a: &Entries,
+        new: &[LocalResponse],
+    ) -> Vec<Vec<f64>> {
+        let first_new = self.coupling.len();
+        let total = first_new + new.len();
+        let mut near = vec![0.0; 3 * self.model().mesh().node_count()];
+        let mut columns = vec![vec![0.0; total]; new.len()];
+        for (r, column) in columns.iter_mut().enumerate() {
+            let z = &new[r].response;
+            scatter(&z.near, 1.0, &mut near);
+            let edge = self.edge_products(&new[r].residual, new);
+            for (p, entry) in column.iter_mut().enumerate() {
+                let (b, residual_modes) = match p < first_new {
+                    true => (&self.coupling[p], &self.residual_modes[p]),
+                    false => (&coupling[p - first_new], &new[p - first_new].residual_modes),
+                };
+                let modal: f64 = residual_modes
+                    .iter()
+                    .zip(&z.modal)
+                    .map(|(x, c)| x * c)
+                    .sum();
+                let near_part: f64 = b.iter().map(|&(d, v)| v * near[d]).sum();
+                *entry = a.get(&(p, first_new + r)).copied().unwrap_or(0.0) - near_part
+                    + edge[p]
+                    + modal;
+            }
+            scatter(&z.near, -1.0, &mut near);
+        }
+        columns
+    }
+
+    /// `r_pᵀ ρ` for every unknown `p`, old (through their responses per dof) then `new`.
+    fn edge_products(&self, residual: &[(usize, f64)], new: &[LocalResponse]) -> Vec<f64> {
+        let mut products = vec![0.0; self.coupling.len() + new.len()];
+        if residual.is_empty() {
+            return products;
+        }
+        for &(d, rho) in residual {
+            for &(p, v) in &self.z_near[d] {
+                products[p as usize] += v * rho;
+            }
+        }
+        let mut dense = vec![0.0; 3 * self.model().mesh().node_count()];
+        scatter(residual, 1.0, &mut dense);
+        for (k, response) in new.iter().enumerate() {
+            products[self.coupling.len() + k] = response
+                .response
+                .near
+                .iter()
+                .map(|&(d, v)| v * dense[d])
+                .sum();
+        }
+        products
     }
 
     /// Appends the new unknowns' responses: `Z`'s rest as it is, and `Ẑ`'s modal part and
@@ -581,6 +668,22 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
     fn backward(&self, x: Vec<f64>) -> Vec<f64> {
         backward(&self.factor, x)
     }
+}
+
+/// A compressed response's patch reaches this many mean element edges from the loaded nodes.
+const PATCH_EDGES: f64 = 3.0;
+
+/// The mean edge length of the model's tetrahedra (m).
+fn mean_edge_m(model: &FemModel) -> f64 {
+    let nodes = model.mesh().nodes();
+    let (mut sum, mut count) = (0.0, 0usize);
+    for tet in model.mesh().tets() {
+        for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+            sum += (nodes[tet[i]] - nodes[tet[j]]).norm();
+            count += 1;
+        }
+    }
+    sum / count.max(1) as f64
 }
 
 /// The patch's unit loads along x, y and z: each node's share on its dof of that axis.

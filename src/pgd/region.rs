@@ -263,6 +263,11 @@ impl RegionResponse {
             .map(|m| m as usize)
     }
 
+    /// Whether the region holds `node`, or holds it still (a load there moves nothing).
+    pub fn covers(&self, node: usize) -> bool {
+        self.slot.get(node).is_some_and(|&m| m != OUTSIDE)
+    }
+
     /// `Yᵀ f`: the modal coefficients of the response to the sparse load `load` (loads on
     /// held nodes move nothing). `Err(node)` names a loaded node outside the region.
     pub fn modal_coefficients(&self, load: &[(usize, f64)]) -> Result<Vec<f64>, usize> {

@@ -96,6 +96,10 @@ pub enum Command {
         /// section (the reference path; a sparse solve per enriched function).
         #[arg(long, requires = "cuts")]
         exact_response: bool,
+        /// With --cuts: how far from a segment's enriched functions the patch solved for
+        /// them reaches, in millimetres (default: three mean element edges).
+        #[arg(long, requires = "cuts", conflicts_with = "exact_response")]
+        cut_patch_mm: Option<f64>,
         /// Print the report as JSON.
         #[arg(long)]
         json: bool,

@@ -93,6 +93,7 @@ fn main() -> ExitCode {
             max_indentation_mm,
             cuts,
             exact_response,
+            cut_patch_mm,
             json,
         } => {
             let file = vademecum.unwrap_or_else(|| args::default_vademecum(&mesh, law.law()));
@@ -101,6 +102,7 @@ fn main() -> ExitCode {
                     pattern,
                     samples: samples.unwrap_or(CutValidationSettings::default().samples),
                     seed: sample_seed,
+                    patch_radius_m: cut_patch_mm.map(|mm| mm * 1e-3),
                     ..CutValidationSettings::default()
                 };
                 return validate_cut_section(&mesh, &file, (&settings, exact_response), json);
