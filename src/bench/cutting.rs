@@ -79,6 +79,7 @@ pub fn run(cells: [usize; 3]) -> Result<CuttingBenchReport, String> {
         depth_m: 20.0 * MM,
         near_radius_m: 6.0 * MM,
         modes: 40,
+        patch_radius_m: None,
     };
     let region = RegionResponse::region_nodes(&stiffness, &top_faces, settings.depth_m);
     let (vademecum, _) =

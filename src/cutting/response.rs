@@ -28,6 +28,9 @@ pub trait UncutResponse {
     /// Whether a load at `node` is in the region the response answers for.
     fn covers(&self, node: usize) -> bool;
 
+    /// How far the cut state's patch solves reach (m), where the response says.
+    fn patch_radius_m(&self) -> Option<f64>;
+
     /// The responses to `loads`; an error names a loaded node the response does not cover.
     fn respond(&self, loads: &[SparseDofs]) -> Result<Vec<Response>, CutError>;
 
@@ -50,6 +53,10 @@ impl<R: UncutResponse + ?Sized> UncutResponse for &R {
 
     fn covers(&self, node: usize) -> bool {
         (**self).covers(node)
+    }
+
+    fn patch_radius_m(&self) -> Option<f64> {
+        (**self).patch_radius_m()
     }
 
     fn respond(&self, loads: &[SparseDofs]) -> Result<Vec<Response>, CutError> {
@@ -95,6 +102,10 @@ impl UncutResponse for ExactResponse {
 
     fn covers(&self, _: usize) -> bool {
         true
+    }
+
+    fn patch_radius_m(&self) -> Option<f64> {
+        None
     }
 
     fn respond(&self, loads: &[SparseDofs]) -> Result<Vec<Response>, CutError> {
@@ -145,6 +156,10 @@ impl UncutResponse for RegionResponse {
 
     fn covers(&self, node: usize) -> bool {
         RegionResponse::covers(self, node)
+    }
+
+    fn patch_radius_m(&self) -> Option<f64> {
+        self.patch_radius_m
     }
 
     fn respond(&self, loads: &[SparseDofs]) -> Result<Vec<Response>, CutError> {

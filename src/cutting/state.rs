@@ -91,7 +91,9 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
     /// its uncut solves.
     pub fn new(model: M, response: R) -> Self {
         let local = (response.modes() > 0).then(|| {
-            let radius_m = PATCH_EDGES * mean_edge_m(model.borrow());
+            let radius_m = response
+                .patch_radius_m()
+                .unwrap_or_else(|| PATCH_EDGES * mean_edge_m(model.borrow()));
             PatchSolver::new(model.borrow(), &response, radius_m)
         });
         Self::with_local(model, response, local)
@@ -670,7 +672,8 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
     }
 }
 
-/// A compressed response's patch reaches this many mean element edges from the loaded nodes.
+/// A compressed response that does not say how far its patches reach has them reach this
+/// many mean element edges from the loaded nodes.
 const PATCH_EDGES: f64 = 3.0;
 
 /// The mean edge length of the model's tetrahedra (m).

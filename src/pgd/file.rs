@@ -177,14 +177,17 @@ fn read_cuts(r: &mut Reader, header: &Header) -> Result<Option<RegionResponse>, 
         r.take("cut near fields")?,
     );
     check_cuts(r, header, (&positions, &held, &spatial, &parametric), &near)?;
-    Ok(Some(RegionResponse::new(
-        positions,
-        spatial,
-        parametric,
-        held,
-        near,
-        header.node_count,
-    )))
+    Ok(Some(
+        RegionResponse::new(
+            positions,
+            spatial,
+            parametric,
+            held,
+            near,
+            header.node_count,
+        )
+        .with_patch_radius(header.cuts.as_ref().and_then(|c| c.settings.patch_radius_m)),
+    ))
 }
 
 /// The cut arrays agree with the header and with each other.

@@ -33,25 +33,33 @@ pub struct RegionSettings {
     pub near_radius_m: f64,
     /// PGD modes of the far field.
     pub modes: usize,
+    /// How far from a segment's enriched functions the cut state's patch solve reaches (m);
+    /// `None` (files written before it was stored) leaves the cut state's default.
+    #[serde(default)]
+    pub patch_radius_m: Option<f64>,
 }
 
 impl RegionSettings {
     /// Cuts as deep as the organ's surgery takes them. The cornea: every node (1.5 times its
     /// thickness under the anterior face, so that the posterior face, which the intraocular
     /// pressure loads, is in; radial keratotomy cuts to 95 % of the thickness), a near field
-    /// of 1 mm (two elements of the keratotomy mesh). The abdominal organs: 20 mm under the
-    /// accessible faces, an 8 mm near field.
+    /// of 1 mm (two elements of the keratotomy mesh), patches of 3 mm (the cornea is a thin
+    /// shell, whose bending carries an incision's effect several thicknesses away). The
+    /// abdominal organs: 20 mm under the accessible faces, an 8 mm near field, patches of
+    /// 20 mm (about three elements).
     pub fn for_organ(organ: Option<Organ>) -> Self {
         match organ {
             Some(Organ::Cornea) => Self {
                 depth_m: 1.5 * CORNEA_THICKNESS_M,
                 near_radius_m: 1e-3,
                 modes: 40,
+                patch_radius_m: Some(3e-3),
             },
             _ => Self {
                 depth_m: 0.02,
                 near_radius_m: 8e-3,
                 modes: 40,
+                patch_radius_m: Some(0.02),
             },
         }
     }
@@ -84,6 +92,8 @@ pub struct RegionResponse {
     pub near_offsets: Vec<u32>,
     pub near_nodes: Vec<u32>,
     pub near: Vec<f32>,
+    /// The radius of the cut state's patch solves (m), from the settings it was built with.
+    pub patch_radius_m: Option<f64>,
     /// Per volume node, its position, [`HELD`] where every dof is prescribed, or [`OUTSIDE`].
     slot: Vec<u32>,
 }
@@ -203,7 +213,8 @@ impl RegionResponse {
             held_nodes(&stiffness.model.dofs().free_index),
             (near_offsets, near.concat(), near_values),
             mesh.node_count(),
-        );
+        )
+        .with_patch_radius(settings.patch_radius_m);
         let report = RegionReport {
             positions: region.positions.len(),
             modes: field.modes(),
@@ -242,7 +253,16 @@ impl RegionResponse {
             near_offsets,
             near_nodes,
             near,
+            patch_radius_m: None,
             slot,
+        }
+    }
+
+    /// The response with the radius its cut state's patch solves reach (m).
+    pub fn with_patch_radius(self, patch_radius_m: Option<f64>) -> Self {
+        Self {
+            patch_radius_m,
+            ..self
         }
     }
 

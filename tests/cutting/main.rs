@@ -473,6 +473,7 @@ fn block_cut_vademecum() -> (FemModel, Loads, pgd_surgery::pgd::RegionResponse) 
         depth_m: 20.0 * MM,
         near_radius_m: 6.0 * MM,
         modes: 40,
+        patch_radius_m: None,
     };
     let region = RegionResponse::region_nodes(&stiffness, &top, settings.depth_m);
     let (response, report) =

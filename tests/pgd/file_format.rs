@@ -102,6 +102,7 @@ fn a_cut_section_survives_the_round_trip() {
         depth_m: 0.02,
         near_radius_m: 0.01,
         modes: 3,
+        patch_radius_m: Some(0.005),
     };
     let report = add_cuts(&mut vademecum, &model, &settings, &Silent).unwrap();
     assert!(report.positions > 0 && report.modes > 0, "{report:?}");

@@ -327,6 +327,7 @@ impl BuildArgs {
             depth_m: length("cut-depth-mm", self.cut_depth_mm, defaults.depth_m)?,
             near_radius_m: length("cut-near-mm", self.cut_near_mm, defaults.near_radius_m)?,
             modes,
+            patch_radius_m: defaults.patch_radius_m,
         }))
     }
 
