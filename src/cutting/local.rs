@@ -50,6 +50,14 @@ pub struct LocalResponse {
     pub residual_modes: Vec<f64>,
 }
 
+/// The stiffness entries between a patch and the free dofs just outside it.
+struct Edge {
+    /// The outside dofs (full numbering).
+    rows: Vec<usize>,
+    /// `(patch dof, place in rows, K entry)`.
+    entries: Vec<(usize, usize, f64)>,
+}
+
 /// The rest stiffness and the modes' Gram matrix, to solve patches around new functions.
 pub struct PatchSolver {
     /// Free-dof rest stiffness, both triangles.
@@ -110,10 +118,36 @@ impl PatchSolver {
             }
         }
         self.solve_patch(&patch, &local, &mut block)?;
+        let edge = self.edge(&patch, &local);
         Ok(block
             .chunks_exact(n)
-            .map(|column| self.local_response(&patch, &local, column, modes))
+            .map(|column| self.local_response(&patch, &edge, column, modes))
             .collect())
+    }
+
+    /// The stiffness entries that couple the patch's dofs to the free dofs just outside it:
+    /// all that a patch response's residual reads.
+    fn edge(&self, patch: &[usize], local: &[usize]) -> Edge {
+        let (row_idx, col_ptr) = (
+            self.stiffness.symbolic().row_idx(),
+            self.stiffness.symbolic().col_ptr(),
+        );
+        let values = self.stiffness.val();
+        let mut rows: Vec<usize> = Vec::new();
+        let mut slot = std::collections::HashMap::new();
+        let mut entries = Vec::new();
+        for (i, &f) in patch.iter().enumerate() {
+            for p in col_ptr[f]..col_ptr[f + 1] {
+                if local[row_idx[p]] == usize::MAX {
+                    let k = *slot.entry(row_idx[p]).or_insert_with(|| {
+                        rows.push(self.free_dofs[row_idx[p]]);
+                        rows.len() - 1
+                    });
+                    entries.push((i, k, values[p]));
+                }
+            }
+        }
+        Edge { rows, entries }
     }
 
     /// The free dofs of the nodes within the radius of a loaded node, found by walking the
@@ -207,25 +241,16 @@ impl PatchSolver {
     fn local_response(
         &self,
         patch: &[usize],
-        local: &[usize],
+        edge: &Edge,
         column: &[f64],
         modes: &impl UncutResponse,
     ) -> LocalResponse {
-        let (row_idx, col_ptr) = (
-            self.stiffness.symbolic().row_idx(),
-            self.stiffness.symbolic().col_ptr(),
-        );
-        let values = self.stiffness.val();
         // K r outside the patch (inside, it equals the load to round-off).
-        let mut reaction = std::collections::BTreeMap::new();
-        for (&f, &r) in patch.iter().zip(column) {
-            for p in col_ptr[f]..col_ptr[f + 1] {
-                if local[row_idx[p]] == usize::MAX {
-                    *reaction.entry(self.free_dofs[row_idx[p]]).or_insert(0.0) += values[p] * r;
-                }
-            }
+        let mut reaction = vec![0.0; edge.rows.len()];
+        for &(i, k, value) in &edge.entries {
+            reaction[k] += value * column[i];
         }
-        let residual: SparseDofs = reaction.into_iter().collect();
+        let residual: SparseDofs = edge.rows.iter().copied().zip(reaction).collect();
         let residual_modes = modes.spatial_products(&residual);
         let modal = -(&self.gram_inverse * DVector::from_column_slice(&residual_modes));
         LocalResponse {
