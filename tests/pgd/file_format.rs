@@ -111,6 +111,11 @@ fn a_cut_section_survives_the_round_trip() {
     let back = load(&path).unwrap();
     assert_eq!(back, vademecum);
     let cuts = back.cuts.as_ref().unwrap();
+    assert_eq!(
+        cuts.patch_radius_m,
+        Some(0.005),
+        "the patch radius travels in the header"
+    );
     let node = cuts.positions[0] as usize;
     let unit = [(3 * node + 2, 1.0)];
     assert_eq!(

@@ -98,11 +98,18 @@ fn main() -> ExitCode {
         } => {
             let file = vademecum.unwrap_or_else(|| args::default_vademecum(&mesh, law.law()));
             if let Some(pattern) = cuts {
+                let patch_radius_m = match cut_patch_mm {
+                    Some(mm) => match args::millimetres("cut-patch-mm", Some(mm), 0.0) {
+                        Ok(m) => Some(m),
+                        Err(e) => return fail("pgd validate --cuts", &e),
+                    },
+                    None => None,
+                };
                 let settings = CutValidationSettings {
                     pattern,
                     samples: samples.unwrap_or(CutValidationSettings::default().samples),
                     seed: sample_seed,
-                    patch_radius_m: cut_patch_mm.map(|mm| mm * 1e-3),
+                    patch_radius_m,
                     ..CutValidationSettings::default()
                 };
                 return validate_cut_section(&mesh, &file, (&settings, exact_response), json);
