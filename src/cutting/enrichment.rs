@@ -85,8 +85,18 @@ impl Enrichment {
 
     /// The enrichment with the cut's front placed as `front` says.
     pub fn with_front(mesh: &TetMesh, faces: &[CutFace], front: Front) -> Self {
-        let snap_m = SNAP * mesh_size_m(mesh);
-        let supports = supports(mesh);
+        Self::over(mesh, &Supports::new(mesh), faces, front)
+    }
+
+    /// [`Self::with_front`] with the mesh's `supports` at hand (a cut state keeps them, as
+    /// its cuts grow over the same mesh).
+    pub fn over(mesh: &TetMesh, supports: &Supports, faces: &[CutFace], front: Front) -> Self {
+        let Supports {
+            elements: supports,
+            reach_m: reach,
+            snap_m,
+        } = supports;
+        let snap_m = *snap_m;
         let mut functions = Vec::new();
         for (k, face) in faces.iter().enumerate() {
             let phi: Vec<f64> = mesh
@@ -95,6 +105,11 @@ impl Enrichment {
                 .map(|p| snapped(face.signed_distance(p), snap_m))
                 .collect();
             for (node, support) in supports.iter().enumerate() {
+                // A plane farther from the node than its support reaches leaves the support
+                // on one side.
+                if phi[node].abs() > reach[node] {
+                    continue;
+                }
                 if cuts_support(mesh, (face, front), &phi, support, snap_m) {
                     functions.push(Enriched {
                         node,
@@ -120,41 +135,37 @@ impl Enrichment {
     /// from the piece's side of every face enriching it; pieces that see a node the same way
     /// share it, as elements of a mesh share nodes, and a chunk is a connected set of them.
     pub fn detaches(&self, mesh: &TetMesh, held: impl Fn(usize) -> bool) -> bool {
+        // A corner no enriched function names is its node, as in the uncut mesh (ids
+        // `0..n`); the others are keyed by how their piece sees the faces.
+        let n = mesh.node_count();
+        let mut anchored: Vec<bool> = (0..n).map(&held).collect();
+        let mut used = vec![false; n];
         let mut seen: HashMap<(usize, Vec<(usize, i8)>), usize> = HashMap::new();
         let mut chunks = UnionFind::default();
-        let mut anchored = Vec::new();
+        chunks.grow(n);
         for (tet, cut) in mesh.tets().iter().zip(&self.elements) {
-            let whole = [Piece {
-                volume_m3: 0.0,
-                sides: vec![],
-            }];
-            let pieces = if cut.pieces.is_empty() {
-                &whole[..]
-            } else {
-                &cut.pieces
-            };
-            for piece in pieces {
-                let corners = (0..4).map(|a| {
-                    let view: Vec<(usize, i8)> = cut
-                        .functions
-                        .iter()
-                        .filter(|&&(_, corner)| corner == a)
-                        .map(|&(j, _)| {
-                            let k = self.functions[j].face;
-                            let slot = cut.faces.iter().position(|&f| f == k).expect("named");
-                            (k, piece.sides[slot])
+            if cut.functions.is_empty() || cut.pieces.is_empty() {
+                tet.iter().for_each(|&node| used[node] = true);
+                for w in tet.windows(2) {
+                    chunks.join(w[0], w[1]);
+                }
+                continue;
+            }
+            for piece in &cut.pieces {
+                let ids: Vec<usize> = (0..4)
+                    .map(|a| {
+                        let view = self.corner_view(cut, piece, a);
+                        if view.is_empty() {
+                            used[tet[a]] = true;
+                            return tet[a];
+                        }
+                        *seen.entry((tet[a], view)).or_insert_with(|| {
+                            anchored.push(held(tet[a]));
+                            chunks.grow(anchored.len());
+                            anchored.len() - 1
                         })
-                        .collect();
-                    let key = (tet[a], view);
-                    let next = seen.len();
-                    let id = *seen.entry(key).or_insert_with(|| {
-                        anchored.push(held(tet[a]));
-                        next
-                    });
-                    chunks.grow(id + 1);
-                    id
-                });
-                let ids: Vec<usize> = corners.collect();
+                    })
+                    .collect();
                 for w in ids.windows(2) {
                     chunks.join(w[0], w[1]);
                 }
@@ -166,7 +177,21 @@ impl Enrichment {
                 held_chunk[chunks.root(id)] = true;
             }
         }
-        (0..anchored.len()).any(|id| !held_chunk[chunks.root(id)])
+        (0..anchored.len()).any(|id| (id >= n || used[id]) && !held_chunk[chunks.root(id)])
+    }
+
+    /// How `piece` sees corner `a` of its element: the side of every face enriching that
+    /// corner's node, by face.
+    fn corner_view(&self, cut: &ElementCut, piece: &Piece, a: usize) -> Vec<(usize, i8)> {
+        cut.functions
+            .iter()
+            .filter(|&&(_, corner)| corner == a)
+            .map(|&(j, _)| {
+                let k = self.functions[j].face;
+                let slot = cut.faces.iter().position(|&f| f == k).expect("named");
+                (k, piece.sides[slot])
+            })
+            .collect()
     }
 }
 
@@ -197,15 +222,42 @@ impl UnionFind {
     }
 }
 
-/// Each node's elements.
-fn supports(mesh: &TetMesh) -> Vec<Vec<usize>> {
-    let mut out = vec![Vec::new(); mesh.node_count()];
-    for (t, tet) in mesh.tets().iter().enumerate() {
-        for &n in tet {
-            out[n].push(t);
+/// What enriching a mesh needs of it whatever the cut: each node's support and its reach.
+#[derive(Clone, Debug)]
+pub struct Supports {
+    /// Each node's elements.
+    elements: Vec<Vec<usize>>,
+    /// Per node, the farthest any corner of its elements lies from it (m).
+    reach_m: Vec<f64>,
+    /// Distances to a face's plane this small count as on it (m).
+    snap_m: f64,
+}
+
+impl Supports {
+    pub fn new(mesh: &TetMesh) -> Self {
+        let mut elements = vec![Vec::new(); mesh.node_count()];
+        for (t, tet) in mesh.tets().iter().enumerate() {
+            for &n in tet {
+                elements[n].push(t);
+            }
+        }
+        let nodes = mesh.nodes();
+        let reach_m = elements
+            .iter()
+            .enumerate()
+            .map(|(n, support): (usize, &Vec<usize>)| {
+                let corners = support.iter().flat_map(|&t| mesh.tets()[t]);
+                corners
+                    .map(|m| (nodes[m] - nodes[n]).norm())
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        Self {
+            elements,
+            reach_m,
+            snap_m: SNAP * mesh_size_m(mesh),
         }
     }
-    out
 }
 
 fn mesh_size_m(mesh: &TetMesh) -> f64 {

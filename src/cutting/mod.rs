@@ -21,7 +21,7 @@ mod view;
 mod worker;
 pub mod xfem;
 
-pub use enrichment::{ElementCut, Enriched, Enrichment, Front, Piece, SLIVER};
+pub use enrichment::{ElementCut, Enriched, Enrichment, Front, Piece, SLIVER, Supports};
 pub use incision::{CutFace, Extent, Incision, MIN_SEGMENT_M};
 pub use response::{ExactResponse, Response, UncutResponse};
 pub use scalpel::{

@@ -26,7 +26,7 @@ use nalgebra::{Matrix3, Point3, Vector3};
 use rayon::prelude::*;
 
 use super::CutError;
-use super::enrichment::{Enriched, Enrichment, Front};
+use super::enrichment::{Enriched, Enrichment, Front, Supports};
 use super::incision::{CutFace, Incision};
 use super::local::{LocalResponse, PatchSolver};
 use super::response::{Response, UncutResponse};
@@ -84,6 +84,8 @@ pub struct CutState<M: Borrow<FemModel>, R: UncutResponse> {
     factor: Vec<Vec<f64>>,
     /// Where the cut's front falls between element faces.
     front: Front,
+    /// The mesh's supports, which every segment's enrichment reads.
+    supports: Supports,
 }
 
 impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
@@ -102,6 +104,7 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
     fn with_local(model: M, response: R, local: Option<PatchSolver>) -> Self {
         let surface = Surface::extract(model.borrow().mesh());
         let nodes = model.borrow().mesh().node_count();
+        let supports = Supports::new(model.borrow().mesh());
         Self {
             model,
             response,
@@ -118,6 +121,7 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
             local,
             factor: Vec::new(),
             front: Front::Inward,
+            supports,
         }
     }
 
@@ -199,7 +203,7 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
     /// Takes `faces` as the cut, growing the system by the functions they add; a refused cut
     /// leaves the state as it was.
     fn apply(&mut self, faces: Vec<CutFace>) -> Result<(), CutError> {
-        let enrichment = Enrichment::with_front(self.model().mesh(), &faces, self.front);
+        let enrichment = Enrichment::over(self.model().mesh(), &self.supports, &faces, self.front);
         let held = |n: usize| self.model().dofs().free_index[3 * n] == PRESCRIBED;
         if enrichment.detaches(self.model().mesh(), held) {
             return Err(CutError::Detached);
@@ -237,7 +241,7 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
     /// standing load such as the intraocular pressure has it computed once, exactly).
     pub fn solve_from(&self, uncut: Response) -> CutSolution {
         let (nodes_m, q) = self.condensed(uncut);
-        let order = Enrichment::with_front(self.model().mesh(), &self.faces, self.front);
+        let order = Enrichment::over(self.model().mesh(), &self.supports, &self.faces, self.front);
         let index = self.function_index();
         let mut enriched_m = Vec::with_capacity(q.len());
         for f in &order.functions {
