@@ -277,11 +277,6 @@ fn gram_inverse(
 ) -> DMatrix<f64> {
     let m = modes.modes();
     let free = &model.dofs().free_dofs;
-    let (row_idx, col_ptr) = (
-        stiffness.symbolic().row_idx(),
-        stiffness.symbolic().col_ptr(),
-    );
-    let values = stiffness.val();
     let mut full = vec![0.0; 3 * model.mesh().node_count()];
     let (mut x, mut kx) = (Vec::with_capacity(m), Vec::with_capacity(m));
     for k in 0..m {
@@ -291,11 +286,7 @@ fn gram_inverse(
         modes.add_spatial(&unit, &mut full);
         let xk: Vec<f64> = free.iter().map(|&d| full[d]).collect();
         let mut yk = vec![0.0; free.len()];
-        for (j, &xj) in xk.iter().enumerate() {
-            for p in col_ptr[j]..col_ptr[j + 1] {
-                yk[row_idx[p]] += values[p] * xj;
-            }
-        }
+        model.pattern().mul(stiffness.val(), &xk, &mut yk);
         x.push(xk);
         kx.push(yk);
     }

@@ -15,6 +15,16 @@ pub struct Response {
     pub near: SparseDofs,
 }
 
+/// The nonzero entries of the full load vector `loads_n`, as a sparse load.
+pub(super) fn sparse_load(loads_n: &[f64]) -> SparseDofs {
+    loads_n
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| **v != 0.0)
+        .map(|(d, &v)| (d, v))
+        .collect()
+}
+
 /// Solves the uncut organ for sparse loads over full dofs (three per node; held dofs ignored,
 /// answered as zero).
 pub trait UncutResponse {

@@ -9,8 +9,9 @@
 //! `S q = −Bᵀ K⁻¹ f` with `S = A − Bᵀ K⁻¹ B`, then `u = K⁻¹ f − K⁻¹ B q`.
 //!
 //! `K⁻¹` is the uncut organ's response ([`UncutResponse`]), and `Z = K⁻¹ B` its response to
-//! each enriched function's forces, kept in the response's own form (modal coefficients and a
-//! sparse near field for a cut vademecum, so that nothing here costs a sparse solve) and, at
+//! each enriched function's forces: exact, or over a cut vademecum a patch solve corrected by
+//! its modes (`local.rs`, which makes `S` the Schur complement of a Ritz system and so keeps
+//! it positive definite), kept as modal coefficients and a sparse near field and, at
 //! the surface's dofs, as `Ẑ = Z L⁻ᵀ`, `L` the Cholesky factor of `S`, so that the tick's
 //! felt force reads it and solves nothing. A segment only ever adds enriched functions (a
 //! longer face enriches the nodes its growth cuts whole; a turn starts a face with its own),
@@ -29,7 +30,7 @@ use super::CutError;
 use super::enrichment::{Enriched, Enrichment, Front, Supports};
 use super::incision::{CutFace, Incision};
 use super::local::{LocalResponse, PatchSolver};
-use super::response::{Response, UncutResponse};
+use super::response::{Response, UncutResponse, sparse_load};
 use super::view::{CutView, add_surface_part, backward, gram, surface_dof};
 use super::xfem::{CutSolution, element_functions, piece_weights};
 use crate::fem::{FemModel, PRESCRIBED};
@@ -227,13 +228,7 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
     /// [`Enrichment::new`] over [`Self::faces`]. Fails only for a load outside the region a
     /// cut vademecum covers.
     pub fn solve(&self, loads_n: &[f64]) -> Result<CutSolution, CutError> {
-        let load: Vec<(usize, f64)> = loads_n
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| **v != 0.0)
-            .map(|(d, &v)| (d, v))
-            .collect();
-        let uncut = self.response.respond(&[load])?.remove(0);
+        let uncut = self.response.respond(&[sparse_load(loads_n)])?.remove(0);
         Ok(self.solve_from(uncut))
     }
 
@@ -480,11 +475,12 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
         let first_new = self.coupling.len();
         let total = first_new + new.len();
         let mut near = vec![0.0; 3 * self.model().mesh().node_count()];
+        let mut scratch = near.clone();
         let mut columns = vec![vec![0.0; total]; new.len()];
         for (r, column) in columns.iter_mut().enumerate() {
             let z = &new[r].response;
             scatter(&z.near, 1.0, &mut near);
-            let edge = self.edge_products(&new[r].residual, new);
+            let edge = self.edge_products(&new[r].residual, new, &mut scratch);
             for (p, entry) in column.iter_mut().enumerate() {
                 let (b, residual_modes) = match p < first_new {
                     true => (&self.coupling[p], &self.residual_modes[p]),
@@ -505,8 +501,14 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
         columns
     }
 
-    /// `r_pᵀ ρ` for every unknown `p`, old (through their responses per dof) then `new`.
-    fn edge_products(&self, residual: &[(usize, f64)], new: &[LocalResponse]) -> Vec<f64> {
+    /// `r_pᵀ ρ` for every unknown `p`, old (through their responses per dof) then `new`;
+    /// `scratch` (full dofs, zero) is left zero.
+    fn edge_products(
+        &self,
+        residual: &[(usize, f64)],
+        new: &[LocalResponse],
+        scratch: &mut [f64],
+    ) -> Vec<f64> {
         let mut products = vec![0.0; self.coupling.len() + new.len()];
         if residual.is_empty() {
             return products;
@@ -516,16 +518,16 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
                 products[p as usize] += v * rho;
             }
         }
-        let mut dense = vec![0.0; 3 * self.model().mesh().node_count()];
-        scatter(residual, 1.0, &mut dense);
+        scatter(residual, 1.0, scratch);
         for (k, response) in new.iter().enumerate() {
             products[self.coupling.len() + k] = response
                 .response
                 .near
                 .iter()
-                .map(|&(d, v)| v * dense[d])
+                .map(|&(d, v)| v * scratch[d])
                 .sum();
         }
+        scatter(residual, -1.0, scratch);
         products
     }
 

@@ -12,7 +12,7 @@ use serde::Serialize;
 use super::enrichment::Enrichment;
 use super::incision::CutFace;
 use super::keratotomy::{ANTERIOR_RADIUS_M, Cornea, INCISION_END_M, anterior_nodes, incision};
-use super::response::{ExactResponse, UncutResponse};
+use super::response::{ExactResponse, UncutResponse, sparse_load};
 use super::state::CutState;
 use super::{CutError, xfem};
 use crate::fem::{FemModel, Loads, patch_weight};
@@ -228,11 +228,10 @@ fn run_case(
     let clock = Instant::now();
     let full = xfem::solve(model, &enrichment, &plan.loads)?;
     full_ms.push(clock.elapsed().as_secs_f64() * 1e3);
-    let load: Vec<(usize, f64)> = (plan.loads.as_slice().iter().enumerate())
-        .filter(|(_, f)| **f != 0.0)
-        .map(|(d, &f)| (d, f))
-        .collect();
-    let online = state.solve_from(exact.respond(&[load])?.remove(0));
+    let uncut = exact
+        .respond(&[sparse_load(plan.loads.as_slice())])?
+        .remove(0);
+    let online = state.solve_from(uncut);
     let compliance = CutState::new(model, exact).uncut_compliance(&plan.patch)?;
     let felt = state.felt_force_over(&plan.patch, compliance, plan.press_m);
     let reference = xfem::felt_force(model, &enrichment, &plan.patch, plan.press_m)?;
