@@ -25,7 +25,10 @@ pub use pgd_indent::{
     IndentReport, IndentRequest, LawCurve, indent_organ, plot_indentation, print_indentation,
 };
 pub use pgd_mesh::report_mesh;
-pub use pgd_validate::{print_cut_validation, print_validation, validate_cuts, validate_vademecum};
+pub use pgd_validate::{
+    plot_force_depth, print_cut_validation, print_force_depth, print_validation, validate_cuts,
+    validate_vademecum,
+};
 pub use trainer_commands::{debrief, numbered, prepare_scenarios, validate_scenarios};
 pub use trainer_devices::list_devices;
 pub use trainer_history::{HistoryRequest, HistoryTarget, keep_scored, show_history};

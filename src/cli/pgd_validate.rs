@@ -1,7 +1,7 @@
 //! `pgd validate`: a vademecum against full FEM on its own mesh, at random loads it was not
 //! built on, printed as a table.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::pgd_build::write_convergence;
 use crate::cutting::keratotomy::Cornea;
@@ -13,6 +13,7 @@ use crate::fem::FemModel;
 use crate::mesh::TetMesh;
 use crate::mesh::organs::Organ;
 use crate::pgd::{self, ValidationReport, ValidationSettings};
+use crate::report::{LineChart, Series, line_chart};
 use crate::store::Bar;
 
 /// Checks the vademecum in `file` against full FEM on `mesh` (the organ `source` names, if it
@@ -59,6 +60,70 @@ pub fn print_validation(report: &ValidationReport) {
             100.0 * s.max
         );
     }
+}
+
+/// Each force–depth curve of `report` as a table: full FEM's indentation and force, the
+/// vademecum's force for that indentation.
+pub fn print_force_depth(report: &ValidationReport) {
+    for (k, curve) in report.curves.iter().enumerate() {
+        let [x, y, z] = curve.point_m.map(|c| c * 1e3);
+        println!(
+            "press {} along the normal at ({x:.1}, {y:.1}, {z:.1}) mm: largest force error {:.1} %",
+            k + 1,
+            100.0 * curve.max_force_error()
+        );
+        println!("  depth (mm)   full FEM (N)   vademecum (N)");
+        for ((d, f), v) in curve
+            .depth_m
+            .iter()
+            .zip(&curve.fem_force_n)
+            .zip(&curve.vademecum_force_n)
+        {
+            println!("  {:>10.2} {:>14.5} {:>15.5}", d * 1e3, f, v);
+        }
+        if let Some(reason) = &curve.stopped {
+            println!("  full FEM stops there: {reason}");
+        }
+    }
+}
+
+/// Draws the force–depth curves of full FEM and the vademecum side by side, beside the
+/// vademecum (`FILE.force-depth.png`), and returns where.
+pub fn plot_force_depth(report: &ValidationReport, vademecum: &Path) -> Result<PathBuf, String> {
+    let path = vademecum.with_extension("force-depth.png");
+    let curve_points = |depths: &[f64], forces: &[f64]| {
+        std::iter::once((0.0, 0.0))
+            .chain(depths.iter().zip(forces).map(|(d, f)| (d * 1e3, *f)))
+            .collect()
+    };
+    let series = report
+        .curves
+        .iter()
+        .enumerate()
+        .flat_map(|(k, curve)| {
+            [
+                Series {
+                    name: format!("press {}: full FEM", k + 1),
+                    points: curve_points(&curve.depth_m, &curve.fem_force_n),
+                },
+                Series {
+                    name: format!("press {}: vademecum", k + 1),
+                    points: curve_points(&curve.depth_m, &curve.vademecum_force_n),
+                },
+            ]
+        })
+        .collect();
+    let name = vademecum.file_name().unwrap_or_default().to_string_lossy();
+    line_chart(
+        &path,
+        &LineChart {
+            title: format!("{name}: force against depth under the tool"),
+            x_label: "indentation under the tool (mm)",
+            y_label: "force (N)",
+            series,
+        },
+    )?;
+    Ok(path)
 }
 
 /// Checks the cut section of the vademecum in `file` against full X-FEM on `mesh` (as it was

@@ -85,6 +85,17 @@ impl FemModel {
         loads: &Loads,
         settings: &NewtonSettings,
     ) -> Result<StaticSolution, FemError> {
+        self.solve_static_path(loads, settings, |_, _| {})
+    }
+
+    /// [`Self::solve_static`], handing `visit` each load step's equilibrium on the way (the
+    /// step's load factor and the displacement): one solve gives a whole load–response curve.
+    pub fn solve_static_path(
+        &self,
+        loads: &Loads,
+        settings: &NewtonSettings,
+        mut visit: impl FnMut(f64, &[f64]),
+    ) -> Result<StaticSolution, FemError> {
         check_settings(settings)?;
         if loads.node_count() != self.mesh().node_count() {
             return Err(FemError::InvalidInput {
@@ -100,6 +111,7 @@ impl FemModel {
             let factor = step as f64 / settings.load_steps as f64;
             let this = (step, settings.load_steps);
             let report = self.load_step(&mut solver, &mut u, loads, factor, this, settings)?;
+            visit(factor, &u);
             steps.push(report);
         }
         Ok(StaticSolution {

@@ -2,6 +2,7 @@
 //! load at any accessible surface point in any direction, plus the local part a truncated sum
 //! cannot carry (see `docs/pgd.md`). Plain Rust, no Bevy.
 
+mod anderson;
 mod build;
 pub mod container;
 mod deformation;
@@ -39,7 +40,7 @@ pub use statistics::Statistics;
 pub use stiffness::RestStiffness;
 pub use surface_modes::SurfaceModes;
 pub use vademecum::{Header, Patch, Step, SurfacePoint, Vademecum};
-pub use validate::{Sample, ValidationReport, ValidationSettings, validate};
+pub use validate::{ForceDepthCurve, Sample, ValidationReport, ValidationSettings, validate};
 
 use crate::mesh::TetMesh;
 

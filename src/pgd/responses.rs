@@ -7,11 +7,15 @@ use faer::{ColRef, MatRef};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::anderson::Anderson;
 use super::load_patches::{LoadOperator, LoadPatches};
 use super::stiffness::RestStiffness;
 
 /// Columns solved together: one pass over the factor serves them all.
 const BLOCK_COLUMNS: usize = 48;
+
+/// Halvings of a fixed-point update allowed to keep every element's volume positive.
+const MAX_HALVINGS: usize = 20;
 
 /// Free-dof columns of the responses, column-major (`free_count` rows).
 #[derive(Clone)]
@@ -165,6 +169,9 @@ pub struct SecantSettings {
     /// Converged when an iteration changes the response by less than this (relative).
     pub tolerance: f64,
     pub max_iterations: usize,
+    /// Differences remembered by each response's Anderson acceleration (0: plain iteration).
+    #[serde(default = "default_anderson_depth")]
+    pub anderson_depth: usize,
     /// A step is kept while at most this fraction of its loads fail to converge; those keep
     /// the previous step's secant response (reported, never silent).
     pub max_unconverged_fraction: f64,
@@ -175,9 +182,14 @@ impl Default for SecantSettings {
         Self {
             tolerance: 1e-3,
             max_iterations: 40,
+            anderson_depth: default_anderson_depth(),
             max_unconverged_fraction: 0.005,
         }
     }
+}
+
+fn default_anderson_depth() -> usize {
+    5
 }
 
 /// How the fixed points of one load step went.
@@ -224,9 +236,9 @@ fn add_unit_load(stiffness: &RestStiffness, patches: &LoadPatches, p: usize, col
 }
 
 /// The fixed point for the columns of one block (`first` is the first column's parameter),
-/// iterating only the columns still moving. Each column is relaxed by Aitken's dynamic factor
-/// (Irons–Tuck): where the law softens, the plain iteration with the rest stiffness overshoots
-/// and crawls; the factor, measured from the last two updates, takes most of that away.
+/// iterating only the columns still moving. Each column is accelerated by Anderson's method
+/// ([`Anderson`]): where the law stiffens or softens, the plain iteration with the rest
+/// stiffness overshoots or crawls.
 fn secant_block(
     stiffness: &RestStiffness,
     patches: &LoadPatches,
@@ -239,39 +251,55 @@ fn secant_block(
     // A load on a clamped node has no response and no magnitude: nothing to iterate.
     let mut active: Vec<usize> = (0..columns).filter(|&j| magnitudes_n[j] != 0.0).collect();
     let mut change = vec![0.0; columns];
-    let mut relaxation = vec![1.0; columns];
-    let mut last_update: Vec<Vec<f64>> = vec![Vec::new(); columns];
+    let mut accelerators: Vec<Anderson> = (0..columns)
+        .map(|_| Anderson::new(settings.anderson_depth))
+        .collect();
     let mut report = SecantReport {
         responses: columns,
         ..SecantReport::default()
     };
     let start = chunk.to_vec();
+    let mut previous = start.clone();
     let mut work = NonlinearWork::new(stiffness);
     for iteration in 1..=settings.max_iterations {
         let mut rhs = Vec::with_capacity(active.len() * rows);
         for &j in &active {
-            let column = &chunk[j * rows..(j + 1) * rows];
-            let start = rhs.len();
-            rhs.extend(work.right_hand_side(column, magnitudes_n[j]));
-            add_unit_load(stiffness, patches, first + j, &mut rhs[start..]);
+            let span = j * rows..(j + 1) * rows;
+            let begin = rhs.len();
+            match work.finite_right_hand_side(
+                (&mut chunk[span.clone()], &previous[span]),
+                magnitudes_n[j],
+                &mut rhs,
+            ) {
+                // No iterate between the last two keeps every element's volume positive.
+                None => {
+                    change[j] = f64::NAN;
+                    rhs.truncate(begin);
+                    rhs.extend(std::iter::repeat_n(0.0, rows));
+                }
+                Some(0) => {}
+                Some(_) => accelerators[j].reset(),
+            }
+            add_unit_load(stiffness, patches, first + j, &mut rhs[begin..]);
+        }
+        for &j in &active {
+            previous[j * rows..(j + 1) * rows].copy_from_slice(&chunk[j * rows..(j + 1) * rows]);
         }
         stiffness.solve_block(&mut rhs);
         for (&j, target) in active.iter().zip(rhs.chunks_exact(rows)) {
-            let column = &mut chunk[j * rows..(j + 1) * rows];
-            let update: Vec<f64> = target
-                .iter()
-                .zip(column.iter())
-                .map(|(t, u)| t - u)
-                .collect();
-            relaxation[j] = aitken(relaxation[j], &last_update[j], &update);
-            column
-                .iter_mut()
-                .zip(&update)
-                .for_each(|(u, d)| *u += relaxation[j] * d);
+            if change[j].is_nan() {
+                continue;
+            }
+            let span = j * rows..(j + 1) * rows;
+            let column = &mut chunk[span.clone()];
+            accelerators[j].advance(column, target.to_vec());
             let norm = column.iter().map(|u| u * u).sum::<f64>();
-            let step = update.iter().map(|d| d * d).sum::<f64>();
-            change[j] = relaxation[j].abs() * (step / norm).sqrt();
-            last_update[j] = update;
+            let step = column
+                .iter()
+                .zip(&previous[span])
+                .map(|(u, p)| (u - p) * (u - p))
+                .sum::<f64>();
+            change[j] = (step / norm).sqrt();
         }
         report.total_iterations += active.len();
         report.max_iterations = iteration;
@@ -292,25 +320,6 @@ fn secant_block(
     report
 }
 
-/// Aitken's relaxation factor for the next update, from the previous factor and the last two
-/// unrelaxed updates; 1 on the first iteration, clamped to keep a bad estimate harmless.
-fn aitken(previous: f64, last: &[f64], update: &[f64]) -> f64 {
-    if last.is_empty() {
-        return 1.0;
-    }
-    let (mut num, mut den) = (0.0, 0.0);
-    for (a, b) in last.iter().zip(update) {
-        let d = b - a;
-        num += a * d;
-        den += d * d;
-    }
-    if den > 0.0 {
-        (-previous * num / den).clamp(0.05, 2.0)
-    } else {
-        previous
-    }
-}
-
 /// Buffers for evaluating the nonlinear terms of one response at a time.
 struct NonlinearWork<'a> {
     stiffness: &'a RestStiffness<'a>,
@@ -325,6 +334,37 @@ impl<'a> NonlinearWork<'a> {
             full: vec![0.0; stiffness.full_count()],
             force: vec![0.0; stiffness.full_count()],
         }
+    }
+
+    /// Appends `−N(λ ũ) / λ` to `rhs` for the iterate `ũ` (`column`); where the iterate turns
+    /// an element inside out (the neo-Hookean force is then not finite), it is first moved
+    /// halfway back towards `previous`, up to [`MAX_HALVINGS`] times, as Newton's line search
+    /// does. The starting iterate (equal to `previous`), the step before's response at this
+    /// step's larger force, is moved towards the rest state instead. Returns the halvings
+    /// taken, `None` if none gave a finite force.
+    fn finite_right_hand_side(
+        &mut self,
+        (column, previous): (&mut [f64], &[f64]),
+        lambda: f64,
+        rhs: &mut Vec<f64>,
+    ) -> Option<usize> {
+        let begin = rhs.len();
+        let towards_rest = column == previous;
+        for halvings in 0..=MAX_HALVINGS {
+            rhs.truncate(begin);
+            rhs.extend(self.right_hand_side(column, lambda));
+            if rhs[begin..].iter().all(|v| v.is_finite()) {
+                return Some(halvings);
+            }
+            for (u, p) in column.iter_mut().zip(previous) {
+                *u = if towards_rest {
+                    0.5 * *u
+                } else {
+                    0.5 * (*u + p)
+                };
+            }
+        }
+        None
     }
 
     /// `−N(λ ũ) / λ` over free dofs, for a secant response `ũ` at force magnitude `λ`.

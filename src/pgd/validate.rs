@@ -16,7 +16,7 @@ use super::statistics::Statistics;
 use super::vademecum::{SurfacePoint, Vademecum};
 use crate::fem::{FemError, FemModel, Loads, NewtonSettings, PatchKernel};
 use crate::mesh::organs::Organ;
-use crate::mesh::{Surface, area_vector};
+use crate::mesh::{Surface, TetMesh, area_vector};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct ValidationSettings {
@@ -30,6 +30,11 @@ pub struct ValidationSettings {
     pub near_radius_m: f64,
     /// Load steps of the reference Newton solve (KSV).
     pub newton_load_steps: usize,
+    /// Presses along the inward normal drawn as force–depth curves, each at its own random
+    /// point, after the samples.
+    pub curves: usize,
+    /// Force levels per curve, up to the deepest indentation of the range (linear).
+    pub curve_levels: usize,
 }
 
 impl Default for ValidationSettings {
@@ -53,6 +58,8 @@ impl ValidationSettings {
             max_tilt_deg: 45.0,
             near_radius_m: radii.watched_m,
             newton_load_steps: 4,
+            curves: 2,
+            curve_levels: 8,
         }
     }
 
@@ -91,6 +98,34 @@ pub struct ValidationReport {
     pub field_error: Statistics,
     pub near_field_error: Statistics,
     pub samples: Vec<Sample>,
+    pub curves: Vec<ForceDepthCurve>,
+}
+
+/// A press along the inward normal at one point: the force levels full FEM was loaded with,
+/// the indentation it made under the tool at each, and the force the vademecum renders for
+/// that indentation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ForceDepthCurve {
+    pub point_m: [f64; 3],
+    /// Full FEM's indentation under the tool along the press (m), per force level.
+    pub depth_m: Vec<f64>,
+    pub fem_force_n: Vec<f64>,
+    /// The vademecum's force along the press (N) for full FEM's indentation.
+    pub vademecum_force_n: Vec<f64>,
+    /// Why full FEM stopped before the last force level (a law that loses stability, as
+    /// KSV does under compression), if it did.
+    pub stopped: Option<String>,
+}
+
+impl ForceDepthCurve {
+    /// The largest `|F_vademecum − F_fem| / F_fem` along the curve.
+    pub fn max_force_error(&self) -> f64 {
+        self.fem_force_n
+            .iter()
+            .zip(&self.vademecum_force_n)
+            .map(|(f, v)| (v - f).abs() / f)
+            .fold(0.0, f64::max)
+    }
 }
 
 /// Compares `vademecum` with full FEM on `model` (the mesh it was built for).
@@ -116,11 +151,20 @@ pub fn validate(
         })
         .collect();
     let total_area: f64 = areas.iter().sum();
-    progress.start("full FEM references", settings.samples as u64);
+    progress.start(
+        "full FEM references",
+        (settings.samples + settings.curves) as u64,
+    );
     let mut samples = Vec::with_capacity(settings.samples);
     for _ in 0..settings.samples {
         let at = random_point(&mut rng, &areas, total_area);
         samples.push(sample(model, vademecum, &kernel, &at, &mut rng, settings)?);
+        progress.advance(1);
+    }
+    let mut curves = Vec::with_capacity(settings.curves);
+    for _ in 0..settings.curves {
+        let at = random_point(&mut rng, &areas, total_area);
+        curves.push(force_depth_curve(model, vademecum, &kernel, &at, settings)?);
         progress.advance(1);
     }
     Ok(ValidationReport {
@@ -129,6 +173,7 @@ pub fn validate(
         field_error: Statistics::of(samples.iter().map(|s| s.field_error)),
         near_field_error: Statistics::of(samples.iter().map(|s| s.near_field_error)),
         samples,
+        curves,
     })
 }
 
@@ -152,6 +197,61 @@ fn random_point(rng: &mut fastrand::Rng, areas: &[f64], total: f64) -> SurfacePo
     }
 }
 
+/// A surface point's rest coordinates and inward normal (of its triangle).
+fn point_and_inward(
+    mesh: &TetMesh,
+    vademecum: &Vademecum,
+    at: &SurfacePoint,
+) -> (Point3<f64>, Vector3<f64>) {
+    let corners =
+        vademecum.triangles[at.triangle].map(|m| vademecum.positions[m as usize] as usize);
+    let point = corners
+        .iter()
+        .zip(at.barycentric)
+        .fold(Point3::origin(), |p, (&n, l)| {
+            p + mesh.nodes()[n].coords * l
+        });
+    (point, -area_vector(mesh.nodes(), &corners).normalize())
+}
+
+/// The force (N) along `direction` whose linear response is `indentation_m` deep at `at`.
+fn linear_force(
+    vademecum: &Vademecum,
+    at: &SurfacePoint,
+    direction: &Vector3<f64>,
+    indentation_m: f64,
+) -> Vector3<f64> {
+    let compliance =
+        direction.dot(&(vademecum.step_compliance(0, &vademecum.patch(at)) * direction));
+    direction * (indentation_m / compliance)
+}
+
+/// `force` spread over the tool's patch at `point`, and the patch's nodal shares.
+fn patch_loads(
+    mesh: &TetMesh,
+    kernel: &PatchKernel,
+    (point, facing): (Point3<f64>, &Vector3<f64>),
+    force: &Vector3<f64>,
+) -> Result<(Loads, Vec<(usize, f64)>), FemError> {
+    let shares = kernel.shares(point, facing)?;
+    let mut loads = Loads::new(mesh.node_count());
+    for &(node, share) in &shares {
+        loads.add_nodal_force(node, (force * share).into())?;
+    }
+    Ok((loads, shares))
+}
+
+/// The displacement under the tool: the patch's share-weighted mean.
+fn under_tool(displacement_m: &[f64], shares: &[(usize, f64)]) -> Vector3<f64> {
+    shares.iter().fold(Vector3::zeros(), |acc, &(n, share)| {
+        acc + Vector3::new(
+            displacement_m[3 * n],
+            displacement_m[3 * n + 1],
+            displacement_m[3 * n + 2],
+        ) * share
+    })
+}
+
 fn sample(
     model: &FemModel,
     vademecum: &Vademecum,
@@ -161,39 +261,20 @@ fn sample(
     settings: &ValidationSettings,
 ) -> Result<Sample, FemError> {
     let mesh = model.mesh();
-    let corners =
-        vademecum.triangles[at.triangle].map(|m| vademecum.positions[m as usize] as usize);
-    let point = corners
-        .iter()
-        .zip(at.barycentric)
-        .fold(Point3::origin(), |p, (&n, l)| {
-            p + mesh.nodes()[n].coords * l
-        });
-    let direction = tilted_inward(
-        rng,
-        -area_vector(mesh.nodes(), &corners).normalize(),
-        settings,
-    );
+    let (point, inward) = point_and_inward(mesh, vademecum, at);
+    let direction = tilted_inward(rng, inward, settings);
     let (low, high) = settings.indentation_range_m;
     let indentation_m = low + (high - low) * rng.f64();
     // The linear compliance along the direction sets the force for the wanted indentation.
-    let stiffness =
-        direction.dot(&(vademecum.step_compliance(0, &vademecum.patch(at)) * direction));
-    let force = direction * (indentation_m / stiffness);
-
-    let shares = kernel.shares(point, &vademecum.triangle_facing(at.triangle))?;
-    let mut loads = Loads::new(mesh.node_count());
-    for &(node, share) in &shares {
-        loads.add_nodal_force(node, (force * share).into())?;
-    }
+    let force = linear_force(vademecum, at, &direction, indentation_m);
+    let facing = vademecum.triangle_facing(at.triangle);
+    let (loads, shares) = patch_loads(mesh, kernel, (point, &facing), &force)?;
     let newton = NewtonSettings {
         load_steps: settings.newton_load_steps,
         ..NewtonSettings::default()
     };
     let reference = model.solve_static(&loads, &newton)?.displacement_m;
-    let under_tool = shares.iter().fold(Vector3::zeros(), |acc, &(n, share)| {
-        acc + Vector3::new(reference[3 * n], reference[3 * n + 1], reference[3 * n + 2]) * share
-    });
+    let under_tool = under_tool(&reference, &shares);
 
     let rendered = vademecum.force_for_indentation(at, &under_tool);
     let field = vademecum.field(at, &rendered);
@@ -206,6 +287,43 @@ fn sample(
         field_error: relative_error(&field, &reference, |_| true),
         near_field_error: relative_error(&field, &reference, near),
     })
+}
+
+/// Full FEM pressed along the inward normal at `at` in `curve_levels` equal force steps up to
+/// the deepest indentation's linear force, one Newton path; the vademecum answers each step's
+/// indentation.
+fn force_depth_curve(
+    model: &FemModel,
+    vademecum: &Vademecum,
+    kernel: &PatchKernel,
+    at: &SurfacePoint,
+    settings: &ValidationSettings,
+) -> Result<ForceDepthCurve, FemError> {
+    let mesh = model.mesh();
+    let (point, inward) = point_and_inward(mesh, vademecum, at);
+    let force = linear_force(vademecum, at, &inward, settings.indentation_range_m.1);
+    let facing = vademecum.triangle_facing(at.triangle);
+    let (loads, shares) = patch_loads(mesh, kernel, (point, &facing), &force)?;
+    let newton = NewtonSettings {
+        load_steps: settings.curve_levels,
+        ..NewtonSettings::default()
+    };
+    let mut curve = ForceDepthCurve {
+        point_m: point.coords.into(),
+        depth_m: Vec::new(),
+        fem_force_n: Vec::new(),
+        vademecum_force_n: Vec::new(),
+        stopped: None,
+    };
+    let path = model.solve_static_path(&loads, &newton, |factor, displacement_m| {
+        let indentation = under_tool(displacement_m, &shares);
+        let rendered = vademecum.force_for_indentation(at, &indentation);
+        curve.depth_m.push(indentation.dot(&inward));
+        curve.fem_force_n.push(factor * force.norm());
+        curve.vademecum_force_n.push(rendered.dot(&inward));
+    });
+    curve.stopped = path.err().map(|e| e.to_string());
+    Ok(curve)
 }
 
 /// A unit vector within `max_tilt_deg` of `inward`, uniformly spread in azimuth.

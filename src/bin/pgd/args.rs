@@ -11,7 +11,9 @@ use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
 use pgd_surgery::mesh::TetMesh;
 use pgd_surgery::mesh::io::ImportOptions;
 use pgd_surgery::mesh::organs::{CORNEA_LAYERS, Organ, OrganSettings};
-use pgd_surgery::pgd::{self, BuildSettings, PgdSettings, RegionSettings, ValidationSettings};
+use pgd_surgery::pgd::{
+    self, BuildSettings, PgdSettings, RegionSettings, SecantSettings, ValidationSettings,
+};
 use pgd_surgery::store::vademecum_file_name;
 use pgd_surgery::{bench, cli, store};
 
@@ -85,6 +87,11 @@ pub enum Command {
         /// organ's tool radius, 20 for the abdominal organs; the smallest is a tenth of it).
         #[arg(long)]
         max_indentation_mm: Option<f64>,
+        /// Presses along the normal at random points, full FEM against the vademecum from
+        /// zero to the largest indentation, printed and drawn as force–depth curves
+        /// (FILE.force-depth.png beside the vademecum).
+        #[arg(long, default_value_t = ValidationSettings::default().curves)]
+        curves: usize,
         /// Check the cut section instead, on cut patterns drawn at random, each incision made
         /// in three segments: `radial:N` (the cornea), N radial incisions at random angles,
         /// optical zones of 3–5 mm and depths of 60–95 %, under 15 mmHg; `straight:N`, N
@@ -287,6 +294,10 @@ pub struct BuildArgs {
     /// millimetres, increasing. The deepest is the range the vademecum is valid over.
     #[arg(long, value_delimiter = ',', default_values_t = pgd::DEFAULT_LOAD_STEPS_M.map(|m| m * 1e3))]
     pub load_steps_mm: Vec<f64>,
+    /// Nonlinear laws: a load step is kept while at most this fraction of its loads fail to
+    /// converge (those keep the step before's secant response, counted in the report).
+    #[arg(long, default_value_t = SecantSettings::default().max_unconverged_fraction)]
+    pub max_unconverged: f64,
     /// Also build the cut section: the uncut organ's response to a unit force at every node
     /// within --cut-depth-mm of the accessible faces, which an incision anywhere there is
     /// condensed onto online (docs/cutting.md).
@@ -367,6 +378,10 @@ impl BuildArgs {
                 ..PgdSettings::default()
             },
             load_steps_m: steps.iter().map(|s| s * 1e-3).collect(),
+            secant: SecantSettings {
+                max_unconverged_fraction: self.max_unconverged,
+                ..defaults.secant
+            },
             ..defaults
         })
     }

@@ -91,6 +91,7 @@ fn main() -> ExitCode {
             samples,
             sample_seed,
             max_indentation_mm,
+            curves,
             cuts,
             exact_response,
             cut_patch_mm,
@@ -119,6 +120,7 @@ fn main() -> ExitCode {
                 let defaults = ValidationSettings {
                     samples: samples.unwrap_or(defaults.samples),
                     seed: sample_seed,
+                    curves,
                     ..defaults
                 };
                 match max_indentation_mm {
@@ -129,14 +131,20 @@ fn main() -> ExitCode {
             let validated = mesh
                 .load()
                 .and_then(|loaded| cli::validate_vademecum(&mesh.source, loaded, &file, settings));
-            match validated {
-                Ok(report) if json => print_json(&report),
-                Ok(report) => {
-                    cli::print_validation(&report);
-                    ExitCode::SUCCESS
-                }
-                Err(e) => fail("pgd validate", &e),
+            let report = match validated {
+                Ok(report) => report,
+                Err(e) => return fail("pgd validate", &e),
+            };
+            match cli::plot_force_depth(&report, &file) {
+                Ok(png) => eprintln!("force-depth curves: {}", png.display()),
+                Err(e) => return fail("pgd validate", &e),
             }
+            if json {
+                return print_json(&report);
+            }
+            cli::print_validation(&report);
+            cli::print_force_depth(&report);
+            ExitCode::SUCCESS
         }
         Command::Cut {
             organ,
