@@ -160,3 +160,34 @@ fn a_load_step_beyond_stability_is_left_out() {
     assert_eq!(vademecum.steps.len(), 2);
     assert_eq!(vademecum.valid_indentation_m(), 1e-3);
 }
+
+/// Against full neo-Hookean FEM (Newton) at random off-node points and depths up to the
+/// deepest load step, a third of the block's thickness, the neo-Hookean vademecum's felt force
+/// stays within the 7 % just-noticeable difference (p95), and closer than the linear
+/// vademecum's.
+#[test]
+fn the_neo_hookean_vademecum_follows_full_fem_to_its_deepest_step() {
+    let model = block_model_of(block_mesh([6, 4, 3]), Law::NeoHookean);
+    let linear_model = block_model_of(block_mesh([6, 4, 3]), Law::Linear);
+    let steps = vec![2.5e-3, 5e-3, 10e-3];
+    let (neo_hookean, report) = build(&organ(&model), &ksv_settings(steps), &Silent).unwrap();
+    assert!(report.failed_step.is_none(), "{:?}", report.failed_step);
+    let (linear, _) = build(&organ(&linear_model), &settings(60, 1e-3), &Silent).unwrap();
+    let loads = ValidationSettings {
+        samples: 12,
+        near_radius_m: 0.015,
+        indentation_range_m: (1e-3, 10e-3),
+        ..ValidationSettings::default()
+    };
+    let with_neo_hookean = validate(&model, &neo_hookean, &loads, &Silent).unwrap();
+    let with_linear = validate(&model, &linear, &loads, &Silent).unwrap();
+    eprintln!(
+        "felt-force error against full neo-Hookean FEM, p95: neo-Hookean vademecum {:.4}, linear vademecum {:.4}",
+        with_neo_hookean.force_error.p95, with_linear.force_error.p95
+    );
+    for curve in &with_neo_hookean.curves {
+        eprintln!("{curve:?}");
+    }
+    assert!(with_neo_hookean.force_error.p95 < 0.07);
+    assert!(with_neo_hookean.force_error.p95 < with_linear.force_error.p95);
+}
