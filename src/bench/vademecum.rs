@@ -65,7 +65,7 @@ pub fn run(organ: Organ, laws: &[Law], repeats: usize) -> Result<VademecumBenchR
         let started = Instant::now();
         let (vademecum, report) = pgd::build(
             &organ_model,
-            &BuildSettings::for_organ(Some(organ)),
+            &BuildSettings::for_organ_law(Some(organ), law),
             &Silent,
         )?;
         let build_seconds = started.elapsed().as_secs_f64();

@@ -35,7 +35,9 @@ pub use local::LocalPart;
 pub use region::{CutHeader, RegionReport, RegionResponse, RegionSettings, SparseDofs};
 pub use responses::{Responses, SecantLoads, SecantReport, SecantSettings};
 pub use separated::SeparatedField;
-pub use settings::{BuildSettings, DEFAULT_LOAD_STEPS_M};
+pub use settings::{
+    BuildSettings, DEFAULT_LOAD_STEPS_M, NEO_HOOKEAN_STEPS_TOOL_RADII, default_load_steps_m,
+};
 pub use statistics::Statistics;
 pub use stiffness::RestStiffness;
 pub use surface_modes::SurfaceModes;

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::enrichment::PgdSettings;
 use super::responses::SecantSettings;
+use crate::fem::Law;
 use crate::mesh::organs::Organ;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -47,6 +48,16 @@ impl BuildSettings {
         }
     }
 
+    /// The default settings for `organ` under `law`: [`Self::for_organ`] with the law's
+    /// load steps ([`default_load_steps_m`]).
+    pub fn for_organ_law(organ: Option<Organ>, law: Law) -> Self {
+        let settings = Self::for_organ(organ);
+        Self {
+            load_steps_m: default_load_steps_m(settings.tool_tip_radius_m, law),
+            ..settings
+        }
+    }
+
     /// The settings a user chooses, in a line (for messages).
     pub fn summary(&self) -> String {
         format!(
@@ -67,3 +78,27 @@ impl BuildSettings {
 /// law stays stable under a 6 mm tool on the organs here: beyond about 1.5 mm the elements
 /// under the tool lose stability in compression (measured in docs/pgd.md).
 pub const DEFAULT_LOAD_STEPS_M: [f64; 3] = [0.5e-3, 1.0e-3, 1.5e-3];
+
+/// Neo-Hookean load steps, in tool radii: 2.5 to 25 mm under the abdominal organs' 6 mm tool,
+/// the depths a trainee presses; the same proportions under the cornea's.
+pub const NEO_HOOKEAN_STEPS_TOOL_RADII: [f64; 6] = [
+    2.5 / 6.0,
+    5.0 / 6.0,
+    10.0 / 6.0,
+    15.0 / 6.0,
+    20.0 / 6.0,
+    25.0 / 6.0,
+];
+
+/// The load steps `law` is built with by default under a tool of `tool_tip_radius_m`: the
+/// neo-Hookean law's reach the depths a trainee presses, KSV's stop where it loses stability
+/// (the linear law has none; it keeps KSV's in its header).
+pub fn default_load_steps_m(tool_tip_radius_m: f64, law: Law) -> Vec<f64> {
+    match law {
+        Law::NeoHookean => NEO_HOOKEAN_STEPS_TOOL_RADII
+            .iter()
+            .map(|r| r * tool_tip_radius_m)
+            .collect(),
+        Law::Linear | Law::KirchhoffSaintVenant => DEFAULT_LOAD_STEPS_M.to_vec(),
+    }
+}

@@ -61,7 +61,7 @@ impl VademecumSpec {
     /// The vademecum of the organ `name` from `source` under `law`, the organ's default
     /// settings and tissue, kept in `file`.
     pub fn new(name: &str, source: OrganSource, law: Law, file: PathBuf) -> Self {
-        let build = BuildSettings::for_organ(source.organ());
+        let build = BuildSettings::for_organ_law(source.organ(), law);
         Self {
             name: name.to_owned(),
             source,
@@ -84,7 +84,7 @@ impl VademecumSpec {
         };
         let mut command = format!("cargo run --release --bin pgd -- build {source} --law {law}");
         let mesh = OrganSettings::default();
-        let build = BuildSettings::for_organ(self.source.organ());
+        let build = BuildSettings::for_organ_law(self.source.organ(), self.law);
         // A mesh file's mesh is as it is: the generator's settings do not apply.
         if let OrganSource::Generated(_) = self.source {
             if self.mesh.resolution != mesh.resolution {

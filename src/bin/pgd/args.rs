@@ -290,9 +290,11 @@ pub struct BuildArgs {
     /// At most this many PGD modes per load step.
     #[arg(long, default_value_t = PgdSettings::default().max_modes)]
     pub max_modes: usize,
-    /// KSV: indentation under the tool at each load step after the linear one, in
-    /// millimetres, increasing. The deepest is the range the vademecum is valid over.
-    #[arg(long, value_delimiter = ',', default_values_t = pgd::DEFAULT_LOAD_STEPS_M.map(|m| m * 1e3))]
+    /// Nonlinear laws: the linear response's depth under the tool at each load step after
+    /// the linear one, in millimetres, increasing; the deepest is the range the vademecum is
+    /// valid over (default: 0.5,1,1.5 for KSV; for neo-Hookean 2.5,5,10,15,20,25 under the
+    /// 6 mm tool, in proportion under the cornea's).
+    #[arg(long, value_delimiter = ',')]
     pub load_steps_mm: Vec<f64>,
     /// Nonlinear laws: a load step is kept while at most this fraction of its loads fail to
     /// converge (those keep the step before's secant response, counted in the report).
@@ -355,8 +357,8 @@ impl BuildArgs {
         }))
     }
 
-    pub fn settings(&self, organ: Option<Organ>) -> Result<BuildSettings, String> {
-        let defaults = BuildSettings::for_organ(organ);
+    pub fn settings(&self, organ: Option<Organ>, law: Law) -> Result<BuildSettings, String> {
+        let defaults = BuildSettings::for_organ_law(organ, law);
         let steps = &self.load_steps_mm;
         if steps.iter().any(|s| !(s.is_finite() && *s > 0.0))
             || steps.windows(2).any(|w| w[1] <= w[0])
@@ -365,10 +367,15 @@ impl BuildArgs {
                 "--load-steps-mm {steps:?}: expected positive indentations in increasing order"
             ));
         }
+        let tool_tip_radius_m = self
+            .tool_radius_mm
+            .map_or(defaults.tool_tip_radius_m, |mm| mm * 1e-3);
+        let load_steps_m = match steps.is_empty() {
+            true => pgd::default_load_steps_m(tool_tip_radius_m, law),
+            false => steps.iter().map(|s| s * 1e-3).collect(),
+        };
         Ok(BuildSettings {
-            tool_tip_radius_m: self
-                .tool_radius_mm
-                .map_or(defaults.tool_tip_radius_m, |mm| mm * 1e-3),
+            tool_tip_radius_m,
             local_radius_m: self
                 .local_radius_mm
                 .map_or(defaults.local_radius_m, |mm| mm * 1e-3),
@@ -377,7 +384,7 @@ impl BuildArgs {
                 max_modes: self.max_modes,
                 ..PgdSettings::default()
             },
-            load_steps_m: steps.iter().map(|s| s * 1e-3).collect(),
+            load_steps_m,
             secant: SecantSettings {
                 max_unconverged_fraction: self.max_unconverged,
                 ..defaults.secant

@@ -216,7 +216,7 @@ fn job<'a>(
         mesh: tet_mesh,
         material: material.material(organ)?,
         inclusions: &material.inclusion,
-        settings: build.settings(organ)?,
+        settings: build.settings(organ, material.law.law())?,
         cuts: build.cut_settings(organ)?,
     })
 }
