@@ -86,6 +86,14 @@ pub fn run(cells: [usize; 3], repeats: usize) -> Result<FemBenchReport, FemError
     time("assemble neo-Hookean (nodal volumes)", &mut || {
         neo_hookean.force_and_tangent(&u);
     });
+    let mut nonlinear = vec![0.0; u.len()];
+    time("neo-Hookean internal force", &mut || {
+        neo_hookean.internal_force(&u);
+    });
+    time("neo-Hookean nonlinear force (secant step)", &mut || {
+        nonlinear.fill(0.0);
+        neo_hookean.add_nonlinear_force(&u, &mut nonlinear);
+    });
     time("symbolic Cholesky (AMD)", &mut || {
         DirectSolver::new(model.pattern()).expect("analysed above");
     });

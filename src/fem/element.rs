@@ -232,12 +232,17 @@ fn neo_hookean_stress(lambda: f64, mu: f64, h: &Matrix3<f64>) -> (Matrix3<f64>, 
     (p, inverse_t, log_j)
 }
 
+/// `J − 1 = I₁ + I₂ + I₃` from the invariants of the displacement gradient `h`.
+pub(super) fn j_minus_one(h: &Matrix3<f64>) -> f64 {
+    let trace = h.trace();
+    trace + 0.5 * (trace * trace - (h * h).trace()) + h.determinant()
+}
+
 /// `J − 1` and `F⁻ᵀ` for the displacement gradient `h`, `F⁻ᵀ` NaN for an element turned inside
 /// out (J ≤ 0). `J − 1 = I₁ + I₂ + I₃` from the invariants of `h`, not `det F − 1`, which
 /// cancels catastrophically for small strains.
 pub(super) fn volume_change(h: &Matrix3<f64>) -> (f64, Matrix3<f64>) {
-    let trace = h.trace();
-    let j_minus_one = trace + 0.5 * (trace * trace - (h * h).trace()) + h.determinant();
+    let j_minus_one = j_minus_one(h);
     let inverse_t = match (Matrix3::identity() + h).try_inverse() {
         Some(inverse) if j_minus_one > -1.0 => inverse.transpose(),
         _ => Matrix3::from_element(f64::NAN),

@@ -165,14 +165,16 @@ impl FemModel {
         if self.material.law == Law::Linear {
             return;
         }
+        if let Some(volumetric) = &self.volumetric {
+            let shear_modulus = |t| self.lame(t).1;
+            volumetric.add_nonlinear_force((&self.mesh, &self.geometry), shear_modulus, u_m, out);
+            return;
+        }
         for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
             let (lambda, mu) = self.element_lame(t);
             let ue = gather(tet, u_m);
             let fe = geo.nonlinear_force(self.material.law, lambda, mu, &ue);
             scatter_vector(tet, &fe, out);
-        }
-        if let Some(volumetric) = &self.volumetric {
-            volumetric.add_nonlinear_force(&self.mesh, &self.geometry, u_m, out);
         }
     }
 

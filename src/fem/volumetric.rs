@@ -19,7 +19,9 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::DofMap;
-use super::element::{ElementMatrix, ElementVector, TetGeometry, gather, volume_change};
+use super::element::{
+    ElementMatrix, ElementVector, TetGeometry, gather, j_minus_one, volume_change,
+};
 use super::pattern::{FreePattern, add_at};
 use crate::mesh::TetMesh;
 
@@ -48,8 +50,6 @@ struct Ring {
 struct ElementVolume {
     /// `J − 1`, formed from the invariants of the displacement gradient.
     j_minus_one: f64,
-    /// `tr(H)`, the linear volumetric strain.
-    trace: f64,
     /// `d_a = V_e cof(F) g_a`, the derivative of the element's volume by its corners.
     d: [Vector3<f64>; 4],
     /// `c_a = F⁻ᵀ g_a`.
@@ -200,27 +200,53 @@ impl NodalVolumes {
         }
     }
 
-    /// Adds the volumetric force minus its rest linearization, `f_vol(u) − K₀ u`, on every dof:
-    /// per element `p̄_e d_a − q̄_e V_e g_a`, with `q_n = λ_n θ_n` the linear nodal pressure of
-    /// the nodal volumetric strain `θ_n = Σ_e V_e tr(H_e) / 4V_n`.
+    /// Adds the neo-Hookean force minus its rest linearization, `f(u) − K₀ u`, on every dof:
+    /// the shear part of element `e` (modulus `shear_modulus_pa(e)`) and the volumetric part
+    /// on nodal volumes, in one pass over the elements once the nodal pressures are known.
+    /// Per element the corner forces are `V S g_a` with
+    /// `S = μ (F⁻ᵀ − I) Hᵀ + p̄ J F⁻ᵀ − q̄ I`: the shear stress `μ (F − F⁻ᵀ)` less its
+    /// linearization `μ (H + Hᵀ)`, and the volumetric `p̄ d_a` less its linearization
+    /// `q̄ V g_a`, `q_n = λ_n θ_n` the linear pressure of the nodal volumetric strain
+    /// `θ_n = Σ_e V_e tr(H_e) / 4V_n`. The secant fixed point evaluates this once per
+    /// response and iteration: it is the vademecum build's inner loop.
     pub(super) fn add_nonlinear_force(
         &self,
-        mesh: &TetMesh,
-        geometry: &[TetGeometry],
+        (mesh, geometry): (&TetMesh, &[TetGeometry]),
+        shear_modulus_pa: impl Fn(usize) -> f64,
         u_m: &[f64],
         out: &mut [f64],
     ) {
-        let (pressure, _, elements) = self.state(mesh, geometry, u_m);
-        let linear: Vec<f64> = self
-            .nodal_mean(mesh, geometry, |t| elements[t].trace)
-            .iter()
-            .zip(&self.lambda_pa)
-            .map(|(theta, lambda)| lambda * theta)
-            .collect();
-        for ((tet, geo), element) in mesh.tets().iter().zip(geometry).zip(&elements) {
-            let (p, q) = (corner_mean(tet, &pressure), corner_mean(tet, &linear));
+        let nodes = self.reference_m3.len();
+        let (mut change, mut theta) = (vec![0.0; nodes], vec![0.0; nodes]);
+        for (tet, geo) in mesh.tets().iter().zip(geometry) {
+            let h = geo.displacement_gradient(&gather(tet, u_m));
+            let share = geo.volume_m3 / 4.0;
+            let (j_minus_one, trace) = (j_minus_one(&h), h.trace());
+            for &node in tet {
+                change[node] += share * j_minus_one;
+                theta[node] += share * trace;
+            }
+        }
+        // Nodal pressure `p_n` (kept in `change`) and linear pressure `q_n` (in `theta`).
+        for n in 0..nodes {
+            let volume = self.reference_m3[n];
+            let (j_minus_one, strain) = match volume > 0.0 {
+                true => (change[n] / volume, theta[n] / volume),
+                false => (0.0, 0.0),
+            };
+            let lambda = self.lambda_pa[n];
+            change[n] = lambda * j_minus_one.ln_1p() / (1.0 + j_minus_one);
+            theta[n] = lambda * strain;
+        }
+        for (t, (tet, geo)) in mesh.tets().iter().zip(geometry).enumerate() {
+            let h = geo.displacement_gradient(&gather(tet, u_m));
+            let (j_minus_one, inverse_t) = volume_change(&h);
+            let (p, q) = (corner_mean(tet, &change), corner_mean(tet, &theta));
+            let stress = (inverse_t - Matrix3::identity()) * h.transpose() * shear_modulus_pa(t)
+                + inverse_t * (p * (1.0 + j_minus_one))
+                - Matrix3::identity() * q;
             for (a, &node) in tet.iter().enumerate() {
-                let f = element.d[a] * p - geo.grads[a] * (q * geo.volume_m3);
+                let f = stress * geo.grads[a] * geo.volume_m3;
                 for c in 0..3 {
                     out[3 * node + c] += f[c];
                 }
@@ -270,7 +296,6 @@ fn element_volume(geo: &TetGeometry, u: &ElementVector) -> ElementVolume {
     let cofactor = inverse_t * (1.0 + j_minus_one);
     ElementVolume {
         j_minus_one,
-        trace: h.trace(),
         d: geo.grads.map(|g| cofactor * g * geo.volume_m3),
         c: geo.grads.map(|g| inverse_t * g),
     }
