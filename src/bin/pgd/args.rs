@@ -389,7 +389,6 @@ impl BuildArgs {
                 max_unconverged_fraction: self.max_unconverged,
                 ..defaults.secant
             },
-            ..defaults
         })
     }
 }
