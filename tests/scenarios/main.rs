@@ -20,6 +20,7 @@ use pgd_surgery::devices::{Scripted, TICK_S, Trajectory};
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::io::write_vtu;
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate};
+use pgd_surgery::pgd::BuildSettings;
 use pgd_surgery::report::write_report;
 use pgd_surgery::scenario::{Scenario, Scorecard, Task, load, parse};
 use pgd_surgery::store::OnStale;
@@ -707,8 +708,9 @@ fn the_scenario_chooses_the_contact_master() {
 }
 
 /// `law` picks the tissue's law per organ: the liver's vademecum is built under the
-/// neo-Hookean law, with its load steps and their range, and kept beside the linear one under
-/// the law's name; the gallbladder beside it stays linear.
+/// neo-Hookean law, with its load steps (the law's defaults, as deep as the fixed point
+/// carries them: to 15 mm on the coarse liver) and their range, and kept beside the linear one
+/// under the law's name; the gallbladder beside it stays linear.
 #[test]
 fn the_scenario_picks_the_law_per_organ() {
     let text = r#"Scenario(title: "Press", briefing: "Press.",
@@ -721,8 +723,19 @@ fn the_scenario_picks_the_law_per_organ() {
     assert_eq!(law(0), Law::NeoHookean);
     assert_eq!(law(1), Law::Linear);
     let liver = &scene.organs[0].1;
-    assert_eq!(liver.steps.len(), 4, "the linear step and three load steps");
-    assert_eq!(liver.valid_indentation_m(), 1.5e-3);
+    let levels = &liver.header.indentation_levels_m;
+    assert_eq!(
+        liver.steps.len(),
+        levels.len(),
+        "the linear step and the load steps"
+    );
+    let defaults = BuildSettings::for_organ_law(Some(Organ::Liver), Law::NeoHookean).load_steps_m;
+    let same = |(a, b): (&f64, &f64)| (a - b).abs() <= 1e-12;
+    assert!(
+        levels[1..].iter().zip(&defaults).all(same),
+        "{levels:?} {defaults:?}"
+    );
+    assert!(liver.valid_indentation_m() >= 10e-3, "{levels:?}");
     assert!(vademecums().join("liver-neo-hookean.coarse.vdm").is_file());
     assert_eq!(scene.organs[1].1.valid_indentation_m(), 0.0);
 }
