@@ -114,7 +114,7 @@ impl NodalVolumes {
             }
             let (j, log_j) = (1.0 + change, change.ln_1p());
             let lambda = self.lambda_pa[n];
-            pressure[n] = lambda * log_j / j;
+            pressure[n] = nodal_pressure(lambda, change);
             stiffness[n] = lambda * (1.0 - log_j) / (j * j * volume);
         }
         (pressure, stiffness, elements)
@@ -216,32 +216,31 @@ impl NodalVolumes {
         u_m: &[f64],
         out: &mut [f64],
     ) {
-        let nodes = self.reference_m3.len();
-        let (mut change, mut theta) = (vec![0.0; nodes], vec![0.0; nodes]);
-        for (tet, geo) in mesh.tets().iter().zip(geometry) {
-            let h = geo.displacement_gradient(&gather(tet, u_m));
-            let share = geo.volume_m3 / 4.0;
-            let (j_minus_one, trace) = (j_minus_one(&h), h.trace());
-            for &node in tet {
-                change[node] += share * j_minus_one;
-                theta[node] += share * trace;
-            }
-        }
-        // Nodal pressure `p_n` (kept in `change`) and linear pressure `q_n` (in `theta`).
-        for n in 0..nodes {
-            let volume = self.reference_m3[n];
-            let (j_minus_one, strain) = match volume > 0.0 {
-                true => (change[n] / volume, theta[n] / volume),
-                false => (0.0, 0.0),
-            };
-            let lambda = self.lambda_pa[n];
-            change[n] = lambda * j_minus_one.ln_1p() / (1.0 + j_minus_one);
-            theta[n] = lambda * strain;
-        }
+        let strains: Vec<(f64, f64)> = mesh
+            .tets()
+            .iter()
+            .zip(geometry)
+            .map(|(tet, geo)| {
+                let h = geo.displacement_gradient(&gather(tet, u_m));
+                (j_minus_one(&h), h.trace())
+            })
+            .collect();
+        let pressure: Vec<f64> = self
+            .nodal_mean(mesh, geometry, |t| strains[t].0)
+            .iter()
+            .zip(&self.lambda_pa)
+            .map(|(&change, &lambda)| nodal_pressure(lambda, change))
+            .collect();
+        let linear: Vec<f64> = self
+            .nodal_mean(mesh, geometry, |t| strains[t].1)
+            .iter()
+            .zip(&self.lambda_pa)
+            .map(|(theta, lambda)| lambda * theta)
+            .collect();
         for (t, (tet, geo)) in mesh.tets().iter().zip(geometry).enumerate() {
             let h = geo.displacement_gradient(&gather(tet, u_m));
             let (j_minus_one, inverse_t) = volume_change(&h);
-            let (p, q) = (corner_mean(tet, &change), corner_mean(tet, &theta));
+            let (p, q) = (corner_mean(tet, &pressure), corner_mean(tet, &linear));
             let stress = (inverse_t - Matrix3::identity()) * h.transpose() * shear_modulus_pa(t)
                 + inverse_t * (p * (1.0 + j_minus_one))
                 - Matrix3::identity() * q;
@@ -273,6 +272,11 @@ impl Ring {
             positions,
         }
     }
+}
+
+/// The nodal pressure `p = λ ln J̄ / J̄` at the volume change `J̄ − 1`.
+fn nodal_pressure(lambda_pa: f64, j_minus_one: f64) -> f64 {
+    lambda_pa * j_minus_one.ln_1p() / (1.0 + j_minus_one)
 }
 
 /// The mean of a nodal quantity over an element's corners.
