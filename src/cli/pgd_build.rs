@@ -110,6 +110,9 @@ pub fn print_build_report(report: &BuildReport, out: &Path) {
             print_fixed_point(fixed_point);
         }
     }
+    if let Some(baseline) = &report.newton_baseline {
+        print_newton_baseline(baseline, report.total_seconds);
+    }
     if let Some(cuts) = &report.cuts {
         print_cut_report(cuts);
     }
@@ -137,12 +140,29 @@ fn print_cut_report(cuts: &pgd::RegionReport) {
     );
 }
 
+fn print_newton_baseline(baseline: &pgd::NewtonBaseline, build_seconds: f64) {
+    println!(
+        "brute force: a Newton path per load to {:.1} mm ({} increments) takes {:.1} s \
+         (mean of {}, {} failed), so {:.0} s for all {} loads: {:.0}x this build's {:.0} s",
+        baseline.deepest_m * 1e3,
+        baseline.increments,
+        baseline.seconds_per_load,
+        baseline.samples,
+        baseline.failed,
+        baseline.estimated_seconds,
+        baseline.loads,
+        baseline.estimated_seconds / build_seconds,
+        build_seconds
+    );
+}
+
 fn print_fixed_point(report: &pgd::SecantReport) {
     println!(
         "  secant fixed point: {:.1} iterations per load on average, at most {}; \
-         {} of {} loads unconverged (largest last change {:.1e})",
+         {} loads solved by Newton instead, {} of {} unconverged (largest last change {:.1e})",
         report.mean_iterations(),
         report.max_iterations,
+        report.newton_solved,
         report.unconverged,
         report.responses,
         report.worst_change

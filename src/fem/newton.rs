@@ -120,6 +120,33 @@ impl FemModel {
         })
     }
 
+    /// Newton in one increment from `start_m` (every dof; the prescribed ones are set here)
+    /// to equilibrium under `loads`: for a start already close to it, such as the solution at
+    /// a slightly smaller load.
+    pub fn solve_static_from(
+        &self,
+        start_m: Vec<f64>,
+        loads: &Loads,
+        settings: &NewtonSettings,
+    ) -> Result<StaticSolution, FemError> {
+        check_settings(settings)?;
+        if start_m.len() != loads.as_slice().len() || loads.node_count() != self.mesh().node_count()
+        {
+            return Err(FemError::InvalidInput {
+                what: "start displacement: dof count",
+                value: start_m.len() as f64,
+                problem: "not three per mesh node",
+            });
+        }
+        let mut solver = DirectSolver::new(self.pattern())?;
+        let mut u = start_m;
+        let report = self.load_step(&mut solver, &mut u, loads, 1.0, (1, 1), settings)?;
+        Ok(StaticSolution {
+            displacement_m: u,
+            steps: vec![report],
+        })
+    }
+
     fn load_step(
         &self,
         solver: &mut DirectSolver,

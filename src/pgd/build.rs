@@ -14,12 +14,13 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use super::baseline::NewtonBaseline;
 use super::enrichment::{ModeReport, enrich};
 use super::error_curve::{EnergyError, ErrorCurve, FieldError, optimal_errors};
 use super::load_patches::{LoadOperator, LoadPatches};
 use super::local::{LocalPart, distance_neighbours, near_nodes};
 use super::region::{CutHeader, RegionReport, RegionResponse, RegionSettings};
-use super::responses::{Responses, SecantLoads, SecantReport};
+use super::responses::{Responses, SecantLoads, SecantReport, Trend};
 use super::separated::SeparatedField;
 use super::settings::BuildSettings;
 use super::stiffness::RestStiffness;
@@ -67,6 +68,10 @@ pub struct BuildReport {
     /// The cut section, when one was asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cuts: Option<RegionReport>,
+    /// Nonlinear laws, when asked for: the brute-force alternative (a Newton path per load)
+    /// timed on a sample, not counted in `total_seconds`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub newton_baseline: Option<NewtonBaseline>,
     pub total_seconds: f64,
     /// The file's size (bytes), once written.
     pub file_bytes: u64,
@@ -220,6 +225,7 @@ pub fn build(
         failed_step,
         near_field_share,
         cuts: None,
+        newton_baseline: None,
         total_seconds: started.elapsed().as_secs_f64(),
         file_bytes: 0,
     };
@@ -254,6 +260,9 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     if stiffness.model.material().law == Law::Linear {
         return Ok((steps, reports, None));
     }
+    // The step before the last, and its level: with the last they give the next start's trend.
+    let mut before: Option<(Responses, f64)> = None;
+    let mut last_level_m = 0.0;
     for &level_m in &context.settings.load_steps_m {
         let clock = Instant::now();
         // Each position's load is sized so that its linear response is `level_m` deep, and
@@ -269,14 +278,20 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
             &format!("{law} step {:.1} mm", level_m * 1e3),
             patches.parameter_count() as u64,
         );
+        let trend = before.take().map(|(responses, from_m)| {
+            Trend::new(&responses, &exact, (from_m, last_level_m, level_m))
+        });
+        before = Some((exact.clone(), last_level_m));
+        last_level_m = level_m;
         let fixed_point;
         (exact, fixed_point) = exact.secant(
             stiffness,
-            patches,
-            &magnitudes,
+            (patches, &magnitudes),
+            trend.as_ref(),
             &context.settings.secant,
             &|n| progress.advance(n as u64),
         );
+        drop(trend);
         if !fixed_point.acceptable(&context.settings.secant) {
             progress.message(&format!(
                 "{law} step {:.1} mm: the fixed point did not converge for {} of {} loads; \

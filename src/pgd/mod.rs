@@ -3,6 +3,7 @@
 //! cannot carry (see `docs/pgd.md`). Plain Rust, no Bevy.
 
 mod anderson;
+mod baseline;
 mod build;
 pub mod container;
 mod deformation;
@@ -24,6 +25,7 @@ mod vademecum;
 mod validate;
 pub mod web_form;
 
+pub use baseline::{NewtonBaseline, newton_baseline};
 pub use build::{BuildReport, OrganModel, StepReport, WIDE_NEAR_FIELD_SHARE, add_cuts, build};
 pub use deformation::{Deformation, PatchLoad, PointLoad, RigidCarry};
 pub use enrichment::{ModeReport, PgdSettings, enrich};

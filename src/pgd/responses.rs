@@ -10,12 +10,19 @@ use serde::{Deserialize, Serialize};
 use super::anderson::Anderson;
 use super::load_patches::{LoadOperator, LoadPatches};
 use super::stiffness::RestStiffness;
+use crate::fem::{Loads, NewtonSettings};
 
 /// Columns solved together: one pass over the factor serves them all.
 const BLOCK_COLUMNS: usize = 48;
 
 /// Halvings of a fixed-point update allowed to keep every element's volume positive.
 const MAX_HALVINGS: usize = 20;
+
+/// Relative residual at which a Newton solve of a load the fixed point left is converged.
+const NEWTON_TOLERANCE: f64 = 1e-8;
+
+/// Load increments of the Newton path from rest, when the step before's response is no start.
+const NEWTON_PATH_STEPS: usize = 4;
 
 /// Free-dof columns of the responses, column-major (`free_count` rows).
 #[derive(Clone)]
@@ -59,34 +66,98 @@ impl Responses {
     /// per unit force, the response to a force of `magnitudes_n[p]` along parameter `p`,
     /// `ũ = u / λ` with `K u = λ e_p − N(u)`. The nonlinear terms `N` of the previous iterate
     /// go to the right-hand side (paper 000), so every iteration reuses the factorization of
-    /// the rest stiffness; `self` is the starting iterate.
+    /// the rest stiffness. `self` is the step before's responses, which an unconverged load
+    /// keeps; the iteration starts from `self + trend`.
     pub fn secant(
         mut self,
         stiffness: &RestStiffness,
-        patches: &LoadPatches,
-        magnitudes_n: &[f64],
+        (patches, magnitudes_n): (&LoadPatches, &[f64]),
+        trend: Option<&Trend>,
         settings: &SecantSettings,
         progress: &(dyn Fn(usize) + Sync),
     ) -> (Self, SecantReport) {
         let rows = self.rows;
-        let report = self
+        let (mut report, unconverged) = self
             .columns
             .par_chunks_mut(rows * BLOCK_COLUMNS)
             .enumerate()
             .map(|(block, chunk)| {
                 let first = block * BLOCK_COLUMNS;
-                let report = secant_block(
+                let trend = trend.map(|t| t.block(block, chunk.len()));
+                let done = secant_block(
                     stiffness,
                     patches,
                     (first, &magnitudes_n[first..]),
-                    chunk,
+                    (chunk, trend),
                     settings,
                 );
                 progress(chunk.len() / rows);
-                report
+                done
             })
-            .reduce(SecantReport::default, SecantReport::merge);
+            .reduce(
+                || (SecantReport::default(), Vec::new()),
+                |(a, mut failed), (b, more)| {
+                    failed.extend(more);
+                    (a.merge(b), failed)
+                },
+            );
+        let few =
+            unconverged.len() as f64 <= settings.max_newton_fraction * report.responses as f64;
+        if few && !unconverged.is_empty() {
+            let solved = self.solve_by_newton(stiffness, (patches, magnitudes_n), &unconverged);
+            report.newton_solved = solved;
+            report.unconverged -= solved;
+        }
         (self, report)
+    }
+
+    /// Solves the loads `parameters` by Newton, one full nonlinear solve each (in parallel),
+    /// from the step before's response they hold (or from rest, in increments, if that start
+    /// inverts an element): for the few that the fixed point with the rest stiffness cannot
+    /// carry. A load Newton fails on too keeps that response. Returns the number solved.
+    fn solve_by_newton(
+        &mut self,
+        stiffness: &RestStiffness,
+        (patches, magnitudes_n): (&LoadPatches, &[f64]),
+        parameters: &[usize],
+    ) -> usize {
+        let model = stiffness.model;
+        let settings = NewtonSettings {
+            relative_tolerance: NEWTON_TOLERANCE,
+            ..NewtonSettings::default()
+        };
+        let solved: Vec<(usize, Vec<f64>)> = parameters
+            .par_iter()
+            .filter_map(|&p| {
+                let lambda = magnitudes_n[p];
+                let start = stiffness
+                    .extend(self.column(p))
+                    .iter()
+                    .map(|u| u * lambda)
+                    .collect();
+                let mut force_n = [0.0; 3];
+                force_n[p % 3] = lambda;
+                let mut loads = Loads::new(model.mesh().node_count());
+                loads
+                    .add_nodal_force(patches.positions[p / 3], force_n)
+                    .ok()?;
+                // A start that turns an element inside out: a load path from rest instead.
+                let path = NewtonSettings {
+                    load_steps: NEWTON_PATH_STEPS,
+                    ..settings
+                };
+                let solution = model
+                    .solve_static_from(start, &loads, &settings)
+                    .or_else(|_| model.solve_static(&loads, &path))
+                    .ok()?;
+                let secant = stiffness.restrict(&solution.displacement_m);
+                Some((p, secant.iter().map(|u| u / lambda).collect()))
+            })
+            .collect();
+        for (p, column) in &solved {
+            self.columns[p * self.rows..(p + 1) * self.rows].copy_from_slice(column);
+        }
+        solved.len()
     }
 
     /// The energy Gram `Uᵀ K U` (column-major) of responses that need not satisfy `K U = F`
@@ -163,6 +234,42 @@ impl LoadOperator for SecantLoads<'_> {
     }
 }
 
+/// How the secant responses moved over the last step, scaled to the next one: `r (Ũ_k − Ũ_{k−1})`
+/// with `r` the ratio of the steps' widths. Added to `Ũ_k`, it starts the next step's fixed
+/// point on the line through the last two steps (a secant predictor in the load), closer to
+/// its solution than `Ũ_k` where the response changes steadily with depth.
+pub struct Trend {
+    rows: usize,
+    columns: Vec<f64>,
+}
+
+impl Trend {
+    /// From `before` to `after` (levels `from_m` and `at_m`), extended to `to_m`.
+    pub fn new(
+        before: &Responses,
+        after: &Responses,
+        (from_m, at_m, to_m): (f64, f64, f64),
+    ) -> Self {
+        let ratio = (to_m - at_m) / (at_m - from_m);
+        let columns = after
+            .columns
+            .par_iter()
+            .zip(&before.columns)
+            .map(|(a, b)| ratio * (a - b))
+            .collect();
+        Self {
+            rows: after.rows,
+            columns,
+        }
+    }
+
+    /// The part of block `block` (`len` values) of the responses.
+    fn block(&self, block: usize, len: usize) -> &[f64] {
+        let start = block * BLOCK_COLUMNS * self.rows;
+        &self.columns[start..start + len]
+    }
+}
+
 /// The fixed point of a KSV load step, per response.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SecantSettings {
@@ -175,6 +282,10 @@ pub struct SecantSettings {
     /// A step is kept while at most this fraction of its loads fail to converge; those keep
     /// the previous step's secant response (reported, never silent).
     pub max_unconverged_fraction: f64,
+    /// When at most this fraction of a step's loads fail the fixed point, each of them is
+    /// solved by Newton instead (a factorization per iteration, so only for a few).
+    #[serde(default = "default_max_newton_fraction")]
+    pub max_newton_fraction: f64,
 }
 
 impl Default for SecantSettings {
@@ -184,12 +295,17 @@ impl Default for SecantSettings {
             max_iterations: 40,
             anderson_depth: default_anderson_depth(),
             max_unconverged_fraction: 0.005,
+            max_newton_fraction: default_max_newton_fraction(),
         }
     }
 }
 
 fn default_anderson_depth() -> usize {
     5
+}
+
+fn default_max_newton_fraction() -> f64 {
+    0.03
 }
 
 /// How the fixed points of one load step went.
@@ -202,6 +318,8 @@ pub struct SecantReport {
     /// the load step is beyond what the fixed point (and, usually, the KSV law) can carry.
     /// They keep their starting iterate, the previous step's secant response.
     pub unconverged: usize,
+    /// Responses the fixed point left that Newton then solved (not counted as unconverged).
+    pub newton_solved: usize,
     /// The largest final relative change over all responses.
     pub worst_change: f64,
 }
@@ -213,6 +331,7 @@ impl SecantReport {
             total_iterations: self.total_iterations + other.total_iterations,
             max_iterations: self.max_iterations.max(other.max_iterations),
             unconverged: self.unconverged + other.unconverged,
+            newton_solved: self.newton_solved + other.newton_solved,
             worst_change: self.worst_change.max(other.worst_change),
         }
     }
@@ -243,9 +362,9 @@ fn secant_block(
     stiffness: &RestStiffness,
     patches: &LoadPatches,
     (first, magnitudes_n): (usize, &[f64]),
-    chunk: &mut [f64],
+    (chunk, trend): (&mut [f64], Option<&[f64]>),
     settings: &SecantSettings,
-) -> SecantReport {
+) -> (SecantReport, Vec<usize>) {
     let rows = stiffness.free_count();
     let columns = chunk.len() / rows;
     // A load on a clamped node has no response and no magnitude: nothing to iterate.
@@ -259,7 +378,10 @@ fn secant_block(
         ..SecantReport::default()
     };
     let start = chunk.to_vec();
-    let mut previous = start.clone();
+    if let Some(trend) = trend {
+        chunk.iter_mut().zip(trend).for_each(|(u, t)| *u += t);
+    }
+    let mut previous = chunk.to_vec();
     let mut work = NonlinearWork::new(stiffness);
     for iteration in 1..=settings.max_iterations {
         let mut rhs = Vec::with_capacity(active.len() * rows);
@@ -309,15 +431,18 @@ fn secant_block(
             break;
         }
     }
-    for j in (0..columns).filter(|&j| change[j].is_nan() || change[j] >= settings.tolerance) {
-        report.unconverged += 1;
+    let unconverged: Vec<usize> = (0..columns)
+        .filter(|&j| change[j].is_nan() || change[j] >= settings.tolerance)
+        .collect();
+    for &j in &unconverged {
         chunk[j * rows..(j + 1) * rows].copy_from_slice(&start[j * rows..(j + 1) * rows]);
     }
+    report.unconverged = unconverged.len();
     report.worst_change = change
         .iter()
         .map(|c| if c.is_finite() { *c } else { f64::INFINITY })
         .fold(0.0, f64::max);
-    report
+    (report, unconverged.iter().map(|j| first + j).collect())
 }
 
 /// Buffers for evaluating the nonlinear terms of one response at a time.

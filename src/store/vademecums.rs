@@ -157,6 +157,7 @@ pub fn ensure_vademecum(
         inclusions: &spec.inclusions,
         settings: spec.build.clone(),
         cuts: None,
+        newton_samples: 0,
     };
     let (vademecum, _, [csv, png]) = build_and_save(job, &spec.file)?;
     eprintln!(
@@ -178,7 +179,12 @@ pub struct BuildJob<'a> {
     pub settings: BuildSettings,
     /// Also build the cut section over this region.
     pub cuts: Option<RegionSettings>,
+    /// Nonlinear laws: Newton paths timed as the brute-force baseline (0: none).
+    pub newton_samples: usize,
 }
+
+/// Seed of the load parameters the brute-force baseline times.
+const NEWTON_SEED: u64 = 5;
 
 /// Builds `job`'s vademecum with progress bars (the organ clamped at its `clamped` region,
 /// loaded over its `accessible` one) and saves it at `file`, with its convergence curves
@@ -204,6 +210,15 @@ pub fn build_and_save(
             .map_err(|e| format!("{source}: cut section: {e}"))?;
         built.total_seconds += report.total_seconds;
         built.cuts = Some(report);
+    }
+    if job.newton_samples > 0 {
+        eprintln!(
+            "timing the brute-force baseline: {} Newton paths",
+            job.newton_samples
+        );
+        built.newton_baseline =
+            pgd::newton_baseline(&model, &vademecum, job.newton_samples, NEWTON_SEED)
+                .map_err(|e| format!("{source}: brute-force baseline: {e}"))?;
     }
     pgd::save(file, &vademecum).map_err(|e| e.to_string())?;
     built.file_bytes = std::fs::metadata(file).map_or(0, |m| m.len());

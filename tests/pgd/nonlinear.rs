@@ -1,13 +1,14 @@
 //! Nonlinear vademecums by load steps: their secant responses are equilibria (KSV, and
 //! neo-Hookean deep enough to turn elements inside out on the way), they follow full FEM of
 //! their law better than the linear vademecum does (the neo-Hookean one within 7 %), and a
-//! load step beyond the law's stability is left out and bounds the valid range.
+//! load step beyond the law's stability is left out and bounds the valid range; the
+//! brute-force baseline times Newton paths through the same steps.
 
 use pgd_surgery::fem::{FemModel, Law, Loads, NewtonSettings, PatchKernel};
 use pgd_surgery::mesh::Surface;
 use pgd_surgery::pgd::{
-    BuildSettings, LoadPatches, Responses, RestStiffness, SecantSettings, Silent, ValidationReport,
-    ValidationSettings, build, validate,
+    BuildSettings, LoadPatches, Responses, RestStiffness, SecantReport, SecantSettings, Silent,
+    ValidationReport, ValidationSettings, build, newton_baseline, validate,
 };
 
 use crate::common::{block_mesh, block_model_of, organ, settings};
@@ -27,11 +28,25 @@ fn top_nodes(model: &FemModel) -> Vec<usize> {
         .collect()
 }
 
+/// The fixed point run to 1e-9, the tolerance of the equilibrium tests.
+fn tight() -> SecantSettings {
+    SecantSettings {
+        tolerance: 1e-9,
+        max_iterations: 300,
+        ..SecantSettings::default()
+    }
+}
+
 /// For a force of magnitude λ along parameter p, `λ ũ_p` must be the equilibrium that Newton
-/// finds for the same nodal force: tolerance 1e-6 relative, with the fixed point run to 1e-9
-/// (the Newton solve converges to 1e-10 of the load). Each force pushes its own node `depth_m`
-/// in the linear response.
-fn secant_responses_are_equilibria(law: Law, depth_m: f64, newton_steps: usize) {
+/// finds for the same nodal force: tolerance 1e-6 relative (the Newton solve converges to
+/// 1e-10 of the load). Each force pushes its own node `depth_m` in the linear response. The
+/// secant responses come from `fixed_point`; its report is returned.
+fn secant_responses_are_equilibria(
+    law: Law,
+    depth_m: f64,
+    newton_steps: usize,
+    fixed_point: &SecantSettings,
+) -> SecantReport {
     let model = block_model_of(block_mesh([6, 4, 3]), law);
     let mesh = model.mesh();
     let surface = Surface::extract(mesh);
@@ -43,13 +58,14 @@ fn secant_responses_are_equilibria(law: Law, depth_m: f64, newton_steps: usize) 
     let magnitudes: Vec<f64> = (0..linear.count())
         .map(|p| depth_m / linear.column(p)[own_dof(p)])
         .collect();
-    let fixed_point = SecantSettings {
-        tolerance: 1e-9,
-        max_iterations: 300,
-        ..SecantSettings::default()
-    };
     let before = linear.columns.clone();
-    let (secant, report) = linear.secant(&stiffness, &patches, &magnitudes, &fixed_point, &|_| {});
+    let (secant, report) = linear.secant(
+        &stiffness,
+        (&patches, &magnitudes),
+        None,
+        fixed_point,
+        &|_| {},
+    );
     assert_eq!(report.unconverged, 0, "{report:?}");
     for p in 0..secant.count() {
         let mut loads = Loads::new(mesh.node_count());
@@ -80,18 +96,35 @@ fn secant_responses_are_equilibria(law: Law, depth_m: f64, newton_steps: usize) 
             "the load should be in the nonlinear range"
         );
     }
+    report
 }
 
 #[test]
 fn a_secant_response_is_the_ksv_equilibrium_per_unit_force() {
-    secant_responses_are_equilibria(Law::KirchhoffSaintVenant, 3e-3, 1);
+    let report = secant_responses_are_equilibria(Law::KirchhoffSaintVenant, 3e-3, 1, &tight());
+    assert_eq!(report.newton_solved, 0, "{report:?}");
 }
 
 /// 25 mm under a nodal load on 1 cm elements: the fixed point's first iterates turn elements
 /// inside out, and it converges only because it backs off such iterates.
 #[test]
 fn a_deep_neo_hookean_secant_response_is_the_equilibrium_per_unit_force() {
-    secant_responses_are_equilibria(Law::NeoHookean, 25e-3, 16);
+    let report = secant_responses_are_equilibria(Law::NeoHookean, 25e-3, 16, &tight());
+    assert_eq!(report.newton_solved, 0, "{report:?}");
+}
+
+/// Loads the fixed point leaves unconverged (here all of them: one iteration allowed) are
+/// solved by Newton from the step before's response, to the same equilibrium.
+#[test]
+fn loads_the_fixed_point_leaves_are_solved_by_newton() {
+    let one_iteration = SecantSettings {
+        max_iterations: 1,
+        max_newton_fraction: 1.0,
+        ..tight()
+    };
+    let report = secant_responses_are_equilibria(Law::NeoHookean, 10e-3, 4, &one_iteration);
+    assert_eq!(report.newton_solved, report.responses, "{report:?}");
+    assert_eq!(report.unconverged, 0);
 }
 
 fn relative(a: &[f64], b: &[f64]) -> f64 {
@@ -188,4 +221,29 @@ fn the_neo_hookean_vademecum_follows_full_fem_to_its_deepest_step() {
     let (with_neo_hookean, with_linear) = against_full_fem(Law::NeoHookean, steps, (1e-3, 10e-3));
     assert!(with_neo_hookean.force_error.p95 < 0.07);
     assert!(with_neo_hookean.force_error.p95 < with_linear.force_error.p95);
+}
+
+/// The brute-force baseline times Newton paths through the vademecum's steps, loaded as the
+/// build loads them: on the block every sampled path converges in as many increments as the
+/// deepest step holds the first, and the sample's mean is scaled to every load. A linear
+/// vademecum has no nonlinear baseline.
+#[test]
+fn the_newton_baseline_times_converged_paths_through_the_steps() {
+    let model = block_model_of(block_mesh([4, 3, 2]), Law::NeoHookean);
+    let (vademecum, _) = build(&organ(&model), &ksv_settings(vec![2.5e-3, 5e-3]), &Silent).unwrap();
+    let baseline = newton_baseline(&model, &vademecum, 2, 1).unwrap().unwrap();
+    assert_eq!((baseline.samples, baseline.failed), (2, 0), "{baseline:?}");
+    assert_eq!((baseline.increments, baseline.deepest_m), (2, 5e-3));
+    assert_eq!(baseline.loads, 3 * vademecum.positions.len());
+    assert!(baseline.seconds_per_load > 0.0);
+    let scaled = baseline.seconds_per_load * baseline.loads as f64;
+    assert!((baseline.estimated_seconds - scaled).abs() <= 1e-12 * scaled);
+
+    let linear_model = block_model_of(block_mesh([4, 3, 2]), Law::Linear);
+    let (linear, _) = build(&organ(&linear_model), &settings(60, 1e-3), &Silent).unwrap();
+    assert!(
+        newton_baseline(&linear_model, &linear, 2, 1)
+            .unwrap()
+            .is_none()
+    );
 }

@@ -300,6 +300,14 @@ pub struct BuildArgs {
     /// converge (those keep the step before's secant response, counted in the report).
     #[arg(long, default_value_t = SecantSettings::default().max_unconverged_fraction)]
     pub max_unconverged: f64,
+    /// Nonlinear laws: when at most this fraction of a step's loads fail the fixed point,
+    /// each is solved by Newton instead (0: never).
+    #[arg(long, default_value_t = SecantSettings::default().max_newton_fraction)]
+    pub max_newton: f64,
+    /// Nonlinear laws: time the brute-force alternative on this many random loads, a full
+    /// Newton path each to the deepest step kept, and scale it to all loads (0: skip).
+    #[arg(long, default_value_t = 3)]
+    pub newton_samples: usize,
     /// Also build the cut section: the uncut organ's response to a unit force at every node
     /// within --cut-depth-mm of the accessible faces, which an incision anywhere there is
     /// condensed onto online (docs/cutting.md).
@@ -387,6 +395,7 @@ impl BuildArgs {
             load_steps_m,
             secant: SecantSettings {
                 max_unconverged_fraction: self.max_unconverged,
+                max_newton_fraction: self.max_newton,
                 ..defaults.secant
             },
         })
@@ -449,6 +458,9 @@ pub enum BenchTarget {
         /// Every organ moves (reduced dynamics, stepped every tick), as with a grasper.
         #[arg(long)]
         dynamic: bool,
+        /// The organs' tissue law (each organ's vademecum is built under it).
+        #[arg(long, value_enum, default_value = "linear")]
+        law: LawArg,
         /// Print the report as JSON instead of a table.
         #[arg(long)]
         json: bool,

@@ -218,6 +218,7 @@ fn job<'a>(
         inclusions: &material.inclusion,
         settings: build.settings(organ, material.law.law())?,
         cuts: build.cut_settings(organ)?,
+        newton_samples: build.newton_samples,
     })
 }
 
@@ -295,10 +296,12 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             realtime_seconds,
             vademecums,
             dynamic,
+            law,
             json,
         } => {
             let organs = SCENE_ORGANS.map(|organ| SceneOrgan {
                 dynamic,
+                law: law.law(),
                 ..SceneOrgan::from(organ)
             });
             let scene = match abdomen_scene(&organs, &vademecums, Detail::Full) {

@@ -1,0 +1,101 @@
+//! The brute-force alternative a nonlinear vademecum build must beat, timed on the same
+//! machine in the same run: one full Newton path (with line search) per load parameter,
+//! through the vademecum's load steps to its deepest one. Timing every parameter would take
+//! hours on an organ, so a random sample is timed and the mean scaled to all of them.
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::Vademecum;
+use crate::fem::{FemError, FemModel, Loads, NewtonSettings};
+
+/// Newton's residual tolerance for the baseline: tighter than the secant fixed point's change
+/// (1e-3), so that the baseline is not cheapened, and far from the reference solves' 1e-10.
+const RELATIVE_TOLERANCE: f64 = 1e-6;
+
+/// The timed sample and what it scales to.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct NewtonBaseline {
+    /// Load parameters timed.
+    pub samples: usize,
+    /// Of them, those whose Newton path failed (an element turned inside out, or no
+    /// convergence): timed up to the failure.
+    pub failed: usize,
+    /// Uniform increments of each path: the first load step is one increment and the deepest
+    /// is a whole number of them.
+    pub increments: usize,
+    pub deepest_m: f64,
+    /// Mean seconds of one Newton path.
+    pub seconds_per_load: f64,
+    /// All load parameters of the vademecum.
+    pub loads: usize,
+    /// `seconds_per_load × loads`: the brute-force build of the same responses.
+    pub estimated_seconds: f64,
+}
+
+/// Times `samples` Newton paths of `model` (the model `vademecum` was built for) at random load
+/// parameters (seeded by `seed`), each loaded as the build loads it at its deepest step: a
+/// nodal force, pushing into the organ, whose linear response is that step's depth. `None`
+/// for a vademecum with one (linear) step.
+pub fn newton_baseline(
+    model: &FemModel,
+    vademecum: &Vademecum,
+    samples: usize,
+    seed: u64,
+) -> Result<Option<NewtonBaseline>, FemError> {
+    let levels = &vademecum.header.indentation_levels_m;
+    let (Some(&first_m), Some(&deepest_m)) = (levels.get(1), levels.last()) else {
+        return Ok(None);
+    };
+    let increments = ((deepest_m / first_m).round() as usize).max(1);
+    let settings = NewtonSettings {
+        load_steps: increments,
+        relative_tolerance: RELATIVE_TOLERANCE,
+        ..NewtonSettings::default()
+    };
+    let loads = 3 * vademecum.positions.len();
+    let mut rng = fastrand::Rng::with_seed(seed);
+    let (mut seconds, mut failed) = (0.0, 0);
+    for _ in 0..samples {
+        let force = nodal_load(model, vademecum, rng.usize(..loads), deepest_m)?;
+        let clock = Instant::now();
+        let solved = model.solve_static(&force, &settings);
+        seconds += clock.elapsed().as_secs_f64();
+        failed += usize::from(solved.is_err());
+    }
+    let seconds_per_load = seconds / samples.max(1) as f64;
+    Ok(Some(NewtonBaseline {
+        samples,
+        failed,
+        increments,
+        deepest_m,
+        seconds_per_load,
+        loads,
+        estimated_seconds: seconds_per_load * loads as f64,
+    }))
+}
+
+/// The nodal force of load parameter `p` whose linear response is `depth_m` deep, pushing
+/// into the organ (against the outward normal's component along the parameter's axis).
+fn nodal_load(
+    model: &FemModel,
+    vademecum: &Vademecum,
+    p: usize,
+    depth_m: f64,
+) -> Result<Loads, FemError> {
+    let (position, axis) = (p / 3, p % 3);
+    let compliance_m_per_n = f64::from(vademecum.reference_compliance_m_per_n[position]);
+    let inward = if vademecum.position_normals[position][axis] > 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    let mut force_n = [0.0; 3];
+    if compliance_m_per_n > 0.0 {
+        force_n[axis] = inward * depth_m / compliance_m_per_n;
+    }
+    let mut loads = Loads::new(model.mesh().node_count());
+    loads.add_nodal_force(vademecum.positions[position] as usize, force_n)?;
+    Ok(loads)
+}
