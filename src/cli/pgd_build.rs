@@ -100,9 +100,9 @@ pub fn print_build_report(report: &BuildReport, out: &Path) {
     }
     if let Some(failed) = &report.failed_step {
         println!(
-            "load step {:.1} mm left out: its fixed point did not converge (the law loses \
-             stability under the tool, or the step is too far from the linear response); the \
-             vademecum is valid to {:.1} mm",
+            "load step {:.1} mm left out: too many of its loads did not converge, more than \
+             --max-newton lets Newton solve (the law loses stability under the tool, or the \
+             step is too far from the one before); the vademecum is valid to {:.1} mm",
             failed.indentation_m * 1e3,
             report.steps.last().map_or(0.0, |s| s.indentation_m * 1e3)
         );
@@ -142,7 +142,7 @@ fn print_cut_report(cuts: &pgd::RegionReport) {
 
 fn print_newton_baseline(baseline: &pgd::NewtonBaseline, build_seconds: f64) {
     println!(
-        "brute force: a Newton path per load to {:.1} mm ({} increments) takes {:.1} s \
+        "brute force: a Newton path per load to {:.1} mm (increments: {}) takes {:.1} s \
          (mean of {}, {} failed), so {:.0} s for all {} loads: {:.0}x this build's {:.0} s",
         baseline.deepest_m * 1e3,
         baseline.increments,
