@@ -8,6 +8,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::Vademecum;
+use super::load_patches::parameter_load;
 use crate::fem::{FemError, FemModel, Loads, NewtonSettings};
 
 /// Newton's residual tolerance for the baseline: tighter than the secant fixed point's change
@@ -91,11 +92,10 @@ fn nodal_load(
     } else {
         1.0
     };
-    let mut force_n = [0.0; 3];
-    if compliance_m_per_n > 0.0 {
-        force_n[axis] = inward * depth_m / compliance_m_per_n;
-    }
-    let mut loads = Loads::new(model.mesh().node_count());
-    loads.add_nodal_force(vademecum.positions[position] as usize, force_n)?;
-    Ok(loads)
+    let magnitude_n = match compliance_m_per_n > 0.0 {
+        true => inward * depth_m / compliance_m_per_n,
+        false => 0.0,
+    };
+    let node = vademecum.positions[position] as usize;
+    parameter_load(model.mesh().node_count(), (node, axis), magnitude_n)
 }

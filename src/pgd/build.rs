@@ -291,7 +291,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
             &context.settings.secant,
             &|n| progress.advance(n as u64),
         );
-        drop(trend);
+        drop(trend); // a full copy of the responses: freed before the step's PGD
         if !fixed_point.acceptable(&context.settings.secant) {
             progress.message(&format!(
                 "{law} step {:.1} mm: the fixed point did not converge for {} of {} loads; \

@@ -7,7 +7,7 @@
 //! exactly at `s`, not for an interpolation of patches centred on nodes. The load matrix `F`
 //! (dofs × parameters) is never formed: it is applied, and transposed, node by node.
 
-use crate::fem::{FemError, PatchKernel};
+use crate::fem::{FemError, Loads, PatchKernel};
 use crate::mesh::{NOT_ON_SURFACE, Surface};
 
 /// A load matrix `F` (full dofs × parameters) that can be applied and transposed: the PGD's
@@ -74,4 +74,19 @@ impl LoadOperator for LoadPatches {
             out[3 * m..3 * m + 3].copy_from_slice(&r[3 * node..3 * node + 3]);
         }
     }
+}
+
+/// The nodal force of a load parameter at a magnitude: `magnitude_n` along `axis` at `node`,
+/// in a model of `node_count` nodes. What a load step applies to one parameter, and what a
+/// full Newton solve of that parameter is given.
+pub(super) fn parameter_load(
+    node_count: usize,
+    (node, axis): (usize, usize),
+    magnitude_n: f64,
+) -> Result<Loads, FemError> {
+    let mut force_n = [0.0; 3];
+    force_n[axis] = magnitude_n;
+    let mut loads = Loads::new(node_count);
+    loads.add_nodal_force(node, force_n)?;
+    Ok(loads)
 }

@@ -8,9 +8,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::anderson::Anderson;
-use super::load_patches::{LoadOperator, LoadPatches};
+use super::load_patches::{LoadOperator, LoadPatches, parameter_load};
 use super::stiffness::RestStiffness;
-use crate::fem::{Loads, NewtonSettings};
+use crate::fem::NewtonSettings;
 
 /// Columns solved together: one pass over the factor serves them all.
 const BLOCK_COLUMNS: usize = 48;
@@ -135,12 +135,9 @@ impl Responses {
                     .iter()
                     .map(|u| u * lambda)
                     .collect();
-                let mut force_n = [0.0; 3];
-                force_n[p % 3] = lambda;
-                let mut loads = Loads::new(model.mesh().node_count());
-                loads
-                    .add_nodal_force(patches.positions[p / 3], force_n)
-                    .ok()?;
+                let node = patches.positions[p / 3];
+                let loads =
+                    parameter_load(model.mesh().node_count(), (node, p % 3), lambda).ok()?;
                 // A start that turns an element inside out: a load path from rest instead.
                 let path = NewtonSettings {
                     load_steps: NEWTON_PATH_STEPS,

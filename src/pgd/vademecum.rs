@@ -2,6 +2,8 @@
 //! point of the accessible surface, the displacement under the tool, the felt force for an
 //! indentation, and the whole displacement field, each in O(modes + local entries).
 
+use std::ops::RangeInclusive;
+
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -241,22 +243,36 @@ impl Vademecum {
     /// Weight of load step `step` for a nodal load whose linear response is `level_m` deep:
     /// piecewise linear between the steps' levels, held at the last step beyond it.
     fn step_weight(&self, step: usize, level_m: f64) -> f64 {
-        let levels = &self.header.indentation_levels_m;
-        let last = levels.len() - 1;
-        match levels.iter().position(|&l| l >= level_m) {
-            None => f64::from(step == last),
-            Some(0) => f64::from(step == 0),
-            Some(k) => {
-                let t = (level_m - levels[k - 1]) / (levels[k] - levels[k - 1]);
-                if step == k {
-                    t
-                } else if step == k - 1 {
-                    1.0 - t
-                } else {
-                    0.0
-                }
-            }
+        let (first, last) = self.steps_at(level_m);
+        if first == last {
+            return f64::from(step == first);
         }
+        let levels = &self.header.indentation_levels_m;
+        let t = (level_m - levels[first]) / (levels[last] - levels[first]);
+        if step == last {
+            t
+        } else if step == first {
+            1.0 - t
+        } else {
+            0.0
+        }
+    }
+
+    /// The first and last steps [`Self::step_weight`] blends for a nodal load `level_m` deep
+    /// (the last step beyond the deepest level, or for a level that is not a number).
+    fn steps_at(&self, level_m: f64) -> (usize, usize) {
+        let levels = &self.header.indentation_levels_m;
+        match levels.iter().position(|&l| l >= level_m) {
+            None => (levels.len() - 1, levels.len() - 1),
+            Some(0) => (0, 0),
+            Some(k) => (k - 1, k),
+        }
+    }
+
+    /// The linear depth (m) of position `j`'s load, share `l` of a total force of
+    /// `force_norm_n`: what picks its load step.
+    fn nodal_level_m(&self, j: usize, l: f64, force_norm_n: f64) -> f64 {
+        l * force_norm_n * self.reference_compliance_m_per_n[j] as f64
     }
 
     /// The share of a total force `force_n` that position `j` (share `l` of the patch) carries
@@ -266,8 +282,26 @@ impl Vademecum {
         if self.steps.len() == 1 {
             return l;
         }
-        let level = l * force_n.norm() * self.reference_compliance_m_per_n[j] as f64;
-        l * self.step_weight(step, level)
+        l * self.step_weight(step, self.nodal_level_m(j, l, force_n.norm()))
+    }
+
+    /// The load steps the positions of `patch` blend under `force_n`: from the shallowest
+    /// load's first to the deepest load's last (a step in between that no load uses adds
+    /// nothing).
+    fn loaded_steps(&self, patch: &Patch, force_n: &Vector3<f64>) -> RangeInclusive<usize> {
+        let force_norm_n = force_n.norm();
+        let (shallowest, deepest) = patch
+            .shares
+            .iter()
+            .map(|&(j, l)| self.nodal_level_m(j, l, force_norm_n))
+            .map(|level| if level.is_nan() { f64::INFINITY } else { level })
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), level| {
+                (lo.min(level), hi.max(level))
+            });
+        if shallowest > deepest {
+            return 0..=0;
+        }
+        self.steps_at(shallowest).0..=self.steps_at(deepest).1
     }
 
     /// The 3 × 3 compliance (m/N) of load step `step` for `patch`: the patch-averaged
@@ -336,19 +370,13 @@ impl Vademecum {
     }
 
     /// The compliance for a force `force_n` on `patch` (load steps blended). Each nodal load
-    /// sits between two steps, so only the steps some position of the patch loads are
-    /// scanned: two or three of a neo-Hookean vademecum's seven.
+    /// sits between two steps, so only the steps the patch's loads reach are scanned: two or
+    /// three of a neo-Hookean vademecum's seven.
     pub fn compliance(&self, patch: &Patch, force_n: &Vector3<f64>) -> Matrix3<f64> {
         if self.steps.len() == 1 {
             return self.step_compliance(0, patch);
         }
-        (0..self.steps.len())
-            .filter(|&k| {
-                patch
-                    .shares
-                    .iter()
-                    .any(|&(j, l)| self.step_share(k, j, l, force_n) != 0.0)
-            })
+        self.loaded_steps(patch, force_n)
             .map(|k| self.weighted_compliance(k, patch, |j, l| self.step_share(k, j, l, force_n)))
             .sum()
     }
