@@ -16,7 +16,7 @@ use crate::devices::{
     Workspace,
 };
 use crate::dynamics::{DynamicModel, GraspSettings, TRAINER_MODES};
-use crate::fem::{FemModel, Inclusion, Law, Material};
+use crate::fem::{FemModel, Inclusion, Law};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::{Organ, OrganSettings, region};
 use crate::pgd::{BuildSettings, Vademecum};
@@ -386,10 +386,7 @@ fn organ_model(
     law: Law,
 ) -> Result<FemModel, String> {
     let header = &vademecum.header;
-    let material = Material {
-        law,
-        ..header.material
-    };
+    let material = header.material.with_law(law);
     crate::pgd::organ::clamped_model(mesh.clone(), material)
         .and_then(|m| m.with_inclusions(&header.inclusions))
         .map_err(|e| format!("{name}: {e}"))

@@ -65,7 +65,7 @@ impl ReducedKsv {
         let nonlinear = match law {
             Law::Linear => false,
             Law::KirchhoffSaintVenant => true,
-            Law::NeoHookean => return Err(DynamicsError::unsupported(law)),
+            Law::NeoHookean | Law::Exponential => return Err(DynamicsError::unsupported(law)),
         };
         let r = basis.len();
         let (pairs, pair_of) = index_pairs(r);

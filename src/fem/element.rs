@@ -9,7 +9,9 @@
 //!
 //! The compressible neo-Hookean element has `P = μ (F − F⁻ᵀ) + λ ln J F⁻ᵀ` and the tangent
 //! `∂P_iJ/∂F_kL = μ δ_ik δ_JL + (μ − λ ln J) F⁻¹_Jk F⁻¹_Li + λ F⁻¹_Ji F⁻¹_Lk`, whose blocks
-//! reduce to the same linear-elastic block at `F = I`.
+//! reduce to the same linear-elastic block at `F = I`. The exponential law replaces `μ` by
+//! `μ' = μ e^{b x}` and adds the growth of `μ'`, `2bμ' D_iJ D_kL` with `D = F − F⁻ᵀ` (since
+//! `∂x/∂F = 2D`); `x` is second order in the strain, so the rest block is unchanged.
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
@@ -67,57 +69,53 @@ impl TetGeometry {
     /// Internal force and tangent stiffness of this element for the element displacement `u`.
     pub fn force_and_tangent(
         &self,
-        law: Law,
-        lambda: f64,
-        mu: f64,
+        tissue: &ElementTissue,
         u: &ElementVector,
     ) -> (ElementVector, ElementMatrix) {
+        let ElementTissue { law, lambda, mu, .. } = *tissue;
         match law {
             Law::Linear => {
                 let k = self.linear_stiffness(lambda, mu);
                 (k * u, k)
             }
             Law::KirchhoffSaintVenant => self.ksv_force_and_tangent(lambda, mu, u),
-            Law::NeoHookean => self.neo_hookean_force_and_tangent(lambda, mu, u),
+            Law::NeoHookean | Law::Exponential => self.hyperelastic_force_and_tangent(tissue, u),
         }
     }
 
     /// Internal force only, for residual evaluations in line searches. Non-finite for a
     /// neo-Hookean element turned inside out (J ≤ 0), where the energy is infinite.
-    pub fn force(&self, law: Law, lambda: f64, mu: f64, u: &ElementVector) -> ElementVector {
-        match law {
-            Law::Linear => self.linear_stiffness(lambda, mu) * u,
-            _ => self.nodal_forces(&self.first_piola(law, lambda, mu, u)),
+    pub fn force(&self, tissue: &ElementTissue, u: &ElementVector) -> ElementVector {
+        match tissue.law {
+            Law::Linear => self.linear_stiffness(tissue.lambda, tissue.mu) * u,
+            _ => self.nodal_forces(&self.first_piola(tissue, u)),
         }
     }
 
     /// The internal force minus the linear one, `f(u) − K_e u`: the nonlinear terms that the
     /// load-step scheme of paper 000 moves to the right-hand side. Zero for the linear law.
-    pub fn nonlinear_force(
-        &self,
-        law: Law,
-        lambda: f64,
-        mu: f64,
-        u: &ElementVector,
-    ) -> ElementVector {
-        if law == Law::Linear {
+    pub fn nonlinear_force(&self, tissue: &ElementTissue, u: &ElementVector) -> ElementVector {
+        if tissue.law == Law::Linear {
             return ElementVector::zeros();
         }
         let h = self.displacement_gradient(u);
         let strain = (h + h.transpose()) * 0.5;
-        let linear = Matrix3::identity() * (lambda * strain.trace()) + strain * (2.0 * mu);
-        self.nodal_forces(&(self.first_piola(law, lambda, mu, u) - linear))
+        let linear =
+            Matrix3::identity() * (tissue.lambda * strain.trace()) + strain * (2.0 * tissue.mu);
+        self.nodal_forces(&(self.first_piola(tissue, u) - linear))
     }
 
     /// First Piola–Kirchhoff stress `P` of a nonlinear law at the element's displacement.
-    fn first_piola(&self, law: Law, lambda: f64, mu: f64, u: &ElementVector) -> Matrix3<f64> {
-        match law {
+    fn first_piola(&self, tissue: &ElementTissue, u: &ElementVector) -> Matrix3<f64> {
+        match tissue.law {
             Law::Linear => unreachable!("the linear law has no separate stress path"),
             Law::KirchhoffSaintVenant => {
-                let (f, s) = self.ksv_stress(lambda, mu, u);
+                let (f, s) = self.ksv_stress(tissue.lambda, tissue.mu, u);
                 f * s
             }
-            Law::NeoHookean => neo_hookean_stress(lambda, mu, &self.displacement_gradient(u)).0,
+            Law::NeoHookean | Law::Exponential => {
+                hyperelastic_stress(tissue, &self.displacement_gradient(u)).p
+            }
         }
     }
 
@@ -155,23 +153,29 @@ impl TetGeometry {
         (f, s)
     }
 
-    /// The neo-Hookean force and its tangent block
-    /// `K_ab = V [μ (g_a·g_b) I + (μ − λ ln J) c_b c_aᵀ + λ c_a c_bᵀ]`, `c = F⁻ᵀ g`.
-    fn neo_hookean_force_and_tangent(
+    /// The neo-Hookean family's force and its tangent block
+    /// `K_ab = V [μ' (g_a·g_b) I + (μ' − λ ln J) c_b c_aᵀ + λ c_a c_bᵀ + 2bμ' (D g_a)(D g_b)ᵀ]`,
+    /// `c = F⁻ᵀ g`, `D = F − F⁻ᵀ`, `μ' = μ e^{b x}` (the last term is the growth of `μ'`).
+    fn hyperelastic_force_and_tangent(
         &self,
-        lambda: f64,
-        mu: f64,
+        tissue: &ElementTissue,
         u: &ElementVector,
     ) -> (ElementVector, ElementMatrix) {
-        let (p, inverse_t, log_j) = neo_hookean_stress(lambda, mu, &self.displacement_gradient(u));
-        let force = self.nodal_forces(&p);
-        let c: [Vector3<f64>; 4] = self.grads.map(|g| inverse_t * g);
+        let stress = hyperelastic_stress(tissue, &self.displacement_gradient(u));
+        let force = self.nodal_forces(&stress.p);
+        let (lambda, shear) = (tissue.lambda, stress.shear_pa);
+        let c: [Vector3<f64>; 4] = self.grads.map(|g| stress.inverse_t * g);
+        let growth = 2.0 * tissue.stiffening * shear;
+        let dg: [Vector3<f64>; 4] = self.grads.map(|g| stress.f_minus_inverse_t * g);
         let mut k = ElementMatrix::zeros();
         for a in 0..4 {
             for b in 0..4 {
-                let block = Matrix3::identity() * (mu * self.grads[a].dot(&self.grads[b]))
-                    + (c[b] * c[a].transpose()) * (mu - lambda * log_j)
+                let mut block = Matrix3::identity() * (shear * self.grads[a].dot(&self.grads[b]))
+                    + (c[b] * c[a].transpose()) * (shear - lambda * stress.log_j)
                     + (c[a] * c[b].transpose()) * lambda;
+                if growth != 0.0 {
+                    block += (dg[a] * dg[b].transpose()) * growth;
+                }
                 k.fixed_view_mut::<3, 3>(3 * a, 3 * b)
                     .copy_from(&(block * self.volume_m3));
             }
@@ -217,19 +221,59 @@ impl TetGeometry {
     }
 }
 
-/// Neo-Hookean `P`, `F⁻ᵀ` and `ln J` for the displacement gradient `h`. An element turned
-/// inside out (J ≤ 0) has infinite energy: its stress is NaN, which a line search backs off from.
+/// What an element's law needs: the law, the element's Lamé constants (Pa; λ is zero where
+/// the volumetric energy lives on nodal volumes) and the exponential law's stiffening.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ElementTissue {
+    pub law: Law,
+    pub lambda: f64,
+    pub mu: f64,
+    pub stiffening: f64,
+}
+
+/// The stress of the neo-Hookean family at one displacement gradient.
+struct HyperelasticStress {
+    /// First Piola–Kirchhoff stress.
+    p: Matrix3<f64>,
+    inverse_t: Matrix3<f64>,
+    /// `F − F⁻ᵀ`, the direction of the shear stress.
+    f_minus_inverse_t: Matrix3<f64>,
+    log_j: f64,
+    /// The current shear modulus `μ e^{b x}` (μ for the neo-Hookean law).
+    shear_pa: f64,
+}
+
+/// `P = μ' (F − F⁻ᵀ) + λ ln J F⁻ᵀ` with `μ' = μ e^{b x}`, for the displacement gradient `h`.
+/// An element turned inside out (J ≤ 0) has infinite energy: its stress is NaN, which a line
+/// search backs off from.
 ///
 /// `F − F⁻ᵀ` and `ln J` are formed from `h` directly (`F⁻¹ − I = −h F⁻¹`, and `J − 1` from the
 /// invariants of `h`): differences of numbers near 1 would cancel catastrophically for small
 /// strains and put a floor under Newton's relative residual.
-fn neo_hookean_stress(lambda: f64, mu: f64, h: &Matrix3<f64>) -> (Matrix3<f64>, Matrix3<f64>, f64) {
+fn hyperelastic_stress(tissue: &ElementTissue, h: &Matrix3<f64>) -> HyperelasticStress {
     let (j_minus_one, inverse_t) = volume_change(h);
     let log_j = j_minus_one.ln_1p();
     // F − F⁻ᵀ = h + (h F⁻¹)ᵀ = h + F⁻ᵀ hᵀ.
     let f_minus_inverse_t = h + inverse_t * h.transpose();
-    let p = f_minus_inverse_t * mu + inverse_t * (lambda * log_j);
-    (p, inverse_t, log_j)
+    let shear_pa = tissue.mu * (1.0 + shear_growth(tissue.stiffening, h, log_j));
+    HyperelasticStress {
+        p: f_minus_inverse_t * shear_pa + inverse_t * (tissue.lambda * log_j),
+        inverse_t,
+        f_minus_inverse_t,
+        log_j,
+        shear_pa,
+    }
+}
+
+/// How much the exponential law has grown the shear modulus, `e^{b x} − 1` with
+/// `x = I₁ − 3 − 2 ln J` (0 for `b = 0`, the neo-Hookean law). `I₁ − 3 = 2 tr h + |h|²` and
+/// `exp_m1` keep it accurate at small strain, where the growth is second order.
+pub(super) fn shear_growth(stiffening: f64, h: &Matrix3<f64>, log_j: f64) -> f64 {
+    if stiffening == 0.0 {
+        return 0.0;
+    }
+    let x = 2.0 * h.trace() + h.norm_squared() - 2.0 * log_j;
+    (stiffening * x).exp_m1()
 }
 
 /// `J − 1 = I₁ + I₂ + I₃` from the invariants of the displacement gradient `h`.

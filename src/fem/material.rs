@@ -17,6 +17,12 @@ pub enum Law {
     /// limit as the linear law, stable at any compression (the energy grows without bound as
     /// an element's volume goes to zero) and stiffening as tissue is pressed.
     NeoHookean,
+    /// The neo-Hookean law with an exponentially stiffening shear part (Demiray's form, made
+    /// compressible): `ψ = μ/(2b) (e^{b x} − 1) + λ/2 (ln J)²`, `x = I₁ − 3 − 2 ln J ≥ 0`,
+    /// `b` the material's [`Material::stiffening`]. Its stress is the neo-Hookean one with the
+    /// shear modulus `μ e^{b x}`, so it matches the linear law at small strain, tends to the
+    /// neo-Hookean law as `b → 0`, and firms up as tissue is pressed the way liver does.
+    Exponential,
 }
 
 impl Law {
@@ -26,13 +32,28 @@ impl Law {
             Law::Linear => "linear",
             Law::KirchhoffSaintVenant => "ksv",
             Law::NeoHookean => "neo-hookean",
+            Law::Exponential => "exponential",
+        }
+    }
+
+    /// Whether the law is nonlinear and stable at any compression, so that its vademecums
+    /// reach the depths a trainee presses (the neo-Hookean family).
+    pub fn is_hyperelastic(self) -> bool {
+        matches!(self, Law::NeoHookean | Law::Exponential)
+    }
+
+    /// The stiffening a material of this law gets unless told otherwise.
+    pub fn default_stiffening(self) -> f64 {
+        match self {
+            Law::Exponential => DEFAULT_STIFFENING,
+            _ => 0.0,
         }
     }
 
     /// Whether the law's volumetric energy lives on nodal volumes (see `volumetric.rs`) rather
     /// than in each element.
     pub(super) fn has_nodal_volumes(self) -> bool {
-        self == Law::NeoHookean
+        self.is_hyperelastic()
     }
 }
 
@@ -43,14 +64,26 @@ pub struct Material {
     pub young_pa: f64,
     pub poisson: f64,
     pub density_kg_m3: f64,
+    /// The exponent `b` of the exponential law (dimensionless; see [`Law::Exponential`]):
+    /// how fast the shear modulus grows with strain. Ignored by the other laws.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub stiffening: f64,
 }
+
+fn is_zero(value: &f64) -> bool {
+    *value == 0.0
+}
+
+/// The exponential law's default stiffening `b`, for tissue without a fit of its own.
+pub const DEFAULT_STIFFENING: f64 = 2.0;
 
 /// Soft tissue is close to water.
 pub const TISSUE_DENSITY_KG_M3: f64 = 1060.0;
 
 impl Material {
-    /// A validated material. Young's modulus and density must be positive and finite; Poisson's
-    /// ratio must lie in (−1, 0.5), where the strain energy is positive definite.
+    /// A validated material, with the law's default stiffening. Young's modulus and density must
+    /// be positive and finite; Poisson's ratio must lie in (−1, 0.5), where the strain energy
+    /// is positive definite.
     pub fn new(
         law: Law,
         young_pa: f64,
@@ -62,7 +95,27 @@ impl Material {
             young_pa,
             poisson,
             density_kg_m3,
+            stiffening: law.default_stiffening(),
         };
+        material.validate()?;
+        Ok(material)
+    }
+
+    /// The same tissue under `law`: a new law gets its default stiffening.
+    pub fn with_law(self, law: Law) -> Self {
+        match law == self.law {
+            true => self,
+            false => Self {
+                law,
+                stiffening: law.default_stiffening(),
+                ..self
+            },
+        }
+    }
+
+    /// The material with the exponential law's stiffening `b` (validated: finite, ≥ 0).
+    pub fn with_stiffening(self, stiffening: f64) -> Result<Self, FemError> {
+        let material = Self { stiffening, ..self };
         material.validate()?;
         Ok(material)
     }
@@ -74,6 +127,7 @@ impl Material {
             young_pa: 1600.0,
             poisson: 0.48,
             density_kg_m3: TISSUE_DENSITY_KG_M3,
+            stiffening: law.default_stiffening(),
         }
     }
 
@@ -99,6 +153,13 @@ impl Material {
                 "poisson",
                 self.poisson,
                 "a ratio strictly between -1 and 0.5 (0.5 is incompressible, which linear tetrahedra cannot represent)",
+            );
+        }
+        if !(self.stiffening.is_finite() && self.stiffening >= 0.0) {
+            return bad(
+                "stiffening",
+                self.stiffening,
+                "a finite, non-negative exponent (0 is the neo-Hookean law)",
             );
         }
         if !(self.density_kg_m3.is_finite() && self.density_kg_m3 > 0.0) {

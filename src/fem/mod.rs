@@ -18,14 +18,14 @@ mod pattern;
 mod volumetric;
 
 pub use dofs::{Dirichlet, DofMap, PRESCRIBED};
-pub use element::{ElementMatrix, ElementVector, TetGeometry};
+pub use element::{ElementMatrix, ElementTissue, ElementVector, TetGeometry};
 pub use error::FemError;
 pub use inclusion::Inclusion;
 pub use indentation::{ForceDepthPoint, Indentation, IndentationSettings, SphereIndenter};
 pub use linear_solver::{DirectSolver, Factorization};
 pub use loads::{Loads, PatchKernel, on_pressed_side, patch_weight};
 pub use mass::{consistent_mass, lumped_mass};
-pub use material::{Law, Material, TISSUE_DENSITY_KG_M3};
+pub use material::{DEFAULT_STIFFENING, Law, Material, TISSUE_DENSITY_KG_M3};
 pub use model::FemModel;
 pub use newton::{NewtonSettings, StaticSolution, StepReport};
 pub use pattern::FreePattern;

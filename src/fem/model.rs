@@ -3,7 +3,7 @@
 
 use nalgebra::{SMatrix, SymmetricEigen, Vector3};
 
-use super::element::{ElementVector, TetGeometry, gather};
+use super::element::{ElementTissue, ElementVector, TetGeometry, gather};
 use super::inclusion::{Inclusion, modulus_scale};
 use super::pattern::FreePattern;
 use super::volumetric::NodalVolumes;
@@ -118,13 +118,15 @@ impl FemModel {
         (scale * lambda, scale * mu)
     }
 
-    /// The Lamé constants the element itself carries: all of them, except the first when the
-    /// volumetric energy lives on nodal volumes.
-    fn element_lame(&self, element: usize) -> (f64, f64) {
+    /// The law and constants the element itself carries: all the Lamé constants, except the
+    /// first when the volumetric energy lives on nodal volumes.
+    fn element_tissue(&self, element: usize) -> ElementTissue {
         let (lambda, mu) = self.lame(element);
-        match self.volumetric {
-            Some(_) => (0.0, mu),
-            None => (lambda, mu),
+        ElementTissue {
+            law: self.material.law,
+            lambda: if self.volumetric.is_some() { 0.0 } else { lambda },
+            mu,
+            stiffening: self.material.stiffening,
         }
     }
 
@@ -148,9 +150,7 @@ impl FemModel {
     pub fn internal_force(&self, u_m: &[f64]) -> Vec<f64> {
         let mut force = vec![0.0; u_m.len()];
         for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
-            let (lambda, mu) = self.element_lame(t);
-            let ue = gather(tet, u_m);
-            let fe = geo.force(self.material.law, lambda, mu, &ue);
+            let fe = geo.force(&self.element_tissue(t), &gather(tet, u_m));
             scatter_vector(tet, &fe, &mut force);
         }
         if let Some(volumetric) = &self.volumetric {
@@ -166,14 +166,12 @@ impl FemModel {
             return;
         }
         if let Some(volumetric) = &self.volumetric {
-            let shear_modulus = |t| self.lame(t).1;
-            volumetric.add_nonlinear_force((&self.mesh, &self.geometry), shear_modulus, u_m, out);
+            let tissue = |t| self.element_tissue(t);
+            volumetric.add_nonlinear_force((&self.mesh, &self.geometry), tissue, u_m, out);
             return;
         }
         for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
-            let (lambda, mu) = self.element_lame(t);
-            let ue = gather(tet, u_m);
-            let fe = geo.nonlinear_force(self.material.law, lambda, mu, &ue);
+            let fe = geo.nonlinear_force(&self.element_tissue(t), &gather(tet, u_m));
             scatter_vector(tet, &fe, out);
         }
     }
@@ -184,9 +182,7 @@ impl FemModel {
         let mut force = vec![0.0; u_m.len()];
         let mut values = self.pattern.zero_values();
         for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
-            let (lambda, mu) = self.element_lame(t);
-            let ue = gather(tet, u_m);
-            let (fe, ke) = geo.force_and_tangent(self.material.law, lambda, mu, &ue);
+            let (fe, ke) = geo.force_and_tangent(&self.element_tissue(t), &gather(tet, u_m));
             scatter_vector(tet, &fe, &mut force);
             self.pattern.scatter(t, &ke, &mut values);
         }

@@ -20,7 +20,8 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::DofMap;
 use super::element::{
-    ElementMatrix, ElementVector, TetGeometry, gather, j_minus_one, volume_change,
+    ElementMatrix, ElementTissue, ElementVector, TetGeometry, gather, j_minus_one, shear_growth,
+    volume_change,
 };
 use super::pattern::{FreePattern, add_at};
 use crate::mesh::TetMesh;
@@ -200,19 +201,20 @@ impl NodalVolumes {
         }
     }
 
-    /// Adds the neo-Hookean force minus its rest linearization, `f(u) − K₀ u`, on every dof:
-    /// the shear part of element `e` (modulus `shear_modulus_pa(e)`) and the volumetric part
-    /// on nodal volumes, in one pass over the elements once the nodal pressures are known.
-    /// Per element the corner forces are `V S g_a` with
-    /// `S = μ (F⁻ᵀ − I) Hᵀ + p̄ J F⁻ᵀ − q̄ I`: the shear stress `μ (F − F⁻ᵀ)` less its
-    /// linearization `μ (H + Hᵀ)`, and the volumetric `p̄ d_a` less its linearization
+    /// Adds the neo-Hookean family's force minus its rest linearization, `f(u) − K₀ u`, on
+    /// every dof: the shear part of element `e` (its law and modulus from `tissue(e)`) and the
+    /// volumetric part on nodal volumes, in one pass over the elements once the nodal pressures
+    /// are known. Per element the corner forces are `V S g_a` with
+    /// `S = μ (F⁻ᵀ − I) Hᵀ + (μ' − μ)(F − F⁻ᵀ) + p̄ J F⁻ᵀ − q̄ I`: the shear stress
+    /// `μ' (F − F⁻ᵀ)` less its linearization `μ (H + Hᵀ)` (`μ' = μ` for the neo-Hookean law,
+    /// `μ e^{b x}` for the exponential one), and the volumetric `p̄ d_a` less its linearization
     /// `q̄ V g_a`, `q_n = λ_n θ_n` the linear pressure of the nodal volumetric strain
     /// `θ_n = Σ_e V_e tr(H_e) / 4V_n`. The secant fixed point evaluates this once per
     /// response and iteration: it is the vademecum build's inner loop.
     pub(super) fn add_nonlinear_force(
         &self,
         (mesh, geometry): (&TetMesh, &[TetGeometry]),
-        shear_modulus_pa: impl Fn(usize) -> f64,
+        tissue: impl Fn(usize) -> ElementTissue,
         u_m: &[f64],
         out: &mut [f64],
     ) {
@@ -241,9 +243,14 @@ impl NodalVolumes {
             let h = geo.displacement_gradient(&gather(tet, u_m));
             let (j_minus_one, inverse_t) = volume_change(&h);
             let (p, q) = (corner_mean(tet, &pressure), corner_mean(tet, &linear));
-            let stress = (inverse_t - Matrix3::identity()) * h.transpose() * shear_modulus_pa(t)
+            let ElementTissue { mu, stiffening, .. } = tissue(t);
+            let growth = shear_growth(stiffening, &h, j_minus_one.ln_1p());
+            let mut stress = (inverse_t - Matrix3::identity()) * h.transpose() * mu
                 + inverse_t * (p * (1.0 + j_minus_one))
                 - Matrix3::identity() * q;
+            if growth != 0.0 {
+                stress += (h + inverse_t * h.transpose()) * (mu * growth);
+            }
             for (a, &node) in tet.iter().enumerate() {
                 let f = stress * geo.grads[a] * geo.volume_m3;
                 for c in 0..3 {

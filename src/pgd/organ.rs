@@ -66,6 +66,7 @@ pub fn material(organ: Organ, law: Law) -> Material {
         young_pa: young_pa(organ),
         poisson: POISSON,
         density_kg_m3: TISSUE_DENSITY_KG_M3,
+        stiffening: law.default_stiffening(),
     }
 }
 

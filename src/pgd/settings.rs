@@ -95,7 +95,7 @@ pub const NEO_HOOKEAN_STEPS_TOOL_RADII: [f64; 6] = [
 /// (the linear law has none; it keeps KSV's in its header).
 pub fn default_load_steps_m(tool_tip_radius_m: f64, law: Law) -> Vec<f64> {
     match law {
-        Law::NeoHookean => NEO_HOOKEAN_STEPS_TOOL_RADII
+        Law::NeoHookean | Law::Exponential => NEO_HOOKEAN_STEPS_TOOL_RADII
             .iter()
             .map(|r| r * tool_tip_radius_m)
             .collect(),

@@ -142,12 +142,8 @@ fn a_free_body_conserves_linear_and_angular_momentum() {
 /// ticks.
 #[test]
 fn a_step_longer_than_every_period_stays_bounded() {
-    let material = Material {
-        law: Law::KirchhoffSaintVenant,
-        young_pa: 1e9,
-        poisson: 0.3,
-        density_kg_m3: TISSUE_DENSITY_KG_M3,
-    };
+    let material =
+        Material::new(Law::KirchhoffSaintVenant, 1e9, 0.3, TISSUE_DENSITY_KG_M3).unwrap();
     let model = block([3, 2, 2], material, true);
     let (basis, reduced) = lowest_modes(&model, 20);
     let periods: Vec<f64> = basis

@@ -8,6 +8,6 @@ mod inclusion;
 mod indentation;
 mod ksv;
 mod loads_and_mass;
-mod neo_hookean;
+mod hyperelastic;
 mod patch;
 mod surface;

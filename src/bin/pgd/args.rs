@@ -232,6 +232,9 @@ pub enum LawArg {
     /// Compressible neo-Hookean by load steps: stable at any compression, stiffens as the
     /// tool presses deeper.
     NeoHookean,
+    /// Neo-Hookean with a shear modulus that grows exponentially with strain (`--stiffening`):
+    /// firms up under the tool the way liver does.
+    Exponential,
 }
 
 impl LawArg {
@@ -240,6 +243,7 @@ impl LawArg {
             LawArg::Linear => Law::Linear,
             LawArg::Ksv => Law::KirchhoffSaintVenant,
             LawArg::NeoHookean => Law::NeoHookean,
+            LawArg::Exponential => Law::Exponential,
         }
     }
 }
@@ -255,6 +259,10 @@ pub struct MaterialArgs {
     /// Poisson's ratio.
     #[arg(long, default_value_t = pgd::organ::POISSON)]
     pub poisson: f64,
+    /// The exponential law's stiffening exponent b: the shear modulus grows as e^(b x), x the
+    /// strain invariant I1 − 3 − 2 ln J (default: 2).
+    #[arg(long, value_name = "B")]
+    pub stiffening: Option<f64>,
     /// A stiffer (or softer) sphere in the tissue, such as a tumour to find by palpation:
     /// its centre and radius in millimetres and its Young's modulus over the organ's, as
     /// `X,Y,Z,RADIUS,RATIO` (e.g. `10,-5,30,7,6`). Repeat for several.
@@ -268,7 +276,13 @@ impl MaterialArgs {
         let young_pa = self
             .young_pa
             .unwrap_or_else(|| pgd::organ::young_pa(organ.unwrap_or(Organ::Liver)));
-        Material::new(law, young_pa, self.poisson, TISSUE_DENSITY_KG_M3).map_err(|e| e.to_string())
+        let material = Material::new(law, young_pa, self.poisson, TISSUE_DENSITY_KG_M3)
+            .map_err(|e| e.to_string())?;
+        match (self.stiffening, law) {
+            (None, _) => Ok(material),
+            (Some(b), Law::Exponential) => material.with_stiffening(b).map_err(|e| e.to_string()),
+            (Some(_), _) => Err("--stiffening applies to --law exponential only".into()),
+        }
     }
 }
 

@@ -38,10 +38,7 @@ fn indent_command(
         let base = material.material(organ)?;
         let materials: Vec<_> = laws
             .iter()
-            .map(|law| pgd_surgery::fem::Material {
-                law: law.law(),
-                ..base
-            })
+            .map(|law| base.with_law(law.law()))
             .collect();
         let report = cli::indent_organ((organ, m), &materials, &request, &Bar::default())?;
         cli::plot_indentation(&report, &plot)?;

@@ -1,8 +1,9 @@
-//! The compressible neo-Hookean law against exact homogeneous solutions (uniaxial stretch and
-//! compression, simple shear) and its tangent against finite differences.
+//! The compressible neo-Hookean law and its exponentially stiffening sibling against exact
+//! homogeneous solutions (uniaxial stretch and compression, simple shear), their tangents
+//! against finite differences and their nonlinear force against the full one.
 
 use nalgebra::Matrix3;
-use pgd_surgery::fem::{Dirichlet, FemModel, Law, Loads, Material, NewtonSettings};
+use pgd_surgery::fem::{Dirichlet, FemModel, Law, Loads, Material, NewtonSettings, PRESCRIBED};
 use pgd_surgery::mesh::{TetMesh, box_mesh};
 
 use crate::beams::cantilever;
@@ -12,26 +13,40 @@ const SIDE_M: f64 = 0.02;
 const YOUNG_PA: f64 = 4.0e3;
 const POISSON: f64 = 0.45;
 
+/// The exponential law's exponent in these tests: at 40 % uniaxial compression its end
+/// force is 2.6 times the neo-Hookean one.
+const STIFFENING: f64 = 2.0;
+
+/// The law with exponent `b`: neo-Hookean for 0, exponential otherwise.
+fn material(b: f64) -> Material {
+    let law = if b == 0.0 { Law::NeoHookean } else { Law::Exponential };
+    Material::new(law, YOUNG_PA, POISSON, 1000.0)
+        .and_then(|m| m.with_stiffening(b))
+        .unwrap()
+}
+
 fn lame() -> (f64, f64) {
     let mu = YOUNG_PA / (2.0 * (1.0 + POISSON));
     let lambda = YOUNG_PA * POISSON / ((1.0 + POISSON) * (1.0 - 2.0 * POISSON));
     (lambda, mu)
 }
 
-/// `P = μ (F − F⁻ᵀ) + λ ln J F⁻ᵀ`, written out independently of the element code.
-fn first_piola(f: &Matrix3<f64>) -> Matrix3<f64> {
+/// `P = μ e^{b x} (F − F⁻ᵀ) + λ ln J F⁻ᵀ`, `x = tr(FᵀF) − 3 − 2 ln J`, written out
+/// independently of the element code.
+fn first_piola(f: &Matrix3<f64>, b: f64) -> Matrix3<f64> {
     let (lambda, mu) = lame();
     let inverse_t = f.try_inverse().unwrap().transpose();
-    (f - inverse_t) * mu + inverse_t * (lambda * f.determinant().ln())
+    let log_j = f.determinant().ln();
+    let x = (f.transpose() * f).trace() - 3.0 - 2.0 * log_j;
+    (f - inverse_t) * (mu * (b * x).exp()) + inverse_t * (lambda * log_j)
 }
 
 fn cube() -> TetMesh {
     box_mesh([SIDE_M; 3], [3, 3, 3]).unwrap()
 }
 
-fn solve(mesh: TetMesh, dirichlet: Dirichlet, load_steps: usize) -> (FemModel, Vec<f64>) {
-    let material = Material::new(Law::NeoHookean, YOUNG_PA, POISSON, 1000.0).unwrap();
-    let model = FemModel::new(mesh, material, dirichlet).unwrap();
+fn solve(mesh: TetMesh, dirichlet: Dirichlet, b: f64, load_steps: usize) -> (FemModel, Vec<f64>) {
+    let model = FemModel::new(mesh, material(b), dirichlet).unwrap();
     let settings = NewtonSettings {
         load_steps,
         relative_tolerance: 1e-12,
@@ -52,10 +67,15 @@ fn reaction(model: &FemModel, u: &[f64], nodes: &[usize]) -> [f64; 3] {
 }
 
 /// The lateral stretch that leaves the sides of a bar stretched by `axial` free of stress:
-/// `μ (t − 1/t) + λ ln(axial t²) / t = 0`, by bisection (the left side increases with t).
-fn lateral_stretch(axial: f64) -> f64 {
+/// `μ e^{b x} (t − 1/t) + λ ln(axial t²) / t = 0` with `x = axial² + 2t² − 3 − 2 ln(axial t²)`,
+/// by bisection (the left side increases with t).
+fn lateral_stretch(axial: f64, b: f64) -> f64 {
     let (lambda, mu) = lame();
-    let stress = |t: f64| mu * (t - 1.0 / t) + lambda * (axial * t * t).ln() / t;
+    let stress = |t: f64| {
+        let log_j = (axial * t * t).ln();
+        let x = axial * axial + 2.0 * t * t - 3.0 - 2.0 * log_j;
+        mu * (b * x).exp() * (t - 1.0 / t) + lambda * log_j / t
+    };
     let (mut low, mut high) = (0.2, 2.0);
     for _ in 0..200 {
         let mid = 0.5 * (low + high);
@@ -69,7 +89,7 @@ fn lateral_stretch(axial: f64) -> f64 {
 }
 
 /// A cube on rollers at x = 0, y = 0, z = 0, its face x = L moved to stretch it by `axial`.
-fn uniaxial(axial: f64) {
+fn uniaxial(axial: f64, b: f64) {
     let mesh = cube();
     let mut dirichlet = Dirichlet::new(mesh.node_count());
     for (axis, side) in ["x0", "y0", "z0"].into_iter().enumerate() {
@@ -83,9 +103,9 @@ fn uniaxial(axial: f64) {
             .prescribe_component(n, 0, (axial - 1.0) * SIDE_M)
             .unwrap();
     }
-    let (model, u) = solve(mesh, dirichlet, 4);
+    let (model, u) = solve(mesh, dirichlet, b, 4);
 
-    let lateral = lateral_stretch(axial);
+    let lateral = lateral_stretch(axial, b);
     let mut worst: f64 = 0.0;
     for (n, x) in model.mesh().nodes().iter().enumerate() {
         let exact = [
@@ -103,7 +123,7 @@ fn uniaxial(axial: f64) {
         "stretch {axial}: displacement off the exact field by {worst:e} m"
     );
     let f = Matrix3::from_diagonal(&nalgebra::Vector3::new(axial, lateral, lateral));
-    let exact_force = first_piola(&f)[(0, 0)] * SIDE_M * SIDE_M;
+    let exact_force = first_piola(&f, b)[(0, 0)] * SIDE_M * SIDE_M;
     let force = reaction(&model, &u, &pulled)[0];
     assert!(
         (force - exact_force).abs() <= 1e-8 * exact_force.abs(),
@@ -113,16 +133,23 @@ fn uniaxial(axial: f64) {
 
 #[test]
 fn uniaxial_stretch_matches_the_exact_homogeneous_solution() {
-    uniaxial(1.3);
+    uniaxial(1.3, 0.0);
+    uniaxial(1.3, STIFFENING);
 }
 
 #[test]
 fn uniaxial_compression_to_sixty_percent_matches_the_exact_solution() {
-    uniaxial(0.6);
+    uniaxial(0.6, 0.0);
+    uniaxial(0.6, STIFFENING);
 }
 
 #[test]
 fn simple_shear_matches_the_exact_homogeneous_solution() {
+    simple_shear(0.0);
+    simple_shear(STIFFENING);
+}
+
+fn simple_shear(b: f64) {
     let gamma = 0.4;
     let mesh = cube();
     let surface: Vec<usize> = (0..mesh.node_count())
@@ -137,7 +164,7 @@ fn simple_shear_matches_the_exact_homogeneous_solution() {
         dirichlet.prescribe(n, [gamma * y, 0.0, 0.0]).unwrap();
     }
     let top = mesh.node_set("y1").unwrap().to_vec();
-    let (model, u) = solve(mesh, dirichlet, 2);
+    let (model, u) = solve(mesh, dirichlet, b, 2);
 
     for (n, x) in model.mesh().nodes().iter().enumerate() {
         let error = (u[3 * n] - gamma * x[1]).abs() + u[3 * n + 1].abs() + u[3 * n + 2].abs();
@@ -146,9 +173,9 @@ fn simple_shear_matches_the_exact_homogeneous_solution() {
             "node {n} off the affine shear by {error:e} m"
         );
     }
-    // With J = 1, P e_y = (μγ, 0, 0): the top carries a shear force μγL² and no normal force.
+    // With J = 1, P e_y = (μ'γ, 0, 0): the top carries a shear force μ'γL² and no normal force.
     let f = Matrix3::new(1.0, gamma, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
-    let exact = first_piola(&f) * nalgebra::Vector3::y() * SIDE_M * SIDE_M;
+    let exact = first_piola(&f, b) * nalgebra::Vector3::y() * SIDE_M * SIDE_M;
     let force = reaction(&model, &u, &top);
     let (_, mu) = lame();
     for c in 0..3 {
@@ -164,4 +191,49 @@ fn neo_hookean_tangent_matches_finite_differences() {
     let beam = cantilever(1, Law::NeoHookean, 0.45, 0.0);
     let error = tangent_error(&beam.model, 1e-3);
     assert!(error < 1e-7, "tangent vs central differences: {error:e}");
+}
+
+/// At displacements of 1 mm per node on 3 mm cells the strain invariant x reaches about 0.1,
+/// where the growth of the shear modulus is a third of the tangent.
+#[test]
+fn exponential_tangent_matches_finite_differences() {
+    let beam = cantilever(1, Law::Exponential, 0.45, 0.0);
+    let error = tangent_error(&beam.model, 1e-3);
+    assert!(error < 1e-7, "tangent vs central differences: {error:e}");
+}
+
+/// The nonlinear force the vademecum build moves to the right-hand side is the internal force
+/// less the rest stiffness times the displacement, assembled independently.
+#[test]
+fn nonlinear_force_is_the_internal_force_less_the_rest_stiffness() {
+    for law in [Law::NeoHookean, Law::Exponential] {
+        let model = cantilever(1, law, 0.45, 0.0).model;
+        let dofs = model.dofs();
+        let u: Vec<f64> = (0..3 * model.mesh().node_count())
+            .map(|d| match dofs.free_index[d] {
+                PRESCRIBED => 0.0,
+                _ => 1e-3 * ((d as f64 * 0.7).sin()),
+            })
+            .collect();
+        let mut nonlinear = vec![0.0; u.len()];
+        model.add_nonlinear_force(&u, &mut nonlinear);
+        let rest = model.rest_stiffness();
+        let mut k0u = vec![0.0; dofs.free_count()];
+        model.pattern().mul(&rest, &dofs.restrict(&u), &mut k0u);
+        let full = dofs.restrict(&model.internal_force(&u));
+        let expected: Vec<f64> = full.iter().zip(&k0u).map(|(f, k)| f - k).collect();
+        let got = dofs.restrict(&nonlinear);
+        let scale = expected.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let error = got
+            .iter()
+            .zip(&expected)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+            .sqrt();
+        assert!(
+            error <= 1e-9 * scale,
+            "{}: nonlinear force off by {error:e} of {scale:e} N",
+            law.name()
+        );
+    }
 }
