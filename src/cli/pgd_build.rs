@@ -159,7 +159,7 @@ fn print_newton_baseline(baseline: &pgd::NewtonBaseline, build_seconds: f64) {
 fn print_fixed_point(report: &pgd::SecantReport) {
     println!(
         "  secant fixed point: {:.1} iterations per load on average, at most {}; \
-         {} loads solved by Newton instead, {} of {} unconverged (largest last change {:.1e})",
+         {} loads solved by Newton instead, {} of {} unconverged (largest last residual {:.1e})",
         report.mean_iterations(),
         report.max_iterations,
         report.newton_solved,

@@ -72,7 +72,9 @@ impl TetGeometry {
         tissue: &ElementTissue,
         u: &ElementVector,
     ) -> (ElementVector, ElementMatrix) {
-        let ElementTissue { law, lambda, mu, .. } = *tissue;
+        let ElementTissue {
+            law, lambda, mu, ..
+        } = *tissue;
         match law {
             Law::Linear => {
                 let k = self.linear_stiffness(lambda, mu);

@@ -124,7 +124,11 @@ impl FemModel {
         let (lambda, mu) = self.lame(element);
         ElementTissue {
             law: self.material.law,
-            lambda: if self.volumetric.is_some() { 0.0 } else { lambda },
+            lambda: if self.volumetric.is_some() {
+                0.0
+            } else {
+                lambda
+            },
             mu,
             stiffening: self.material.stiffening,
         }

@@ -3,6 +3,11 @@
 //! cancel best in least squares. Where the secant iteration of a stiffening law contracts
 //! slowly (a deep load step, whose tangent is several times the rest stiffness), a scalar
 //! relaxation still crawls; a few remembered directions take most of that away.
+//!
+//! Where the law stiffens more than twice over (the exponential law pressed deep), the plain
+//! iteration overshoots and diverges: the step then mixes in only a fraction β of the
+//! residual, `x ← x̄ + β f̄` (`x̄`, `f̄` the combined iterate and residual), β halved each time
+//! the caller sees the iteration grow.
 
 use std::collections::VecDeque;
 
@@ -14,6 +19,8 @@ pub struct Anderson {
     residual_steps: VecDeque<Vec<f64>>,
     value_steps: VecDeque<Vec<f64>>,
     last: Option<(Vec<f64>, Vec<f64>)>,
+    /// The fraction β of the combined residual each step takes (1: undamped).
+    mixing: f64,
 }
 
 impl Anderson {
@@ -24,7 +31,15 @@ impl Anderson {
             residual_steps: VecDeque::with_capacity(depth),
             value_steps: VecDeque::with_capacity(depth),
             last: None,
+            mixing: 1.0,
         }
+    }
+
+    /// Halves the step's mixing and forgets the history gathered at the old one: the
+    /// iteration grew, so the law is stiffer than the rest stiffness by more than 2/β.
+    pub fn damp(&mut self) {
+        self.mixing *= 0.5;
+        self.reset();
     }
 
     /// Forgets the history: after the iterate was moved off the accelerated path.
@@ -38,7 +53,10 @@ impl Anderson {
     pub fn advance(&mut self, x: &mut [f64], g: Vec<f64>) {
         let residual: Vec<f64> = g.iter().zip(x.iter()).map(|(g, x)| g - x).collect();
         if self.depth == 0 {
-            x.copy_from_slice(&g);
+            let beta = self.mixing;
+            x.iter_mut()
+                .zip(&residual)
+                .for_each(|(x, r)| *x += beta * r);
             return;
         }
         if let Some((last_residual, last_value)) = self.last.take() {
@@ -51,9 +69,23 @@ impl Anderson {
             self.value_steps.push_back(difference(&g, &last_value));
         }
         let weights = self.weights(&residual);
+        // x̄ + f̄ = g − Σ γ Δg; the damped step takes back (1 − β) f̄, f̄ = f − Σ γ Δf.
         x.copy_from_slice(&g);
-        for (w, step) in weights.iter().zip(&self.value_steps) {
-            x.iter_mut().zip(step).for_each(|(x, s)| *x -= w * s);
+        let undamped = 1.0 - self.mixing;
+        if undamped != 0.0 {
+            x.iter_mut()
+                .zip(&residual)
+                .for_each(|(x, r)| *x -= undamped * r);
+        }
+        for ((w, step), residual_step) in weights
+            .iter()
+            .zip(&self.value_steps)
+            .zip(&self.residual_steps)
+        {
+            let back = undamped * w;
+            x.iter_mut()
+                .zip(step.iter().zip(residual_step))
+                .for_each(|(x, (s, r))| *x -= w * s - back * r);
         }
         self.last = Some((residual, g));
     }
@@ -123,5 +155,26 @@ mod tests {
         assert!(dot(&residual, &residual).sqrt() < 1e-10, "{x:?}");
         assert!(accelerated <= 8, "{accelerated} iterations");
         assert!(plain > 1000, "{plain} iterations");
+    }
+
+    /// `G(x) = −3 x + 4` overshoots (its slope is below −1): the plain iteration diverges, a
+    /// mixing of β = 1/4 lands on the fixed point x = 1 in one step, with or without memory.
+    #[test]
+    fn damping_tames_an_overshooting_iteration() {
+        let g = |x: &[f64]| vec![-3.0 * x[0] + 4.0];
+        for depth in [0, 3] {
+            let mut anderson = Anderson::new(depth);
+            let mut x = vec![0.0];
+            let value = g(&x);
+            anderson.advance(&mut x, value);
+            assert_eq!(x, vec![4.0], "the first step is undamped");
+            anderson.damp();
+            anderson.damp();
+            for _ in 0..5 {
+                let value = g(&x);
+                anderson.advance(&mut x, value);
+            }
+            assert!((x[0] - 1.0).abs() < 1e-12, "depth {depth}: {x:?}");
+        }
     }
 }

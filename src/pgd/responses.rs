@@ -270,7 +270,8 @@ impl Trend {
 /// The fixed point of a KSV load step, per response.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SecantSettings {
-    /// Converged when an iteration changes the response by less than this (relative).
+    /// Converged when the fixed point's residual `G(ũ) − ũ` is less than this, relative to
+    /// `G(ũ)`.
     pub tolerance: f64,
     pub max_iterations: usize,
     /// Differences remembered by each response's Anderson acceleration (0: plain iteration).
@@ -317,7 +318,7 @@ pub struct SecantReport {
     pub unconverged: usize,
     /// Responses the fixed point left that Newton then solved (not counted as unconverged).
     pub newton_solved: usize,
-    /// The largest final relative change over all responses.
+    /// The largest final relative residual over all responses.
     pub worst_change: f64,
 }
 
@@ -367,6 +368,7 @@ fn secant_block(
     // A load on a clamped node has no response and no magnitude: nothing to iterate.
     let mut active: Vec<usize> = (0..columns).filter(|&j| magnitudes_n[j] != 0.0).collect();
     let mut change = vec![0.0; columns];
+    let mut growing = vec![0usize; columns];
     let mut accelerators: Vec<Anderson> = (0..columns)
         .map(|_| Anderson::new(settings.anderson_depth))
         .collect();
@@ -410,15 +412,20 @@ fn secant_block(
                 continue;
             }
             let span = j * rows..(j + 1) * rows;
-            let column = &mut chunk[span.clone()];
-            accelerators[j].advance(column, target.to_vec());
-            let norm = column.iter().map(|u| u * u).sum::<f64>();
-            let step = column
+            // The fixed point's own residual `G(x) − x`, whatever step the acceleration and
+            // damping then take.
+            let norm = target.iter().map(|u| u * u).sum::<f64>();
+            let residual = target
                 .iter()
-                .zip(&previous[span])
-                .map(|(u, p)| (u - p) * (u - p))
+                .zip(&previous[span.clone()])
+                .map(|(g, x)| (g - x) * (g - x))
                 .sum::<f64>();
-            change[j] = (step / norm).sqrt();
+            accelerators[j].advance(&mut chunk[span], target.to_vec());
+            let before = change[j];
+            change[j] = (residual / norm).sqrt();
+            if overshoots(&mut growing[j], before, change[j]) {
+                accelerators[j].damp();
+            }
         }
         report.total_iterations += active.len();
         report.max_iterations = iteration;
@@ -441,6 +448,25 @@ fn secant_block(
         .fold(0.0, f64::max);
     (report, unconverged.iter().map(|j| first + j).collect())
 }
+
+/// Whether an iteration is overshooting: its change grew [`GROWING_STEPS`] times running
+/// (`growing` counts them). A stiffening law's iteration with the rest stiffness grows by the
+/// stiffening less one each step; Anderson's history makes single growths common otherwise.
+fn overshoots(growing: &mut usize, before: f64, after: f64) -> bool {
+    *growing = if after > before && before > 0.0 {
+        *growing + 1
+    } else {
+        0
+    };
+    let overshooting = *growing >= GROWING_STEPS;
+    if overshooting {
+        *growing = 0;
+    }
+    overshooting
+}
+
+/// Consecutive growths of a fixed point's change that make it damp its steps.
+const GROWING_STEPS: usize = 2;
 
 /// Buffers for evaluating the nonlinear terms of one response at a time.
 struct NonlinearWork<'a> {

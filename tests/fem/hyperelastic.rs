@@ -19,7 +19,11 @@ const STIFFENING: f64 = 2.0;
 
 /// The law with exponent `b`: neo-Hookean for 0, exponential otherwise.
 fn material(b: f64) -> Material {
-    let law = if b == 0.0 { Law::NeoHookean } else { Law::Exponential };
+    let law = if b == 0.0 {
+        Law::NeoHookean
+    } else {
+        Law::Exponential
+    };
     Material::new(law, YOUNG_PA, POISSON, 1000.0)
         .and_then(|m| m.with_stiffening(b))
         .unwrap()

@@ -4,10 +4,10 @@
 mod bad_input;
 mod beams;
 mod cantilever;
+mod hyperelastic;
 mod inclusion;
 mod indentation;
 mod ksv;
 mod loads_and_mass;
-mod hyperelastic;
 mod patch;
 mod surface;

@@ -36,10 +36,7 @@ fn indent_command(
     let plot = plot.unwrap_or_else(|| format!("{}-indentation.png", mesh.stem()).into());
     let report = mesh.load().and_then(|(organ, m)| {
         let base = material.material(organ)?;
-        let materials: Vec<_> = laws
-            .iter()
-            .map(|law| base.with_law(law.law()))
-            .collect();
+        let materials: Vec<_> = laws.iter().map(|law| base.with_law(law.law())).collect();
         let report = cli::indent_organ((organ, m), &materials, &request, &Bar::default())?;
         cli::plot_indentation(&report, &plot)?;
         Ok(report)
