@@ -1,11 +1,12 @@
 //! The finite-element core: linear tetrahedra, isotropic linear elasticity, Kirchhoff–Saint
-//! Venant and neo-Hookean tissue, sparse assembly, loads, mass, static solvers, and indentation
-//! by a rigid sphere. Plain Rust on faer and nalgebra, no Bevy: the offline PGD builder and
+//! Venant, neo-Hookean and exponential tissue (and the exponential law's fit to uniaxial tests),
+//! sparse assembly, loads, mass, static solvers, and indentation by a rigid sphere. Plain Rust on faer and nalgebra, no Bevy: the offline PGD builder and
 //! every validation stand on it.
 
 mod dofs;
 mod element;
 mod error;
+mod fit;
 mod inclusion;
 mod indentation;
 mod linear_solver;
@@ -20,6 +21,7 @@ mod volumetric;
 pub use dofs::{Dirichlet, DofMap, PRESCRIBED};
 pub use element::{ElementMatrix, ElementTissue, ElementVector, TetGeometry};
 pub use error::FemError;
+pub use fit::{ExponentialFit, UniaxialPoint, fit_exponential, uniaxial_nominal_stress_pa};
 pub use inclusion::Inclusion;
 pub use indentation::{ForceDepthPoint, Indentation, IndentationSettings, SphereIndenter};
 pub use linear_solver::{DirectSolver, Factorization};

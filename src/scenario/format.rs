@@ -376,7 +376,8 @@ pub struct OrganEntry {
     /// At most this many separated modes in its vademecum, when not the builder's default.
     #[serde(default)]
     pub max_modes: Option<ModeCount>,
-    /// Its tissue's law (`Linear`, `NeoHookean`, `KirchhoffSaintVenant`), when not linear.
+    /// Its tissue's law (`Linear`, `NeoHookean`, `Exponential`, `KirchhoffSaintVenant`), when
+    /// not linear.
     #[serde(default)]
     pub law: Option<Law>,
     /// Whether it moves (reduced dynamics, and the grasper can pull it) or stays

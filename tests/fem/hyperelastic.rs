@@ -49,8 +49,13 @@ fn cube() -> TetMesh {
     box_mesh([SIDE_M; 3], [3, 3, 3]).unwrap()
 }
 
-fn solve(mesh: TetMesh, dirichlet: Dirichlet, b: f64, load_steps: usize) -> (FemModel, Vec<f64>) {
-    let model = FemModel::new(mesh, material(b), dirichlet).unwrap();
+fn solve(
+    mesh: TetMesh,
+    dirichlet: Dirichlet,
+    material: Material,
+    load_steps: usize,
+) -> (FemModel, Vec<f64>) {
+    let model = FemModel::new(mesh, material, dirichlet).unwrap();
     let settings = NewtonSettings {
         load_steps,
         relative_tolerance: 1e-12,
@@ -92,8 +97,9 @@ fn lateral_stretch(axial: f64, b: f64) -> f64 {
     0.5 * (low + high)
 }
 
-/// A cube on rollers at x = 0, y = 0, z = 0, its face x = L moved to stretch it by `axial`.
-fn uniaxial(axial: f64, b: f64) {
+/// A cube of `material` on rollers at x = 0, y = 0, z = 0, its face x = L moved to stretch it
+/// by `axial`: the model, its displacement, and the nodes of the moved face.
+pub fn stretched_cube(material: Material, axial: f64) -> (FemModel, Vec<f64>, Vec<usize>) {
     let mesh = cube();
     let mut dirichlet = Dirichlet::new(mesh.node_count());
     for (axis, side) in ["x0", "y0", "z0"].into_iter().enumerate() {
@@ -107,8 +113,19 @@ fn uniaxial(axial: f64, b: f64) {
             .prescribe_component(n, 0, (axial - 1.0) * SIDE_M)
             .unwrap();
     }
-    let (model, u) = solve(mesh, dirichlet, b, 4);
+    let (model, u) = solve(mesh, dirichlet, material, 4);
+    (model, u, pulled)
+}
 
+/// The nominal stress (Pa) on the moved face of [`stretched_cube`].
+pub fn end_stress_pa(material: Material, axial: f64) -> f64 {
+    let (model, u, pulled) = stretched_cube(material, axial);
+    reaction(&model, &u, &pulled)[0] / (SIDE_M * SIDE_M)
+}
+
+/// The stretched cube against the exact homogeneous solution.
+fn uniaxial(axial: f64, b: f64) {
+    let (model, u, pulled) = stretched_cube(material(b), axial);
     let lateral = lateral_stretch(axial, b);
     let mut worst: f64 = 0.0;
     for (n, x) in model.mesh().nodes().iter().enumerate() {
@@ -168,7 +185,7 @@ fn simple_shear(b: f64) {
         dirichlet.prescribe(n, [gamma * y, 0.0, 0.0]).unwrap();
     }
     let top = mesh.node_set("y1").unwrap().to_vec();
-    let (model, u) = solve(mesh, dirichlet, b, 2);
+    let (model, u) = solve(mesh, dirichlet, material(b), 2);
 
     for (n, x) in model.mesh().nodes().iter().enumerate() {
         let error = (u[3 * n] - gamma * x[1]).abs() + u[3 * n + 1].abs() + u[3 * n + 2].abs();

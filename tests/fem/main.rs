@@ -4,6 +4,7 @@
 mod bad_input;
 mod beams;
 mod cantilever;
+mod fit;
 mod hyperelastic;
 mod inclusion;
 mod indentation;
