@@ -1,5 +1,5 @@
 //! What the binaries' commands do and print, apart from parsing their arguments: `pgd build`,
-//! `validate`, `indent` and `mesh`; `trainer validate`, `devices`, `history` and the end of an
+//! `validate`, `indent`, `fit` and `mesh`; `trainer validate`, `devices`, `history` and the end of an
 //! attempt (kept in the history); the parsers of option values, with errors that name the range; how a command ends (JSON or a table, or an error).
 //! The binaries keep their clap option types beside them and call in here.
 
@@ -7,6 +7,7 @@ mod output;
 mod parse;
 mod pgd_bench_dynamics;
 mod pgd_build;
+mod pgd_fit;
 mod pgd_indent;
 mod pgd_mesh;
 mod pgd_validate;
@@ -21,6 +22,7 @@ pub use parse::{
 };
 pub use pgd_bench_dynamics::{DynamicsRequest, bench_dynamics, plot_energy};
 pub use pgd_build::{build_vademecum, print_build_report};
+pub use pgd_fit::{FitReport, fit_uniaxial_test, plot_fit};
 pub use pgd_indent::{
     IndentReport, IndentRequest, LawCurve, indent_organ, plot_indentation, print_indentation,
 };

@@ -167,6 +167,23 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Fit the exponential law to a uniaxial test of tissue (compression or tension): Young's
+    /// modulus and stiffening b by least squares, the neo-Hookean fit beside it, and both
+    /// drawn against the data.
+    Fit {
+        /// CSV with the columns `stretch,nominal_stress_pa` (stretch below 1 and stress
+        /// negative in compression), one row per measurement.
+        data: PathBuf,
+        /// Poisson's ratio the fit holds fixed.
+        #[arg(long, default_value_t = pgd::organ::POISSON)]
+        poisson: f64,
+        /// Where to draw the fit (default: <data>.fit.png beside the data).
+        #[arg(long, value_name = "FILE.png")]
+        plot: Option<PathBuf>,
+        /// Print the fit as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Time the numerical core and print medians (and ratios to a baseline run alongside).
     Bench {
         #[command(subcommand)]

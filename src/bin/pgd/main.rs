@@ -174,7 +174,33 @@ fn main() -> ExitCode {
             plot,
             json,
         } => indent_command(&mesh, &material, &laws, (at, depth_mm, steps), plot, json),
+        Command::Fit {
+            data,
+            poisson,
+            plot,
+            json,
+        } => fit_command(&data, poisson, plot, json),
         Command::Bench { what } => bench_command(what),
+    }
+}
+
+fn fit_command(
+    data: &Path,
+    poisson: f64,
+    plot: Option<std::path::PathBuf>,
+    json: bool,
+) -> ExitCode {
+    let plot = plot.unwrap_or_else(|| data.with_extension("").with_extension("fit.png"));
+    let report = cli::fit_uniaxial_test(data, poisson)
+        .and_then(|report| cli::plot_fit(&report, &plot).map(|()| report));
+    match report {
+        Ok(report) if json => print_json(&report),
+        Ok(report) => {
+            print!("{report}");
+            println!("fit drawn in {}", plot.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => fail("pgd fit", &e),
     }
 }
 
