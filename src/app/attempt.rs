@@ -120,6 +120,7 @@ fn scene_organ(scenario: &Scenario, entry: &OrganEntry) -> Result<SceneOrgan, St
         poisson: entry.poisson_ratio.map(|nu| nu.0),
         max_modes: entry.max_modes.map(|n| n.0),
         law: entry.law.unwrap_or(Law::Linear),
+        stiffening: entry.stiffening.map(|b| b.0),
         dynamic: entry.dynamic.unwrap_or(scenario.grasps()),
         cut_toughness_j_per_m2: scenario.blade().and_then(|_| entry.toughness_j_per_m2()),
         inclusions: scenario

@@ -140,6 +140,8 @@ pub struct SceneOrgan {
     pub inclusions: Vec<Inclusion>,
     /// The tissue's law, which its vademecum is built under.
     pub law: Law,
+    /// The exponential law's stiffening when not its default.
+    pub stiffening: Option<f64>,
     /// Whether it moves (reduced dynamics; the grasper pulls it) rather than staying
     /// quasi-static.
     pub dynamic: bool,
@@ -157,6 +159,7 @@ impl From<Organ> for SceneOrgan {
             max_modes: None,
             inclusions: Vec::new(),
             law: Law::Linear,
+            stiffening: None,
             dynamic: false,
             cut_toughness_j_per_m2: None,
         }
@@ -196,6 +199,9 @@ impl SceneOrgan {
         if let Some(poisson) = self.poisson {
             tag(format!("poisson-{poisson}"));
         }
+        if let Some(stiffening) = self.stiffening {
+            tag(format!("stiffening-{stiffening}"));
+        }
         if let Some(max_modes) = self.max_modes {
             tag(format!("modes-{max_modes}"));
         }
@@ -205,6 +211,7 @@ impl SceneOrgan {
         spec.build.tool_tip_radius_m = tip_m;
         spec.young_pa = self.young_pa;
         spec.poisson = self.poisson;
+        spec.stiffening = self.stiffening;
         spec.build.pgd.max_modes = self.max_modes.unwrap_or(spec.build.pgd.max_modes);
         spec.inclusions = self.inclusions.clone();
         spec

@@ -14,7 +14,7 @@ use crate::fem::Law;
 
 use super::units::{
     DepthFraction, Dioptres, EdgeLength, FieldOfView, IncisionCount, Millimetres, ModeCount,
-    Newtons, Pascals, PoissonRatio, Ratio, Scale, ScopeAngle, Seconds, Toughness,
+    Newtons, Pascals, PoissonRatio, Ratio, Scale, ScopeAngle, Seconds, Stiffening, Toughness,
 };
 
 #[derive(Clone, Debug, PartialEq, Deserialize)]
@@ -380,6 +380,9 @@ pub struct OrganEntry {
     /// not linear.
     #[serde(default)]
     pub law: Option<Law>,
+    /// The exponential law's stiffening b, when not its default (`law: Exponential` only).
+    #[serde(default)]
+    pub stiffening: Option<Stiffening>,
     /// Whether it moves (reduced dynamics, and the grasper can pull it) or stays
     /// quasi-static; by default it moves when the tool is a grasper.
     #[serde(default)]
@@ -412,6 +415,7 @@ impl OrganEntry {
             poisson_ratio: None,
             max_modes: None,
             law: None,
+            stiffening: None,
             dynamic: None,
             toughness_j_per_m2: None,
         }

@@ -11,6 +11,7 @@ use super::format::{LaparoscopeEntry, OrganEntry, Scenario, Task, metres};
 use super::keratotomy::MIN_INCISION_M;
 use crate::contact::PointshellDensity;
 use crate::devices::{DeviceSpec, MAX_INSTRUMENTS};
+use crate::fem::Law;
 use crate::mesh::Surface;
 use crate::mesh::organs::{Organ, OrganSettings, region};
 use parry3d::query::PointQuery;
@@ -165,6 +166,7 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
     }
     for (k, organ) in scenario.organs.iter().enumerate() {
         problems.extend(check_organ(k, organ));
+        problems.extend(check_stiffening(k, organ));
         if scenario.organs[..k].iter().any(|o| o.name == organ.name) {
             problems.push(Problem {
                 field: format!("organs[{k}]"),
@@ -706,6 +708,21 @@ fn check_organ(k: usize, organ: &OrganEntry) -> Option<Problem> {
             missing.map(|what| problem(format!("{} has {what}", mesh.display()), regions_hint))
         }
     }
+}
+
+/// A problem if the `k`th organ sets a stiffening under a law that has none.
+fn check_stiffening(k: usize, organ: &OrganEntry) -> Option<Problem> {
+    let law = organ.law.unwrap_or(Law::Linear);
+    (organ.stiffening.is_some() && law != Law::Exponential).then(|| Problem {
+        field: format!("organs[{k}].stiffening"),
+        anchors: vec![
+            "organs".into(),
+            format!("\"{}\"", organ.name),
+            "stiffening".into(),
+        ],
+        message: format!("the {} law has no stiffening", law.name()),
+        hint: "set `law: Exponential` with it, or leave it out".into(),
+    })
 }
 
 /// A problem if holding for `hold_s` (at `field`) cannot fit in the task's time limit.

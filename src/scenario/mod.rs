@@ -31,5 +31,5 @@ pub use motion::{IDLE_M_PER_S, MOVING_M_PER_S, MotionMetrics, MotionTracker, STR
 pub use score::{CutMade, Scorecard, TaskScore, score};
 pub use units::{
     DepthFraction, Dioptres, EdgeLength, FieldOfView, IncisionCount, Millimetres, ModeCount,
-    Newtons, Pascals, PoissonRatio, Ratio, Scale, ScopeAngle, Seconds, Toughness,
+    Newtons, Pascals, PoissonRatio, Ratio, Scale, ScopeAngle, Seconds, Stiffening, Toughness,
 };

@@ -142,6 +142,23 @@ impl TryFrom<f64> for PoissonRatio {
     }
 }
 
+/// The exponential law's stiffening exponent b: from 0 (neo-Hookean) to 50.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct Stiffening(pub f64);
+
+impl TryFrom<f64> for Stiffening {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (0.0..=50.0).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v} is not a stiffening exponent: from 0 (neo-Hookean) to 50 (`pgd fit` gives it from a uniaxial test of the tissue)"
+            )),
+        }
+    }
+}
+
 /// A number of vademecum modes: from 1 to 400.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(try_from = "u64")]

@@ -38,6 +38,8 @@ pub struct VademecumSpec {
     pub young_pa: Option<f64>,
     /// The tissue's Poisson's ratio when not the organs' own.
     pub poisson: Option<f64>,
+    /// The exponential law's stiffening when not its default.
+    pub stiffening: Option<f64>,
     /// Stiffer or softer regions in the organ's tissue (none by default).
     pub inclusions: Vec<Inclusion>,
     pub build: BuildSettings,
@@ -69,6 +71,7 @@ impl VademecumSpec {
             mesh: OrganSettings::default(),
             young_pa: None,
             poisson: None,
+            stiffening: None,
             inclusions: Vec::new(),
             build,
             file,
@@ -112,6 +115,9 @@ impl VademecumSpec {
         if let Some(poisson) = self.poisson {
             command += &format!(" --poisson {poisson}");
         }
+        if let Some(stiffening) = self.stiffening {
+            command += &format!(" --stiffening {stiffening}");
+        }
         for inclusion in &self.inclusions {
             command += &format!(" --inclusion {}", inclusion_arg(inclusion));
         }
@@ -141,6 +147,7 @@ pub fn ensure_vademecum(
     let mut material = pgd::organ::material(spec.source.material_of(), spec.law);
     material.young_pa = spec.young_pa.unwrap_or(material.young_pa);
     material.poisson = spec.poisson.unwrap_or(material.poisson);
+    material.stiffening = spec.stiffening.unwrap_or(material.stiffening);
     let why = match checked(spec, &mesh, &material) {
         Ok(vademecum) => return Ok((vademecum, mesh)),
         Err(why) => why,

@@ -344,6 +344,18 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "not a tissue's toughness",
         ),
         (
+            "stiffening-without-exponential",
+            4,
+            "organs[0].stiffening",
+            "the neo-hookean law has no stiffening",
+        ),
+        (
+            "stiffening-out-of-range",
+            4,
+            "stiffening",
+            "not a stiffening exponent",
+        ),
+        (
             "pointshell-cut-too-fine",
             6,
             "contact.pointshell",
@@ -738,6 +750,25 @@ fn the_scenario_picks_the_law_per_organ() {
     assert!(liver.valid_indentation_m() >= 10e-3, "{levels:?}");
     assert!(vademecums().join("liver-neo-hookean.coarse.vdm").is_file());
     assert_eq!(scene.organs[1].1.valid_indentation_m(), 0.0);
+}
+
+/// `stiffening` sets the exponential law's b per organ: the liver's vademecum is built with
+/// it, kept under a name that says so, and its build command passes it on.
+#[test]
+fn the_scenario_sets_the_exponential_stiffening_per_organ() {
+    let text = r#"Scenario(title: "Press", briefing: "Press.",
+        organs: [Organ(name: "liver", law: Exponential, stiffening: 3.5)],
+        tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3,
+                             hold_s: 1.0, time_limit_s: 5.0)])"#;
+    let scenario = parse(Path::new("stiffening.scenario.ron"), text).unwrap();
+    let scene = scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap();
+    let material = scene.organs[0].1.header.material;
+    assert_eq!((material.law, material.stiffening), (Law::Exponential, 3.5));
+    assert!(
+        vademecums()
+            .join("liver-exponential.coarse.stiffening-3.5.vdm")
+            .is_file()
+    );
 }
 
 /// A scenario may name the device it is meant for, as `--device` names it; the window opens
