@@ -449,7 +449,7 @@ fn secant_block(
     (report, unconverged.iter().map(|j| first + j).collect())
 }
 
-/// Whether an iteration is overshooting: its change grew [`GROWING_STEPS`] times running
+/// Whether an iteration is overshooting: its residual grew [`GROWING_STEPS`] times running
 /// (`growing` counts them). A stiffening law's iteration with the rest stiffness grows by the
 /// stiffening less one each step; Anderson's history makes single growths common otherwise.
 fn overshoots(growing: &mut usize, before: f64, after: f64) -> bool {
@@ -465,7 +465,7 @@ fn overshoots(growing: &mut usize, before: f64, after: f64) -> bool {
     overshooting
 }
 
-/// Consecutive growths of a fixed point's change that make it damp its steps.
+/// Consecutive growths of a fixed point's residual that make it damp its steps.
 const GROWING_STEPS: usize = 2;
 
 /// Buffers for evaluating the nonlinear terms of one response at a time.
