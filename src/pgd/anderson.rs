@@ -5,9 +5,9 @@
 //! relaxation still crawls; a few remembered directions take most of that away.
 //!
 //! Where the law stiffens more than twice over (the exponential law pressed deep), the plain
-//! iteration overshoots and diverges: the step then mixes in only a fraction β of the
-//! residual, `x ← x̄ + β f̄` (`x̄`, `f̄` the combined iterate and residual), β halved each time
-//! the caller sees the iteration grow.
+//! iteration overshoots and diverges: each step mixes in only a fraction β of the residual,
+//! `x ← x̄ + β f̄` (`x̄`, `f̄` the combined iterate and residual), β given at the start and
+//! halved each time the caller sees the iteration grow.
 
 use std::collections::VecDeque;
 
@@ -24,14 +24,15 @@ pub struct Anderson {
 }
 
 impl Anderson {
-    /// Remembers up to `depth` differences (0: the plain iteration).
-    pub fn new(depth: usize) -> Self {
+    /// Remembers up to `depth` differences (0: the plain iteration); each step takes the
+    /// fraction `mixing` of the combined residual (1: undamped).
+    pub fn new(depth: usize, mixing: f64) -> Self {
         Self {
             depth,
             residual_steps: VecDeque::with_capacity(depth),
             value_steps: VecDeque::with_capacity(depth),
             last: None,
-            mixing: 1.0,
+            mixing,
         }
     }
 
@@ -135,7 +136,7 @@ mod tests {
                 .collect()
         };
         let solve = |depth: usize| {
-            let mut anderson = Anderson::new(depth);
+            let mut anderson = Anderson::new(depth, 1.0);
             let mut x = vec![0.0; 3];
             for iteration in 1..=2000 {
                 let before = x.clone();
@@ -163,7 +164,7 @@ mod tests {
     fn damping_tames_an_overshooting_iteration() {
         let g = |x: &[f64]| vec![-3.0 * x[0] + 4.0];
         for depth in [0, 3] {
-            let mut anderson = Anderson::new(depth);
+            let mut anderson = Anderson::new(depth, 1.0);
             let mut x = vec![0.0];
             let value = g(&x);
             anderson.advance(&mut x, value);

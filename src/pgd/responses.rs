@@ -277,6 +277,12 @@ pub struct SecantSettings {
     /// Differences remembered by each response's Anderson acceleration (0: plain iteration).
     #[serde(default = "default_anderson_depth")]
     pub anderson_depth: usize,
+    /// The fraction β of the fixed point's residual each step takes at first (1: paper 000's
+    /// iteration), halved while the residual keeps growing. Under a stiffening law the full
+    /// step overshoots: the elements under a nodal load are pressed so far on the first step
+    /// that the exponential law's modulus explodes.
+    #[serde(default = "default_mixing")]
+    pub mixing: f64,
     /// A step is kept while at most this fraction of its loads fail to converge; those keep
     /// the previous step's secant response (reported, never silent).
     pub max_unconverged_fraction: f64,
@@ -292,6 +298,7 @@ impl Default for SecantSettings {
             tolerance: 1e-3,
             max_iterations: 40,
             anderson_depth: default_anderson_depth(),
+            mixing: default_mixing(),
             max_unconverged_fraction: 0.005,
             max_newton_fraction: default_max_newton_fraction(),
         }
@@ -300,6 +307,10 @@ impl Default for SecantSettings {
 
 fn default_anderson_depth() -> usize {
     5
+}
+
+fn default_mixing() -> f64 {
+    0.5
 }
 
 fn default_max_newton_fraction() -> f64 {
@@ -370,7 +381,7 @@ fn secant_block(
     let mut change = vec![0.0; columns];
     let mut growing = vec![0usize; columns];
     let mut accelerators: Vec<Anderson> = (0..columns)
-        .map(|_| Anderson::new(settings.anderson_depth))
+        .map(|_| Anderson::new(settings.anderson_depth, settings.mixing))
         .collect();
     let mut report = SecantReport {
         responses: columns,

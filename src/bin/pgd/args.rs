@@ -335,6 +335,10 @@ pub struct BuildArgs {
     /// each is solved by Newton instead (0: never).
     #[arg(long, default_value_t = SecantSettings::default().max_newton_fraction)]
     pub max_newton: f64,
+    /// Nonlinear laws: the fraction of its residual the fixed point's first steps take
+    /// (1: undamped; halved while the residual grows).
+    #[arg(long, default_value_t = SecantSettings::default().mixing)]
+    pub mixing: f64,
     /// Nonlinear laws: time the brute-force alternative on this many random loads, a full
     /// Newton path each to the deepest step kept, and scale it to all loads (0: skip).
     #[arg(long, default_value_t = 3)]
@@ -406,6 +410,12 @@ impl BuildArgs {
                 "--load-steps-mm {steps:?}: expected positive indentations in increasing order"
             ));
         }
+        if !(self.mixing > 0.0 && self.mixing <= 1.0) {
+            return Err(format!(
+                "--mixing {}: expected a fraction of the residual in (0, 1]",
+                self.mixing
+            ));
+        }
         let tool_tip_radius_m = self
             .tool_radius_mm
             .map_or(defaults.tool_tip_radius_m, |mm| mm * 1e-3);
@@ -427,6 +437,7 @@ impl BuildArgs {
             secant: SecantSettings {
                 max_unconverged_fraction: self.max_unconverged,
                 max_newton_fraction: self.max_newton,
+                mixing: self.mixing,
                 ..defaults.secant
             },
         })
