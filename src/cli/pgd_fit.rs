@@ -4,20 +4,13 @@
 use std::fmt;
 use std::path::Path;
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use crate::fem::{
     ExponentialFit, Law, Material, TISSUE_DENSITY_KG_M3, UniaxialPoint, fit_exponential,
     uniaxial_nominal_stress_pa,
 };
 use crate::report::{LineChart, Series, line_chart};
-
-/// One row of the test's CSV.
-#[derive(Deserialize)]
-struct Row {
-    stretch: f64,
-    nominal_stress_pa: f64,
-}
 
 /// The fit of one test file.
 #[derive(Debug, Serialize)]
@@ -50,18 +43,15 @@ fn read_test(path: &Path) -> Result<Vec<UniaxialPoint>, String> {
         .from_path(path)
         .map_err(|e| format!("{}: {e}", path.display()))?;
     let mut data = Vec::new();
-    for record in reader.deserialize::<Row>() {
-        let row = record.map_err(|e| {
+    for record in reader.deserialize::<UniaxialPoint>() {
+        let point = record.map_err(|e| {
             let line = e.position().map_or(0, |p| p.line());
             at(
                 line,
                 format!("{e} (expected the columns stretch,nominal_stress_pa)"),
             )
         })?;
-        data.push(UniaxialPoint {
-            stretch: row.stretch,
-            nominal_stress_pa: row.nominal_stress_pa,
-        });
+        data.push(point);
     }
     Ok(data)
 }

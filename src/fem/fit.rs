@@ -8,12 +8,12 @@
 //! `E` and `t` does not depend on it, so `P₁₁ = E p(a; b)`: for each `b` the best `E` is a
 //! linear least-squares fit, and `b` is the one-dimensional minimum of what remains.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::{FemError, Law, Material, TISSUE_DENSITY_KG_M3};
 
-/// One measurement of a uniaxial test.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// One measurement of a uniaxial test (a row of `pgd fit`'s CSV).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 pub struct UniaxialPoint {
     /// Deformed over reference length along the load (below 1 in compression).
     pub stretch: f64,
@@ -86,8 +86,9 @@ pub fn fit_exponential(points: &[UniaxialPoint], poisson: f64) -> Result<Exponen
     let grid: Vec<f64> = (0..=100)
         .map(|i| MAX_STIFFENING * (i as f64 / 100.0).powi(2))
         .collect();
+    let squares: Vec<f64> = grid.iter().map(|&b| misfit(b).1).collect();
     let best = (0..grid.len())
-        .min_by(|&i, &j| misfit(grid[i]).1.total_cmp(&misfit(grid[j]).1))
+        .min_by(|&i, &j| squares[i].total_cmp(&squares[j]))
         .expect("the grid is not empty");
     let low = grid[best.saturating_sub(1)];
     let high = grid[(best + 1).min(grid.len() - 1)];

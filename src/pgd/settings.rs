@@ -91,14 +91,14 @@ pub const NEO_HOOKEAN_STEPS_TOOL_RADII: [f64; 6] = [
 ];
 
 /// The load steps `law` is built with by default under a tool of `tool_tip_radius_m`: the
-/// neo-Hookean law's reach the depths a trainee presses, KSV's stop where it loses stability
+/// neo-Hookean family's reach the depths a trainee presses, KSV's stop where it loses stability
 /// (the linear law has none; it keeps KSV's in its header).
 pub fn default_load_steps_m(tool_tip_radius_m: f64, law: Law) -> Vec<f64> {
-    match law {
-        Law::NeoHookean | Law::Exponential => NEO_HOOKEAN_STEPS_TOOL_RADII
+    match law.is_hyperelastic() {
+        true => NEO_HOOKEAN_STEPS_TOOL_RADII
             .iter()
             .map(|r| r * tool_tip_radius_m)
             .collect(),
-        Law::Linear | Law::KirchhoffSaintVenant => DEFAULT_LOAD_STEPS_M.to_vec(),
+        false => DEFAULT_LOAD_STEPS_M.to_vec(),
     }
 }
