@@ -10,7 +10,7 @@ use super::error::VademecumError;
 use super::local::LocalPart;
 use super::region::RegionResponse;
 use super::settings::BuildSettings;
-use super::vademecum::{Header, Step, Vademecum};
+use super::vademecum::{Header, MAX_STEPS, Step, Vademecum};
 use crate::fem::{Inclusion, Material};
 use crate::mesh::TetMesh;
 
@@ -293,6 +293,11 @@ fn validate(path: &Path, v: &Vademecum) -> Result<(), VademecumError> {
     }
     if v.steps.len() != v.header.indentation_levels_m.len() || v.steps.is_empty() {
         return fail("steps (their count differs from the header's load steps)");
+    }
+    if v.steps.len() > MAX_STEPS {
+        return fail(&format!(
+            "steps (more than the {MAX_STEPS} a press can blend)"
+        ));
     }
     for (k, step) in v.steps.iter().enumerate() {
         let modes = v

@@ -43,7 +43,7 @@ pub use settings::{
 pub use statistics::Statistics;
 pub use stiffness::RestStiffness;
 pub use surface_modes::SurfaceModes;
-pub use vademecum::{Header, Patch, Step, SurfacePoint, Vademecum};
+pub use vademecum::{Header, MAX_STEPS, Patch, Step, SurfacePoint, Vademecum};
 pub use validate::{ForceDepthCurve, Sample, ValidationReport, ValidationSettings, validate};
 
 use crate::mesh::TetMesh;

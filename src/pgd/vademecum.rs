@@ -70,6 +70,24 @@ pub struct SurfacePoint {
 pub struct Patch {
     pub shares: Vec<(usize, f64)>,
     slot_of: Vec<u32>,
+    columns: StepColumns,
+}
+
+/// The most load steps a vademecum holds, the linear one included: a press marks the steps
+/// whose columns it filled in one word.
+pub const MAX_STEPS: usize = 64;
+
+/// Per load step, each patch member's column of the patch compliance, `Σ_i β_i C_ij` (3 × 3,
+/// row-major): the patch-averaged displacement per unit load on member `j`. A nonlinear press
+/// fills a step's columns the first time its secant iteration reaches that step, so every
+/// iteration after costs one pass over the members rather than one over their rows of blocks.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct StepColumns {
+    /// Step-major: `columns[step * members + slot]`.
+    columns: Vec<[f64; 9]>,
+    members: usize,
+    /// One bit per step whose columns are filled.
+    filled: u64,
 }
 
 const NO_SLOT: u32 = u32::MAX;
@@ -80,6 +98,43 @@ impl Patch {
             NO_SLOT => None,
             slot => Some(slot as usize),
         }
+    }
+
+    /// Sizes the step columns for `steps` load steps of the current shares, none filled.
+    fn reset_columns(&mut self, steps: usize) {
+        let members = self.shares.len();
+        self.columns.columns.resize(steps * members, [0.0; 9]);
+        self.columns.members = members;
+        self.columns.filled = 0;
+    }
+
+    /// Fills load step `step`'s columns from its local part (one pass over the members' rows)
+    /// unless they are filled already.
+    fn fill_columns(&mut self, step: usize, local: &LocalPart) {
+        if self.columns.filled & (1 << step) != 0 {
+            return;
+        }
+        let members = self.columns.members;
+        let columns = &mut self.columns.columns[step * members..(step + 1) * members];
+        columns.fill([0.0; 9]);
+        for &(i, li) in &self.shares {
+            for e in local.neighbours_of(i) {
+                let slot = self.slot_of[local.neighbours[e] as usize];
+                if slot == NO_SLOT {
+                    continue;
+                }
+                let block = &local.compliance[9 * e..9 * e + 9];
+                for (ck, &bk) in columns[slot as usize].iter_mut().zip(block) {
+                    *ck += li * bk as f64;
+                }
+            }
+        }
+        self.columns.filled |= 1 << step;
+    }
+
+    /// Member `slot`'s column in load step `step` (filled by [`Self::fill_columns`]).
+    fn column(&self, step: usize, slot: usize) -> &[f64; 9] {
+        &self.columns.columns[step * self.columns.members + slot]
     }
 
     /// Replaces the shares, keeping the slot table in step (sized for `positions`).
@@ -240,15 +295,10 @@ impl Vademecum {
         }
     }
 
-    /// Weight of load step `step` for a nodal load whose linear response is `level_m` deep:
-    /// piecewise linear between the steps' levels, held at the last step beyond it.
+    /// Weight of load step `step` for a nodal load whose linear response is `level_m` deep
+    /// ([`Self::blend`]).
     fn step_weight(&self, step: usize, level_m: f64) -> f64 {
-        let (first, last) = self.steps_at(level_m);
-        if first == last {
-            return f64::from(step == first);
-        }
-        let levels = &self.header.indentation_levels_m;
-        let t = (level_m - levels[first]) / (levels[last] - levels[first]);
+        let (first, last, t) = self.blend(level_m);
         if step == last {
             t
         } else if step == first {
@@ -256,6 +306,22 @@ impl Vademecum {
         } else {
             0.0
         }
+    }
+
+    /// The two load steps a nodal load whose linear response is `level_m` deep blends, and the
+    /// second one's weight: piecewise linear between the steps' levels, held at the last step
+    /// beyond it (both steps the same, weight one, outside the levels).
+    fn blend(&self, level_m: f64) -> (usize, usize, f64) {
+        let (first, last) = self.steps_at(level_m);
+        if first == last {
+            return (first, last, 1.0);
+        }
+        let levels = &self.header.indentation_levels_m;
+        (
+            first,
+            last,
+            (level_m - levels[first]) / (levels[last] - levels[first]),
+        )
     }
 
     /// The first and last steps [`Self::step_weight`] blends for a nodal load `level_m` deep
@@ -393,43 +459,61 @@ impl Vademecum {
         at: &SurfacePoint,
         indentation_m: &Vector3<f64>,
     ) -> Vector3<f64> {
-        self.patch_force_for_indentation(&self.patch(at), indentation_m)
+        self.patch_press(&mut self.patch(at), indentation_m).0
     }
 
-    /// [`Self::force_for_indentation`] on a patch already found: a secant iteration over the
-    /// load steps, one 3 × 3 solve when linear. Zero if the patch's compliance is singular.
-    pub fn patch_force_for_indentation(
-        &self,
-        patch: &Patch,
-        indentation_m: &Vector3<f64>,
-    ) -> Vector3<f64> {
-        self.patch_press(patch, indentation_m).0
-    }
-
-    /// [`Self::patch_force_for_indentation`] and the stiffness it used (N/m, the inverse of
-    /// the patch compliance, the secant one for a KSV vademecum; zero if singular): how the
-    /// force would change for a change of the indentation.
+    /// The force (N) that pushes `patch` by `indentation_m` and the stiffness it used (N/m,
+    /// the inverse of the patch compliance, the secant one for a nonlinear vademecum; zero if
+    /// singular): how the force would change for a change of the indentation. One 3 × 3 solve
+    /// when linear; a secant iteration over the load steps otherwise, on the patch's step
+    /// columns, each step's filled once.
     pub fn patch_press(
         &self,
-        patch: &Patch,
+        patch: &mut Patch,
         indentation_m: &Vector3<f64>,
     ) -> (Vector3<f64>, Matrix3<f64>) {
         let solve = |c: Matrix3<f64>| {
             let stiffness = c.try_inverse().unwrap_or_else(Matrix3::zeros);
             (stiffness * indentation_m, stiffness)
         };
-        let mut press = solve(self.step_compliance(0, patch));
-        if self.steps.len() > 1 {
-            for _ in 0..SECANT_ITERATIONS {
-                let next = solve(self.compliance(patch, &press.0));
-                let settled = (next.0 - press.0).norm() <= SECANT_TOLERANCE * next.0.norm();
-                press = next;
-                if settled {
-                    break;
-                }
+        if self.steps.len() == 1 {
+            return solve(self.linear_compliance(patch));
+        }
+        patch.reset_columns(self.steps.len());
+        let mut press = solve(self.column_compliance(patch, &Vector3::zeros()));
+        for _ in 0..SECANT_ITERATIONS {
+            let next = solve(self.column_compliance(patch, &press.0));
+            let settled = (next.0 - press.0).norm() <= SECANT_TOLERANCE * next.0.norm();
+            press = next;
+            if settled {
+                break;
             }
         }
         press
+    }
+
+    /// [`Self::compliance`] from the patch's step columns, filling those of the steps its
+    /// loads reach under `force_n`.
+    fn column_compliance(&self, patch: &mut Patch, force_n: &Vector3<f64>) -> Matrix3<f64> {
+        let force_norm_n = force_n.norm();
+        let blend = |(j, l): (usize, f64)| self.blend(self.nodal_level_m(j, l, force_norm_n));
+        for slot in 0..patch.shares.len() {
+            let (first, last, _) = blend(patch.shares[slot]);
+            patch.fill_columns(first, &self.steps[first].local);
+            patch.fill_columns(last, &self.steps[last].local);
+        }
+        let mut c = [0.0f64; 9];
+        for (slot, &share) in patch.shares.iter().enumerate() {
+            let (first, last, t) = blend(share);
+            for (step, w) in [(first, share.1 * (1.0 - t)), (last, share.1 * t)] {
+                if w != 0.0 {
+                    for (ck, &bk) in c.iter_mut().zip(patch.column(step, slot)) {
+                        *ck += w * bk;
+                    }
+                }
+            }
+        }
+        Matrix3::from_row_slice(&c)
     }
 
     /// The displacement field (m, all dofs) for a force (N) at `at`.

@@ -4,11 +4,12 @@
 //! load step beyond the law's stability is left out and bounds the valid range; the
 //! brute-force baseline times Newton paths through the same steps.
 
+use nalgebra::Vector3;
 use pgd_surgery::fem::{FemModel, Law, Loads, NewtonSettings, PatchKernel};
 use pgd_surgery::mesh::Surface;
 use pgd_surgery::pgd::{
     BuildSettings, LoadPatches, Responses, RestStiffness, SecantReport, SecantSettings, Silent,
-    ValidationReport, ValidationSettings, build, newton_baseline, validate,
+    SurfacePoint, ValidationReport, ValidationSettings, build, newton_baseline, validate,
 };
 
 use crate::common::{block_mesh, block_model_of, organ, settings};
@@ -241,6 +242,48 @@ fn the_exponential_vademecum_follows_full_fem_to_its_deepest_step() {
     let steps = vec![2.5e-3, 5e-3, 10e-3];
     let (with_exponential, with_linear) = against_full_fem(Law::Exponential, steps, (1e-3, 10e-3));
     assert!(with_exponential.force_error.p95 < 0.2 * with_linear.force_error.p95);
+}
+
+/// The felt force of a nonlinear vademecum is a fixed point of its load-step blend: the
+/// compliance the patch's loads pick under that force, summed block by block over the patch
+/// (`Vademecum::compliance`, the reference), carries it to the indentation asked for. Checked
+/// at presses from 0.5 to 9 mm over the block's loaded face, across its three steps, obliquely
+/// and along the normal, to 1e-5 (the secant iteration stops at a change of 1e-6).
+#[test]
+fn the_felt_force_is_a_fixed_point_of_the_step_blend() {
+    let model = block_model_of(block_mesh([6, 4, 3]), Law::NeoHookean);
+    let (vademecum, _) = build(
+        &organ(&model),
+        &ksv_settings(vec![2.5e-3, 5e-3, 10e-3]),
+        &Silent,
+    )
+    .unwrap();
+    let mut deepest_level_m = 0.0f64;
+    for (t, depth_m) in (0..vademecum.triangles.len())
+        .step_by(5)
+        .zip([0.5e-3, 3e-3, 6e-3, 9e-3].iter().cycle())
+    {
+        let at = SurfacePoint {
+            triangle: t,
+            barycentric: [0.2, 0.3, 0.5],
+        };
+        let normal = vademecum.triangle_facing(t);
+        let slant = normal.cross(&Vector3::x()).normalize() * 0.3;
+        for indentation_m in [-normal * *depth_m, (slant - normal) * *depth_m] {
+            let force_n = vademecum.force_for_indentation(&at, &indentation_m);
+            let patch = vademecum.patch(&at);
+            let reached_m = vademecum.compliance(&patch, &force_n) * force_n;
+            let error = (reached_m - indentation_m).norm() / indentation_m.norm();
+            assert!(
+                error < 1e-5,
+                "triangle {t}, {indentation_m:?}: off by {error:e}"
+            );
+            let linear_m = vademecum.compliance(&patch, &Vector3::zeros()) * force_n;
+            deepest_level_m = deepest_level_m.max(linear_m.norm());
+        }
+    }
+    // The presses reach the deepest step, whose blend differs most from the linear one.
+    assert!(deepest_level_m > 5e-3, "{deepest_level_m}");
 }
 
 /// The brute-force baseline times Newton paths through the vademecum's steps, loaded as the

@@ -410,6 +410,13 @@ impl BuildArgs {
                 "--load-steps-mm {steps:?}: expected positive indentations in increasing order"
             ));
         }
+        if steps.len() >= pgd::MAX_STEPS {
+            return Err(format!(
+                "--load-steps-mm: {} steps; at most {} beside the linear one",
+                steps.len(),
+                pgd::MAX_STEPS - 1
+            ));
+        }
         if !(self.mixing > 0.0 && self.mixing <= 1.0) {
             return Err(format!(
                 "--mixing {}: expected a fraction of the residual in (0, 1]",
