@@ -43,9 +43,9 @@ pub struct ToolContact {
     /// tool's patch.
     pub moved_m: Vector3<f64>,
     /// How far the tip reaches below the rest surface, along the normal (m); clamped to the
-    /// vademecum's valid range.
+    /// depth the vademecum's load steps answer ([`Vademecum::patch_press_in_range`]).
     pub depth_m: f64,
-    /// How much deeper than that range the tip reaches (m); zero within it. The force stays
+    /// How much deeper than that the tip reaches (m); zero within the range. The force stays
     /// at the range's edge there, bounded and finite, and the run's report says so.
     pub beyond_range_m: f64,
     /// The displacement the tool's load adds to the surface under it (m): into the surface by
@@ -92,12 +92,16 @@ where
         load.release();
         return None;
     };
-    let (force_n, stiffness_n_per_m) = vademecum.patch_press(patch, &contact.indentation_m);
+    let (force_n, stiffness_n_per_m, answered) =
+        vademecum.patch_press_in_range(patch, &contact.indentation_m);
     load.shares.clone_from(&patch.shares);
     load.force_n = force_n;
     Some(ToolContact {
         force_n,
         stiffness_n_per_m,
+        depth_m: contact.depth_m * answered,
+        beyond_range_m: contact.depth_m * (1.0 - answered),
+        indentation_m: contact.indentation_m * answered,
         ..contact
     })
 }
@@ -150,17 +154,12 @@ where
     if depth_m <= 0.0 {
         return None;
     }
-    let valid_m = match vademecum.steps.len() {
-        1 => f64::INFINITY,
-        _ => vademecum.valid_indentation_m(),
-    };
-    let (depth_m, beyond_range_m) = (depth_m.min(valid_m), (depth_m - valid_m).max(0.0));
     let sideways_m = moved_m - hit.normal * moved_m.dot(&hit.normal);
     Some(ToolContact {
         hit,
         moved_m,
         depth_m,
-        beyond_range_m,
+        beyond_range_m: 0.0,
         indentation_m: -hit.normal * depth_m - sideways_m,
         stiffness_n_per_m: Matrix3::zeros(),
         force_n: Vector3::zeros(),

@@ -492,6 +492,39 @@ impl Vademecum {
         press
     }
 
+    /// [`Self::patch_press`] held within the load steps' range, and the share of
+    /// `indentation_m` it answers (one within the range). A step's level is the depth its nodal
+    /// loads would press alone, so a patch leaves the range when the load of any one of its
+    /// positions goes deeper than the last step, whatever the tool's own depth: where one
+    /// position carries most of the patch, sooner than the tool reaches the last level. There
+    /// the force is held at the magnitude that puts that position on the last step, along the
+    /// direction the blend's stiffness there gives (the blend depends on the force's magnitude
+    /// only), and answers that share of the indentation.
+    pub fn patch_press_in_range(
+        &self,
+        patch: &mut Patch,
+        indentation_m: &Vector3<f64>,
+    ) -> (Vector3<f64>, Matrix3<f64>, f64) {
+        let (force_n, stiffness) = self.patch_press(patch, indentation_m);
+        if self.steps.len() == 1 {
+            return (force_n, stiffness, 1.0);
+        }
+        let deepest_per_n = patch
+            .shares
+            .iter()
+            .map(|&(j, l)| self.nodal_level_m(j, l, 1.0))
+            .fold(0.0, f64::max);
+        let edge_n = self.valid_indentation_m() / deepest_per_n;
+        if !(force_n.norm() > edge_n) {
+            return (force_n, stiffness, 1.0);
+        }
+        let at_edge = self.column_compliance(patch, &(Vector3::x() * edge_n));
+        let stiffness = at_edge.try_inverse().unwrap_or_else(Matrix3::zeros);
+        let unclamped_n = stiffness * indentation_m;
+        let answered = (edge_n / unclamped_n.norm()).min(1.0);
+        (unclamped_n * answered, stiffness, answered)
+    }
+
     /// [`Self::compliance`] from the patch's step columns, filling those of the steps its
     /// loads reach under `force_n`.
     fn column_compliance(&self, patch: &mut Patch, force_n: &Vector3<f64>) -> Matrix3<f64> {

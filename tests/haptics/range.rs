@@ -75,38 +75,49 @@ fn press(vademecum: &Arc<Vademecum>, depth_m: f64) -> (HeadlessReport, ForceTrac
     (report, trace)
 }
 
-/// Pressed ten times deeper than the range, the force is finite everywhere and no more than
-/// at the range's edge (1e-6 relative: the same depth gives the same force), the report
-/// counts the ticks beyond the range and how far (the 10 mm press held at 1 mm: about 9 mm
-/// beyond, less what the tracked contact point moves); within the range nothing is reported.
+/// Pressed ten times deeper than the load steps reach, the force is finite everywhere and held
+/// where one position of the patch reaches the last step (the range's edge: here the tool is
+/// shallower than the step's 1 mm there, one position carrying most of the patch), and the
+/// report counts the ticks beyond and how far. Pressed just short of that edge, nothing is
+/// reported and the force is just under the held one (within 2 %, 1 % short of the edge).
 #[test]
 fn a_press_beyond_the_range_is_held_at_its_edge_and_reported() {
     let vademecum = Arc::new(block_vademecum());
     assert_eq!(vademecum.valid_indentation_m(), RANGE_M);
-    let (edge, edge_trace) = press(&vademecum, RANGE_M);
     let (deep, deep_trace) = press(&vademecum, 10.0 * RANGE_M);
-    eprintln!("{edge}\n{deep}");
-    assert_eq!(edge.range.beyond_ticks, 0, "{edge}");
-    assert!(edge.force.max_desired_n > 0.01, "{edge}");
     assert!(
         deep_trace
             .desired_n
             .iter()
             .all(|f| f.iter().all(|c| c.is_finite()))
     );
-    let largest = |trace: &ForceTrace| trace.desired_n.iter().map(|f| f.norm()).fold(0.0, f64::max);
-    let (edge_n, deep_n) = (largest(&edge_trace), largest(&deep_trace));
-    assert!(
-        (deep_n - edge_n).abs() <= 1e-6 * edge_n,
-        "{deep_n} N beyond the range against {edge_n} N at its edge"
-    );
-    // The 0.5 s press spends 90 % of its depth beyond the range, then the hold and the
-    // lift's first part: well over 500 ticks.
+    // The 0.5 s press spends most of its depth beyond the range, then the hold and the lift's
+    // first part: well over 500 ticks.
     assert!(deep.range.beyond_ticks > 500, "{deep}");
-    assert!((deep.range.max_beyond_mm - 9.0).abs() < 0.5, "{deep}");
     assert_eq!(deep.range.organs, vec![("block".to_owned(), RANGE_M * 1e3)]);
     assert!(
         deep.to_string().contains("beyond the vademecum's range"),
         "{deep}"
+    );
+    let edge_m = 10.0 * RANGE_M - deep.range.max_beyond_mm * 1e-3;
+    assert!(edge_m > 0.2 * RANGE_M && edge_m <= RANGE_M, "{deep}");
+    let largest = |trace: &ForceTrace| trace.desired_n.iter().map(|f| f.norm()).fold(0.0, f64::max);
+    let held_n = largest(&deep_trace);
+    let held_ticks = deep_trace
+        .desired_n
+        .iter()
+        .filter(|f| (f.norm() - held_n).abs() <= 1e-9 * held_n)
+        .count();
+    assert!(
+        held_ticks > 500,
+        "{held_ticks} ticks at the held {held_n} N"
+    );
+    let (short, short_trace) = press(&vademecum, 0.99 * edge_m);
+    eprintln!("{short}\n{deep}");
+    assert_eq!(short.range.beyond_ticks, 0, "{short}");
+    let short_n = largest(&short_trace);
+    assert!(
+        short_n < held_n && short_n > 0.98 * held_n,
+        "{short_n} N just short of the edge against {held_n} N held"
     );
 }

@@ -7,6 +7,7 @@
 mod cutting;
 mod history;
 mod motion;
+mod stiffening;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

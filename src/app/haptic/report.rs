@@ -59,13 +59,16 @@ impl ForceSummary {
 }
 
 /// How often and how far the tool pressed beyond what an organ's nonlinear vademecum covers
-/// (its deepest load step): there the force is held at the range's edge.
+/// (until a position of the tool's patch carries a load deeper than the last load step):
+/// there the force is held at the range's edge.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct RangeSummary {
     pub beyond_ticks: u64,
     /// The farthest the tip reached beyond the range (mm).
     pub max_beyond_mm: f64,
-    /// The organs pressed beyond their range, each with its range (mm).
+    /// The organs pressed beyond their range, each with its deepest load step (mm): the depth
+    /// one position's load makes alone, which the tool's own depth at the range's edge
+    /// falls short of where one position carries most of the patch.
     pub organs: Vec<(String, f64)>,
 }
 
@@ -92,7 +95,7 @@ impl fmt::Display for RangeSummary {
         let organs: Vec<String> = self
             .organs
             .iter()
-            .map(|(name, valid_mm)| format!("{name} (valid to {valid_mm:.1} mm)"))
+            .map(|(name, valid_mm)| format!("{name} (load steps to {valid_mm:.1} mm)"))
             .collect();
         write!(
             f,

@@ -1,0 +1,122 @@
+//! The trainer's felt force over a scripted 20 mm press into the coarse liver: under the
+//! exponential law it firms up as the tool goes deeper (the slope of force against depth
+//! grows from one stretch of the press to the next) until the press leaves the range its load
+//! steps answer; from there on the force is held and the report says how far beyond the tool
+//! went. Under the linear law, pressed the same way, the slope stays put.
+
+use std::path::Path;
+
+use pgd_surgery::app::attempt::scenario_scene;
+use pgd_surgery::app::haptic::{ForceTrace, HapticLoop, HapticScene, HeadlessReport};
+use pgd_surgery::app::scene::{Detail, press_targets};
+use pgd_surgery::devices::{PressMotion, Scripted, TICK_S, press_and_slide};
+use pgd_surgery::scenario::parse;
+use pgd_surgery::store::OnStale;
+
+use crate::vademecums;
+
+const DEPTH_M: f64 = 20e-3;
+
+/// The coarse liver alone under the law `law` names in a scenario (its default stiffening for
+/// the exponential law), its vademecum built with the defaults.
+fn liver_scene(law: &str) -> HapticScene {
+    let text = format!(
+        r#"Scenario(title: "Press", briefing: "Press.",
+        organs: [Organ(name: "liver", law: {law})],
+        tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3,
+                             hold_s: 1.0, time_limit_s: 5.0)])"#
+    );
+    let scenario = parse(Path::new("press.scenario.ron"), &text).unwrap();
+    scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap()
+}
+
+/// A press 20 mm deep at the demo's point on the liver, in 1 s: the run's report and, per
+/// tick of the way in, the tool's depth below the rest surface (m) and the
+/// felt force along the surface's normal (N).
+fn press_20_mm(scene: &HapticScene) -> (HeadlessReport, Vec<(f64, f64)>) {
+    let target = press_targets(scene)[0];
+    let motion = PressMotion {
+        tip_radius_m: scene.probe.tip_radius_m,
+        depth_m: DEPTH_M,
+        slide_m: 0.0,
+        press_s: 1.0,
+        ..PressMotion::default()
+    };
+    let script = press_and_slide(&[target], &motion);
+    let in_s = motion.approach_s + motion.press_s;
+    let depth_at = |time_s: f64| {
+        let tip = script.sample(time_s).tip_m;
+        motion.tip_radius_m - (tip - target.point_m).dot(&target.normal)
+    };
+    let depths: Vec<f64> = (0..(in_s / TICK_S).round() as usize)
+        .map(|k| depth_at(k as f64 * TICK_S))
+        .collect();
+    let device = Box::new(Scripted::new("20 mm press", script));
+    let mut haptic = HapticLoop::new(scene, device).unwrap();
+    haptic.keep_trace();
+    let report = haptic.run_simulated(depths.len() as u64);
+    let trace = std::mem::take(&mut *haptic.world_mut().resource_mut::<ForceTrace>());
+    let felt: Vec<(f64, f64)> = depths
+        .iter()
+        .zip(&trace.desired_n)
+        .map(|(&depth_m, force_n)| (depth_m, force_n.dot(&target.normal)))
+        .collect();
+    (report, felt)
+}
+
+/// The least-squares slope (N/m) of the felt force against depth over depths in `from..to`.
+fn slope(felt: &[(f64, f64)], (from_m, to_m): (f64, f64)) -> f64 {
+    let points: Vec<&(f64, f64)> = felt
+        .iter()
+        .filter(|(d, _)| *d >= from_m && *d < to_m)
+        .collect();
+    let n = points.len() as f64;
+    let mean_d = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let mean_f = points.iter().map(|p| p.1).sum::<f64>() / n;
+    let covariance: f64 = points.iter().map(|p| (p.0 - mean_d) * (p.1 - mean_f)).sum();
+    let variance: f64 = points.iter().map(|p| (p.0 - mean_d).powi(2)).sum();
+    covariance / variance
+}
+
+/// The slopes over three equal stretches of depth from 1 mm to `edge_m`.
+fn slopes(felt: &[(f64, f64)], edge_m: f64) -> [f64; 3] {
+    let width_m = (edge_m - 1e-3) / 3.0;
+    [0.0, 1.0, 2.0].map(|k| {
+        let from_m = 1e-3 + k * width_m;
+        slope(felt, (from_m, from_m + width_m))
+    })
+}
+
+/// The exponential liver, pressed 20 mm: the force is finite and pushes the tool out; over
+/// the depths its load steps answer, its slope grows from stretch to stretch, by over 30 %
+/// from the first to the last, where the linear liver's slope changes by under 1 % over the
+/// same depths. Deeper, the report counts the ticks beyond the range and the force stays at
+/// the range edge's (1e-9 relative).
+#[test]
+fn a_20_mm_press_on_the_exponential_liver_firms_up_then_is_held() {
+    let (report, felt) = press_20_mm(&liver_scene("Exponential"));
+    let (linear_report, linear_felt) = press_20_mm(&liver_scene("Linear"));
+    assert!(felt.iter().all(|(_, f)| f.is_finite()));
+    assert!((felt.last().unwrap().0 - DEPTH_M).abs() < 0.1e-3);
+    assert_eq!(linear_report.range.beyond_ticks, 0, "{linear_report}");
+    assert!(report.range.beyond_ticks > 0, "{report}");
+    let edge_m = DEPTH_M - report.range.max_beyond_mm * 1e-3;
+    let (stiffening, linear) = (slopes(&felt, edge_m), slopes(&linear_felt, edge_m));
+    eprintln!(
+        "{report}
+range edge {:.2} mm; slopes (N/m) exponential {stiffening:?}, linear {linear:?}",
+        edge_m * 1e3
+    );
+    assert!(edge_m > 5e-3, "{report}");
+    assert!(stiffening.windows(2).all(|s| s[1] > s[0]), "{stiffening:?}");
+    assert!(stiffening[2] > 1.3 * stiffening[0], "{stiffening:?}");
+    assert!((linear[2] / linear[0] - 1.0).abs() < 0.01, "{linear:?}");
+    let held_n = felt.last().unwrap().1;
+    assert!(held_n > 0.0);
+    for (depth_m, force_n) in felt.iter().filter(|(d, _)| *d > edge_m + 0.1e-3) {
+        assert!(
+            (force_n - held_n).abs() <= 1e-9 * held_n,
+            "{force_n} N at {depth_m} m, held at {held_n} N"
+        );
+    }
+}
