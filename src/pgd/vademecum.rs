@@ -515,7 +515,7 @@ impl Vademecum {
             .map(|&(j, l)| self.nodal_level_m(j, l, 1.0))
             .fold(0.0, f64::max);
         let edge_n = self.valid_indentation_m() / deepest_per_n;
-        if !(force_n.norm() > edge_n) {
+        if force_n.norm().is_nan() || force_n.norm() <= edge_n {
             return (force_n, stiffness, 1.0);
         }
         let at_edge = self.column_compliance(patch, &(Vector3::x() * edge_n));
