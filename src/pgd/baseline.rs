@@ -8,7 +8,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::Vademecum;
-use super::load_patches::parameter_load;
+use super::load_patches::{inward_sign, parameter_load};
 use crate::fem::{FemError, FemModel, Loads, NewtonSettings};
 
 /// Newton's residual tolerance for the baseline: tighter than the secant fixed point's change
@@ -87,11 +87,7 @@ fn nodal_load(
 ) -> Result<Loads, FemError> {
     let (position, axis) = (p / 3, p % 3);
     let compliance_m_per_n = f64::from(vademecum.reference_compliance_m_per_n[position]);
-    let inward = if vademecum.position_normals[position][axis] > 0.0 {
-        -1.0
-    } else {
-        1.0
-    };
+    let inward = inward_sign(&vademecum.position_normals[position], axis);
     let magnitude_n = match compliance_m_per_n > 0.0 {
         true => inward * depth_m / compliance_m_per_n,
         false => 0.0,

@@ -17,7 +17,7 @@ use serde::Serialize;
 use super::baseline::NewtonBaseline;
 use super::enrichment::{ModeReport, enrich};
 use super::error_curve::{EnergyError, ErrorCurve, FieldError, optimal_errors};
-use super::load_patches::{LoadOperator, LoadPatches};
+use super::load_patches::{LoadOperator, LoadPatches, inward_sign};
 use super::local::{LocalPart, distance_neighbours, near_nodes};
 use super::region::{CutHeader, RegionReport, RegionResponse, RegionSettings};
 use super::responses::{Responses, SecantLoads, SecantReport, Trend};
@@ -27,7 +27,7 @@ use super::stiffness::RestStiffness;
 use super::vademecum::{Header, Step, Vademecum};
 use super::{Progress, mesh_hash};
 use crate::fem::{FemError, FemModel, Law, PatchKernel, on_pressed_side};
-use crate::mesh::{Surface, TetMesh, area_vector};
+use crate::mesh::Surface;
 use nalgebra::Vector3;
 
 /// What the model is, beyond its mesh: the names written into the header.
@@ -171,7 +171,10 @@ pub fn build(
     let stiffness = RestStiffness::new(model)?;
     let context = StepContext {
         stiffness: &stiffness,
-        push_signs: push_signs(mesh, &surface, &patches.positions),
+        push_signs: normals
+            .iter()
+            .flat_map(|n| (0..3).map(|axis| inward_sign(n, axis)))
+            .collect(),
         patches: &patches,
         neighbours: &neighbours,
         settings,
@@ -432,27 +435,6 @@ fn step_of(field: &SeparatedField, local: LocalPart) -> Step {
             .collect(),
         local,
     }
-}
-
-/// Per parameter (position, axis), the sign of a force along the axis that points into the
-/// organ at the position, from the outward normals of the surface triangles around it.
-fn push_signs(mesh: &TetMesh, surface: &Surface, positions: &[usize]) -> Vec<f64> {
-    let mut outward = vec![Vector3::zeros(); mesh.node_count()];
-    for t in &surface.triangles {
-        let a = area_vector(mesh.nodes(), t);
-        t.iter().for_each(|&n| outward[n] += a);
-    }
-    positions
-        .iter()
-        .flat_map(|&n| (0..3).map(move |d| n * 3 + d))
-        .map(|dof| {
-            if outward[dof / 3][dof % 3] > 0.0 {
-                -1.0
-            } else {
-                1.0
-            }
-        })
-        .collect()
 }
 
 /// Per position, the largest diagonal entry of its self-compliance block (m/N).

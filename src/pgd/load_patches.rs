@@ -90,3 +90,10 @@ pub(super) fn parameter_load(
     loads.add_nodal_force(node, force_n)?;
     Ok(loads)
 }
+
+/// The sign of a force along `axis` that pushes into the organ at a position whose outward
+/// unit normal is `outward`: a nonlinear law answers a push and a pull differently, so the
+/// build's load steps and the brute-force baseline both push.
+pub(super) fn inward_sign(outward: &[f32; 3], axis: usize) -> f64 {
+    if outward[axis] > 0.0 { -1.0 } else { 1.0 }
+}
