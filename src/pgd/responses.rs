@@ -275,20 +275,23 @@ pub struct SecantSettings {
     pub tolerance: f64,
     pub max_iterations: usize,
     /// Differences remembered by each response's Anderson acceleration (0: plain iteration).
-    #[serde(default = "default_anderson_depth")]
+    /// A setting missing from a file's header reads as what files were built with before it
+    /// existed (here the plain iteration; undamped and no Newton below), so such a file is
+    /// seen as built otherwise than the current defaults would build it.
+    #[serde(default)]
     pub anderson_depth: usize,
     /// The fraction β of the fixed point's residual each step takes at first (1: paper 000's
     /// iteration), halved while the residual keeps growing. Under a stiffening law the full
     /// step overshoots: the elements under a nodal load are pressed so far on the first step
     /// that the exponential law's modulus explodes.
-    #[serde(default = "default_mixing")]
+    #[serde(default = "undamped")]
     pub mixing: f64,
     /// A step is kept while at most this fraction of its loads fail to converge; those keep
     /// the previous step's secant response (reported, never silent).
     pub max_unconverged_fraction: f64,
     /// When at most this fraction of a step's loads fail the fixed point, each of them is
     /// solved by Newton instead (a factorization per iteration, so only for a few).
-    #[serde(default = "default_max_newton_fraction")]
+    #[serde(default)]
     pub max_newton_fraction: f64,
 }
 
@@ -297,24 +300,17 @@ impl Default for SecantSettings {
         Self {
             tolerance: 1e-3,
             max_iterations: 40,
-            anderson_depth: default_anderson_depth(),
-            mixing: default_mixing(),
+            anderson_depth: 5,
+            mixing: 0.5,
             max_unconverged_fraction: 0.005,
-            max_newton_fraction: default_max_newton_fraction(),
+            max_newton_fraction: 0.03,
         }
     }
 }
 
-fn default_anderson_depth() -> usize {
-    5
-}
-
-fn default_mixing() -> f64 {
-    0.5
-}
-
-fn default_max_newton_fraction() -> f64 {
-    0.03
+/// The mixing of a file built before the setting existed: the full step.
+fn undamped() -> f64 {
+    1.0
 }
 
 /// How the fixed points of one load step went.

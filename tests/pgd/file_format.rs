@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use pgd_surgery::pgd::{BuildSettings, FORMAT_VERSION, VademecumError, load, save};
+use pgd_surgery::pgd::{BuildSettings, FORMAT_VERSION, SecantSettings, VademecumError, load, save};
 
 use crate::common::{block_mesh, block_model, build_block};
 
@@ -156,4 +156,21 @@ fn the_web_form_is_smaller_and_feels_the_same() {
         "web form {} bytes of {full}",
         web.len()
     );
+}
+
+/// A header written before the fixed point's Anderson acceleration, damping and Newton
+/// fallback existed reads them as what it was built with (the plain, undamped iteration, no
+/// Newton), not as today's defaults: such a file is seen as built otherwise, and rebuilt.
+#[test]
+fn settings_missing_from_an_older_header_read_as_what_it_was_built_with() {
+    let older = r#"{"tolerance": 0.001, "max_iterations": 40, "max_unconverged_fraction": 0.005}"#;
+    let read: SecantSettings = serde_json::from_str(older).unwrap();
+    assert_eq!(
+        (read.anderson_depth, read.mixing, read.max_newton_fraction),
+        (0, 1.0, 0.0)
+    );
+    assert_ne!(read, SecantSettings::default());
+    let current = serde_json::to_string(&SecantSettings::default()).unwrap();
+    let round_trip: SecantSettings = serde_json::from_str(&current).unwrap();
+    assert_eq!(round_trip, SecantSettings::default());
 }
