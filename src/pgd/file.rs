@@ -9,9 +9,10 @@ use super::container::{self, Kind, Reader, put};
 use super::error::VademecumError;
 use super::local::LocalPart;
 use super::region::RegionResponse;
+use super::responses::SecantSettings;
 use super::settings::BuildSettings;
 use super::vademecum::{Header, MAX_STEPS, Step, Vademecum};
-use crate::fem::{Inclusion, Material};
+use crate::fem::{Inclusion, Law, Material};
 use crate::mesh::TetMesh;
 
 /// Bumped on any change of layout or meaning; older files are refused, not misread.
@@ -103,17 +104,27 @@ impl Vademecum {
     }
 
     /// Refuses a vademecum built with other settings than `settings` (a tool tip of another
-    /// radius would feel another stiffness).
+    /// radius would feel another stiffness). A linear vademecum has no load steps, so the
+    /// load steps and their fixed point's settings do not count for it.
     pub fn check_settings(
         &self,
         file: &Path,
         settings: &BuildSettings,
     ) -> Result<(), VademecumError> {
-        if self.header.settings != *settings {
+        let law = self.header.material.law;
+        let relevant = |s: &BuildSettings| match law {
+            Law::Linear => BuildSettings {
+                load_steps_m: Vec::new(),
+                secant: SecantSettings::default(),
+                ..s.clone()
+            },
+            _ => s.clone(),
+        };
+        if relevant(&self.header.settings) != relevant(settings) {
             return Err(VademecumError::OtherSettings {
                 file: file.to_path_buf(),
-                expected: settings.summary(),
-                found: self.header.settings.summary(),
+                expected: settings.summary(law),
+                found: self.header.settings.summary(law),
             });
         }
         Ok(())

@@ -58,18 +58,28 @@ impl BuildSettings {
         }
     }
 
-    /// The settings a user chooses, in a line (for messages).
-    pub fn summary(&self) -> String {
-        format!(
-            "tool tip {:.1} mm, local radius {:.1} mm, target error {}, at most {} modes, load steps {:?} mm",
+    /// The settings a user chooses for a vademecum under `law`, in a line (for messages).
+    pub fn summary(&self, law: Law) -> String {
+        let common = format!(
+            "tool tip {:.1} mm, local radius {:.1} mm, target error {}, at most {} modes",
             self.tool_tip_radius_m * 1e3,
             self.local_radius_m * 1e3,
             self.target_error,
             self.pgd.max_modes,
+        );
+        if law == Law::Linear {
+            return common;
+        }
+        let secant = &self.secant;
+        format!(
+            "{common}, load steps {:?} mm, fixed point: mixing {}, Anderson depth {}, Newton for up to {} % of a step's loads",
             self.load_steps_m
                 .iter()
                 .map(|m| m * 1e3)
-                .collect::<Vec<_>>()
+                .collect::<Vec<_>>(),
+            secant.mixing,
+            secant.anderson_depth,
+            100.0 * secant.max_newton_fraction
         )
     }
 }

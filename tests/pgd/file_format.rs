@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+use pgd_surgery::fem::Law;
 use pgd_surgery::pgd::{BuildSettings, FORMAT_VERSION, SecantSettings, VademecumError, load, save};
 
 use crate::common::{block_mesh, block_model, build_block};
@@ -173,4 +174,29 @@ fn settings_missing_from_an_older_header_read_as_what_it_was_built_with() {
     let current = serde_json::to_string(&SecantSettings::default()).unwrap();
     let round_trip: SecantSettings = serde_json::from_str(&current).unwrap();
     assert_eq!(round_trip, SecantSettings::default());
+}
+
+/// The fixed point's settings count only for a vademecum built by load steps: a linear one
+/// built with other ones is taken, a neo-Hookean one is refused, its message naming them.
+#[test]
+fn fixed_point_settings_count_for_nonlinear_vademecums_only() {
+    let model = block_model(block_mesh([4, 3, 2]));
+    let linear = build_block(&model, 4);
+    let path = temp("fixed-point.vdm");
+    let damped_otherwise = BuildSettings {
+        secant: SecantSettings {
+            mixing: 0.25,
+            ..linear.header.settings.secant
+        },
+        load_steps_m: vec![2e-3],
+        ..linear.header.settings.clone()
+    };
+    linear.check_settings(&path, &damped_otherwise).unwrap();
+    let mut nonlinear = linear.clone();
+    nonlinear.header.material.law = Law::NeoHookean;
+    let err = nonlinear
+        .check_settings(&path, &damped_otherwise)
+        .unwrap_err();
+    assert!(matches!(err, VademecumError::OtherSettings { .. }), "{err}");
+    assert!(err.to_string().contains("mixing 0.25"), "{err}");
 }
