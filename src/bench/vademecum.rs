@@ -179,7 +179,7 @@ impl std::fmt::Display for VademecumBenchReport {
             writeln!(
                 f,
                 "build {:?}: {:.1} s (brute force {:.1} s, PGD {:.1} s, PGD/brute force {:.2}), \
-                 peak memory {}, modes per step {:?}, valid to {:.1} mm, {:.1} MB",
+                 peak memory {}, modes per step {:?}, steps to {:.1} mm, {:.1} MB",
                 b.law,
                 b.build_seconds,
                 b.brute_force_seconds,

@@ -208,8 +208,9 @@ impl Vademecum {
         (0..self.steps.len()).map(|s| self.modes(s)).sum()
     }
 
-    /// The deepest indentation (m) the load steps cover: beyond it a nonlinear vademecum is
-    /// extrapolated, and the trainer must keep the tool shallower.
+    /// The deepest load step's level (m): the depth one position's load makes alone. A press
+    /// stays within the range while every position of its patch does
+    /// ([`Self::patch_press_in_range`]), which can end at a shallower tool depth.
     pub fn valid_indentation_m(&self) -> f64 {
         self.header
             .indentation_levels_m
