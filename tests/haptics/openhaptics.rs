@@ -5,7 +5,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
-use pgd_surgery::app::haptic::{HapticLoop, HapticThread, Scheduling};
+use pgd_surgery::app::haptic::{FaultLog, HapticLoop, HapticThread, Scheduling};
 use pgd_surgery::devices::{HapticDevice, OpenHaptics, SafetySettings, TimerMode, WATCHDOG_S};
 
 use crate::common::{TIP_RADIUS_M, scene, target};
@@ -259,7 +259,7 @@ fn the_force_answers_the_stylus_through_the_real_schedule() {
         }
         latencies_ms.push(stepped.elapsed().as_secs_f64() * 1e3);
     }
-    let (report, _) = thread.stop();
+    let (report, haptic) = thread.stop();
     latencies_ms.sort_by(f64::total_cmp);
     let quantile = |q: f64| latencies_ms[((latencies_ms.len() - 1) as f64 * q).round() as usize];
     eprintln!(
@@ -270,5 +270,16 @@ fn the_force_answers_the_stylus_through_the_real_schedule() {
         latencies_ms.len(),
         report.compute.p99_us
     );
-    assert!(latencies_ms.iter().all(|&l| l < 200.0), "{latencies_ms:?}");
+    // Should a step go unanswered, the faults and the thread's timing say why.
+    let faults: Vec<String> = haptic
+        .world()
+        .resource::<FaultLog>()
+        .log
+        .iter()
+        .map(|(tick, fault)| format!("tick {tick}: {fault}"))
+        .collect();
+    assert!(
+        latencies_ms.iter().all(|&l| l < 200.0),
+        "{latencies_ms:?}\nfaults: {faults:?}\n{report:?}"
+    );
 }
