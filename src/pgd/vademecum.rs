@@ -66,7 +66,7 @@ pub struct SurfacePoint {
 /// load (summing to one), and the patch slot of every position, so that the pairs of a patch
 /// compliance are found by one lookup each. Reused from tick to tick, it allocates nothing
 /// once grown.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default)]
 pub struct Patch {
     pub shares: Vec<(usize, f64)>,
     slot_of: Vec<u32>,
@@ -81,7 +81,7 @@ pub const MAX_STEPS: usize = 64;
 /// row-major): the patch-averaged displacement per unit load on member `j`. A nonlinear press
 /// fills a step's columns the first time its secant iteration reaches that step, so every
 /// iteration after costs one pass over the members rather than one over their rows of blocks.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default)]
 struct StepColumns {
     /// Step-major: `columns[step * members + slot]`.
     columns: Vec<[f64; 9]>,
