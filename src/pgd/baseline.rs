@@ -36,8 +36,9 @@ pub struct NewtonBaseline {
 }
 
 /// Times `samples` Newton paths of `model` (the model `vademecum` was built for) at random load
-/// parameters (seeded by `seed`), each loaded as the build loads it at its deepest step: a
-/// nodal force, pushing into the organ, whose linear response is that step's depth. `None`
+/// parameters (seeded by `seed`), each loaded as the build loads it at its deepest step: the
+/// tool's patch centred on its position, pushing into the organ, whose linear response is
+/// that step's depth. `None`
 /// for a vademecum with one (linear) step.
 pub fn newton_baseline(
     model: &FemModel,
@@ -77,8 +78,9 @@ pub fn newton_baseline(
     }))
 }
 
-/// The nodal force of load parameter `p` whose linear response is `depth_m` deep, pushing
-/// into the organ (against the outward normal's component along the parameter's axis).
+/// The load of parameter `p` whose linear response is `depth_m` deep, pushing into the organ
+/// (against the outward normal's component along the parameter's axis): for a nonlinear
+/// vademecum, the tool's patch centred on the parameter's position, as its steps load it.
 fn nodal_load(
     model: &FemModel,
     vademecum: &Vademecum,
@@ -92,6 +94,9 @@ fn nodal_load(
         true => inward * depth_m / compliance_m_per_n,
         false => 0.0,
     };
-    let node = vademecum.positions[position] as usize;
-    parameter_load(model.mesh().node_count(), (node, axis), magnitude_n)
+    let shares = vademecum.patch_centred_on(position);
+    let nodal_shares = shares
+        .iter()
+        .map(|&(j, share)| (vademecum.positions[j] as usize, share));
+    parameter_load(model.mesh().node_count(), nodal_shares, axis, magnitude_n)
 }

@@ -4,10 +4,11 @@
 //! Every load step: the exact responses to every unit load are computed in blocks with the
 //! rest stiffness factorized once (they give the local part and the baseline), the global part
 //! is built by PGD enrichment, and the error estimator (the L2 error of the whole vademecum,
-//! exact here) picks the number of modes. The linear step is step 0; a Kirchhoff–Saint Venant
-//! material adds one step per indentation level, whose secant responses are found by the
-//! fixed point of paper 000 (nonlinear terms of the previous iterate on the right-hand side),
-//! starting from the step before.
+//! exact here) picks the number of modes. The linear step is step 0; a nonlinear law adds one
+//! step per indentation level, whose loads are the tool's patch centred on each position and
+//! whose secant responses are found by the fixed point of paper 000 (nonlinear terms of the
+//! previous iterate on the right-hand side), starting from the step before; the step keeps
+//! their correction to the linear response.
 
 use std::time::Instant;
 
@@ -17,18 +18,19 @@ use serde::Serialize;
 use super::baseline::NewtonBaseline;
 use super::enrichment::{ModeReport, enrich};
 use super::error_curve::{EnergyError, ErrorCurve, FieldError, optimal_errors};
-use super::load_patches::{LoadOperator, LoadPatches, inward_sign};
+use super::load_patches::{LoadOperator, LoadPatches, UnitLoads, inward_sign};
 use super::local::{LocalPart, distance_neighbours, near_nodes};
 use super::region::{CutHeader, RegionReport, RegionResponse, RegionSettings};
 use super::responses::{Responses, SecantLoads, SecantReport, Trend};
 use super::separated::SeparatedField;
 use super::settings::BuildSettings;
 use super::stiffness::RestStiffness;
-use super::vademecum::{Header, Step, Vademecum};
+use super::tool_patch::{PatchGeometry, ToolPatchLoads};
+use super::vademecum::{Header, Step, StepLoads, Vademecum};
 use super::{Progress, mesh_hash};
 use crate::fem::{FemError, FemModel, Law, PatchKernel, on_pressed_side};
 use crate::mesh::Surface;
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 /// What the model is, beyond its mesh: the names written into the header.
 pub struct OrganModel<'a> {
@@ -167,9 +169,16 @@ pub fn build(
     // Wide enough to couple any two nodes of one patch, and to find a patch's nodes from the
     // corners of the triangle it is centred in.
     let neighbours = distance_neighbours(&coords, 2.0 * radius_m + longest_edge_m);
+    let areas: Vec<f32> = patches.weights.iter().map(|&a| a as f32).collect();
     progress.message("factorizing the stiffness");
     let stiffness = RestStiffness::new(model)?;
     let context = StepContext {
+        geometry: PatchGeometry {
+            coords_m: &coords,
+            areas_m2: &areas,
+            normals: &normals,
+            radius_m,
+        },
         stiffness: &stiffness,
         push_signs: normals
             .iter()
@@ -180,7 +189,7 @@ pub fn build(
         settings,
         progress,
     };
-    let (steps, reports, failed_step) = load_steps(&context)?;
+    let (steps, reports, failed_step, reference) = load_steps(&context)?;
     let near_field_share = steps[0].local.correction_nodes.len() as f64
         / (patches.positions.len() * mesh.node_count()) as f64;
     if near_field_share > WIDE_NEAR_FIELD_SHARE {
@@ -204,6 +213,7 @@ pub fn build(
         load_directions: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         settings: settings.clone(),
         indentation_levels_m: reports.iter().map(|r| r.indentation_m).collect(),
+        step_loads: StepLoads::ToolPatch,
         modes_per_step: reports.iter().map(|r| r.modes_kept).collect(),
         convergence: reports.iter().map(|r| r.curve.clone()).collect(),
         build_seconds: started.elapsed().as_secs_f64(),
@@ -213,10 +223,10 @@ pub fn build(
         header,
         positions: patches.positions.iter().map(|&n| n as u32).collect(),
         position_coords_m: coords,
-        position_areas_m2: patches.weights.iter().map(|&a| a as f32).collect(),
+        position_areas_m2: areas,
         position_normals: normals,
         triangles,
-        reference_compliance_m_per_n: self_compliances(&steps[0].local),
+        reference_compliance_m_per_n: reference,
         steps,
         cuts: None,
     };
@@ -237,6 +247,8 @@ pub fn build(
 
 /// What every load step is built with.
 struct StepContext<'a> {
+    /// The load positions, for the tool's patch centred on each.
+    geometry: PatchGeometry<'a>,
     stiffness: &'a RestStiffness<'a>,
     /// Per parameter, the sign of a force along its axis that pushes into the organ.
     push_signs: Vec<f64>,
@@ -246,50 +258,59 @@ struct StepContext<'a> {
     progress: &'a dyn Progress,
 }
 
-/// The steps built, their reports, and the report of a step left out.
-type LoadSteps = (Vec<Step>, Vec<StepReport>, Option<StepReport>);
+/// The steps built, their reports, the report of a step left out, and per position the
+/// reference compliance that turns a force into the level picking load steps.
+type LoadSteps = (Vec<Step>, Vec<StepReport>, Option<StepReport>, Vec<f32>);
 
 /// The linear step, then (nonlinear laws) one step per indentation level until the last or
-/// the first whose fixed point fails.
+/// the first whose fixed point fails. A nonlinear step loads the tool's patch centred on each
+/// position, sized so that its linear response is the level deep, and keeps the nonlinear
+/// correction to the linear response of that patch: the trainer adds it to the exact linear
+/// response of the patch where the tool is.
 fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     let (stiffness, patches, progress) = (context.stiffness, context.patches, context.progress);
     let clock = Instant::now();
     progress.start("exact responses", patches.parameter_count() as u64);
-    let mut exact = Responses::linear(stiffness, patches, &|n| progress.advance(n as u64));
+    let exact = Responses::linear(stiffness, patches, &|n| progress.advance(n as u64));
     let gram = exact.gram(stiffness, patches);
     let (step, report) = separated_step(context, &exact, patches, gram, clock)?;
-    let reference: Vec<f32> = self_compliances(&step.local);
-    let (mut steps, mut reports) = (vec![step], vec![report]);
     if stiffness.model.material().law == Law::Linear {
-        return Ok((steps, reports, None));
+        let reference = self_compliances(&step.local);
+        return Ok((vec![step], vec![report], None, reference));
     }
+    let tool = ToolPatchLoads::new(
+        patches.positions.clone(),
+        &context.geometry,
+        context.neighbours,
+    );
+    let linear = exact.combined(&tool.shares);
+    drop(exact);
+    let compliances = patch_self_compliances(stiffness, &tool, &linear);
+    let reference = normal_references(&compliances, context.geometry.normals);
+    let (mut steps, mut reports) = (vec![step], vec![report]);
+    let mut secant = linear.clone();
     // The step before the last, and its level: with the last they give the next start's trend.
     let mut before: Option<(Responses, f64)> = None;
     let mut last_level_m = 0.0;
     for &level_m in &context.settings.load_steps_m {
         let clock = Instant::now();
-        // Each position's load is sized so that its linear response is `level_m` deep, and
+        // Each patch's load is sized so that its linear displacement is `level_m` long, and
         // pushes into the organ: a nonlinear law answers a push and a pull differently.
-        let magnitudes: Vec<f64> = reference
-            .iter()
-            .flat_map(|&c| [if c > 0.0 { level_m / c as f64 } else { 0.0 }; 3])
-            .zip(&context.push_signs)
-            .map(|(m, sign)| m * sign)
-            .collect();
+        let magnitudes = step_magnitudes(context, &compliances, level_m);
         let law = stiffness.model.material().law.name();
         progress.start(
             &format!("{law} step {:.1} mm", level_m * 1e3),
             patches.parameter_count() as u64,
         );
         let trend = before.take().map(|(responses, from_m)| {
-            Trend::new(&responses, &exact, (from_m, last_level_m, level_m))
+            Trend::new(&responses, &secant, (from_m, last_level_m, level_m))
         });
-        before = Some((exact.clone(), last_level_m));
+        before = Some((secant.clone(), last_level_m));
         last_level_m = level_m;
         let fixed_point;
-        (exact, fixed_point) = exact.secant(
+        (secant, fixed_point) = secant.secant(
             stiffness,
-            (patches, &magnitudes),
+            (&tool, &magnitudes),
             trend.as_ref(),
             &context.settings.secant,
             &|n| progress.advance(n as u64),
@@ -309,20 +330,83 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
                 fixed_point: Some(fixed_point),
                 ..StepReport::default()
             };
-            return Ok((steps, reports, Some(failed)));
+            return Ok((steps, reports, Some(failed), reference));
         }
-        let gram = exact.energy_gram(stiffness);
-        let loads = SecantLoads {
-            stiffness,
-            responses: &exact,
-        };
-        let (step, mut report) = separated_step(context, &exact, &loads, gram, clock)?;
+        // The step keeps the correction `Ũ − U_lin`, restored after.
+        secant.add_scaled(&linear, -1.0);
+        let built = correction_step(context, &secant, clock);
+        secant.add_scaled(&linear, 1.0);
+        let (step, mut report) = built?;
         report.indentation_m = level_m;
         report.fixed_point = Some(fixed_point);
         steps.push(step);
         reports.push(report);
     }
-    Ok((steps, reports, None))
+    Ok((steps, reports, None, reference))
+}
+
+/// A nonlinear step from its corrections `D = Ũ − U_lin`: separated with the right-hand side
+/// `K D` they answer.
+fn correction_step(
+    context: &StepContext,
+    corrections: &Responses,
+    clock: Instant,
+) -> Result<(Step, StepReport), FemError> {
+    let gram = corrections.energy_gram(context.stiffness);
+    let loads = SecantLoads {
+        stiffness: context.stiffness,
+        responses: corrections,
+    };
+    separated_step(context, corrections, &loads, gram, clock)
+}
+
+/// Per position, the linear self-compliance (m/N) of the patch centred on it, 3 × 3 (column
+/// `d`: the patch's displacement under a unit force along axis `d`).
+fn patch_self_compliances(
+    stiffness: &RestStiffness,
+    tool: &ToolPatchLoads,
+    linear: &Responses,
+) -> Vec<Matrix3<f64>> {
+    let free_index = &stiffness.model.dofs().free_index;
+    (0..tool.positions.len())
+        .map(|m| {
+            Matrix3::from_fn(|c, d| {
+                let column = linear.column(3 * m + d);
+                tool.nodal_shares(3 * m + d)
+                    .map(|(node, share)| match free_index[3 * node + c] {
+                        crate::fem::PRESCRIBED => 0.0,
+                        free => share * column[free],
+                    })
+                    .sum::<f64>()
+            })
+        })
+        .collect()
+}
+
+/// Per load parameter `3m + d`, the magnitude (N) of the force along axis `d` whose linear
+/// displacement under the patch centred on `m` is `level_m` long, pushing into the organ.
+fn step_magnitudes(context: &StepContext, compliances: &[Matrix3<f64>], level_m: f64) -> Vec<f64> {
+    compliances
+        .iter()
+        .flat_map(|c| {
+            [0, 1, 2].map(|d| match c.column(d).norm() {
+                per_n if per_n > 0.0 => level_m / per_n,
+                _ => 0.0,
+            })
+        })
+        .zip(&context.push_signs)
+        .map(|(magnitude, sign)| magnitude * sign)
+        .collect()
+}
+
+/// Per position, how deep (m) a unit force along its outward normal presses the patch
+/// centred on it: what turns a force into the level that picks a step.
+fn normal_references(compliances: &[Matrix3<f64>], normals: &[[f32; 3]]) -> Vec<f32> {
+    compliances
+        .iter()
+        .zip(normals)
+        .map(|(c, n)| (c * Vector3::from(n.map(f64::from))).norm() as f32)
+        .collect()
 }
 
 /// One load step from its exact responses: baseline, PGD global part, local part. `loads` is

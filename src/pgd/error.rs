@@ -27,6 +27,10 @@ pub enum VademecumError {
         found: u32,
         expected: u32,
     },
+    #[error(
+        "{file}: its nonlinear load steps are nodal loads, which this build no longer evaluates (it loads the tool's patch); rebuild it with `pgd build`"
+    )]
+    NodalLoadSteps { file: PathBuf },
     #[error("{file}: truncated: {found} bytes where the header announces {expected}")]
     Truncated {
         file: PathBuf,

@@ -11,7 +11,7 @@ use super::local::LocalPart;
 use super::region::RegionResponse;
 use super::responses::SecantSettings;
 use super::settings::BuildSettings;
-use super::vademecum::{Header, MAX_STEPS, Step, Vademecum};
+use super::vademecum::{Header, MAX_STEPS, Step, StepLoads, Vademecum};
 use crate::fem::{Inclusion, Law, Material};
 use crate::mesh::TetMesh;
 
@@ -304,6 +304,11 @@ fn validate(path: &Path, v: &Vademecum) -> Result<(), VademecumError> {
     }
     if v.steps.len() != v.header.indentation_levels_m.len() || v.steps.is_empty() {
         return fail("steps (their count differs from the header's load steps)");
+    }
+    if v.steps.len() > 1 && v.header.step_loads == StepLoads::Nodal {
+        return Err(VademecumError::NodalLoadSteps {
+            file: path.to_path_buf(),
+        });
     }
     if v.steps.len() > MAX_STEPS {
         return fail(&format!(

@@ -76,19 +76,35 @@ impl LoadOperator for LoadPatches {
     }
 }
 
-/// The nodal force of a load parameter at a magnitude: `magnitude_n` along `axis` at `node`,
-/// in a model of `node_count` nodes. What a load step applies to one parameter, and what a
-/// full Newton solve of that parameter is given.
+/// The nodal shares of each load parameter's unit force: what a nonlinear step applies to one
+/// parameter and what a full Newton solve of it is given.
+pub trait UnitLoads: Sync {
+    /// The volume nodes the unit force of parameter `p` acts on (along axis `p % 3`), with
+    /// the share each carries.
+    fn nodal_shares(&self, p: usize) -> impl Iterator<Item = (usize, f64)>;
+}
+
+impl UnitLoads for LoadPatches {
+    fn nodal_shares(&self, p: usize) -> impl Iterator<Item = (usize, f64)> {
+        std::iter::once((self.positions[p / 3], 1.0))
+    }
+}
+
+/// The nodal forces of a unit load's `nodal_shares` at a magnitude along `axis`, in a model of
+/// `node_count` nodes.
 pub(super) fn parameter_load(
     node_count: usize,
-    (node, axis): (usize, usize),
+    nodal_shares: impl Iterator<Item = (usize, f64)>,
+    axis: usize,
     magnitude_n: f64,
 ) -> Result<Loads, FemError> {
-    let mut force_n = [0.0; 3];
-    force_n[axis] = magnitude_n;
-    let mut loads = Loads::new(node_count);
-    loads.add_nodal_force(node, force_n)?;
-    Ok(loads)
+    let mut nodal = Loads::new(node_count);
+    for (node, share) in nodal_shares {
+        let mut force_n = [0.0; 3];
+        force_n[axis] = share * magnitude_n;
+        nodal.add_nodal_force(node, force_n)?;
+    }
+    Ok(nodal)
 }
 
 /// The sign of a force along `axis` that pushes into the organ at a position whose outward

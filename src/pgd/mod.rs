@@ -21,6 +21,7 @@ mod settings;
 mod statistics;
 mod stiffness;
 mod surface_modes;
+mod tool_patch;
 mod vademecum;
 mod validate;
 pub mod web_form;
@@ -43,7 +44,7 @@ pub use settings::{
 pub use statistics::Statistics;
 pub use stiffness::RestStiffness;
 pub use surface_modes::SurfaceModes;
-pub use vademecum::{Header, MAX_STEPS, Patch, Step, SurfacePoint, Vademecum};
+pub use vademecum::{Header, MAX_STEPS, Patch, Step, StepLoads, SurfacePoint, Vademecum};
 pub use validate::{ForceDepthCurve, Sample, ValidationReport, ValidationSettings, validate};
 
 use crate::mesh::TetMesh;

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::anderson::Anderson;
-use super::load_patches::{LoadOperator, LoadPatches, parameter_load};
+use super::load_patches::{LoadOperator, LoadPatches, UnitLoads, parameter_load};
 use super::stiffness::RestStiffness;
 use crate::fem::NewtonSettings;
 
@@ -62,6 +62,36 @@ impl Responses {
         Self { rows, columns }
     }
 
+    /// The responses to combinations of these responses' loads, one per entry of `shares`:
+    /// column `3m + d` is `Σ_j β_j u_{3j+d}` over the shares `(j, β_j)` of `shares[m]`. By
+    /// linearity, the linear responses to the tool's patch centred on each position.
+    pub fn combined(&self, shares: &[Vec<(usize, f64)>]) -> Self {
+        let rows = self.rows;
+        let mut columns = vec![0.0; rows * 3 * shares.len()];
+        columns
+            .par_chunks_mut(rows)
+            .enumerate()
+            .for_each(|(p, column)| {
+                for &(j, share) in &shares[p / 3] {
+                    let source = self.column(3 * j + p % 3);
+                    column
+                        .iter_mut()
+                        .zip(source)
+                        .for_each(|(c, u)| *c += share * u);
+                }
+            });
+        Self { rows, columns }
+    }
+
+    /// `self += sign · other`, column by column: a step's secant responses to and from their
+    /// nonlinear corrections.
+    pub fn add_scaled(&mut self, other: &Self, sign: f64) {
+        self.columns
+            .par_iter_mut()
+            .zip(&other.columns)
+            .for_each(|(a, b)| *a += sign * b);
+    }
+
     /// Turns linear (or previous-step) responses into the secant responses of a KSV load step:
     /// per unit force, the response to a force of `magnitudes_n[p]` along parameter `p`,
     /// `ũ = u / λ` with `K u = λ e_p − N(u)`. The nonlinear terms `N` of the previous iterate
@@ -71,7 +101,7 @@ impl Responses {
     pub fn secant(
         mut self,
         stiffness: &RestStiffness,
-        (patches, magnitudes_n): (&LoadPatches, &[f64]),
+        (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
         trend: Option<&Trend>,
         settings: &SecantSettings,
         progress: &(dyn Fn(usize) + Sync),
@@ -118,7 +148,7 @@ impl Responses {
     fn solve_by_newton(
         &mut self,
         stiffness: &RestStiffness,
-        (patches, magnitudes_n): (&LoadPatches, &[f64]),
+        (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
         parameters: &[usize],
     ) -> usize {
         let model = stiffness.model;
@@ -135,9 +165,9 @@ impl Responses {
                     .iter()
                     .map(|u| u * lambda)
                     .collect();
-                let node = patches.positions[p / 3];
+                let shares = patches.nodal_shares(p);
                 let loads =
-                    parameter_load(model.mesh().node_count(), (node, p % 3), lambda).ok()?;
+                    parameter_load(model.mesh().node_count(), shares, p % 3, lambda).ok()?;
                 // A start that turns an element inside out: a load path from rest instead.
                 let path = NewtonSettings {
                     load_steps: NEWTON_PATH_STEPS,
@@ -351,11 +381,14 @@ impl SecantReport {
     }
 }
 
-/// `column[free dof of parameter p] += 1`: the unit load of parameter `p`.
-fn add_unit_load(stiffness: &RestStiffness, patches: &LoadPatches, p: usize, column: &mut [f64]) {
-    let free = stiffness.model.dofs().free_index[3 * patches.positions[p / 3] + p % 3];
-    if free != crate::fem::PRESCRIBED {
-        column[free] += 1.0;
+/// Adds the unit load of parameter `p` to `column` (free dofs).
+fn add_unit_load(stiffness: &RestStiffness, loads: &impl UnitLoads, p: usize, column: &mut [f64]) {
+    let free_index = &stiffness.model.dofs().free_index;
+    for (node, share) in loads.nodal_shares(p) {
+        let free = free_index[3 * node + p % 3];
+        if free != crate::fem::PRESCRIBED {
+            column[free] += share;
+        }
     }
 }
 
@@ -365,7 +398,7 @@ fn add_unit_load(stiffness: &RestStiffness, patches: &LoadPatches, p: usize, col
 /// stiffness overshoots or crawls.
 fn secant_block(
     stiffness: &RestStiffness,
-    patches: &LoadPatches,
+    patches: &impl UnitLoads,
     (first, magnitudes_n): (usize, &[f64]),
     (chunk, trend): (&mut [f64], Option<&[f64]>),
     settings: &SecantSettings,

@@ -11,7 +11,8 @@ use super::error_curve::ErrorCurve;
 use super::local::LocalPart;
 use super::region::{CutHeader, RegionResponse};
 use super::settings::BuildSettings;
-use crate::fem::{Inclusion, Material, on_pressed_side, patch_weight};
+use super::tool_patch::PatchGeometry;
+use crate::fem::{Inclusion, Material};
 
 /// What the vademecum was built from and how: enough to refuse a stale file and to say how it
 /// was made.
@@ -36,6 +37,10 @@ pub struct Header {
     pub settings: BuildSettings,
     /// Per load step: the indentation (m) its loads make under the tool (0 for the linear step).
     pub indentation_levels_m: Vec<f64>,
+    /// What a nonlinear step's loads are (files from before the field: nodal loads, which
+    /// this version does not evaluate; such a file is refused and rebuilt).
+    #[serde(default)]
+    pub step_loads: StepLoads,
     pub modes_per_step: Vec<usize>,
     /// Per load step, the error against the number of modes (for the convergence plot).
     pub convergence: Vec<ErrorCurve>,
@@ -43,6 +48,17 @@ pub struct Header {
     /// The cut section's region and build (none in a vademecum built without cuts).
     #[serde(default)]
     pub cuts: Option<CutHeader>,
+}
+
+/// The load a nonlinear step answers at each position.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StepLoads {
+    /// A force on the position's node alone, the whole secant response kept.
+    #[default]
+    Nodal,
+    /// The tool's patch centred on the position, at the tool's own depth; the step keeps the
+    /// nonlinear correction to the linear response of that patch.
+    ToolPatch,
 }
 
 /// One load step's response per unit force: a separated global part plus the local part.
@@ -167,8 +183,9 @@ pub struct Vademecum {
     pub position_normals: Vec<[f32; 3]>,
     /// The accessible triangles, as position indices.
     pub triangles: Vec<[u32; 3]>,
-    /// Per position, the largest self-compliance of the linear step (m/N): turns a force into
-    /// the indentation level that selects load steps.
+    /// Per position, how deep (m/N) a unit force along its outward normal presses the tool's
+    /// patch centred on it, linearly (a linear vademecum: its largest nodal self-compliance):
+    /// turns a force into the indentation level that selects load steps.
     pub reference_compliance_m_per_n: Vec<f32>,
     /// Load steps in increasing indentation; one for a linear vademecum.
     pub steps: Vec<Step>,
@@ -208,9 +225,9 @@ impl Vademecum {
         (0..self.steps.len()).map(|s| self.modes(s)).sum()
     }
 
-    /// The deepest load step's level (m): the depth one position's load makes alone. A press
-    /// stays within the range while every position of its patch does
-    /// ([`Self::patch_press_in_range`]), which can end at a shallower tool depth.
+    /// The deepest load step's level (m): the linear depth of the tool's patch there. A press
+    /// stays within the range while its patch's level does
+    /// ([`Self::patch_press_in_range`]).
     pub fn valid_indentation_m(&self) -> f64 {
         self.header
             .indentation_levels_m
@@ -267,25 +284,16 @@ impl Vademecum {
     /// neighbours: they reach `2 r + longest edge` from it, and every position of the patch
     /// lies within `r + longest edge` of each corner.
     pub fn patch_into(&self, at: &SurfacePoint, patch: &mut Patch) {
-        let centre = self.point(at);
-        let radius_m = self.header.settings.tool_tip_radius_m;
         let local = &self.steps[0].local;
         let corners = self.triangles[at.triangle];
-        let facing = self.triangle_facing(at.triangle);
-        let weights = local.neighbours_of(corners[0] as usize).filter_map(|e| {
-            let m = local.neighbours[e] as usize;
-            let normal = Vector3::from(self.position_normals[m].map(f64::from));
-            if !on_pressed_side(&normal, &facing) {
-                return None;
-            }
-            let p = Vector3::from(self.position_coords_m[m].map(f64::from));
-            let w = patch_weight(
-                self.position_areas_m2[m] as f64,
-                (p - centre).norm(),
-                radius_m,
-            );
-            (w > 0.0).then_some((m, w))
-        });
+        let candidates = local
+            .neighbours_of(corners[0] as usize)
+            .map(|e| local.neighbours[e] as usize);
+        let weights = self.geometry().weights(
+            self.point(at),
+            self.triangle_facing(at.triangle),
+            candidates,
+        );
         patch.set(self.positions.len(), weights);
         let total: f64 = patch.shares.iter().map(|s| s.1).sum();
         if total > 0.0 {
@@ -296,8 +304,25 @@ impl Vademecum {
         }
     }
 
-    /// Weight of load step `step` for a nodal load whose linear response is `level_m` deep
-    /// ([`Self::blend`]).
+    /// The load positions as the tool's patch sees them.
+    fn geometry(&self) -> PatchGeometry<'_> {
+        PatchGeometry {
+            coords_m: &self.position_coords_m,
+            areas_m2: &self.position_areas_m2,
+            normals: &self.position_normals,
+            radius_m: self.header.settings.tool_tip_radius_m,
+        }
+    }
+
+    /// The shares of the tool's patch centred on position `m`: what a nonlinear step loaded
+    /// there.
+    pub fn patch_centred_on(&self, m: usize) -> Vec<(usize, f64)> {
+        let local = &self.steps[0].local;
+        let neighbours = &local.neighbours[local.neighbours_of(m)];
+        self.geometry().centred_on(m, neighbours)
+    }
+
+    /// Weight of load step `step` at a level `level_m` deep ([`Self::blend`]).
     fn step_weight(&self, step: usize, level_m: f64) -> f64 {
         let (first, last, t) = self.blend(level_m);
         if step == last {
@@ -309,9 +334,9 @@ impl Vademecum {
         }
     }
 
-    /// The two load steps a nodal load whose linear response is `level_m` deep blends, and the
-    /// second one's weight: piecewise linear between the steps' levels, held at the last step
-    /// beyond it (both steps the same, weight one, outside the levels).
+    /// The two load steps a level `level_m` deep blends, and the second one's weight:
+    /// piecewise linear between the steps' levels, held at the last step beyond it (both
+    /// steps the same, weight one, outside the levels).
     fn blend(&self, level_m: f64) -> (usize, usize, f64) {
         let (first, last) = self.steps_at(level_m);
         if first == last {
@@ -325,8 +350,8 @@ impl Vademecum {
         )
     }
 
-    /// The first and last steps [`Self::step_weight`] blends for a nodal load `level_m` deep
-    /// (the last step beyond the deepest level, or for a level that is not a number).
+    /// The first and last steps [`Self::step_weight`] blends at a level `level_m` deep (the
+    /// last step beyond the deepest level, or for a level that is not a number).
     fn steps_at(&self, level_m: f64) -> (usize, usize) {
         let levels = &self.header.indentation_levels_m;
         match levels.iter().position(|&l| l >= level_m) {
@@ -336,39 +361,35 @@ impl Vademecum {
         }
     }
 
-    /// The linear depth (m) of position `j`'s load, share `l` of a total force of
-    /// `force_norm_n`: what picks its load step.
-    fn nodal_level_m(&self, j: usize, l: f64, force_norm_n: f64) -> f64 {
-        l * force_norm_n * self.reference_compliance_m_per_n[j] as f64
+    /// The linear depth (m) of the tool's patch centred on position `j` under the whole force
+    /// `force_norm_n`: what picks the load steps of position `j`'s correction.
+    fn level_m(&self, j: usize, force_norm_n: f64) -> f64 {
+        force_norm_n * self.reference_compliance_m_per_n[j] as f64
     }
 
     /// The share of a total force `force_n` that position `j` (share `l` of the patch) carries
-    /// in load step `step`: each nodal load picks its own load step, as the secant responses
-    /// were built per nodal load.
+    /// in load step `step`. The linear step carries the whole share; a nonlinear step holds
+    /// the correction of the patch centred on `j`, at the level the whole force presses it,
+    /// and carries the share its blend gives it (the linear step's correction being none).
     pub(crate) fn step_share(&self, step: usize, j: usize, l: f64, force_n: &Vector3<f64>) -> f64 {
-        if self.steps.len() == 1 {
+        if step == 0 {
             return l;
         }
-        l * self.step_weight(step, self.nodal_level_m(j, l, force_n.norm()))
+        l * self.step_weight(step, self.level_m(j, force_n.norm()))
     }
 
-    /// The load steps the positions of `patch` blend under `force_n`: from the shallowest
-    /// load's first to the deepest load's last (a step in between that no load uses adds
+    /// The load steps the positions of `patch` use under `force_n`: the linear one and the
+    /// corrections up to the deepest position's (a step in between that no position uses adds
     /// nothing).
     fn loaded_steps(&self, patch: &Patch, force_n: &Vector3<f64>) -> RangeInclusive<usize> {
         let force_norm_n = force_n.norm();
-        let (shallowest, deepest) = patch
+        let deepest = patch
             .shares
             .iter()
-            .map(|&(j, l)| self.nodal_level_m(j, l, force_norm_n))
+            .map(|&(j, _)| self.level_m(j, force_norm_n))
             .map(|level| if level.is_nan() { f64::INFINITY } else { level })
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), level| {
-                (lo.min(level), hi.max(level))
-            });
-        if shallowest > deepest {
-            return 0..=0;
-        }
-        self.steps_at(shallowest).0..=self.steps_at(deepest).1
+            .fold(0.0, f64::max);
+        0..=self.steps_at(deepest).1
     }
 
     /// The 3 × 3 compliance (m/N) of load step `step` for `patch`: the patch-averaged
@@ -436,9 +457,8 @@ impl Vademecum {
         Matrix3::from_row_slice(&c)
     }
 
-    /// The compliance for a force `force_n` on `patch` (load steps blended). Each nodal load
-    /// sits between two steps, so only the steps the patch's loads reach are scanned: two or
-    /// three of a neo-Hookean vademecum's seven.
+    /// The compliance for a force `force_n` on `patch`: the linear step's plus the blended
+    /// corrections of the steps the patch's positions reach.
     pub fn compliance(&self, patch: &Patch, force_n: &Vector3<f64>) -> Matrix3<f64> {
         if self.steps.len() == 1 {
             return self.step_compliance(0, patch);
@@ -494,13 +514,11 @@ impl Vademecum {
     }
 
     /// [`Self::patch_press`] held within the load steps' range, and the share of
-    /// `indentation_m` it answers (one within the range). A step's level is the depth its nodal
-    /// loads would press alone, so a patch leaves the range when the load of any one of its
-    /// positions goes deeper than the last step, whatever the tool's own depth: where one
-    /// position carries most of the patch, sooner than the tool reaches the last level. There
-    /// the force is held at the magnitude that puts that position on the last step, along the
-    /// direction the blend's stiffness there gives (the blend depends on the force's magnitude
-    /// only), and answers that share of the indentation.
+    /// `indentation_m` it answers (one within the range). The patch's level is the
+    /// share-weighted level of the patches centred on its positions (close to the linear depth
+    /// of the tool's own patch); past the last step's the force is held at the magnitude that
+    /// puts the patch there, along the direction the blend's stiffness there gives (the blend
+    /// depends on the force's magnitude only), and answers that share of the indentation.
     pub fn patch_press_in_range(
         &self,
         patch: &mut Patch,
@@ -510,12 +528,12 @@ impl Vademecum {
         if self.steps.len() == 1 {
             return (force_n, stiffness, 1.0);
         }
-        let deepest_per_n = patch
+        let level_per_n: f64 = patch
             .shares
             .iter()
-            .map(|&(j, l)| self.nodal_level_m(j, l, 1.0))
-            .fold(0.0, f64::max);
-        let edge_n = self.valid_indentation_m() / deepest_per_n;
+            .map(|&(j, l)| l * self.level_m(j, 1.0))
+            .sum();
+        let edge_n = self.valid_indentation_m() / level_per_n;
         if force_n.norm().is_nan() || force_n.norm() <= edge_n {
             return (force_n, stiffness, 1.0);
         }
@@ -526,24 +544,27 @@ impl Vademecum {
         (unclamped_n * answered, stiffness, answered)
     }
 
-    /// [`Self::compliance`] from the patch's step columns, filling those of the steps its
-    /// loads reach under `force_n`.
+    /// [`Self::compliance`] from the patch's step columns, filling the linear step's and those
+    /// of the steps its positions reach under `force_n`.
     fn column_compliance(&self, patch: &mut Patch, force_n: &Vector3<f64>) -> Matrix3<f64> {
         let force_norm_n = force_n.norm();
-        let blend = |(j, l): (usize, f64)| self.blend(self.nodal_level_m(j, l, force_norm_n));
+        let blend = |j: usize| self.blend(self.level_m(j, force_norm_n));
+        patch.fill_columns(0, &self.steps[0].local);
         for slot in 0..patch.shares.len() {
-            let (first, last, _) = blend(patch.shares[slot]);
+            let (first, last, _) = blend(patch.shares[slot].0);
             patch.fill_columns(first, &self.steps[first].local);
             patch.fill_columns(last, &self.steps[last].local);
         }
         let mut c = [0.0f64; 9];
-        for (slot, &share) in patch.shares.iter().enumerate() {
-            let (first, last, t) = blend(share);
-            for (step, w) in [(first, share.1 * (1.0 - t)), (last, share.1 * t)] {
-                if w != 0.0 {
-                    for (ck, &bk) in c.iter_mut().zip(patch.column(step, slot)) {
-                        *ck += w * bk;
-                    }
+        for (slot, &(j, l)) in patch.shares.iter().enumerate() {
+            let (first, last, t) = blend(j);
+            let corrections = [(first, l * (1.0 - t)), (last, l * t)];
+            let used = corrections
+                .into_iter()
+                .filter(|&(step, w)| step != 0 && w != 0.0);
+            for (step, w) in std::iter::once((0, l)).chain(used) {
+                for (ck, &bk) in c.iter_mut().zip(patch.column(step, slot)) {
+                    *ck += w * bk;
                 }
             }
         }

@@ -4,7 +4,9 @@
 use std::path::PathBuf;
 
 use pgd_surgery::fem::Law;
-use pgd_surgery::pgd::{BuildSettings, FORMAT_VERSION, SecantSettings, VademecumError, load, save};
+use pgd_surgery::pgd::{
+    BuildSettings, FORMAT_VERSION, SecantSettings, StepLoads, VademecumError, load, save,
+};
 
 use crate::common::{block_mesh, block_model, build_block};
 
@@ -199,4 +201,45 @@ fn fixed_point_settings_count_for_nonlinear_vademecums_only() {
         .unwrap_err();
     assert!(matches!(err, VademecumError::OtherSettings { .. }), "{err}");
     assert!(err.to_string().contains("mixing 0.25"), "{err}");
+}
+
+/// A vademecum whose nonlinear steps were built from nodal loads (files from before the steps
+/// loaded the tool's patch, which read as nodal) is refused with a message that says to
+/// rebuild it; the same file with steps of the tool's patch loads, and a linear file of either
+/// kind, load.
+#[test]
+fn nonlinear_steps_of_nodal_loads_are_refused() {
+    let model = block_model(block_mesh([4, 3, 2]));
+    let linear = build_block(&model, 4);
+    let mut nonlinear = linear.clone();
+    nonlinear.header.material.law = Law::NeoHookean;
+    nonlinear.steps.push(linear.steps[0].clone());
+    nonlinear.header.indentation_levels_m.push(1e-3);
+    nonlinear
+        .header
+        .modes_per_step
+        .push(linear.header.modes_per_step[0]);
+    nonlinear
+        .header
+        .convergence
+        .push(linear.header.convergence[0].clone());
+    for (vademecum, name) in [(&linear, "linear"), (&nonlinear, "nonlinear")] {
+        for step_loads in [StepLoads::Nodal, StepLoads::ToolPatch] {
+            let mut file = vademecum.clone();
+            file.header.step_loads = step_loads;
+            let path = temp(&format!("{name}-{step_loads:?}.vdm"));
+            save(&path, &file).unwrap();
+            let loaded = load(&path);
+            if name == "nonlinear" && step_loads == StepLoads::Nodal {
+                let err = loaded.unwrap_err();
+                assert!(
+                    matches!(err, VademecumError::NodalLoadSteps { .. }),
+                    "{err}"
+                );
+                assert!(err.to_string().contains("rebuild it"), "{err}");
+            } else {
+                assert_eq!(loaded.unwrap().header.step_loads, step_loads);
+            }
+        }
+    }
 }
