@@ -306,12 +306,13 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
             Trend::new(&responses, &secant, (from_m, last_level_m, level_m))
         });
         before = Some((secant.clone(), last_level_m));
+        let last_level_before = last_level_m;
         last_level_m = level_m;
         let fixed_point;
         (secant, fixed_point) = secant.secant(
             stiffness,
             (&tool, &magnitudes),
-            trend.as_ref(),
+            (trend.as_ref(), last_level_before / level_m),
             &context.settings.secant,
             &|n| progress.advance(n as u64),
         );

@@ -82,6 +82,11 @@ pub trait UnitLoads: Sync {
     /// The volume nodes the unit force of parameter `p` acts on (along axis `p % 3`), with
     /// the share each carries.
     fn nodal_shares(&self, p: usize) -> impl Iterator<Item = (usize, f64)>;
+
+    /// The axis parameter `p`'s force is along.
+    fn axis(&self, p: usize) -> usize {
+        p % 3
+    }
 }
 
 impl UnitLoads for LoadPatches {

@@ -15,6 +15,26 @@ use crate::fem::NewtonSettings;
 /// Columns solved together: one pass over the factor serves them all.
 const BLOCK_COLUMNS: usize = 48;
 
+/// Smaller increments a load that diverged over its step's whole increment is taken through.
+const SUBSTEPS: usize = 4;
+
+/// Some of a step's loads, renumbered from zero: what the substeps of those that diverged
+/// iterate on together.
+struct Subset<'a, L> {
+    loads: &'a L,
+    parameters: &'a [usize],
+}
+
+impl<L: UnitLoads> UnitLoads for Subset<'_, L> {
+    fn nodal_shares(&self, j: usize) -> impl Iterator<Item = (usize, f64)> {
+        self.loads.nodal_shares(self.parameters[j])
+    }
+
+    fn axis(&self, j: usize) -> usize {
+        self.loads.axis(self.parameters[j])
+    }
+}
+
 /// Halvings of a fixed-point update allowed to keep every element's volume positive.
 const MAX_HALVINGS: usize = 20;
 
@@ -102,12 +122,12 @@ impl Responses {
         mut self,
         stiffness: &RestStiffness,
         (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
-        trend: Option<&Trend>,
+        (trend, fraction_before): (Option<&Trend>, f64),
         settings: &SecantSettings,
         progress: &(dyn Fn(usize) + Sync),
     ) -> (Self, SecantReport) {
         let rows = self.rows;
-        let (mut report, unconverged) = self
+        let (mut report, mut unconverged) = self
             .columns
             .par_chunks_mut(rows * BLOCK_COLUMNS)
             .enumerate()
@@ -131,6 +151,15 @@ impl Responses {
                     (a.merge(b), failed)
                 },
             );
+        let rescued = self.continue_in_substeps(
+            stiffness,
+            (patches, magnitudes_n),
+            (&unconverged, fraction_before),
+            settings,
+        );
+        report.substep_solved = rescued.len();
+        report.unconverged -= rescued.len();
+        unconverged.retain(|p| rescued.binary_search(p).is_err());
         let few =
             unconverged.len() as f64 <= settings.max_newton_fraction * report.responses as f64;
         if few && !unconverged.is_empty() {
@@ -139,6 +168,63 @@ impl Responses {
             report.unconverged -= solved;
         }
         (self, report)
+    }
+
+    /// Takes the loads `failed` (sorted) that diverged on the step's whole increment through
+    /// [`SUBSTEPS`] smaller ones, each fixed point started from the one before: from
+    /// `fraction_before` of the step's magnitude (the step before's level; those loads hold
+    /// its response) to the whole. The fixed point with the rest stiffness diverges where the
+    /// tangent has moved far from it over one increment; a shorter increment starts it nearer
+    /// its solution, for a few fixed points' cost where Newton would factorize the tangent at
+    /// every iteration. Returns the loads so solved (sorted); the others keep their start.
+    fn continue_in_substeps(
+        &mut self,
+        stiffness: &RestStiffness,
+        (loads, magnitudes_n): (&impl UnitLoads, &[f64]),
+        (failed, fraction_before): (&[usize], f64),
+        settings: &SecantSettings,
+    ) -> Vec<usize> {
+        let rows = self.rows;
+        let solved: Vec<(usize, Vec<f64>)> = failed
+            .par_chunks(BLOCK_COLUMNS)
+            .flat_map_iter(|parameters| {
+                let subset = Subset { loads, parameters };
+                let mut chunk: Vec<f64> = parameters
+                    .iter()
+                    .flat_map(|&p| self.column(p).iter().copied())
+                    .collect();
+                let mut alive = vec![true; parameters.len()];
+                for i in 1..=SUBSTEPS {
+                    let t = fraction_before + (1.0 - fraction_before) * i as f64 / SUBSTEPS as f64;
+                    let magnitudes: Vec<f64> = parameters
+                        .iter()
+                        .zip(&alive)
+                        .map(|(&p, &a)| if a { t * magnitudes_n[p] } else { 0.0 })
+                        .collect();
+                    let (_, diverged) = secant_block(
+                        stiffness,
+                        &subset,
+                        (0, &magnitudes),
+                        (&mut chunk, None),
+                        settings,
+                    );
+                    diverged.into_iter().for_each(|j| alive[j] = false);
+                }
+                let columns: Vec<Vec<f64>> =
+                    chunk.chunks_exact(rows).map(<[f64]>::to_vec).collect();
+                parameters
+                    .iter()
+                    .copied()
+                    .zip(columns)
+                    .zip(alive)
+                    .filter_map(|(solved, alive)| alive.then_some(solved))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        for (p, column) in &solved {
+            self.columns[p * rows..(p + 1) * rows].copy_from_slice(column);
+        }
+        solved.into_iter().map(|(p, _)| p).collect()
     }
 
     /// Solves the loads `parameters` by Newton, one full nonlinear solve each (in parallel),
@@ -166,8 +252,8 @@ impl Responses {
                     .map(|u| u * lambda)
                     .collect();
                 let shares = patches.nodal_shares(p);
-                let loads =
-                    parameter_load(model.mesh().node_count(), shares, p % 3, lambda).ok()?;
+                let axis = patches.axis(p);
+                let loads = parameter_load(model.mesh().node_count(), shares, axis, lambda).ok()?;
                 // A start that turns an element inside out: a load path from rest instead.
                 let path = NewtonSettings {
                     load_steps: NEWTON_PATH_STEPS,
@@ -353,6 +439,9 @@ pub struct SecantReport {
     /// the load step is beyond what the fixed point (and, usually, the KSV law) can carry.
     /// They keep their starting iterate, the previous step's secant response.
     pub unconverged: usize,
+    /// Responses that diverged over the step's whole increment and converged through smaller
+    /// ones (not counted as unconverged).
+    pub substep_solved: usize,
     /// Responses the fixed point left that Newton then solved (not counted as unconverged).
     pub newton_solved: usize,
     /// The largest final relative residual over all responses.
@@ -366,6 +455,7 @@ impl SecantReport {
             total_iterations: self.total_iterations + other.total_iterations,
             max_iterations: self.max_iterations.max(other.max_iterations),
             unconverged: self.unconverged + other.unconverged,
+            substep_solved: self.substep_solved + other.substep_solved,
             newton_solved: self.newton_solved + other.newton_solved,
             worst_change: self.worst_change.max(other.worst_change),
         }
@@ -384,8 +474,9 @@ impl SecantReport {
 /// Adds the unit load of parameter `p` to `column` (free dofs).
 fn add_unit_load(stiffness: &RestStiffness, loads: &impl UnitLoads, p: usize, column: &mut [f64]) {
     let free_index = &stiffness.model.dofs().free_index;
+    let axis = loads.axis(p);
     for (node, share) in loads.nodal_shares(p) {
-        let free = free_index[3 * node + p % 3];
+        let free = free_index[3 * node + axis];
         if free != crate::fem::PRESCRIBED {
             column[free] += share;
         }
