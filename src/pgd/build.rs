@@ -16,14 +16,15 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::baseline::NewtonBaseline;
-use super::enrichment::{ModeReport, enrich};
+use super::enrichment::enrich;
 use super::error_curve::{EnergyError, ErrorCurve, FieldError, optimal_errors};
 use super::load_patches::{LoadOperator, LoadPatches, UnitLoads, inward_sign};
 use super::local::{LocalPart, distance_neighbours, near_nodes};
 use super::region::{CutHeader, RegionReport, RegionResponse, RegionSettings};
-use super::responses::{Responses, SecantLoads, SecantReport, Trend};
+use super::responses::{Responses, SecantReport, Trend};
 use super::separated::SeparatedField;
 use super::settings::BuildSettings;
+use super::snapshot_modes::WeightedGram;
 use super::stiffness::RestStiffness;
 use super::tool_patch::{PatchGeometry, ToolPatchLoads};
 use super::vademecum::{Header, Step, StepLoads, Vademecum};
@@ -273,7 +274,13 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     progress.start("exact responses", patches.parameter_count() as u64);
     let exact = Responses::linear(stiffness, patches, &|n| progress.advance(n as u64));
     let gram = exact.gram(stiffness, patches);
-    let (step, report) = separated_step(context, &exact, patches, gram, clock)?;
+    let (step, report) = separated_step(
+        context,
+        &exact,
+        Separation::Enrichment(patches),
+        gram,
+        clock,
+    )?;
     if stiffness.model.material().law == Law::Linear {
         let reference = self_compliances(&step.local);
         return Ok((vec![step], vec![report], None, reference));
@@ -346,19 +353,14 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     Ok((steps, reports, None, reference))
 }
 
-/// A nonlinear step from its corrections `D = Ũ − U_lin`: separated with the right-hand side
-/// `K D` they answer.
+/// A nonlinear step from its corrections `D = Ũ − U_lin`, separated by their own best modes.
 fn correction_step(
     context: &StepContext,
     corrections: &Responses,
     clock: Instant,
 ) -> Result<(Step, StepReport), FemError> {
     let gram = corrections.energy_gram(context.stiffness);
-    let loads = SecantLoads {
-        stiffness: context.stiffness,
-        responses: corrections,
-    };
-    separated_step(context, corrections, &loads, gram, clock)
+    separated_step(context, corrections, Separation::Snapshots, gram, clock)
 }
 
 /// Per position, the linear self-compliance (m/N) of the patch centred on it, 3 × 3 (column
@@ -410,13 +412,22 @@ fn normal_references(compliances: &[Matrix3<f64>], normals: &[[f32; 3]]) -> Vec<
         .collect()
 }
 
-/// One load step from its exact responses: baseline, PGD global part, local part. `loads` is
-/// the step's right-hand side, `gram` its responses' energy Gram, `clock` started when its
-/// exact responses did.
+/// How a step's global part is separated from its exact responses.
+enum Separation<'a> {
+    /// Greedy PGD enrichment against the step's loads (the linear step: its loads are sparse
+    /// and a mode costs a few solves).
+    Enrichment(&'a (dyn LoadOperator + Sync)),
+    /// The responses' own best modes, from their Gram's eigenvectors (the nonlinear steps'
+    /// corrections, whose right-hand side `K D` is dense: see [`WeightedGram`]).
+    Snapshots,
+}
+
+/// One load step from its exact responses: baseline, global part, local part. `gram` is the
+/// responses' energy Gram, `clock` started when its exact responses did.
 fn separated_step(
     context: &StepContext,
     exact: &Responses,
-    loads: &(dyn LoadOperator + Sync),
+    separation: Separation,
     gram: Vec<f64>,
     clock: Instant,
 ) -> Result<(Step, StepReport), FemError> {
@@ -429,7 +440,22 @@ fn separated_step(
         ..
     } = *context;
     let weights = patches.parameter_weights();
-    let optimal = optimal_errors(&gram, &weights, settings.pgd.max_modes);
+    let max_modes = settings.pgd.max_modes;
+    let snapshots = match separation {
+        Separation::Snapshots => {
+            progress.message("modes of the corrections");
+            let eigen = WeightedGram::new(&gram, &weights, max_modes);
+            Some((
+                eigen.optimal_errors(max_modes),
+                eigen.modes(stiffness, exact, &gram),
+            ))
+        }
+        Separation::Enrichment(_) => None,
+    };
+    let optimal = match &snapshots {
+        Some((optimal, _)) => optimal.clone(),
+        None => optimal_errors(&gram, &weights, max_modes),
+    };
     let brute_force_seconds = clock.elapsed().as_secs_f64();
 
     let clock = Instant::now();
@@ -448,14 +474,39 @@ fn separated_step(
         .collect();
     drop(gram);
     let mut residual = exact.clone();
-    let (field, modes, mut curve) = separated_part(
-        stiffness,
-        loads,
-        (&weights, &self_compliance, &near),
-        &mut residual,
-        settings,
+    let mut estimator = ModeErrors {
+        energy: EnergyError::new(&weights, &self_compliance),
+        field: FieldError::new(stiffness, &residual, &weights, &near),
+        curve: ErrorCurve::default(),
+        target: settings.target_error,
         progress,
-    )?;
+    };
+    progress.start("PGD modes", max_modes as u64);
+    let (field, modes) = match (separation, snapshots) {
+        (Separation::Enrichment(loads), _) => enrich(
+            stiffness,
+            loads,
+            &weights,
+            &settings.pgd,
+            &mut |field, _| {
+                estimator.energy_error(field, stiffness, loads);
+                estimator.go_on(field, &mut residual)
+            },
+        )?,
+        (Separation::Snapshots, Some((optimal, all))) => {
+            let mut field = SeparatedField::default();
+            for (x, y) in all.spatial.into_iter().zip(all.parametric) {
+                field.push(x, y);
+                estimator.curve.separated.push(optimal[field.modes() - 1]);
+                if !estimator.go_on(&field, &mut residual) {
+                    break;
+                }
+            }
+            (field, Vec::new())
+        }
+        (Separation::Snapshots, None) => unreachable!("snapshot modes are computed above"),
+    };
+    let mut curve = estimator.curve;
     curve.optimal = optimal[..curve.separated.len().min(optimal.len())].to_vec();
     let pgd_seconds = clock.elapsed().as_secs_f64();
 
@@ -475,38 +526,45 @@ fn separated_step(
     Ok((step_of(&field, local), report))
 }
 
-/// PGD enrichment until the error estimator reaches the target or the cap. `residual` enters
-/// as the exact responses and leaves as what the separated sum misses.
-fn separated_part(
-    stiffness: &RestStiffness,
-    loads: &dyn LoadOperator,
-    (weights, self_compliance, near): (&[f64], &[f64], &[Vec<u32>]),
-    residual: &mut Responses,
-    settings: &BuildSettings,
-    progress: &dyn Progress,
-) -> Result<(SeparatedField, Vec<ModeReport>, ErrorCurve), FemError> {
-    progress.start("PGD modes", settings.pgd.max_modes as u64);
-    let mut energy = EnergyError::new(weights, self_compliance);
-    let estimator = FieldError::new(stiffness, residual, weights, near);
-    let mut curve = ErrorCurve::default();
-    let (field, modes) = enrich(stiffness, loads, weights, &settings.pgd, &mut |field, _| {
-        curve
-            .separated
-            .push(energy.add_mode(field, stiffness, loads));
+/// The error curve of a step's global part as modes are added, and when to stop adding them.
+struct ModeErrors<'a> {
+    energy: EnergyError,
+    field: FieldError<'a>,
+    curve: ErrorCurve,
+    target: f64,
+    progress: &'a dyn Progress,
+}
+
+impl ModeErrors<'_> {
+    /// Records the energy error of `field`'s newest mode (the enrichment's own estimate).
+    fn energy_error(
+        &mut self,
+        field: &SeparatedField,
+        stiffness: &RestStiffness,
+        loads: &dyn LoadOperator,
+    ) {
+        let error = self.energy.add_mode(field, stiffness, loads);
+        self.curve.separated.push(error);
+    }
+
+    /// Takes `field`'s newest mode out of `residual` (the exact responses less the modes so
+    /// far), records the field errors and says whether another mode is wanted.
+    fn go_on(&mut self, field: &SeparatedField, residual: &mut Responses) -> bool {
         let k = field.modes() - 1;
-        let errors = estimator.subtract_mode(residual, &field.spatial[k], &field.parametric[k]);
-        curve.field.push(errors.rms);
-        curve.field_p95.push(errors.p95);
-        progress.advance(1);
-        progress.message(&format!(
+        let errors = self
+            .field
+            .subtract_mode(residual, &field.spatial[k], &field.parametric[k]);
+        self.curve.field.push(errors.rms);
+        self.curve.field_p95.push(errors.p95);
+        self.progress.advance(1);
+        self.progress.message(&format!(
             "mode {}: error {:.2} % rms, {:.2} % p95 over the loads",
             field.modes(),
             100.0 * errors.rms,
             100.0 * errors.p95
         ));
-        errors.rms > settings.target_error
-    })?;
-    Ok((field, modes, curve))
+        errors.rms > self.target
+    }
 }
 
 fn step_of(field: &SeparatedField, local: LocalPart) -> Step {

@@ -82,15 +82,26 @@ impl EnergyError {
 
 /// Optimal relative errors for 1..=`max_modes` terms, from the Gram `G` (column-major).
 pub fn optimal_errors(gram: &[f64], weights: &[f64], max_modes: usize) -> Vec<f64> {
-    let n = weights.len();
-    let root: Vec<f64> = weights.iter().map(|w| w.sqrt()).collect();
-    let scaled = Mat::from_fn(n, n, |i, j| {
-        0.5 * (gram[j * n + i] + gram[i * n + j]) * root[i] * root[j]
-    });
-    let mut eigenvalues = scaled
+    let mut eigenvalues = weighted_gram(gram, weights)
         .self_adjoint_eigenvalues(Side::Lower)
         .expect("a symmetric matrix has real eigenvalues");
     eigenvalues.sort_by(|a, b| b.total_cmp(a));
+    tail_errors(&eigenvalues, max_modes)
+}
+
+/// `W^½ G W^½` for the Gram `G` (column-major), symmetrized: its eigenvalues are the energies
+/// of the best separated sum's terms.
+pub(super) fn weighted_gram(gram: &[f64], weights: &[f64]) -> Mat<f64> {
+    let n = weights.len();
+    let root: Vec<f64> = weights.iter().map(|w| w.sqrt()).collect();
+    Mat::from_fn(n, n, |i, j| {
+        0.5 * (gram[j * n + i] + gram[i * n + j]) * root[i] * root[j]
+    })
+}
+
+/// The relative error left by the first `1..=max_modes` of `eigenvalues` (decreasing): the
+/// square root of the share of the total they leave out.
+pub(super) fn tail_errors(eigenvalues: &[f64], max_modes: usize) -> Vec<f64> {
     let total: f64 = eigenvalues.iter().map(|l| l.max(0.0)).sum();
     let mut tail = total;
     eigenvalues

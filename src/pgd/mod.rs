@@ -18,6 +18,7 @@ mod region;
 mod responses;
 mod separated;
 mod settings;
+mod snapshot_modes;
 mod statistics;
 mod stiffness;
 mod surface_modes;
@@ -36,7 +37,7 @@ pub use file::{FORMAT_VERSION, decode, encode, load, read_header, save};
 pub use load_patches::{LoadOperator, LoadPatches};
 pub use local::LocalPart;
 pub use region::{CutHeader, RegionReport, RegionResponse, RegionSettings, SparseDofs};
-pub use responses::{Responses, SecantLoads, SecantReport, SecantSettings};
+pub use responses::{Responses, SecantReport, SecantSettings};
 pub use separated::SeparatedField;
 pub use settings::{
     BuildSettings, DEFAULT_LOAD_STEPS_M, NEO_HOOKEAN_STEPS_TOOL_RADII, default_load_steps_m,

@@ -3,7 +3,7 @@
 //! baseline computes, and what the vademecum's local part (compliances, near-field
 //! corrections) is cut from.
 
-use faer::{ColRef, MatRef};
+use faer::MatRef;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -301,49 +301,6 @@ impl Responses {
             loads.apply_transpose(&stiffness.extend(self.column(p)), out);
         });
         gram
-    }
-}
-
-/// The right-hand side of a KSV load step, per unit force: `B = K Ũ` for the step's secant
-/// responses `Ũ` (the unit loads minus the nonlinear terms, `F − N(λŨ)/λ`), applied through
-/// `Ũ` and the rest stiffness so that the dense `B` is never stored.
-pub struct SecantLoads<'a> {
-    pub stiffness: &'a RestStiffness<'a>,
-    pub responses: &'a Responses,
-}
-
-impl LoadOperator for SecantLoads<'_> {
-    fn parameter_count(&self) -> usize {
-        self.responses.count()
-    }
-
-    /// `Ũ s` is a dense product over every response (the whole `Ũ`, hundreds of MB, streamed
-    /// once): faer's GEMV, on all cores.
-    fn apply(&self, s: &[f64], out: &mut [f64]) {
-        let responses = self.responses;
-        let u_all = MatRef::from_column_major_slice(&responses.columns, responses.rows, s.len());
-        let u = u_all * ColRef::from_slice(s);
-        let u: Vec<f64> = u.iter().copied().collect();
-        let mut ku = vec![0.0; u.len()];
-        self.stiffness.mul(&u, &mut ku);
-        for (v, &d) in ku.iter().zip(&self.stiffness.model.dofs().free_dofs) {
-            out[d] += v;
-        }
-    }
-
-    fn apply_transpose(&self, r: &[f64], out: &mut [f64]) {
-        let r_free = self.stiffness.restrict(r);
-        let mut kr = vec![0.0; r_free.len()];
-        self.stiffness.mul(&r_free, &mut kr);
-        out.par_iter_mut().enumerate().for_each(|(p, o)| {
-            *o = self
-                .responses
-                .column(p)
-                .iter()
-                .zip(&kr)
-                .map(|(a, b)| a * b)
-                .sum();
-        });
     }
 }
 

@@ -326,3 +326,20 @@ fn the_newton_baseline_times_converged_paths_through_the_steps() {
             .is_none()
     );
 }
+
+/// A nonlinear step's global part is its corrections' own best modes: with as many modes as
+/// the step has loads, separated sum and near field give back every load's exact correction
+/// (the build's field error, each load relative to its own correction, below 1e-6).
+#[test]
+fn a_nonlinear_step_keeps_the_best_modes_of_its_corrections() {
+    let model = block_model_of(block_mesh([6, 4, 3]), Law::NeoHookean);
+    let all_modes = BuildSettings {
+        load_steps_m: vec![2.5e-3],
+        ..settings(1000, 1e-9)
+    };
+    let (_, report) = build(&organ(&model), &all_modes, &Silent).unwrap();
+    let curve = &report.steps[1].curve;
+    let last = *curve.field.last().unwrap();
+    eprintln!("{} modes: field error {last:.2e}", curve.field.len());
+    assert!(last < 1e-6, "{:?}", curve.field);
+}
