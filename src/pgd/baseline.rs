@@ -8,7 +8,9 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::Vademecum;
-use super::load_patches::{inward_sign, parameter_load};
+use nalgebra::Vector3;
+
+use super::load_patches::parameter_load;
 use crate::fem::{FemError, FemModel, Loads, NewtonSettings};
 
 /// Newton's residual tolerance for the baseline: tighter than the secant fixed point's change
@@ -29,14 +31,14 @@ pub struct NewtonBaseline {
     pub deepest_m: f64,
     /// Mean seconds of one Newton path.
     pub seconds_per_load: f64,
-    /// All load parameters of the vademecum.
+    /// The loads of each of the vademecum's nonlinear steps: one per position.
     pub loads: usize,
     /// `seconds_per_load × loads`: the brute-force build of the same responses.
     pub estimated_seconds: f64,
 }
 
 /// Times `samples` Newton paths of `model` (the model `vademecum` was built for) at random load
-/// parameters (seeded by `seed`), each loaded as the build loads it at its deepest step: the
+/// positions (seeded by `seed`), each loaded as the build loads it at its deepest step: the
 /// tool's patch centred on its position, pushing into the organ, whose linear response is
 /// that step's depth. `None`
 /// for a vademecum with one (linear) step.
@@ -56,7 +58,7 @@ pub fn newton_baseline(
         relative_tolerance: RELATIVE_TOLERANCE,
         ..NewtonSettings::default()
     };
-    let loads = 3 * vademecum.positions.len();
+    let loads = vademecum.positions.len();
     let mut rng = fastrand::Rng::with_seed(seed);
     let (mut seconds, mut failed) = (0.0, 0);
     for _ in 0..samples {
@@ -78,25 +80,24 @@ pub fn newton_baseline(
     }))
 }
 
-/// The load of parameter `p` whose linear response is `depth_m` deep, pushing into the organ
-/// (against the outward normal's component along the parameter's axis): for a nonlinear
-/// vademecum, the tool's patch centred on the parameter's position, as its steps load it.
+/// The load at position `m` whose linear response is `depth_m` deep, as a nonlinear
+/// vademecum's steps load it: the tool's patch centred on the position, pushing along its
+/// inward normal.
 fn nodal_load(
     model: &FemModel,
     vademecum: &Vademecum,
-    p: usize,
+    m: usize,
     depth_m: f64,
 ) -> Result<Loads, FemError> {
-    let (position, axis) = (p / 3, p % 3);
-    let compliance_m_per_n = f64::from(vademecum.reference_compliance_m_per_n[position]);
-    let inward = inward_sign(&vademecum.position_normals[position], axis);
+    let compliance_m_per_n = f64::from(vademecum.reference_compliance_m_per_n[m]);
     let magnitude_n = match compliance_m_per_n > 0.0 {
-        true => inward * depth_m / compliance_m_per_n,
+        true => depth_m / compliance_m_per_n,
         false => 0.0,
     };
-    let shares = vademecum.patch_centred_on(position);
+    let inward = -Vector3::from(vademecum.position_normals[m].map(f64::from)).normalize();
+    let shares = vademecum.patch_centred_on(m);
     let nodal_shares = shares
         .iter()
         .map(|&(j, share)| (vademecum.positions[j] as usize, share));
-    parameter_load(model.mesh().node_count(), nodal_shares, axis, magnitude_n)
+    parameter_load(model.mesh().node_count(), nodal_shares, inward, magnitude_n)
 }

@@ -18,8 +18,10 @@ use serde::Serialize;
 use super::baseline::NewtonBaseline;
 use super::enrichment::enrich;
 use super::error_curve::{EnergyError, ErrorCurve, FieldError, optimal_errors};
-use super::load_patches::{LoadOperator, LoadPatches, UnitLoads, inward_sign};
-use super::local::{LocalPart, distance_neighbours, near_nodes};
+use super::load_patches::{LoadOperator, LoadPatches, UnitLoads};
+use super::local::{
+    AlongDirections, LocalPart, ParameterResponses, distance_neighbours, near_nodes,
+};
 use super::region::{CutHeader, RegionReport, RegionResponse, RegionSettings};
 use super::responses::{Responses, SecantReport, Trend};
 use super::separated::SeparatedField;
@@ -31,7 +33,7 @@ use super::vademecum::{Header, Step, StepLoads, Vademecum};
 use super::{Progress, mesh_hash};
 use crate::fem::{FemError, FemModel, Law, PatchKernel, on_pressed_side};
 use crate::mesh::Surface;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 /// What the model is, beyond its mesh: the names written into the header.
 pub struct OrganModel<'a> {
@@ -181,10 +183,6 @@ pub fn build(
             radius_m,
         },
         stiffness: &stiffness,
-        push_signs: normals
-            .iter()
-            .flat_map(|n| (0..3).map(|axis| inward_sign(n, axis)))
-            .collect(),
         patches: &patches,
         neighbours: &neighbours,
         settings,
@@ -214,7 +212,7 @@ pub fn build(
         load_directions: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         settings: settings.clone(),
         indentation_levels_m: reports.iter().map(|r| r.indentation_m).collect(),
-        step_loads: StepLoads::ToolPatch,
+        step_loads: StepLoads::InwardToolPatch,
         modes_per_step: reports.iter().map(|r| r.modes_kept).collect(),
         convergence: reports.iter().map(|r| r.curve.clone()).collect(),
         build_seconds: started.elapsed().as_secs_f64(),
@@ -251,8 +249,6 @@ struct StepContext<'a> {
     /// The load positions, for the tool's patch centred on each.
     geometry: PatchGeometry<'a>,
     stiffness: &'a RestStiffness<'a>,
-    /// Per parameter, the sign of a force along its axis that pushes into the organ.
-    push_signs: Vec<f64>,
     patches: &'a LoadPatches,
     neighbours: &'a [Vec<u32>],
     settings: &'a BuildSettings,
@@ -265,9 +261,9 @@ type LoadSteps = (Vec<Step>, Vec<StepReport>, Option<StepReport>, Vec<f32>);
 
 /// The linear step, then (nonlinear laws) one step per indentation level until the last or
 /// the first whose fixed point fails. A nonlinear step loads the tool's patch centred on each
-/// position, sized so that its linear response is the level deep, and keeps the nonlinear
-/// correction to the linear response of that patch: the trainer adds it to the exact linear
-/// response of the patch where the tool is.
+/// position, pushing along its inward normal, sized so that its linear response is the level
+/// deep, and keeps the nonlinear correction to the linear response of that patch: the trainer
+/// adds it to the exact linear response of the patch where the tool is.
 fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     let (stiffness, patches, progress) = (context.stiffness, context.patches, context.progress);
     let clock = Instant::now();
@@ -290,10 +286,9 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         &context.geometry,
         context.neighbours,
     );
-    let linear = exact.combined(&tool.shares);
+    let linear = exact.combined(&tool.shares, &tool.inward);
     drop(exact);
-    let compliances = patch_self_compliances(stiffness, &tool, &linear);
-    let reference = normal_references(&compliances, context.geometry.normals);
+    let reference = patch_depths(stiffness, &tool, &linear);
     let (mut steps, mut reports) = (vec![step], vec![report]);
     let mut secant = linear.clone();
     // The step before the last, and its level: with the last they give the next start's trend.
@@ -301,13 +296,18 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     let mut last_level_m = 0.0;
     for &level_m in &context.settings.load_steps_m {
         let clock = Instant::now();
-        // Each patch's load is sized so that its linear displacement is `level_m` long, and
-        // pushes into the organ: a nonlinear law answers a push and a pull differently.
-        let magnitudes = step_magnitudes(context, &compliances, level_m);
+        // Each patch's push is sized so that its linear displacement is `level_m` long.
+        let magnitudes: Vec<f64> = reference
+            .iter()
+            .map(|&per_n| match per_n > 0.0 {
+                true => level_m / f64::from(per_n),
+                false => 0.0,
+            })
+            .collect();
         let law = stiffness.model.material().law.name();
         progress.start(
             &format!("{law} step {:.1} mm", level_m * 1e3),
-            patches.parameter_count() as u64,
+            tool.positions.len() as u64,
         );
         let trend = before.take().map(|(responses, from_m)| {
             Trend::new(&responses, &secant, (from_m, last_level_m, level_m))
@@ -342,7 +342,11 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         }
         // The step keeps the correction `Ũ − U_lin`, restored after.
         secant.add_scaled(&linear, -1.0);
-        let built = correction_step(context, &secant, clock);
+        let gram = secant.energy_gram(stiffness);
+        let separation = Separation::Snapshots {
+            directions: &tool.inward,
+        };
+        let built = separated_step(context, &secant, separation, gram, clock);
         secant.add_scaled(&linear, 1.0);
         let (step, mut report) = built?;
         report.indentation_m = level_m;
@@ -353,73 +357,52 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     Ok((steps, reports, None, reference))
 }
 
-/// A nonlinear step from its corrections `D = Ũ − U_lin`, separated by their own best modes.
-fn correction_step(
-    context: &StepContext,
-    corrections: &Responses,
-    clock: Instant,
-) -> Result<(Step, StepReport), FemError> {
-    let gram = corrections.energy_gram(context.stiffness);
-    separated_step(context, corrections, Separation::Snapshots, gram, clock)
-}
-
-/// Per position, the linear self-compliance (m/N) of the patch centred on it, 3 × 3 (column
-/// `d`: the patch's displacement under a unit force along axis `d`).
-fn patch_self_compliances(
-    stiffness: &RestStiffness,
-    tool: &ToolPatchLoads,
-    linear: &Responses,
-) -> Vec<Matrix3<f64>> {
+/// Per position, how deep (m) a unit force along its inward normal presses the patch centred
+/// on it, linearly (the patch's mean displacement, from the `linear` responses of `tool`'s
+/// loads): what turns a force into the level that picks a step.
+fn patch_depths(stiffness: &RestStiffness, tool: &ToolPatchLoads, linear: &Responses) -> Vec<f32> {
     let free_index = &stiffness.model.dofs().free_index;
     (0..tool.positions.len())
         .map(|m| {
-            Matrix3::from_fn(|c, d| {
-                let column = linear.column(3 * m + d);
-                tool.nodal_shares(3 * m + d)
+            let column = linear.column(m);
+            let depth = Vector3::from_fn(|c, _| {
+                tool.nodal_shares(m)
                     .map(|(node, share)| match free_index[3 * node + c] {
                         crate::fem::PRESCRIBED => 0.0,
                         free => share * column[free],
                     })
                     .sum::<f64>()
-            })
+            });
+            depth.norm() as f32
         })
-        .collect()
-}
-
-/// Per load parameter `3m + d`, the magnitude (N) of the force along axis `d` whose linear
-/// displacement under the patch centred on `m` is `level_m` long, pushing into the organ.
-fn step_magnitudes(context: &StepContext, compliances: &[Matrix3<f64>], level_m: f64) -> Vec<f64> {
-    compliances
-        .iter()
-        .flat_map(|c| {
-            [0, 1, 2].map(|d| match c.column(d).norm() {
-                per_n if per_n > 0.0 => level_m / per_n,
-                _ => 0.0,
-            })
-        })
-        .zip(&context.push_signs)
-        .map(|(magnitude, sign)| magnitude * sign)
-        .collect()
-}
-
-/// Per position, how deep (m) a unit force along its outward normal presses the patch
-/// centred on it: what turns a force into the level that picks a step.
-fn normal_references(compliances: &[Matrix3<f64>], normals: &[[f32; 3]]) -> Vec<f32> {
-    compliances
-        .iter()
-        .zip(normals)
-        .map(|(c, n)| (c * Vector3::from(n.map(f64::from))).norm() as f32)
         .collect()
 }
 
 /// How a step's global part is separated from its exact responses.
 enum Separation<'a> {
-    /// Greedy PGD enrichment against the step's loads (the linear step: its loads are sparse
-    /// and a mode costs a few solves).
+    /// Greedy PGD enrichment against the step's loads, one response per parameter (the
+    /// linear step: its loads are sparse and a mode costs a few solves).
     Enrichment(&'a (dyn LoadOperator + Sync)),
-    /// The responses' own best modes, from their Gram's eigenvectors (the nonlinear steps'
-    /// corrections, whose right-hand side `K D` is dense: see [`WeightedGram`]).
-    Snapshots,
+    /// The responses' own best modes, from their Gram's eigenvectors (see [`WeightedGram`]):
+    /// a nonlinear step's corrections, one per position along its direction, whose
+    /// right-hand side `K D` is dense.
+    Snapshots { directions: &'a [Vector3<f64>] },
+}
+
+impl Separation<'_> {
+    /// `responses` (in this separation's layout) by load parameter.
+    fn per_parameter<'r>(&self, responses: &'r Responses) -> Box<dyn ParameterResponses + 'r>
+    where
+        Self: 'r,
+    {
+        match *self {
+            Separation::Enrichment(_) => Box::new(responses),
+            Separation::Snapshots { directions } => Box::new(AlongDirections {
+                responses,
+                directions,
+            }),
+        }
+    }
 }
 
 /// One load step from its exact responses: baseline, global part, local part. `gram` is the
@@ -439,18 +422,16 @@ fn separated_step(
         progress,
         ..
     } = *context;
-    let weights = patches.parameter_weights();
     let max_modes = settings.pgd.max_modes;
-    let snapshots = match separation {
-        Separation::Snapshots => {
+    let (weights, snapshots) = match separation {
+        Separation::Snapshots { .. } => {
             progress.message("modes of the corrections");
+            let weights = patches.weights.clone();
             let eigen = WeightedGram::new(&gram, &weights, max_modes);
-            Some((
-                eigen.optimal_errors(max_modes),
-                eigen.modes(stiffness, exact, &gram),
-            ))
+            let modes = eigen.modes(stiffness, exact, &gram);
+            (weights, Some((eigen.optimal_errors(max_modes), modes)))
         }
-        Separation::Enrichment(_) => None,
+        Separation::Enrichment(_) => (patches.parameter_weights(), None),
     };
     let optimal = match &snapshots {
         Some((optimal, _)) => optimal.clone(),
@@ -460,7 +441,9 @@ fn separated_step(
 
     let clock = Instant::now();
     progress.message("local compliances");
-    let mut local = LocalPart::with_compliances(stiffness, patches, exact, neighbours);
+    let exact_per_parameter = separation.per_parameter(exact);
+    let mut local =
+        LocalPart::with_compliances(stiffness, patches, &*exact_per_parameter, neighbours);
     let near = near_nodes(
         stiffness.model.mesh(),
         &patches.positions,
@@ -482,18 +465,23 @@ fn separated_step(
         progress,
     };
     progress.start("PGD modes", max_modes as u64);
-    let (field, modes) = match (separation, snapshots) {
-        (Separation::Enrichment(loads), _) => enrich(
-            stiffness,
-            loads,
-            &weights,
-            &settings.pgd,
-            &mut |field, _| {
-                estimator.energy_error(field, stiffness, loads);
-                estimator.go_on(field, &mut residual)
-            },
-        )?,
-        (Separation::Snapshots, Some((optimal, all))) => {
+    let (field, modes) = match snapshots {
+        None => {
+            let Separation::Enrichment(loads) = separation else {
+                unreachable!("snapshot modes are computed above")
+            };
+            enrich(
+                stiffness,
+                loads,
+                &weights,
+                &settings.pgd,
+                &mut |field, _| {
+                    estimator.energy_error(field, stiffness, loads);
+                    estimator.go_on(field, &mut residual)
+                },
+            )?
+        }
+        Some((optimal, all)) => {
             let mut field = SeparatedField::default();
             for (x, y) in all.spatial.into_iter().zip(all.parametric) {
                 field.push(x, y);
@@ -504,14 +492,13 @@ fn separated_step(
             }
             (field, Vec::new())
         }
-        (Separation::Snapshots, None) => unreachable!("snapshot modes are computed above"),
     };
     let mut curve = estimator.curve;
     curve.optimal = optimal[..curve.separated.len().min(optimal.len())].to_vec();
     let pgd_seconds = clock.elapsed().as_secs_f64();
 
     let clock = Instant::now();
-    local.set_corrections(stiffness, &residual, &near);
+    local.set_corrections(stiffness, &*separation.per_parameter(&residual), &near);
     local_seconds += clock.elapsed().as_secs_f64();
     let report = StepReport {
         indentation_m: 0.0,
@@ -523,7 +510,31 @@ fn separated_step(
         local_seconds,
         fixed_point: None,
     };
+    let field = match separation {
+        Separation::Enrichment(_) => field,
+        Separation::Snapshots { directions } => per_axis(field, directions),
+    };
     Ok((step_of(&field, local), report))
+}
+
+/// Modes whose parametric part is per position along `directions`, turned into modes over the
+/// parameters `3m + d`: a unit force along axis `d` is answered by its component along the
+/// position's direction.
+fn per_axis(field: SeparatedField, directions: &[Vector3<f64>]) -> SeparatedField {
+    let parametric = field
+        .parametric
+        .iter()
+        .map(|y| {
+            y.iter()
+                .zip(directions)
+                .flat_map(|(v, w)| w.iter().map(move |c| v * c))
+                .collect()
+        })
+        .collect();
+    SeparatedField {
+        spatial: field.spatial,
+        parametric,
+    }
 }
 
 /// The error curve of a step's global part as modes are added, and when to stop adding them.

@@ -28,9 +28,12 @@ pub enum VademecumError {
         expected: u32,
     },
     #[error(
-        "{file}: its nonlinear load steps are nodal loads, which this build no longer evaluates (it loads the tool's patch); rebuild it with `pgd build`"
+        "{file}: its nonlinear load steps were built with {found:?} loads, where this version pushes the tool's patch along the inward normal; rebuild it with `pgd build`"
     )]
-    NodalLoadSteps { file: PathBuf },
+    OlderLoadSteps {
+        file: PathBuf,
+        found: super::StepLoads,
+    },
     #[error("{file}: truncated: {found} bytes where the header announces {expected}")]
     Truncated {
         file: PathBuf,

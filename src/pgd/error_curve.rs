@@ -205,7 +205,8 @@ impl<'a> FieldError<'a> {
                 let r = columns.column(p);
                 let mut sum = dot(r, r);
                 if far_only {
-                    for &node in &self.near[p / 3] {
+                    let per_position = columns.count() / self.near.len();
+                    for &node in &self.near[p / per_position] {
                         for c in 0..3 {
                             let free = self.free_index[3 * node as usize + c];
                             if free != crate::fem::PRESCRIBED {

@@ -305,9 +305,10 @@ fn validate(path: &Path, v: &Vademecum) -> Result<(), VademecumError> {
     if v.steps.len() != v.header.indentation_levels_m.len() || v.steps.is_empty() {
         return fail("steps (their count differs from the header's load steps)");
     }
-    if v.steps.len() > 1 && v.header.step_loads == StepLoads::Nodal {
-        return Err(VademecumError::NodalLoadSteps {
+    if v.steps.len() > 1 && v.header.step_loads != StepLoads::InwardToolPatch {
+        return Err(VademecumError::OlderLoadSteps {
             file: path.to_path_buf(),
+            found: v.header.step_loads,
         });
     }
     if v.steps.len() > MAX_STEPS {

@@ -7,6 +7,8 @@
 //! exactly at `s`, not for an interpolation of patches centred on nodes. The load matrix `F`
 //! (dofs × parameters) is never formed: it is applied, and transposed, node by node.
 
+use nalgebra::Vector3;
+
 use crate::fem::{FemError, Loads, PatchKernel};
 use crate::mesh::{NOT_ON_SURFACE, Surface};
 
@@ -79,13 +81,12 @@ impl LoadOperator for LoadPatches {
 /// The nodal shares of each load parameter's unit force: what a nonlinear step applies to one
 /// parameter and what a full Newton solve of it is given.
 pub trait UnitLoads: Sync {
-    /// The volume nodes the unit force of parameter `p` acts on (along axis `p % 3`), with
-    /// the share each carries.
+    /// The volume nodes the unit force of parameter `p` acts on, with the share each carries.
     fn nodal_shares(&self, p: usize) -> impl Iterator<Item = (usize, f64)>;
 
-    /// The axis parameter `p`'s force is along.
-    fn axis(&self, p: usize) -> usize {
-        p % 3
+    /// The unit vector parameter `p`'s force is along: axis `p % 3` unless said otherwise.
+    fn direction(&self, p: usize) -> Vector3<f64> {
+        Vector3::ith(p % 3, 1.0)
     }
 }
 
@@ -95,26 +96,18 @@ impl UnitLoads for LoadPatches {
     }
 }
 
-/// The nodal forces of a unit load's `nodal_shares` at a magnitude along `axis`, in a model of
-/// `node_count` nodes.
+/// The nodal forces of a unit load's `nodal_shares` at a magnitude along `direction`, in a
+/// model of `node_count` nodes.
 pub(super) fn parameter_load(
     node_count: usize,
     nodal_shares: impl Iterator<Item = (usize, f64)>,
-    axis: usize,
+    direction: Vector3<f64>,
     magnitude_n: f64,
 ) -> Result<Loads, FemError> {
     let mut nodal = Loads::new(node_count);
     for (node, share) in nodal_shares {
-        let mut force_n = [0.0; 3];
-        force_n[axis] = share * magnitude_n;
-        nodal.add_nodal_force(node, force_n)?;
+        let force_n = direction * (share * magnitude_n);
+        nodal.add_nodal_force(node, force_n.into())?;
     }
     Ok(nodal)
-}
-
-/// The sign of a force along `axis` that pushes into the organ at a position whose outward
-/// unit normal is `outward`: a nonlinear law answers a push and a pull differently, so the
-/// build's load steps and the brute-force baseline both push.
-pub(super) fn inward_sign(outward: &[f32; 3], axis: usize) -> f64 {
-    if outward[axis] > 0.0 { -1.0 } else { 1.0 }
 }

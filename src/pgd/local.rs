@@ -32,6 +32,33 @@ pub struct LocalPart {
     pub correction: Vec<f32>,
 }
 
+/// Responses by load parameter `3m + d` (a unit force along axis `d` at position `m`), free dof
+/// by free dof: what the local part is cut from.
+pub trait ParameterResponses {
+    fn entry(&self, p: usize, free: usize) -> f64;
+}
+
+impl ParameterResponses for &Responses {
+    fn entry(&self, p: usize, free: usize) -> f64 {
+        self.columns[p * self.rows + free]
+    }
+}
+
+/// Responses kept once per position, to a unit force along that position's own direction: a
+/// unit force along axis `d` is answered by its component along the direction, `w_d`, times
+/// that response (a nonlinear step's corrections, which answer the inward push alone).
+pub struct AlongDirections<'a> {
+    pub responses: &'a Responses,
+    pub directions: &'a [Vector3<f64>],
+}
+
+impl ParameterResponses for AlongDirections<'_> {
+    fn entry(&self, p: usize, free: usize) -> f64 {
+        let m = p / 3;
+        self.directions[m][p % 3] * self.responses.columns[m * self.responses.rows + free]
+    }
+}
+
 /// Per position, the positions within `radius_m` of it (itself first): every pair two
 /// patches can couple.
 pub fn distance_neighbours(coords: &[[f32; 3]], radius_m: f64) -> Vec<Vec<u32>> {
@@ -54,11 +81,11 @@ pub fn distance_neighbours(coords: &[[f32; 3]], radius_m: f64) -> Vec<Vec<u32>> 
 }
 
 impl LocalPart {
-    /// The compliance blocks, from the exact responses (one column per parameter).
+    /// The compliance blocks, from the exact responses.
     pub fn with_compliances(
         stiffness: &RestStiffness,
         patches: &LoadPatches,
-        responses: &Responses,
+        responses: &dyn ParameterResponses,
         neighbours: &[Vec<u32>],
     ) -> Self {
         let mut part = Self::default();
@@ -75,12 +102,11 @@ impl LocalPart {
         part
     }
 
-    /// Stores the residual of the separated sum (`residual`, one column per parameter) at each
-    /// position's near-field nodes.
+    /// Stores the residual of the separated sum at each position's near-field nodes.
     pub fn set_corrections(
         &mut self,
         stiffness: &RestStiffness,
-        residual: &Responses,
+        residual: &dyn ParameterResponses,
         near: &[Vec<u32>],
     ) {
         let free_index = &stiffness.model.dofs().free_index;
@@ -90,11 +116,10 @@ impl LocalPart {
         for (m, nodes) in near.iter().enumerate() {
             for &node in nodes {
                 for d in 0..3 {
-                    let r = residual.column(3 * m + d);
                     for c in 0..3 {
                         let value = match free_index[3 * node as usize + c] {
                             crate::fem::PRESCRIBED => 0.0,
-                            free => r[free],
+                            free => residual.entry(3 * m + d, free),
                         };
                         self.correction.push(value as f32);
                     }
@@ -174,7 +199,7 @@ pub fn near_nodes(mesh: &TetMesh, positions: &[usize], radius_m: f64) -> Vec<Vec
 fn compliance_block(
     stiffness: &RestStiffness,
     patches: &LoadPatches,
-    responses: &Responses,
+    responses: &dyn ParameterResponses,
     m: usize,
     j: usize,
 ) -> [f32; 9] {
@@ -182,11 +207,10 @@ fn compliance_block(
     let node = patches.positions[m];
     let mut block = [0.0f32; 9];
     for d in 0..3 {
-        let u = responses.column(3 * j + d);
         for c in 0..3 {
             block[c * 3 + d] = match free_index[3 * node + c] {
                 crate::fem::PRESCRIBED => 0.0,
-                free => u[free] as f32,
+                free => responses.entry(3 * j + d, free) as f32,
             };
         }
     }

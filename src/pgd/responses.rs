@@ -4,6 +4,7 @@
 //! corrections) is cut from.
 
 use faer::MatRef;
+use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -30,8 +31,8 @@ impl<L: UnitLoads> UnitLoads for Subset<'_, L> {
         self.loads.nodal_shares(self.parameters[j])
     }
 
-    fn axis(&self, j: usize) -> usize {
-        self.loads.axis(self.parameters[j])
+    fn direction(&self, j: usize) -> Vector3<f64> {
+        self.loads.direction(self.parameters[j])
     }
 }
 
@@ -82,22 +83,25 @@ impl Responses {
         Self { rows, columns }
     }
 
-    /// The responses to combinations of these responses' loads, one per entry of `shares`:
-    /// column `3m + d` is `Σ_j β_j u_{3j+d}` over the shares `(j, β_j)` of `shares[m]`. By
-    /// linearity, the linear responses to the tool's patch centred on each position.
-    pub fn combined(&self, shares: &[Vec<(usize, f64)>]) -> Self {
+    /// The responses to combinations of these responses' loads, one per entry of `shares`
+    /// and `directions`: column `m` is `Σ_j β_j Σ_d w_d u_{3j+d}` over the shares `(j, β_j)`
+    /// of `shares[m]` and the components `w_d` of `directions[m]`. By linearity, the linear
+    /// responses to the tool's patch centred on each position, pushed along its direction.
+    pub fn combined(&self, shares: &[Vec<(usize, f64)>], directions: &[Vector3<f64>]) -> Self {
         let rows = self.rows;
-        let mut columns = vec![0.0; rows * 3 * shares.len()];
+        let mut columns = vec![0.0; rows * shares.len()];
         columns
             .par_chunks_mut(rows)
             .enumerate()
-            .for_each(|(p, column)| {
-                for &(j, share) in &shares[p / 3] {
-                    let source = self.column(3 * j + p % 3);
-                    column
-                        .iter_mut()
-                        .zip(source)
-                        .for_each(|(c, u)| *c += share * u);
+            .for_each(|(m, column)| {
+                for &(j, share) in &shares[m] {
+                    for (d, w) in directions[m].iter().enumerate() {
+                        let source = self.column(3 * j + d);
+                        column
+                            .iter_mut()
+                            .zip(source)
+                            .for_each(|(c, u)| *c += share * w * u);
+                    }
                 }
             });
         Self { rows, columns }
@@ -252,8 +256,9 @@ impl Responses {
                     .map(|u| u * lambda)
                     .collect();
                 let shares = patches.nodal_shares(p);
-                let axis = patches.axis(p);
-                let loads = parameter_load(model.mesh().node_count(), shares, axis, lambda).ok()?;
+                let direction = patches.direction(p);
+                let loads =
+                    parameter_load(model.mesh().node_count(), shares, direction, lambda).ok()?;
                 // A start that turns an element inside out: a load path from rest instead.
                 let path = NewtonSettings {
                     load_steps: NEWTON_PATH_STEPS,
@@ -376,7 +381,7 @@ impl Default for SecantSettings {
             anderson_depth: 5,
             mixing: 0.5,
             max_unconverged_fraction: 0.005,
-            max_newton_fraction: 0.03,
+            max_newton_fraction: 0.06,
         }
     }
 }
@@ -431,11 +436,13 @@ impl SecantReport {
 /// Adds the unit load of parameter `p` to `column` (free dofs).
 fn add_unit_load(stiffness: &RestStiffness, loads: &impl UnitLoads, p: usize, column: &mut [f64]) {
     let free_index = &stiffness.model.dofs().free_index;
-    let axis = loads.axis(p);
+    let direction = loads.direction(p);
     for (node, share) in loads.nodal_shares(p) {
-        let free = free_index[3 * node + axis];
-        if free != crate::fem::PRESCRIBED {
-            column[free] += share;
+        for (c, component) in direction.iter().enumerate() {
+            let free = free_index[3 * node + c];
+            if free != crate::fem::PRESCRIBED {
+                column[free] += share * component;
+            }
         }
     }
 }

@@ -58,13 +58,17 @@ impl<'a> PatchGeometry<'a> {
     }
 }
 
-/// The loads of a nonlinear step: parameter `3m + d` is a unit force along axis `d` spread over
-/// the tool's patch centred on position `m`.
+/// The loads of a nonlinear step: load `m` is a unit force spread over the tool's patch centred
+/// on position `m`, pushing into the organ along its inward normal. A nonlinear law answers a
+/// push and a pull differently, and the tool, frictionless, presses along the surface's
+/// normal: the step answers that press, and a force's other components are answered linearly.
 pub struct ToolPatchLoads {
     /// The volume node of each position.
     pub positions: Vec<usize>,
     /// Per position, its patch's shares over positions.
     pub shares: Vec<Vec<(usize, f64)>>,
+    /// Per position, its inward unit normal.
+    pub inward: Vec<Vector3<f64>>,
 }
 
 impl ToolPatchLoads {
@@ -73,14 +77,27 @@ impl ToolPatchLoads {
         let shares = (0..positions.len())
             .map(|m| geometry.centred_on(m, &neighbours[m]))
             .collect();
-        Self { positions, shares }
+        let inward = geometry
+            .normals
+            .iter()
+            .map(|n| -Vector3::from(n.map(f64::from)).normalize())
+            .collect();
+        Self {
+            positions,
+            shares,
+            inward,
+        }
     }
 }
 
 impl UnitLoads for ToolPatchLoads {
-    fn nodal_shares(&self, p: usize) -> impl Iterator<Item = (usize, f64)> {
-        self.shares[p / 3]
+    fn nodal_shares(&self, m: usize) -> impl Iterator<Item = (usize, f64)> {
+        self.shares[m]
             .iter()
             .map(|&(j, share)| (self.positions[j], share))
+    }
+
+    fn direction(&self, m: usize) -> Vector3<f64> {
+        self.inward[m]
     }
 }

@@ -37,8 +37,9 @@ pub struct Header {
     pub settings: BuildSettings,
     /// Per load step: the indentation (m) its loads make under the tool (0 for the linear step).
     pub indentation_levels_m: Vec<f64>,
-    /// What a nonlinear step's loads are (files from before the field: nodal loads, which
-    /// this version does not evaluate; such a file is refused and rebuilt).
+    /// What a nonlinear step's loads are (files from before the field: nodal loads). A
+    /// nonlinear file whose steps were built otherwise than this version builds them is
+    /// refused and rebuilt.
     #[serde(default)]
     pub step_loads: StepLoads,
     pub modes_per_step: Vec<usize>,
@@ -56,9 +57,13 @@ pub enum StepLoads {
     /// A force on the position's node alone, the whole secant response kept.
     #[default]
     Nodal,
-    /// The tool's patch centred on the position, at the tool's own depth; the step keeps the
-    /// nonlinear correction to the linear response of that patch.
+    /// The tool's patch centred on the position, along each axis, at the tool's own depth;
+    /// the step keeps the nonlinear correction to the linear response of that patch.
     ToolPatch,
+    /// The tool's patch centred on the position, pushing along its inward normal, at the
+    /// tool's own depth; the step keeps the nonlinear correction to the linear response of
+    /// that patch, and a force's components answer to it by their share along the normal.
+    InwardToolPatch,
 }
 
 /// One load step's response per unit force: a separated global part plus the local part.

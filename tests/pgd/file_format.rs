@@ -204,11 +204,11 @@ fn fixed_point_settings_count_for_nonlinear_vademecums_only() {
 }
 
 /// A vademecum whose nonlinear steps were built from nodal loads (files from before the steps
-/// loaded the tool's patch, which read as nodal) is refused with a message that says to
-/// rebuild it; the same file with steps of the tool's patch loads, and a linear file of either
-/// kind, load.
+/// loaded the tool's patch, which read as nodal) or from the tool's patch along each axis is
+/// refused with a message that says to rebuild it; the same file with steps of the tool's
+/// patch pushed along the inward normal, and a linear file of any kind, load.
 #[test]
-fn nonlinear_steps_of_nodal_loads_are_refused() {
+fn nonlinear_steps_built_otherwise_are_refused() {
     let model = block_model(block_mesh([4, 3, 2]));
     let linear = build_block(&model, 4);
     let mut nonlinear = linear.clone();
@@ -224,16 +224,20 @@ fn nonlinear_steps_of_nodal_loads_are_refused() {
         .convergence
         .push(linear.header.convergence[0].clone());
     for (vademecum, name) in [(&linear, "linear"), (&nonlinear, "nonlinear")] {
-        for step_loads in [StepLoads::Nodal, StepLoads::ToolPatch] {
+        for step_loads in [
+            StepLoads::Nodal,
+            StepLoads::ToolPatch,
+            StepLoads::InwardToolPatch,
+        ] {
             let mut file = vademecum.clone();
             file.header.step_loads = step_loads;
             let path = temp(&format!("{name}-{step_loads:?}.vdm"));
             save(&path, &file).unwrap();
             let loaded = load(&path);
-            if name == "nonlinear" && step_loads == StepLoads::Nodal {
+            if name == "nonlinear" && step_loads != StepLoads::InwardToolPatch {
                 let err = loaded.unwrap_err();
                 assert!(
-                    matches!(err, VademecumError::NodalLoadSteps { .. }),
+                    matches!(err, VademecumError::OlderLoadSteps { .. }),
                     "{err}"
                 );
                 assert!(err.to_string().contains("rebuild it"), "{err}");
