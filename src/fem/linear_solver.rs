@@ -15,6 +15,9 @@ use super::pattern::FreePattern;
 pub struct DirectSolver {
     llt: SymbolicLlt<usize>,
     lu: Option<SymbolicLu<usize>>,
+    /// Cholesky failed on an earlier matrix: the next ones of the same solve, as far from
+    /// rest, go to LU at once rather than pay for a failing Cholesky first.
+    indefinite: bool,
 }
 
 /// A numeric factorization ready to solve.
@@ -29,7 +32,11 @@ impl DirectSolver {
     pub fn new(pattern: &FreePattern) -> Result<Self, FemError> {
         let llt = SymbolicLlt::try_new(pattern.symbolic().as_ref(), Side::Lower)
             .map_err(|e| FemError::Factorization(format!("{e:?}")))?;
-        Ok(Self { llt, lu: None })
+        Ok(Self {
+            llt,
+            lu: None,
+            indefinite: false,
+        })
     }
 
     /// Cholesky factorization; fails with [`FemError::NotPositiveDefinite`] on a singular or
@@ -42,13 +49,20 @@ impl DirectSolver {
         }
     }
 
-    /// Cholesky when the matrix allows it, LU otherwise (Newton tangents past a limit point).
+    /// Cholesky when the matrix allows it, LU otherwise (Newton tangents past a limit point),
+    /// and LU from then on.
     pub fn cholesky_or_lu(
         &mut self,
         matrix: &SparseColMat<usize, f64>,
     ) -> Result<Factorization, FemError> {
+        if self.indefinite {
+            return self.lu(matrix);
+        }
         match self.cholesky(matrix) {
-            Err(FemError::NotPositiveDefinite) => self.lu(matrix),
+            Err(FemError::NotPositiveDefinite) => {
+                self.indefinite = true;
+                self.lu(matrix)
+            }
             other => other,
         }
     }

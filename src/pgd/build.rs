@@ -324,6 +324,17 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
             &|n| progress.advance(n as u64),
         );
         drop(trend); // a full copy of the responses: freed before the step's PGD
+        progress.message(&format!(
+            "{law} step {:.1} mm: {} loads, {:.1} fixed-point iterations each on average, \
+             {} through substeps, {} by Newton, {} left ({:.0} s)",
+            level_m * 1e3,
+            fixed_point.responses,
+            fixed_point.mean_iterations(),
+            fixed_point.substep_solved,
+            fixed_point.newton_solved,
+            fixed_point.unconverged,
+            clock.elapsed().as_secs_f64()
+        ));
         if !fixed_point.acceptable(&context.settings.secant) {
             progress.message(&format!(
                 "{law} step {:.1} mm: the fixed point did not converge for {} of {} loads; \
