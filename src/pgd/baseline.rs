@@ -8,9 +8,8 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::Vademecum;
-use nalgebra::Vector3;
-
 use super::load_patches::parameter_load;
+use super::tool_patch::inward_normal;
 use crate::fem::{FemError, FemModel, Loads, NewtonSettings};
 
 /// Newton's residual tolerance for the baseline: tighter than the secant fixed point's change
@@ -94,7 +93,7 @@ fn nodal_load(
         true => depth_m / compliance_m_per_n,
         false => 0.0,
     };
-    let inward = -Vector3::from(vademecum.position_normals[m].map(f64::from)).normalize();
+    let inward = inward_normal(&vademecum.position_normals[m]);
     let shares = vademecum.patch_centred_on(m);
     let nodal_shares = shares
         .iter()

@@ -26,7 +26,7 @@ use super::region::{CutHeader, RegionReport, RegionResponse, RegionSettings};
 use super::responses::{Responses, SecantReport, Trend};
 use super::separated::SeparatedField;
 use super::settings::BuildSettings;
-use super::snapshot_modes::WeightedGram;
+use super::snapshot_modes::SnapshotModes;
 use super::stiffness::RestStiffness;
 use super::tool_patch::{PatchGeometry, ToolPatchLoads};
 use super::vademecum::{Header, Step, StepLoads, Vademecum};
@@ -354,8 +354,12 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         // The step keeps the correction `Ũ − U_lin`, restored after.
         secant.add_scaled(&linear, -1.0);
         let gram = secant.energy_gram(stiffness);
+        progress.message("modes of the corrections");
+        let weights = (&gram[..], &patches.weights[..]);
+        let best = SnapshotModes::new(stiffness, &secant, weights, context.settings.pgd.max_modes);
         let separation = Separation::Snapshots {
             directions: &tool.inward,
+            best,
         };
         let built = separated_step(context, &secant, separation, gram, clock);
         secant.add_scaled(&linear, 1.0);
@@ -394,10 +398,13 @@ enum Separation<'a> {
     /// Greedy PGD enrichment against the step's loads, one response per parameter (the
     /// linear step: its loads are sparse and a mode costs a few solves).
     Enrichment(&'a (dyn LoadOperator + Sync)),
-    /// The responses' own best modes, from their Gram's eigenvectors (see [`WeightedGram`]):
+    /// The responses' own best modes, from their Gram's eigenvectors (see [`SnapshotModes`]):
     /// a nonlinear step's corrections, one per position along its direction, whose
     /// right-hand side `K D` is dense.
-    Snapshots { directions: &'a [Vector3<f64>] },
+    Snapshots {
+        directions: &'a [Vector3<f64>],
+        best: SnapshotModes,
+    },
 }
 
 impl Separation<'_> {
@@ -408,7 +415,7 @@ impl Separation<'_> {
     {
         match *self {
             Separation::Enrichment(_) => Box::new(responses),
-            Separation::Snapshots { directions } => Box::new(AlongDirections {
+            Separation::Snapshots { directions, .. } => Box::new(AlongDirections {
                 responses,
                 directions,
             }),
@@ -434,19 +441,13 @@ fn separated_step(
         ..
     } = *context;
     let max_modes = settings.pgd.max_modes;
-    let (weights, snapshots) = match separation {
-        Separation::Snapshots { .. } => {
-            progress.message("modes of the corrections");
-            let weights = patches.weights.clone();
-            let eigen = WeightedGram::new(&gram, &weights, max_modes);
-            let modes = eigen.modes(stiffness, exact, &gram);
-            (weights, Some((eigen.optimal_errors(max_modes), modes)))
+    let (weights, optimal) = match &separation {
+        Separation::Enrichment(_) => {
+            let weights = patches.parameter_weights();
+            let optimal = optimal_errors(&gram, &weights, max_modes);
+            (weights, optimal)
         }
-        Separation::Enrichment(_) => (patches.parameter_weights(), None),
-    };
-    let optimal = match &snapshots {
-        Some((optimal, _)) => optimal.clone(),
-        None => optimal_errors(&gram, &weights, max_modes),
+        Separation::Snapshots { best, .. } => (patches.weights.clone(), best.optimal.clone()),
     };
     let brute_force_seconds = clock.elapsed().as_secs_f64();
 
@@ -476,26 +477,21 @@ fn separated_step(
         progress,
     };
     progress.start("PGD modes", max_modes as u64);
-    let (field, modes) = match snapshots {
-        None => {
-            let Separation::Enrichment(loads) = separation else {
-                unreachable!("snapshot modes are computed above")
-            };
-            enrich(
-                stiffness,
-                loads,
-                &weights,
-                &settings.pgd,
-                &mut |field, _| {
-                    estimator.energy_error(field, stiffness, loads);
-                    estimator.go_on(field, &mut residual)
-                },
-            )?
-        }
-        Some((optimal, all)) => {
+    let (field, modes) = match &separation {
+        Separation::Enrichment(loads) => enrich(
+            stiffness,
+            *loads,
+            &weights,
+            &settings.pgd,
+            &mut |field, _| {
+                estimator.energy_error(field, stiffness, *loads);
+                estimator.go_on(field, &mut residual)
+            },
+        )?,
+        Separation::Snapshots { best, .. } => {
             let mut field = SeparatedField::default();
-            for (x, y) in all.spatial.into_iter().zip(all.parametric) {
-                field.push(x, y);
+            for (x, y) in best.field.spatial.iter().zip(&best.field.parametric) {
+                field.push(x.clone(), y.clone());
                 estimator.curve.separated.push(optimal[field.modes() - 1]);
                 if !estimator.go_on(&field, &mut residual) {
                     break;
@@ -523,7 +519,7 @@ fn separated_step(
     };
     let field = match separation {
         Separation::Enrichment(_) => field,
-        Separation::Snapshots { directions } => per_axis(field, directions),
+        Separation::Snapshots { directions, .. } => per_axis(field, directions),
     };
     Ok((step_of(&field, local), report))
 }

@@ -77,11 +77,7 @@ impl ToolPatchLoads {
         let shares = (0..positions.len())
             .map(|m| geometry.centred_on(m, &neighbours[m]))
             .collect();
-        let inward = geometry
-            .normals
-            .iter()
-            .map(|n| -Vector3::from(n.map(f64::from)).normalize())
-            .collect();
+        let inward = geometry.normals.iter().map(inward_normal).collect();
         Self {
             positions,
             shares,
@@ -100,4 +96,10 @@ impl UnitLoads for ToolPatchLoads {
     fn direction(&self, m: usize) -> Vector3<f64> {
         self.inward[m]
     }
+}
+
+/// The inward unit normal of a position whose outward normal is `outward`: the direction a
+/// nonlinear step pushes it along.
+pub(super) fn inward_normal(outward: &[f32; 3]) -> Vector3<f64> {
+    -Vector3::from(outward.map(f64::from)).normalize()
 }
