@@ -161,12 +161,25 @@ fn print_newton_baseline(baseline: &pgd::NewtonBaseline, build_seconds: f64) {
 fn print_fixed_point(report: &pgd::SecantReport) {
     println!(
         "  secant fixed point: {:.1} iterations per load on average, at most {}; \
-         {} loads solved by Newton instead, {} of {} unconverged (largest last residual {:.1e})",
+         {} loads solved through smaller increments, {} by Newton instead, {} of {} \
+         unconverged (largest last residual {:.1e})",
         report.mean_iterations(),
         report.max_iterations,
+        report.substep_solved,
         report.newton_solved,
         report.unconverged,
         report.responses,
         report.worst_change
     );
+    let solves = &report.newton_solves;
+    if report.newton_solved > 0 {
+        println!(
+            "  Newton: {:.1} s; {} directions by preconditioned conjugate gradients \
+             ({:.0} iterations each), {} tangents factorized",
+            report.newton_seconds,
+            solves.directions,
+            solves.iterations_per_direction(),
+            solves.factorizations
+        );
+    }
 }

@@ -14,8 +14,8 @@
 
 use nalgebra::{Matrix3, Point3, Vector3};
 
-use super::linear_solver::DirectSolver;
 use super::newton::ExtraForce;
+use super::tangent_solver::TangentSolver;
 use super::{FemError, FemModel, NewtonSettings};
 
 /// A rigid sphere pressed into a body along a straight line.
@@ -155,7 +155,7 @@ impl FemModel {
             radius_m: indenter.radius_m,
         };
         let mut press = Press {
-            solver: DirectSolver::new(self.pattern())?,
+            solver: TangentSolver::direct(self.pattern())?,
             u: self.dirichlet().scaled_values(1.0),
             contact,
             settings,
@@ -230,7 +230,7 @@ impl FemModel {
 
 /// The state of one indentation between depths.
 struct Press<'a> {
-    solver: DirectSolver,
+    solver: TangentSolver<'static>,
     u: Vec<f64>,
     contact: SphereContact,
     settings: &'a IndentationSettings,

@@ -84,18 +84,18 @@ impl Factorization {
     /// Overwrites `rhs` with the solution.
     pub fn solve_in_place(&self, rhs: &mut [f64]) {
         let n = rhs.len();
-        let rhs = MatMut::from_column_major_slice_mut(rhs, n, 1);
-        match self {
-            Self::Llt(f) => f.solve_in_place(rhs),
-            Self::Lu(f) => f.solve_in_place(rhs),
-        }
+        self.solve_mat_in_place(MatMut::from_column_major_slice_mut(rhs, n, 1));
     }
 
     /// Overwrites the column-major block `rhs` (`rows` rows) with the solutions: one pass over
     /// the factor for all columns, much faster than column by column.
     pub fn solve_block_in_place(&self, rhs: &mut [f64], rows: usize) {
         let cols = rhs.len() / rows;
-        let rhs = MatMut::from_column_major_slice_mut(rhs, rows, cols);
+        self.solve_mat_in_place(MatMut::from_column_major_slice_mut(rhs, rows, cols));
+    }
+
+    /// Overwrites the columns of `rhs` with the solutions.
+    pub fn solve_mat_in_place(&self, rhs: MatMut<'_, f64>) {
         match self {
             Self::Llt(f) => f.solve_in_place(rhs),
             Self::Lu(f) => f.solve_in_place(rhs),

@@ -16,6 +16,7 @@ mod material;
 mod model;
 mod newton;
 mod pattern;
+mod tangent_solver;
 mod volumetric;
 
 pub use dofs::{Dirichlet, DofMap, PRESCRIBED};
@@ -31,3 +32,4 @@ pub use material::{DEFAULT_STIFFENING, Law, Material, TISSUE_DENSITY_KG_M3};
 pub use model::FemModel;
 pub use newton::{NewtonSettings, StaticSolution, StepReport};
 pub use pattern::FreePattern;
+pub use tangent_solver::{KrylovStatistics, TangentSolver};

@@ -6,12 +6,18 @@
 //! step briefly raises the stiff axial residuals, and a norm-based search would keep cutting
 //! it, stalling far from equilibrium.
 
-use super::linear_solver::DirectSolver;
+use super::tangent_solver::TangentSolver;
 use super::{FemError, FemModel, Loads};
 use crate::dense_sums::dot;
 
 /// Halvings of a Newton step allowed to keep every element's volume positive (2⁻³⁰ ≈ 1e-9).
 const MAX_HALVINGS: usize = 30;
+
+/// The largest residual, relative to its right-hand side, an iterative solve may leave in a
+/// Newton direction. Each direction is solved to `min(0.1, √ρ)`, `ρ` Newton's relative
+/// residual: loose far from equilibrium, tight near it, which keeps Newton's convergence
+/// superlinear (Eisenstat and Walker's forcing terms).
+const MAX_FORCING: f64 = 0.1;
 
 /// A conservative force on the body beside its elastic one, such as a rigid tool's contact.
 /// It is added to the internal force as the body's resistance (a force pushing the body enters
@@ -94,6 +100,27 @@ impl FemModel {
         &self,
         loads: &Loads,
         settings: &NewtonSettings,
+        visit: impl FnMut(f64, &[f64]),
+    ) -> Result<StaticSolution, FemError> {
+        let mut solver = TangentSolver::direct(self.pattern())?;
+        self.solve_static_path_with(&mut solver, loads, settings, visit)
+    }
+
+    /// [`Self::solve_static`] with Newton's linear systems solved by `solver`.
+    pub fn solve_static_with(
+        &self,
+        solver: &mut TangentSolver,
+        loads: &Loads,
+        settings: &NewtonSettings,
+    ) -> Result<StaticSolution, FemError> {
+        self.solve_static_path_with(solver, loads, settings, |_, _| {})
+    }
+
+    fn solve_static_path_with(
+        &self,
+        solver: &mut TangentSolver,
+        loads: &Loads,
+        settings: &NewtonSettings,
         mut visit: impl FnMut(f64, &[f64]),
     ) -> Result<StaticSolution, FemError> {
         check_settings(settings)?;
@@ -104,13 +131,12 @@ impl FemModel {
                 problem: "not the mesh's node count",
             });
         }
-        let mut solver = DirectSolver::new(self.pattern())?;
         let mut u = vec![0.0; loads.as_slice().len()];
         let mut steps = Vec::with_capacity(settings.load_steps);
         for step in 1..=settings.load_steps {
             let factor = step as f64 / settings.load_steps as f64;
             let this = (step, settings.load_steps);
-            let report = self.load_step(&mut solver, &mut u, loads, factor, this, settings)?;
+            let report = self.load_step(solver, &mut u, loads, factor, this, settings)?;
             visit(factor, &u);
             steps.push(report);
         }
@@ -121,13 +147,14 @@ impl FemModel {
     }
 
     /// Newton in one increment from `start_m` (every dof; the prescribed ones are set here)
-    /// to equilibrium under `loads`: for a start already close to it, such as the solution at
-    /// a slightly smaller load.
+    /// to equilibrium under `loads`, its linear systems solved by `solver`: for a start
+    /// already close to it, such as the solution at a slightly smaller load.
     pub fn solve_static_from(
         &self,
         start_m: Vec<f64>,
         loads: &Loads,
         settings: &NewtonSettings,
+        solver: &mut TangentSolver,
     ) -> Result<StaticSolution, FemError> {
         check_settings(settings)?;
         if start_m.len() != loads.as_slice().len() || loads.node_count() != self.mesh().node_count()
@@ -138,9 +165,8 @@ impl FemModel {
                 problem: "not three per mesh node",
             });
         }
-        let mut solver = DirectSolver::new(self.pattern())?;
         let mut u = start_m;
-        let report = self.load_step(&mut solver, &mut u, loads, 1.0, (1, 1), settings)?;
+        let report = self.load_step(solver, &mut u, loads, 1.0, (1, 1), settings)?;
         Ok(StaticSolution {
             displacement_m: u,
             steps: vec![report],
@@ -149,7 +175,7 @@ impl FemModel {
 
     fn load_step(
         &self,
-        solver: &mut DirectSolver,
+        solver: &mut TangentSolver,
         u: &mut [f64],
         loads: &Loads,
         factor: f64,
@@ -168,7 +194,7 @@ impl FemModel {
     /// `step` is (this load step, all of them), for error messages.
     pub(super) fn equilibrate(
         &self,
-        solver: &mut DirectSolver,
+        solver: &mut TangentSolver,
         u: &mut [f64],
         f_ext: &[f64],
         extra: &dyn ExtraForce,
@@ -198,9 +224,8 @@ impl FemModel {
                 break;
             }
             let mut du = residual.clone();
-            solver
-                .cholesky_or_lu(&self.pattern().matrix(tangent))?
-                .solve_in_place(&mut du);
+            let forcing = relative.sqrt().min(MAX_FORCING);
+            solver.solve(&self.pattern().matrix(tangent), &mut du, forcing)?;
             let length = self.line_search(u, &du, (f_ext, extra), &residual, settings);
             report.step_lengths.push(length);
         }

@@ -11,7 +11,8 @@ use serde::{Deserialize, Serialize};
 use super::anderson::Anderson;
 use super::load_patches::{LoadOperator, LoadPatches, UnitLoads, parameter_load};
 use super::stiffness::RestStiffness;
-use crate::fem::NewtonSettings;
+use crate::fem::{KrylovStatistics, NewtonSettings};
+use web_time::Instant;
 
 /// Columns solved together: one pass over the factor serves them all.
 const BLOCK_COLUMNS: usize = 48;
@@ -167,8 +168,12 @@ impl Responses {
         let few =
             unconverged.len() as f64 <= settings.max_newton_fraction * report.responses as f64;
         if few && !unconverged.is_empty() {
-            let solved = self.solve_by_newton(stiffness, (patches, magnitudes_n), &unconverged);
+            let start = Instant::now();
+            let (solved, solves) =
+                self.solve_by_newton(stiffness, (patches, magnitudes_n), &unconverged);
+            report.newton_seconds = start.elapsed().as_secs_f64();
             report.newton_solved = solved;
+            report.newton_solves = solves;
             report.unconverged -= solved;
         }
         (self, report)
@@ -234,19 +239,22 @@ impl Responses {
     /// Solves the loads `parameters` by Newton, one full nonlinear solve each (in parallel),
     /// from the step before's response they hold (or from rest, in increments, if that start
     /// inverts an element): for the few that the fixed point with the rest stiffness cannot
-    /// carry. A load Newton fails on too keeps that response. Returns the number solved.
+    /// carry. A load Newton fails on too keeps that response. Its linear systems are solved
+    /// by conjugate gradients preconditioned with the rest stiffness's factor
+    /// ([`RestStiffness::newton_solver`]). Returns the number solved and what their linear
+    /// solves cost.
     fn solve_by_newton(
         &mut self,
         stiffness: &RestStiffness,
         (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
         parameters: &[usize],
-    ) -> usize {
+    ) -> (usize, KrylovStatistics) {
         let model = stiffness.model;
         let settings = NewtonSettings {
             relative_tolerance: NEWTON_TOLERANCE,
             ..NewtonSettings::default()
         };
-        let solved: Vec<(usize, Vec<f64>)> = parameters
+        let solved: Vec<(usize, Vec<f64>, KrylovStatistics)> = parameters
             .par_iter()
             .filter_map(|&p| {
                 let lambda = magnitudes_n[p];
@@ -264,18 +272,22 @@ impl Responses {
                     load_steps: NEWTON_PATH_STEPS,
                     ..settings
                 };
+                let mut solver = stiffness.newton_solver();
                 let solution = model
-                    .solve_static_from(start, &loads, &settings)
-                    .or_else(|_| model.solve_static(&loads, &path))
+                    .solve_static_from(start, &loads, &settings, &mut solver)
+                    .or_else(|_| model.solve_static_with(&mut solver, &loads, &path))
                     .ok()?;
                 let secant = stiffness.restrict(&solution.displacement_m);
-                Some((p, secant.iter().map(|u| u / lambda).collect()))
+                let column = secant.iter().map(|u| u / lambda).collect();
+                Some((p, column, solver.statistics()))
             })
             .collect();
-        for (p, column) in &solved {
+        let mut statistics = KrylovStatistics::default();
+        for (p, column, solves) in &solved {
             self.columns[p * self.rows..(p + 1) * self.rows].copy_from_slice(column);
+            statistics = statistics.merge(*solves);
         }
-        solved.len()
+        (solved.len(), statistics)
     }
 
     /// The energy Gram `Uᵀ K U` (column-major) of responses that need not satisfy `K U = F`
@@ -406,6 +418,10 @@ pub struct SecantReport {
     pub substep_solved: usize,
     /// Responses the fixed point left that Newton then solved (not counted as unconverged).
     pub newton_solved: usize,
+    /// What Newton's linear solves for them cost.
+    pub newton_solves: KrylovStatistics,
+    /// Time spent in those Newton solves (s).
+    pub newton_seconds: f64,
     /// The largest final relative residual over all responses.
     pub worst_change: f64,
 }
@@ -419,6 +435,8 @@ impl SecantReport {
             unconverged: self.unconverged + other.unconverged,
             substep_solved: self.substep_solved + other.substep_solved,
             newton_solved: self.newton_solved + other.newton_solved,
+            newton_solves: self.newton_solves.merge(other.newton_solves),
+            newton_seconds: self.newton_seconds + other.newton_seconds,
             worst_change: self.worst_change.max(other.worst_change),
         }
     }

@@ -1,7 +1,7 @@
 //! The rest stiffness of a model, assembled and factorized once for a whole build: every PGD
 //! R-step, every exact response and every load step of the nonlinear scheme solves with it.
 
-use crate::fem::{DirectSolver, Factorization, FemError, FemModel};
+use crate::fem::{DirectSolver, Factorization, FemError, FemModel, TangentSolver};
 
 pub struct RestStiffness<'a> {
     pub model: &'a FemModel,
@@ -30,6 +30,12 @@ impl<'a> RestStiffness<'a> {
     pub fn solve_block(&self, rhs: &mut [f64]) {
         self.factor
             .solve_block_in_place(rhs, self.model.dofs().free_count());
+    }
+
+    /// Newton's linear solves by conjugate gradients preconditioned with this factor: the
+    /// loads the fixed point leaves differ from rest mostly around the tool.
+    pub fn newton_solver(&self) -> TangentSolver<'_> {
+        TangentSolver::preconditioned(self.model.pattern(), &self.factor)
     }
 
     pub fn free_count(&self) -> usize {

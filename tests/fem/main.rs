@@ -12,3 +12,4 @@ mod ksv;
 mod loads_and_mass;
 mod patch;
 mod surface;
+mod tangent_solver;

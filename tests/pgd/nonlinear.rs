@@ -139,7 +139,9 @@ fn loads_that_diverge_over_the_whole_step_converge_through_substeps() {
 }
 
 /// Loads the fixed point leaves unconverged (here all of them: one iteration allowed) are
-/// solved by Newton from the step before's response, to the same equilibrium.
+/// solved by Newton from the step before's response, to the same equilibrium as a Newton
+/// path with factorized tangents; Newton's directions come from conjugate gradients
+/// preconditioned by the rest stiffness, with no tangent factorized.
 #[test]
 fn loads_the_fixed_point_leaves_are_solved_by_newton() {
     let one_iteration = SecantSettings {
@@ -150,6 +152,9 @@ fn loads_the_fixed_point_leaves_are_solved_by_newton() {
     let report = secant_responses_are_equilibria(Law::NeoHookean, 10e-3, 4, &one_iteration);
     assert_eq!(report.newton_solved, report.responses, "{report:?}");
     assert_eq!(report.unconverged, 0);
+    let solves = report.newton_solves;
+    assert!(solves.directions >= report.responses, "{solves:?}");
+    assert_eq!(solves.factorizations, 0, "{solves:?}");
 }
 
 fn relative(a: &[f64], b: &[f64]) -> f64 {

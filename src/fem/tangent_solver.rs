@@ -1,0 +1,234 @@
+//! How Newton solves with each tangent: a factorization of it, or conjugate gradients
+//! preconditioned by a factorization the caller already holds.
+//!
+//! A PGD build holds the rest stiffness's Cholesky factor for its whole run. The loads its
+//! fixed point leaves to Newton differ from rest mostly around the tool, so the preconditioned
+//! tangent is the identity plus a perturbation of the nodes that stiffened: conjugate
+//! gradients then converge in a few dozen iterations, each a pair of triangular solves and a
+//! sparse product, where a direct solve factorizes every tangent anew (LU once a tangent has
+//! been indefinite, several times the cost of a Cholesky). Newton only needs each direction to
+//! a relative residual that shrinks with its own (an inexact Newton method, Eisenstat and
+//! Walker's), so the early directions cost fewer iterations still.
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::matrix_free::conjugate_gradient::{
+    CgError, CgParams, conjugate_gradient, conjugate_gradient_scratch,
+};
+use faer::matrix_free::{InitialGuessStatus, LinOp, Precond};
+use faer::sparse::SparseColMat;
+use faer::{MatMut, MatRef, Par};
+use serde::Serialize;
+
+use super::FemError;
+use super::linear_solver::{DirectSolver, Factorization};
+use super::pattern::FreePattern;
+
+/// Conjugate-gradient iterations allowed for one Newton direction before the solve gives up
+/// on them and factorizes.
+const MAX_CG_ITERATIONS: usize = 400;
+
+/// Solves Newton's linear systems `K_t du = r`.
+pub enum TangentSolver<'a> {
+    /// Factorizes each tangent: Cholesky, LU past a limit point.
+    Direct(DirectSolver),
+    /// Conjugate gradients preconditioned by a fixed factorization, falling back to
+    /// factorizing once a tangent is found indefinite or the iterations do not converge.
+    Preconditioned(Preconditioned<'a>),
+}
+
+/// Conjugate gradients on the tangent, preconditioned by a factorization of a nearby matrix.
+pub struct Preconditioned<'a> {
+    preconditioner: &'a Factorization,
+    pattern: &'a FreePattern,
+    /// Made on the first fallback: the rest of the solve factorizes, since the tangents after
+    /// an indefinite one are as far from the preconditioner.
+    direct: Option<DirectSolver>,
+    statistics: KrylovStatistics,
+}
+
+/// What the preconditioned solves cost.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct KrylovStatistics {
+    /// Newton directions found by conjugate gradients.
+    pub directions: usize,
+    /// Their conjugate-gradient iterations, all together.
+    pub iterations: usize,
+    /// Tangents factorized after conjugate gradients gave up.
+    pub factorizations: usize,
+}
+
+impl KrylovStatistics {
+    /// Both costs together.
+    pub fn merge(self, other: Self) -> Self {
+        Self {
+            directions: self.directions + other.directions,
+            iterations: self.iterations + other.iterations,
+            factorizations: self.factorizations + other.factorizations,
+        }
+    }
+
+    /// Conjugate-gradient iterations per Newton direction they found.
+    pub fn iterations_per_direction(&self) -> f64 {
+        self.iterations as f64 / self.directions.max(1) as f64
+    }
+}
+
+impl<'a> TangentSolver<'a> {
+    pub fn direct(pattern: &FreePattern) -> Result<Self, FemError> {
+        DirectSolver::new(pattern).map(Self::Direct)
+    }
+
+    /// Conjugate gradients preconditioned by `preconditioner`, a factorization of a matrix
+    /// of `pattern`'s free dofs (the rest stiffness).
+    pub fn preconditioned(pattern: &'a FreePattern, preconditioner: &'a Factorization) -> Self {
+        Self::Preconditioned(Preconditioned {
+            preconditioner,
+            pattern,
+            direct: None,
+            statistics: KrylovStatistics::default(),
+        })
+    }
+
+    /// What the preconditioned solves cost so far (all zero for a direct solver).
+    pub fn statistics(&self) -> KrylovStatistics {
+        match self {
+            Self::Direct(_) => KrylovStatistics::default(),
+            Self::Preconditioned(p) => p.statistics,
+        }
+    }
+
+    /// Overwrites `rhs` with `tangent⁻¹ rhs`; an iterative solve stops at a residual of
+    /// `forcing` relative to `rhs`.
+    pub(super) fn solve(
+        &mut self,
+        tangent: &SparseColMat<usize, f64>,
+        rhs: &mut [f64],
+        forcing: f64,
+    ) -> Result<(), FemError> {
+        match self {
+            Self::Direct(solver) => {
+                solver.cholesky_or_lu(tangent)?.solve_in_place(rhs);
+                Ok(())
+            }
+            Self::Preconditioned(p) => p.solve(tangent, rhs, forcing),
+        }
+    }
+}
+
+impl Preconditioned<'_> {
+    fn solve(
+        &mut self,
+        tangent: &SparseColMat<usize, f64>,
+        rhs: &mut [f64],
+        forcing: f64,
+    ) -> Result<(), FemError> {
+        if self.direct.is_none() {
+            if let Some(iterations) = self.conjugate_gradients(tangent, rhs, forcing) {
+                self.statistics.directions += 1;
+                self.statistics.iterations += iterations;
+                return Ok(());
+            }
+            self.direct = Some(DirectSolver::new(self.pattern)?);
+        }
+        let direct = self.direct.as_mut().expect("made above");
+        direct.cholesky_or_lu(tangent)?.solve_in_place(rhs);
+        self.statistics.factorizations += 1;
+        Ok(())
+    }
+
+    /// The iterations used, with `rhs` overwritten by the solution; `None`, with `rhs` left as
+    /// it was, when the tangent is indefinite or the iterations do not converge.
+    fn conjugate_gradients(
+        &self,
+        tangent: &SparseColMat<usize, f64>,
+        rhs: &mut [f64],
+        forcing: f64,
+    ) -> Option<usize> {
+        let n = rhs.len();
+        let precond = FactorPrecond {
+            factor: self.preconditioner,
+            dim: n,
+        };
+        let matrix = tangent.as_ref();
+        // The zero start is given as a start that may not be zero: faer 0.24's conjugate
+        // gradients leave the first residual unset when told the start is zero.
+        let params = CgParams {
+            initial_guess: InitialGuessStatus::MaybeNonZero,
+            rel_tolerance: forcing,
+            max_iters: MAX_CG_ITERATIONS,
+            ..CgParams::default()
+        };
+        let mut solution = vec![0.0; n];
+        let mut scratch = MemBuffer::new(conjugate_gradient_scratch(precond, matrix, 1, Par::Seq));
+        let result = conjugate_gradient(
+            MatMut::from_column_major_slice_mut(&mut solution, n, 1),
+            precond,
+            matrix,
+            MatRef::from_column_major_slice(rhs, n, 1),
+            params,
+            |_| {},
+            Par::Seq,
+            MemStack::new(&mut scratch),
+        );
+        match result {
+            Ok(info) => {
+                rhs.copy_from_slice(&solution);
+                Some(info.iter_count)
+            }
+            Err(CgError::NonPositiveDefiniteOperator)
+            | Err(CgError::NonPositiveDefinitePreconditioner)
+            | Err(CgError::NoConvergence { .. }) => None,
+        }
+    }
+}
+
+/// A factorization applied as a preconditioner: `z = M⁻¹ r` by its triangular solves.
+#[derive(Clone, Copy)]
+struct FactorPrecond<'a> {
+    factor: &'a Factorization,
+    dim: usize,
+}
+
+impl std::fmt::Debug for FactorPrecond<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "FactorPrecond({} dofs)", self.dim)
+    }
+}
+
+impl LinOp<f64> for FactorPrecond<'_> {
+    fn apply_scratch(&self, _rhs_ncols: usize, _par: Par) -> StackReq {
+        StackReq::EMPTY
+    }
+
+    fn nrows(&self) -> usize {
+        self.dim
+    }
+
+    fn ncols(&self) -> usize {
+        self.dim
+    }
+
+    fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _: Par, _: &mut MemStack) {
+        out.copy_from(rhs);
+        self.factor.solve_mat_in_place(out);
+    }
+
+    /// Real matrices: the conjugate is the operator itself.
+    fn conj_apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, s: &mut MemStack) {
+        self.apply(out, rhs, par, s);
+    }
+}
+
+impl Precond<f64> for FactorPrecond<'_> {
+    fn apply_in_place_scratch(&self, _rhs_ncols: usize, _par: Par) -> StackReq {
+        StackReq::EMPTY
+    }
+
+    fn apply_in_place(&self, rhs: MatMut<'_, f64>, _: Par, _: &mut MemStack) {
+        self.factor.solve_mat_in_place(rhs);
+    }
+
+    fn conj_apply_in_place(&self, rhs: MatMut<'_, f64>, par: Par, stack: &mut MemStack) {
+        self.apply_in_place(rhs, par, stack);
+    }
+}
