@@ -175,10 +175,12 @@ fn print_fixed_point(report: &pgd::SecantReport) {
     if report.newton_solved > 0 {
         println!(
             "  Newton: {:.1} s; {} directions by preconditioned conjugate gradients \
-             ({:.0} iterations each), {} tangents factorized",
+             ({:.0} iterations each, {} cut short at negative curvature), {} tangents \
+             factorized",
             report.newton_seconds,
             solves.directions,
             solves.iterations_per_direction(),
+            solves.truncated,
             solves.factorizations
         );
     }

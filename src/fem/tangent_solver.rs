@@ -8,7 +8,9 @@
 //! sparse product, where a direct solve factorizes every tangent anew (LU once a tangent has
 //! been indefinite, several times the cost of a Cholesky). Newton only needs each direction to
 //! a relative residual that shrinks with its own (an inexact Newton method, Eisenstat and
-//! Walker's), so the early directions cost fewer iterations still.
+//! Walker's), so the early directions cost fewer iterations still. Where a tangent is
+//! indefinite (an iterate far from equilibrium), the iterations stop at the first direction of
+//! negative curvature and Newton takes the descent direction they had reached.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::matrix_free::conjugate_gradient::{
@@ -31,8 +33,8 @@ const MAX_CG_ITERATIONS: usize = 400;
 pub enum TangentSolver<'a> {
     /// Factorizes each tangent: Cholesky, LU past a limit point.
     Direct(DirectSolver),
-    /// Conjugate gradients preconditioned by a fixed factorization, falling back to
-    /// factorizing once a tangent is found indefinite or the iterations do not converge.
+    /// Conjugate gradients preconditioned by a fixed factorization, cut short at negative
+    /// curvature, factorizing only where the iterations do not converge.
     Preconditioned(Preconditioned<'a>),
 }
 
@@ -40,8 +42,7 @@ pub enum TangentSolver<'a> {
 pub struct Preconditioned<'a> {
     preconditioner: &'a Factorization,
     pattern: &'a FreePattern,
-    /// Made on the first fallback: the rest of the solve factorizes, since the tangents after
-    /// an indefinite one are as far from the preconditioner.
+    /// Made on the first tangent conjugate gradients do not solve.
     direct: Option<DirectSolver>,
     statistics: KrylovStatistics,
 }
@@ -53,7 +54,9 @@ pub struct KrylovStatistics {
     pub directions: usize,
     /// Their conjugate-gradient iterations, all together.
     pub iterations: usize,
-    /// Tangents factorized after conjugate gradients gave up.
+    /// Of those, directions cut short at negative curvature (an indefinite tangent).
+    pub truncated: usize,
+    /// Tangents factorized where conjugate gradients did not converge.
     pub factorizations: usize,
 }
 
@@ -63,6 +66,7 @@ impl KrylovStatistics {
         Self {
             directions: self.directions + other.directions,
             iterations: self.iterations + other.iterations,
+            truncated: self.truncated + other.truncated,
             factorizations: self.factorizations + other.factorizations,
         }
     }
@@ -122,28 +126,43 @@ impl Preconditioned<'_> {
         rhs: &mut [f64],
         forcing: f64,
     ) -> Result<(), FemError> {
-        if self.direct.is_none() {
-            if let Some(iterations) = self.conjugate_gradients(tangent, rhs, forcing) {
+        match self.conjugate_gradients(tangent, rhs, forcing) {
+            Outcome::Converged(iterations) => {
                 self.statistics.directions += 1;
                 self.statistics.iterations += iterations;
-                return Ok(());
             }
-            self.direct = Some(DirectSolver::new(self.pattern)?);
+            Outcome::NegativeCurvature(iterations) => {
+                self.statistics.directions += 1;
+                self.statistics.iterations += iterations;
+                self.statistics.truncated += 1;
+            }
+            Outcome::Failed => {
+                let direct = match &mut self.direct {
+                    Some(direct) => direct,
+                    none => none.insert(DirectSolver::new(self.pattern)?),
+                };
+                direct.cholesky_or_lu(tangent)?.solve_in_place(rhs);
+                self.statistics.factorizations += 1;
+            }
         }
-        let direct = self.direct.as_mut().expect("made above");
-        direct.cholesky_or_lu(tangent)?.solve_in_place(rhs);
-        self.statistics.factorizations += 1;
         Ok(())
     }
 
-    /// The iterations used, with `rhs` overwritten by the solution; `None`, with `rhs` left as
-    /// it was, when the tangent is indefinite or the iterations do not converge.
+    /// Conjugate gradients from zero, overwriting `rhs` with the direction they give; on
+    /// [`Outcome::Failed`] `rhs` is left as it was.
+    ///
+    /// Past a limit point, or far from equilibrium, the tangent can be indefinite. The
+    /// iterates before the first direction of negative curvature are then still descent
+    /// directions of the energy (Steihaug's truncated Newton): the last of them is taken, or,
+    /// when the very first direction has negative curvature, the preconditioned residual
+    /// `M⁻¹ r` (the fixed point's own step). The line search sizes either; near equilibrium
+    /// the tangent is positive definite again and Newton's full steps return.
     fn conjugate_gradients(
         &self,
         tangent: &SparseColMat<usize, f64>,
         rhs: &mut [f64],
         forcing: f64,
-    ) -> Option<usize> {
+    ) -> Outcome {
         let n = rhs.len();
         let precond = FactorPrecond {
             factor: self.preconditioner,
@@ -159,6 +178,8 @@ impl Preconditioned<'_> {
             ..CgParams::default()
         };
         let mut solution = vec![0.0; n];
+        let mut last = vec![0.0; n];
+        let mut iterates = 0;
         let mut scratch = MemBuffer::new(conjugate_gradient_scratch(precond, matrix, 1, Par::Seq));
         let result = conjugate_gradient(
             MatMut::from_column_major_slice_mut(&mut solution, n, 1),
@@ -166,20 +187,41 @@ impl Preconditioned<'_> {
             matrix,
             MatRef::from_column_major_slice(rhs, n, 1),
             params,
-            |_| {},
+            |x| {
+                last.iter_mut()
+                    .enumerate()
+                    .for_each(|(i, v)| *v = x[(i, 0)]);
+                iterates += 1;
+            },
             Par::Seq,
             MemStack::new(&mut scratch),
         );
         match result {
             Ok(info) => {
                 rhs.copy_from_slice(&solution);
-                Some(info.iter_count)
+                Outcome::Converged(info.iter_count)
             }
-            Err(CgError::NonPositiveDefiniteOperator)
-            | Err(CgError::NonPositiveDefinitePreconditioner)
-            | Err(CgError::NoConvergence { .. }) => None,
+            Err(CgError::NonPositiveDefiniteOperator) if iterates > 0 => {
+                rhs.copy_from_slice(&last);
+                Outcome::NegativeCurvature(iterates)
+            }
+            Err(CgError::NonPositiveDefiniteOperator) => {
+                self.preconditioner.solve_in_place(rhs);
+                Outcome::NegativeCurvature(0)
+            }
+            Err(CgError::NonPositiveDefinitePreconditioner)
+            | Err(CgError::NoConvergence { .. }) => Outcome::Failed,
         }
     }
+}
+
+/// How conjugate gradients ended, with the iterations they took.
+enum Outcome {
+    Converged(usize),
+    /// Stopped at a direction of negative curvature; the direction is the iterate before it.
+    NegativeCurvature(usize),
+    /// No convergence within [`MAX_CG_ITERATIONS`]: the tangent is factorized instead.
+    Failed,
 }
 
 /// A factorization applied as a preconditioner: `z = M⁻¹ r` by its triangular solves.
