@@ -1,9 +1,10 @@
 //! Newton with its directions from conjugate gradients preconditioned by the rest stiffness's
-//! factor reaches the equilibrium that Newton with a factorized tangent reaches, and it does
-//! so without factorizing any tangent.
+//! factor reaches the equilibrium that Newton with a factorized tangent reaches, through an
+//! indefinite tangent too, and it does so without factorizing any tangent.
 
 use pgd_surgery::fem::{
-    DirectSolver, Dirichlet, FemModel, Law, Loads, Material, NewtonSettings, TangentSolver,
+    DirectSolver, Dirichlet, Factorization, FemModel, Law, Loads, Material, NewtonSettings,
+    TangentSolver,
 };
 use pgd_surgery::mesh::box_mesh;
 
@@ -41,26 +42,34 @@ fn relative(a: &[f64], b: &[f64]) -> f64 {
     (diff / norm).sqrt()
 }
 
+/// Newton to 1e-11 of the load, in four load steps.
+fn tight() -> NewtonSettings {
+    NewtonSettings {
+        load_steps: 4,
+        relative_tolerance: 1e-11,
+        ..NewtonSettings::default()
+    }
+}
+
+fn rest_factor(model: &FemModel) -> Factorization {
+    let rest = model.pattern().matrix(model.rest_stiffness());
+    DirectSolver::new(model.pattern())
+        .unwrap()
+        .cholesky(&rest)
+        .unwrap()
+}
+
 /// The same equilibrium to 1e-8 (both Newton solves converge to 1e-11 of the load), deep in
 /// the exponential law's stiffening: the pushed node moves by more than a third of the
 /// block's thickness.
 #[test]
 fn preconditioned_newton_reaches_the_direct_equilibrium() {
     let (model, loads) = pressed_block(1.5);
-    let settings = NewtonSettings {
-        load_steps: 4,
-        relative_tolerance: 1e-11,
-        ..NewtonSettings::default()
-    };
-    let direct = model.solve_static(&loads, &settings).unwrap();
-    let rest = model.pattern().matrix(model.rest_stiffness());
-    let factor = DirectSolver::new(model.pattern())
-        .unwrap()
-        .cholesky(&rest)
-        .unwrap();
+    let direct = model.solve_static(&loads, &tight()).unwrap();
+    let factor = rest_factor(&model);
     let mut solver = TangentSolver::preconditioned(model.pattern(), &factor);
     let krylov = model
-        .solve_static_with(&mut solver, &loads, &settings)
+        .solve_static_with(&mut solver, &loads, &tight())
         .unwrap();
     let deepest = direct
         .displacement_m
@@ -72,5 +81,31 @@ fn preconditioned_newton_reaches_the_direct_equilibrium() {
     assert!(deepest > 0.01, "not deep enough to test: {deepest} m");
     assert!(error < 1e-8, "{error}");
     assert!(statistics.directions > 0, "{statistics:?}");
+    assert_eq!(statistics.factorizations, 0, "{statistics:?}");
+}
+
+/// Started from the equilibrium turned the other way (the node pulled up as far as it is
+/// pushed down), the first tangent is indefinite: conjugate gradients stop at negative
+/// curvature, Newton takes the descent direction they reached, and it still lands on the
+/// direct solve's equilibrium (1e-8) without factorizing a tangent.
+#[test]
+fn an_indefinite_tangent_gives_a_truncated_direction_and_newton_still_converges() {
+    let (model, loads) = pressed_block(1.5);
+    let direct = model.solve_static(&loads, &tight()).unwrap();
+    let factor = rest_factor(&model);
+    let mut solver = TangentSolver::preconditioned(model.pattern(), &factor);
+    let reversed = direct.displacement_m.iter().map(|u| -u).collect();
+    let one_step = NewtonSettings {
+        load_steps: 1,
+        ..tight()
+    };
+    let krylov = model
+        .solve_static_from(reversed, &loads, &one_step, &mut solver)
+        .unwrap();
+    let statistics = solver.statistics();
+    let error = relative(&krylov.displacement_m, &direct.displacement_m);
+    eprintln!("error {error:.1e}, {statistics:?}");
+    assert!(statistics.truncated > 0, "{statistics:?}");
+    assert!(error < 1e-8, "{error}");
     assert_eq!(statistics.factorizations, 0, "{statistics:?}");
 }
