@@ -117,20 +117,24 @@ impl Responses {
             .for_each(|(a, b)| *a += sign * b);
     }
 
-    /// Turns linear (or previous-step) responses into the secant responses of a KSV load step:
-    /// per unit force, the response to a force of `magnitudes_n[p]` along parameter `p`,
-    /// `ũ = u / λ` with `K u = λ e_p − N(u)`. The nonlinear terms `N` of the previous iterate
-    /// go to the right-hand side (paper 000), so every iteration reuses the factorization of
-    /// the rest stiffness. `self` is the step before's responses, which an unconverged load
-    /// keeps; the iteration starts from `self + trend`.
+    /// Turns linear (or previous-step) responses into the secant responses of a load step
+    /// pressed to a depth: per unit force, the response `ũ = u / λ` with `K u = λ f_p − N(u)`
+    /// whose own patch is `depths_m[p]` deep (`λ |c_p · ũ| = depth`, [`patch_depth`]), and the
+    /// force `λ` that takes. The nonlinear terms `N` of the previous iterate go to the
+    /// right-hand side (paper 000), so every iteration reuses the factorization of the rest
+    /// stiffness; each iteration sizes the force so that the iterate is the step's depth deep
+    /// (displacement control), so the terms are never evaluated deeper than the step, where a
+    /// stiffening law's force under a fixed load overshoots. `self` is the step before's
+    /// responses, which an unconverged load keeps; the iteration starts from `self + trend`.
+    /// Returns the responses, each one's force (N; 0 where the depth is) and the report.
     pub fn secant(
         mut self,
         stiffness: &RestStiffness,
-        (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
+        (patches, depths_m): (&impl UnitLoads, &[f64]),
         (trend, fraction_before): (Option<&Trend>, f64),
         settings: &SecantSettings,
         progress: &(dyn Fn(usize) + Sync),
-    ) -> (Self, SecantReport) {
+    ) -> (Self, Vec<f64>, SecantReport) {
         let rows = self.rows;
         let (mut report, mut unconverged) = self
             .columns
@@ -142,7 +146,7 @@ impl Responses {
                 let done = secant_block(
                     stiffness,
                     patches,
-                    (first, &magnitudes_n[first..]),
+                    (first, &depths_m[first..]),
                     (chunk, trend),
                     settings,
                 );
@@ -158,38 +162,61 @@ impl Responses {
             );
         let rescued = self.continue_in_substeps(
             stiffness,
-            (patches, magnitudes_n),
+            (patches, depths_m),
             (&unconverged, fraction_before),
             settings,
         );
         report.substep_solved = rescued.len();
         report.unconverged -= rescued.len();
         unconverged.retain(|p| rescued.binary_search(p).is_err());
+        // Every response is its depth deep at this force, except those Newton solves below.
+        let mut forces_n: Vec<f64> = (0..self.count())
+            .map(|p| self.force_for_depth(stiffness, patches, p, depths_m[p]))
+            .collect();
         let few =
             unconverged.len() as f64 <= settings.max_newton_fraction * report.responses as f64;
         if few && !unconverged.is_empty() {
             let start = Instant::now();
-            let (solved, solves) =
-                self.solve_by_newton(stiffness, (patches, magnitudes_n), &unconverged);
+            let (solved, solves) = self.solve_by_newton(
+                stiffness,
+                (patches, depths_m),
+                (&unconverged, settings.tolerance),
+                &mut forces_n,
+            );
             report.newton_seconds = start.elapsed().as_secs_f64();
             report.newton_solved = solved;
             report.newton_solves = solves;
             report.unconverged -= solved;
         }
-        (self, report)
+        (self, forces_n, report)
+    }
+
+    /// The force (N) that presses load `p`'s patch `depth_m` deep along its response
+    /// (0 for no depth).
+    fn force_for_depth(
+        &self,
+        stiffness: &RestStiffness,
+        loads: &impl UnitLoads,
+        p: usize,
+        depth_m: f64,
+    ) -> f64 {
+        match depth_m {
+            0.0 => 0.0,
+            _ => depth_m / patch_depth(stiffness, loads, p, self.column(p)),
+        }
     }
 
     /// Takes the loads `failed` (sorted) that diverged on the step's whole increment through
     /// [`SUBSTEPS`] smaller ones, each fixed point started from the one before: from
-    /// `fraction_before` of the step's magnitude (the step before's level; those loads hold
-    /// its response) to the whole. The fixed point with the rest stiffness diverges where the
+    /// `fraction_before` of the step's depth (the step before's; those loads hold its
+    /// response) to the whole. The fixed point with the rest stiffness diverges where the
     /// tangent has moved far from it over one increment; a shorter increment starts it nearer
     /// its solution, for a few fixed points' cost where Newton would factorize the tangent at
     /// every iteration. Returns the loads so solved (sorted); the others keep their start.
     fn continue_in_substeps(
         &mut self,
         stiffness: &RestStiffness,
-        (loads, magnitudes_n): (&impl UnitLoads, &[f64]),
+        (loads, depths_m): (&impl UnitLoads, &[f64]),
         (failed, fraction_before): (&[usize], f64),
         settings: &SecantSettings,
     ) -> Vec<usize> {
@@ -205,15 +232,15 @@ impl Responses {
                 let mut alive = vec![true; parameters.len()];
                 for i in 1..=SUBSTEPS {
                     let t = fraction_before + (1.0 - fraction_before) * i as f64 / SUBSTEPS as f64;
-                    let magnitudes: Vec<f64> = parameters
+                    let depths: Vec<f64> = parameters
                         .iter()
                         .zip(&alive)
-                        .map(|(&p, &a)| if a { t * magnitudes_n[p] } else { 0.0 })
+                        .map(|(&p, &a)| if a { t * depths_m[p] } else { 0.0 })
                         .collect();
                     let (_, diverged) = secant_block(
                         stiffness,
                         &subset,
-                        (0, &magnitudes),
+                        (0, &depths),
                         (&mut chunk, None),
                         settings,
                     );
@@ -236,55 +263,30 @@ impl Responses {
         solved.into_iter().map(|(p, _)| p).collect()
     }
 
-    /// Solves the loads `parameters` by Newton, one full nonlinear solve each (in parallel),
-    /// from the step before's response they hold (or from rest, in increments, if that start
-    /// inverts an element): for the few that the fixed point with the rest stiffness cannot
-    /// carry. A load Newton fails on too keeps that response. Its linear systems are solved
-    /// by conjugate gradients preconditioned with the rest stiffness's factor
-    /// ([`RestStiffness::newton_solver`]). Returns the number solved and what their linear
-    /// solves cost.
+    /// Solves the loads `parameters` by Newton, each pressed to its depth (in parallel): for
+    /// the few that the fixed point with the rest stiffness cannot carry. A load Newton fails
+    /// on too keeps the step before's response it holds. Returns the number solved and what
+    /// their linear solves cost, and puts each solved load's force in `forces_n`.
     fn solve_by_newton(
         &mut self,
         stiffness: &RestStiffness,
-        (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
-        parameters: &[usize],
+        (patches, depths_m): (&impl UnitLoads, &[f64]),
+        (parameters, tolerance): (&[usize], f64),
+        forces_n: &mut [f64],
     ) -> (usize, KrylovStatistics) {
-        let model = stiffness.model;
-        let settings = NewtonSettings {
-            relative_tolerance: NEWTON_TOLERANCE,
-            ..NewtonSettings::default()
-        };
-        let solved: Vec<(usize, Vec<f64>, KrylovStatistics)> = parameters
+        let solved: Vec<(usize, Vec<f64>, f64, KrylovStatistics)> = parameters
             .par_iter()
             .filter_map(|&p| {
-                let lambda = magnitudes_n[p];
-                let start = stiffness
-                    .extend(self.column(p))
-                    .iter()
-                    .map(|u| u * lambda)
-                    .collect();
-                let shares = patches.nodal_shares(p);
-                let direction = patches.direction(p);
-                let loads =
-                    parameter_load(model.mesh().node_count(), shares, direction, lambda).ok()?;
-                // A start that turns an element inside out: a load path from rest instead.
-                let path = NewtonSettings {
-                    load_steps: NEWTON_PATH_STEPS,
-                    ..settings
-                };
-                let mut solver = stiffness.newton_solver();
-                let solution = model
-                    .solve_static_from(start, &loads, &settings, &mut solver)
-                    .or_else(|_| model.solve_static_with(&mut solver, &loads, &path))
-                    .ok()?;
-                let secant = stiffness.restrict(&solution.displacement_m);
-                let column = secant.iter().map(|u| u / lambda).collect();
-                Some((p, column, solver.statistics()))
+                let load = (patches, p, depths_m[p]);
+                let (column, force_n, solves) =
+                    newton_to_depth(stiffness, load, self.column(p), tolerance)?;
+                Some((p, column, force_n, solves))
             })
             .collect();
         let mut statistics = KrylovStatistics::default();
-        for (p, column, solves) in &solved {
+        for (p, column, force_n, solves) in &solved {
             self.columns[p * self.rows..(p + 1) * self.rows].copy_from_slice(column);
+            forces_n[*p] = *force_n;
             statistics = statistics.merge(*solves);
         }
         (solved.len(), statistics)
@@ -319,6 +321,71 @@ impl Responses {
         });
         gram
     }
+}
+
+/// Rounds of Newton solves a load takes to find the force that presses it to its depth.
+const DEPTH_ROUNDS: usize = 8;
+
+/// Newton's solution for load `p` of `loads` pressed `depth_m` deep, to `tolerance` of the
+/// depth, from the secant response `start` (per unit force): Newton at the force that presses
+/// `start` that deep (from rest, in increments, if that start turns an element inside out),
+/// then at forces corrected by the secant through the last two (force, depth) pairs, each
+/// from the solution before. Returns the response per unit force, the force, and what the
+/// linear solves cost; `None` where Newton fails.
+fn newton_to_depth(
+    stiffness: &RestStiffness,
+    (loads, p, depth_m): (&impl UnitLoads, usize, f64),
+    start: &[f64],
+    tolerance: f64,
+) -> Option<(Vec<f64>, f64, KrylovStatistics)> {
+    let model = stiffness.model;
+    let settings = NewtonSettings {
+        relative_tolerance: NEWTON_TOLERANCE,
+        ..NewtonSettings::default()
+    };
+    let path = NewtonSettings {
+        load_steps: NEWTON_PATH_STEPS,
+        ..settings
+    };
+    let pushed = |force_n: f64| {
+        let (shares, direction) = (loads.nodal_shares(p), loads.direction(p));
+        parameter_load(model.mesh().node_count(), shares, direction, force_n).ok()
+    };
+    let mut solver = stiffness.newton_solver();
+    let mut force_n = depth_m / patch_depth(stiffness, loads, p, start);
+    let from = stiffness
+        .extend(start)
+        .iter()
+        .map(|u| u * force_n)
+        .collect();
+    let first = pushed(force_n)?;
+    let mut solution = model
+        .solve_static_from(from, &first, &settings, &mut solver)
+        .or_else(|_| model.solve_static_with(&mut solver, &first, &path))
+        .ok()?
+        .displacement_m;
+    let mut before: Option<(f64, f64)> = None;
+    for _ in 0..DEPTH_ROUNDS {
+        let free = stiffness.restrict(&solution);
+        let reached_m = patch_depth(stiffness, loads, p, &free);
+        if (reached_m - depth_m).abs() <= tolerance * depth_m {
+            let column = free.iter().map(|u| u / force_n).collect();
+            return Some((column, force_n, solver.statistics()));
+        }
+        let next_n = match before {
+            Some((f, d)) if reached_m != d => {
+                force_n + (depth_m - reached_m) * (force_n - f) / (reached_m - d)
+            }
+            _ => force_n * depth_m / reached_m,
+        };
+        before = Some((force_n, reached_m));
+        force_n = next_n;
+        solution = model
+            .solve_static_from(solution, &pushed(force_n)?, &settings, &mut solver)
+            .ok()?
+            .displacement_m;
+    }
+    None
 }
 
 /// How the secant responses moved over the last step, scaled to the next one: `r (Ũ_k − Ũ_{k−1})`
@@ -451,6 +518,29 @@ impl SecantReport {
     }
 }
 
+/// How deep (m) a free-dof response `column` presses the patch of load `p`: its nodes'
+/// displacement averaged with their shares, along the load's direction. A load step's depth
+/// is this one; it is linear in the response, so a combination of responses as deep, with
+/// weights summing to one, is as deep.
+pub fn patch_depth(
+    stiffness: &RestStiffness,
+    loads: &impl UnitLoads,
+    p: usize,
+    column: &[f64],
+) -> f64 {
+    let free_index = &stiffness.model.dofs().free_index;
+    let mean = Vector3::from_fn(|c, _| {
+        loads
+            .nodal_shares(p)
+            .map(|(node, share)| match free_index[3 * node + c] {
+                crate::fem::PRESCRIBED => 0.0,
+                free => share * column[free],
+            })
+            .sum::<f64>()
+    });
+    loads.direction(p).dot(&mean)
+}
+
 /// Adds the unit load of parameter `p` to `column` (free dofs).
 fn add_unit_load(stiffness: &RestStiffness, loads: &impl UnitLoads, p: usize, column: &mut [f64]) {
     let free_index = &stiffness.model.dofs().free_index;
@@ -466,20 +556,26 @@ fn add_unit_load(stiffness: &RestStiffness, loads: &impl UnitLoads, p: usize, co
 }
 
 /// The fixed point for the columns of one block (`first` is the first column's parameter),
-/// iterating only the columns still moving. Each column is accelerated by Anderson's method
-/// ([`Anderson`]): where the law stiffens or softens, the plain iteration with the rest
-/// stiffness overshoots or crawls.
+/// each pressed to its depth (none for a depth of zero), iterating only the columns still
+/// moving. It iterates on the displacement `u` under displacement control: with `v` the
+/// response to the nonlinear terms of the iterate, `K₀ v = −N(u)`, the next iterate is
+/// `λ u_lin + v`, `u_lin` the linear response to the unit load and `λ` the force that puts it
+/// at the depth (the depth is linear in `u`, so every iterate, and any affine combination of
+/// them that the acceleration and damping take, is that deep). The responses come back per
+/// unit force, `u / λ`. Each column is accelerated by Anderson's method ([`Anderson`]): where
+/// the law stiffens or softens, the plain iteration with the rest stiffness overshoots or
+/// crawls.
 fn secant_block(
     stiffness: &RestStiffness,
     patches: &impl UnitLoads,
-    (first, magnitudes_n): (usize, &[f64]),
+    (first, depths_m): (usize, &[f64]),
     (chunk, trend): (&mut [f64], Option<&[f64]>),
     settings: &SecantSettings,
 ) -> (SecantReport, Vec<usize>) {
     let rows = stiffness.free_count();
     let columns = chunk.len() / rows;
-    // A load on a clamped node has no response and no magnitude: nothing to iterate.
-    let mut active: Vec<usize> = (0..columns).filter(|&j| magnitudes_n[j] != 0.0).collect();
+    // A load on a clamped node has no response and no depth: nothing to iterate.
+    let mut active: Vec<usize> = (0..columns).filter(|&j| depths_m[j] != 0.0).collect();
     let mut change = vec![0.0; columns];
     let mut growing = vec![0usize; columns];
     let mut accelerators: Vec<Anderson> = (0..columns)
@@ -493,6 +589,18 @@ fn secant_block(
     if let Some(trend) = trend {
         chunk.iter_mut().zip(trend).for_each(|(u, t)| *u += t);
     }
+    let depth = |j: usize, column: &[f64]| patch_depth(stiffness, patches, first + j, column);
+    let mut linear = vec![0.0; chunk.len()];
+    for &j in &active {
+        add_unit_load(stiffness, patches, first + j, &mut linear[j * rows..]);
+    }
+    stiffness.solve_block(&mut linear);
+    let mut forces_n = vec![0.0; columns];
+    for &j in &active {
+        let column = &mut chunk[j * rows..(j + 1) * rows];
+        let scale = depths_m[j] / depth(j, column);
+        column.iter_mut().for_each(|u| *u *= scale);
+    }
     let mut previous = chunk.to_vec();
     let mut work = NonlinearWork::new(stiffness);
     for iteration in 1..=settings.max_iterations {
@@ -500,11 +608,8 @@ fn secant_block(
         for &j in &active {
             let span = j * rows..(j + 1) * rows;
             let begin = rhs.len();
-            match work.finite_right_hand_side(
-                (&mut chunk[span.clone()], &previous[span]),
-                magnitudes_n[j],
-                &mut rhs,
-            ) {
+            match work.finite_right_hand_side((&mut chunk[span.clone()], &previous[span]), &mut rhs)
+            {
                 // No iterate between the last two keeps every element's volume positive.
                 None => {
                     change[j] = f64::NAN;
@@ -514,17 +619,23 @@ fn secant_block(
                 Some(0) => {}
                 Some(_) => accelerators[j].reset(),
             }
-            add_unit_load(stiffness, patches, first + j, &mut rhs[begin..]);
         }
         for &j in &active {
             previous[j * rows..(j + 1) * rows].copy_from_slice(&chunk[j * rows..(j + 1) * rows]);
         }
         stiffness.solve_block(&mut rhs);
-        for (&j, target) in active.iter().zip(rhs.chunks_exact(rows)) {
+        for (&j, v) in active.iter().zip(rhs.chunks_exact(rows)) {
             if change[j].is_nan() {
                 continue;
             }
             let span = j * rows..(j + 1) * rows;
+            let linear = &linear[span.clone()];
+            forces_n[j] = (depths_m[j] - depth(j, v)) / depth(j, linear);
+            let target: Vec<f64> = linear
+                .iter()
+                .zip(v)
+                .map(|(l, v)| forces_n[j] * l + v)
+                .collect();
             // The fixed point's own residual `G(x) − x`, whatever step the acceleration and
             // damping then take.
             let norm = target.iter().map(|u| u * u).sum::<f64>();
@@ -533,7 +644,7 @@ fn secant_block(
                 .zip(&previous[span.clone()])
                 .map(|(g, x)| (g - x) * (g - x))
                 .sum::<f64>();
-            accelerators[j].advance(&mut chunk[span], target.to_vec());
+            accelerators[j].advance(&mut chunk[span], target);
             let before = change[j];
             change[j] = (residual / norm).sqrt();
             if overshoots(&mut growing[j], before, change[j]) {
@@ -548,12 +659,16 @@ fn secant_block(
             break;
         }
     }
-    let unconverged: Vec<usize> = (0..columns)
-        .filter(|&j| change[j].is_nan() || change[j] >= settings.tolerance)
-        .collect();
-    for &j in &unconverged {
-        chunk[j * rows..(j + 1) * rows].copy_from_slice(&start[j * rows..(j + 1) * rows]);
+    let failed = |j: usize| change[j].is_nan() || change[j] >= settings.tolerance;
+    for j in 0..columns {
+        let span = j * rows..(j + 1) * rows;
+        if failed(j) {
+            chunk[span.clone()].copy_from_slice(&start[span]);
+        } else if depths_m[j] != 0.0 {
+            chunk[span].iter_mut().for_each(|u| *u /= forces_n[j]);
+        }
     }
+    let unconverged: Vec<usize> = (0..columns).filter(|&j| failed(j)).collect();
     report.unconverged = unconverged.len();
     report.worst_change = change
         .iter()
@@ -597,48 +712,46 @@ impl<'a> NonlinearWork<'a> {
         }
     }
 
-    /// Appends `−N(λ ũ) / λ` to `rhs` for the iterate `ũ` (`column`); where the iterate turns
-    /// an element inside out (the neo-Hookean force is then not finite), it is first moved
+    /// Appends `−N(u)` to `rhs` for the iterate `u` (`column`); where the iterate turns an
+    /// element inside out (the neo-Hookean force is then not finite), it is first moved
     /// halfway back towards `previous`, up to [`MAX_HALVINGS`] times, as Newton's line search
-    /// does. The starting iterate (equal to `previous`), the step before's response at this
-    /// step's larger force, is moved towards the rest state instead. Returns the halvings
-    /// taken, `None` if none gave a finite force.
+    /// does. The starting iterate (equal to `previous`) has nowhere to go back to: moved
+    /// towards rest it would no longer be the step's depth deep. Returns the halvings taken,
+    /// `None` if none gave a finite force.
     fn finite_right_hand_side(
         &mut self,
         (column, previous): (&mut [f64], &[f64]),
-        lambda: f64,
         rhs: &mut Vec<f64>,
     ) -> Option<usize> {
         let begin = rhs.len();
-        let towards_rest = column == previous;
+        let start = column == previous;
         for halvings in 0..=MAX_HALVINGS {
             rhs.truncate(begin);
-            rhs.extend(self.right_hand_side(column, lambda));
+            rhs.extend(self.right_hand_side(column));
             if rhs[begin..].iter().all(|v| v.is_finite()) {
                 return Some(halvings);
             }
+            if start {
+                return None;
+            }
             for (u, p) in column.iter_mut().zip(previous) {
-                *u = if towards_rest {
-                    0.5 * *u
-                } else {
-                    0.5 * (*u + p)
-                };
+                *u = 0.5 * (*u + p);
             }
         }
         None
     }
 
-    /// `−N(λ ũ) / λ` over free dofs, for a secant response `ũ` at force magnitude `λ`.
-    fn right_hand_side(&mut self, secant: &[f64], lambda: f64) -> impl Iterator<Item = f64> {
+    /// `−N(u)` over free dofs, for a displacement `u` over free dofs.
+    fn right_hand_side(&mut self, u: &[f64]) -> impl Iterator<Item = f64> {
         let free_dofs = &self.stiffness.model.dofs().free_dofs;
         self.full.fill(0.0);
-        for (&d, &v) in free_dofs.iter().zip(secant) {
-            self.full[d] = lambda * v;
+        for (&d, &v) in free_dofs.iter().zip(u) {
+            self.full[d] = v;
         }
         self.force.fill(0.0);
         self.stiffness
             .model
             .add_nonlinear_force(&self.full, &mut self.force);
-        free_dofs.iter().map(move |&d| -self.force[d] / lambda)
+        free_dofs.iter().map(move |&d| -self.force[d])
     }
 }

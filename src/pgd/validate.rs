@@ -214,17 +214,28 @@ fn point_and_inward(
     (point, -area_vector(mesh.nodes(), &corners).normalize())
 }
 
-/// The force (N) along `direction` whose linear response is `indentation_m` deep at `at`.
-fn linear_force(
+/// The force along `direction` that the vademecum says presses the tool's patch at `at`
+/// `indentation_m` along it: through its secant compliance along the direction at that
+/// force, in a few rounds from the linear one (exact for a linear vademecum). It sets full
+/// FEM's loads at the depths wanted whatever the law, where the linear force would press a
+/// stiffening tissue less deep.
+fn pressing_force(
     vademecum: &Vademecum,
     at: &SurfacePoint,
     direction: &Vector3<f64>,
     indentation_m: f64,
 ) -> Vector3<f64> {
-    let compliance =
-        direction.dot(&(vademecum.step_compliance(0, &vademecum.patch(at)) * direction));
-    direction * (indentation_m / compliance)
+    let patch = vademecum.patch(at);
+    let mut force = Vector3::zeros();
+    for _ in 0..PRESSING_ROUNDS {
+        let compliance = direction.dot(&(vademecum.compliance(&patch, &force) * direction));
+        force = direction * (indentation_m / compliance);
+    }
+    force
 }
+
+/// Rounds of [`pressing_force`]: the compliance changes little from one to the next.
+const PRESSING_ROUNDS: usize = 6;
 
 /// `force` spread over the tool's patch at `point`, and the patch's nodal shares.
 fn patch_loads(
@@ -265,8 +276,7 @@ fn sample(
     let direction = tilted_inward(rng, inward, settings);
     let (low, high) = settings.indentation_range_m;
     let indentation_m = low + (high - low) * rng.f64();
-    // The linear compliance along the direction sets the force for the wanted indentation.
-    let force = linear_force(vademecum, at, &direction, indentation_m);
+    let force = pressing_force(vademecum, at, &direction, indentation_m);
     let facing = vademecum.triangle_facing(at.triangle);
     let (loads, shares) = patch_loads(mesh, kernel, (point, &facing), &force)?;
     let newton = NewtonSettings {
@@ -290,8 +300,8 @@ fn sample(
 }
 
 /// Full FEM pressed along the inward normal at `at` in `curve_levels` equal force steps up to
-/// the deepest indentation's linear force, one Newton path; the vademecum answers each step's
-/// indentation.
+/// the force the vademecum gives the deepest indentation, one Newton path; the vademecum
+/// answers each step's indentation.
 fn force_depth_curve(
     model: &FemModel,
     vademecum: &Vademecum,
@@ -301,7 +311,7 @@ fn force_depth_curve(
 ) -> Result<ForceDepthCurve, FemError> {
     let mesh = model.mesh();
     let (point, inward) = point_and_inward(mesh, vademecum, at);
-    let force = linear_force(vademecum, at, &inward, settings.indentation_range_m.1);
+    let force = pressing_force(vademecum, at, &inward, settings.indentation_range_m.1);
     let facing = vademecum.triangle_facing(at.triangle);
     let (loads, shares) = patch_loads(mesh, kernel, (point, &facing), &force)?;
     let newton = NewtonSettings {
