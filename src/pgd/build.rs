@@ -23,7 +23,7 @@ use super::local::{
     AlongDirections, LocalPart, ParameterResponses, distance_neighbours, near_nodes,
 };
 use super::region::{CutHeader, RegionReport, RegionResponse, RegionSettings};
-use super::responses::{Responses, SecantReport, Trend, patch_depth};
+use super::responses::{Responses, SecantReport, Trend, patch_displacement};
 use super::separated::SeparatedField;
 use super::settings::BuildSettings;
 use super::snapshot_modes::SnapshotModes;
@@ -285,7 +285,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     );
     let linear = exact.combined(&tool.shares, &tool.inward);
     drop(exact);
-    let linear_depths = patch_depths(stiffness, &tool, &linear);
+    let press_directions = press_directions(stiffness, &tool, &linear);
     let (mut steps, mut reports) = (vec![step], vec![report]);
     let mut secant = linear.clone();
     // The step before the last, and its level: with the last they give the next start's trend.
@@ -293,11 +293,8 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     let mut last_level_m = 0.0;
     for &level_m in &context.settings.load_steps_m {
         let clock = Instant::now();
-        // Each patch is pressed `level_m` deep (none that does not move).
-        let depths: Vec<f64> = linear_depths
-            .iter()
-            .map(|&per_n| if per_n > 0.0 { level_m } else { 0.0 })
-            .collect();
+        // Each patch is pressed `level_m` deep along the way it moves.
+        let presses: Vec<Vector3<f64>> = press_directions.iter().map(|d| d * level_m).collect();
         let law = stiffness.model.material().law.name();
         progress.start(
             &format!("{law} step {:.1} mm", level_m * 1e3),
@@ -312,7 +309,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         let (fixed_point, forces_n);
         (secant, forces_n, fixed_point) = secant.secant(
             stiffness,
-            (&tool, &depths),
+            (&tool, &presses),
             (trend.as_ref(), last_level_before / level_m),
             &context.settings.secant,
             &|n| progress.advance(n as u64),
@@ -367,12 +364,17 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     Ok((steps, reports, None))
 }
 
-/// Per position, how deep (m) a unit force along its inward normal presses the patch centred
-/// on it, linearly (from the `linear` responses of `tool`'s loads): zero where it does not
-/// move, and no step presses it.
-fn patch_depths(stiffness: &RestStiffness, tool: &ToolPatchLoads, linear: &Responses) -> Vec<f64> {
+/// Per position, the unit vector the patch centred on it moves along, linearly, under a push
+/// along its inward normal (from the `linear` responses of `tool`'s loads): what a step's depth
+/// is measured along. Zero where the patch does not move: no step presses it.
+fn press_directions(
+    stiffness: &RestStiffness,
+    tool: &ToolPatchLoads,
+    linear: &Responses,
+) -> Vec<Vector3<f64>> {
     (0..tool.positions.len())
-        .map(|m| patch_depth(stiffness, tool, m, linear.column(m)))
+        .map(|m| patch_displacement(stiffness, tool, m, linear.column(m)))
+        .map(|moved| moved.try_normalize(0.0).unwrap_or_else(Vector3::zeros))
         .collect()
 }
 

@@ -119,7 +119,8 @@ impl Responses {
 
     /// Turns linear (or previous-step) responses into the secant responses of a load step
     /// pressed to a depth: per unit force, the response `ũ = u / λ` with `K u = λ f_p − N(u)`
-    /// whose own patch is `depths_m[p]` deep (`λ |c_p · ũ| = depth`, [`patch_depth`]), and the
+    /// whose own patch is pressed `presses_m[p]` deep ([`patch_depth`]: along that
+    /// displacement, as long; a zero press is none), and the
     /// force `λ` that takes. The nonlinear terms `N` of the previous iterate go to the
     /// right-hand side (paper 000), so every iteration reuses the factorization of the rest
     /// stiffness; each iteration sizes the force so that the iterate is the step's depth deep
@@ -130,7 +131,7 @@ impl Responses {
     pub fn secant(
         mut self,
         stiffness: &RestStiffness,
-        (patches, depths_m): (&impl UnitLoads, &[f64]),
+        (patches, presses_m): (&impl UnitLoads, &[Vector3<f64>]),
         (trend, fraction_before): (Option<&Trend>, f64),
         settings: &SecantSettings,
         progress: &(dyn Fn(usize) + Sync),
@@ -146,7 +147,7 @@ impl Responses {
                 let done = secant_block(
                     stiffness,
                     patches,
-                    (first, &depths_m[first..]),
+                    (first, &presses_m[first..]),
                     (chunk, trend),
                     settings,
                 );
@@ -162,7 +163,7 @@ impl Responses {
             );
         let rescued = self.continue_in_substeps(
             stiffness,
-            (patches, depths_m),
+            (patches, presses_m),
             (&unconverged, fraction_before),
             settings,
         );
@@ -171,18 +172,14 @@ impl Responses {
         unconverged.retain(|p| rescued.binary_search(p).is_err());
         // Every response is its depth deep at this force, except those Newton solves below.
         let mut forces_n: Vec<f64> = (0..self.count())
-            .map(|p| self.force_for_depth(stiffness, patches, p, depths_m[p]))
+            .map(|p| self.force_for_depth(stiffness, (patches, p), &presses_m[p]))
             .collect();
         let few =
             unconverged.len() as f64 <= settings.max_newton_fraction * report.responses as f64;
         if few && !unconverged.is_empty() {
             let start = Instant::now();
-            let (solved, solves) = self.solve_by_newton(
-                stiffness,
-                (patches, depths_m),
-                (&unconverged, settings.tolerance),
-                &mut forces_n,
-            );
+            let (solved, solves) =
+                self.solve_by_newton(stiffness, (patches, presses_m), &unconverged, &mut forces_n);
             report.newton_seconds = start.elapsed().as_secs_f64();
             report.newton_solved = solved;
             report.newton_solves = solves;
@@ -191,18 +188,18 @@ impl Responses {
         (self, forces_n, report)
     }
 
-    /// The force (N) that presses load `p`'s patch `depth_m` deep along its response
-    /// (0 for no depth).
+    /// The force (N) that presses load `p`'s patch as deep as `press_m` along its response
+    /// (0 for no press).
     fn force_for_depth(
         &self,
         stiffness: &RestStiffness,
-        loads: &impl UnitLoads,
-        p: usize,
-        depth_m: f64,
+        (loads, p): (&impl UnitLoads, usize),
+        press_m: &Vector3<f64>,
     ) -> f64 {
+        let depth_m = press_m.norm();
         match depth_m {
             0.0 => 0.0,
-            _ => depth_m / patch_depth(stiffness, loads, p, self.column(p)),
+            _ => depth_m / patch_depth(stiffness, (loads, p), self.column(p), press_m),
         }
     }
 
@@ -216,7 +213,7 @@ impl Responses {
     fn continue_in_substeps(
         &mut self,
         stiffness: &RestStiffness,
-        (loads, depths_m): (&impl UnitLoads, &[f64]),
+        (loads, presses_m): (&impl UnitLoads, &[Vector3<f64>]),
         (failed, fraction_before): (&[usize], f64),
         settings: &SecantSettings,
     ) -> Vec<usize> {
@@ -232,15 +229,15 @@ impl Responses {
                 let mut alive = vec![true; parameters.len()];
                 for i in 1..=SUBSTEPS {
                     let t = fraction_before + (1.0 - fraction_before) * i as f64 / SUBSTEPS as f64;
-                    let depths: Vec<f64> = parameters
+                    let presses: Vec<Vector3<f64>> = parameters
                         .iter()
                         .zip(&alive)
-                        .map(|(&p, &a)| if a { t * depths_m[p] } else { 0.0 })
+                        .map(|(&p, &a)| presses_m[p] * if a { t } else { 0.0 })
                         .collect();
                     let (_, diverged) = secant_block(
                         stiffness,
                         &subset,
-                        (0, &depths),
+                        (0, &presses),
                         (&mut chunk, None),
                         settings,
                     );
@@ -263,23 +260,24 @@ impl Responses {
         solved.into_iter().map(|(p, _)| p).collect()
     }
 
-    /// Solves the loads `parameters` by Newton, each pressed to its depth (in parallel): for
-    /// the few that the fixed point with the rest stiffness cannot carry. A load Newton fails
-    /// on too keeps the step before's response it holds. Returns the number solved and what
-    /// their linear solves cost, and puts each solved load's force in `forces_n`.
+    /// Solves the loads `parameters` by Newton (in parallel), each at the force that presses
+    /// the step before's response it holds to its depth ([`newton_at_depth_force`]): for the
+    /// few that the fixed point with the rest stiffness cannot carry. A load Newton fails on
+    /// too keeps that response. Returns the number solved and what their linear solves cost,
+    /// and puts each solved load's force in `forces_n`.
     fn solve_by_newton(
         &mut self,
         stiffness: &RestStiffness,
-        (patches, depths_m): (&impl UnitLoads, &[f64]),
-        (parameters, tolerance): (&[usize], f64),
+        (patches, presses_m): (&impl UnitLoads, &[Vector3<f64>]),
+        parameters: &[usize],
         forces_n: &mut [f64],
     ) -> (usize, KrylovStatistics) {
         let solved: Vec<(usize, Vec<f64>, f64, KrylovStatistics)> = parameters
             .par_iter()
             .filter_map(|&p| {
-                let load = (patches, p, depths_m[p]);
+                let load = (patches, p, &presses_m[p]);
                 let (column, force_n, solves) =
-                    newton_to_depth(stiffness, load, self.column(p), tolerance)?;
+                    newton_at_depth_force(stiffness, load, self.column(p))?;
                 Some((p, column, force_n, solves))
             })
             .collect();
@@ -323,20 +321,16 @@ impl Responses {
     }
 }
 
-/// Rounds of Newton solves a load takes to find the force that presses it to its depth.
-const DEPTH_ROUNDS: usize = 8;
-
-/// Newton's solution for load `p` of `loads` pressed `depth_m` deep, to `tolerance` of the
-/// depth, from the secant response `start` (per unit force): Newton at the force that presses
-/// `start` that deep (from rest, in increments, if that start turns an element inside out),
-/// then at forces corrected by the secant through the last two (force, depth) pairs, each
-/// from the solution before. Returns the response per unit force, the force, and what the
-/// linear solves cost; `None` where Newton fails.
-fn newton_to_depth(
+/// Newton's solution for load `p` of `loads` at the force that presses the secant response
+/// `start` (per unit force, the step before's) as deep as `press_m`, from `start` at that
+/// force (from rest, in increments, if that start turns an element inside out). A law that
+/// stiffens over the increment stops short of the depth; the force is what the response is
+/// kept with, so the blend between steps stays true to it. Returns the response per unit
+/// force, the force, and what the linear solves cost; `None` where Newton fails.
+fn newton_at_depth_force(
     stiffness: &RestStiffness,
-    (loads, p, depth_m): (&impl UnitLoads, usize, f64),
+    (loads, p, press_m): (&impl UnitLoads, usize, &Vector3<f64>),
     start: &[f64],
-    tolerance: f64,
 ) -> Option<(Vec<f64>, f64, KrylovStatistics)> {
     let model = stiffness.model;
     let settings = NewtonSettings {
@@ -347,45 +341,22 @@ fn newton_to_depth(
         load_steps: NEWTON_PATH_STEPS,
         ..settings
     };
-    let pushed = |force_n: f64| {
-        let (shares, direction) = (loads.nodal_shares(p), loads.direction(p));
-        parameter_load(model.mesh().node_count(), shares, direction, force_n).ok()
-    };
-    let mut solver = stiffness.newton_solver();
-    let mut force_n = depth_m / patch_depth(stiffness, loads, p, start);
+    let force_n = press_m.norm() / patch_depth(stiffness, (loads, p), start, press_m);
+    let (shares, direction) = (loads.nodal_shares(p), loads.direction(p));
+    let pushed = parameter_load(model.mesh().node_count(), shares, direction, force_n).ok()?;
     let from = stiffness
         .extend(start)
         .iter()
         .map(|u| u * force_n)
         .collect();
-    let first = pushed(force_n)?;
-    let mut solution = model
-        .solve_static_from(from, &first, &settings, &mut solver)
-        .or_else(|_| model.solve_static_with(&mut solver, &first, &path))
-        .ok()?
-        .displacement_m;
-    let mut before: Option<(f64, f64)> = None;
-    for _ in 0..DEPTH_ROUNDS {
-        let free = stiffness.restrict(&solution);
-        let reached_m = patch_depth(stiffness, loads, p, &free);
-        if (reached_m - depth_m).abs() <= tolerance * depth_m {
-            let column = free.iter().map(|u| u / force_n).collect();
-            return Some((column, force_n, solver.statistics()));
-        }
-        let next_n = match before {
-            Some((f, d)) if reached_m != d => {
-                force_n + (depth_m - reached_m) * (force_n - f) / (reached_m - d)
-            }
-            _ => force_n * depth_m / reached_m,
-        };
-        before = Some((force_n, reached_m));
-        force_n = next_n;
-        solution = model
-            .solve_static_from(solution, &pushed(force_n)?, &settings, &mut solver)
-            .ok()?
-            .displacement_m;
-    }
-    None
+    let mut solver = stiffness.newton_solver();
+    let solution = model
+        .solve_static_from(from, &pushed, &settings, &mut solver)
+        .or_else(|_| model.solve_static_with(&mut solver, &pushed, &path))
+        .ok()?;
+    let secant = stiffness.restrict(&solution.displacement_m);
+    let column = secant.iter().map(|u| u / force_n).collect();
+    Some((column, force_n, solver.statistics()))
 }
 
 /// How the secant responses moved over the last step, scaled to the next one: `r (Ũ_k − Ũ_{k−1})`
@@ -518,18 +489,16 @@ impl SecantReport {
     }
 }
 
-/// How deep (m) a free-dof response `column` presses the patch of load `p`: its nodes'
-/// displacement averaged with their shares, along the load's direction. A load step's depth
-/// is this one; it is linear in the response, so a combination of responses as deep, with
-/// weights summing to one, is as deep.
-pub fn patch_depth(
+/// The displacement (m) of the patch of load `p` in a free-dof response `column`: its nodes'
+/// displacements averaged with their shares.
+pub fn patch_displacement(
     stiffness: &RestStiffness,
     loads: &impl UnitLoads,
     p: usize,
     column: &[f64],
-) -> f64 {
+) -> Vector3<f64> {
     let free_index = &stiffness.model.dofs().free_index;
-    let mean = Vector3::from_fn(|c, _| {
+    Vector3::from_fn(|c, _| {
         loads
             .nodal_shares(p)
             .map(|(node, share)| match free_index[3 * node + c] {
@@ -537,8 +506,22 @@ pub fn patch_depth(
                 free => share * column[free],
             })
             .sum::<f64>()
-    });
-    loads.direction(p).dot(&mean)
+    })
+}
+
+/// How deep (m) a response `column` presses the patch of load `p` towards `press` (the
+/// displacement a step presses it to): its [`patch_displacement`] along `press`. A load
+/// step's depth is this one; it is linear in the response, so a combination of responses as
+/// deep, with weights summing to one, is as deep.
+pub fn patch_depth(
+    stiffness: &RestStiffness,
+    (loads, p): (&impl UnitLoads, usize),
+    column: &[f64],
+    press: &Vector3<f64>,
+) -> f64 {
+    press
+        .normalize()
+        .dot(&patch_displacement(stiffness, loads, p, column))
 }
 
 /// Adds the unit load of parameter `p` to `column` (free dofs).
@@ -568,13 +551,14 @@ fn add_unit_load(stiffness: &RestStiffness, loads: &impl UnitLoads, p: usize, co
 fn secant_block(
     stiffness: &RestStiffness,
     patches: &impl UnitLoads,
-    (first, depths_m): (usize, &[f64]),
+    (first, presses_m): (usize, &[Vector3<f64>]),
     (chunk, trend): (&mut [f64], Option<&[f64]>),
     settings: &SecantSettings,
 ) -> (SecantReport, Vec<usize>) {
     let rows = stiffness.free_count();
     let columns = chunk.len() / rows;
     // A load on a clamped node has no response and no depth: nothing to iterate.
+    let depths_m: Vec<f64> = presses_m[..columns].iter().map(|p| p.norm()).collect();
     let mut active: Vec<usize> = (0..columns).filter(|&j| depths_m[j] != 0.0).collect();
     let mut change = vec![0.0; columns];
     let mut growing = vec![0usize; columns];
@@ -589,7 +573,9 @@ fn secant_block(
     if let Some(trend) = trend {
         chunk.iter_mut().zip(trend).for_each(|(u, t)| *u += t);
     }
-    let depth = |j: usize, column: &[f64]| patch_depth(stiffness, patches, first + j, column);
+    let depth = |j: usize, column: &[f64]| {
+        patch_depth(stiffness, (patches, first + j), column, &presses_m[j])
+    };
     let mut linear = vec![0.0; chunk.len()];
     for &j in &active {
         add_unit_load(stiffness, patches, first + j, &mut linear[j * rows..]);
@@ -715,27 +701,29 @@ impl<'a> NonlinearWork<'a> {
     /// Appends `−N(u)` to `rhs` for the iterate `u` (`column`); where the iterate turns an
     /// element inside out (the neo-Hookean force is then not finite), it is first moved
     /// halfway back towards `previous`, up to [`MAX_HALVINGS`] times, as Newton's line search
-    /// does. The starting iterate (equal to `previous`) has nowhere to go back to: moved
-    /// towards rest it would no longer be the step's depth deep. Returns the halvings taken,
-    /// `None` if none gave a finite force.
+    /// does. The starting iterate (equal to `previous`), the step before's response pressed to
+    /// this step's depth, is moved towards the rest state instead: the next iterate is the
+    /// step's depth deep whatever this one's depth. Returns the halvings taken, `None` if none
+    /// gave a finite force.
     fn finite_right_hand_side(
         &mut self,
         (column, previous): (&mut [f64], &[f64]),
         rhs: &mut Vec<f64>,
     ) -> Option<usize> {
         let begin = rhs.len();
-        let start = column == previous;
+        let towards_rest = column == previous;
         for halvings in 0..=MAX_HALVINGS {
             rhs.truncate(begin);
             rhs.extend(self.right_hand_side(column));
             if rhs[begin..].iter().all(|v| v.is_finite()) {
                 return Some(halvings);
             }
-            if start {
-                return None;
-            }
             for (u, p) in column.iter_mut().zip(previous) {
-                *u = 0.5 * (*u + p);
+                *u = if towards_rest {
+                    0.5 * *u
+                } else {
+                    0.5 * (*u + p)
+                };
             }
         }
         None

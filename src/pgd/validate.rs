@@ -215,10 +215,10 @@ fn point_and_inward(
 }
 
 /// The force along `direction` that the vademecum says presses the tool's patch at `at`
-/// `indentation_m` along it: through its secant compliance along the direction at that
-/// force, in a few rounds from the linear one (exact for a linear vademecum). It sets full
-/// FEM's loads at the depths wanted whatever the law, where the linear force would press a
-/// stiffening tissue less deep.
+/// `indentation_m` along it: the root of that depth against the force's magnitude, by the
+/// secant method from rest and the linear force (exact for a linear vademecum at once). It
+/// sets full FEM's loads at the depths wanted whatever the law, where the linear force would
+/// press a stiffening tissue less deep.
 fn pressing_force(
     vademecum: &Vademecum,
     at: &SurfacePoint,
@@ -226,16 +226,25 @@ fn pressing_force(
     indentation_m: f64,
 ) -> Vector3<f64> {
     let patch = vademecum.patch(at);
-    let mut force = Vector3::zeros();
+    let depth_m = |force_n: f64| {
+        let force = direction * force_n;
+        direction.dot(&(vademecum.compliance(&patch, &force) * force))
+    };
+    let (mut before, mut force_n) = ((0.0, 0.0), indentation_m / depth_m(1.0));
     for _ in 0..PRESSING_ROUNDS {
-        let compliance = direction.dot(&(vademecum.compliance(&patch, &force) * direction));
-        force = direction * (indentation_m / compliance);
+        let reached_m = depth_m(force_n);
+        if (reached_m - indentation_m).abs() <= 1e-9 * indentation_m || reached_m == before.1 {
+            break;
+        }
+        let slope = (reached_m - before.1) / (force_n - before.0);
+        before = (force_n, reached_m);
+        force_n += (indentation_m - reached_m) / slope;
     }
-    force
+    direction * force_n
 }
 
-/// Rounds of [`pressing_force`]: the compliance changes little from one to the next.
-const PRESSING_ROUNDS: usize = 6;
+/// Rounds of [`pressing_force`]'s secant method.
+const PRESSING_ROUNDS: usize = 20;
 
 /// `force` spread over the tool's patch at `point`, and the patch's nodal shares.
 fn patch_loads(
