@@ -38,8 +38,9 @@ pub struct NewtonBaseline {
 
 /// Times `samples` Newton paths of `model` (the model `vademecum` was built for) at random load
 /// positions (seeded by `seed`), each loaded as the build loads it at its deepest step: the
-/// tool's patch centred on its position, pushing into the organ with the force that presses it
-/// that step's depth. `None` for a vademecum with one (linear) step.
+/// tool's patch centred on its position, pushing into the organ, whose linear response is
+/// that step's depth. `None`
+/// for a vademecum with one (linear) step.
 pub fn newton_baseline(
     model: &FemModel,
     vademecum: &Vademecum,
@@ -60,7 +61,7 @@ pub fn newton_baseline(
     let mut rng = fastrand::Rng::with_seed(seed);
     let (mut seconds, mut failed) = (0.0, 0);
     for _ in 0..samples {
-        let force = deepest_load(model, vademecum, rng.usize(..loads))?;
+        let force = nodal_load(model, vademecum, rng.usize(..loads), deepest_m)?;
         let clock = Instant::now();
         let solved = model.solve_static(&force, &settings);
         seconds += clock.elapsed().as_secs_f64();
@@ -78,11 +79,20 @@ pub fn newton_baseline(
     }))
 }
 
-/// The load at position `m` of a nonlinear vademecum's deepest step: the tool's patch centred
-/// on the position, pushing along its inward normal with the step's force there.
-fn deepest_load(model: &FemModel, vademecum: &Vademecum, m: usize) -> Result<Loads, FemError> {
-    let deepest = vademecum.steps.last().expect("a vademecum has a step");
-    let magnitude_n = f64::from(deepest.forces_n[m]);
+/// The load at position `m` whose linear response is `depth_m` deep, as a nonlinear
+/// vademecum's steps load it: the tool's patch centred on the position, pushing along its
+/// inward normal.
+fn nodal_load(
+    model: &FemModel,
+    vademecum: &Vademecum,
+    m: usize,
+    depth_m: f64,
+) -> Result<Loads, FemError> {
+    let compliance_m_per_n = f64::from(vademecum.reference_compliance_m_per_n[m]);
+    let magnitude_n = match compliance_m_per_n > 0.0 {
+        true => depth_m / compliance_m_per_n,
+        false => 0.0,
+    };
     let inward = inward_normal(&vademecum.position_normals[m]);
     let shares = vademecum.patch_centred_on(m);
     let nodal_shares = shares

@@ -18,12 +18,12 @@ use serde::Serialize;
 use super::baseline::NewtonBaseline;
 use super::enrichment::enrich;
 use super::error_curve::{EnergyError, ErrorCurve, FieldError, optimal_errors};
-use super::load_patches::{LoadOperator, LoadPatches};
+use super::load_patches::{LoadOperator, LoadPatches, UnitLoads};
 use super::local::{
     AlongDirections, LocalPart, ParameterResponses, distance_neighbours, near_nodes,
 };
 use super::region::{CutHeader, RegionReport, RegionResponse, RegionSettings};
-use super::responses::{Responses, SecantReport, Trend, patch_displacement};
+use super::responses::{Responses, SecantReport, Trend};
 use super::separated::SeparatedField;
 use super::settings::BuildSettings;
 use super::snapshot_modes::SnapshotModes;
@@ -188,7 +188,7 @@ pub fn build(
         settings,
         progress,
     };
-    let (steps, reports, failed_step) = load_steps(&context)?;
+    let (steps, reports, failed_step, reference) = load_steps(&context)?;
     let near_field_share = steps[0].local.correction_nodes.len() as f64
         / (patches.positions.len() * mesh.node_count()) as f64;
     if near_field_share > WIDE_NEAR_FIELD_SHARE {
@@ -225,6 +225,7 @@ pub fn build(
         position_areas_m2: areas,
         position_normals: normals,
         triangles,
+        reference_compliance_m_per_n: reference,
         steps,
         cuts: None,
     };
@@ -254,14 +255,15 @@ struct StepContext<'a> {
     progress: &'a dyn Progress,
 }
 
-/// The steps built, their reports, and the report of a step left out.
-type LoadSteps = (Vec<Step>, Vec<StepReport>, Option<StepReport>);
+/// The steps built, their reports, the report of a step left out, and per position the
+/// reference compliance that turns a force into the level picking load steps.
+type LoadSteps = (Vec<Step>, Vec<StepReport>, Option<StepReport>, Vec<f32>);
 
 /// The linear step, then (nonlinear laws) one step per indentation level until the last or
-/// the first whose fixed point fails. A nonlinear step presses the tool's patch centred on each
-/// position along its inward normal, the level deep, and keeps the force that takes and the
-/// nonlinear correction to the linear response of that patch: the trainer adds it to the
-/// exact linear response of the patch where the tool is.
+/// the first whose fixed point fails. A nonlinear step loads the tool's patch centred on each
+/// position, pushing along its inward normal, sized so that its linear response is the level
+/// deep, and keeps the nonlinear correction to the linear response of that patch: the trainer
+/// adds it to the exact linear response of the patch where the tool is.
 fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     let (stiffness, patches, progress) = (context.stiffness, context.patches, context.progress);
     let clock = Instant::now();
@@ -276,7 +278,8 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         clock,
     )?;
     if stiffness.model.material().law == Law::Linear {
-        return Ok((vec![step], vec![report], None));
+        let reference = self_compliances(&step.local);
+        return Ok((vec![step], vec![report], None, reference));
     }
     let tool = ToolPatchLoads::new(
         patches.positions.clone(),
@@ -285,7 +288,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     );
     let linear = exact.combined(&tool.shares, &tool.inward);
     drop(exact);
-    let press_directions = press_directions(stiffness, &tool, &linear);
+    let reference = patch_depths(stiffness, &tool, &linear);
     let (mut steps, mut reports) = (vec![step], vec![report]);
     let mut secant = linear.clone();
     // The step before the last, and its level: with the last they give the next start's trend.
@@ -293,8 +296,14 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     let mut last_level_m = 0.0;
     for &level_m in &context.settings.load_steps_m {
         let clock = Instant::now();
-        // Each patch is pressed `level_m` deep along the way it moves.
-        let presses: Vec<Vector3<f64>> = press_directions.iter().map(|d| d * level_m).collect();
+        // Each patch's push is sized so that its linear displacement is `level_m` long.
+        let magnitudes: Vec<f64> = reference
+            .iter()
+            .map(|&per_n| match per_n > 0.0 {
+                true => level_m / f64::from(per_n),
+                false => 0.0,
+            })
+            .collect();
         let law = stiffness.model.material().law.name();
         progress.start(
             &format!("{law} step {:.1} mm", level_m * 1e3),
@@ -306,10 +315,10 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         before = Some((secant.clone(), last_level_m));
         let last_level_before = last_level_m;
         last_level_m = level_m;
-        let (fixed_point, forces_n);
-        (secant, forces_n, fixed_point) = secant.secant(
+        let fixed_point;
+        (secant, fixed_point) = secant.secant(
             stiffness,
-            (&tool, &presses),
+            (&tool, &magnitudes),
             (trend.as_ref(), last_level_before / level_m),
             &context.settings.secant,
             &|n| progress.advance(n as u64),
@@ -340,7 +349,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
                 fixed_point: Some(fixed_point),
                 ..StepReport::default()
             };
-            return Ok((steps, reports, Some(failed)));
+            return Ok((steps, reports, Some(failed), reference));
         }
         // The step keeps the correction `Ũ − U_lin`, restored after.
         secant.add_scaled(&linear, -1.0);
@@ -354,27 +363,33 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         };
         let built = separated_step(context, &secant, separation, gram, clock);
         secant.add_scaled(&linear, 1.0);
-        let (mut step, mut report) = built?;
-        step.forces_n = forces_n.iter().map(|&f| f as f32).collect();
+        let (step, mut report) = built?;
         report.indentation_m = level_m;
         report.fixed_point = Some(fixed_point);
         steps.push(step);
         reports.push(report);
     }
-    Ok((steps, reports, None))
+    Ok((steps, reports, None, reference))
 }
 
-/// Per position, the unit vector the patch centred on it moves along, linearly, under a push
-/// along its inward normal (from the `linear` responses of `tool`'s loads): what a step's depth
-/// is measured along. Zero where the patch does not move: no step presses it.
-fn press_directions(
-    stiffness: &RestStiffness,
-    tool: &ToolPatchLoads,
-    linear: &Responses,
-) -> Vec<Vector3<f64>> {
+/// Per position, how deep (m) a unit force along its inward normal presses the patch centred
+/// on it, linearly (the patch's mean displacement, from the `linear` responses of `tool`'s
+/// loads): what turns a force into the level that picks a step.
+fn patch_depths(stiffness: &RestStiffness, tool: &ToolPatchLoads, linear: &Responses) -> Vec<f32> {
+    let free_index = &stiffness.model.dofs().free_index;
     (0..tool.positions.len())
-        .map(|m| patch_displacement(stiffness, tool, m, linear.column(m)))
-        .map(|moved| moved.try_normalize(0.0).unwrap_or_else(Vector3::zeros))
+        .map(|m| {
+            let column = linear.column(m);
+            let depth = Vector3::from_fn(|c, _| {
+                tool.nodal_shares(m)
+                    .map(|(node, share)| match free_index[3 * node + c] {
+                        crate::fem::PRESCRIBED => 0.0,
+                        free => share * column[free],
+                    })
+                    .sum::<f64>()
+            });
+            depth.norm() as f32
+        })
         .collect()
 }
 
@@ -580,8 +595,18 @@ fn step_of(field: &SeparatedField, local: LocalPart) -> Step {
             .map(|&v| v as f32)
             .collect(),
         local,
-        forces_n: Vec::new(),
     }
+}
+
+/// Per position, the largest diagonal entry of its self-compliance block (m/N).
+fn self_compliances(local: &LocalPart) -> Vec<f32> {
+    (0..local.neighbour_offsets.len() - 1)
+        .map(|m| {
+            let e = local.neighbours_of(m).start;
+            let block = &local.compliance[9 * e..9 * e + 9];
+            block[0].max(block[4]).max(block[8])
+        })
+        .collect()
 }
 
 /// Adds the cut section to `vademecum`, built for `model` (the model it was built for): the

@@ -16,7 +16,7 @@ use crate::fem::{Inclusion, Law, Material};
 use crate::mesh::TetMesh;
 
 /// Bumped on any change of layout or meaning; older files are refused, not misread.
-pub const FORMAT_VERSION: u32 = 6;
+pub const FORMAT_VERSION: u32 = 5;
 const KIND: Kind = Kind {
     magic: b"PGDVADEM",
     version: FORMAT_VERSION,
@@ -148,6 +148,7 @@ fn payload(v: &Vademecum) -> Vec<u8> {
     put(&mut out, &v.position_areas_m2);
     put(&mut out, v.position_normals.as_flattened());
     put(&mut out, v.triangles.as_flattened());
+    put(&mut out, &v.reference_compliance_m_per_n);
     put(&mut out, &[v.steps.len() as u32]);
     for step in &v.steps {
         put(&mut out, &step.spatial);
@@ -159,7 +160,6 @@ fn payload(v: &Vademecum) -> Vec<u8> {
         put(&mut out, &l.correction_offsets);
         put(&mut out, &l.correction_nodes);
         put(&mut out, &l.correction);
-        put(&mut out, &step.forces_n);
     }
     if let Some(cuts) = &v.cuts {
         put(&mut out, &cuts.positions);
@@ -244,6 +244,7 @@ fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumEr
         return Err(r.malformed("triangles"));
     }
     let triangles = flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    let reference_compliance_m_per_n = r.take("reference compliances")?;
     let count: Vec<u32> = r.take("step count")?;
     let count = *count.first().ok_or_else(|| r.malformed("step count"))?;
     let mut steps = Vec::new();
@@ -259,7 +260,6 @@ fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumEr
                 correction_nodes: r.take("correction nodes")?,
                 correction: r.take("corrections")?,
             },
-            forces_n: r.take("load-step forces")?,
         });
     }
     let cuts = read_cuts(r, &header)?;
@@ -271,6 +271,7 @@ fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumEr
         position_areas_m2,
         position_normals,
         triangles,
+        reference_compliance_m_per_n,
         steps,
         cuts,
     })
@@ -297,6 +298,9 @@ fn validate(path: &Path, v: &Vademecum) -> Result<(), VademecumError> {
         || v.position_normals.len() != m
     {
         return fail("position coordinates, areas or normals (one per position expected)");
+    }
+    if v.reference_compliance_m_per_n.len() != m {
+        return fail("reference compliances (one per position expected)");
     }
     if v.steps.len() != v.header.indentation_levels_m.len() || v.steps.is_empty() {
         return fail("steps (their count differs from the header's load steps)");
@@ -351,37 +355,7 @@ fn validate(path: &Path, v: &Vademecum) -> Result<(), VademecumError> {
             return fail(&format!("near-field corrections of step {k}"));
         }
     }
-    check_step_forces(v).map_or(Ok(()), |what| fail(&what))
-}
-
-/// What is wrong with the load steps' forces, if anything: each nonlinear step has one per
-/// position, and at every position that moves they grow from step to step (the blend between
-/// two steps divides by their difference); one that does not (clamped) has none.
-fn check_step_forces(v: &Vademecum) -> Option<String> {
-    let m = v.positions.len();
-    if !v.steps[0].forces_n.is_empty() {
-        return Some("load-step forces (the linear step has none)".into());
-    }
-    let mut below = vec![0.0f32; m];
-    for (k, step) in v.steps.iter().enumerate().skip(1) {
-        if step.forces_n.len() != m {
-            return Some(format!(
-                "load-step forces of step {k} (one per position expected)"
-            ));
-        }
-        let growing = step
-            .forces_n
-            .iter()
-            .zip(&below)
-            .all(|(&f, &b)| f.is_finite() && (f > b || f == 0.0 && b == 0.0));
-        if !growing {
-            return Some(format!(
-                "load-step forces of step {k} (not finite, or not above the step before's)"
-            ));
-        }
-        below.clone_from(&step.forces_n);
-    }
-    None
+    Ok(())
 }
 
 /// A material and its inclusions, for a message.

@@ -117,25 +117,20 @@ impl Responses {
             .for_each(|(a, b)| *a += sign * b);
     }
 
-    /// Turns linear (or previous-step) responses into the secant responses of a load step
-    /// pressed to a depth: per unit force, the response `ũ = u / λ` with `K u = λ f_p − N(u)`
-    /// whose own patch is pressed `presses_m[p]` deep ([`patch_depth`]: along that
-    /// displacement, as long; a zero press is none), and the
-    /// force `λ` that takes. The nonlinear terms `N` of the previous iterate go to the
-    /// right-hand side (paper 000), so every iteration reuses the factorization of the rest
-    /// stiffness; each iteration sizes the force so that the iterate is the step's depth deep
-    /// (displacement control), so the terms are never evaluated deeper than the step, where a
-    /// stiffening law's force under a fixed load overshoots. `self` is the step before's
-    /// responses, which an unconverged load keeps; the iteration starts from `self + trend`.
-    /// Returns the responses, each one's force (N; 0 where the depth is) and the report.
+    /// Turns linear (or previous-step) responses into the secant responses of a KSV load step:
+    /// per unit force, the response to a force of `magnitudes_n[p]` along parameter `p`,
+    /// `ũ = u / λ` with `K u = λ e_p − N(u)`. The nonlinear terms `N` of the previous iterate
+    /// go to the right-hand side (paper 000), so every iteration reuses the factorization of
+    /// the rest stiffness. `self` is the step before's responses, which an unconverged load
+    /// keeps; the iteration starts from `self + trend`.
     pub fn secant(
         mut self,
         stiffness: &RestStiffness,
-        (patches, presses_m): (&impl UnitLoads, &[Vector3<f64>]),
+        (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
         (trend, fraction_before): (Option<&Trend>, f64),
         settings: &SecantSettings,
         progress: &(dyn Fn(usize) + Sync),
-    ) -> (Self, Vec<f64>, SecantReport) {
+    ) -> (Self, SecantReport) {
         let rows = self.rows;
         let (mut report, mut unconverged) = self
             .columns
@@ -147,7 +142,7 @@ impl Responses {
                 let done = secant_block(
                     stiffness,
                     patches,
-                    (first, &presses_m[first..]),
+                    (first, &magnitudes_n[first..]),
                     (chunk, trend),
                     settings,
                 );
@@ -163,57 +158,38 @@ impl Responses {
             );
         let rescued = self.continue_in_substeps(
             stiffness,
-            (patches, presses_m),
+            (patches, magnitudes_n),
             (&unconverged, fraction_before),
             settings,
         );
         report.substep_solved = rescued.len();
         report.unconverged -= rescued.len();
         unconverged.retain(|p| rescued.binary_search(p).is_err());
-        // Every response is its depth deep at this force, except those Newton solves below.
-        let mut forces_n: Vec<f64> = (0..self.count())
-            .map(|p| self.force_for_depth(stiffness, (patches, p), &presses_m[p]))
-            .collect();
         let few =
             unconverged.len() as f64 <= settings.max_newton_fraction * report.responses as f64;
         if few && !unconverged.is_empty() {
             let start = Instant::now();
             let (solved, solves) =
-                self.solve_by_newton(stiffness, (patches, presses_m), &unconverged, &mut forces_n);
+                self.solve_by_newton(stiffness, (patches, magnitudes_n), &unconverged);
             report.newton_seconds = start.elapsed().as_secs_f64();
             report.newton_solved = solved;
             report.newton_solves = solves;
             report.unconverged -= solved;
         }
-        (self, forces_n, report)
-    }
-
-    /// The force (N) that presses load `p`'s patch as deep as `press_m` along its response
-    /// (0 for no press).
-    fn force_for_depth(
-        &self,
-        stiffness: &RestStiffness,
-        (loads, p): (&impl UnitLoads, usize),
-        press_m: &Vector3<f64>,
-    ) -> f64 {
-        let depth_m = press_m.norm();
-        match depth_m {
-            0.0 => 0.0,
-            _ => depth_m / patch_depth(stiffness, (loads, p), self.column(p), press_m),
-        }
+        (self, report)
     }
 
     /// Takes the loads `failed` (sorted) that diverged on the step's whole increment through
     /// [`SUBSTEPS`] smaller ones, each fixed point started from the one before: from
-    /// `fraction_before` of the step's depth (the step before's; those loads hold its
-    /// response) to the whole. The fixed point with the rest stiffness diverges where the
+    /// `fraction_before` of the step's magnitude (the step before's level; those loads hold
+    /// its response) to the whole. The fixed point with the rest stiffness diverges where the
     /// tangent has moved far from it over one increment; a shorter increment starts it nearer
     /// its solution, for a few fixed points' cost where Newton would factorize the tangent at
     /// every iteration. Returns the loads so solved (sorted); the others keep their start.
     fn continue_in_substeps(
         &mut self,
         stiffness: &RestStiffness,
-        (loads, presses_m): (&impl UnitLoads, &[Vector3<f64>]),
+        (loads, magnitudes_n): (&impl UnitLoads, &[f64]),
         (failed, fraction_before): (&[usize], f64),
         settings: &SecantSettings,
     ) -> Vec<usize> {
@@ -229,15 +205,15 @@ impl Responses {
                 let mut alive = vec![true; parameters.len()];
                 for i in 1..=SUBSTEPS {
                     let t = fraction_before + (1.0 - fraction_before) * i as f64 / SUBSTEPS as f64;
-                    let presses: Vec<Vector3<f64>> = parameters
+                    let magnitudes: Vec<f64> = parameters
                         .iter()
                         .zip(&alive)
-                        .map(|(&p, &a)| presses_m[p] * if a { t } else { 0.0 })
+                        .map(|(&p, &a)| if a { t * magnitudes_n[p] } else { 0.0 })
                         .collect();
                     let (_, diverged) = secant_block(
                         stiffness,
                         &subset,
-                        (0, &presses),
+                        (0, &magnitudes),
                         (&mut chunk, None),
                         settings,
                     );
@@ -260,31 +236,55 @@ impl Responses {
         solved.into_iter().map(|(p, _)| p).collect()
     }
 
-    /// Solves the loads `parameters` by Newton (in parallel), each at the force that presses
-    /// the step before's response it holds to its depth ([`newton_at_depth_force`]): for the
-    /// few that the fixed point with the rest stiffness cannot carry. A load Newton fails on
-    /// too keeps that response. Returns the number solved and what their linear solves cost,
-    /// and puts each solved load's force in `forces_n`.
+    /// Solves the loads `parameters` by Newton, one full nonlinear solve each (in parallel),
+    /// from the step before's response they hold (or from rest, in increments, if that start
+    /// inverts an element): for the few that the fixed point with the rest stiffness cannot
+    /// carry. A load Newton fails on too keeps that response. Its linear systems are solved
+    /// by conjugate gradients preconditioned with the rest stiffness's factor
+    /// ([`RestStiffness::newton_solver`]). Returns the number solved and what their linear
+    /// solves cost.
     fn solve_by_newton(
         &mut self,
         stiffness: &RestStiffness,
-        (patches, presses_m): (&impl UnitLoads, &[Vector3<f64>]),
+        (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
         parameters: &[usize],
-        forces_n: &mut [f64],
     ) -> (usize, KrylovStatistics) {
-        let solved: Vec<(usize, Vec<f64>, f64, KrylovStatistics)> = parameters
+        let model = stiffness.model;
+        let settings = NewtonSettings {
+            relative_tolerance: NEWTON_TOLERANCE,
+            ..NewtonSettings::default()
+        };
+        let solved: Vec<(usize, Vec<f64>, KrylovStatistics)> = parameters
             .par_iter()
             .filter_map(|&p| {
-                let load = (patches, p, &presses_m[p]);
-                let (column, force_n, solves) =
-                    newton_at_depth_force(stiffness, load, self.column(p))?;
-                Some((p, column, force_n, solves))
+                let lambda = magnitudes_n[p];
+                let start = stiffness
+                    .extend(self.column(p))
+                    .iter()
+                    .map(|u| u * lambda)
+                    .collect();
+                let shares = patches.nodal_shares(p);
+                let direction = patches.direction(p);
+                let loads =
+                    parameter_load(model.mesh().node_count(), shares, direction, lambda).ok()?;
+                // A start that turns an element inside out: a load path from rest instead.
+                let path = NewtonSettings {
+                    load_steps: NEWTON_PATH_STEPS,
+                    ..settings
+                };
+                let mut solver = stiffness.newton_solver();
+                let solution = model
+                    .solve_static_from(start, &loads, &settings, &mut solver)
+                    .or_else(|_| model.solve_static_with(&mut solver, &loads, &path))
+                    .ok()?;
+                let secant = stiffness.restrict(&solution.displacement_m);
+                let column = secant.iter().map(|u| u / lambda).collect();
+                Some((p, column, solver.statistics()))
             })
             .collect();
         let mut statistics = KrylovStatistics::default();
-        for (p, column, force_n, solves) in &solved {
+        for (p, column, solves) in &solved {
             self.columns[p * self.rows..(p + 1) * self.rows].copy_from_slice(column);
-            forces_n[*p] = *force_n;
             statistics = statistics.merge(*solves);
         }
         (solved.len(), statistics)
@@ -319,44 +319,6 @@ impl Responses {
         });
         gram
     }
-}
-
-/// Newton's solution for load `p` of `loads` at the force that presses the secant response
-/// `start` (per unit force, the step before's) as deep as `press_m`, from `start` at that
-/// force (from rest, in increments, if that start turns an element inside out). A law that
-/// stiffens over the increment stops short of the depth; the force is what the response is
-/// kept with, so the blend between steps stays true to it. Returns the response per unit
-/// force, the force, and what the linear solves cost; `None` where Newton fails.
-fn newton_at_depth_force(
-    stiffness: &RestStiffness,
-    (loads, p, press_m): (&impl UnitLoads, usize, &Vector3<f64>),
-    start: &[f64],
-) -> Option<(Vec<f64>, f64, KrylovStatistics)> {
-    let model = stiffness.model;
-    let settings = NewtonSettings {
-        relative_tolerance: NEWTON_TOLERANCE,
-        ..NewtonSettings::default()
-    };
-    let path = NewtonSettings {
-        load_steps: NEWTON_PATH_STEPS,
-        ..settings
-    };
-    let force_n = press_m.norm() / patch_depth(stiffness, (loads, p), start, press_m);
-    let (shares, direction) = (loads.nodal_shares(p), loads.direction(p));
-    let pushed = parameter_load(model.mesh().node_count(), shares, direction, force_n).ok()?;
-    let from = stiffness
-        .extend(start)
-        .iter()
-        .map(|u| u * force_n)
-        .collect();
-    let mut solver = stiffness.newton_solver();
-    let solution = model
-        .solve_static_from(from, &pushed, &settings, &mut solver)
-        .or_else(|_| model.solve_static_with(&mut solver, &pushed, &path))
-        .ok()?;
-    let secant = stiffness.restrict(&solution.displacement_m);
-    let column = secant.iter().map(|u| u / force_n).collect();
-    Some((column, force_n, solver.statistics()))
 }
 
 /// How the secant responses moved over the last step, scaled to the next one: `r (Ũ_k − Ũ_{k−1})`
@@ -489,41 +451,6 @@ impl SecantReport {
     }
 }
 
-/// The displacement (m) of the patch of load `p` in a free-dof response `column`: its nodes'
-/// displacements averaged with their shares.
-pub fn patch_displacement(
-    stiffness: &RestStiffness,
-    loads: &impl UnitLoads,
-    p: usize,
-    column: &[f64],
-) -> Vector3<f64> {
-    let free_index = &stiffness.model.dofs().free_index;
-    Vector3::from_fn(|c, _| {
-        loads
-            .nodal_shares(p)
-            .map(|(node, share)| match free_index[3 * node + c] {
-                crate::fem::PRESCRIBED => 0.0,
-                free => share * column[free],
-            })
-            .sum::<f64>()
-    })
-}
-
-/// How deep (m) a response `column` presses the patch of load `p` towards `press` (the
-/// displacement a step presses it to): its [`patch_displacement`] along `press`. A load
-/// step's depth is this one; it is linear in the response, so a combination of responses as
-/// deep, with weights summing to one, is as deep.
-pub fn patch_depth(
-    stiffness: &RestStiffness,
-    (loads, p): (&impl UnitLoads, usize),
-    column: &[f64],
-    press: &Vector3<f64>,
-) -> f64 {
-    press
-        .normalize()
-        .dot(&patch_displacement(stiffness, loads, p, column))
-}
-
 /// Adds the unit load of parameter `p` to `column` (free dofs).
 fn add_unit_load(stiffness: &RestStiffness, loads: &impl UnitLoads, p: usize, column: &mut [f64]) {
     let free_index = &stiffness.model.dofs().free_index;
@@ -539,27 +466,20 @@ fn add_unit_load(stiffness: &RestStiffness, loads: &impl UnitLoads, p: usize, co
 }
 
 /// The fixed point for the columns of one block (`first` is the first column's parameter),
-/// each pressed to its depth (none for a depth of zero), iterating only the columns still
-/// moving. It iterates on the displacement `u` under displacement control: with `v` the
-/// response to the nonlinear terms of the iterate, `K₀ v = −N(u)`, the next iterate is
-/// `λ u_lin + v`, `u_lin` the linear response to the unit load and `λ` the force that puts it
-/// at the depth (the depth is linear in `u`, so every iterate, and any affine combination of
-/// them that the acceleration and damping take, is that deep). The responses come back per
-/// unit force, `u / λ`. Each column is accelerated by Anderson's method ([`Anderson`]): where
-/// the law stiffens or softens, the plain iteration with the rest stiffness overshoots or
-/// crawls.
+/// iterating only the columns still moving. Each column is accelerated by Anderson's method
+/// ([`Anderson`]): where the law stiffens or softens, the plain iteration with the rest
+/// stiffness overshoots or crawls.
 fn secant_block(
     stiffness: &RestStiffness,
     patches: &impl UnitLoads,
-    (first, presses_m): (usize, &[Vector3<f64>]),
+    (first, magnitudes_n): (usize, &[f64]),
     (chunk, trend): (&mut [f64], Option<&[f64]>),
     settings: &SecantSettings,
 ) -> (SecantReport, Vec<usize>) {
     let rows = stiffness.free_count();
     let columns = chunk.len() / rows;
-    // A load on a clamped node has no response and no depth: nothing to iterate.
-    let depths_m: Vec<f64> = presses_m[..columns].iter().map(|p| p.norm()).collect();
-    let mut active: Vec<usize> = (0..columns).filter(|&j| depths_m[j] != 0.0).collect();
+    // A load on a clamped node has no response and no magnitude: nothing to iterate.
+    let mut active: Vec<usize> = (0..columns).filter(|&j| magnitudes_n[j] != 0.0).collect();
     let mut change = vec![0.0; columns];
     let mut growing = vec![0usize; columns];
     let mut accelerators: Vec<Anderson> = (0..columns)
@@ -573,20 +493,6 @@ fn secant_block(
     if let Some(trend) = trend {
         chunk.iter_mut().zip(trend).for_each(|(u, t)| *u += t);
     }
-    let depth = |j: usize, column: &[f64]| {
-        patch_depth(stiffness, (patches, first + j), column, &presses_m[j])
-    };
-    let mut linear = vec![0.0; chunk.len()];
-    for &j in &active {
-        add_unit_load(stiffness, patches, first + j, &mut linear[j * rows..]);
-    }
-    stiffness.solve_block(&mut linear);
-    let mut forces_n = vec![0.0; columns];
-    for &j in &active {
-        let column = &mut chunk[j * rows..(j + 1) * rows];
-        let scale = depths_m[j] / depth(j, column);
-        column.iter_mut().for_each(|u| *u *= scale);
-    }
     let mut previous = chunk.to_vec();
     let mut work = NonlinearWork::new(stiffness);
     for iteration in 1..=settings.max_iterations {
@@ -594,8 +500,11 @@ fn secant_block(
         for &j in &active {
             let span = j * rows..(j + 1) * rows;
             let begin = rhs.len();
-            match work.finite_right_hand_side((&mut chunk[span.clone()], &previous[span]), &mut rhs)
-            {
+            match work.finite_right_hand_side(
+                (&mut chunk[span.clone()], &previous[span]),
+                magnitudes_n[j],
+                &mut rhs,
+            ) {
                 // No iterate between the last two keeps every element's volume positive.
                 None => {
                     change[j] = f64::NAN;
@@ -605,23 +514,17 @@ fn secant_block(
                 Some(0) => {}
                 Some(_) => accelerators[j].reset(),
             }
+            add_unit_load(stiffness, patches, first + j, &mut rhs[begin..]);
         }
         for &j in &active {
             previous[j * rows..(j + 1) * rows].copy_from_slice(&chunk[j * rows..(j + 1) * rows]);
         }
         stiffness.solve_block(&mut rhs);
-        for (&j, v) in active.iter().zip(rhs.chunks_exact(rows)) {
+        for (&j, target) in active.iter().zip(rhs.chunks_exact(rows)) {
             if change[j].is_nan() {
                 continue;
             }
             let span = j * rows..(j + 1) * rows;
-            let linear = &linear[span.clone()];
-            forces_n[j] = (depths_m[j] - depth(j, v)) / depth(j, linear);
-            let target: Vec<f64> = linear
-                .iter()
-                .zip(v)
-                .map(|(l, v)| forces_n[j] * l + v)
-                .collect();
             // The fixed point's own residual `G(x) − x`, whatever step the acceleration and
             // damping then take.
             let norm = target.iter().map(|u| u * u).sum::<f64>();
@@ -630,7 +533,7 @@ fn secant_block(
                 .zip(&previous[span.clone()])
                 .map(|(g, x)| (g - x) * (g - x))
                 .sum::<f64>();
-            accelerators[j].advance(&mut chunk[span], target);
+            accelerators[j].advance(&mut chunk[span], target.to_vec());
             let before = change[j];
             change[j] = (residual / norm).sqrt();
             if overshoots(&mut growing[j], before, change[j]) {
@@ -645,16 +548,12 @@ fn secant_block(
             break;
         }
     }
-    let failed = |j: usize| change[j].is_nan() || change[j] >= settings.tolerance;
-    for j in 0..columns {
-        let span = j * rows..(j + 1) * rows;
-        if failed(j) {
-            chunk[span.clone()].copy_from_slice(&start[span]);
-        } else if depths_m[j] != 0.0 {
-            chunk[span].iter_mut().for_each(|u| *u /= forces_n[j]);
-        }
+    let unconverged: Vec<usize> = (0..columns)
+        .filter(|&j| change[j].is_nan() || change[j] >= settings.tolerance)
+        .collect();
+    for &j in &unconverged {
+        chunk[j * rows..(j + 1) * rows].copy_from_slice(&start[j * rows..(j + 1) * rows]);
     }
-    let unconverged: Vec<usize> = (0..columns).filter(|&j| failed(j)).collect();
     report.unconverged = unconverged.len();
     report.worst_change = change
         .iter()
@@ -698,23 +597,23 @@ impl<'a> NonlinearWork<'a> {
         }
     }
 
-    /// Appends `−N(u)` to `rhs` for the iterate `u` (`column`); where the iterate turns an
-    /// element inside out (the neo-Hookean force is then not finite), it is first moved
+    /// Appends `−N(λ ũ) / λ` to `rhs` for the iterate `ũ` (`column`); where the iterate turns
+    /// an element inside out (the neo-Hookean force is then not finite), it is first moved
     /// halfway back towards `previous`, up to [`MAX_HALVINGS`] times, as Newton's line search
-    /// does. The starting iterate (equal to `previous`), the step before's response pressed to
-    /// this step's depth, is moved towards the rest state instead: the next iterate is the
-    /// step's depth deep whatever this one's depth. Returns the halvings taken, `None` if none
-    /// gave a finite force.
+    /// does. The starting iterate (equal to `previous`), the step before's response at this
+    /// step's larger force, is moved towards the rest state instead. Returns the halvings
+    /// taken, `None` if none gave a finite force.
     fn finite_right_hand_side(
         &mut self,
         (column, previous): (&mut [f64], &[f64]),
+        lambda: f64,
         rhs: &mut Vec<f64>,
     ) -> Option<usize> {
         let begin = rhs.len();
         let towards_rest = column == previous;
         for halvings in 0..=MAX_HALVINGS {
             rhs.truncate(begin);
-            rhs.extend(self.right_hand_side(column));
+            rhs.extend(self.right_hand_side(column, lambda));
             if rhs[begin..].iter().all(|v| v.is_finite()) {
                 return Some(halvings);
             }
@@ -729,17 +628,17 @@ impl<'a> NonlinearWork<'a> {
         None
     }
 
-    /// `−N(u)` over free dofs, for a displacement `u` over free dofs.
-    fn right_hand_side(&mut self, u: &[f64]) -> impl Iterator<Item = f64> {
+    /// `−N(λ ũ) / λ` over free dofs, for a secant response `ũ` at force magnitude `λ`.
+    fn right_hand_side(&mut self, secant: &[f64], lambda: f64) -> impl Iterator<Item = f64> {
         let free_dofs = &self.stiffness.model.dofs().free_dofs;
         self.full.fill(0.0);
-        for (&d, &v) in free_dofs.iter().zip(u) {
-            self.full[d] = v;
+        for (&d, &v) in free_dofs.iter().zip(secant) {
+            self.full[d] = lambda * v;
         }
         self.force.fill(0.0);
         self.stiffness
             .model
             .add_nonlinear_force(&self.full, &mut self.force);
-        free_dofs.iter().map(move |&d| -self.force[d])
+        free_dofs.iter().map(move |&d| -self.force[d] / lambda)
     }
 }

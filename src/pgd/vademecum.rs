@@ -74,10 +74,6 @@ pub struct Step {
     /// Parametric modes, one after another, each over all `3 × positions` parameters.
     pub parametric: Vec<f32>,
     pub local: LocalPart,
-    /// A nonlinear step, per position: the force (N) along its inward normal that presses the
-    /// patch centred on it the step's depth, what the step's response and correction there
-    /// are for. Empty for the linear step (force zero).
-    pub forces_n: Vec<f32>,
 }
 
 /// A point of the accessible surface: a triangle and barycentric weights on its positions.
@@ -192,6 +188,10 @@ pub struct Vademecum {
     pub position_normals: Vec<[f32; 3]>,
     /// The accessible triangles, as position indices.
     pub triangles: Vec<[u32; 3]>,
+    /// Per position, how deep (m/N) a unit force along its outward normal presses the tool's
+    /// patch centred on it, linearly (a linear vademecum: its largest nodal self-compliance):
+    /// turns a force into the indentation level that selects load steps.
+    pub reference_compliance_m_per_n: Vec<f32>,
     /// Load steps in increasing indentation; one for a linear vademecum.
     pub steps: Vec<Step>,
     /// The uncut organ's compressed responses to loads anywhere cuts may go: what a cut state
@@ -230,8 +230,9 @@ impl Vademecum {
         (0..self.steps.len()).map(|s| self.modes(s)).sum()
     }
 
-    /// The deepest load step's depth (m) under the tool. A press stays within the range while
-    /// its force stays within that step's forces ([`Self::patch_press_in_range`]).
+    /// The deepest load step's level (m): the linear depth of the tool's patch there. A press
+    /// stays within the range while its patch's level does
+    /// ([`Self::patch_press_in_range`]).
     pub fn valid_indentation_m(&self) -> f64 {
         self.header
             .indentation_levels_m
@@ -326,10 +327,9 @@ impl Vademecum {
         self.geometry().centred_on(m, neighbours)
     }
 
-    /// Weight of load step `step` for position `j` under a force `force_norm_n` long
-    /// ([`Self::blend`]).
-    fn step_weight(&self, step: usize, j: usize, force_norm_n: f64) -> f64 {
-        let (first, last, t) = self.blend(j, force_norm_n);
+    /// Weight of load step `step` at a level `level_m` deep ([`Self::blend`]).
+    fn step_weight(&self, step: usize, level_m: f64) -> f64 {
+        let (first, last, t) = self.blend(level_m);
         if step == last {
             t
         } else if step == first {
@@ -339,48 +339,48 @@ impl Vademecum {
         }
     }
 
-    /// The two load steps position `j`'s patch blends under a force `force_norm_n` long, and
-    /// the second one's weight: piecewise linear between the steps' forces there, held at the
-    /// last step beyond it (both steps the same, weight one, outside the forces).
-    fn blend(&self, j: usize, force_norm_n: f64) -> (usize, usize, f64) {
-        let (first, last) = self.steps_at(j, force_norm_n);
+    /// The two load steps a level `level_m` deep blends, and the second one's weight:
+    /// piecewise linear between the steps' levels, held at the last step beyond it (both
+    /// steps the same, weight one, outside the levels).
+    fn blend(&self, level_m: f64) -> (usize, usize, f64) {
+        let (first, last) = self.steps_at(level_m);
         if first == last {
             return (first, last, 1.0);
         }
-        let (from_n, to_n) = (self.step_force_n(first, j), self.step_force_n(last, j));
-        (first, last, (force_norm_n - from_n) / (to_n - from_n))
+        let levels = &self.header.indentation_levels_m;
+        (
+            first,
+            last,
+            (level_m - levels[first]) / (levels[last] - levels[first]),
+        )
     }
 
-    /// The first and last steps [`Self::step_weight`] blends for position `j` under a force
-    /// `force_norm_n` long (the last step beyond the deepest step's force, or for a force that
-    /// is not a number).
-    fn steps_at(&self, j: usize, force_norm_n: f64) -> (usize, usize) {
-        let last = self.steps.len() - 1;
-        match (0..=last).find(|&k| self.step_force_n(k, j) >= force_norm_n) {
-            None => (last, last),
+    /// The first and last steps [`Self::step_weight`] blends at a level `level_m` deep (the
+    /// last step beyond the deepest level, or for a level that is not a number).
+    fn steps_at(&self, level_m: f64) -> (usize, usize) {
+        let levels = &self.header.indentation_levels_m;
+        match levels.iter().position(|&l| l >= level_m) {
+            None => (levels.len() - 1, levels.len() - 1),
             Some(0) => (0, 0),
             Some(k) => (k - 1, k),
         }
     }
 
-    /// The force (N) that presses the patch centred on position `j` load step `step`'s depth
-    /// (zero for the linear step).
-    fn step_force_n(&self, step: usize, j: usize) -> f64 {
-        match step {
-            0 => 0.0,
-            _ => f64::from(self.steps[step].forces_n[j]),
-        }
+    /// The linear depth (m) of the tool's patch centred on position `j` under the whole force
+    /// `force_norm_n`: what picks the load steps of position `j`'s correction.
+    fn level_m(&self, j: usize, force_norm_n: f64) -> f64 {
+        force_norm_n * self.reference_compliance_m_per_n[j] as f64
     }
 
     /// The share of a total force `force_n` that position `j` (share `l` of the patch) carries
     /// in load step `step`. The linear step carries the whole share; a nonlinear step holds
-    /// the correction of the patch centred on `j` at the step's force, and carries the share
-    /// the whole force's blend there gives it (the linear step's correction being none).
+    /// the correction of the patch centred on `j`, at the level the whole force presses it,
+    /// and carries the share its blend gives it (the linear step's correction being none).
     pub(crate) fn step_share(&self, step: usize, j: usize, l: f64, force_n: &Vector3<f64>) -> f64 {
         if step == 0 {
             return l;
         }
-        l * self.step_weight(step, j, force_n.norm())
+        l * self.step_weight(step, self.level_m(j, force_n.norm()))
     }
 
     /// The load steps the positions of `patch` use under `force_n`: the linear one and the
@@ -391,10 +391,10 @@ impl Vademecum {
         let deepest = patch
             .shares
             .iter()
-            .map(|&(j, _)| self.steps_at(j, force_norm_n).1)
-            .max()
-            .unwrap_or(0);
-        0..=deepest
+            .map(|&(j, _)| self.level_m(j, force_norm_n))
+            .map(|level| if level.is_nan() { f64::INFINITY } else { level })
+            .fold(0.0, f64::max);
+        0..=self.steps_at(deepest).1
     }
 
     /// The 3 × 3 compliance (m/N) of load step `step` for `patch`: the patch-averaged
@@ -519,12 +519,11 @@ impl Vademecum {
     }
 
     /// [`Self::patch_press`] held within the load steps' range, and the share of
-    /// `indentation_m` it answers (one within the range). The range's edge is the
-    /// share-weighted last-step force of the patches centred on the patch's positions (the
-    /// force that presses the tool's own patch about the last step's depth); past it the force
-    /// is held at that magnitude, along the direction the blend's stiffness there gives (the
-    /// blend depends on the force's magnitude only), and answers that share of the
-    /// indentation.
+    /// `indentation_m` it answers (one within the range). The patch's level is the
+    /// share-weighted level of the patches centred on its positions (close to the linear depth
+    /// of the tool's own patch); past the last step's the force is held at the magnitude that
+    /// puts the patch there, along the direction the blend's stiffness there gives (the blend
+    /// depends on the force's magnitude only), and answers that share of the indentation.
     pub fn patch_press_in_range(
         &self,
         patch: &mut Patch,
@@ -534,12 +533,12 @@ impl Vademecum {
         if self.steps.len() == 1 {
             return (force_n, stiffness, 1.0);
         }
-        let last = self.steps.len() - 1;
-        let edge_n: f64 = patch
+        let level_per_n: f64 = patch
             .shares
             .iter()
-            .map(|&(j, l)| l * self.step_force_n(last, j))
+            .map(|&(j, l)| l * self.level_m(j, 1.0))
             .sum();
+        let edge_n = self.valid_indentation_m() / level_per_n;
         if force_n.norm().is_nan() || force_n.norm() <= edge_n {
             return (force_n, stiffness, 1.0);
         }
@@ -554,7 +553,7 @@ impl Vademecum {
     /// of the steps its positions reach under `force_n`.
     fn column_compliance(&self, patch: &mut Patch, force_n: &Vector3<f64>) -> Matrix3<f64> {
         let force_norm_n = force_n.norm();
-        let blend = |j: usize| self.blend(j, force_norm_n);
+        let blend = |j: usize| self.blend(self.level_m(j, force_norm_n));
         patch.fill_columns(0, &self.steps[0].local);
         for slot in 0..patch.shares.len() {
             let (first, last, _) = blend(patch.shares[slot].0);

@@ -214,37 +214,17 @@ fn point_and_inward(
     (point, -area_vector(mesh.nodes(), &corners).normalize())
 }
 
-/// The force along `direction` that the vademecum says presses the tool's patch at `at`
-/// `indentation_m` along it: the root of that depth against the force's magnitude, by the
-/// secant method from rest and the linear force (exact for a linear vademecum at once). It
-/// sets full FEM's loads at the depths wanted whatever the law, where the linear force would
-/// press a stiffening tissue less deep.
-fn pressing_force(
+/// The force (N) along `direction` whose linear response is `indentation_m` deep at `at`.
+fn linear_force(
     vademecum: &Vademecum,
     at: &SurfacePoint,
     direction: &Vector3<f64>,
     indentation_m: f64,
 ) -> Vector3<f64> {
-    let patch = vademecum.patch(at);
-    let depth_m = |force_n: f64| {
-        let force = direction * force_n;
-        direction.dot(&(vademecum.compliance(&patch, &force) * force))
-    };
-    let (mut before, mut force_n) = ((0.0, 0.0), indentation_m / depth_m(1.0));
-    for _ in 0..PRESSING_ROUNDS {
-        let reached_m = depth_m(force_n);
-        if (reached_m - indentation_m).abs() <= 1e-9 * indentation_m || reached_m == before.1 {
-            break;
-        }
-        let slope = (reached_m - before.1) / (force_n - before.0);
-        before = (force_n, reached_m);
-        force_n += (indentation_m - reached_m) / slope;
-    }
-    direction * force_n
+    let compliance =
+        direction.dot(&(vademecum.step_compliance(0, &vademecum.patch(at)) * direction));
+    direction * (indentation_m / compliance)
 }
-
-/// Rounds of [`pressing_force`]'s secant method.
-const PRESSING_ROUNDS: usize = 20;
 
 /// `force` spread over the tool's patch at `point`, and the patch's nodal shares.
 fn patch_loads(
@@ -285,7 +265,8 @@ fn sample(
     let direction = tilted_inward(rng, inward, settings);
     let (low, high) = settings.indentation_range_m;
     let indentation_m = low + (high - low) * rng.f64();
-    let force = pressing_force(vademecum, at, &direction, indentation_m);
+    // The linear compliance along the direction sets the force for the wanted indentation.
+    let force = linear_force(vademecum, at, &direction, indentation_m);
     let facing = vademecum.triangle_facing(at.triangle);
     let (loads, shares) = patch_loads(mesh, kernel, (point, &facing), &force)?;
     let newton = NewtonSettings {
@@ -309,8 +290,8 @@ fn sample(
 }
 
 /// Full FEM pressed along the inward normal at `at` in `curve_levels` equal force steps up to
-/// the force the vademecum gives the deepest indentation, one Newton path; the vademecum
-/// answers each step's indentation.
+/// the deepest indentation's linear force, one Newton path; the vademecum answers each step's
+/// indentation.
 fn force_depth_curve(
     model: &FemModel,
     vademecum: &Vademecum,
@@ -320,7 +301,7 @@ fn force_depth_curve(
 ) -> Result<ForceDepthCurve, FemError> {
     let mesh = model.mesh();
     let (point, inward) = point_and_inward(mesh, vademecum, at);
-    let force = pressing_force(vademecum, at, &inward, settings.indentation_range_m.1);
+    let force = linear_force(vademecum, at, &inward, settings.indentation_range_m.1);
     let facing = vademecum.triangle_facing(at.triangle);
     let (loads, shares) = patch_loads(mesh, kernel, (point, &facing), &force)?;
     let newton = NewtonSettings {

@@ -30,6 +30,7 @@ const MAX_EXPANDED_BYTES: usize = 1 << 30;
 pub fn vademecum(vademecum: &Vademecum) -> Vec<u8> {
     let mut rounded = vademecum.clone();
     let round_all = |values: &mut [f32]| values.iter_mut().for_each(|v| *v = round(*v));
+    round_all(&mut rounded.reference_compliance_m_per_n);
     for step in &mut rounded.steps {
         round_all(&mut step.spatial);
         round_all(&mut step.parametric);

@@ -203,13 +203,17 @@ fn fixed_point_settings_count_for_nonlinear_vademecums_only() {
     assert!(err.to_string().contains("mixing 0.25"), "{err}");
 }
 
-/// `linear` with its step repeated as a neo-Hookean step at 1 mm, pressed by 1 N everywhere.
-fn with_a_nonlinear_step(linear: &pgd_surgery::pgd::Vademecum) -> pgd_surgery::pgd::Vademecum {
+/// A vademecum whose nonlinear steps were built from nodal loads (files from before the steps
+/// loaded the tool's patch, which read as nodal) or from the tool's patch along each axis is
+/// refused with a message that says to rebuild it; the same file with steps of the tool's
+/// patch pushed along the inward normal, and a linear file of any kind, load.
+#[test]
+fn nonlinear_steps_built_otherwise_are_refused() {
+    let model = block_model(block_mesh([4, 3, 2]));
+    let linear = build_block(&model, 4);
     let mut nonlinear = linear.clone();
     nonlinear.header.material.law = Law::NeoHookean;
-    let mut step = linear.steps[0].clone();
-    step.forces_n = vec![1.0; linear.positions.len()];
-    nonlinear.steps.push(step);
+    nonlinear.steps.push(linear.steps[0].clone());
     nonlinear.header.indentation_levels_m.push(1e-3);
     nonlinear
         .header
@@ -219,46 +223,6 @@ fn with_a_nonlinear_step(linear: &pgd_surgery::pgd::Vademecum) -> pgd_surgery::p
         .header
         .convergence
         .push(linear.header.convergence[0].clone());
-    nonlinear
-}
-
-/// A nonlinear step's forces must grow from the step before's at every position that moves
-/// (the step blend divides by their difference): a file whose forces do not, or are missing,
-/// is refused as malformed, naming the step.
-#[test]
-fn load_step_forces_that_do_not_grow_are_refused() {
-    let model = block_model(block_mesh([4, 3, 2]));
-    let nonlinear = with_a_nonlinear_step(&build_block(&model, 2));
-    let path = temp("growing.vdm");
-    save(&path, &nonlinear).unwrap();
-    assert_eq!(load(&path).unwrap(), nonlinear);
-    for forces_n in [vec![1.0, -1.0], vec![f32::NAN], vec![]] {
-        let mut file = nonlinear.clone();
-        let step = &mut file.steps[1].forces_n;
-        step.iter_mut()
-            .zip(forces_n.iter().cycle())
-            .for_each(|(f, g)| *f = *g);
-        if forces_n.is_empty() {
-            step.pop();
-        }
-        let path = temp("not-growing.vdm");
-        save(&path, &file).unwrap();
-        let err = load(&path).unwrap_err();
-        assert!(matches!(err, VademecumError::Malformed { .. }), "{err}");
-        assert!(err.to_string().contains("forces of step 1"), "{err}");
-        assert!(err.to_string().contains("not-growing.vdm"), "{err}");
-    }
-}
-
-/// A vademecum whose nonlinear steps were built from nodal loads (files from before the steps
-/// loaded the tool's patch, which read as nodal) or from the tool's patch along each axis is
-/// refused with a message that says to rebuild it; the same file with steps of the tool's
-/// patch pushed along the inward normal, and a linear file of any kind, load.
-#[test]
-fn nonlinear_steps_built_otherwise_are_refused() {
-    let model = block_model(block_mesh([4, 3, 2]));
-    let linear = build_block(&model, 4);
-    let nonlinear = with_a_nonlinear_step(&linear);
     for (vademecum, name) in [(&linear, "linear"), (&nonlinear, "nonlinear")] {
         for step_loads in [
             StepLoads::Nodal,

@@ -9,8 +9,7 @@ use pgd_surgery::fem::{FemModel, Law, Loads, NewtonSettings, PatchKernel};
 use pgd_surgery::mesh::Surface;
 use pgd_surgery::pgd::{
     BuildSettings, LoadPatches, Responses, RestStiffness, SecantReport, SecantSettings, Silent,
-    SurfacePoint, ValidationReport, ValidationSettings, build, newton_baseline, patch_depth,
-    validate,
+    SurfacePoint, ValidationReport, ValidationSettings, build, newton_baseline, validate,
 };
 
 use crate::common::{block_mesh, block_model_of, organ, settings};
@@ -39,12 +38,10 @@ fn tight() -> SecantSettings {
     }
 }
 
-/// Each load parameter p is pressed `depth_m` deep along its axis (its node's displacement)
-/// by a force λ_p; `λ_p ũ_p` must be the equilibrium that Newton finds for the same nodal
-/// force: tolerance 1e-6 relative (the Newton solve converges to 1e-10 of the load). Loads the
-/// fixed point solves are that deep to its tolerance; those it leaves to Newton are pushed by
-/// the force that presses the step before's response that deep, and land off it as far as
-/// the law's secant stiffness changes over the step. The secant responses come from `fixed_point`; its report is returned.
+/// For a force of magnitude λ along parameter p, `λ ũ_p` must be the equilibrium that Newton
+/// finds for the same nodal force: tolerance 1e-6 relative (the Newton solve converges to
+/// 1e-10 of the load). Each force pushes its own node `depth_m` in the linear response. The
+/// secant responses come from `fixed_point`; its report is returned.
 fn secant_responses_are_equilibria(
     law: Law,
     depth_m: f64,
@@ -58,13 +55,14 @@ fn secant_responses_are_equilibria(
     let patches = LoadPatches::new(&surface, &kernel, top_nodes(&model)).unwrap();
     let stiffness = RestStiffness::new(&model).unwrap();
     let linear = Responses::linear(&stiffness, &patches, &|_| {});
-    let presses: Vec<Vector3<f64>> = (0..linear.count())
-        .map(|p| Vector3::ith(p % 3, depth_m))
+    let own_dof = |p: usize| model.dofs().free_index[3 * patches.positions[p / 3] + p % 3];
+    let magnitudes: Vec<f64> = (0..linear.count())
+        .map(|p| depth_m / linear.column(p)[own_dof(p)])
         .collect();
     let before = linear.columns.clone();
-    let (secant, magnitudes, report) = linear.secant(
+    let (secant, report) = linear.secant(
         &stiffness,
-        (&patches, &presses),
+        (&patches, &magnitudes),
         (None, 0.0),
         fixed_point,
         &|_| {},
@@ -88,12 +86,6 @@ fn secant_responses_are_equilibria(
             .iter()
             .map(|u| u / magnitudes[p])
             .collect();
-        let depth = patch_depth(&stiffness, (&patches, p), secant.column(p), &presses[p]);
-        let depth = depth * magnitudes[p];
-        match report.newton_solved {
-            0 => assert!((depth - depth_m).abs() <= fixed_point.tolerance * depth_m),
-            _ => assert!((depth - depth_m).abs() < 0.5 * depth_m, "{depth} m deep"),
-        }
         let error = relative(secant.column(p), &reference);
         let nonlinearity = relative(&before[p * secant.rows..(p + 1) * secant.rows], &reference);
         eprintln!(
@@ -123,7 +115,7 @@ fn a_deep_neo_hookean_secant_response_is_the_equilibrium_per_unit_force() {
 }
 
 /// The exponential law (b = 2) under the same loads to 10 mm: the same fixed point lands on
-/// the equilibrium. (At 15 mm, under a nodal load's concentrated strain, the modulus grows by
+/// the equilibrium. (At 25 mm, under a nodal load's concentrated strain, the modulus grows by
 /// e^{2x} and the fixed point on the rest stiffness diverges for some loads: below.)
 #[test]
 fn a_deep_exponential_secant_response_is_the_equilibrium_per_unit_force() {
@@ -131,25 +123,24 @@ fn a_deep_exponential_secant_response_is_the_equilibrium_per_unit_force() {
     assert_eq!(report.newton_solved, 0, "{report:?}");
 }
 
-/// The exponential law 15 mm under a nodal load: over the whole increment from rest the
-/// fixed point diverges for some loads; taken through four smaller increments each, they
-/// reach the same equilibrium as Newton's (1e-6), Newton left out.
+/// The exponential law 25 mm under a nodal load: over the whole increment from rest the
+/// fixed point diverges for some loads (2 of the 6 here); taken through four smaller
+/// increments each, they reach the same equilibrium as Newton's (1e-6), Newton left out.
 #[test]
 fn loads_that_diverge_over_the_whole_step_converge_through_substeps() {
     let no_newton = SecantSettings {
         max_newton_fraction: 0.0,
         ..tight()
     };
-    let report = secant_responses_are_equilibria(Law::Exponential, 15e-3, 16, &no_newton);
+    let report = secant_responses_are_equilibria(Law::Exponential, 25e-3, 16, &no_newton);
     eprintln!("{report:?}");
     assert!(report.substep_solved > 0, "{report:?}");
     assert_eq!(report.newton_solved, 0, "{report:?}");
 }
 
 /// Loads the fixed point leaves unconverged (here all of them: one iteration allowed) are
-/// solved by Newton from the step before's response, at the force that presses it the step's
-/// depth (they land off it by the change of the secant stiffness), to the same equilibrium as a
-/// Newton path with factorized tangents; Newton's directions come from conjugate gradients
+/// solved by Newton from the step before's response, to the same equilibrium as a Newton
+/// path with factorized tangents; Newton's directions come from conjugate gradients
 /// preconditioned by the rest stiffness, with no tangent factorized.
 #[test]
 fn loads_the_fixed_point_leaves_are_solved_by_newton() {
@@ -180,7 +171,7 @@ fn ksv_settings(load_steps_m: Vec<f64>) -> BuildSettings {
 }
 
 /// The block's vademecum under `law` with load steps `steps_m`, and the linear one, each
-/// checked against full FEM under `law` at 12 random off-node loads pressed to depths in
+/// checked against full FEM under `law` at 12 random off-node loads with linear depths in
 /// `range_m`: the two reports.
 fn against_full_fem(
     law: Law,
@@ -215,7 +206,7 @@ fn against_full_fem(
 /// vademecum's felt force must be closer (p95) than the linear vademecum's: the load steps
 /// carry the nonlinearity. Measured: 10.2 % against 14.3 % with directions up to 45° off the
 /// normal (whose tangential part the steps answer linearly), 8.9 % against 15.8 % along it.
-/// The steps reach 1.5 mm of the tool's depth: pushed along the normal, a 2 mm step
+/// The steps reach 1.5 mm of the tool's linear depth: pushed along the normal, a 2 mm step
 /// leaves 2 of the block's 75 loads that Newton cannot solve either (KSV softens under
 /// compression and loses stability).
 #[test]
@@ -256,7 +247,7 @@ fn a_load_step_beyond_stability_is_left_out() {
 /// Against full neo-Hookean FEM (Newton) at random off-node points and depths up to the
 /// deepest load step, a third of the block's thickness, the neo-Hookean vademecum's felt force
 /// stays within the 7 % just-noticeable difference (p95), and closer than the linear
-/// vademecum's. Measured: 4.9 % against 88 %.
+/// vademecum's. Measured: 4.7 % against 88 %.
 #[test]
 fn the_neo_hookean_vademecum_follows_full_fem_to_its_deepest_step() {
     let steps = vec![2.5e-3, 5e-3, 10e-3];
@@ -266,15 +257,15 @@ fn the_neo_hookean_vademecum_follows_full_fem_to_its_deepest_step() {
 }
 
 /// The exponential law's vademecum against its own full FEM, as above: every load converges,
-/// and its felt force is over four times closer than the linear vademecum's. Measured: 10.7 %
-/// against 52.9 % (4.9 times), over the 7 % target; the worst samples lie within a tool radius
-/// of the block's sides, where the corrections of patches centred on the mesh's nodes,
-/// interpolated over the tool's patch, depart most from the patch's own response.
+/// and its felt force is over five times closer than the linear vademecum's. Measured: 9.6 %
+/// against 53 % (8.2 % against 51 % along the normal), over the 7 % target: the corrections of patches centred on the mesh's nodes,
+/// interpolated over the tool's patch and between steps, depart from the patch's own response
+/// as the law stiffens.
 #[test]
 fn the_exponential_vademecum_follows_full_fem_to_its_deepest_step() {
     let steps = vec![2.5e-3, 5e-3, 10e-3];
     let (with_exponential, with_linear) = against_full_fem(Law::Exponential, steps, (1e-3, 10e-3));
-    assert!(with_exponential.force_error.p95 < 0.25 * with_linear.force_error.p95);
+    assert!(with_exponential.force_error.p95 < 0.2 * with_linear.force_error.p95);
 }
 
 /// The felt force of a nonlinear vademecum is a fixed point of its load-step blend: the
