@@ -4,8 +4,8 @@
 //! A PGD build holds the rest stiffness's Cholesky factor for its whole run. The loads its
 //! fixed point leaves to Newton differ from rest mostly around the tool, so the preconditioned
 //! tangent is the identity plus a perturbation of the nodes that stiffened: conjugate
-//! gradients then converge in about ten iterations (on the liver), each a pair of triangular solves and a
-//! sparse product, where a direct solve factorizes every tangent anew (LU once a tangent has
+//! gradients then converge in about ten iterations (on the liver), each a pair of triangular
+//! solves and a sparse product, where a direct solve factorizes every tangent anew (LU once a tangent has
 //! been indefinite, several times the cost of a Cholesky). Newton only needs each direction to
 //! a relative residual that shrinks with its own (an inexact Newton method, Eisenstat and
 //! Walker's), so the early directions cost fewer iterations still. Where a tangent is
@@ -126,23 +126,29 @@ impl Preconditioned<'_> {
         rhs: &mut [f64],
         forcing: f64,
     ) -> Result<(), FemError> {
-        let outcome = self.conjugate_gradients(tangent, rhs, forcing);
-        match outcome {
-            Outcome::Converged(iterations) | Outcome::NegativeCurvature(iterations) => {
-                self.statistics.directions += 1;
-                self.statistics.iterations += iterations;
-                let truncated = matches!(outcome, Outcome::NegativeCurvature(_));
-                self.statistics.truncated += usize::from(truncated);
-            }
-            Outcome::Failed => {
-                let direct = match &mut self.direct {
-                    Some(direct) => direct,
-                    none => none.insert(DirectSolver::new(self.pattern)?),
-                };
-                direct.cholesky_or_lu(tangent)?.solve_in_place(rhs);
-                self.statistics.factorizations += 1;
-            }
-        }
+        let (iterations, truncated) = match self.conjugate_gradients(tangent, rhs, forcing) {
+            Outcome::Converged(iterations) => (iterations, false),
+            Outcome::NegativeCurvature(iterations) => (iterations, true),
+            Outcome::Failed => return self.factorized(tangent, rhs),
+        };
+        self.statistics.directions += 1;
+        self.statistics.iterations += iterations;
+        self.statistics.truncated += usize::from(truncated);
+        Ok(())
+    }
+
+    /// Solves with a factorization of `tangent`, where conjugate gradients did not converge.
+    fn factorized(
+        &mut self,
+        tangent: &SparseColMat<usize, f64>,
+        rhs: &mut [f64],
+    ) -> Result<(), FemError> {
+        let direct = match &mut self.direct {
+            Some(direct) => direct,
+            none => none.insert(DirectSolver::new(self.pattern)?),
+        };
+        direct.cholesky_or_lu(tangent)?.solve_in_place(rhs);
+        self.statistics.factorizations += 1;
         Ok(())
     }
 
