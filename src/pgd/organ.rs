@@ -57,6 +57,21 @@ impl ToolRadii {
     }
 }
 
+/// How deep nonlinear load steps press an organ, against the liver: the smallest side of its
+/// generated mesh's bounding box (its thickness, how far a tool pressed into it can go before
+/// it meets the organ's other side) over the liver's 100 mm, so that each abdominal organ is
+/// pressed to the same share of its thickness: 25 mm of the liver is 10.5 mm of the
+/// pancreas (42 mm thick), 6 mm of the duodenum (24 mm). 1 for a mesh file, taken as liver,
+/// and for the cornea, whose steps follow its own tool.
+pub fn press_scale(organ: Option<Organ>) -> f64 {
+    match organ {
+        Some(Organ::Gallbladder) => 0.39,
+        Some(Organ::Pancreas) => 0.42,
+        Some(Organ::Duodenum) => 0.24,
+        Some(Organ::Liver | Organ::Cornea) | None => 1.0,
+    }
+}
+
 /// Nearly incompressible soft tissue, as in paper 000.
 pub const POISSON: f64 = 0.48;
 

@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::enrichment::PgdSettings;
+use super::organ::press_scale;
 use super::responses::SecantSettings;
 use crate::fem::Law;
 use crate::mesh::organs::Organ;
@@ -53,7 +54,7 @@ impl BuildSettings {
     pub fn for_organ_law(organ: Option<Organ>, law: Law) -> Self {
         let settings = Self::for_organ(organ);
         Self {
-            load_steps_m: default_load_steps_m(settings.tool_tip_radius_m, law),
+            load_steps_m: default_load_steps_m(organ, settings.tool_tip_radius_m, law),
             ..settings
         }
     }
@@ -89,8 +90,8 @@ impl BuildSettings {
 /// under the tool lose stability in compression (measured in docs/pgd.md).
 pub const DEFAULT_LOAD_STEPS_M: [f64; 3] = [0.5e-3, 1.0e-3, 1.5e-3];
 
-/// Neo-Hookean load steps, in tool radii: 2.5 to 25 mm under the abdominal organs' 6 mm tool,
-/// the depths a trainee presses; the same proportions under the cornea's.
+/// Neo-Hookean load steps on the liver, in tool radii: 2.5 to 25 mm under the abdominal organs'
+/// 6 mm tool, the depths a trainee presses; the same proportions under the cornea's.
 pub const NEO_HOOKEAN_STEPS_TOOL_RADII: [f64; 6] = [
     2.5 / 6.0,
     5.0 / 6.0,
@@ -100,15 +101,42 @@ pub const NEO_HOOKEAN_STEPS_TOOL_RADII: [f64; 6] = [
     25.0 / 6.0,
 ];
 
-/// The load steps `law` is built with by default under a tool of `tool_tip_radius_m`: the
-/// neo-Hookean family's reach the depths a trainee presses, KSV's stop where it loses stability
-/// (the linear law has none; it keeps KSV's in its header).
-pub fn default_load_steps_m(tool_tip_radius_m: f64, law: Law) -> Vec<f64> {
+/// The load steps `law` is built with by default for `organ` under a tool of
+/// `tool_tip_radius_m`: the neo-Hookean family's reach the depths a trainee presses, the same
+/// share of each organ's thickness ([`press_scale`]); KSV's stop where it loses stability (the
+/// linear law has none; it keeps KSV's in its header).
+pub fn default_load_steps_m(organ: Option<Organ>, tool_tip_radius_m: f64, law: Law) -> Vec<f64> {
+    let scale = press_scale(organ);
     match law.is_hyperelastic() {
         true => NEO_HOOKEAN_STEPS_TOOL_RADII
             .iter()
-            .map(|r| r * tool_tip_radius_m)
+            .map(|r| r * tool_tip_radius_m * scale)
             .collect(),
         false => DEFAULT_LOAD_STEPS_M.to_vec(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn steps(organ: Organ) -> Vec<f64> {
+        BuildSettings::for_organ_law(Some(organ), Law::Exponential).load_steps_m
+    }
+
+    /// The liver is pressed to 25 mm; the other abdominal organs to the same share of their
+    /// thickness, step for step.
+    #[test]
+    fn the_organs_steps_are_the_livers_in_proportion_to_their_thickness() {
+        let liver = steps(Organ::Liver);
+        assert!((liver.last().unwrap() - 0.025).abs() < 1e-12, "{liver:?}");
+        for (organ, scale) in [(Organ::Pancreas, 0.42), (Organ::Duodenum, 0.24)] {
+            let scaled: Vec<f64> = liver.iter().map(|l| l * scale).collect();
+            let own = steps(organ);
+            assert_eq!(own.len(), scaled.len());
+            for (a, b) in own.iter().zip(&scaled) {
+                assert!((a - b).abs() < 1e-12, "{}: {own:?}", organ.name());
+            }
+        }
     }
 }

@@ -10,6 +10,7 @@ use parry3d::shape::{TriMesh, TriMeshFlags};
 use pgd_surgery::mesh::organs::{self, Abdomen, Organ, OrganSettings, region};
 use pgd_surgery::mesh::{QualityReport, Surface, TetMesh};
 use pgd_surgery::parry_interop::to_parry;
+use pgd_surgery::pgd::organ::press_scale;
 
 /// Each default organ, generated once for all tests of this file.
 fn organ(o: Organ) -> TetMesh {
@@ -179,6 +180,28 @@ fn organs_have_anatomical_proportions() {
         centroid(&gb).z < centroid(&liver).z,
         "the gallbladder lies below the liver"
     );
+}
+
+/// The nonlinear load steps press each abdominal organ to the same share of its thickness,
+/// the smallest side of its bounding box: the scale they use is the generated organs' own.
+#[test]
+fn the_press_scale_is_each_organs_thickness_over_the_livers() {
+    let thickness = |o: Organ| {
+        let mesh = organ(o);
+        (0..3)
+            .map(|axis| extent(&mesh, axis))
+            .fold(f64::MAX, f64::min)
+    };
+    let liver = thickness(Organ::Liver);
+    for o in [Organ::Gallbladder, Organ::Pancreas, Organ::Duodenum] {
+        let measured = thickness(o) / liver;
+        let scale = press_scale(Some(o));
+        assert!(
+            (scale - measured).abs() < 0.01,
+            "{}: press scale {scale}, thickness over the liver's {measured}",
+            o.name()
+        );
+    }
 }
 
 /// The surface of a mesh as a parry shape, to query distances and containment.

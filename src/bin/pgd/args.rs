@@ -323,8 +323,9 @@ pub struct BuildArgs {
     pub max_modes: usize,
     /// Nonlinear laws: the linear response's depth under the tool at each load step after
     /// the linear one, in millimetres, increasing; the deepest is the range the vademecum is
-    /// valid over (default: 0.5,1,1.5 for KSV; for neo-Hookean 2.5,5,10,15,20,25 under the
-    /// 6 mm tool, in proportion under the cornea's).
+    /// valid over (default: 0.5,1,1.5 for KSV; for the neo-Hookean and exponential laws
+    /// 2.5,5,10,15,20,25 on the liver under the 6 mm tool, the same share of the other organs'
+    /// thickness, in proportion to the cornea's tool).
     #[arg(long, value_delimiter = ',')]
     pub load_steps_mm: Vec<f64>,
     /// Nonlinear laws: a load step is kept while at most this fraction of its loads fail to
@@ -427,7 +428,7 @@ impl BuildArgs {
             .tool_radius_mm
             .map_or(defaults.tool_tip_radius_m, |mm| mm * 1e-3);
         let load_steps_m = match steps.is_empty() {
-            true => pgd::default_load_steps_m(tool_tip_radius_m, law),
+            true => pgd::default_load_steps_m(organ, tool_tip_radius_m, law),
             false => steps.iter().map(|s| s * 1e-3).collect(),
         };
         Ok(BuildSettings {
