@@ -173,8 +173,11 @@ impl Responses {
             unconverged.len() as f64 <= settings.max_newton_fraction * report.responses as f64;
         if few && !unconverged.is_empty() {
             let start = Instant::now();
-            let (solved, solves) =
-                self.solve_by_newton(stiffness, (patches, magnitudes_n), &unconverged);
+            let (solved, solves) = self.solve_by_newton(
+                stiffness,
+                (patches, magnitudes_n),
+                (&unconverged, fraction_before),
+            );
             report.newton_seconds = start.elapsed().as_secs_f64();
             report.newton_solved = solved;
             report.newton_solves = solves;
@@ -241,17 +244,21 @@ impl Responses {
     }
 
     /// Solves the loads `parameters` by Newton, one full nonlinear solve each (in parallel),
-    /// from the step before's response they hold (or from rest, in increments, if that start
-    /// inverts an element): for the few that the fixed point with the rest stiffness cannot
-    /// carry. A load Newton fails on too keeps that response. Its linear systems are solved
-    /// by conjugate gradients preconditioned with the rest stiffness's factor
+    /// from the step before's equilibrium: the response they hold at `fraction_before` of the
+    /// step's magnitude (from rest, in increments, if that start turns an element inside
+    /// out): for the few that the fixed point with the rest stiffness cannot carry. Newton's
+    /// first direction from there is the tangent's prediction of the increment; the step
+    /// before's response at the whole magnitude, the secant's prediction, presses a stiffening
+    /// law too deep (a residual as large as the load, and a dozen iterations to recover). A
+    /// load Newton fails on too keeps that response. Its linear systems are solved by
+    /// conjugate gradients preconditioned with the rest stiffness's factor
     /// ([`RestStiffness::newton_solver`]). Returns the number solved and what their linear
     /// solves cost.
     fn solve_by_newton(
         &mut self,
         stiffness: &RestStiffness,
         (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
-        parameters: &[usize],
+        (parameters, fraction_before): (&[usize], f64),
     ) -> (usize, KrylovStatistics) {
         let model = stiffness.model;
         let settings = NewtonSettings {
@@ -265,7 +272,7 @@ impl Responses {
                 let start = stiffness
                     .extend(self.column(p))
                     .iter()
-                    .map(|u| u * lambda)
+                    .map(|u| u * fraction_before * lambda)
                     .collect();
                 let shares = patches.nodal_shares(p);
                 let direction = patches.direction(p);
