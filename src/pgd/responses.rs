@@ -43,7 +43,7 @@ const MAX_HALVINGS: usize = 20;
 /// Relative residual at which a Newton solve of a load the fixed point left is converged: a
 /// hundred times below the fixed point's tolerance on its change, which the other loads of
 /// the step are held to. Tighter costs Newton iterations that change nothing the step keeps
-/// (1e-8 took 13–31 % more conjugate-gradient iterations on the coarse pancreas, and left a
+/// (1e-8 took 23–45 % more conjugate-gradient iterations on the coarse pancreas, and left a
 /// load unconverged after 30 iterations that 1e-5 solves).
 const NEWTON_TOLERANCE: f64 = 1e-5;
 
