@@ -5,12 +5,12 @@
 //! fixed point leaves to Newton differ from rest mostly around the tool, so the preconditioned
 //! tangent is the identity plus a perturbation of the nodes that stiffened: conjugate
 //! gradients then converge in about ten iterations (on the liver), each a pair of triangular
-//! solves and a sparse product, where a direct solve factorizes every tangent anew (LU once a tangent has
-//! been indefinite, several times the cost of a Cholesky). Newton only needs each direction to
-//! a relative residual that shrinks with its own (an inexact Newton method, Eisenstat and
-//! Walker's), so the early directions cost fewer iterations still. Where a tangent is
-//! indefinite (an iterate far from equilibrium), the iterations stop at the first direction of
-//! negative curvature and Newton takes the descent direction they had reached.
+//! solves and a sparse product, where a direct solve factorizes every tangent anew (LU once a
+//! tangent has been indefinite, several times the cost of a Cholesky). Newton only needs each
+//! direction to a relative residual that shrinks with its own (an inexact Newton method,
+//! Eisenstat and Walker's), so the early directions cost fewer iterations still. Where a
+//! tangent is indefinite (an iterate far from equilibrium), the iterations stop at the first
+//! direction of negative curvature and Newton takes the descent direction they had reached.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::matrix_free::conjugate_gradient::{

@@ -39,8 +39,7 @@ pub struct NewtonBaseline {
 /// Times `samples` Newton paths of `model` (the model `vademecum` was built for) at random load
 /// positions (seeded by `seed`), each loaded as the build loads it at its deepest step: the
 /// tool's patch centred on its position, pushing into the organ, whose linear response is
-/// that step's depth. `None`
-/// for a vademecum with one (linear) step.
+/// that step's depth. `None` for a vademecum with one (linear) step.
 pub fn newton_baseline(
     model: &FemModel,
     vademecum: &Vademecum,
