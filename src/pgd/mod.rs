@@ -46,7 +46,9 @@ pub use statistics::Statistics;
 pub use stiffness::RestStiffness;
 pub use surface_modes::SurfaceModes;
 pub use vademecum::{Header, MAX_STEPS, Patch, Step, StepLoads, SurfacePoint, Vademecum};
-pub use validate::{ForceDepthCurve, Sample, ValidationReport, ValidationSettings, validate};
+pub use validate::{
+    ForceDepthCurve, Sample, ValidationReport, ValidationSettings, force_depth_curve_at, validate,
+};
 
 use crate::mesh::TetMesh;
 

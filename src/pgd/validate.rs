@@ -22,7 +22,8 @@ use crate::mesh::{Surface, TetMesh, area_vector};
 pub struct ValidationSettings {
     pub samples: usize,
     pub seed: u64,
-    /// Indentations are drawn uniformly in this range (m).
+    /// Indentations are drawn uniformly in this range (m) of the tool's linear depth, cut
+    /// at the vademecum's range at each point (where the trainer starts holding the force).
     pub indentation_range_m: (f64, f64),
     /// Directions deviate from the inward normal by up to this angle.
     pub max_tilt_deg: f64,
@@ -33,7 +34,8 @@ pub struct ValidationSettings {
     /// Presses along the inward normal drawn as force–depth curves, each at its own random
     /// point, after the samples.
     pub curves: usize,
-    /// Force levels per curve, up to the deepest indentation of the range (linear).
+    /// Force levels per curve, up to the deepest indentation of the range (linear), or the
+    /// vademecum's range at the curve's point if shallower.
     pub curve_levels: usize,
 }
 
@@ -177,6 +179,23 @@ pub fn validate(
     })
 }
 
+/// The force–depth curve at `at` alone, full FEM against the vademecum, as `validate` draws
+/// at random points: for a point that matters, such as the surface over a nodule.
+pub fn force_depth_curve_at(
+    model: &FemModel,
+    vademecum: &Vademecum,
+    at: &SurfacePoint,
+    settings: &ValidationSettings,
+) -> Result<ForceDepthCurve, FemError> {
+    let surface = Surface::extract(model.mesh());
+    let kernel = PatchKernel::new(
+        model.mesh(),
+        &surface,
+        vademecum.header.settings.tool_tip_radius_m,
+    )?;
+    force_depth_curve(model, vademecum, &kernel, at, settings)
+}
+
 /// A uniformly distributed point of the accessible surface.
 fn random_point(rng: &mut fastrand::Rng, areas: &[f64], total: f64) -> SurfacePoint {
     let mut target = rng.f64() * total;
@@ -221,9 +240,26 @@ fn linear_force(
     direction: &Vector3<f64>,
     indentation_m: f64,
 ) -> Vector3<f64> {
-    let compliance =
-        direction.dot(&(vademecum.step_compliance(0, &vademecum.patch(at)) * direction));
-    direction * (indentation_m / compliance)
+    direction * (indentation_m / linear_compliance(vademecum, at, direction))
+}
+
+/// The tool's linear compliance (m/N) at `at` along `direction`.
+fn linear_compliance(vademecum: &Vademecum, at: &SurfacePoint, direction: &Vector3<f64>) -> f64 {
+    direction.dot(&(vademecum.step_compliance(0, &vademecum.patch(at)) * direction))
+}
+
+/// The deepest linear indentation (m) along `direction` at `at` that the vademecum answers,
+/// `wanted_m` or its range's edge there if shallower: beyond it the trainer holds the force,
+/// so that is not what the validation measures.
+fn within_range_m(
+    vademecum: &Vademecum,
+    at: &SurfacePoint,
+    direction: &Vector3<f64>,
+    wanted_m: f64,
+) -> f64 {
+    let edge_m =
+        vademecum.range_force_n(&vademecum.patch(at)) * linear_compliance(vademecum, at, direction);
+    wanted_m.min(edge_m)
 }
 
 /// `force` spread over the tool's patch at `point`, and the patch's nodal shares.
@@ -263,7 +299,8 @@ fn sample(
     let mesh = model.mesh();
     let (point, inward) = point_and_inward(mesh, vademecum, at);
     let direction = tilted_inward(rng, inward, settings);
-    let (low, high) = settings.indentation_range_m;
+    let high = within_range_m(vademecum, at, &direction, settings.indentation_range_m.1);
+    let low = settings.indentation_range_m.0.min(high);
     let indentation_m = low + (high - low) * rng.f64();
     // The linear compliance along the direction sets the force for the wanted indentation.
     let force = linear_force(vademecum, at, &direction, indentation_m);
@@ -301,7 +338,8 @@ fn force_depth_curve(
 ) -> Result<ForceDepthCurve, FemError> {
     let mesh = model.mesh();
     let (point, inward) = point_and_inward(mesh, vademecum, at);
-    let force = linear_force(vademecum, at, &inward, settings.indentation_range_m.1);
+    let deepest_m = within_range_m(vademecum, at, &inward, settings.indentation_range_m.1);
+    let force = linear_force(vademecum, at, &inward, deepest_m);
     let facing = vademecum.triangle_facing(at.triangle);
     let (loads, shares) = patch_loads(mesh, kernel, (point, &facing), &force)?;
     let newton = NewtonSettings {
