@@ -101,8 +101,8 @@ pub fn print_build_report(report: &BuildReport, out: &Path) {
     if let Some(failed) = &report.failed_step {
         println!(
             "load step {:.1} mm left out: too many of its loads did not converge, more than \
-             --max-newton lets Newton solve (the law loses stability under the tool, or the \
-             step is too far from the one before); the load steps stop at {:.1} mm (the depth \
+             Newton could solve within --newton-budget (the law loses stability under the \
+             tool, or the step is too far from the one before); the load steps stop at {:.1} mm (the depth \
              of one position's load alone: the trainer holds the force once a position under \
              the tool goes past it)",
             failed.indentation_m * 1e3,
@@ -161,12 +161,13 @@ fn print_newton_baseline(baseline: &pgd::NewtonBaseline, build_seconds: f64) {
 fn print_fixed_point(report: &pgd::SecantReport) {
     println!(
         "  secant fixed point: {:.1} iterations per load on average, at most {}; \
-         {} loads solved through smaller increments, {} by Newton instead, {} of {} \
-         unconverged (largest last residual {:.1e})",
+         {} loads solved through smaller increments, {} by Newton instead ({} left \
+         over its budget), {} of {} unconverged (largest last residual {:.1e})",
         report.mean_iterations(),
         report.max_iterations,
         report.substep_solved,
         report.newton_solved,
+        report.newton_over_budget,
         report.unconverged,
         report.responses,
         report.worst_change
@@ -174,10 +175,11 @@ fn print_fixed_point(report: &pgd::SecantReport) {
     let solves = &report.newton_solves;
     if report.newton_solved > 0 {
         println!(
-            "  Newton: {:.1} s; {} directions by preconditioned conjugate gradients \
-             ({:.0} iterations each, {} cut short at negative curvature), {} tangents \
-             factorized",
+            "  Newton: {:.1} s, {:.2} times the fixed point's cost in triangular solves; {} \
+             directions by preconditioned conjugate gradients ({:.0} iterations each, {} cut \
+             short at negative curvature), {} tangents factorized",
             report.newton_seconds,
+            solves.cost_in_solves() / report.fixed_point_solves(),
             solves.directions,
             solves.iterations_per_direction(),
             solves.truncated,

@@ -30,6 +30,14 @@ use super::pattern::FreePattern;
 /// on them and factorizes.
 const MAX_CG_ITERATIONS: usize = 400;
 
+// The costs of Newton's parts in triangular solves with the rest factor, on the liver-sized
+// box of `pgd bench fem` (one run, 13.3 ms a pair of solves): a neo-Hookean tangent's
+// product (its two-ring pattern, four mat-vecs' worth: 3.3 ms), its assembly (70 ms) and its
+// Cholesky factorization (844 ms; LU, past a limit point, costs more still).
+const PRODUCT_SOLVES: f64 = 0.25;
+const ASSEMBLY_SOLVES: f64 = 5.3;
+const FACTORIZATION_SOLVES: f64 = 63.0;
+
 /// Solves Newton's linear systems `K_t du = r`.
 pub enum TangentSolver<'a> {
     /// Factorizes each tangent: Cholesky, LU past a limit point.
@@ -70,6 +78,18 @@ impl KrylovStatistics {
             truncated: self.truncated + other.truncated,
             factorizations: self.factorizations + other.factorizations,
         }
+    }
+
+    /// Their cost in triangular solves with the rest stiffness's factor, the unit a secant
+    /// fixed point's iterations are counted in: each conjugate-gradient iteration a solve and
+    /// a tangent product, each direction a tangent assembly, each factorization the
+    /// iterations given up before it and itself.
+    pub fn cost_in_solves(&self) -> f64 {
+        let iteration = 1.0 + PRODUCT_SOLVES;
+        let abandoned = MAX_CG_ITERATIONS as f64 * iteration + FACTORIZATION_SOLVES;
+        iteration * self.iterations as f64
+            + ASSEMBLY_SOLVES * self.directions as f64
+            + abandoned * self.factorizations as f64
     }
 
     /// Conjugate-gradient iterations per Newton direction they found.

@@ -73,14 +73,14 @@ impl BuildSettings {
         }
         let secant = &self.secant;
         format!(
-            "{common}, load steps {:?} mm, fixed point: mixing {}, Anderson depth {}, Newton for up to {} % of a step's loads",
+            "{common}, load steps {:?} mm, fixed point: mixing {}, Anderson depth {}, Newton while it costs at most {} times the fixed point",
             self.load_steps_m
                 .iter()
                 .map(|m| m * 1e3)
                 .collect::<Vec<_>>(),
             secant.mixing,
             secant.anderson_depth,
-            100.0 * secant.max_newton_fraction
+            secant.newton_budget
         )
     }
 }

@@ -169,7 +169,7 @@ fn settings_missing_from_an_older_header_read_as_what_it_was_built_with() {
     let older = r#"{"tolerance": 0.001, "max_iterations": 40, "max_unconverged_fraction": 0.005}"#;
     let read: SecantSettings = serde_json::from_str(older).unwrap();
     assert_eq!(
-        (read.anderson_depth, read.mixing, read.max_newton_fraction),
+        (read.anderson_depth, read.mixing, read.newton_budget),
         (0, 1.0, 0.0)
     );
     assert_ne!(read, SecantSettings::default());

@@ -332,10 +332,11 @@ pub struct BuildArgs {
     /// converge (those keep the step before's secant response, counted in the report).
     #[arg(long, default_value_t = SecantSettings::default().max_unconverged_fraction)]
     pub max_unconverged: f64,
-    /// Nonlinear laws: when at most this fraction of a step's loads fail the fixed point,
-    /// each is solved by Newton instead (0: never).
-    #[arg(long, default_value_t = SecantSettings::default().max_newton_fraction)]
-    pub max_newton: f64,
+    /// Nonlinear laws: the loads a step's fixed point leaves are solved by Newton while it
+    /// costs at most this many times the step's fixed point; a step whose leftovers would
+    /// cost more is left out (0: never Newton).
+    #[arg(long, default_value_t = SecantSettings::default().newton_budget)]
+    pub newton_budget: f64,
     /// Nonlinear laws: the fraction of its residual the fixed point's first steps take
     /// (1: undamped; halved while the residual grows).
     #[arg(long, default_value_t = SecantSettings::default().mixing)]
@@ -444,7 +445,7 @@ impl BuildArgs {
             load_steps_m,
             secant: SecantSettings {
                 max_unconverged_fraction: self.max_unconverged,
-                max_newton_fraction: self.max_newton,
+                newton_budget: self.newton_budget,
                 mixing: self.mixing,
                 ..defaults.secant
             },
