@@ -60,6 +60,20 @@ pub fn print_validation(report: &ValidationReport) {
             100.0 * s.max
         );
     }
+    if let Some(edge) = &report.range_edge_m {
+        let least_m = report
+            .samples
+            .iter()
+            .map(|s| s.range_edge_m)
+            .fold(f64::INFINITY, f64::min);
+        println!(
+            "  the load steps answer the tool's linear depth to {:.1} mm at these points (p50; \
+             {:.1} mm at the least, {:.1} mm at the most); deeper, the trainer holds the force",
+            edge.p50 * 1e3,
+            least_m * 1e3,
+            edge.max * 1e3
+        );
+    }
 }
 
 /// Each force–depth curve of `report` as a table: full FEM's indentation and force, the

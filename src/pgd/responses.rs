@@ -452,7 +452,7 @@ impl Default for SecantSettings {
             anderson_depth: 5,
             mixing: 0.5,
             max_unconverged_fraction: 0.005,
-            newton_budget: 1.0,
+            newton_budget: 4.0,
         }
     }
 }

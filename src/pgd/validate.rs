@@ -90,6 +90,10 @@ pub struct Sample {
     pub field_error: f64,
     /// Relative L2 error over the nodes near the tool.
     pub near_field_error: f64,
+    /// How deep (m) the tool's patch at the point is pressed along the inward normal,
+    /// linearly, at the edge of the range its load steps answer (infinite for a linear
+    /// vademecum).
+    pub range_edge_m: f64,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -99,6 +103,9 @@ pub struct ValidationReport {
     pub force_error: Statistics,
     pub field_error: Statistics,
     pub near_field_error: Statistics,
+    /// The samples' range edges (m; a nonlinear vademecum only): how deep the steps answer
+    /// across the surface, in the tool's own linear depth.
+    pub range_edge_m: Option<Statistics>,
     pub samples: Vec<Sample>,
     pub curves: Vec<ForceDepthCurve>,
 }
@@ -174,6 +181,8 @@ pub fn validate(
         force_error: Statistics::of(samples.iter().map(|s| s.force_error)),
         field_error: Statistics::of(samples.iter().map(|s| s.field_error)),
         near_field_error: Statistics::of(samples.iter().map(|s| s.near_field_error)),
+        range_edge_m: (vademecum.steps.len() > 1)
+            .then(|| Statistics::of(samples.iter().map(|s| s.range_edge_m))),
         samples,
         curves,
     })
@@ -257,9 +266,12 @@ fn within_range_m(
     direction: &Vector3<f64>,
     wanted_m: f64,
 ) -> f64 {
-    let edge_m =
-        vademecum.range_force_n(&vademecum.patch(at)) * linear_compliance(vademecum, at, direction);
-    wanted_m.min(edge_m)
+    wanted_m.min(range_edge_m(vademecum, at, direction))
+}
+
+/// The linear indentation (m) along `direction` at `at` at the edge of the vademecum's range.
+fn range_edge_m(vademecum: &Vademecum, at: &SurfacePoint, direction: &Vector3<f64>) -> f64 {
+    vademecum.range_force_n(&vademecum.patch(at)) * linear_compliance(vademecum, at, direction)
 }
 
 /// `force` spread over the tool's patch at `point`, and the patch's nodal shares.
@@ -323,6 +335,7 @@ fn sample(
         force_error: (rendered - force).norm() / force.norm(),
         field_error: relative_error(&field, &reference, |_| true),
         near_field_error: relative_error(&field, &reference, near),
+        range_edge_m: range_edge_m(vademecum, at, &inward),
     })
 }
 

@@ -231,12 +231,18 @@ fn against_full_fem(
     };
     let with_nonlinear = validate(&model, &nonlinear, &loads, &Silent).unwrap();
     let with_linear = validate(&model, &linear, &loads, &Silent).unwrap();
+    let edge = with_nonlinear.range_edge_m.clone().unwrap();
     eprintln!(
-        "felt-force error against full {} FEM, p95: its vademecum {:.4}, the linear one {:.4}",
+        "felt-force error against full {} FEM, p95: its vademecum {:.4}, the linear one {:.4}; \
+         range edge p50 {:.2} mm, max {:.2} mm",
         law.name(),
         with_nonlinear.force_error.p95,
-        with_linear.force_error.p95
+        with_linear.force_error.p95,
+        edge.p50 * 1e3,
+        edge.max * 1e3
     );
+    assert!(with_linear.range_edge_m.is_none());
+    assert!(edge.p50 > 0.0 && edge.max.is_finite(), "{edge:?}");
     (with_nonlinear, with_linear)
 }
 
