@@ -546,10 +546,10 @@ impl Vademecum {
 
     /// The largest force (N) on `patch` its load steps answer: the one that puts the patch's
     /// share-weighted level at the deepest step's (infinite for a linear vademecum). A
-    /// patch's positions are pressed to their levels by the patch centred on each, which on
-    /// a mesh coarse under the tool is more compliant than a patch between nodes (up to 1.8
-    /// times on the test block's 1 cm grid under a 12 mm tool), so the edge can come at a
-    /// shallower linear depth of the tool's own patch than the deepest step's level.
+    /// patch's positions are levelled by the patch centred on each, which on a mesh coarse
+    /// under the tool can be more or less compliant than the patch between nodes (1.6 times
+    /// over the middle of the test block's 1 cm grid under a 12 mm tool), so the edge can lie
+    /// at another linear depth of the tool's own patch than the deepest step's level.
     pub fn range_force_n(&self, patch: &Patch) -> f64 {
         if self.steps.len() == 1 {
             return f64::INFINITY;

@@ -130,7 +130,7 @@ fn slopes(depth_m: &[f64], force_n: &[f64]) -> Vec<f64> {
 
 /// Under the exponential law the nodule firms up under the tool as the tissue around it
 /// does. Pressed along the normal over it, as deep as the vademecum's load steps answer
-/// there (10 mm of their linear depth; 4.5 mm of the tool's): full FEM of the heterogeneous
+/// there (4.5 mm, under steps to 10 mm of linear depth): full FEM of the heterogeneous
 /// block stiffens from level to level (its slope grows by over 30 %; measured 42 %); the
 /// vademecum built on it follows full FEM within the 7 % force JND at every level
 /// (measured 5.1 %) and stiffens too (by over 20 %; measured 33 %); and at every depth it
