@@ -87,6 +87,10 @@ pub enum Command {
         /// organ's tool radius, 20 for the abdominal organs; the smallest is a tenth of it).
         #[arg(long)]
         max_indentation_mm: Option<f64>,
+        /// The random loads' directions lie within this angle of the inward normal, in
+        /// degrees (0: along it; less than 90).
+        #[arg(long, default_value_t = ValidationSettings::default().max_tilt_deg)]
+        max_tilt_deg: f64,
         /// Presses along the normal at random points, full FEM against the vademecum from
         /// zero to the largest indentation, printed and drawn as force–depth curves
         /// (FILE.force-depth.png beside the vademecum).

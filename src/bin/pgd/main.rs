@@ -85,6 +85,7 @@ fn main() -> ExitCode {
             samples,
             sample_seed,
             max_indentation_mm,
+            max_tilt_deg,
             curves,
             cuts,
             exact_response,
@@ -109,12 +110,17 @@ fn main() -> ExitCode {
                 };
                 return validate_cut_section(&mesh, &file, (&settings, exact_response), json);
             }
+            if !(0.0..90.0).contains(&max_tilt_deg) {
+                let problem = format!("--max-tilt-deg {max_tilt_deg}: not in 0 to 90 degrees");
+                return fail("pgd validate", &problem);
+            }
             let settings = |organ| {
                 let defaults = ValidationSettings::for_organ(organ);
                 let defaults = ValidationSettings {
                     samples: samples.unwrap_or(defaults.samples),
                     seed: sample_seed,
                     curves,
+                    max_tilt_deg,
                     ..defaults
                 };
                 match max_indentation_mm {
