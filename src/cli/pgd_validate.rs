@@ -102,8 +102,15 @@ pub fn print_force_depth(report: &ValidationReport) {
 }
 
 /// Draws the force–depth curves of full FEM and the vademecum side by side, beside the
-/// vademecum (`FILE.force-depth.png`), and returns where.
-pub fn plot_force_depth(report: &ValidationReport, vademecum: &Path) -> Result<PathBuf, String> {
+/// vademecum (`FILE.force-depth.png`), and returns where; nothing when there are no curves
+/// (`--curves 0`), which would leave the chart without a range.
+pub fn plot_force_depth(
+    report: &ValidationReport,
+    vademecum: &Path,
+) -> Result<Option<PathBuf>, String> {
+    if report.curves.is_empty() {
+        return Ok(None);
+    }
     let path = vademecum.with_extension("force-depth.png");
     let curve_points = |depths: &[f64], forces: &[f64]| {
         std::iter::once((0.0, 0.0))
@@ -137,7 +144,7 @@ pub fn plot_force_depth(report: &ValidationReport, vademecum: &Path) -> Result<P
             series,
         },
     )?;
-    Ok(path)
+    Ok(Some(path))
 }
 
 /// Checks the cut section of the vademecum in `file` against full X-FEM on `mesh` (as it was

@@ -1,9 +1,10 @@
 //! What the offline tools hand to users: the convergence table and plot, the force–depth
-//! curves of `pgd indent`, and the trainer's refusal of a vademecum that does not fit its organ.
+//! curves of `pgd indent` and `pgd validate`, and the trainer's refusal of a vademecum that does not fit its organ.
 
+use pgd_surgery::cli::plot_force_depth;
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::organs::Organ;
-use pgd_surgery::pgd::save;
+use pgd_surgery::pgd::{Silent, ValidationSettings, save, validate};
 use pgd_surgery::report::{self, StepCurve};
 use pgd_surgery::store::{self, OnStale, VademecumSpec};
 
@@ -103,4 +104,25 @@ fn pgd_indent_gives_a_force_depth_curve_per_law() {
     };
     let refused = indent_organ((None, mesh), &materials, &no_steps, &silent).unwrap_err();
     assert!(refused.contains("--steps"), "{refused}");
+}
+
+/// `pgd validate` draws its force–depth curves beside the vademecum as a PNG; asked for none
+/// (`--curves 0`), it draws nothing rather than an empty chart.
+#[test]
+fn the_force_depth_plot_is_drawn_only_when_there_are_curves() {
+    let model = block_model(block_mesh([4, 3, 2]));
+    let vademecum = build_block(&model, 5);
+    let file = temp_dir("force-depth").join("block.vdm");
+    let checked = |curves: usize| {
+        let settings = ValidationSettings {
+            samples: 1,
+            curves,
+            indentation_range_m: (1e-3, 3e-3),
+            ..ValidationSettings::default()
+        };
+        validate(&model, &vademecum, &settings, &Silent).unwrap()
+    };
+    assert_eq!(plot_force_depth(&checked(0), &file), Ok(None));
+    let png = plot_force_depth(&checked(1), &file).unwrap().unwrap();
+    assert!(std::fs::read(png).unwrap().starts_with(b"\x89PNG"));
 }

@@ -136,7 +136,8 @@ fn main() -> ExitCode {
                 Err(e) => return fail("pgd validate", &e),
             };
             match cli::plot_force_depth(&report, &file) {
-                Ok(png) => eprintln!("force-depth curves: {}", png.display()),
+                Ok(Some(png)) => eprintln!("force-depth curves: {}", png.display()),
+                Ok(None) => {}
                 Err(e) => return fail("pgd validate", &e),
             }
             if json {
