@@ -102,9 +102,9 @@ pub fn print_build_report(report: &BuildReport, out: &Path) {
         println!(
             "load step {:.1} mm left out: too many of its loads did not converge, more than \
              Newton could solve within --newton-budget (the law loses stability under the \
-             tool, or the step is too far from the one before); the load steps stop at {:.1} mm (the depth \
-             of one position's load alone: the trainer holds the force once a position under \
-             the tool goes past it)",
+             tool, or the step is too far from the one before); the load steps stop at \
+             {:.1} mm (the depth of one position's load alone: the trainer holds the force \
+             once a position under the tool goes past it)",
             failed.indentation_m * 1e3,
             report.steps.last().map_or(0.0, |s| s.indentation_m * 1e3)
         );

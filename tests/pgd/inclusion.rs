@@ -151,15 +151,15 @@ fn under_the_exponential_law_the_nodule_stiffens_with_depth() {
     let felt = slopes(&curve.depth_m, &curve.vademecum_force_n);
     let error = curve.max_force_error();
     let inward = Vector3::new(0.0, 0.0, -1.0);
+    let plain_over = surface_point_near(&plain, Vector3::new(0.03, 0.02, 0.03));
     let ratios: Vec<f64> = curve
         .depth_m
         .iter()
         .zip(&curve.vademecum_force_n)
         .map(|(&depth_m, force_n)| {
-            let point = surface_point_near(&plain, Vector3::new(0.03, 0.02, 0.03));
             force_n
                 / plain
-                    .force_for_indentation(&point, &(inward * depth_m))
+                    .force_for_indentation(&plain_over, &(inward * depth_m))
                     .dot(&inward)
         })
         .collect();

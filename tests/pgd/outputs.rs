@@ -1,5 +1,6 @@
 //! What the offline tools hand to users: the convergence table and plot, the force–depth
-//! curves of `pgd indent` and `pgd validate`, and the trainer's refusal of a vademecum that does not fit its organ.
+//! curves of `pgd indent` and `pgd validate`, and the trainer's refusal of a vademecum that
+//! does not fit its organ.
 
 use pgd_surgery::cli::plot_force_depth;
 use pgd_surgery::fem::Law;
