@@ -96,18 +96,21 @@ pub fn print_build_report(report: &BuildReport, out: &Path) {
         );
         if let Some(fixed_point) = &step.fixed_point {
             print_fixed_point(fixed_point);
+            print_reached(step, report.positions);
         }
     }
     if let Some(failed) = &report.failed_step {
         println!(
-            "load step {:.1} mm left out: too many of its loads did not converge, more than \
-             Newton could solve within --newton-budget (the law loses stability under the \
-             tool, or the step is too far from the one before); the load steps stop at \
-             {:.1} mm (the depth of one position's load alone: the trainer holds the force \
-             once a position under the tool goes past it)",
+            "load step {:.1} mm left out: it reached too few positions (--min-reached-share), \
+             the others' loads failing to converge even with Newton within --newton-budget \
+             (the law loses stability under the tool, or the step is too far from the one \
+             before); the load steps stop at {:.1} mm (the depth of one position's load \
+             alone: the trainer holds the force once a position under the tool goes past its \
+             range)",
             failed.indentation_m * 1e3,
             report.steps.last().map_or(0.0, |s| s.indentation_m * 1e3)
         );
+        print_reached(failed, report.positions);
         if let Some(fixed_point) = &failed.fixed_point {
             print_fixed_point(fixed_point);
         }
@@ -155,6 +158,15 @@ fn print_newton_baseline(baseline: &pgd::NewtonBaseline, build_seconds: f64) {
         baseline.loads,
         baseline.estimated_seconds / build_seconds,
         build_seconds
+    );
+}
+
+fn print_reached(step: &pgd::StepReport, positions: usize) {
+    println!(
+        "  range: {} of {} positions reach this step ({:.0} %)",
+        step.positions_reached,
+        positions,
+        100.0 * step.positions_reached as f64 / positions as f64
     );
 }
 

@@ -56,6 +56,9 @@ pub struct StepReport {
     pub local_seconds: f64,
     /// KSV steps: how the fixed point of the secant responses went.
     pub fixed_point: Option<SecantReport>,
+    /// Nonlinear steps: the positions whose range reaches this step (the loads that
+    /// converged here and at every step before).
+    pub positions_reached: usize,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -188,7 +191,13 @@ pub fn build(
         settings,
         progress,
     };
-    let (steps, reports, failed_step, reference) = load_steps(&context)?;
+    let LoadSteps {
+        steps,
+        reports,
+        failed: failed_step,
+        reference,
+        range_level_m,
+    } = load_steps(&context)?;
     let near_field_share = steps[0].local.correction_nodes.len() as f64
         / (patches.positions.len() * mesh.node_count()) as f64;
     if near_field_share > WIDE_NEAR_FIELD_SHARE {
@@ -226,6 +235,7 @@ pub fn build(
         position_normals: normals,
         triangles,
         reference_compliance_m_per_n: reference,
+        range_level_m,
         steps,
         cuts: None,
     };
@@ -256,14 +266,22 @@ struct StepContext<'a> {
 }
 
 /// The steps built, their reports, the report of a step left out, and per position the
-/// reference compliance that turns a force into the level picking load steps.
-type LoadSteps = (Vec<Step>, Vec<StepReport>, Option<StepReport>, Vec<f32>);
+/// reference compliance that turns a force into the level picking load steps and the level
+/// its range reaches.
+struct LoadSteps {
+    steps: Vec<Step>,
+    reports: Vec<StepReport>,
+    failed: Option<StepReport>,
+    reference: Vec<f32>,
+    range_level_m: Vec<f32>,
+}
 
 /// The linear step, then (nonlinear laws) one step per indentation level until the last or
-/// the first whose fixed point fails. A nonlinear step loads the tool's patch centred on each
+/// the first one [`kept`] refuses. A nonlinear step loads the tool's patch centred on each
 /// position, pushing along its inward normal, sized so that its linear response is the level
 /// deep, and keeps the nonlinear correction to the linear response of that patch: the trainer
-/// adds it to the exact linear response of the patch where the tool is.
+/// adds it to the exact linear response of the patch where the tool is. A position whose load
+/// fails past the first step is not loaded deeper: its range ends at the step before.
 fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     let (stiffness, patches, progress) = (context.stiffness, context.patches, context.progress);
     let clock = Instant::now();
@@ -279,7 +297,13 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     )?;
     if stiffness.model.material().law == Law::Linear {
         let reference = self_compliances(&step.local);
-        return Ok((vec![step], vec![report], None, reference));
+        return Ok(LoadSteps {
+            steps: vec![step],
+            reports: vec![report],
+            failed: None,
+            range_level_m: vec![0.0; reference.len()],
+            reference,
+        });
     }
     let tool = ToolPatchLoads::new(
         patches.positions.clone(),
@@ -294,14 +318,21 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     // The step before the last, and its level: with the last they give the next start's trend.
     let mut before: Option<(Responses, f64)> = None;
     let mut last_level_m = 0.0;
+    let mut range_level_m = vec![0.0f32; reference.len()];
     for &level_m in &context.settings.load_steps_m {
         let clock = Instant::now();
-        // Each patch's push is sized so that its linear displacement is `level_m` long.
+        // Each patch's push is sized so that its linear displacement is `level_m` long; a
+        // position whose range ended is not pushed.
         let magnitudes: Vec<f64> = reference
             .iter()
-            .map(|&per_n| match per_n > 0.0 {
-                true => level_m / f64::from(per_n),
-                false => 0.0,
+            .zip(&range_level_m)
+            .map(|(&per_n, &range_m)| {
+                let reaching = per_n > 0.0 && range_m == last_level_m as f32;
+                if reaching {
+                    level_m / f64::from(per_n)
+                } else {
+                    0.0
+                }
             })
             .collect();
         let law = stiffness.model.material().law.name();
@@ -315,8 +346,8 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         before = Some((secant.clone(), last_level_m));
         let last_level_before = last_level_m;
         last_level_m = level_m;
-        let fixed_point;
-        (secant, fixed_point) = secant.secant(
+        let (fixed_point, unconverged);
+        (secant, fixed_point, unconverged) = secant.secant(
             stiffness,
             (&tool, &magnitudes),
             (trend.as_ref(), last_level_before / level_m),
@@ -335,7 +366,8 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
             fixed_point.unconverged,
             clock.elapsed().as_secs_f64()
         ));
-        if !fixed_point.acceptable(&context.settings.secant) {
+        let reached = reached_positions(&magnitudes, &unconverged, &fixed_point, context);
+        if !kept(&reached, steps.len(), &reference, context.settings) {
             progress.message(&format!(
                 "{law} step {:.1} mm: the fixed point did not converge for {} of {} loads; \
                  the vademecum stops at the step before",
@@ -347,10 +379,20 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
                 indentation_m: level_m,
                 brute_force_seconds: clock.elapsed().as_secs_f64(),
                 fixed_point: Some(fixed_point),
+                positions_reached: reached.len(),
                 ..StepReport::default()
             };
-            return Ok((steps, reports, Some(failed), reference));
+            return Ok(LoadSteps {
+                steps,
+                reports,
+                failed: Some(failed),
+                reference,
+                range_level_m,
+            });
         }
+        reached
+            .iter()
+            .for_each(|&m| range_level_m[m] = level_m as f32);
         // The step keeps the correction `Ũ − U_lin`, restored after.
         secant.add_scaled(&linear, -1.0);
         let gram = secant.energy_gram(stiffness);
@@ -366,10 +408,50 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         let (step, mut report) = built?;
         report.indentation_m = level_m;
         report.fixed_point = Some(fixed_point);
+        report.positions_reached = reached.len();
         steps.push(step);
         reports.push(report);
     }
-    Ok((steps, reports, None, reference))
+    Ok(LoadSteps {
+        steps,
+        reports,
+        failed: None,
+        reference,
+        range_level_m,
+    })
+}
+
+/// The positions a step reaches: those pushed at it whose load converged, or all those
+/// pushed when no more than the tolerated share of loads failed (the failed ones keep the
+/// step before's response, as counted in the step's report).
+fn reached_positions(
+    magnitudes_n: &[f64],
+    unconverged: &[usize],
+    fixed_point: &SecantReport,
+    context: &StepContext,
+) -> Vec<usize> {
+    let tolerated = fixed_point.acceptable(&context.settings.secant);
+    (0..magnitudes_n.len())
+        .filter(|&m| magnitudes_n[m] > 0.0)
+        .filter(|m| tolerated || unconverged.binary_search(m).is_err())
+        .collect()
+}
+
+/// Whether a nonlinear step is kept, given the positions it reaches and the steps built
+/// before it (the linear one at least). The first nonlinear step must reach every loaded
+/// position (but the tolerated failures): a position it leaves would have no range at all.
+/// A deeper one is kept while it reaches [`SecantSettings::min_reached_share`] of them.
+fn kept(
+    reached: &[usize],
+    steps_before: usize,
+    reference: &[f32],
+    settings: &BuildSettings,
+) -> bool {
+    let loaded = reference.iter().filter(|&&per_n| per_n > 0.0).count();
+    match steps_before {
+        1 => reached.len() == loaded,
+        _ => reached.len() as f64 >= settings.secant.min_reached_share * loaded as f64,
+    }
 }
 
 /// Per position, how deep (m) a unit force along its inward normal presses the patch centred
@@ -516,6 +598,7 @@ fn separated_step(
         brute_force_seconds,
         local_seconds,
         fixed_point: None,
+        positions_reached: 0,
     };
     let field = match separation {
         Separation::Enrichment(_) => field,

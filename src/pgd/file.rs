@@ -16,7 +16,7 @@ use crate::fem::{Inclusion, Law, Material};
 use crate::mesh::TetMesh;
 
 /// Bumped on any change of layout or meaning; older files are refused, not misread.
-pub const FORMAT_VERSION: u32 = 5;
+pub const FORMAT_VERSION: u32 = 6;
 const KIND: Kind = Kind {
     magic: b"PGDVADEM",
     version: FORMAT_VERSION,
@@ -149,6 +149,7 @@ fn payload(v: &Vademecum) -> Vec<u8> {
     put(&mut out, v.position_normals.as_flattened());
     put(&mut out, v.triangles.as_flattened());
     put(&mut out, &v.reference_compliance_m_per_n);
+    put(&mut out, &v.range_level_m);
     put(&mut out, &[v.steps.len() as u32]);
     for step in &v.steps {
         put(&mut out, &step.spatial);
@@ -245,6 +246,7 @@ fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumEr
     }
     let triangles = flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
     let reference_compliance_m_per_n = r.take("reference compliances")?;
+    let range_level_m = r.take("range levels")?;
     let count: Vec<u32> = r.take("step count")?;
     let count = *count.first().ok_or_else(|| r.malformed("step count"))?;
     let mut steps = Vec::new();
@@ -272,6 +274,7 @@ fn read_payload(r: &mut Reader, header: Header) -> Result<Vademecum, VademecumEr
         position_normals,
         triangles,
         reference_compliance_m_per_n,
+        range_level_m,
         steps,
         cuts,
     })
@@ -299,8 +302,11 @@ fn validate(path: &Path, v: &Vademecum) -> Result<(), VademecumError> {
     {
         return fail("position coordinates, areas or normals (one per position expected)");
     }
-    if v.reference_compliance_m_per_n.len() != m {
-        return fail("reference compliances (one per position expected)");
+    if v.reference_compliance_m_per_n.len() != m || v.range_level_m.len() != m {
+        return fail("reference compliances or range levels (one per position expected)");
+    }
+    if !v.range_level_m.iter().all(|r| r.is_finite() && *r >= 0.0) {
+        return fail("range levels (each a finite, non-negative depth expected)");
     }
     if v.steps.len() != v.header.indentation_levels_m.len() || v.steps.is_empty() {
         return fail("steps (their count differs from the header's load steps)");

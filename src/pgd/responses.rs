@@ -63,7 +63,8 @@ const NONLINEAR_FORCE_SOLVES: f64 = 0.25;
 /// What [`Responses::solve_by_newton`] did with the loads it was given.
 #[derive(Default)]
 struct NewtonOutcome {
-    solved: usize,
+    /// The loads it solved (sorted).
+    solved: Vec<usize>,
     /// What its linear solves cost.
     solves: KrylovStatistics,
     /// Loads it did not try, their estimated cost being over its budget.
@@ -146,7 +147,8 @@ impl Responses {
     /// `ũ = u / λ` with `K u = λ e_p − N(u)`. The nonlinear terms `N` of the previous iterate
     /// go to the right-hand side (paper 000), so every iteration reuses the factorization of
     /// the rest stiffness. `self` is the step before's responses, which an unconverged load
-    /// keeps; the iteration starts from `self + trend`.
+    /// keeps; the iteration starts from `self + trend`. Also returns the loads left
+    /// unconverged (sorted). A load of zero magnitude is not iterated and keeps its column.
     pub fn secant(
         mut self,
         stiffness: &RestStiffness,
@@ -154,7 +156,7 @@ impl Responses {
         (trend, fraction_before): (Option<&Trend>, f64),
         settings: &SecantSettings,
         progress: &(dyn Fn(usize) + Sync),
-    ) -> (Self, SecantReport) {
+    ) -> (Self, SecantReport, Vec<usize>) {
         let rows = self.rows;
         let (mut report, mut unconverged) = self
             .columns
@@ -199,12 +201,13 @@ impl Responses {
                 budget,
             );
             report.newton_seconds = start.elapsed().as_secs_f64();
-            report.newton_solved = newton.solved;
+            report.newton_solved = newton.solved.len();
             report.newton_solves = newton.solves;
             report.newton_over_budget = newton.left;
-            report.unconverged -= newton.solved;
+            report.unconverged -= newton.solved.len();
+            unconverged.retain(|p| newton.solved.binary_search(p).is_err());
         }
-        (self, report)
+        (self, report, unconverged)
     }
 
     /// Takes the loads `failed` (sorted) that diverged on the step's whole increment through
@@ -297,20 +300,21 @@ impl Responses {
             }
             let (solved, solves) =
                 self.newton_batch(stiffness, (patches, magnitudes_n), (loads, fraction_before));
-            outcome.solved += solved;
+            outcome.solved.extend(solved);
             outcome.solves = outcome.solves.merge(solves);
         }
+        outcome.solved.sort_unstable();
         outcome
     }
 
-    /// One batch of [`Self::solve_by_newton`], in parallel: the number solved and what their
+    /// One batch of [`Self::solve_by_newton`], in parallel: the loads solved and what their
     /// linear solves cost.
     fn newton_batch(
         &mut self,
         stiffness: &RestStiffness,
         (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
         (parameters, fraction_before): (&[usize], f64),
-    ) -> (usize, KrylovStatistics) {
+    ) -> (Vec<usize>, KrylovStatistics) {
         let model = stiffness.model;
         let settings = NewtonSettings {
             relative_tolerance: NEWTON_TOLERANCE,
@@ -349,7 +353,7 @@ impl Responses {
             self.columns[p * self.rows..(p + 1) * self.rows].copy_from_slice(column);
             statistics = statistics.merge(*solves);
         }
-        (solved.len(), statistics)
+        (solved.into_iter().map(|(p, ..)| p).collect(), statistics)
     }
 
     /// The energy Gram `Uᵀ K U` (column-major) of responses that need not satisfy `K U = F`
@@ -438,9 +442,16 @@ pub struct SecantSettings {
     /// that the exponential law's modulus explodes.
     #[serde(default = "undamped")]
     pub mixing: f64,
-    /// A step is kept while at most this fraction of its loads fail to converge; those keep
-    /// the previous step's secant response (reported, never silent).
+    /// Loads failing to converge at a step, up to this fraction of them, keep the previous
+    /// step's secant response (reported, never silent) and their positions' range goes on;
+    /// past it the failed positions' range ends at the step before.
     pub max_unconverged_fraction: f64,
+    /// A step after the first nonlinear one is kept while the positions whose range reaches
+    /// it are at least this share of the loaded ones. Beside a clamped attachment the tissue
+    /// is squeezed between the tool and the clamp, and the loads there fail steps before the
+    /// others: their range ends sooner, the rest go deeper.
+    #[serde(default = "every_position")]
+    pub min_reached_share: f64,
     /// The loads a step's fixed point leaves are solved by Newton while its linear solves
     /// cost at most this many times the step's fixed point (both counted in triangular
     /// solves with the rest factor); a step whose leftovers would cost more is left out, so
@@ -457,6 +468,7 @@ impl Default for SecantSettings {
             anderson_depth: 5,
             mixing: 0.5,
             max_unconverged_fraction: 0.005,
+            min_reached_share: 0.25,
             newton_budget: 4.0,
         }
     }
@@ -464,6 +476,12 @@ impl Default for SecantSettings {
 
 /// The mixing of a file built before the setting existed: the full step.
 fn undamped() -> f64 {
+    1.0
+}
+
+/// The reached share of a file built before the setting existed: a step reached every
+/// position (but the tolerated failures).
+fn every_position() -> f64 {
     1.0
 }
 
@@ -551,7 +569,8 @@ fn secant_block(
 ) -> (SecantReport, Vec<usize>) {
     let rows = stiffness.free_count();
     let columns = chunk.len() / rows;
-    // A load on a clamped node has no response and no magnitude: nothing to iterate.
+    // A load on a clamped node, or past its position's range, has no magnitude: nothing to
+    // iterate.
     let mut active: Vec<usize> = (0..columns).filter(|&j| magnitudes_n[j] != 0.0).collect();
     let mut change = vec![0.0; columns];
     let mut growing = vec![0usize; columns];
@@ -624,7 +643,9 @@ fn secant_block(
     let unconverged: Vec<usize> = (0..columns)
         .filter(|&j| change[j].is_nan() || change[j] >= settings.tolerance)
         .collect();
-    for &j in &unconverged {
+    // Unconverged and unloaded columns keep their start, without the trend.
+    let unloaded = (0..columns).filter(|&j| magnitudes_n[j] == 0.0);
+    for j in unconverged.iter().copied().chain(unloaded) {
         chunk[j * rows..(j + 1) * rows].copy_from_slice(&start[j * rows..(j + 1) * rows]);
     }
     report.unconverged = unconverged.len();

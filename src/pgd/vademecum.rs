@@ -192,6 +192,11 @@ pub struct Vademecum {
     /// patch centred on it, linearly (a linear vademecum: its largest nodal self-compliance):
     /// turns a force into the indentation level that selects load steps.
     pub reference_compliance_m_per_n: Vec<f32>,
+    /// Per position, the level (m) of the deepest load step its load converged at (zero in a
+    /// linear vademecum): a position whose load fails at a step is not loaded deeper, its
+    /// columns there keeping the step before's correction. Beside a clamped attachment the
+    /// range so ends sooner than elsewhere.
+    pub range_level_m: Vec<f32>,
     /// Load steps in increasing indentation; one for a linear vademecum.
     pub steps: Vec<Step>,
     /// The uncut organ's compressed responses to loads anywhere cuts may go: what a cut state
@@ -545,7 +550,8 @@ impl Vademecum {
     }
 
     /// The largest force (N) on `patch` its load steps answer: the one that puts the patch's
-    /// share-weighted level at the deepest step's (infinite for a linear vademecum). A
+    /// share-weighted level at the share-weighted level its positions' loads converged to
+    /// ([`Self::range_level_m`]; infinite for a linear vademecum). A
     /// patch's positions are levelled by the patch centred on each, which on a mesh coarse
     /// under the tool can be more or less compliant than the patch between nodes (1.6 times
     /// over the middle of the test block's 1 cm grid under a 12 mm tool), so the edge can lie
@@ -554,12 +560,11 @@ impl Vademecum {
         if self.steps.len() == 1 {
             return f64::INFINITY;
         }
-        let level_per_n: f64 = patch
-            .shares
-            .iter()
-            .map(|&(j, l)| l * self.level_m(j, 1.0))
-            .sum();
-        self.valid_indentation_m() / level_per_n
+        let (range_m, level_per_n) = patch.shares.iter().fold((0.0, 0.0), |(r, n), &(j, l)| {
+            let range_m = f64::from(self.range_level_m[j]);
+            (r + l * range_m, n + l * self.level_m(j, 1.0))
+        });
+        range_m / level_per_n
     }
 
     /// [`Self::compliance`] from the patch's step columns, filling the linear step's and those

@@ -161,16 +161,22 @@ fn the_web_form_is_smaller_and_feels_the_same() {
     );
 }
 
-/// A header written before the fixed point's Anderson acceleration, damping and Newton
-/// fallback existed reads them as what it was built with (the plain, undamped iteration, no
-/// Newton), not as today's defaults: such a file is seen as built otherwise, and rebuilt.
+/// A header written before the fixed point's Anderson acceleration, damping, Newton fallback
+/// and per-position range existed reads them as what it was built with (the plain, undamped
+/// iteration, no Newton, every position reaching each step), not as today's defaults: such a
+/// file is seen as built otherwise, and rebuilt.
 #[test]
 fn settings_missing_from_an_older_header_read_as_what_it_was_built_with() {
     let older = r#"{"tolerance": 0.001, "max_iterations": 40, "max_unconverged_fraction": 0.005}"#;
     let read: SecantSettings = serde_json::from_str(older).unwrap();
     assert_eq!(
-        (read.anderson_depth, read.mixing, read.newton_budget),
-        (0, 1.0, 0.0)
+        (
+            read.anderson_depth,
+            read.mixing,
+            read.newton_budget,
+            read.min_reached_share
+        ),
+        (0, 1.0, 0.0, 1.0)
     );
     assert_ne!(read, SecantSettings::default());
     let current = serde_json::to_string(&SecantSettings::default()).unwrap();

@@ -60,7 +60,7 @@ fn secant_responses_are_equilibria(
         .map(|p| depth_m / linear.column(p)[own_dof(p)])
         .collect();
     let before = linear.columns.clone();
-    let (secant, report) = linear.secant(
+    let (secant, report, _) = linear.secant(
         &stiffness,
         (&patches, &magnitudes),
         (None, 0.0),
@@ -180,7 +180,7 @@ fn newton_stops_at_its_budget() {
         newton_budget: 1e-9,
         ..tight()
     };
-    let (_, report) = linear.secant(
+    let (_, report, unconverged) = linear.secant(
         &stiffness,
         (&patches, &magnitudes),
         (None, 0.0),
@@ -193,6 +193,11 @@ fn newton_stops_at_its_budget() {
     assert!(report.newton_solved > 0, "{report:?}");
     assert!(report.newton_over_budget > 16, "{report:?}");
     assert!(report.unconverged >= report.newton_over_budget);
+    assert_eq!(
+        unconverged.len(),
+        report.unconverged,
+        "the loads left are listed"
+    );
 }
 
 fn relative(a: &[f64], b: &[f64]) -> f64 {
@@ -286,6 +291,56 @@ fn a_load_step_beyond_stability_is_left_out() {
     assert!(failed.fixed_point.unwrap().unconverged > 0);
     assert_eq!(vademecum.steps.len(), 2);
     assert_eq!(vademecum.valid_indentation_m(), 1e-3);
+}
+
+/// A position whose load fails at a step past the first ends its range at the step before,
+/// and the step is kept for the others: pushed along the normal, the KSV block's 2 mm step
+/// leaves a few loads that neither the fixed point nor Newton solves. A press whose patch
+/// holds such a position is held sooner than with every range at 2 mm; one whose patch
+/// holds none is held where it was.
+#[test]
+fn a_position_whose_load_fails_ends_its_range_alone() {
+    let model = block_model_of(block_mesh([6, 4, 3]), Law::KirchhoffSaintVenant);
+    let steps = vec![0.5e-3, 1e-3, 1.5e-3, 2e-3];
+    let (vademecum, report) = build(&organ(&model), &ksv_settings(steps), &Silent).unwrap();
+    assert!(report.failed_step.is_none(), "{:?}", report.failed_step);
+    assert_eq!(vademecum.valid_indentation_m(), 2e-3);
+    let deepest = report.steps.last().unwrap();
+    let loaded = report.steps[1].positions_reached;
+    let short: Vec<usize> = (0..vademecum.positions.len())
+        .filter(|&m| vademecum.range_level_m[m] < 2e-3_f32)
+        .collect();
+    assert!(!short.is_empty(), "the 2 mm step left no load: {deepest:?}");
+    assert_eq!(deepest.positions_reached + short.len(), loaded);
+    assert!(short.iter().all(|&m| vademecum.range_level_m[m] == 1.5e-3));
+    let mut everywhere = vademecum.clone();
+    everywhere.range_level_m.fill(2e-3);
+    // The tool at each corner of the accessible triangles.
+    let corners = (0..vademecum.triangles.len()).flat_map(|triangle| {
+        (0..3).map(move |corner| {
+            let mut barycentric = [0.0; 3];
+            barycentric[corner] = 1.0;
+            SurfacePoint {
+                triangle,
+                barycentric,
+            }
+        })
+    });
+    let mut held_sooner = 0;
+    for at in corners {
+        let patch = vademecum.patch(&at);
+        let holds_short = patch.shares.iter().any(|(j, _)| short.contains(j));
+        let (edge_n, everywhere_n) = (
+            vademecum.range_force_n(&patch),
+            everywhere.range_force_n(&patch),
+        );
+        match holds_short {
+            true => assert!(edge_n < everywhere_n, "{at:?}: {edge_n} {everywhere_n}"),
+            false => assert_eq!(edge_n, everywhere_n, "{at:?}"),
+        }
+        held_sooner += usize::from(holds_short);
+    }
+    assert!(held_sooner > 0);
 }
 
 /// Against full neo-Hookean FEM (Newton) at random off-node points and depths up to the

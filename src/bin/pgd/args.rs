@@ -332,10 +332,15 @@ pub struct BuildArgs {
     /// thickness, in proportion to the cornea's tool).
     #[arg(long, value_delimiter = ',')]
     pub load_steps_mm: Vec<f64>,
-    /// Nonlinear laws: a load step is kept while at most this fraction of its loads fail to
-    /// converge (those keep the step before's secant response, counted in the report).
+    /// Nonlinear laws: up to this fraction of a load step's loads may fail to converge and
+    /// keep the step before's secant response (counted in the report); past it, the failed
+    /// positions' range ends at the step before.
     #[arg(long, default_value_t = SecantSettings::default().max_unconverged_fraction)]
     pub max_unconverged: f64,
+    /// Nonlinear laws: a load step after the first is kept while at least this share of
+    /// the positions still reach it (their loads converged at it and every step before).
+    #[arg(long, default_value_t = SecantSettings::default().min_reached_share)]
+    pub min_reached_share: f64,
     /// Nonlinear laws: the loads a step's fixed point leaves are solved by Newton while it
     /// costs at most this many times the step's fixed point; a step whose leftovers would
     /// cost more is left out (0: never Newton).
@@ -449,6 +454,7 @@ impl BuildArgs {
             load_steps_m,
             secant: SecantSettings {
                 max_unconverged_fraction: self.max_unconverged,
+                min_reached_share: self.min_reached_share,
                 newton_budget: self.newton_budget,
                 mixing: self.mixing,
                 ..defaults.secant
