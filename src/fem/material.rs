@@ -26,6 +26,14 @@ pub enum Law {
 }
 
 impl Law {
+    /// Whether its shear modulus grows with the strain: how much a press along the normal
+    /// stiffens the tissue under the tool then says how much it stiffens it across (see
+    /// `pgd::Vademecum::compliance`). The other laws' nonlinearity is geometric and
+    /// volumetric, and differs between the two.
+    pub fn modulus_grows_with_strain(self) -> bool {
+        self == Law::Exponential
+    }
+
     /// The name the command line and reports use.
     pub fn name(self) -> &'static str {
         match self {

@@ -3,7 +3,7 @@
 
 use nalgebra::{SMatrix, SymmetricEigen, Vector3};
 
-use super::element::{ElementTissue, ElementVector, TetGeometry, gather};
+use super::element::{ElementTissue, ElementVector, TetGeometry, gather, j_minus_one};
 use super::inclusion::{Inclusion, modulus_scale};
 use super::pattern::FreePattern;
 use super::volumetric::NodalVolumes;
@@ -161,6 +161,15 @@ impl FemModel {
             volumetric.add_force(&self.mesh, &self.geometry, u_m, &mut force);
         }
         force
+    }
+
+    /// Whether the full displacement `u_m` turns an element inside out (J ≤ 0): not a state
+    /// tissue can be in, though the Kirchhoff–Saint Venant law, whose energy stays finite
+    /// there, has equilibria in it.
+    pub fn turns_an_element_inside_out(&self, u_m: &[f64]) -> bool {
+        let tets = self.mesh.tets().iter().zip(&self.geometry);
+        tets.into_iter()
+            .any(|(tet, geo)| j_minus_one(&geo.displacement_gradient(&gather(tet, u_m))) <= -1.0)
     }
 
     /// The nonlinear part of the internal force (N) on every dof, `f_int(u) − K₀ u` with `K₀`

@@ -274,7 +274,8 @@ impl Responses {
     /// first direction from there is the tangent's prediction of the increment; the step
     /// before's response at the whole magnitude, the secant's prediction, presses a stiffening
     /// law too deep (a residual as large as the load, and a dozen iterations to recover). A
-    /// load Newton fails on too keeps that response. Its linear systems are solved by
+    /// load Newton fails on too keeps that response, as does one whose equilibrium turns an
+    /// element inside out (the KSV law has such equilibria past its stability). Its linear systems are solved by
     /// conjugate gradients preconditioned with the rest stiffness's factor
     /// ([`RestStiffness::newton_solver`]).
     ///
@@ -342,7 +343,8 @@ impl Responses {
                 let solution = model
                     .solve_static_from(start, &loads, &settings, &mut solver)
                     .or_else(|_| model.solve_static_with(&mut solver, &loads, &path))
-                    .ok()?;
+                    .ok()
+                    .filter(|s| !model.turns_an_element_inside_out(&s.displacement_m))?;
                 let secant = stiffness.restrict(&solution.displacement_m);
                 let column = secant.iter().map(|u| u / lambda).collect();
                 Some((p, column, solver.statistics()))

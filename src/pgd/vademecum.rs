@@ -468,14 +468,40 @@ impl Vademecum {
     }
 
     /// The compliance for a force `force_n` on `patch`: the linear step's plus the blended
-    /// corrections of the steps the patch's positions reach.
+    /// corrections of the steps the patch's positions reach, and (a law whose modulus grows
+    /// with the strain) their share across the normal ([`across_the_normal`]), summed block
+    /// by block: the reference the haptic tick's columns ([`Self::patch_press`]) must agree
+    /// with.
     pub fn compliance(&self, patch: &Patch, force_n: &Vector3<f64>) -> Matrix3<f64> {
         if self.steps.len() == 1 {
             return self.step_compliance(0, patch);
         }
-        self.loaded_steps(patch, force_n)
-            .map(|k| self.weighted_compliance(k, patch, |j, l| self.step_share(k, j, l, force_n)))
-            .sum()
+        let steps: Vec<usize> = self.loaded_steps(patch, force_n).collect();
+        let along: Matrix3<f64> = steps
+            .iter()
+            .map(|&k| self.weighted_compliance(k, patch, |j, l| self.step_share(k, j, l, force_n)))
+            .sum();
+        if !self.header.material.law.modulus_grows_with_strain() {
+            return along;
+        }
+        let across: Matrix3<f64> = patch
+            .shares
+            .iter()
+            .map(|&(j, l)| {
+                // Position j's own loads alone, at unit share.
+                let own = |k: usize, weight: f64| {
+                    self.weighted_compliance(k, patch, |i, _| if i == j { weight } else { 0.0 })
+                };
+                let correction: Matrix3<f64> = steps
+                    .iter()
+                    .filter(|&&k| k != 0)
+                    .map(|&k| own(k, self.step_share(k, j, 1.0, force_n)))
+                    .sum();
+                let normal = Vector3::from(self.position_normals[j].map(f64::from));
+                l * across_the_normal(&own(0, 1.0), &correction, &normal)
+            })
+            .sum();
+        along + across
     }
 
     /// Displacement (m) of the surface under the tool for a force (N) at `at`.
@@ -578,20 +604,24 @@ impl Vademecum {
             patch.fill_columns(first, &self.steps[first].local);
             patch.fill_columns(last, &self.steps[last].local);
         }
-        let mut c = [0.0f64; 9];
+        let transfers = self.header.material.law.modulus_grows_with_strain();
+        let mut c = Matrix3::zeros();
         for (slot, &(j, l)) in patch.shares.iter().enumerate() {
             let (first, last, t) = blend(j);
-            let corrections = [(first, l * (1.0 - t)), (last, l * t)];
-            let used = corrections
-                .into_iter()
-                .filter(|&(step, w)| step != 0 && w != 0.0);
-            for (step, w) in std::iter::once((0, l)).chain(used) {
-                for (ck, &bk) in c.iter_mut().zip(patch.column(step, slot)) {
-                    *ck += w * bk;
+            let linear = Matrix3::from_row_slice(patch.column(0, slot));
+            let mut correction = Matrix3::zeros();
+            for (step, w) in [(first, 1.0 - t), (last, t)] {
+                if step != 0 && w != 0.0 {
+                    correction += w * Matrix3::from_row_slice(patch.column(step, slot));
                 }
             }
+            c += l * (linear + correction);
+            if transfers {
+                let normal = Vector3::from(self.position_normals[j].map(f64::from));
+                c += l * across_the_normal(&linear, &correction, &normal);
+            }
         }
-        Matrix3::from_row_slice(&c)
+        c
     }
 
     /// The displacement field (m, all dofs) for a force (N) at `at`.
@@ -776,4 +806,26 @@ pub(crate) fn add_scaled_modes(modes: &[f32], coefficients: &[f64], u: &mut [f64
             }
         }
     }
+}
+
+/// The correction of a position's compliance to forces across its normal `normal`. A step
+/// holds only the response to a push along the normal (`correction`, whose columns are that
+/// push's, weighted by each axis's share of it), so a force across the normal would be
+/// answered linearly. A law whose modulus grows with the strain stiffens the tissue under
+/// the tool whichever way it is pushed: the responses to forces across the normal are scaled
+/// by the ratio the normal compliance changed by, `nᵀ D n / nᵀ L n` (`L` the linear
+/// compliance), kept above −0.9 so that the compliance stays positive. The tool's own
+/// patch pushed across the normal at each step would be exact, at three times the build.
+fn across_the_normal(
+    linear: &Matrix3<f64>,
+    correction: &Matrix3<f64>,
+    normal: &Vector3<f64>,
+) -> Matrix3<f64> {
+    let along = normal.dot(&(linear * normal));
+    if along <= 0.0 {
+        return Matrix3::zeros();
+    }
+    let ratio = (normal.dot(&(correction * normal)) / along).max(-0.9);
+    let across = Matrix3::identity() - normal * normal.transpose();
+    ratio * linear * across
 }

@@ -138,3 +138,29 @@ fn newton_converges_quadratically_on_a_large_deflection() {
         "too few iterations in the asymptotic range ({pairs})"
     );
 }
+
+/// A displacement that mirrors the beam through a plane across its axis (`x → −x`, J = −1)
+/// turns every element inside out; shrinking it to half its length (J = 1/2) turns none, nor
+/// does rest. Checked on KSV, whose energy stays finite there.
+#[test]
+fn a_mirrored_beam_is_inside_out_and_a_shrunk_one_is_not() {
+    let beam = cantilever(1, Law::KirchhoffSaintVenant, 0.45, 0.0);
+    let model = &beam.model;
+    let along_x = |scale: f64| -> Vec<f64> {
+        let nodes = model.mesh().nodes();
+        let mut u = vec![0.0; 3 * nodes.len()];
+        for (n, p) in nodes.iter().enumerate() {
+            u[3 * n] = (scale - 1.0) * p.x;
+        }
+        u
+    };
+    assert!(model.turns_an_element_inside_out(&along_x(-1.0)));
+    assert!(!model.turns_an_element_inside_out(&along_x(0.5)));
+    assert!(!model.turns_an_element_inside_out(&along_x(1.0)));
+    assert!(
+        model
+            .internal_force(&along_x(-1.0))
+            .iter()
+            .all(|f| f.is_finite())
+    );
+}

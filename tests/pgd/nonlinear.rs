@@ -294,8 +294,9 @@ fn a_load_step_beyond_stability_is_left_out() {
 }
 
 /// A position whose load fails at a step past the first ends its range at the step before,
-/// and the step is kept for the others: pushed along the normal, the KSV block's 2 mm step
-/// leaves a few loads that neither the fixed point nor Newton solves. A press whose patch
+/// and the step is kept for the others: pushed along the normal, the KSV block's 1.5 and 2 mm
+/// steps leave a few loads that neither the fixed point nor Newton solves (KSV loses
+/// stability under compression; an equilibrium with an element inside out does not count). A press whose patch
 /// holds such a position is held sooner than with every range at 2 mm; one whose patch
 /// holds none is held where it was.
 #[test]
@@ -312,7 +313,9 @@ fn a_position_whose_load_fails_ends_its_range_alone() {
         .collect();
     assert!(!short.is_empty(), "the 2 mm step left no load: {deepest:?}");
     assert_eq!(deepest.positions_reached + short.len(), loaded);
-    assert!(short.iter().all(|&m| vademecum.range_level_m[m] == 1.5e-3));
+    let earlier = [0.5e-3_f32, 1e-3, 1.5e-3];
+    let ranges: Vec<f32> = short.iter().map(|&m| vademecum.range_level_m[m]).collect();
+    assert!(ranges.iter().all(|r| earlier.contains(r)), "{ranges:?}");
     let mut everywhere = vademecum.clone();
     everywhere.range_level_m.fill(2e-3);
     // The tool at each corner of the accessible triangles.
@@ -357,26 +360,33 @@ fn the_neo_hookean_vademecum_follows_full_fem_to_its_deepest_step() {
 }
 
 /// The exponential law's vademecum against its own full FEM, as above: every load converges,
-/// and its felt force is over five times closer than the linear vademecum's. Measured: 9.2 %
-/// against 53 %, over the 7 % target: the corrections of patches centred on the mesh's
-/// nodes, interpolated over the tool's patch and between steps, depart from the patch's own
-/// response as the law stiffens, the more so under oblique presses, whose tangential part the
-/// steps answer linearly.
+/// and its felt force stays within the 7 % just-noticeable difference (p95), over eight times
+/// closer than the linear vademecum's. Measured: 6.0 % against 53 %; 9.2 % when the presses'
+/// part across the normal was answered linearly (the steps push along the normal only).
 #[test]
 fn the_exponential_vademecum_follows_full_fem_to_its_deepest_step() {
     let steps = vec![2.5e-3, 5e-3, 10e-3];
     let (with_exponential, with_linear) = against_full_fem(Law::Exponential, steps, (1e-3, 10e-3));
-    assert!(with_exponential.force_error.p95 < 0.2 * with_linear.force_error.p95);
+    assert!(with_exponential.force_error.p95 < 0.07);
+    assert!(with_exponential.force_error.p95 < 0.125 * with_linear.force_error.p95);
 }
 
 /// The felt force of a nonlinear vademecum is a fixed point of its load-step blend: the
 /// compliance the patch's loads pick under that force, summed block by block over the patch
 /// (`Vademecum::compliance`, the reference), carries it to the indentation asked for. Checked
 /// at presses from 0.5 to 9 mm over the block's loaded face, across its three steps, obliquely
-/// and along the normal, to 1e-5 (the secant iteration stops at a change of 1e-6).
+/// and along the normal, to 1e-5 (the secant iteration stops at a change of 1e-6); under the
+/// neo-Hookean law, and under the exponential one, whose steps' stiffening carries across the
+/// normal.
 #[test]
 fn the_felt_force_is_a_fixed_point_of_the_step_blend() {
-    let model = block_model_of(block_mesh([6, 4, 3]), Law::NeoHookean);
+    for law in [Law::NeoHookean, Law::Exponential] {
+        felt_force_is_a_fixed_point_of_the_step_blend(law);
+    }
+}
+
+fn felt_force_is_a_fixed_point_of_the_step_blend(law: Law) {
+    let model = block_model_of(block_mesh([6, 4, 3]), law);
     let (vademecum, _) = build(
         &organ(&model),
         &ksv_settings(vec![2.5e-3, 5e-3, 10e-3]),
@@ -401,7 +411,7 @@ fn the_felt_force_is_a_fixed_point_of_the_step_blend() {
             let error = (reached_m - indentation_m).norm() / indentation_m.norm();
             assert!(
                 error < 1e-5,
-                "triangle {t}, {indentation_m:?}: off by {error:e}"
+                "{law:?}, triangle {t}, {indentation_m:?}: off by {error:e}"
             );
             let linear_m = vademecum.compliance(&patch, &Vector3::zeros()) * force_n;
             deepest_level_m = deepest_level_m.max(linear_m.norm());
