@@ -63,6 +63,7 @@ pub fn print_build_report(report: &BuildReport, out: &Path) {
         report.free_dofs,
         100.0 * report.near_field_share
     );
+    let loaded = report.steps.get(1).map_or(0, |s| s.positions_reached);
     for (k, step) in report.steps.iter().enumerate() {
         let n = step.modes_kept;
         let pgd_error = step.curve.separated.last().copied().unwrap_or(f64::NAN);
@@ -96,7 +97,7 @@ pub fn print_build_report(report: &BuildReport, out: &Path) {
         );
         if let Some(fixed_point) = &step.fixed_point {
             print_fixed_point(fixed_point);
-            print_reached(step, report.positions);
+            print_reached(step, loaded);
         }
     }
     if let Some(failed) = &report.failed_step {
@@ -110,7 +111,7 @@ pub fn print_build_report(report: &BuildReport, out: &Path) {
             failed.indentation_m * 1e3,
             report.steps.last().map_or(0.0, |s| s.indentation_m * 1e3)
         );
-        print_reached(failed, report.positions);
+        print_reached(failed, loaded);
         if let Some(fixed_point) = &failed.fixed_point {
             print_fixed_point(fixed_point);
         }
@@ -161,12 +162,17 @@ fn print_newton_baseline(baseline: &pgd::NewtonBaseline, build_seconds: f64) {
     );
 }
 
-fn print_reached(step: &pgd::StepReport, positions: usize) {
+/// How many of the `loaded` positions (all but those a clamp holds, the first nonlinear
+/// step's) reach `step`.
+fn print_reached(step: &pgd::StepReport, loaded: usize) {
+    if loaded == 0 {
+        return; // the first nonlinear step was left out: it reached too few to count
+    }
     println!(
-        "  range: {} of {} positions reach this step ({:.0} %)",
+        "  range: {} of the {} loaded positions reach this step ({:.0} %)",
         step.positions_reached,
-        positions,
-        100.0 * step.positions_reached as f64 / positions as f64
+        loaded,
+        100.0 * step.positions_reached as f64 / loaded as f64
     );
 }
 
