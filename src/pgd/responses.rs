@@ -17,8 +17,9 @@ use web_time::Instant;
 /// Columns solved together: one pass over the factor serves them all.
 const BLOCK_COLUMNS: usize = 48;
 
-/// Smaller increments a load that diverged over its step's whole increment is taken through.
-const SUBSTEPS: usize = 4;
+/// Smaller increments a load that diverged over its step's whole increment is taken through:
+/// eight reach further than four at about the same cost (docs/pgd.md).
+const SUBSTEPS: usize = 8;
 
 /// Some of a step's loads, renumbered from zero: what the substeps of those that diverged
 /// iterate on together.
