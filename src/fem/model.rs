@@ -167,9 +167,8 @@ impl FemModel {
     /// tissue can be in, though the Kirchhoff–Saint Venant law, whose energy stays finite
     /// there, has equilibria in it.
     pub fn turns_an_element_inside_out(&self, u_m: &[f64]) -> bool {
-        let tets = self.mesh.tets().iter().zip(&self.geometry);
-        tets.into_iter()
-            .any(|(tet, geo)| j_minus_one(&geo.displacement_gradient(&gather(tet, u_m))) <= -1.0)
+        let mut tets = self.mesh.tets().iter().zip(&self.geometry);
+        tets.any(|(tet, geo)| j_minus_one(&geo.displacement_gradient(&gather(tet, u_m))) <= -1.0)
     }
 
     /// The nonlinear part of the internal force (N) on every dof, `f_int(u) − K₀ u` with `K₀`

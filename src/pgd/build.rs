@@ -23,7 +23,7 @@ use super::local::{
     AlongDirections, LocalPart, ParameterResponses, distance_neighbours, near_nodes,
 };
 use super::region::{CutHeader, RegionReport, RegionResponse, RegionSettings};
-use super::responses::{Responses, SecantReport, Trend};
+use super::responses::{Responses, SecantReport, SecantSettings, Trend};
 use super::separated::SeparatedField;
 use super::settings::BuildSettings;
 use super::snapshot_modes::SnapshotModes;
@@ -319,10 +319,12 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     let mut before: Option<(Responses, f64)> = None;
     let mut last_level_m = 0.0;
     let mut range_level_m = vec![0.0f32; reference.len()];
+    let loaded = reference.iter().filter(|&&per_n| per_n > 0.0).count();
     for &level_m in &context.settings.load_steps_m {
         let clock = Instant::now();
         // Each patch's push is sized so that its linear displacement is `level_m` long; a
-        // position whose range ended is not pushed.
+        // position whose range ended (short of the last step's level, stored as the same f32)
+        // is not pushed.
         let magnitudes: Vec<f64> = reference
             .iter()
             .zip(&range_level_m)
@@ -366,8 +368,10 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
             fixed_point.unconverged,
             clock.elapsed().as_secs_f64()
         ));
-        let reached = reached_positions(&magnitudes, &unconverged, &fixed_point, context);
-        if !kept(&reached, steps.len(), &reference, context.settings) {
+        let secant_settings = &context.settings.secant;
+        let reached = reached_positions(&magnitudes, &unconverged, &fixed_point, secant_settings);
+        let first = steps.len() == 1;
+        if !kept(reached.len(), (loaded, first), secant_settings) {
             progress.message(&format!(
                 "{law} step {:.1} mm: the fixed point did not converge for {} of {} loads; \
                  the vademecum stops at the step before",
@@ -428,29 +432,23 @@ fn reached_positions(
     magnitudes_n: &[f64],
     unconverged: &[usize],
     fixed_point: &SecantReport,
-    context: &StepContext,
+    settings: &SecantSettings,
 ) -> Vec<usize> {
-    let tolerated = fixed_point.acceptable(&context.settings.secant);
+    let tolerated = fixed_point.acceptable(settings);
     (0..magnitudes_n.len())
         .filter(|&m| magnitudes_n[m] > 0.0)
         .filter(|m| tolerated || unconverged.binary_search(m).is_err())
         .collect()
 }
 
-/// Whether a nonlinear step is kept, given the positions it reaches and the steps built
-/// before it (the linear one at least). The first nonlinear step must reach every loaded
-/// position (but the tolerated failures): a position it leaves would have no range at all.
-/// A deeper one is kept while it reaches [`SecantSettings::min_reached_share`] of them.
-fn kept(
-    reached: &[usize],
-    steps_before: usize,
-    reference: &[f32],
-    settings: &BuildSettings,
-) -> bool {
-    let loaded = reference.iter().filter(|&&per_n| per_n > 0.0).count();
-    match steps_before {
-        1 => reached.len() == loaded,
-        _ => reached.len() as f64 >= settings.secant.min_reached_share * loaded as f64,
+/// Whether a nonlinear step that reaches `reached` of the `loaded` positions (those no
+/// clamp holds) is kept. The `first` nonlinear step must reach them all (but the tolerated
+/// failures): a position it leaves would have no range at all. A deeper one is kept while
+/// it reaches [`SecantSettings::min_reached_share`] of them.
+fn kept(reached: usize, (loaded, first): (usize, bool), settings: &SecantSettings) -> bool {
+    match first {
+        true => reached == loaded,
+        false => reached as f64 >= settings.min_reached_share * loaded as f64,
     }
 }
 

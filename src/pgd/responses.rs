@@ -276,9 +276,9 @@ impl Responses {
     /// before's response at the whole magnitude, the secant's prediction, presses a stiffening
     /// law too deep (a residual as large as the load, and a dozen iterations to recover). A
     /// load Newton fails on too keeps that response, as does one whose equilibrium turns an
-    /// element inside out (the KSV law has such equilibria past its stability). Its linear systems are solved by
-    /// conjugate gradients preconditioned with the rest stiffness's factor
-    /// ([`RestStiffness::newton_solver`]).
+    /// element inside out (the KSV law has such equilibria past its stability). Its linear
+    /// systems are solved by conjugate gradients preconditioned with the rest stiffness's
+    /// factor ([`RestStiffness::newton_solver`]).
     ///
     /// The loads go [`NEWTON_BATCH`] at a time, and Newton stops before a batch when what
     /// it has spent, plus the rest at the mean cost so far, would pass `budget_solves`
