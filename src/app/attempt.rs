@@ -13,7 +13,6 @@ use super::haptic::{
 use super::scene::{Detail, SceneOrgan, scene_files, scene_of};
 use crate::contact::{ContactSurface, CouplingSettings};
 use crate::devices::{HapticDevice, Instrument, ScopeHandle, TICK_S};
-use crate::fem::Law;
 use crate::mesh::organs::Organ;
 use crate::scenario::{
     self, CutMade, Exercise, Keratometer, LaparoscopeEntry, Nodule, NoduleSite, OrganEntry, Port,
@@ -119,10 +118,10 @@ fn scene_organ(scenario: &Scenario, entry: &OrganEntry) -> Result<SceneOrgan, St
         young_pa: entry.young_pa.map(|e| e.0),
         poisson: entry.poisson_ratio.map(|nu| nu.0),
         max_modes: entry.max_modes.map(|n| n.0),
-        law: entry.law.unwrap_or(Law::Linear),
+        law: scenario.law_of(entry),
         stiffening: entry.stiffening.map(|b| b.0),
-        dynamic: entry.dynamic.unwrap_or(scenario.grasps()),
-        cut_toughness_j_per_m2: scenario.blade().and_then(|_| entry.toughness_j_per_m2()),
+        dynamic: scenario.moves(entry),
+        cut_toughness_j_per_m2: scenario.cut_toughness_j_per_m2(entry),
         inclusions: scenario
             .nodules
             .iter()

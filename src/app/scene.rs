@@ -20,7 +20,9 @@ use crate::fem::{FemModel, Inclusion, Law};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::{Organ, OrganSettings, region};
 use crate::pgd::{BuildSettings, Vademecum};
-use crate::scenario::Keratometer;
+use crate::scenario::{Keratometer, default_law};
+#[cfg(not(target_arch = "wasm32"))]
+use crate::store::build_in_background;
 use crate::store::{OnStale, OrganSource, VademecumSpec, ensure_vademecum, vademecum_file_name};
 
 pub const SCENE_ORGANS: [Organ; 4] = Organ::ABDOMEN;
@@ -43,12 +45,13 @@ pub const CUT_CORNEA_COARSE: (f64, usize) = (0.3, 4);
 /// How finely the scene's organs are meshed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Detail {
-    /// The papers' meshes and each organ's own tool (vademecums build in about 3 minutes).
+    /// The papers' meshes and each organ's own tool (linear vademecums build in about 3
+    /// minutes, nonlinear ones in tens of minutes each).
     #[default]
     Full,
     /// A quarter of the nodes and, on the abdominal organs, a 12 mm tool, whose patch must
-    /// span the coarser edges: the vademecums build in seconds, for a quick look on a slow
-    /// machine and for tests. The coarse cornea's edges are still shorter than its own
+    /// span the coarser edges: the linear vademecums build in seconds and the four exponential
+    /// ones in about 6 minutes, for a quick look on a slow machine and for tests. The coarse cornea's edges are still shorter than its own
     /// 0.5 mm spatula, which it keeps.
     Coarse,
 }
@@ -158,7 +161,7 @@ impl From<Organ> for SceneOrgan {
             poisson: None,
             max_modes: None,
             inclusions: Vec::new(),
-            law: Law::Linear,
+            law: default_law(Some(organ), false, false),
             stiffening: None,
             dynamic: false,
             cut_toughness_j_per_m2: None,
@@ -256,7 +259,13 @@ pub fn scene_of(
         .iter()
         .map(|organ| {
             let spec = organ.vademecum(dir, detail, tip);
-            let (vademecum, mesh) = ensure_vademecum(&spec, on_stale)?;
+            let (vademecum, mesh) = match on_stale {
+                #[cfg(not(target_arch = "wasm32"))]
+                OnStale::Meanwhile if organ.law != Law::Linear => {
+                    linear_meanwhile(organ, spec.clone(), (dir, detail, tip))?
+                }
+                _ => ensure_vademecum(&spec, on_stale)?,
+            };
             if organ.name == coupling.master {
                 field_file = Some(spec.field_file());
             }
@@ -296,6 +305,32 @@ pub fn scene_of(
         instruments: vec![Instrument { action, port: None }],
         scope: None,
     })
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+/// `spec`, the nonlinear vademecum of `organ`, if it is built; else the organ's linear one
+/// (built now if need be), `spec` queued to build in the background.
+fn linear_meanwhile(
+    organ: &SceneOrgan,
+    spec: VademecumSpec,
+    (dir, detail, tip_m): (&Path, Detail, f64),
+) -> Result<(Vademecum, TetMesh), String> {
+    if let Ok(built) = ensure_vademecum(&spec, OnStale::Refuse) {
+        return Ok(built);
+    }
+    eprintln!(
+        "{}: linear tissue until its {} vademecum is built, in the background ({})",
+        organ.name,
+        organ.law.name(),
+        spec.file.display()
+    );
+    build_in_background(spec);
+    let linear = SceneOrgan {
+        law: Law::Linear,
+        stiffening: None,
+        ..organ.clone()
+    };
+    ensure_vademecum(&linear.vademecum(dir, detail, tip_m), OnStale::Rebuild)
 }
 
 /// The dynamic models of the organs that move (their tissue under the KSV law, whose reduced

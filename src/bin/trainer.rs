@@ -71,7 +71,7 @@ struct Cli {
     #[arg(long, global = true, default_value = "vademecums")]
     vademecums: PathBuf,
     /// Coarse organs (a quarter of the nodes, a 12 mm tool): their vademecums build in
-    /// seconds. For a quick look on a slow machine, and for tests.
+    /// minutes. For a quick look on a slow machine, and for tests.
     #[arg(long, global = true)]
     coarse: bool,
     /// Fail (with the command to run) instead of rebuilding a missing or stale vademecum.
@@ -216,10 +216,12 @@ fn main() -> ExitCode {
         );
         return ExitCode::from(2);
     }
-    let on_stale = if cli.no_rebuild {
-        OnStale::Refuse
-    } else {
-        OnStale::Rebuild
+    // The window opens at once on a first run: nonlinear tissue comes as its vademecums are
+    // built in the background. A headless run builds them first, to be the same every time.
+    let on_stale = match (cli.no_rebuild, cli.headless) {
+        (true, _) => OnStale::Refuse,
+        (false, true) => OnStale::Rebuild,
+        (false, false) => OnStale::Meanwhile,
     };
     let realtime = match cli.headless {
         true => cli.realtime.then_some(cli.timer),

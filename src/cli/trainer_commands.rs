@@ -53,7 +53,8 @@ pub fn validate_scenarios(files: &[PathBuf]) -> ExitCode {
 
 /// `trainer prepare`: the vademecums and distance fields the scenario files need, built under
 /// `dir` where missing or stale, then listed one per line (what a class, or the web page's
-/// site, must have), and with `web` their web forms written there, with their sizes and how
+/// site, must have), and with `web` their web forms written there (for the page's scenes:
+/// linear tissue where a scenario names no law, [`scenario::Scenario::for_the_web`]), with their sizes and how
 /// much the felt force changes. Fails if any file does not read or any scene cannot be built.
 pub fn prepare_scenarios(
     files: &[PathBuf],
@@ -66,6 +67,7 @@ pub fn prepare_scenarios(
     for file in files {
         let prepared = scenario::load(file)
             .map_err(|e| e.to_string())
+            .map(|s| if web.is_some() { s.for_the_web() } else { s })
             .and_then(|s| {
                 scenario_scene(&s, dir, detail, OnStale::Rebuild)?;
                 scenario_files(&s, dir, detail)

@@ -42,11 +42,12 @@ pub struct ToolContact {
     /// How far the organ's other loads have moved the surface there (m), averaged over the
     /// tool's patch.
     pub moved_m: Vector3<f64>,
-    /// How far the tip reaches below the rest surface, along the normal (m); clamped to the
-    /// depth the vademecum's load steps answer ([`Vademecum::patch_press_in_range`]).
+    /// How far the tip reaches below the rest surface, along the normal (m).
     pub depth_m: f64,
-    /// How much deeper than that the tip reaches (m); zero within the range. The force stays
-    /// at the range's edge there, bounded and finite, and the run's report says so.
+    /// How much of that depth lies beyond what the vademecum's load steps cover (m); zero
+    /// within the range. The tissue stops stiffening there, its force growing on at the
+    /// range edge's secant stiffness ([`Vademecum::patch_press_in_range`]), and the run's
+    /// report says so.
     pub beyond_range_m: f64,
     /// The displacement the tool's load adds to the surface under it (m): into the surface by
     /// the depth, and back sideways by what the other loads moved it.
@@ -92,16 +93,14 @@ where
         load.release();
         return None;
     };
-    let (force_n, stiffness_n_per_m, answered) =
+    let (force_n, stiffness_n_per_m, beyond) =
         vademecum.patch_press_in_range(patch, &contact.indentation_m);
     load.shares.clone_from(&patch.shares);
     load.force_n = force_n;
     Some(ToolContact {
         force_n,
         stiffness_n_per_m,
-        depth_m: contact.depth_m * answered,
-        beyond_range_m: contact.depth_m * (1.0 - answered),
-        indentation_m: contact.indentation_m * answered,
+        beyond_range_m: contact.depth_m * beyond,
         ..contact
     })
 }

@@ -112,15 +112,26 @@ impl Vademecum {
         settings: &BuildSettings,
     ) -> Result<(), VademecumError> {
         let law = self.header.material.law;
+        // The steps are compared apart, to 1e-9 relative: a command line gives them in decimal.
         let relevant = |s: &BuildSettings| match law {
             Law::Linear => BuildSettings {
                 load_steps_m: Vec::new(),
                 secant: SecantSettings::default(),
                 ..s.clone()
             },
-            _ => s.clone(),
+            _ => BuildSettings {
+                load_steps_m: Vec::new(),
+                ..s.clone()
+            },
         };
-        if relevant(&self.header.settings) != relevant(settings) {
+        let (built, asked) = (&self.header.settings.load_steps_m, &settings.load_steps_m);
+        let same_steps = law == Law::Linear
+            || (built.len() == asked.len()
+                && built
+                    .iter()
+                    .zip(asked)
+                    .all(|(b, a)| (b - a).abs() <= 1e-9 * a.abs()));
+        if !same_steps || relevant(&self.header.settings) != relevant(settings) {
             return Err(VademecumError::OtherSettings {
                 file: file.to_path_buf(),
                 expected: settings.summary(law),

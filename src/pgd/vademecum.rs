@@ -549,30 +549,26 @@ impl Vademecum {
         press
     }
 
-    /// [`Self::patch_press`] held within the load steps' range, and the share of
-    /// `indentation_m` it answers (one within the range). The patch's level is the
-    /// share-weighted level of the patches centred on its positions (close to the linear depth
-    /// of the tool's own patch); past the last step's the force is held at the magnitude that
-    /// puts the patch there, along the direction the blend's stiffness there gives (the blend
-    /// depends on the force's magnitude only), and answers that share of the indentation.
+    /// [`Self::patch_press`], and the share of `indentation_m` that lies beyond the load
+    /// steps' range (zero within it). The patch's level is the share-weighted level of the
+    /// patches centred on its positions (close to the linear depth of the tool's own patch);
+    /// past the edge ([`Self::range_force_n`]) a position's steps add nothing deeper: its
+    /// columns stop at the last step its load reached, and a level past the deepest step takes
+    /// that step. So the tissue stops stiffening there, and the force goes on growing with the
+    /// depth at the edge's secant stiffness: a trainee pressing too deep still feels the
+    /// tissue push back harder.
     pub fn patch_press_in_range(
         &self,
         patch: &mut Patch,
         indentation_m: &Vector3<f64>,
     ) -> (Vector3<f64>, Matrix3<f64>, f64) {
         let (force_n, stiffness) = self.patch_press(patch, indentation_m);
-        if self.steps.len() == 1 {
-            return (force_n, stiffness, 1.0);
-        }
         let edge_n = self.range_force_n(patch);
-        if force_n.norm().is_nan() || force_n.norm() <= edge_n {
-            return (force_n, stiffness, 1.0);
-        }
-        let at_edge = self.column_compliance(patch, &(Vector3::x() * edge_n));
-        let stiffness = at_edge.try_inverse().unwrap_or_else(Matrix3::zeros);
-        let unclamped_n = stiffness * indentation_m;
-        let answered = (edge_n / unclamped_n.norm()).min(1.0);
-        (unclamped_n * answered, stiffness, answered)
+        let beyond = match force_n.norm() {
+            f if f > edge_n => 1.0 - edge_n / f,
+            _ => 0.0,
+        };
+        (force_n, stiffness, beyond)
     }
 
     /// The largest force (N) on `patch` its load steps answer: the one that puts the patch's

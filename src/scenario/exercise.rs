@@ -10,6 +10,7 @@ use super::format::{OrganEntry, Scenario, Spot, Task, TaskKind, metres, spot_nam
 use super::incision::{BladeSample, IncisionMetrics, IncisionTracker};
 use super::keratotomy::{Keratometer, KeratotomyMetrics, KeratotomyPlan, KeratotomyTracker};
 use super::motion::{MotionMetrics, MotionTracker};
+use super::units::Newtons;
 use crate::pgd::SurfacePoint;
 
 /// What the haptic loop knows of one tick, for scoring.
@@ -497,8 +498,9 @@ impl Running {
                 _ => "pressed",
             };
             let error = format!(
-                "{:.2} s: {verb} harder than {:.2} N",
-                sample.time_s, m.force_limit_n
+                "{:.2} s: {verb} harder than {} N",
+                sample.time_s,
+                Newtons(m.force_limit_n)
             );
             m.errors.push(error);
         }
@@ -631,8 +633,9 @@ impl Running {
             .crossed(force, limit_n, dt, &mut m.surrounding_over_limit_s)
         {
             let error = format!(
-                "{:.2} s: loaded the organs around harder than {limit_n:.2} N",
-                sample.time_s
+                "{:.2} s: loaded the organs around harder than {} N",
+                sample.time_s,
+                Newtons(limit_n)
             );
             m.errors.push(error);
         }

@@ -11,6 +11,7 @@ use serde::{Deserialize, Deserializer};
 use crate::contact::PointshellDensity;
 use crate::devices::DeviceSpec;
 use crate::fem::Law;
+use crate::mesh::organs::Organ;
 
 use super::units::{
     DepthFraction, Dioptres, EdgeLength, FieldOfView, IncisionCount, Millimetres, ModeCount,
@@ -377,7 +378,7 @@ pub struct OrganEntry {
     #[serde(default)]
     pub max_modes: Option<ModeCount>,
     /// Its tissue's law (`Linear`, `NeoHookean`, `Exponential`, `KirchhoffSaintVenant`), when
-    /// not linear.
+    /// not the default ([`default_law`]: exponential where pressed, linear where cut or moved).
     #[serde(default)]
     pub law: Option<Law>,
     /// The exponential law's stiffening b, when not its default (`law: Exponential` only).
@@ -397,7 +398,6 @@ impl OrganEntry {
     /// Its tissue's toughness under a blade (J/m²): the scenario's, or the organ's own where
     /// it is known (a generated liver or cornea).
     pub fn toughness_j_per_m2(&self) -> Option<f64> {
-        use crate::mesh::organs::Organ;
         let own = match (Organ::from_name(&self.name), &self.mesh) {
             (Some(Organ::Liver), None) => Some(crate::cutting::LIVER_TOUGHNESS_J_PER_M2),
             (Some(Organ::Cornea), None) => Some(crate::cutting::CORNEA_TOUGHNESS_J_PER_M2),
@@ -510,6 +510,58 @@ impl Scenario {
         self.instruments_in_hand()
             .iter()
             .any(|(tool, _)| tool.grasps())
+    }
+
+    /// Whether `organ` moves: as it says, else when an instrument grasps.
+    pub fn moves(&self, organ: &OrganEntry) -> bool {
+        organ.dynamic.unwrap_or(self.grasps())
+    }
+
+    /// The toughness (J/m²) of `organ`'s tissue when a blade cuts it (`None`: uncut).
+    pub fn cut_toughness_j_per_m2(&self, organ: &OrganEntry) -> Option<f64> {
+        self.blade().and_then(|_| organ.toughness_j_per_m2())
+    }
+
+    /// `organ`'s tissue law: as it says, else [`default_law`] for it in this scenario.
+    pub fn law_of(&self, organ: &OrganEntry) -> Law {
+        let generated = organ
+            .mesh
+            .is_none()
+            .then(|| Organ::from_name(&organ.name))
+            .flatten();
+        let cut = self.cut_toughness_j_per_m2(organ).is_some();
+        organ
+            .law
+            .unwrap_or_else(|| default_law(generated, cut, self.moves(organ)))
+    }
+}
+
+impl Scenario {
+    /// The scenario as the web page runs it: linear tissue where it names no law. A scene's
+    /// nonlinear vademecums are seven times the size of its linear ones, one load step each
+    /// (the coarse gallbladder's 146 MB against 20 MB), too much for a page to download.
+    pub fn for_the_web(&self) -> Scenario {
+        let mut scenario = self.clone();
+        for organ in &mut scenario.organs {
+            organ.law.get_or_insert(Law::Linear);
+        }
+        scenario
+    }
+}
+
+/// The law an organ's tissue follows when its scenario does not say (`organ` is `None` for a
+/// mesh file, whose tissue is the liver's): the exponential law, which firms up under the
+/// tool as liver does, where the organ is pressed; the linear law where a scalpel cuts it
+/// (the cut state is linear X-FEM), where it moves (its reduced dynamics run the KSV energy
+/// on its linear vademecum's modes), on the cornea, which only the keratotomy's blade cuts,
+/// and on the gallbladder: its thin wall's loads fail past the first load steps over much of
+/// it (at the fundus its range ends 1.3 mN in), so its exponential vademecum is little more
+/// than a linear one there, and softer than it.
+pub fn default_law(organ: Option<Organ>, cut: bool, dynamic: bool) -> Law {
+    let linear_organ = matches!(organ, Some(Organ::Cornea | Organ::Gallbladder));
+    match linear_organ || cut || dynamic {
+        true => Law::Linear,
+        false => Law::Exponential,
     }
 }
 
@@ -715,8 +767,8 @@ impl Task {
                 hold_s,
                 ..
             } => format!(
-                "hold {:.2} to {:.2} N on the {organ} for {} s",
-                min_force_n.0, max_force_n.0, hold_s.0
+                "hold {min_force_n} to {max_force_n} N on the {organ} for {} s",
+                hold_s.0
             ),
             Task::SafeNavigation {
                 targets,
@@ -724,17 +776,15 @@ impl Task {
                 max_force_n,
                 ..
             } => format!(
-                "reach {} in order, avoiding {}, under {:.2} N",
+                "reach {} in order, avoiding {}, under {max_force_n} N",
                 names(targets),
                 names(forbidden),
-                max_force_n.0
             ),
             Task::Palpation {
                 organ, max_force_n, ..
-            } => format!(
-                "find the nodule in the {organ} by feel and mark it, under {:.2} N",
-                max_force_n.0
-            ),
+            } => {
+                format!("find the nodule in the {organ} by feel and mark it, under {max_force_n} N")
+            }
             Task::Retraction {
                 organ,
                 region,
@@ -744,9 +794,9 @@ impl Task {
                 max_surrounding_force_n,
                 ..
             } => format!(
-                "move {region} of the {organ} {:.0} mm and hold it {} s, under {:.2} N, \
-                 loading the organs around under {:.2} N",
-                move_mm.0, hold_s.0, max_force_n.0, max_surrounding_force_n.0
+                "move {region} of the {organ} {:.0} mm and hold it {} s, under {max_force_n} N, \
+                 loading the organs around under {max_surrounding_force_n} N",
+                move_mm.0, hold_s.0
             ),
             Task::Grasp {
                 organ,
@@ -757,8 +807,8 @@ impl Task {
                 ..
             } => format!(
                 "grasp {region} of the {organ}, draw it {:.0} mm, hold it {} s and let go, \
-                 under {:.2} N and without tearing it",
-                move_mm.0, hold_s.0, max_force_n.0
+                 under {max_force_n} N and without tearing it",
+                move_mm.0, hold_s.0
             ),
             Task::Incision {
                 organ,
@@ -768,10 +818,9 @@ impl Task {
                 max_force_n,
                 ..
             } => format!(
-                "cut the marked line on the {organ}, {:.0} mm long and {:.0} mm deep, under {:.2} N",
+                "cut the marked line on the {organ}, {:.0} mm long and {:.0} mm deep, under {max_force_n} N",
                 (metres(*to_mm) - metres(*from_mm)).norm() * 1e3,
                 depth_mm.0,
-                max_force_n.0
             ),
             Task::RadialKeratotomy {
                 organ,
@@ -783,12 +832,11 @@ impl Task {
                 ..
             } => format!(
                 "make {} radial incisions in the {organ} outside a {:.1} mm optical zone, {:.0} % \
-                 deep, for {:.1} D of correction, under {:.2} N",
+                 deep, for {:.1} D of correction, under {max_force_n} N",
                 incisions.0,
                 optical_zone_mm.0,
                 100.0 * depth_fraction.0,
                 target_correction_d.0,
-                max_force_n.0
             ),
         }
     }

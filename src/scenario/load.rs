@@ -166,7 +166,7 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
     }
     for (k, organ) in scenario.organs.iter().enumerate() {
         problems.extend(check_organ(k, organ));
-        problems.extend(check_stiffening(k, organ));
+        problems.extend(check_stiffening(k, organ, scenario.law_of(organ)));
         if scenario.organs[..k].iter().any(|o| o.name == organ.name) {
             problems.push(Problem {
                 field: format!("organs[{k}]"),
@@ -710,9 +710,8 @@ fn check_organ(k: usize, organ: &OrganEntry) -> Option<Problem> {
     }
 }
 
-/// A problem if the `k`th organ sets a stiffening under a law that has none.
-fn check_stiffening(k: usize, organ: &OrganEntry) -> Option<Problem> {
-    let law = organ.law.unwrap_or(Law::Linear);
+/// A problem if the `k`th organ sets a stiffening under its `law`, which has none.
+fn check_stiffening(k: usize, organ: &OrganEntry, law: Law) -> Option<Problem> {
     (organ.stiffening.is_some() && law != Law::Exponential).then(|| Problem {
         field: format!("organs[{k}].stiffening"),
         anchors: vec![

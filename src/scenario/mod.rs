@@ -19,7 +19,7 @@ pub use exercise::{
 };
 pub use format::{
     Contact, Device, Difficulty, Instrument, LaparoscopeEntry, Nodule, OrganEntry, Port, Rubric,
-    Scenario, ScopeKey, Spot, Task, TaskKind, Tool, metres,
+    Scenario, ScopeKey, Spot, Task, TaskKind, Tool, default_law, metres,
 };
 pub use incision::{BladeSample, IncisionMetrics, IncisionTracker};
 pub use keratotomy::{

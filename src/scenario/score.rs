@@ -7,6 +7,7 @@ use super::exercise::{COVERED_TO_FINISH, TaskMetrics};
 use super::format::{Rubric, Scenario, TaskKind};
 use super::incision::IncisionMetrics;
 use super::keratotomy::KeratotomyMetrics;
+use super::units::Newtons;
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TaskScore {
@@ -231,8 +232,11 @@ fn task_feedback(task: &TaskScore) -> Vec<String> {
     }
     if m.time_over_limit_s > 0.0 {
         lines.push(format!(
-            "{}: {:.1} s above {:.2} N (peak {:.2} N)",
-            m.kind, m.time_over_limit_s, m.force_limit_n, m.peak_force_n
+            "{}: {:.1} s above {} N (peak {} N)",
+            m.kind,
+            m.time_over_limit_s,
+            Newtons(m.force_limit_n),
+            Newtons(m.peak_force_n)
         ));
     }
     if let Some(out_s) = m.motion.out_of_view_s.filter(|&s| s >= NOTED_OUT_OF_VIEW_S) {
@@ -251,8 +255,11 @@ fn task_feedback(task: &TaskScore) -> Vec<String> {
         && m.surrounding_over_limit_s > 0.0
     {
         lines.push(format!(
-            "{}: {:.1} s loading the organs around above {limit:.2} N (peak {:.2} N)",
-            m.kind, m.surrounding_over_limit_s, m.surrounding_peak_n
+            "{}: {:.1} s loading the organs around above {} N (peak {} N)",
+            m.kind,
+            m.surrounding_over_limit_s,
+            Newtons(limit),
+            Newtons(m.surrounding_peak_n)
         ));
     }
     if let Some(cut) = &m.incision {

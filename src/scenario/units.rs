@@ -50,6 +50,17 @@ impl TryFrom<f64> for Newtons {
     }
 }
 
+impl std::fmt::Display for Newtons {
+    /// To the millinewton, with two decimals at least: 0.06, 0.035, 0.60.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let text = format!("{:.3}", self.0);
+        match text.strip_suffix('0') {
+            Some(two) => f.write_str(two),
+            None => f.write_str(&text),
+        }
+    }
+}
+
 /// A duration in seconds, more than 0 and at most an hour.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(try_from = "f64")]
@@ -316,5 +327,19 @@ impl TryFrom<f64> for Dioptres {
                  keratotomy corrects 2 to 8)"
             )),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Newtons;
+
+    #[test]
+    fn a_force_is_written_to_the_millinewton_with_two_decimals_at_least() {
+        assert_eq!(Newtons(0.06).to_string(), "0.06");
+        assert_eq!(Newtons(0.035).to_string(), "0.035");
+        assert_eq!(Newtons(0.6).to_string(), "0.60");
+        assert_eq!(Newtons(3.3).to_string(), "3.30");
+        assert_eq!(Newtons(0.0304).to_string(), "0.03");
     }
 }

@@ -4,11 +4,15 @@
 //! and the history of trainees' attempts (SQLite). No Bevy: the app and both binaries call it.
 
 #[cfg(not(target_arch = "wasm32"))]
+mod background;
+#[cfg(not(target_arch = "wasm32"))]
 mod history;
 mod progress;
 mod source;
 mod vademecums;
 
+#[cfg(not(target_arch = "wasm32"))]
+pub use background::{BackgroundStatus, Building, background_status, build_in_background};
 #[cfg(not(target_arch = "wasm32"))]
 pub use history::{
     AttemptRecord, History, HistoryError, HistoryFilter, keep as keep_attempt, now_unix_s,

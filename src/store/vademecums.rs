@@ -9,7 +9,8 @@ use crate::mesh::TetMesh;
 use crate::mesh::io::ImportOptions;
 use crate::mesh::organs::{Organ, OrganSettings, region};
 use crate::pgd::{
-    self, BuildReport, BuildSettings, OrganModel, RegionSettings, Vademecum, VademecumError,
+    self, BuildReport, BuildSettings, OrganModel, Progress, RegionSettings, Vademecum,
+    VademecumError, default_load_steps_m,
 };
 
 use super::{Bar, OrganSource};
@@ -22,6 +23,9 @@ pub enum OnStale {
     Rebuild,
     /// Fail with the command that builds it.
     Refuse,
+    /// A nonlinear one: run on the organ's linear vademecum (built now if need be) while it
+    /// builds in the background (the app chooses the linear one); otherwise as `Rebuild`.
+    Meanwhile,
 }
 
 /// What the trainer wants of one organ's vademecum: the organ's mesh (generated at a
@@ -109,6 +113,19 @@ impl VademecumSpec {
         if self.build.pgd.max_modes != build.pgd.max_modes {
             command += &format!(" --max-modes {}", self.build.pgd.max_modes);
         }
+        // `pgd build` derives the steps from the tool it is given; a spec that keeps another
+        // tool's steps (the coarse organs keep the 6 mm tool's) says them.
+        let steps = &self.build.load_steps_m;
+        let derived =
+            default_load_steps_m(self.source.organ(), self.build.tool_tip_radius_m, self.law);
+        if self.law != Law::Linear && *steps != derived {
+            // To the micrometre: the file's check holds steps equal to 1e-9 relative.
+            let mm: Vec<String> = steps
+                .iter()
+                .map(|s| format!("{}", (s * 1e6).round() / 1e3))
+                .collect();
+            command += &format!(" --load-steps-mm {}", mm.join(","));
+        }
         if let Some(young_pa) = self.young_pa {
             command += &format!(" --young-pa {young_pa}");
         }
@@ -142,6 +159,15 @@ pub fn ensure_vademecum(
     spec: &VademecumSpec,
     on_stale: OnStale,
 ) -> Result<(Vademecum, TetMesh), String> {
+    ensure_with(spec, on_stale, &Bar::default())
+}
+
+/// [`ensure_vademecum`], a build's progress shown on `progress`.
+pub(super) fn ensure_with(
+    spec: &VademecumSpec,
+    on_stale: OnStale,
+    progress: &dyn Progress,
+) -> Result<(Vademecum, TetMesh), String> {
     let name = &spec.name;
     let mesh = spec.source.load(&spec.mesh, &ImportOptions::default())?;
     let mut material = pgd::organ::material(spec.source.material_of(), spec.law);
@@ -166,7 +192,7 @@ pub fn ensure_vademecum(
         cuts: None,
         newton_samples: 0,
     };
-    let (vademecum, _, [csv, png]) = build_and_save(job, &spec.file)?;
+    let (vademecum, _, [csv, png]) = build_and_save_with(job, &spec.file, progress)?;
     eprintln!(
         "wrote {} (convergence curves: {} and {})",
         spec.file.display(),
@@ -200,6 +226,15 @@ pub fn build_and_save(
     job: BuildJob,
     file: &Path,
 ) -> Result<(Vademecum, BuildReport, [PathBuf; 2]), String> {
+    build_and_save_with(job, file, &Bar::default())
+}
+
+/// [`build_and_save`], its progress shown on `progress`.
+fn build_and_save_with(
+    job: BuildJob,
+    file: &Path,
+    progress: &dyn Progress,
+) -> Result<(Vademecum, BuildReport, [PathBuf; 2]), String> {
     let source = job.source;
     let model = pgd::organ::clamped_model(job.mesh, job.material)
         .and_then(|model| model.with_inclusions(job.inclusions))
@@ -210,10 +245,10 @@ pub fn build_and_save(
         clamped_region: region::CLAMPED.into(),
         accessible_region: region::ACCESSIBLE.into(),
     };
-    let (mut vademecum, mut built) = pgd::build(&organ_model, &job.settings, &Bar::default())
-        .map_err(|e| format!("{source}: {e}"))?;
+    let (mut vademecum, mut built) =
+        pgd::build(&organ_model, &job.settings, progress).map_err(|e| format!("{source}: {e}"))?;
     if let Some(cuts) = &job.cuts {
-        let report = pgd::add_cuts(&mut vademecum, &model, cuts, &Bar::default())
+        let report = pgd::add_cuts(&mut vademecum, &model, cuts, progress)
             .map_err(|e| format!("{source}: cut section: {e}"))?;
         built.total_seconds += report.total_seconds;
         built.cuts = Some(report);
@@ -253,4 +288,27 @@ fn inclusion_arg(inclusion: &Inclusion) -> String {
     let [x, y, z] = inclusion.centre_m.map(|c| c * 1e3);
     let radius_mm = inclusion.radius_m * 1e3;
     format!("{x},{y},{z},{radius_mm},{}", inclusion.stiffness_ratio)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A spec that keeps the 6 mm tool's steps under a 12 mm tool (as the coarse organs do)
+    /// says them, since `pgd build` would derive twice as deep ones from the 12 mm tool; the
+    /// organ's own steps under its own tool go unsaid.
+    #[test]
+    fn the_build_command_says_steps_the_tool_would_not_give() {
+        let dir = Path::new("vademecums");
+        let own = VademecumSpec::default_in(dir, Organ::Liver, Law::Exponential);
+        assert!(!own.build_command().contains("--load-steps-mm"));
+        let mut coarse = own.clone();
+        coarse.build.tool_tip_radius_m = 0.012;
+        let command = coarse.build_command();
+        assert!(
+            command.contains("--tool-radius-mm 12 ")
+                && command.contains("--load-steps-mm 2.5,5,10,15,20,25 "),
+            "{command}"
+        );
+    }
 }

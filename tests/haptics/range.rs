@@ -1,6 +1,7 @@
 //! A nonlinear vademecum pressed deeper than its load steps cover: the force stays finite and
-//! held at what the range's edge gives, and the run's report says how far beyond the range the
-//! tool went; a press within the range reports nothing.
+//! goes on growing with the depth at the range edge's secant stiffness (the tissue stops
+//! stiffening there), and the run's report says how far beyond the range the tool went; a
+//! press within the range reports nothing.
 
 use std::sync::Arc;
 
@@ -75,13 +76,21 @@ fn press(vademecum: &Arc<Vademecum>, depth_m: f64) -> (HeadlessReport, ForceTrac
     (report, trace)
 }
 
-/// Pressed ten times deeper than the load steps reach, the force is finite everywhere and held
-/// where the patch reaches the last step (the range's edge: the steps load the tool's own
-/// patch, so within 10 % of the step's 1 mm of tool depth), and the report counts the ticks
-/// beyond and how far. Pressed just short of that edge, nothing is
-/// reported and the force is just under the held one (within 2 %, 1 % short of the edge).
+/// The largest force (N) of a trace.
+fn largest(trace: &ForceTrace) -> f64 {
+    trace.desired_n.iter().map(|f| f.norm()).fold(0.0, f64::max)
+}
+
+/// Pressed ten times deeper than the load steps reach, the force is finite everywhere and the
+/// report counts the ticks beyond the range and how far (the edge where the patch reaches the
+/// last step: the steps load the tool's own patch, so within 10 % of the step's 1 mm of tool
+/// depth). Beyond the edge the patch's compliance is the edge's: the force at ten times the
+/// range is twice the force at five times it, to 1e-3 (the point under the tip follows the
+/// surface the press moves, slightly aside on the block's uneven tets, and the patch with it:
+/// 2.7e-4 measured), and over nine times the force just short of the edge. Pressed just short
+/// of the edge, nothing is reported.
 #[test]
-fn a_press_beyond_the_range_is_held_at_its_edge_and_reported() {
+fn a_press_beyond_the_range_stiffens_no_more_and_is_reported() {
     let vademecum = Arc::new(block_vademecum());
     assert_eq!(vademecum.valid_indentation_m(), RANGE_M);
     let (deep, deep_trace) = press(&vademecum, 10.0 * RANGE_M);
@@ -101,23 +110,19 @@ fn a_press_beyond_the_range_is_held_at_its_edge_and_reported() {
     );
     let edge_m = 10.0 * RANGE_M - deep.range.max_beyond_mm * 1e-3;
     assert!((edge_m / RANGE_M - 1.0).abs() < 0.1, "{deep}");
-    let largest = |trace: &ForceTrace| trace.desired_n.iter().map(|f| f.norm()).fold(0.0, f64::max);
-    let held_n = largest(&deep_trace);
-    let held_ticks = deep_trace
-        .desired_n
-        .iter()
-        .filter(|f| (f.norm() - held_n).abs() <= 1e-9 * held_n)
-        .count();
+    let (half, half_trace) = press(&vademecum, 5.0 * RANGE_M);
+    let (deep_n, half_n) = (largest(&deep_trace), largest(&half_trace));
+    assert!(half.range.beyond_ticks > 0, "{half}");
     assert!(
-        held_ticks > 500,
-        "{held_ticks} ticks at the held {held_n} N"
+        (deep_n / half_n - 2.0).abs() < 1e-3,
+        "{deep_n} N at ten times the range, {half_n} N at five times"
     );
     let (short, short_trace) = press(&vademecum, 0.99 * edge_m);
     eprintln!("{short}\n{deep}");
     assert_eq!(short.range.beyond_ticks, 0, "{short}");
     let short_n = largest(&short_trace);
     assert!(
-        short_n < held_n && short_n > 0.98 * held_n,
-        "{short_n} N just short of the edge against {held_n} N held"
+        deep_n > 9.0 * short_n,
+        "{deep_n} N ten times deeper than the range against {short_n} N just short of its edge"
     );
 }

@@ -127,3 +127,52 @@ fn the_force_depth_plot_is_drawn_only_when_there_are_curves() {
     let png = plot_force_depth(&checked(1), &file).unwrap().unwrap();
     assert!(std::fs::read(png).unwrap().starts_with(b"\x89PNG"));
 }
+
+/// A vademecum queued for the background is built there, on the builder's thread, once
+/// however often it is queued: the builder's status shows it queued or building until it is
+/// idle, and the file is then there, good for the organ it was asked for (an organ from a
+/// mesh file: the block, clamped underneath, pressed on top, neo-Hookean).
+#[test]
+fn a_vademecum_queued_for_the_background_is_built_there_once() {
+    use pgd_surgery::mesh::io::write_vtu;
+    use pgd_surgery::mesh::organs::region;
+    use std::time::{Duration, Instant};
+
+    let dir = temp_dir("background");
+    let mut mesh = block_mesh([4, 3, 2]);
+    let clamped = mesh.node_set("z0").unwrap().to_vec();
+    let accessible = mesh.face_set("z1").unwrap().to_vec();
+    mesh.set_node_set(region::CLAMPED, clamped).unwrap();
+    mesh.set_face_set(region::ACCESSIBLE, accessible).unwrap();
+    let path = dir.join("block.vtu");
+    write_vtu(&path, &mesh, &[]).unwrap();
+    let file = dir.join("block-neo-hookean.vdm");
+    let source = store::OrganSource::File(path);
+    let mut spec = VademecumSpec::new("block", source, Law::NeoHookean, file.clone());
+    spec.build.tool_tip_radius_m = 0.012;
+    spec.build.local_radius_m = 0.015;
+    spec.build.load_steps_m = vec![0.5e-3];
+    store::build_in_background(spec.clone());
+    store::build_in_background(spec.clone());
+    let status = store::background_status();
+    let building = status.building.iter().count();
+    assert_eq!(building + status.queued.len(), 1, "{status:?}");
+    let started = Instant::now();
+    while !store::background_status().is_idle() {
+        assert!(
+            started.elapsed() < Duration::from_secs(600),
+            "still building"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let status = store::background_status();
+    assert!(status.failed.is_empty(), "{status:?}");
+    let (vademecum, _) = store::ensure_vademecum(&spec, OnStale::Refuse).unwrap();
+    assert_eq!(vademecum.header.material.law, Law::NeoHookean);
+    assert_eq!(vademecum.steps.len(), 2);
+    let built = std::fs::metadata(&file).unwrap().modified().unwrap();
+    store::build_in_background(spec);
+    assert!(store::background_status().is_idle());
+    std::thread::sleep(Duration::from_millis(200));
+    assert_eq!(std::fs::metadata(&file).unwrap().modified().unwrap(), built);
+}

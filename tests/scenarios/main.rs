@@ -724,11 +724,11 @@ fn the_scenario_chooses_the_contact_master() {
 /// neo-Hookean law, with its load steps (the law's defaults, as deep as the fixed point and
 /// Newton carry them: to 20 mm of the 12 mm tool's linear depth on the coarse liver, its 25 mm
 /// step left out) and their range, and kept beside the linear one under the law's name; the
-/// gallbladder beside it stays linear.
+/// gallbladder beside it is linear as asked.
 #[test]
 fn the_scenario_picks_the_law_per_organ() {
     let text = r#"Scenario(title: "Press", briefing: "Press.",
-        organs: [Organ(name: "liver", law: NeoHookean), "gallbladder"],
+        organs: [Organ(name: "liver", law: NeoHookean), Organ(name: "gallbladder", law: Linear)],
         tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3,
                              hold_s: 1.0, time_limit_s: 5.0)])"#;
     let scenario = parse(Path::new("law.scenario.ron"), text).unwrap();
@@ -752,6 +752,43 @@ fn the_scenario_picks_the_law_per_organ() {
     assert!(liver.valid_indentation_m() >= 20e-3, "{levels:?}");
     assert!(vademecums().join("liver-neo-hookean.coarse.vdm").is_file());
     assert_eq!(scene.organs[1].1.valid_indentation_m(), 0.0);
+}
+
+/// Where a scenario names no law, a pressed organ's tissue is exponential, and linear where a
+/// scalpel cuts it (the liver: it has a toughness; the pancreas has none and is only
+/// pressed), where a grasper moves it, and on the cornea and the gallbladder; a named law
+/// stands. The web page's copy of a scenario is linear where it names none, and keeps a
+/// named law.
+#[test]
+fn an_organ_without_a_law_is_exponential_where_pressed_and_linear_where_cut_or_moved() {
+    use Law::{Exponential, Linear, NeoHookean};
+    let scenario = |tool: &str, organs: &str| {
+        let text = format!(
+            r#"Scenario(title: "Law", briefing: "", organs: [{organs}], tool: {tool},
+               tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3,
+                                    hold_s: 1.0, time_limit_s: 5.0)])"#
+        );
+        parse(Path::new("law.scenario.ron"), &text).unwrap()
+    };
+    let laws = |s: &Scenario| s.organs.iter().map(|o| s.law_of(o)).collect::<Vec<_>>();
+    let probe = "Probe(tip_radius_mm: 6.0)";
+    let two = r#""liver", "pancreas""#;
+    assert_eq!(laws(&scenario(probe, two)), [Exponential, Exponential]);
+    let scalpel = "Scalpel(tip_radius_mm: 6.0, edge_mm: 3.0)";
+    assert_eq!(laws(&scenario(scalpel, two)), [Linear, Exponential]);
+    let grasper = "Grasper(tip_radius_mm: 6.0)";
+    assert_eq!(laws(&scenario(grasper, two)), [Linear, Linear]);
+    let others = r#""liver", "duodenum", "cornea", "gallbladder""#;
+    assert_eq!(
+        laws(&scenario(probe, others)),
+        [Exponential, Exponential, Linear, Linear]
+    );
+    let named = scenario(
+        probe,
+        r#"Organ(name: "liver", law: NeoHookean), "pancreas""#,
+    );
+    assert_eq!(laws(&named), [NeoHookean, Exponential]);
+    assert_eq!(laws(&named.for_the_web()), [NeoHookean, Linear]);
 }
 
 /// `stiffening` sets the exponential law's b per organ: the liver's vademecum is built with

@@ -37,7 +37,8 @@ const FRAMES: &str = "12";
 fn vademecums() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("window-vademecums");
+        // The scenario tests' folder: the coarse nonlinear organs are built once for both.
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenario-vademecums");
         default_scene(&dir, Detail::Coarse, OnStale::Rebuild).unwrap();
         dir
     })

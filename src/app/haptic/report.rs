@@ -60,7 +60,8 @@ impl ForceSummary {
 
 /// How often and how far the tool pressed beyond what an organ's nonlinear vademecum covers
 /// (until a position of the tool's patch carries a load deeper than the last load step):
-/// there the force is held at the range's edge.
+/// there the tissue stops stiffening, its force growing on at the range edge's secant
+/// stiffness.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct RangeSummary {
     pub beyond_ticks: u64,
@@ -100,7 +101,7 @@ impl fmt::Display for RangeSummary {
         write!(
             f,
             "range: the tool pressed beyond the vademecum's range for {} ticks, up to {:.1} mm \
-             deeper, on {}; the force was held at the range's edge there",
+             deeper, on {}; the tissue's stiffening was held at the range's edge there",
             self.beyond_ticks,
             self.max_beyond_mm,
             organs.join(", ")

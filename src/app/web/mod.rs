@@ -72,6 +72,7 @@ fn opening_scenario(stem: Option<&str>) -> Result<(PathBuf, Scenario), String> {
 /// The scene of `scenario`, its files fetched first (those already fetched are kept).
 async fn fetched_scene(scenario: Scenario, detail: Detail) -> Result<HapticScene, String> {
     let dir = Path::new(VADEMECUMS);
+    let scenario = scenario.for_the_web();
     for file in scenario_files(&scenario, dir, detail)? {
         if container::is_provided(&file) {
             continue;

@@ -105,10 +105,11 @@ fn update_hud(
     let task = lesson.map_or_else(String::new, |lesson| task_line(&lesson, &snapshot));
     let camera = camera_line(&link, &snapshot.0, *mode);
     let instruments = instrument_line(&link, &snapshot.0);
+    let tissue = tissue_line(&link);
     let timing = &snapshot.0.timing;
     text.0 = format!(
         "{task}device: {}\nforce {force_n:.3} N {gauge} limit {limit_n:.1} N\n{status}\n\
-         haptic {:.0} Hz | tick p99 {:.0} us, late p99 {:.0} us, {} skipped | frame {:.1} ms{help}{instruments}{camera}",
+         haptic {:.0} Hz | tick p99 {:.0} us, late p99 {:.0} us, {} skipped | frame {:.1} ms\n{tissue}{help}{instruments}{camera}",
         link.device_name,
         rate.hz,
         timing.compute_p99_us,
@@ -116,6 +117,44 @@ fn update_hud(
         timing.skipped,
         dt * 1e3
     );
+}
+
+/// Each organ's tissue law, and the nonlinear vademecum building in the background, if any
+/// (its organ runs linear tissue until a scene is loaded after it is built).
+fn tissue_line(link: &HapticLink) -> String {
+    let laws: Vec<String> = link
+        .scene
+        .organs
+        .iter()
+        .map(|(name, vademecum)| format!("{name} {}", vademecum.header.material.law.name()))
+        .collect();
+    format!("tissue: {}{}", laws.join(", "), building_line())
+}
+
+/// What the background builder is doing, on its own line.
+#[cfg(not(target_arch = "wasm32"))]
+fn building_line() -> String {
+    let status = crate::store::background_status();
+    let Some(building) = status.building else {
+        return String::new();
+    };
+    let share = match building.total {
+        0 => String::new(),
+        total => format!(" {}/{total}", building.done),
+    };
+    let waiting = match status.queued.len() {
+        0 => String::new(),
+        n => format!(", {n} more waiting"),
+    };
+    format!(
+        "\nbuilding the {} {} in the background ({}{share}{waiting}): M and the scenario again to use it",
+        building.law, building.organ, building.stage
+    )
+}
+
+#[cfg(target_arch = "wasm32")]
+fn building_line() -> String {
+    String::new()
 }
 
 /// With several instruments: the one in hand, and how to change it.
@@ -181,7 +220,7 @@ fn task_line(lesson: &Lesson, snapshot: &Snapshot) -> String {
 }
 
 /// What the status line adds while the tool presses deeper than a nonlinear vademecum covers:
-/// the trainee should know the force no longer grows there.
+/// the trainee should know the tissue no longer firms up there.
 fn beyond_range(snapshot: &HapticSnapshot) -> String {
     let beyond_m = snapshot
         .organs
@@ -190,7 +229,7 @@ fn beyond_range(snapshot: &HapticSnapshot) -> String {
         .fold(0.0, f64::max);
     if beyond_m > 0.0 {
         format!(
-            " | {:.1} mm beyond the model's range: force held",
+            " | {:.1} mm beyond the model's range: stiffening held",
             beyond_m * 1e3
         )
     } else {

@@ -519,9 +519,13 @@ pub enum BenchTarget {
         /// Every organ moves (reduced dynamics, stepped every tick), as with a grasper.
         #[arg(long)]
         dynamic: bool,
-        /// The organs' tissue law (each organ's vademecum is built under it).
-        #[arg(long, value_enum, default_value = "linear")]
-        law: LawArg,
+        /// The organs' tissue law (each organ's vademecum is built under it; default: the
+        /// trainer's, exponential, or linear with --dynamic).
+        #[arg(long, value_enum)]
+        law: Option<LawArg>,
+        /// The coarse organs and their 12 mm tool (vademecums that build in minutes).
+        #[arg(long)]
+        coarse: bool,
         /// Print the report as JSON instead of a table.
         #[arg(long)]
         json: bool,

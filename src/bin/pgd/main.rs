@@ -16,6 +16,7 @@ use pgd_surgery::cutting::keratotomy::{Cornea, Keratotomy};
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::organs::Organ;
 use pgd_surgery::pgd::ValidationSettings;
+use pgd_surgery::scenario::default_law;
 use pgd_surgery::store::{Bar, BuildJob, OnStale};
 use pgd_surgery::{app, bench};
 
@@ -324,14 +325,16 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             vademecums,
             dynamic,
             law,
+            coarse,
             json,
         } => {
             let organs = SCENE_ORGANS.map(|organ| SceneOrgan {
                 dynamic,
-                law: law.law(),
+                law: law.map_or(default_law(Some(organ), false, dynamic), |l| l.law()),
                 ..SceneOrgan::from(organ)
             });
-            let scene = match abdomen_scene(&organs, &vademecums, Detail::Full) {
+            let detail = if coarse { Detail::Coarse } else { Detail::Full };
+            let scene = match abdomen_scene(&organs, &vademecums, detail) {
                 Ok(scene) => scene,
                 Err(e) => return fail("pgd bench haptics", &e),
             };
