@@ -630,13 +630,20 @@ impl Vademecum {
     /// Adds the displacement field of a force `force_n` on the patch `shares` to `u`.
     pub fn add_patch_field(&self, shares: &[(usize, f64)], force_n: &Vector3<f64>, u: &mut [f64]) {
         for k in 0..self.steps.len() {
-            if shares
-                .iter()
-                .any(|&(j, l)| self.step_share(k, j, l, force_n) > 0.0)
-            {
+            if self.step_carries(k, shares, force_n) {
                 self.add_step_field(k, shares, force_n, u);
             }
         }
+    }
+
+    /// Whether load step `step` carries any share of a force `force_n` on `shares`: the
+    /// linear step always; a nonlinear one where a position's level blends it in. The haptic
+    /// tick skips the others' modes, most of a deep vademecum's.
+    fn step_carries(&self, step: usize, shares: &[(usize, f64)], force_n: &Vector3<f64>) -> bool {
+        step == 0
+            || shares
+                .iter()
+                .any(|&(j, l)| self.step_share(step, j, l, force_n) > 0.0)
     }
 
     /// The modal coefficients of load step `step` for a force on the patch `shares`:
@@ -648,31 +655,44 @@ impl Vademecum {
         force_n: &Vector3<f64>,
         coefficients: &mut [f64],
     ) {
-        let params = self.parameter_count();
-        let modes = self.steps[step].parametric.chunks_exact(params);
-        for (c, y) in coefficients.iter_mut().zip(modes) {
-            *c += self.mode_coefficient(step, y, shares, force_n);
+        if !self.step_carries(step, shares, force_n) {
+            return;
         }
+        self.mode_coefficients(step, shares, force_n, |mode, c| coefficients[mode] += c);
     }
 
-    /// One mode's coefficient for a force on `shares`: `Σ_i γ_i Y_i · F`, with `y` the mode's
-    /// parametric part.
-    fn mode_coefficient(
+    /// Calls `add(mode, c)` with each mode's coefficient `Σ_i γ_i Y_i · F` for a force on
+    /// `shares` in load step `step`; a patch of more than [`SHARE_CHUNK`] positions is summed
+    /// a chunk at a time, so a mode's coefficient is the sum of its calls. Each position's
+    /// step share (its blend) is computed once, not once per mode, and kept on the stack.
+    fn mode_coefficients(
         &self,
         step: usize,
-        y: &[f32],
         shares: &[(usize, f64)],
         force_n: &Vector3<f64>,
-    ) -> f64 {
-        shares
-            .iter()
-            .map(|&(i, l)| {
-                self.step_share(step, i, l, force_n)
-                    * (0..3)
-                        .map(|d| y[3 * i + d] as f64 * force_n[d])
-                        .sum::<f64>()
-            })
-            .sum()
+        mut add: impl FnMut(usize, f64),
+    ) {
+        let params = self.parameter_count();
+        let mut weights = [0.0; SHARE_CHUNK];
+        for chunk in shares.chunks(SHARE_CHUNK) {
+            for (w, &(i, l)) in weights.iter_mut().zip(chunk) {
+                *w = self.step_share(step, i, l, force_n);
+            }
+            let modes = self.steps[step].parametric.chunks_exact(params);
+            for (mode, y) in modes.enumerate() {
+                let c = chunk
+                    .iter()
+                    .zip(&weights)
+                    .filter(|&(_, &w)| w != 0.0)
+                    .map(|(&(i, _), &w)| {
+                        w * (0..3)
+                            .map(|d| y[3 * i + d] as f64 * force_n[d])
+                            .sum::<f64>()
+                    })
+                    .sum();
+                add(mode, c);
+            }
+        }
     }
 
     /// Adds `Σ_k c_k X^k` of load step `step` to `u`.
@@ -732,18 +752,16 @@ impl Vademecum {
         blend: &[(usize, f64)],
         u: &mut Vector3<f64>,
     ) {
-        let step_data = &self.steps[step];
-        let (dofs, params) = (self.dof_count(), self.parameter_count());
-        let modes = step_data
-            .spatial
-            .chunks_exact(dofs)
-            .zip(step_data.parametric.chunks_exact(params));
-        for (x, y) in modes {
-            let c = self.mode_coefficient(step, y, shares, force_n);
+        if !self.step_carries(step, shares, force_n) {
+            return;
+        }
+        let (spatial, dofs) = (&self.steps[step].spatial, self.dof_count());
+        self.mode_coefficients(step, shares, force_n, |mode, c| {
+            let x = &spatial[mode * dofs..(mode + 1) * dofs];
             for &(node, w) in blend {
                 *u += Vector3::from_fn(|k, _| c * w * x[3 * node + k] as f64);
             }
-        }
+        });
         self.add_blend_corrections(step, shares, force_n, blend, u);
     }
 
@@ -762,6 +780,9 @@ impl Vademecum {
             let range = local.corrections_of(i);
             let nodes = &local.correction_nodes[range.clone()];
             let l = self.step_share(step, i, l, force_n);
+            if l == 0.0 {
+                continue;
+            }
             for &(node, w) in blend {
                 if let Ok(k) = nodes.binary_search(&(node as u32)) {
                     let e = range.start + k;
@@ -784,6 +805,10 @@ impl Vademecum {
         self.add_corrections(k, shares, force_n, u);
     }
 }
+
+/// How many of a patch's positions a mode's coefficient is summed over at a time, their
+/// weights on the stack (a larger patch takes several chunks, to the same sum).
+const SHARE_CHUNK: usize = 128;
 
 /// Secant iterations of [`Vademecum::force_for_indentation`] over load steps, at most.
 const SECANT_ITERATIONS: usize = 8;

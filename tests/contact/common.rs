@@ -1,4 +1,4 @@
-//! The coarse abdominal scene (all four organs, coupled), built once per test run, and a
+//! The coarse abdominal scene (all four organs, coupled, linear), built once per test run, and a
 //! scripted push run through the haptic schedule with what each tick left recorded.
 
 use std::path::Path;
@@ -8,18 +8,37 @@ use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{
     HapticLoop, HapticScene, OrganCoupling, OrganDeformation, OrganIndex, TickClock,
 };
-use pgd_surgery::app::scene::{Detail, SceneOrgan, default_scene, scene_of};
+use pgd_surgery::app::scene::{Detail, SceneOrgan, scene_of};
 use pgd_surgery::contact::{CouplingSettings, PairReport, PointshellDensity};
 use pgd_surgery::devices::{PressTarget, Scripted, TICK_S, Trajectory, TrajectoryRow};
+use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::organs::Organ;
 use pgd_surgery::pgd::{Deformation, Vademecum};
 use pgd_surgery::store::OnStale;
+
+/// `organ` with linear tissue: the full-FEM references here are linear.
+pub fn linear(organ: Organ) -> SceneOrgan {
+    SceneOrgan {
+        law: Law::Linear,
+        ..SceneOrgan::from(organ)
+    }
+}
 
 pub fn scene() -> &'static HapticScene {
     static SCENE: OnceLock<HapticScene> = OnceLock::new();
     SCENE.get_or_init(|| {
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("contact-vademecums");
-        default_scene(&dir, Detail::Coarse, OnStale::Rebuild).unwrap()
+        let organs = Organ::ABDOMEN.map(linear);
+        let coupling = CouplingSettings::default();
+        scene_of(
+            &organs,
+            None,
+            &coupling,
+            &dir,
+            Detail::Coarse,
+            OnStale::Rebuild,
+        )
+        .unwrap()
     })
 }
 
@@ -154,7 +173,7 @@ pub fn measuring_every_node_scene() -> &'static HapticScene {
 fn scene_with(settings: &CouplingSettings) -> HapticScene {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("contact-vademecums");
     scene(); // builds the vademecums if they are missing
-    let organs = Organ::ABDOMEN.map(SceneOrgan::from);
+    let organs = Organ::ABDOMEN.map(linear);
     scene_of(
         &organs,
         None,

@@ -24,7 +24,7 @@ fn scene_moving(moving: Organ) -> HapticScene {
     scene(); // builds the vademecums if they are missing
     let organs = Organ::ABDOMEN.map(|o| SceneOrgan {
         dynamic: o == moving,
-        ..SceneOrgan::from(o)
+        ..super::linear(o)
     });
     scene_of(
         &organs,
