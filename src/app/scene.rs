@@ -50,9 +50,10 @@ pub enum Detail {
     #[default]
     Full,
     /// A quarter of the nodes and, on the abdominal organs, a 12 mm tool, whose patch must
-    /// span the coarser edges: the linear vademecums build in seconds and the three exponential
-    /// ones in about 3 minutes, for a quick look on a slow machine and for tests. The coarse cornea's edges are still shorter than its own
-    /// 0.5 mm spatula, which it keeps.
+    /// span the coarser edges: the linear vademecums build in seconds and the three
+    /// exponential ones in about 3 minutes, for a quick look on a slow machine and for tests.
+    /// The coarse cornea's edges are still shorter than its own 0.5 mm spatula, which it
+    /// keeps.
     Coarse,
 }
 

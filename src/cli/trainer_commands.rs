@@ -54,8 +54,9 @@ pub fn validate_scenarios(files: &[PathBuf]) -> ExitCode {
 /// `trainer prepare`: the vademecums and distance fields the scenario files need, built under
 /// `dir` where missing or stale, then listed one per line (what a class, or the web page's
 /// site, must have), and with `web` their web forms written there (for the page's scenes:
-/// linear tissue where a scenario names no law, [`scenario::Scenario::for_the_web`]), with their sizes and how
-/// much the felt force changes. Fails if any file does not read or any scene cannot be built.
+/// linear tissue where a scenario names no law, [`scenario::Scenario::for_the_web`]), with
+/// their sizes and how much the felt force changes. Fails if any file does not read or any
+/// scene cannot be built.
 pub fn prepare_scenarios(
     files: &[PathBuf],
     dir: &Path,

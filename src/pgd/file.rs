@@ -113,16 +113,13 @@ impl Vademecum {
     ) -> Result<(), VademecumError> {
         let law = self.header.material.law;
         // The steps are compared apart, to 1e-9 relative: a command line gives them in decimal.
-        let relevant = |s: &BuildSettings| match law {
-            Law::Linear => BuildSettings {
-                load_steps_m: Vec::new(),
-                secant: SecantSettings::default(),
-                ..s.clone()
+        let relevant = |s: &BuildSettings| BuildSettings {
+            load_steps_m: Vec::new(),
+            secant: match law {
+                Law::Linear => SecantSettings::default(),
+                _ => s.secant,
             },
-            _ => BuildSettings {
-                load_steps_m: Vec::new(),
-                ..s.clone()
-            },
+            ..s.clone()
         };
         let (built, asked) = (&self.header.settings.load_steps_m, &settings.load_steps_m);
         let same_steps = law == Law::Linear

@@ -637,8 +637,7 @@ impl Vademecum {
     }
 
     /// Whether load step `step` carries any share of a force `force_n` on `shares`: the
-    /// linear step always; a nonlinear one where a position's level blends it in. The haptic
-    /// tick skips the others' modes, most of a deep vademecum's.
+    /// linear step always; a nonlinear one where a position's level blends it in.
     fn step_carries(&self, step: usize, shares: &[(usize, f64)], force_n: &Vector3<f64>) -> bool {
         step == 0
             || shares
@@ -655,16 +654,15 @@ impl Vademecum {
         force_n: &Vector3<f64>,
         coefficients: &mut [f64],
     ) {
-        if !self.step_carries(step, shares, force_n) {
-            return;
-        }
         self.mode_coefficients(step, shares, force_n, |mode, c| coefficients[mode] += c);
     }
 
     /// Calls `add(mode, c)` with each mode's coefficient `Σ_i γ_i Y_i · F` for a force on
     /// `shares` in load step `step`; a patch of more than [`SHARE_CHUNK`] positions is summed
     /// a chunk at a time, so a mode's coefficient is the sum of its calls. Each position's
-    /// step share (its blend) is computed once, not once per mode, and kept on the stack.
+    /// step share (its blend) is computed once, not once per mode, and kept on the stack; a
+    /// chunk whose positions the step carries no share of calls nothing (the haptic tick
+    /// skips the modes of the steps a press does not reach, most of a deep vademecum's).
     fn mode_coefficients(
         &self,
         step: usize,
@@ -677,6 +675,9 @@ impl Vademecum {
         for chunk in shares.chunks(SHARE_CHUNK) {
             for (w, &(i, l)) in weights.iter_mut().zip(chunk) {
                 *w = self.step_share(step, i, l, force_n);
+            }
+            if weights[..chunk.len()].iter().all(|&w| w == 0.0) {
+                continue;
             }
             let modes = self.steps[step].parametric.chunks_exact(params);
             for (mode, y) in modes.enumerate() {
@@ -752,9 +753,6 @@ impl Vademecum {
         blend: &[(usize, f64)],
         u: &mut Vector3<f64>,
     ) {
-        if !self.step_carries(step, shares, force_n) {
-            return;
-        }
         let (spatial, dofs) = (&self.steps[step].spatial, self.dof_count());
         self.mode_coefficients(step, shares, force_n, |mode, c| {
             let x = &spatial[mode * dofs..(mode + 1) * dofs];

@@ -534,9 +534,7 @@ impl Scenario {
             .law
             .unwrap_or_else(|| default_law(generated, cut, self.moves(organ)))
     }
-}
 
-impl Scenario {
     /// The scenario as the web page runs it: linear tissue where it names no law. A scene's
     /// nonlinear vademecums are seven times the size of its linear ones, one load step each
     /// (the coarse gallbladder's 146 MB against 20 MB), too much for a page to download.

@@ -32,8 +32,21 @@ pub struct Building {
     pub total: u64,
 }
 
+impl Building {
+    /// `spec`'s build, not yet begun.
+    fn of(spec: &VademecumSpec) -> Self {
+        Self {
+            organ: spec.name.clone(),
+            law: spec.law.name(),
+            stage: "starting".into(),
+            done: 0,
+            total: 0,
+        }
+    }
+}
+
 impl BackgroundStatus {
-    /// Nothing built, waiting or failed.
+    /// Nothing building or waiting.
     pub fn is_idle(&self) -> bool {
         self.building.is_none() && self.queued.is_empty()
     }
@@ -110,11 +123,7 @@ fn work(builder: &'static Builder) {
     };
     loop {
         let spec = next(builder);
-        let progress = Shared {
-            builder,
-            organ: spec.name.clone(),
-            law: spec.law.name(),
-        };
+        let progress = Shared(builder);
         let started = Instant::now();
         let built = pool.install(|| ensure_with(&spec, OnStale::Rebuild, &progress));
         let mut state = builder
@@ -147,13 +156,7 @@ fn next(builder: &Builder) -> VademecumSpec {
     loop {
         if let Some(spec) = state.queue.pop_front() {
             state.status.queued.remove(0);
-            state.status.building = Some(Building {
-                organ: spec.name.clone(),
-                law: spec.law.name(),
-                stage: "starting".into(),
-                done: 0,
-                total: 0,
-            });
+            state.status.building = Some(Building::of(&spec));
             return spec;
         }
         state = builder
@@ -181,28 +184,20 @@ fn lowest_priority() {
     let _ = thread_priority::set_current_thread_priority(thread_priority::ThreadPriority::Min);
 }
 
-/// A build's progress, written where [`background_status`] reads it.
-struct Shared {
-    builder: &'static Builder,
-    organ: String,
-    law: &'static str,
-}
+/// A build's progress, written into the build under way, where [`background_status`] reads
+/// it.
+struct Shared(&'static Builder);
 
 impl Shared {
     fn update(&self, change: impl FnOnce(&mut Building)) {
         let mut state = self
-            .builder
+            .0
             .state
             .lock()
             .expect("the builder never panics holding it");
-        let building = state.status.building.get_or_insert_with(|| Building {
-            organ: self.organ.clone(),
-            law: self.law,
-            stage: String::new(),
-            done: 0,
-            total: 0,
-        });
-        change(building);
+        if let Some(building) = state.status.building.as_mut() {
+            change(building);
+        }
     }
 }
 

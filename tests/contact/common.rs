@@ -1,5 +1,5 @@
-//! The coarse abdominal scene (all four organs, coupled, linear), built once per test run, and a
-//! scripted push run through the haptic schedule with what each tick left recorded.
+//! The coarse abdominal scene (all four organs, coupled, linear), built once per test run,
+//! and a scripted push run through the haptic schedule with what each tick left recorded.
 
 use std::path::Path;
 use std::sync::OnceLock;

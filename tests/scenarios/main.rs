@@ -640,9 +640,9 @@ fn held_force_n(scenario: Scenario) -> f64 {
 /// An organ read from a mesh file runs as the generated organ written to that file: the
 /// coarse liver saved as .vtu (with its regions), named relative to the scenario's folder, is
 /// built from the file with the liver's tissue (a mesh file's default; both linear here) and
-/// pushes back on the same press as the generated liver does. The file keeps coordinates to 1e-9 relative or
-/// better, so the two vademecums are built on the same mesh; 1e-6 relative allows for the
-/// rounding.
+/// pushes back on the same press as the generated liver does. The file keeps coordinates to
+/// 1e-9 relative or better, so the two vademecums are built on the same mesh; 1e-6 relative
+/// allows for the rounding.
 #[test]
 fn an_organ_from_a_mesh_file_feels_as_the_organ_it_was_written_from() {
     let folder = Path::new(env!("CARGO_TARGET_TMPDIR")).join("mesh-organ");

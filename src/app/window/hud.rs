@@ -131,12 +131,20 @@ fn tissue_line(link: &HapticLink) -> String {
     format!("tissue: {}{}", laws.join(", "), building_line())
 }
 
-/// What the background builder is doing, on its own line.
+/// What the background builder is doing, on its own line, and which of its builds failed
+/// (their organs stay linear; the log says why).
 #[cfg(not(target_arch = "wasm32"))]
 fn building_line() -> String {
     let status = crate::store::background_status();
+    let failed: String = status
+        .failed
+        .iter()
+        .map(|(organ, _)| {
+            format!("\n{organ}'s nonlinear vademecum could not be built: see the log")
+        })
+        .collect();
     let Some(building) = status.building else {
-        return String::new();
+        return failed;
     };
     let share = match building.total {
         0 => String::new(),
@@ -147,7 +155,7 @@ fn building_line() -> String {
         n => format!(", {n} more waiting"),
     };
     format!(
-        "\nbuilding the {} {} in the background ({}{share}{waiting}): M and the scenario again to use it",
+        "\nbuilding the {} {} in the background ({}{share}{waiting}): M and the scenario again to use it{failed}",
         building.law, building.organ, building.stage
     )
 }
