@@ -43,6 +43,10 @@ pub struct Sample {
     pub tip_in_view: Option<bool>,
     /// ...and whether the point the scenario has the trainee keep in view is.
     pub target_in_view: Option<bool>,
+    /// How far (m) the tool pressed beyond the depth the tissue model covers (the deepest
+    /// load step of the organ's nonlinear vademecum), on the organ it presses deepest so;
+    /// zero within range.
+    pub beyond_range_m: f64,
 }
 
 impl Sample {
@@ -188,6 +192,10 @@ pub struct TaskMetrics {
     /// Radial keratotomy: the incisions against the plan, and the correction they give.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub keratotomy: Option<KeratotomyMetrics>,
+    /// How long the tool pressed beyond the depth the tissue model covers (s), and how far
+    /// at most (mm): there the tissue stops stiffening and the force is extrapolated.
+    pub beyond_range_s: f64,
+    pub max_beyond_range_mm: f64,
     /// A complication (a perforated eye): the attempt fails whatever its score.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub complication: Option<String>,
@@ -485,6 +493,10 @@ impl Running {
         }
         let force = sample.force_n;
         m.peak_force_n = m.peak_force_n.max(force);
+        if sample.beyond_range_m > 0.0 {
+            m.beyond_range_s += dt;
+            m.max_beyond_range_mm = m.max_beyond_range_mm.max(sample.beyond_range_m * 1e3);
+        }
         if sample.touching != 0 || sample.grasping != 0 {
             m.contact_s += dt;
             self.force_sum += force * dt;

@@ -262,6 +262,13 @@ fn task_feedback(task: &TaskScore) -> Vec<String> {
             Newtons(m.surrounding_peak_n)
         ));
     }
+    if m.beyond_range_s > 0.0 {
+        lines.push(format!(
+            "{}: pressed up to {:.1} mm deeper than the tissue model covers, for {:.1} s: the \
+             tissue stopped stiffening there, its force extrapolated from the range's edge",
+            m.kind, m.max_beyond_range_mm, m.beyond_range_s
+        ));
+    }
     if let Some(cut) = &m.incision {
         lines.extend(incision_feedback(m.kind, cut));
     }

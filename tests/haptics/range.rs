@@ -105,6 +105,10 @@ fn a_press_beyond_the_range_stiffens_no_more_and_is_reported() {
     assert!(deep.range.beyond_ticks > 500, "{deep}");
     assert_eq!(deep.range.organs, vec![("block".to_owned(), RANGE_M * 1e3)]);
     assert!(
+        deep.to_string().contains("organs: block (neo-hookean)"),
+        "{deep}"
+    );
+    assert!(
         deep.to_string().contains("beyond the vademecum's range"),
         "{deep}"
     );

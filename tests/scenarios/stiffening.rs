@@ -7,11 +7,13 @@
 
 use std::path::Path;
 
-use pgd_surgery::app::attempt::scenario_scene;
+use pgd_surgery::app::attempt::{run_simulated, scenario_scene};
 use pgd_surgery::app::haptic::{ForceTrace, HapticLoop, HapticScene, HeadlessReport};
 use pgd_surgery::app::scene::{Detail, press_targets};
-use pgd_surgery::devices::{PressMotion, Scripted, TICK_S, press_and_slide};
-use pgd_surgery::scenario::parse;
+use pgd_surgery::devices::{
+    PressMotion, PressTarget, Scripted, TICK_S, Trajectory, press_and_slide,
+};
+use pgd_surgery::scenario::{Scenario, Scorecard, parse};
 use pgd_surgery::store::OnStale;
 
 use crate::vademecums;
@@ -21,6 +23,11 @@ const DEPTH_M: f64 = 20e-3;
 /// The coarse liver alone under the law `law` names in a scenario (its default stiffening for
 /// the exponential law), its vademecum built with the defaults.
 fn liver_scene(law: &str) -> HapticScene {
+    liver(law).1
+}
+
+/// [`liver_scene`] with its scenario.
+fn liver(law: &str) -> (Scenario, HapticScene) {
     let text = format!(
         r#"Scenario(title: "Press", briefing: "Press.",
         organs: [Organ(name: "liver", law: {law})],
@@ -28,13 +35,12 @@ fn liver_scene(law: &str) -> HapticScene {
                              hold_s: 1.0, time_limit_s: 5.0)])"#
     );
     let scenario = parse(Path::new("press.scenario.ron"), &text).unwrap();
-    scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap()
+    let scene = scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap();
+    (scenario, scene)
 }
 
-/// A press 20 mm deep at the demo's point on the liver, in 1 s: the run's report and, per
-/// tick of the way in, the tool's depth below the rest surface (m) and the
-/// felt force along the surface's normal (N), and the felt force's magnitude (N).
-fn press_20_mm(scene: &HapticScene) -> (HeadlessReport, Vec<(f64, f64)>, Vec<f64>) {
+/// The 20 mm press at the demo's point, in 1 s, and that point.
+fn press_script(scene: &HapticScene) -> (Trajectory, PressTarget, PressMotion) {
     let target = press_targets(scene)[0];
     let motion = PressMotion {
         tip_radius_m: scene.probe.tip_radius_m,
@@ -43,7 +49,14 @@ fn press_20_mm(scene: &HapticScene) -> (HeadlessReport, Vec<(f64, f64)>, Vec<f64
         press_s: 1.0,
         ..PressMotion::default()
     };
-    let script = press_and_slide(&[target], &motion);
+    (press_and_slide(&[target], &motion), target, motion)
+}
+
+/// A press 20 mm deep at the demo's point on the liver, in 1 s: the run's report and, per
+/// tick of the way in, the tool's depth below the rest surface (m) and the
+/// felt force along the surface's normal (N), and the felt force's magnitude (N).
+fn press_20_mm(scene: &HapticScene) -> (HeadlessReport, Vec<(f64, f64)>, Vec<f64>) {
+    let (script, target, motion) = press_script(scene);
     let in_s = motion.approach_s + motion.press_s;
     let depth_at = |time_s: f64| {
         let tip = script.sample(time_s).tip_m;
@@ -136,4 +149,39 @@ range edge {:.2} mm; slopes (N/m) exponential {stiffening:?}, linear {linear:?}"
     let beyond_slope = slope(&felt, (edge_m + 0.1e-3, DEPTH_M + 1e-3));
     eprintln!("slope beyond the range {beyond_slope:.1} N/m");
     assert!(beyond_slope < stiffening[2], "{beyond_slope} N/m beyond");
+}
+
+/// The scored attempt says so too: pressed 20 mm into the exponential liver, its feedback
+/// says how far beyond the tissue model's range the tool went (as far as the run's report
+/// says, to 0.05 mm) and for how long; into the linear liver, whose range has no
+/// end, it says nothing of the kind.
+#[test]
+fn a_scored_press_beyond_the_range_says_so_in_its_feedback() {
+    let attempt = |law: &str| {
+        let (scenario, scene) = liver(law);
+        let (script, ..) = press_script(&scene);
+        let ticks = (script.duration_s() / TICK_S).ceil() as u64;
+        let device = Box::new(Scripted::new("20 mm press", script));
+        run_simulated(scenario, &scene, device, ticks).unwrap().card
+    };
+    let (exponential, linear) = (attempt("Exponential"), attempt("Linear"));
+    let beyond = |card: &Scorecard| {
+        card.feedback
+            .iter()
+            .find(|line| line.contains("deeper than the tissue model covers"))
+            .cloned()
+    };
+    assert_eq!(beyond(&linear), None, "{:?}", linear.feedback);
+    let line = beyond(&exponential).unwrap_or_else(|| panic!("{:?}", exponential.feedback));
+    let (report, ..) = press_20_mm(&liver_scene("Exponential"));
+    let metrics = &exponential.tasks[0].metrics;
+    assert!(
+        (metrics.max_beyond_range_mm - report.range.max_beyond_mm).abs() < 0.05,
+        "{line}\n{report}"
+    );
+    assert!(metrics.beyond_range_s > 0.1, "{line}");
+    assert!(
+        line.contains(&format!("{:.1} mm", metrics.max_beyond_range_mm)),
+        "{line}"
+    );
 }

@@ -19,6 +19,15 @@ pub struct OrganBody {
     pub surface: Arc<ContactSurface>,
 }
 
+impl OrganBody {
+    /// The organ's name with the tissue law its vademecum answers, as reports name it
+    /// ("liver (exponential)").
+    pub fn with_law(&self) -> String {
+        let law = self.vademecum.header.material.law.name();
+        format!("{} ({law})", self.name)
+    }
+}
+
 /// The organ's place in the scene's list: the order of [`super::HapticSnapshot::organs`].
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OrganIndex(pub usize);

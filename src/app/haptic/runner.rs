@@ -319,7 +319,7 @@ impl HapticLoop {
             .world
             .query::<(&OrganIndex, &OrganBody)>()
             .iter(&self.world)
-            .map(|(i, b)| (i.0, b.name.clone()))
+            .map(|(i, b)| (i.0, b.with_law()))
             .collect();
         organs.sort();
         organs.into_iter().map(|o| o.1).collect()

@@ -214,6 +214,10 @@ pub fn score_tick(
     let (region_moved_m, surrounding_force_n) = exercise
         .watched_region()
         .map_or((0.0, 0.0), |region| watch(region, &organs));
+    let beyond_range_m = organs
+        .iter()
+        .filter_map(|(_, touch, ..)| touch.contact.map(|c| c.beyond_range_m))
+        .fold(0.0, f64::max);
     let tip_m = tool.sample.map(|s| s.tip_m);
     let elapsed_s = exercise.elapsed_s(clock.time_s);
     let (tip_in_view, target_in_view) = scope.map_or((None, None), |mut scope| {
@@ -233,6 +237,7 @@ pub fn score_tick(
         blade,
         tip_in_view,
         target_in_view,
+        beyond_range_m,
     });
     if exercise.finished() {
         let run = &mut *run;
