@@ -223,6 +223,7 @@ pub fn open_window(
         built_in: super::SHIPPED_SCENARIOS,
         scenes: scene_source(options),
         swap: haptic.swap(),
+        built: std::sync::Arc::new(|| crate::store::background_status().built),
     });
     let lessons = Lessons::default();
     let (exit, frames) = super::window::run(WindowScene {

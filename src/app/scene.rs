@@ -256,6 +256,7 @@ pub fn scene_of(
 ) -> Result<HapticScene, String> {
     let tip = scene_tip_m(organs, tip_radius_m, detail);
     let mut field_file = None;
+    let mut meanwhile = Vec::new();
     let loaded = organs
         .iter()
         .map(|organ| {
@@ -263,7 +264,10 @@ pub fn scene_of(
             let (vademecum, mesh) = match on_stale {
                 #[cfg(not(target_arch = "wasm32"))]
                 OnStale::Meanwhile if organ.law != Law::Linear => {
-                    linear_meanwhile(organ, spec.clone(), (dir, detail, tip))?
+                    let (built, building) =
+                        linear_meanwhile(organ, spec.clone(), (dir, detail, tip))?;
+                    meanwhile.extend(building);
+                    built
                 }
                 _ => ensure_vademecum(&spec, on_stale)?,
             };
@@ -305,19 +309,20 @@ pub fn scene_of(
         cutting,
         instruments: vec![Instrument { action, port: None }],
         scope: None,
+        meanwhile,
     })
 }
 
 #[cfg(not(target_arch = "wasm32"))]
 /// `spec`, the nonlinear vademecum of `organ`, if it is built; else the organ's linear one
-/// (built now if need be), `spec` queued to build in the background.
+/// (built now if need be), `spec` queued to build in the background, and its file.
 fn linear_meanwhile(
     organ: &SceneOrgan,
     spec: VademecumSpec,
     (dir, detail, tip_m): (&Path, Detail, f64),
-) -> Result<(Vademecum, TetMesh), String> {
+) -> Result<((Vademecum, TetMesh), Option<PathBuf>), String> {
     if let Ok(built) = ensure_vademecum(&spec, OnStale::Refuse) {
-        return Ok(built);
+        return Ok((built, None));
     }
     eprintln!(
         "{}: linear tissue until its {} vademecum is built, in the background ({})",
@@ -325,13 +330,15 @@ fn linear_meanwhile(
         organ.law.name(),
         spec.file.display()
     );
+    let file = spec.file.clone();
     build_in_background(spec);
     let linear = SceneOrgan {
         law: Law::Linear,
         stiffening: None,
         ..organ.clone()
     };
-    ensure_vademecum(&linear.vademecum(dir, detail, tip_m), OnStale::Rebuild)
+    let built = ensure_vademecum(&linear.vademecum(dir, detail, tip_m), OnStale::Rebuild)?;
+    Ok((built, Some(file)))
 }
 
 /// The dynamic models of the organs that move (their tissue under the KSV law, whose reduced

@@ -1,7 +1,8 @@
 //! Vademecums built on a thread of their own, at the lowest priority, while the trainer runs
 //! on others: the window opens at once on a first run, on the organs' linear vademecums, and
 //! an organ's tissue turns nonlinear in the first scene loaded after its nonlinear vademecum
-//! is saved. One build at a time, in the order asked, each file once per run.
+//! is saved (the window loads its scene again at the next briefing). One build at a time, in
+//! the order asked, each file once per run.
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -21,6 +22,9 @@ pub struct BackgroundStatus {
     pub queued: Vec<String>,
     /// The organs whose build failed, with why.
     pub failed: Vec<(String, String)>,
+    /// The files built (or found good) so far, in order: a scene running an organ's linear
+    /// tissue meanwhile is loaded again once its file is among them.
+    pub built: Vec<PathBuf>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -132,13 +136,16 @@ fn work(builder: &'static Builder) {
             .expect("the builder never panics holding it");
         state.status.building = None;
         match built {
-            Ok(_) => eprintln!(
-                "{}: its {} vademecum is built ({:.0} s, in the background): the next scene \
-                 loaded uses it",
-                spec.name,
-                spec.law.name(),
-                started.elapsed().as_secs_f64()
-            ),
+            Ok(_) => {
+                eprintln!(
+                    "{}: its {} vademecum is built ({:.0} s, in the background): the next \
+                     briefing uses it",
+                    spec.name,
+                    spec.law.name(),
+                    started.elapsed().as_secs_f64()
+                );
+                state.status.built.push(spec.file.clone());
+            }
             Err(why) => {
                 eprintln!("{}: the background build failed: {why}", spec.name);
                 state.status.failed.push((spec.name.clone(), why));

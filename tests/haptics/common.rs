@@ -65,6 +65,7 @@ pub fn scene(safety: SafetySettings) -> HapticScene {
         },
         workspace: Workspace::default(),
         safety,
+        meanwhile: Vec::new(),
     }
 }
 

@@ -55,6 +55,7 @@ fn press(vademecum: &Arc<Vademecum>, depth_m: f64) -> (HeadlessReport, ForceTrac
         cutting: None,
         instruments: vec![Instrument::default()],
         scope: None,
+        meanwhile: Vec::new(),
     };
     let target = PressTarget {
         point_m: Vector3::new(0.03, 0.02, 0.03),

@@ -1,5 +1,6 @@
 //! The haptic world and its schedule, and the simulated-clock run behind `--headless`.
 
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -47,6 +48,9 @@ pub struct HapticScene {
     pub instruments: Vec<Instrument>,
     /// The laparoscope, if the trainee looks through one.
     pub scope: Option<SceneScope>,
+    /// The nonlinear vademecums building in the background while their organs run linear
+    /// tissue here: the window loads the scene again once they are built.
+    pub meanwhile: Vec<PathBuf>,
 }
 
 #[cfg(test)]
@@ -65,6 +69,7 @@ impl HapticScene {
             cutting: None,
             instruments: vec![Instrument::default()],
             scope: None,
+            meanwhile: Vec::new(),
         }
     }
 }

@@ -134,6 +134,7 @@ fn window_scene(
             Box::pin(fetched_scene(scenario.clone(), detail))
         }),
         swap: swap.clone(),
+        built: Arc::new(Vec::new),
     };
     Ok(WindowScene {
         scene,

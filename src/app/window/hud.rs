@@ -120,7 +120,7 @@ fn update_hud(
 }
 
 /// Each organ's tissue law, and the nonlinear vademecum building in the background, if any
-/// (its organ runs linear tissue until a scene is loaded after it is built).
+/// (its organ runs linear tissue until the briefing after it is built loads the scene again).
 fn tissue_line(link: &HapticLink) -> String {
     let laws: Vec<String> = link
         .scene

@@ -34,7 +34,12 @@ pub struct MenuPlan {
     pub scenes: SceneSource,
     /// Where the haptic thread takes the chosen scenario's world.
     pub swap: SceneSwap,
+    /// The vademecum files built in the background so far ([`HapticScene::meanwhile`]).
+    pub built: BuiltFiles,
 }
+
+/// The files the background builder has built (none in a web page, which builds nothing).
+pub type BuiltFiles = Arc<dyn Fn() -> Vec<PathBuf> + Send + Sync>;
 
 /// A scenario on offer: read and checked, or why not.
 struct Entry {
@@ -84,6 +89,7 @@ pub(super) fn setup(app: &mut App, plan: Option<MenuPlan>) {
                     .chain()
                     .run_if(in_state(Stage::Menu)),
                 finish_loading.run_if(in_state(Stage::Loading)),
+                reload_when_built.run_if(in_state(Stage::Briefing)),
             )
                 .in_set(FrameSet::Input),
         );
@@ -225,11 +231,56 @@ fn choose_on_enter(
     };
     // The same scene needs no vademecum read again.
     let same = super::reload::same_scene(&lesson.scenario, scenario).then(|| lesson.scene.clone());
-    let (file, scenario) = (file.clone(), scenario.clone());
     let scene: BoxedFuture<'static, _> = match same {
         Some(scene) => Box::pin(std::future::ready(Ok(scene))),
-        None => (plan.scenes)(&scenario),
+        None => (plan.scenes)(scenario),
     };
+    load(
+        &mut commands,
+        (file.clone(), scenario.clone()),
+        scene,
+        &mut next,
+    );
+}
+
+/// On the briefing, once a nonlinear vademecum that the lesson's scene runs linear tissue for
+/// meanwhile has been built in the background, the scene is loaded again (once per file), so
+/// that the attempt about to begin is felt with it. Not during an exercise: its tissue would
+/// change under the trainee's hand.
+fn reload_when_built(
+    mut commands: Commands,
+    plan: Res<MenuPlan>,
+    lesson: Res<Lesson>,
+    mut reloaded: Local<Vec<PathBuf>>,
+    mut next: ResMut<NextState<Stage>>,
+) {
+    let waiting = &lesson.scene.meanwhile;
+    if waiting.iter().all(|file| reloaded.contains(file)) {
+        return;
+    }
+    let built = (plan.built)();
+    let ready: Vec<PathBuf> = waiting
+        .iter()
+        .filter(|file| built.contains(file) && !reloaded.contains(file))
+        .cloned()
+        .collect();
+    if ready.is_empty() {
+        return;
+    }
+    reloaded.extend(ready);
+    let scene = (plan.scenes)(&lesson.scenario);
+    let chosen = (lesson.file.clone(), lesson.scenario.clone());
+    load(&mut commands, chosen, scene, &mut next);
+}
+
+/// Reads `scene` for the scenario read from `file` as a task away from the frames; the
+/// briefing opens when it is ready.
+fn load(
+    commands: &mut Commands,
+    (file, scenario): (PathBuf, Scenario),
+    scene: BoxedFuture<'static, Result<HapticScene, String>>,
+    next: &mut NextState<Stage>,
+) {
     let title = scenario.title.clone();
     let task = AsyncComputeTaskPool::get().spawn(async move {
         let scene = scene.await?;
@@ -300,6 +351,7 @@ fn finish_loading(
 
 #[cfg(test)]
 mod tests {
+    use std::sync::Mutex;
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::time::{Duration, Instant};
 
@@ -326,12 +378,16 @@ mod tests {
         built: Arc<AtomicUsize>,
         swap: SceneSwap,
         lessons: Lessons,
+        /// The files the next scene built runs linear tissue for meanwhile...
+        meanwhile: Arc<Mutex<Vec<PathBuf>>>,
+        /// ...and the files the background builder has built.
+        finished: Arc<Mutex<Vec<PathBuf>>>,
     }
 
-    /// A headless window on the first of three scenarios in a folder (the third broken),
-    /// opening on the menu; scenes are built without organs.
-    fn fixture() -> Fixture {
-        let folder = std::env::temp_dir().join(format!("pgd-menu-{}", std::process::id()));
+    /// A headless window on the first of three scenarios in a folder of the test's own (the
+    /// third broken), opening on the menu; scenes are built without organs.
+    fn fixture(test: &str) -> Fixture {
+        let folder = std::env::temp_dir().join(format!("pgd-menu-{test}-{}", std::process::id()));
         std::fs::create_dir_all(&folder).unwrap();
         let write = |name: &str, text: &str| std::fs::write(folder.join(name), text).unwrap();
         write("a.scenario.ron", &scenario_text("Liver press", "liver"));
@@ -351,14 +407,20 @@ mod tests {
         let built = Arc::new(AtomicUsize::new(0));
         let counter = built.clone();
         let swap = SceneSwap::default();
+        let meanwhile = Arc::new(Mutex::new(Vec::new()));
+        let finished = Arc::new(Mutex::new(Vec::new()));
+        let (waiting, done) = (meanwhile.clone(), finished.clone());
         let plan = MenuPlan {
             folder: Some(folder.clone()),
             built_in: &[("scenarios/built-in.scenario.ron", "unused")],
             scenes: Arc::new(move |_: &Scenario| {
                 counter.fetch_add(1, Ordering::SeqCst);
-                Box::pin(std::future::ready(Ok(scene_without_organs())))
+                let mut scene = scene_without_organs();
+                scene.meanwhile = waiting.lock().unwrap().clone();
+                Box::pin(std::future::ready(Ok(scene)))
             }),
             swap: swap.clone(),
+            built: Arc::new(move || done.lock().unwrap().clone()),
         };
         let lessons = Lessons::default();
         let mut app = App::new();
@@ -377,6 +439,8 @@ mod tests {
             built,
             swap,
             lessons,
+            meanwhile,
+            finished,
         }
     }
 
@@ -384,7 +448,11 @@ mod tests {
     fn until_briefing(app: &mut App) {
         let start = Instant::now();
         while stage(app) != Stage::Briefing {
-            assert!(start.elapsed() < Duration::from_secs(20), "never loaded");
+            assert!(
+                start.elapsed() < Duration::from_secs(20),
+                "never loaded: {:?}",
+                stage(app)
+            );
             std::thread::sleep(Duration::from_millis(5));
             app.update();
         }
@@ -402,7 +470,8 @@ mod tests {
             built,
             swap,
             lessons,
-        } = fixture();
+            ..
+        } = fixture("choose");
         app.update();
         app.update();
         assert_eq!(stage(&app), Stage::Menu);
@@ -443,6 +512,69 @@ mod tests {
             built.load(Ordering::SeqCst),
             1,
             "the same scene was built again"
+        );
+        std::fs::remove_dir_all(&folder).unwrap();
+    }
+
+    /// A scene that runs an organ's linear tissue while its nonlinear vademecum builds is
+    /// loaded again on the briefing once that file is built, and only then, once; a file
+    /// built during an exercise waits for the next briefing.
+    #[test]
+    fn a_briefing_takes_up_a_vademecum_built_in_the_background() {
+        let Fixture {
+            mut app,
+            folder,
+            built,
+            meanwhile,
+            finished,
+            ..
+        } = fixture("reload");
+        let (liver, pancreas) = (folder.join("liver.vdm"), folder.join("pancreas.vdm"));
+        *meanwhile.lock().unwrap() = vec![liver.clone()];
+        app.update();
+        tap(&mut app, KeyCode::ArrowDown);
+        tap(&mut app, KeyCode::Enter);
+        until_briefing(&mut app);
+        assert_eq!(built.load(Ordering::SeqCst), 1);
+        finished.lock().unwrap().push(folder.join("another.vdm"));
+        for _ in 0..3 {
+            app.update();
+        }
+        assert_eq!(stage(&app), Stage::Briefing, "reloaded for another file");
+
+        meanwhile.lock().unwrap().clear();
+        finished.lock().unwrap().push(liver.clone());
+        app.update();
+        app.update();
+        assert_eq!(stage(&app), Stage::Loading);
+        until_briefing(&mut app);
+        assert_eq!(built.load(Ordering::SeqCst), 2, "not loaded again");
+        let lesson = app.world().resource::<Lesson>();
+        assert!(lesson.scene.meanwhile.is_empty());
+        assert!(texts(&mut app).contains("Brief of Pancreas press."));
+        for _ in 0..3 {
+            app.update();
+        }
+        assert_eq!(built.load(Ordering::SeqCst), 2, "loaded once more");
+
+        // Chosen again while the pancreas builds, begun, and built during the exercise.
+        *meanwhile.lock().unwrap() = vec![pancreas.clone()];
+        tap(&mut app, KeyCode::KeyM);
+        tap(&mut app, KeyCode::ArrowUp);
+        tap(&mut app, KeyCode::Enter);
+        until_briefing(&mut app);
+        assert_eq!(built.load(Ordering::SeqCst), 3);
+        tap(&mut app, KeyCode::Space);
+        assert_eq!(stage(&app), Stage::Exercise);
+        finished.lock().unwrap().push(pancreas);
+        for _ in 0..3 {
+            app.update();
+        }
+        assert_eq!(stage(&app), Stage::Exercise);
+        assert_eq!(
+            built.load(Ordering::SeqCst),
+            3,
+            "loaded during the exercise"
         );
         std::fs::remove_dir_all(&folder).unwrap();
     }
