@@ -101,14 +101,31 @@ pub const NEO_HOOKEAN_STEPS_TOOL_RADII: [f64; 6] = [
     25.0 / 6.0,
 ];
 
+/// Exponential load steps on the liver, in tool radii: 2.5 to 60 mm of linear depth under the
+/// 6 mm tool. The law stiffens, so a step presses less deep than its level: on the coarse liver
+/// the neo-Hookean steps' 25 mm answered 15.6 mm of tool depth, these steps' 60 mm about 25 mm.
+pub const EXPONENTIAL_STEPS_TOOL_RADII: [f64; 6] = [
+    2.5 / 6.0,
+    5.0 / 6.0,
+    10.0 / 6.0,
+    20.0 / 6.0,
+    35.0 / 6.0,
+    60.0 / 6.0,
+];
+
 /// The load steps `law` is built with by default for `organ` under a tool of
-/// `tool_tip_radius_m`: the neo-Hookean family's reach the depths a trainee presses, the same
-/// share of each organ's thickness ([`press_scale`]); KSV's stop where it loses stability (the
-/// linear law has none; it keeps KSV's in its header).
+/// `tool_tip_radius_m`: the neo-Hookean family's reach the depths a trainee presses (the
+/// exponential law's deeper levels for the same depths), the same share of each organ's
+/// thickness ([`press_scale`]); KSV's stop where it loses stability (the linear law has none;
+/// it keeps KSV's in its header).
 pub fn default_load_steps_m(organ: Option<Organ>, tool_tip_radius_m: f64, law: Law) -> Vec<f64> {
     let scale = press_scale(organ);
+    let radii = match law {
+        Law::Exponential => &EXPONENTIAL_STEPS_TOOL_RADII,
+        _ => &NEO_HOOKEAN_STEPS_TOOL_RADII,
+    };
     match law.is_hyperelastic() {
-        true => NEO_HOOKEAN_STEPS_TOOL_RADII
+        true => radii
             .iter()
             .map(|r| r * tool_tip_radius_m * scale)
             .collect(),
@@ -120,25 +137,31 @@ pub fn default_load_steps_m(organ: Option<Organ>, tool_tip_radius_m: f64, law: L
 mod tests {
     use super::*;
 
-    fn steps(organ: Organ) -> Vec<f64> {
-        BuildSettings::for_organ_law(Some(organ), Law::Exponential).load_steps_m
+    fn steps(organ: Organ, law: Law) -> Vec<f64> {
+        BuildSettings::for_organ_law(Some(organ), law).load_steps_m
     }
 
-    /// The liver is pressed to 25 mm; the other abdominal organs to the same share of their
-    /// thickness, step for step (the scales themselves are checked against the generated
-    /// meshes in `tests/geometry`).
+    /// The liver is pressed to 25 mm of linear depth under the neo-Hookean law, to 60 mm under
+    /// the exponential law, which presses less deep than its levels; the other abdominal
+    /// organs to the same share of their thickness, step for step (the scales themselves are
+    /// checked against the generated meshes in `tests/geometry`).
     #[test]
     fn the_organs_steps_are_the_livers_in_proportion_to_their_thickness() {
-        let liver = steps(Organ::Liver);
-        assert!((liver.last().unwrap() - 0.025).abs() < 1e-12, "{liver:?}");
-        for organ in [Organ::Gallbladder, Organ::Pancreas, Organ::Duodenum] {
-            let scale = press_scale(Some(organ));
-            assert!(scale < 1.0, "{}: {scale}", organ.name());
-            let scaled: Vec<f64> = liver.iter().map(|l| l * scale).collect();
-            let own = steps(organ);
-            assert_eq!(own.len(), scaled.len());
-            for (a, b) in own.iter().zip(&scaled) {
-                assert!((a - b).abs() < 1e-12, "{}: {own:?}", organ.name());
+        for (law, deepest_m) in [(Law::NeoHookean, 0.025), (Law::Exponential, 0.060)] {
+            let liver = steps(Organ::Liver, law);
+            assert!(
+                (liver.last().unwrap() - deepest_m).abs() < 1e-12,
+                "{liver:?}"
+            );
+            for organ in [Organ::Gallbladder, Organ::Pancreas, Organ::Duodenum] {
+                let scale = press_scale(Some(organ));
+                assert!(scale < 1.0, "{}: {scale}", organ.name());
+                let scaled: Vec<f64> = liver.iter().map(|l| l * scale).collect();
+                let own = steps(organ, law);
+                assert_eq!(own.len(), scaled.len());
+                for (a, b) in own.iter().zip(&scaled) {
+                    assert!((a - b).abs() < 1e-12, "{}: {own:?}", organ.name());
+                }
             }
         }
     }

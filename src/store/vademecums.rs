@@ -307,7 +307,7 @@ mod tests {
         let command = coarse.build_command();
         assert!(
             command.contains("--tool-radius-mm 12 ")
-                && command.contains("--load-steps-mm 2.5,5,10,15,20,25 "),
+                && command.contains("--load-steps-mm 2.5,5,10,20,35,60 "),
             "{command}"
         );
     }

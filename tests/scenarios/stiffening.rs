@@ -1,4 +1,4 @@
-//! The trainer's felt force over a scripted 20 mm press into the coarse liver: under the
+//! The trainer's felt force over a scripted 30 mm press into the coarse liver: under the
 //! exponential law it firms up as the tool goes deeper (the slope of force against depth
 //! grows from one stretch of the press to the next) until the press leaves the range its load
 //! steps answer; from there on it stiffens no more, its force growing on at the range edge's
@@ -18,7 +18,7 @@ use pgd_surgery::store::OnStale;
 
 use crate::vademecums;
 
-const DEPTH_M: f64 = 20e-3;
+const DEPTH_M: f64 = 30e-3;
 
 /// The coarse liver alone under the law `law` names in a scenario (its default stiffening for
 /// the exponential law), its vademecum built with the defaults.
@@ -39,7 +39,7 @@ fn liver(law: &str) -> (Scenario, HapticScene) {
     (scenario, scene)
 }
 
-/// The 20 mm press at the demo's point, in 1 s, and that point.
+/// The 30 mm press at the demo's point, in 1 s, and that point.
 fn press_script(scene: &HapticScene) -> (Trajectory, PressTarget, PressMotion) {
     let target = press_targets(scene)[0];
     let motion = PressMotion {
@@ -52,10 +52,10 @@ fn press_script(scene: &HapticScene) -> (Trajectory, PressTarget, PressMotion) {
     (press_and_slide(&[target], &motion), target, motion)
 }
 
-/// A press 20 mm deep at the demo's point on the liver, in 1 s: the run's report and, per
+/// A press 30 mm deep at the demo's point on the liver, in 1 s: the run's report and, per
 /// tick of the way in, the tool's depth below the rest surface (m) and the
 /// felt force along the surface's normal (N), and the felt force's magnitude (N).
-fn press_20_mm(scene: &HapticScene) -> (HeadlessReport, Vec<(f64, f64)>, Vec<f64>) {
+fn press_deep(scene: &HapticScene) -> (HeadlessReport, Vec<(f64, f64)>, Vec<f64>) {
     let (script, target, motion) = press_script(scene);
     let in_s = motion.approach_s + motion.press_s;
     let depth_at = |time_s: f64| {
@@ -65,7 +65,7 @@ fn press_20_mm(scene: &HapticScene) -> (HeadlessReport, Vec<(f64, f64)>, Vec<f64
     let depths: Vec<f64> = (0..(in_s / TICK_S).round() as usize)
         .map(|k| depth_at(k as f64 * TICK_S))
         .collect();
-    let device = Box::new(Scripted::new("20 mm press", script));
+    let device = Box::new(Scripted::new("30 mm press", script));
     let mut haptic = HapticLoop::new(scene, device).unwrap();
     haptic.keep_trace();
     let report = haptic.run_simulated(depths.len() as u64);
@@ -102,17 +102,20 @@ fn slopes(felt: &[(f64, f64)], edge_m: f64) -> [f64; 3] {
     })
 }
 
-/// The exponential liver, pressed 20 mm: the force is finite and pushes the tool out; over
-/// the depths its load steps answer, its slope grows from stretch to stretch, by over 30 %
+/// The exponential liver, pressed 30 mm: the force is finite and pushes the tool out; its
+/// load steps answer the press beyond 22 mm of tool depth (24.9 mm measured), and over those
+/// depths its slope grows from stretch to stretch, by over 30 %
 /// from the first to the last, where the linear liver's slope changes by under 1 % over the
 /// same depths. Deeper, the report counts the ticks beyond the range, and the force grows on
 /// with each tick at the range edge's secant stiffness: its magnitude over the depth stays
-/// within 2 % of the edge's (the patch is not fixed: the press moves the surface under it),
-/// under the last stretch's slope.
+/// within 5 % of the edge's (4.8 % measured; held, it would fall 18 % below: the range ends
+/// where the first position of the patch leaves its steps, and the patch's other positions,
+/// whose ranges end deeper, stiffen on, while the press moves the surface and the patch under
+/// the tool), under the last stretch's slope.
 #[test]
-fn a_20_mm_press_on_the_exponential_liver_firms_up_then_stiffens_no_more() {
-    let (report, felt, magnitudes) = press_20_mm(&liver_scene("Exponential"));
-    let (linear_report, linear_felt, _) = press_20_mm(&liver_scene("Linear"));
+fn a_30_mm_press_on_the_exponential_liver_firms_up_then_stiffens_no_more() {
+    let (report, felt, magnitudes) = press_deep(&liver_scene("Exponential"));
+    let (linear_report, linear_felt, _) = press_deep(&liver_scene("Linear"));
     assert!(felt.iter().all(|(_, f)| f.is_finite()));
     assert!((felt.last().unwrap().0 - DEPTH_M).abs() < 0.1e-3);
     assert_eq!(linear_report.range.beyond_ticks, 0, "{linear_report}");
@@ -124,7 +127,7 @@ fn a_20_mm_press_on_the_exponential_liver_firms_up_then_stiffens_no_more() {
 range edge {:.2} mm; slopes (N/m) exponential {stiffening:?}, linear {linear:?}",
         edge_m * 1e3
     );
-    assert!(edge_m > 5e-3, "{report}");
+    assert!(edge_m > 22e-3, "{report}");
     assert!(stiffening.windows(2).all(|s| s[1] > s[0]), "{stiffening:?}");
     assert!(stiffening[2] > 1.3 * stiffening[0], "{stiffening:?}");
     assert!((linear[2] / linear[0] - 1.0).abs() < 0.01, "{linear:?}");
@@ -138,20 +141,25 @@ range edge {:.2} mm; slopes (N/m) exponential {stiffening:?}, linear {linear:?}"
     assert!(beyond.windows(2).all(|w| w[1].1 > w[0].1), "{beyond:?}");
     let secant = |(depth_m, force_n): (f64, f64)| force_n / depth_m;
     let edge = secant(beyond[0]);
-    for &point in &beyond {
-        assert!(
-            (secant(point) / edge - 1.0).abs() < 0.02,
-            "{} N/m at {} m, {edge} N/m at the edge",
-            secant(point),
-            point.0
-        );
-    }
+    let drift = beyond
+        .iter()
+        .map(|&point| (secant(point) / edge - 1.0).abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "secant beyond the range: at most {:.2} % off the edge's",
+        drift * 100.0
+    );
+    // A force held at the edge's would fall 18 % below it by the press's end.
+    assert!(
+        drift < 0.05,
+        "{drift} off {edge} N/m at the edge: {beyond:?}"
+    );
     let beyond_slope = slope(&felt, (edge_m + 0.1e-3, DEPTH_M + 1e-3));
     eprintln!("slope beyond the range {beyond_slope:.1} N/m");
     assert!(beyond_slope < stiffening[2], "{beyond_slope} N/m beyond");
 }
 
-/// The scored attempt says so too: pressed 20 mm into the exponential liver, its feedback
+/// The scored attempt says so too: pressed 30 mm into the exponential liver, its feedback
 /// says how far beyond the tissue model's range the tool went (as far as the run's report
 /// says, to 0.05 mm) and for how long; into the linear liver, whose range has no
 /// end, it says nothing of the kind.
@@ -161,7 +169,7 @@ fn a_scored_press_beyond_the_range_says_so_in_its_feedback() {
         let (scenario, scene) = liver(law);
         let (script, ..) = press_script(&scene);
         let ticks = (script.duration_s() / TICK_S).ceil() as u64;
-        let device = Box::new(Scripted::new("20 mm press", script));
+        let device = Box::new(Scripted::new("30 mm press", script));
         run_simulated(scenario, &scene, device, ticks).unwrap().card
     };
     let (exponential, linear) = (attempt("Exponential"), attempt("Linear"));
@@ -173,7 +181,7 @@ fn a_scored_press_beyond_the_range_says_so_in_its_feedback() {
     };
     assert_eq!(beyond(&linear), None, "{:?}", linear.feedback);
     let line = beyond(&exponential).unwrap_or_else(|| panic!("{:?}", exponential.feedback));
-    let (report, ..) = press_20_mm(&liver_scene("Exponential"));
+    let (report, ..) = press_deep(&liver_scene("Exponential"));
     let metrics = &exponential.tasks[0].metrics;
     assert!(
         (metrics.max_beyond_range_mm - report.range.max_beyond_mm).abs() < 0.05,

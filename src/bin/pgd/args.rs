@@ -327,9 +327,10 @@ pub struct BuildArgs {
     pub max_modes: usize,
     /// Nonlinear laws: the linear response's depth under the tool at each load step after
     /// the linear one, in millimetres, increasing; the deepest is the range the vademecum is
-    /// valid over (default: 0.5,1,1.5 for KSV; for the neo-Hookean and exponential laws
-    /// 2.5,5,10,15,20,25 on the liver under the 6 mm tool, the same share of the other organs'
-    /// thickness, in proportion to the cornea's tool).
+    /// valid over (default: 0.5,1,1.5 for KSV; 2.5,5,10,15,20,25 for the neo-Hookean law and
+    /// 2.5,5,10,20,35,60 for the exponential law, which presses less deep than its levels, on
+    /// the liver under the 6 mm tool, the same share of the other organs' thickness, in
+    /// proportion to the cornea's tool).
     #[arg(long, value_delimiter = ',')]
     pub load_steps_mm: Vec<f64>,
     /// Nonlinear laws: up to this fraction of a load step's loads may fail to converge and
