@@ -256,7 +256,6 @@ pub fn scene_of(
 ) -> Result<HapticScene, String> {
     let tip = scene_tip_m(organs, tip_radius_m, detail);
     let mut field_file = None;
-    let mut meanwhile = Vec::new();
     let loaded = organs
         .iter()
         .map(|organ| {
@@ -264,10 +263,7 @@ pub fn scene_of(
             let (vademecum, mesh) = match on_stale {
                 #[cfg(not(target_arch = "wasm32"))]
                 OnStale::Meanwhile if organ.law != Law::Linear => {
-                    let (built, building) =
-                        linear_meanwhile(organ, spec.clone(), (dir, detail, tip))?;
-                    meanwhile.extend(building);
-                    built
+                    linear_meanwhile(organ, spec.clone(), (dir, detail, tip))?
                 }
                 _ => ensure_vademecum(&spec, on_stale)?,
             };
@@ -277,6 +273,13 @@ pub fn scene_of(
             Ok((organ.name.clone(), Arc::new(vademecum), mesh))
         })
         .collect::<Result<Vec<_>, String>>()?;
+    // The organs running linear tissue while their own law's vademecum builds.
+    let meanwhile = organs
+        .iter()
+        .zip(&loaded)
+        .filter(|(organ, (_, vademecum, _))| vademecum.header.material.law != organ.law)
+        .map(|(organ, _)| organ.vademecum(dir, detail, tip).file)
+        .collect();
     let dynamics = scene_dynamics(organs, &loaded)?;
     let cutting = scene_cutting(organs, &loaded)?;
     let attachments: Vec<AttachmentSpec> = loaded
@@ -315,14 +318,14 @@ pub fn scene_of(
 
 #[cfg(not(target_arch = "wasm32"))]
 /// `spec`, the nonlinear vademecum of `organ`, if it is built; else the organ's linear one
-/// (built now if need be), `spec` queued to build in the background, and its file.
+/// (built now if need be), `spec` queued to build in the background.
 fn linear_meanwhile(
     organ: &SceneOrgan,
     spec: VademecumSpec,
     (dir, detail, tip_m): (&Path, Detail, f64),
-) -> Result<((Vademecum, TetMesh), Option<PathBuf>), String> {
+) -> Result<(Vademecum, TetMesh), String> {
     if let Ok(built) = ensure_vademecum(&spec, OnStale::Refuse) {
-        return Ok((built, None));
+        return Ok(built);
     }
     eprintln!(
         "{}: linear tissue until its {} vademecum is built, in the background ({})",
@@ -330,15 +333,13 @@ fn linear_meanwhile(
         organ.law.name(),
         spec.file.display()
     );
-    let file = spec.file.clone();
     build_in_background(spec);
     let linear = SceneOrgan {
         law: Law::Linear,
         stiffening: None,
         ..organ.clone()
     };
-    let built = ensure_vademecum(&linear.vademecum(dir, detail, tip_m), OnStale::Rebuild)?;
-    Ok((built, Some(file)))
+    ensure_vademecum(&linear.vademecum(dir, detail, tip_m), OnStale::Rebuild)
 }
 
 /// The dynamic models of the organs that move (their tissue under the KSV law, whose reduced
