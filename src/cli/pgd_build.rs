@@ -106,7 +106,7 @@ pub fn print_build_report(report: &BuildReport, out: &Path) {
              the others' loads failing to converge even with Newton within --newton-budget \
              (the law loses stability under the tool, or the step is too far from the one \
              before); the load steps stop at {:.1} mm (the depth of one position's load \
-             alone: the trainer holds the force once a position under the tool goes past its \
+             alone: the tissue stiffens no more once a position under the tool goes past its \
              range)",
             failed.indentation_m * 1e3,
             report.steps.last().map_or(0.0, |s| s.indentation_m * 1e3)

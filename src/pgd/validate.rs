@@ -258,8 +258,9 @@ fn linear_compliance(vademecum: &Vademecum, at: &SurfacePoint, direction: &Vecto
 }
 
 /// The deepest linear indentation (m) along `direction` at `at` that the vademecum answers,
-/// `wanted_m` or its range's edge there if shallower: beyond it the trainer holds the force,
-/// so that is not what the validation measures.
+/// `wanted_m` or its range's edge there if shallower: beyond it the tissue stiffens no more
+/// (the trainer extrapolates at the edge's secant stiffness), so that is not what the
+/// validation measures.
 fn within_range_m(
     vademecum: &Vademecum,
     at: &SurfacePoint,
