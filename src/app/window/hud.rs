@@ -155,7 +155,8 @@ fn building_line() -> String {
         n => format!(", {n} more waiting"),
     };
     format!(
-        "\nbuilding the {} {} in the background ({}{share}{waiting}): M and the scenario again to use it{failed}",
+        "\nbuilding the {} {} in the background ({}{share}{waiting}): the next briefing uses \
+         it{failed}",
         building.law, building.organ, building.stage
     )
 }
