@@ -20,12 +20,16 @@ pub struct OrganBody {
 }
 
 impl OrganBody {
-    /// The organ's name with the tissue law its vademecum answers, as reports name it
-    /// ("liver (exponential)").
+    /// The organ's name with the tissue law its vademecum answers ([`organ_with_law`]).
     pub fn with_law(&self) -> String {
-        let law = self.vademecum.header.material.law.name();
-        format!("{} ({law})", self.name)
+        organ_with_law(&self.name, &self.vademecum)
     }
+}
+
+/// An organ's name with the tissue law its vademecum answers, as the reports and the HUD
+/// write it ("liver (exponential)").
+pub fn organ_with_law(name: &str, vademecum: &Vademecum) -> String {
+    format!("{name} ({})", vademecum.header.material.law.name())
 }
 
 /// The organ's place in the scene's list: the order of [`super::HapticSnapshot::organs`].

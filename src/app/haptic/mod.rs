@@ -19,7 +19,9 @@ mod thread;
 use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
 
-pub use components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
+pub use components::{
+    OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, organ_with_law,
+};
 pub use cutting::{OrganCut, SettleCuts};
 pub use frame_paced::FramePaced;
 pub use report::{ForceSummary, HeadlessReport, RangeSummary, TickTimes};

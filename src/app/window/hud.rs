@@ -8,7 +8,7 @@ use super::FrameSet;
 use super::bridge::{HapticLink, Snapshot};
 use super::laparoscope::CameraMode;
 use super::lesson::Lesson;
-use crate::app::haptic::HapticSnapshot;
+use crate::app::haptic::{HapticSnapshot, organ_with_law};
 use crate::devices::Action;
 
 #[derive(Component)]
@@ -126,7 +126,7 @@ fn tissue_line(link: &HapticLink) -> String {
         .scene
         .organs
         .iter()
-        .map(|(name, vademecum)| format!("{name} {}", vademecum.header.material.law.name()))
+        .map(|(name, vademecum)| organ_with_law(name, vademecum))
         .collect();
     format!("tissue: {}{}", laws.join(", "), building_line())
 }
