@@ -472,7 +472,7 @@ impl Default for SecantSettings {
             mixing: 0.5,
             max_unconverged_fraction: 0.005,
             min_reached_share: 0.25,
-            newton_budget: 4.0,
+            newton_budget: 12.0,
         }
     }
 }
