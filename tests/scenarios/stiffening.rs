@@ -108,7 +108,7 @@ fn slopes(felt: &[(f64, f64)], edge_m: f64) -> [f64; 3] {
 /// from the first to the last, where the linear liver's slope changes by under 1 % over the
 /// same depths. Deeper, the report counts the ticks beyond the range, and the force grows on
 /// with each tick at the range edge's secant stiffness: its magnitude over the depth stays
-/// within 5 % of the edge's (4.8 % measured; held, it would fall 18 % below: the range ends
+/// within 5 % of the edge's (4.3 % measured; held, it would fall 18 % below: the range ends
 /// where the first position of the patch leaves its steps, and the patch's other positions,
 /// whose ranges end deeper, stiffen on, while the press moves the surface and the patch under
 /// the tool), under the last stretch's slope.
