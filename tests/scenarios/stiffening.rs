@@ -103,7 +103,7 @@ fn slopes(felt: &[(f64, f64)], edge_m: f64) -> [f64; 3] {
 }
 
 /// The exponential liver, pressed 30 mm: the force is finite and pushes the tool out; its
-/// load steps answer the press beyond 22 mm of tool depth (24.9 mm measured), and over those
+/// load steps answer the press beyond 22 mm of tool depth (24.5 mm measured), and over those
 /// depths its slope grows from stretch to stretch, by over 30 %
 /// from the first to the last, where the linear liver's slope changes by under 1 % over the
 /// same depths. Deeper, the report counts the ticks beyond the range, and the force grows on
