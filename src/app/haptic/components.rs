@@ -19,13 +19,6 @@ pub struct OrganBody {
     pub surface: Arc<ContactSurface>,
 }
 
-impl OrganBody {
-    /// The organ's name with the tissue law its vademecum answers ([`organ_with_law`]).
-    pub fn with_law(&self) -> String {
-        organ_with_law(&self.name, &self.vademecum)
-    }
-}
-
 /// An organ's name with the tissue law its vademecum answers, as the reports and the HUD
 /// write it ("liver (exponential)").
 pub fn organ_with_law(name: &str, vademecum: &Vademecum) -> String {

@@ -9,7 +9,9 @@ use bevy::platform::time::Instant;
 
 use bevy::prelude::*;
 
-use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
+use super::components::{
+    OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, organ_with_law,
+};
 use super::cutting::{OrganCut, SettleCuts};
 use super::report::{ForceSummary, HeadlessReport, RangeSummary};
 use super::resources::{
@@ -324,7 +326,7 @@ impl HapticLoop {
             .world
             .query::<(&OrganIndex, &OrganBody)>()
             .iter(&self.world)
-            .map(|(i, b)| (i.0, b.with_law()))
+            .map(|(i, b)| (i.0, organ_with_law(&b.name, &b.vademecum)))
             .collect();
         organs.sort();
         organs.into_iter().map(|o| o.1).collect()
