@@ -430,18 +430,20 @@ impl ContactPair {
             self.nodes.master_positions[i] as usize,
         );
         let (shell_vademecum, master_vademecum) = (&self.shell_vademecum, &self.master_vademecum);
+        let shell_level_n = shell_vademecum.level_force_n(&[(s, 1.0)], &force);
+        let master_level_n = master_vademecum.level_force_n(&[(m, 1.0)], &force);
         self.compliance.shell_rows().add_force(
             i,
             f,
             &self.shell_steps,
-            |step| shell_vademecum.step_share(step, s, 1.0, &force),
+            |step| shell_vademecum.step_share(step, s, 1.0, shell_level_n),
             shell,
         );
         self.compliance.master_rows().add_force(
             i,
             f,
             &self.master_steps,
-            |step| master_vademecum.step_share(step, m, 1.0, &-force),
+            |step| master_vademecum.step_share(step, m, 1.0, master_level_n),
             master,
         );
     }

@@ -377,22 +377,32 @@ impl Vademecum {
         force_norm_n * self.reference_compliance_m_per_n[j] as f64
     }
 
-    /// The share of a total force `force_n` that position `j` (share `l` of the patch) carries
-    /// in load step `step`. The linear step carries the whole share; a nonlinear step holds
-    /// the correction of the patch centred on `j`, at the level the whole force presses it,
-    /// and carries the share its blend gives it (the linear step's correction being none).
-    pub(crate) fn step_share(&self, step: usize, j: usize, l: f64, force_n: &Vector3<f64>) -> f64 {
+    /// The share of a total force that position `j` (share `l` of the patch) carries in load
+    /// step `step`, the force's magnitude as [`Self::level_force_n`] gives it. The linear step
+    /// carries the whole share; a nonlinear step holds the correction of the patch centred on
+    /// `j`, at the level the whole force presses it, and carries the share its blend gives it
+    /// (the linear step's correction being none).
+    pub(crate) fn step_share(&self, step: usize, j: usize, l: f64, level_force_n: f64) -> f64 {
         if step == 0 {
             return l;
         }
-        l * self.step_weight(step, self.level_m(j, force_n.norm()))
+        l * self.step_weight(step, self.level_m(j, level_force_n))
+    }
+
+    /// The magnitude (N) of `force_n` on the patch `shares` that sets its positions' levels:
+    /// the force's own up to the patch's range edge ([`Self::range_force_n`]), the edge's
+    /// beyond it. So past the edge every position of the patch keeps the level it had there,
+    /// and the patch answers at the edge's secant compliance, the same for any deeper press,
+    /// whether or not the positions' own ranges reach further.
+    pub(crate) fn level_force_n(&self, shares: &[(usize, f64)], force_n: &Vector3<f64>) -> f64 {
+        force_n.norm().min(self.shares_range_force_n(shares))
     }
 
     /// The load steps the positions of `patch` use under `force_n`: the linear one and the
     /// corrections up to the deepest position's (a step in between that no position uses adds
     /// nothing).
     fn loaded_steps(&self, patch: &Patch, force_n: &Vector3<f64>) -> RangeInclusive<usize> {
-        let force_norm_n = force_n.norm();
+        let force_norm_n = self.level_force_n(&patch.shares, force_n);
         let deepest = patch
             .shares
             .iter()
@@ -477,9 +487,10 @@ impl Vademecum {
             return self.step_compliance(0, patch);
         }
         let steps: Vec<usize> = self.loaded_steps(patch, force_n).collect();
+        let level_n = self.level_force_n(&patch.shares, force_n);
         let along: Matrix3<f64> = steps
             .iter()
-            .map(|&k| self.weighted_compliance(k, patch, |j, l| self.step_share(k, j, l, force_n)))
+            .map(|&k| self.weighted_compliance(k, patch, |j, l| self.step_share(k, j, l, level_n)))
             .sum();
         if !self.header.material.law.modulus_grows_with_strain() {
             return along;
@@ -495,7 +506,7 @@ impl Vademecum {
                 let correction: Matrix3<f64> = steps
                     .iter()
                     .filter(|&&k| k != 0)
-                    .map(|&k| own(k, self.step_share(k, j, 1.0, force_n)))
+                    .map(|&k| own(k, self.step_share(k, j, 1.0, level_n)))
                     .sum();
                 let normal = Vector3::from(self.position_normals[j].map(f64::from));
                 l * across_the_normal(&own(0, 1.0), &correction, &normal)
@@ -552,11 +563,10 @@ impl Vademecum {
     /// [`Self::patch_press`], and the share of `indentation_m` that lies beyond the load
     /// steps' range (zero within it). The patch's level is the share-weighted level of the
     /// patches centred on its positions (close to the linear depth of the tool's own patch);
-    /// past the edge ([`Self::range_force_n`]) a position's steps add nothing deeper: its
-    /// columns stop at the last step its load reached, and a level past the deepest step takes
-    /// that step. So the tissue stops stiffening there, and the force goes on growing with the
-    /// depth at the edge's secant stiffness: a trainee pressing too deep still feels the
-    /// tissue push back harder.
+    /// past the edge ([`Self::range_force_n`]) every position keeps the level it had there
+    /// ([`Self::level_force_n`]). So the tissue stops stiffening there, and the force goes on
+    /// growing with the depth at the edge's secant stiffness: a trainee pressing too deep
+    /// still feels the tissue push back harder.
     pub fn patch_press_in_range(
         &self,
         patch: &mut Patch,
@@ -579,10 +589,15 @@ impl Vademecum {
     /// over the middle of the test block's 1 cm grid under a 12 mm tool), so the edge can lie
     /// at another linear depth of the tool's own patch than the deepest step's level.
     pub fn range_force_n(&self, patch: &Patch) -> f64 {
+        self.shares_range_force_n(&patch.shares)
+    }
+
+    /// [`Self::range_force_n`] of the patch `shares`.
+    fn shares_range_force_n(&self, shares: &[(usize, f64)]) -> f64 {
         if self.steps.len() == 1 {
             return f64::INFINITY;
         }
-        let (range_m, level_per_n) = patch.shares.iter().fold((0.0, 0.0), |(r, n), &(j, l)| {
+        let (range_m, level_per_n) = shares.iter().fold((0.0, 0.0), |(r, n), &(j, l)| {
             let range_m = f64::from(self.range_level_m[j]);
             (r + l * range_m, n + l * self.level_m(j, 1.0))
         });
@@ -592,7 +607,7 @@ impl Vademecum {
     /// [`Self::compliance`] from the patch's step columns, filling the linear step's and those
     /// of the steps its positions reach under `force_n`.
     fn column_compliance(&self, patch: &mut Patch, force_n: &Vector3<f64>) -> Matrix3<f64> {
-        let force_norm_n = force_n.norm();
+        let force_norm_n = self.level_force_n(&patch.shares, force_n);
         let blend = |j: usize| self.blend(self.level_m(j, force_norm_n));
         patch.fill_columns(0, &self.steps[0].local);
         for slot in 0..patch.shares.len() {
@@ -639,10 +654,11 @@ impl Vademecum {
     /// Whether load step `step` carries any share of a force `force_n` on `shares`: the
     /// linear step always; a nonlinear one where a position's level blends it in.
     fn step_carries(&self, step: usize, shares: &[(usize, f64)], force_n: &Vector3<f64>) -> bool {
+        let level_n = self.level_force_n(shares, force_n);
         step == 0
             || shares
                 .iter()
-                .any(|&(j, l)| self.step_share(step, j, l, force_n) > 0.0)
+                .any(|&(j, l)| self.step_share(step, j, l, level_n) > 0.0)
     }
 
     /// The modal coefficients of load step `step` for a force on the patch `shares`:
@@ -671,10 +687,11 @@ impl Vademecum {
         mut add: impl FnMut(usize, f64),
     ) {
         let params = self.parameter_count();
+        let level_n = self.level_force_n(shares, force_n);
         let mut weights = [0.0; SHARE_CHUNK];
         for chunk in shares.chunks(SHARE_CHUNK) {
             for (w, &(i, l)) in weights.iter_mut().zip(chunk) {
-                *w = self.step_share(step, i, l, force_n);
+                *w = self.step_share(step, i, l, level_n);
             }
             if weights[..chunk.len()].iter().all(|&w| w == 0.0) {
                 continue;
@@ -723,8 +740,9 @@ impl Vademecum {
         u: &mut [f64],
     ) {
         let local = &self.steps[step].local;
+        let level_n = self.level_force_n(shares, force_n);
         for &(i, l) in shares {
-            let l = self.step_share(step, i, l, force_n);
+            let l = self.step_share(step, i, l, level_n);
             if l == 0.0 {
                 continue;
             }
@@ -774,10 +792,11 @@ impl Vademecum {
         u: &mut Vector3<f64>,
     ) {
         let local = &self.steps[step].local;
+        let level_n = self.level_force_n(shares, force_n);
         for &(i, l) in shares {
             let range = local.corrections_of(i);
             let nodes = &local.correction_nodes[range.clone()];
-            let l = self.step_share(step, i, l, force_n);
+            let l = self.step_share(step, i, l, level_n);
             if l == 0.0 {
                 continue;
             }

@@ -9,7 +9,8 @@ use pgd_surgery::fem::{FemModel, Law, Loads, NewtonSettings, PatchKernel};
 use pgd_surgery::mesh::Surface;
 use pgd_surgery::pgd::{
     BuildSettings, LoadPatches, Responses, RestStiffness, SecantReport, SecantSettings, Silent,
-    SurfacePoint, ValidationReport, ValidationSettings, build, newton_baseline, validate,
+    SurfacePoint, Vademecum, ValidationReport, ValidationSettings, build, newton_baseline,
+    validate,
 };
 
 use crate::common::{block_mesh, block_model_of, organ, settings};
@@ -298,7 +299,9 @@ fn a_load_step_beyond_stability_is_left_out() {
 /// steps leave a few loads that neither the fixed point nor Newton solves (KSV loses
 /// stability under compression; an equilibrium with an element inside out does not count). A press whose patch
 /// holds such a position is held sooner than with every range at 2 mm; one whose patch
-/// holds none is held where it was.
+/// holds none is held where it was. Beyond its edge, a patch that holds one answers in
+/// proportion to the indentation, its other positions, whose ranges reach deeper, stiffening
+/// no more either.
 #[test]
 fn a_position_whose_load_fails_ends_its_range_alone() {
     let model = block_model_of(block_mesh([6, 4, 3]), Law::KirchhoffSaintVenant);
@@ -338,12 +341,39 @@ fn a_position_whose_load_fails_ends_its_range_alone() {
             everywhere.range_force_n(&patch),
         );
         match holds_short {
-            true => assert!(edge_n < everywhere_n, "{at:?}: {edge_n} {everywhere_n}"),
+            true => {
+                assert!(edge_n < everywhere_n, "{at:?}: {edge_n} {everywhere_n}");
+                assert_proportional_beyond_the_edge(&vademecum, &at);
+            }
             false => assert_eq!(edge_n, everywhere_n, "{at:?}"),
         }
         held_sooner += usize::from(holds_short);
     }
     assert!(held_sooner > 0);
+}
+
+/// Pressed along the patch's inward facing at `at` 1.05 and 1.5 times as deep as its range
+/// edge, the force grows in the depths' ratio, to 1e-9: beyond the edge the patch's
+/// compliance is the edge's.
+fn assert_proportional_beyond_the_edge(vademecum: &Vademecum, at: &SurfacePoint) {
+    let inward = -vademecum.triangle_facing(at.triangle).normalize();
+    let force = |depth_m: f64| vademecum.force_for_indentation(at, &(inward * depth_m));
+    let edge_n = vademecum.range_force_n(&vademecum.patch(at));
+    // The force grows with the depth: the edge's depth by bisection.
+    let (mut within_m, mut beyond_m) = (0.0, 1e-3);
+    while force(beyond_m).norm() < edge_n {
+        beyond_m *= 2.0;
+    }
+    for _ in 0..60 {
+        let middle_m = 0.5 * (within_m + beyond_m);
+        match force(middle_m).norm() < edge_n {
+            true => within_m = middle_m,
+            false => beyond_m = middle_m,
+        }
+    }
+    let (near, far) = (force(1.05 * beyond_m), force(1.5 * beyond_m));
+    let off = (far - near * (1.5 / 1.05)).norm() / far.norm();
+    assert!(off < 1e-9, "{at:?}: {off} off proportion beyond the edge");
 }
 
 /// Against full neo-Hookean FEM (Newton) at random off-node points and depths up to the

@@ -103,15 +103,16 @@ fn slopes(felt: &[(f64, f64)], edge_m: f64) -> [f64; 3] {
 }
 
 /// The exponential liver, pressed 30 mm: the force is finite and pushes the tool out; its
-/// load steps answer the press beyond 22 mm of tool depth (24.5 mm measured), and over those
+/// load steps answer the press beyond 22 mm of tool depth (24.6 mm measured), and over those
 /// depths its slope grows from stretch to stretch, by over 30 %
 /// from the first to the last, where the linear liver's slope changes by under 1 % over the
 /// same depths. Deeper, the report counts the ticks beyond the range, and the force grows on
-/// with each tick at the range edge's secant stiffness: its magnitude over the depth stays
-/// within 5 % of the edge's (4.3 % measured; held, it would fall 18 % below: the range ends
-/// where the first position of the patch leaves its steps, and the patch's other positions,
-/// whose ranges end deeper, stiffen on, while the press moves the surface and the patch under
-/// the tool), under the last stretch's slope.
+/// with each tick at the range edge's secant stiffness, under the last stretch's slope: its
+/// magnitude over the depth stays within 3 % of the edge's (2.8 % measured; held, it would
+/// fall 18 % below). The vademecum's own answer there is in exact proportion to the
+/// indentation (`tests/pgd/nonlinear.rs`); what drifts is the patch: the point under the tip
+/// slides across a triangle of the coarse mesh as the surface moves, and the patch's four
+/// positions' shares with it.
 #[test]
 fn a_30_mm_press_on_the_exponential_liver_firms_up_then_stiffens_no_more() {
     let (report, felt, magnitudes) = press_deep(&liver_scene("Exponential"));
@@ -149,9 +150,10 @@ range edge {:.2} mm; slopes (N/m) exponential {stiffening:?}, linear {linear:?}"
         "secant beyond the range: at most {:.2} % off the edge's",
         drift * 100.0
     );
+
     // A force held at the edge's would fall 18 % below it by the press's end.
     assert!(
-        drift < 0.05,
+        drift < 0.03,
         "{drift} off {edge} N/m at the edge: {beyond:?}"
     );
     let beyond_slope = slope(&felt, (edge_m + 0.1e-3, DEPTH_M + 1e-3));

@@ -266,9 +266,10 @@ fn for_each_share(
     mut visit: impl FnMut(usize, usize, &Vector3<f64>),
 ) {
     for load in loads.iter().filter(|l| l.is_active()) {
+        let level_n = vademecum.level_force_n(&load.shares, &load.force_n);
         for &(position, share) in &load.shares {
             for step in 0..vademecum.steps.len() {
-                let l = vademecum.step_share(step, position, share, &load.force_n);
+                let l = vademecum.step_share(step, position, share, level_n);
                 if l != 0.0 {
                     visit(step, position, &(load.force_n * l));
                 }
