@@ -86,6 +86,14 @@ pub struct Sample {
     pub indentation_m: f64,
     /// `|F_vademecum − F_fem| / |F_fem|` for the same indentation.
     pub force_error: f64,
+    /// How far (degrees) the press is tilted off the inward normal.
+    pub tilt_deg: f64,
+    /// The felt force's error along the inward normal, signed, over `|F_fem|`: below zero
+    /// the vademecum feels softer than full FEM there.
+    pub along_normal_error: f64,
+    /// The error of the felt force's magnitude across the normal, signed, over `|F_fem|`:
+    /// below zero the vademecum feels softer than full FEM sideways.
+    pub across_normal_error: f64,
     /// Relative L2 error of the displacement over the whole organ.
     pub field_error: f64,
     /// Relative L2 error over the nodes near the tool.
@@ -329,15 +337,34 @@ fn sample(
     let rendered = vademecum.force_for_indentation(at, &under_tool);
     let field = vademecum.field(at, &rendered);
     let near = |n: usize| (mesh.nodes()[n] - point).norm() <= settings.near_radius_m;
+    let (along, across) = normal_and_across(&rendered, &force, &inward);
     Ok(Sample {
         point_m: point.coords.into(),
         force_n: force.into(),
         indentation_m: under_tool.norm(),
         force_error: (rendered - force).norm() / force.norm(),
+        tilt_deg: direction.angle(&inward).to_degrees(),
+        along_normal_error: along,
+        across_normal_error: across,
         field_error: relative_error(&field, &reference, |_| true),
         near_field_error: relative_error(&field, &reference, near),
         range_edge_m: range_edge_m(vademecum, at, &inward),
     })
+}
+
+/// The signed errors of `rendered` against `reference` along the unit `normal` and, in
+/// magnitude, across it, both over `|reference|`: which way an oblique press is off.
+fn normal_and_across(
+    rendered: &Vector3<f64>,
+    reference: &Vector3<f64>,
+    normal: &Vector3<f64>,
+) -> (f64, f64) {
+    let across = |f: &Vector3<f64>| (f - normal * f.dot(normal)).norm();
+    let scale = reference.norm();
+    (
+        (rendered - reference).dot(normal) / scale,
+        (across(rendered) - across(reference)) / scale,
+    )
 }
 
 /// Full FEM pressed along the inward normal at `at` in `curve_levels` equal force steps up to

@@ -8,8 +8,8 @@ use nalgebra::Vector3;
 use pgd_surgery::fem::{FemModel, Law, Loads, NewtonSettings, PatchKernel};
 use pgd_surgery::mesh::Surface;
 use pgd_surgery::pgd::{
-    BuildSettings, LoadPatches, Responses, RestStiffness, SecantReport, SecantSettings, Silent,
-    SurfacePoint, Vademecum, ValidationReport, ValidationSettings, build, newton_baseline,
+    BuildSettings, LoadPatches, Responses, RestStiffness, Sample, SecantReport, SecantSettings,
+    Silent, SurfacePoint, Vademecum, ValidationReport, ValidationSettings, build, newton_baseline,
     validate,
 };
 
@@ -249,7 +249,19 @@ fn against_full_fem(
     );
     assert!(with_linear.range_edge_m.is_none());
     assert!(edge.p50 > 0.0 && edge.max.is_finite(), "{edge:?}");
+    for sample in with_nonlinear.samples.iter().chain(&with_linear.samples) {
+        assert_error_split(sample, loads.max_tilt_deg);
+    }
     (with_nonlinear, with_linear)
+}
+
+/// A sample's press is tilted no further than asked, and its errors along and across the
+/// normal split its felt-force error: the two parts of the error vector are orthogonal, and
+/// the difference of the magnitudes across is no larger than the part across.
+fn assert_error_split(sample: &Sample, max_tilt_deg: f64) {
+    assert!(sample.tilt_deg <= max_tilt_deg + 1e-9, "{sample:?}");
+    let split = sample.along_normal_error.hypot(sample.across_normal_error);
+    assert!(split <= sample.force_error * (1.0 + 1e-9), "{sample:?}");
 }
 
 /// Against full KSV FEM (Newton) at indentations up to the deepest load step, the KSV
