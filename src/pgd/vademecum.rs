@@ -398,15 +398,15 @@ impl Vademecum {
         force_n.norm().min(self.shares_range_force_n(shares))
     }
 
-    /// The load steps the positions of `patch` use under `force_n`: the linear one and the
+    /// The load steps the positions of `patch` use under a force whose magnitude, as
+    /// [`Self::level_force_n`] gives it, is `level_force_n`: the linear one and the
     /// corrections up to the deepest position's (a step in between that no position uses adds
     /// nothing).
-    fn loaded_steps(&self, patch: &Patch, force_n: &Vector3<f64>) -> RangeInclusive<usize> {
-        let force_norm_n = self.level_force_n(&patch.shares, force_n);
+    fn loaded_steps(&self, patch: &Patch, level_force_n: f64) -> RangeInclusive<usize> {
         let deepest = patch
             .shares
             .iter()
-            .map(|&(j, _)| self.level_m(j, force_norm_n))
+            .map(|&(j, _)| self.level_m(j, level_force_n))
             .map(|level| if level.is_nan() { f64::INFINITY } else { level })
             .fold(0.0, f64::max);
         0..=self.steps_at(deepest).1
@@ -486,8 +486,8 @@ impl Vademecum {
         if self.steps.len() == 1 {
             return self.step_compliance(0, patch);
         }
-        let steps: Vec<usize> = self.loaded_steps(patch, force_n).collect();
         let level_n = self.level_force_n(&patch.shares, force_n);
+        let steps: Vec<usize> = self.loaded_steps(patch, level_n).collect();
         let along: Matrix3<f64> = steps
             .iter()
             .map(|&k| self.weighted_compliance(k, patch, |j, l| self.step_share(k, j, l, level_n)))
