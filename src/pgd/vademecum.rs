@@ -540,6 +540,18 @@ impl Vademecum {
         patch: &mut Patch,
         indentation_m: &Vector3<f64>,
     ) -> (Vector3<f64>, Matrix3<f64>) {
+        let edge_n = self.range_force_n(patch);
+        self.press_within(patch, indentation_m, edge_n)
+    }
+
+    /// [`Self::patch_press`] with the patch's range edge `edge_n` (N) known: each secant
+    /// iterate's force sets the positions' levels up to the edge ([`Self::level_force_n`]).
+    fn press_within(
+        &self,
+        patch: &mut Patch,
+        indentation_m: &Vector3<f64>,
+        edge_n: f64,
+    ) -> (Vector3<f64>, Matrix3<f64>) {
         let solve = |c: Matrix3<f64>| {
             let stiffness = c.try_inverse().unwrap_or_else(Matrix3::zeros);
             (stiffness * indentation_m, stiffness)
@@ -548,9 +560,9 @@ impl Vademecum {
             return solve(self.linear_compliance(patch));
         }
         patch.reset_columns(self.steps.len());
-        let mut press = solve(self.column_compliance(patch, &Vector3::zeros()));
+        let mut press = solve(self.column_compliance(patch, 0.0));
         for _ in 0..SECANT_ITERATIONS {
-            let next = solve(self.column_compliance(patch, &press.0));
+            let next = solve(self.column_compliance(patch, press.0.norm().min(edge_n)));
             let settled = (next.0 - press.0).norm() <= SECANT_TOLERANCE * next.0.norm();
             press = next;
             if settled {
@@ -572,8 +584,8 @@ impl Vademecum {
         patch: &mut Patch,
         indentation_m: &Vector3<f64>,
     ) -> (Vector3<f64>, Matrix3<f64>, f64) {
-        let (force_n, stiffness) = self.patch_press(patch, indentation_m);
         let edge_n = self.range_force_n(patch);
+        let (force_n, stiffness) = self.press_within(patch, indentation_m, edge_n);
         let beyond = match force_n.norm() {
             f if f > edge_n => 1.0 - edge_n / f,
             _ => 0.0,
@@ -605,10 +617,10 @@ impl Vademecum {
     }
 
     /// [`Self::compliance`] from the patch's step columns, filling the linear step's and those
-    /// of the steps its positions reach under `force_n`.
-    fn column_compliance(&self, patch: &mut Patch, force_n: &Vector3<f64>) -> Matrix3<f64> {
-        let force_norm_n = self.level_force_n(&patch.shares, force_n);
-        let blend = |j: usize| self.blend(self.level_m(j, force_norm_n));
+    /// of the steps its positions reach under a force whose magnitude, as
+    /// [`Self::level_force_n`] gives it, is `level_force_n`.
+    fn column_compliance(&self, patch: &mut Patch, level_force_n: f64) -> Matrix3<f64> {
+        let blend = |j: usize| self.blend(self.level_m(j, level_force_n));
         patch.fill_columns(0, &self.steps[0].local);
         for slot in 0..patch.shares.len() {
             let (first, last, _) = blend(patch.shares[slot].0);

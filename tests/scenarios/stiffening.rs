@@ -150,7 +150,6 @@ range edge {:.2} mm; slopes (N/m) exponential {stiffening:?}, linear {linear:?}"
         "secant beyond the range: at most {:.2} % off the edge's",
         drift * 100.0
     );
-
     // A force held at the edge's would fall 18 % below it by the press's end.
     assert!(
         drift < 0.03,
