@@ -4,6 +4,7 @@
 mod bad_input;
 mod beams;
 mod cantilever;
+mod cavity;
 mod fit;
 mod hyperelastic;
 mod inclusion;
