@@ -3,7 +3,6 @@
 //! sparse assembly, loads, mass, static solvers, and indentation by a rigid sphere. Plain Rust on faer and nalgebra, no Bevy: the offline PGD builder and
 //! every validation stand on it.
 
-mod cavity;
 mod dofs;
 mod element;
 mod error;
@@ -20,7 +19,6 @@ mod pattern;
 mod tangent_solver;
 mod volumetric;
 
-pub use cavity::{BILE_BULK_MODULUS_PA, Cavity, RankOne};
 pub use dofs::{Dirichlet, DofMap, PRESCRIBED};
 pub use element::{ElementMatrix, ElementTissue, ElementVector, TetGeometry};
 pub use error::FemError;
@@ -31,7 +29,7 @@ pub use linear_solver::{DirectSolver, Factorization};
 pub use loads::{Loads, PatchKernel, on_pressed_side, patch_weight};
 pub use mass::{consistent_mass, lumped_mass};
 pub use material::{DEFAULT_STIFFENING, Law, Material, TISSUE_DENSITY_KG_M3};
-pub use model::{FemModel, Stiffness};
+pub use model::FemModel;
 pub use newton::{NewtonSettings, StaticSolution, StepReport};
 pub use pattern::FreePattern;
-pub use tangent_solver::{KrylovStatistics, Tangent, TangentSolver};
+pub use tangent_solver::{KrylovStatistics, TangentSolver};

@@ -3,7 +3,6 @@
 
 use nalgebra::{SMatrix, SymmetricEigen, Vector3};
 
-use super::cavity::{Cavity, RankOne};
 use super::element::{ElementTissue, ElementVector, TetGeometry, gather, j_minus_one};
 use super::inclusion::{Inclusion, modulus_scale};
 use super::pattern::FreePattern;
@@ -14,14 +13,6 @@ use crate::mesh::TetMesh;
 /// Rigid-mode ranks are read off a normalized 6×6 Gram matrix; eigenvalues below this
 /// fraction of the largest count as zero.
 const RANK_TOLERANCE: f64 = 1e-9;
-
-/// A stiffness over free dofs: a sparse part, and a cavity's rank-one part.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Stiffness {
-    /// Values of the model's [`FreePattern`].
-    pub values: Vec<f64>,
-    pub rank_one: Option<RankOne>,
-}
 
 pub struct FemModel {
     mesh: TetMesh,
@@ -34,8 +25,6 @@ pub struct FemModel {
     /// The neo-Hookean volumetric energy on nodal volumes (see `volumetric.rs`); `None` for
     /// the other laws, whose elements carry all their energy.
     volumetric: Option<NodalVolumes>,
-    /// A closed cavity of fluid inside the body (the gallbladder's bile), if any.
-    cavity: Option<Cavity>,
     dirichlet: Dirichlet,
     dofs: DofMap,
     pattern: FreePattern,
@@ -86,7 +75,6 @@ impl FemModel {
         Ok(Self {
             modulus_scale,
             volumetric,
-            cavity: None,
             inclusions: Vec::new(),
             mesh,
             geometry,
@@ -112,17 +100,6 @@ impl FemModel {
         );
         self.inclusions = inclusions.to_vec();
         Ok(self)
-    }
-
-    /// The model with a cavity of fluid inside it (replacing any it had): its force joins
-    /// the internal force, and its tangent's rank-one part every solve (see `cavity.rs`).
-    pub fn with_cavity(mut self, cavity: Cavity) -> Self {
-        self.cavity = Some(cavity);
-        self
-    }
-
-    pub fn cavity(&self) -> Option<&Cavity> {
-        self.cavity.as_ref()
     }
 
     pub fn material(&self) -> &Material {
@@ -183,15 +160,7 @@ impl FemModel {
         if let Some(volumetric) = &self.volumetric {
             volumetric.add_force(&self.mesh, &self.geometry, u_m, &mut force);
         }
-        if let Some(cavity) = &self.cavity {
-            cavity.add_force(&self.mesh, u_m, self.is_linear(), &mut force);
-        }
         force
-    }
-
-    /// Whether the model is linear throughout: the linear law, and any cavity linearized.
-    fn is_linear(&self) -> bool {
-        self.material.law == Law::Linear
     }
 
     /// Whether the full displacement `u_m` turns an element inside out (J ≤ 0): not a state
@@ -205,14 +174,8 @@ impl FemModel {
     /// The nonlinear part of the internal force (N) on every dof, `f_int(u) − K₀ u` with `K₀`
     /// the rest stiffness: zero for the linear law. Adds into `out` (length: all dofs).
     pub fn add_nonlinear_force(&self, u_m: &[f64], out: &mut [f64]) {
-        if self.is_linear() {
+        if self.material.law == Law::Linear {
             return;
-        }
-        if let Some(cavity) = &self.cavity {
-            cavity.add_force(&self.mesh, u_m, false, out);
-            let mut linear = vec![0.0; out.len()];
-            cavity.add_force(&self.mesh, u_m, true, &mut linear);
-            out.iter_mut().zip(&linear).for_each(|(o, l)| *o -= l);
         }
         if let Some(volumetric) = &self.volumetric {
             let tissue = |t| self.element_tissue(t);
@@ -225,9 +188,9 @@ impl FemModel {
         }
     }
 
-    /// Internal force on every dof, and the tangent stiffness over free dofs (its sparse part
-    /// as values of [`Self::pattern`]), both at the full displacement `u_m`.
-    pub fn force_and_tangent(&self, u_m: &[f64]) -> (Vec<f64>, Stiffness) {
+    /// Internal force on every dof, and the tangent stiffness over free dofs as values of
+    /// [`Self::pattern`], both at the full displacement `u_m`.
+    pub fn force_and_tangent(&self, u_m: &[f64]) -> (Vec<f64>, Vec<f64>) {
         let mut force = vec![0.0; u_m.len()];
         let mut values = self.pattern.zero_values();
         for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
@@ -244,32 +207,11 @@ impl FemModel {
                 &mut values,
             );
         }
-        let rank_one = self.cavity.as_ref().map(|cavity| {
-            let (pattern, dofs) = (&self.pattern, &self.dofs);
-            let linear = self.is_linear();
-            cavity.add_force_and_tangent(
-                &self.mesh,
-                (pattern, dofs),
-                u_m,
-                linear,
-                (&mut force, &mut values),
-            )
-        });
-        (force, Stiffness { values, rank_one })
+        (force, values)
     }
 
-    /// The stiffness at rest (free dofs), the linear-elastic one for every law: its sparse
-    /// part, as values of [`Self::pattern`]; a cavity adds [`Self::rest_rank_one`] to it.
+    /// The stiffness at rest (free dofs): the linear-elastic stiffness for both laws.
     pub fn rest_stiffness(&self) -> Vec<f64> {
-        self.rest().values
-    }
-
-    /// The rank-one part of the rest stiffness: the cavity's, `κ/V₀ g₀ g₀ᵀ`.
-    pub fn rest_rank_one(&self) -> Option<RankOne> {
-        self.rest().rank_one
-    }
-
-    fn rest(&self) -> Stiffness {
         self.force_and_tangent(&vec![0.0; 3 * self.mesh.node_count()])
             .1
     }

@@ -6,7 +6,7 @@
 //! step briefly raises the stiff axial residuals, and a norm-based search would keep cutting
 //! it, stalling far from equilibrium.
 
-use super::tangent_solver::{Tangent, TangentSolver};
+use super::tangent_solver::TangentSolver;
 use super::{FemError, FemModel, Loads};
 use crate::dense_sums::dot;
 
@@ -206,8 +206,8 @@ impl FemModel {
             step_lengths: Vec::new(),
         };
         for iteration in 0..=settings.max_iterations {
-            let (mut f_int, mut stiffness) = self.force_and_tangent(u);
-            extra.add(self, u, &mut f_int, Some(&mut stiffness.values));
+            let (mut f_int, mut tangent) = self.force_and_tangent(u);
+            extra.add(self, u, &mut f_int, Some(&mut tangent));
             let (residual, relative) = self.residual(f_ext, &f_int);
             report.relative_residuals.push(relative);
             if !relative.is_finite() {
@@ -225,11 +225,7 @@ impl FemModel {
             }
             let mut du = residual.clone();
             let forcing = relative.sqrt().min(MAX_FORCING);
-            let tangent = Tangent {
-                sparse: &self.pattern().matrix(stiffness.values),
-                rank_one: stiffness.rank_one.as_ref(),
-            };
-            solver.solve(tangent, &mut du, forcing)?;
+            solver.solve(&self.pattern().matrix(tangent), &mut du, forcing)?;
             let length = self.line_search(u, &du, (f_ext, extra), &residual, settings);
             report.step_lengths.push(length);
         }

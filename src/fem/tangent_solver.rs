@@ -18,13 +18,11 @@ use faer::matrix_free::conjugate_gradient::{
     CgError, CgParams, conjugate_gradient, conjugate_gradient_scratch,
 };
 use faer::matrix_free::{InitialGuessStatus, LinOp, Precond};
-use faer::reborrow::ReborrowMut;
 use faer::sparse::SparseColMat;
 use faer::{MatMut, MatRef, Par};
 use serde::Serialize;
 
 use super::FemError;
-use super::cavity::RankOne;
 use super::linear_solver::{DirectSolver, Factorization};
 use super::pattern::FreePattern;
 
@@ -128,13 +126,13 @@ impl<'a> TangentSolver<'a> {
     /// `forcing` relative to `rhs`.
     pub(super) fn solve(
         &mut self,
-        tangent: Tangent<'_>,
+        tangent: &SparseColMat<usize, f64>,
         rhs: &mut [f64],
         forcing: f64,
     ) -> Result<(), FemError> {
         match self {
             Self::Direct(solver) => {
-                tangent.factorize(solver)?.solve_in_place(rhs);
+                solver.cholesky_or_lu(tangent)?.solve_in_place(rhs);
                 Ok(())
             }
             Self::Preconditioned(p) => p.solve(tangent, rhs, forcing),
@@ -142,61 +140,10 @@ impl<'a> TangentSolver<'a> {
     }
 }
 
-/// A tangent stiffness over free dofs: its sparse part, and the rank-one part of a fluid
-/// cavity where the body has one.
-#[derive(Clone, Copy, Debug)]
-pub struct Tangent<'a> {
-    pub sparse: &'a SparseColMat<usize, f64>,
-    pub rank_one: Option<&'a RankOne>,
-}
-
-impl Tangent<'_> {
-    fn factorize(&self, solver: &mut DirectSolver) -> Result<Factorization, FemError> {
-        let factor = solver.cholesky_or_lu(self.sparse)?;
-        Ok(match self.rank_one {
-            Some(rank_one) => factor.with_rank_one(rank_one.clone()),
-            None => factor,
-        })
-    }
-}
-
-impl LinOp<f64> for Tangent<'_> {
-    fn apply_scratch(&self, rhs_ncols: usize, par: Par) -> StackReq {
-        self.sparse.as_ref().apply_scratch(rhs_ncols, par)
-    }
-
-    fn nrows(&self) -> usize {
-        self.sparse.nrows()
-    }
-
-    fn ncols(&self) -> usize {
-        self.sparse.ncols()
-    }
-
-    fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, s: &mut MemStack) {
-        self.sparse.as_ref().apply(out.rb_mut(), rhs, par, s);
-        let Some(rank_one) = self.rank_one else {
-            return;
-        };
-        let v = &rank_one.vector;
-        for j in 0..rhs.ncols() {
-            let projection: f64 = v.iter().enumerate().map(|(i, vi)| vi * rhs[(i, j)]).sum();
-            for (i, vi) in v.iter().enumerate() {
-                out[(i, j)] += rank_one.coefficient * projection * vi;
-            }
-        }
-    }
-
-    /// Real matrices: the conjugate is the operator itself.
-    fn conj_apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, s: &mut MemStack) {
-        self.apply(out, rhs, par, s);
-    }
-}
-
 impl Preconditioned<'_> {
     fn solve(
         &mut self,
-        tangent: Tangent<'_>,
+        tangent: &SparseColMat<usize, f64>,
         rhs: &mut [f64],
         forcing: f64,
     ) -> Result<(), FemError> {
@@ -212,12 +159,16 @@ impl Preconditioned<'_> {
     }
 
     /// Solves with a factorization of `tangent`, where conjugate gradients did not converge.
-    fn factorized(&mut self, tangent: Tangent<'_>, rhs: &mut [f64]) -> Result<(), FemError> {
+    fn factorized(
+        &mut self,
+        tangent: &SparseColMat<usize, f64>,
+        rhs: &mut [f64],
+    ) -> Result<(), FemError> {
         let direct = match &mut self.direct {
             Some(direct) => direct,
             none => none.insert(DirectSolver::new(self.pattern)?),
         };
-        tangent.factorize(direct)?.solve_in_place(rhs);
+        direct.cholesky_or_lu(tangent)?.solve_in_place(rhs);
         self.statistics.factorizations += 1;
         Ok(())
     }
@@ -231,13 +182,18 @@ impl Preconditioned<'_> {
     /// when the very first direction has negative curvature, the preconditioned residual
     /// `M⁻¹ r` (the fixed point's own step). The line search sizes either; near equilibrium
     /// the tangent is positive definite again and Newton's full steps return.
-    fn conjugate_gradients(&self, tangent: Tangent<'_>, rhs: &mut [f64], forcing: f64) -> Outcome {
+    fn conjugate_gradients(
+        &self,
+        tangent: &SparseColMat<usize, f64>,
+        rhs: &mut [f64],
+        forcing: f64,
+    ) -> Outcome {
         let n = rhs.len();
         let precond = FactorPrecond {
             factor: self.preconditioner,
             dim: n,
         };
-        let matrix = tangent;
+        let matrix = tangent.as_ref();
         // The zero start is given as a start that may not be zero: faer 0.24's conjugate
         // gradients leave the first residual unset when told the start is zero.
         let params = CgParams {

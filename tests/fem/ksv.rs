@@ -33,9 +33,7 @@ pub fn tangent_error(model: &FemModel, size_m: f64) -> f64 {
     }
     let (_, tangent) = model.force_and_tangent(&u);
     let mut kv = vec![0.0; dofs.free_count()];
-    model
-        .pattern()
-        .mul(&tangent.values, &dofs.restrict(&v), &mut kv);
+    model.pattern().mul(&tangent, &dofs.restrict(&v), &mut kv);
     let h = 1e-7;
     let shifted = |sign: f64| -> Vec<f64> {
         let w: Vec<f64> = u.iter().zip(&v).map(|(a, b)| a + sign * h * b).collect();

@@ -4,7 +4,6 @@
 mod bad_input;
 mod beams;
 mod cantilever;
-mod cavity;
 mod fit;
 mod hyperelastic;
 mod inclusion;
