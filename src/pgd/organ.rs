@@ -1,5 +1,5 @@
 //! The mechanical model of each generated organ: its material and its clamped region, as in
-//! paper 000 (see `../shared/BRIEF.md`), ready for a vademecum build.
+//! paper 000, ready for a vademecum build.
 
 use crate::fem::{Dirichlet, FemError, FemModel, Law, Material, TISSUE_DENSITY_KG_M3};
 use crate::mesh::TetMesh;
