@@ -63,7 +63,7 @@ pub fn print_build_report(report: &BuildReport, out: &Path) {
         report.free_dofs,
         100.0 * report.near_field_share
     );
-    let loaded = report.steps.get(1).map_or(0, |s| s.positions_reached);
+    let loaded = report.positions_loaded;
     for (k, step) in report.steps.iter().enumerate() {
         let n = step.modes_kept;
         let pgd_error = step.curve.separated.last().copied().unwrap_or(f64::NAN);
@@ -162,11 +162,10 @@ fn print_newton_baseline(baseline: &pgd::NewtonBaseline, build_seconds: f64) {
     );
 }
 
-/// How many of the `loaded` positions (all but those a clamp holds, the first nonlinear
-/// step's) reach `step`.
+/// How many of the `loaded` positions (all but those a clamp holds) reach `step`.
 fn print_reached(step: &pgd::StepReport, loaded: usize) {
     if loaded == 0 {
-        return; // the first nonlinear step was left out: it reached too few to count
+        return; // a linear vademecum: no step presses any position
     }
     println!(
         "  range: {} of the {} loaded positions reach this step ({:.0} %)",

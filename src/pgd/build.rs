@@ -70,6 +70,9 @@ pub struct BuildReport {
     /// KSV load steps left out because their fixed point did not converge: the vademecum's
     /// valid range stops before them.
     pub failed_step: Option<StepReport>,
+    /// Nonlinear laws: the positions the load steps press (all but those a clamp holds);
+    /// what each step's `positions_reached` counts out of. Zero for the linear law.
+    pub positions_loaded: usize,
     /// The share of the organ's nodes in a load's near field, on average: near 1, every load
     /// keeps its exact response everywhere (a large file, few modes).
     pub near_field_share: f64,
@@ -197,6 +200,7 @@ pub fn build(
         failed: failed_step,
         reference,
         range_level_m,
+        loaded,
     } = load_steps(&context)?;
     let near_field_share = steps[0].local.correction_nodes.len() as f64
         / (patches.positions.len() * mesh.node_count()) as f64;
@@ -245,6 +249,7 @@ pub fn build(
         free_dofs: stiffness.free_count(),
         steps: reports,
         failed_step,
+        positions_loaded: loaded,
         near_field_share,
         cuts: None,
         newton_baseline: None,
@@ -267,13 +272,14 @@ struct StepContext<'a> {
 
 /// The steps built, their reports, the report of a step left out, and per position the
 /// reference compliance that turns a force into the level picking load steps and the level
-/// its range reaches.
+/// its range reaches, and how many positions the nonlinear steps load.
 struct LoadSteps {
     steps: Vec<Step>,
     reports: Vec<StepReport>,
     failed: Option<StepReport>,
     reference: Vec<f32>,
     range_level_m: Vec<f32>,
+    loaded: usize,
 }
 
 /// The linear step, then (nonlinear laws) one step per indentation level until the last or
@@ -303,6 +309,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
             failed: None,
             range_level_m: vec![0.0; reference.len()],
             reference,
+            loaded: 0,
         });
     }
     let tool = ToolPatchLoads::new(
@@ -370,8 +377,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         ));
         let secant_settings = &context.settings.secant;
         let reached = reached_positions(&magnitudes, &unconverged, &fixed_point, secant_settings);
-        let first = steps.len() == 1;
-        if !kept(reached.len(), (loaded, first), secant_settings) {
+        if !kept(reached.len(), loaded, secant_settings) {
             progress.message(&format!(
                 "{law} step {:.1} mm: the fixed point did not converge for {} of {} loads; \
                  the vademecum stops at the step before",
@@ -392,6 +398,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
                 failed: Some(failed),
                 reference,
                 range_level_m,
+                loaded,
             });
         }
         reached
@@ -422,6 +429,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         failed: None,
         reference,
         range_level_m,
+        loaded,
     })
 }
 
@@ -442,14 +450,11 @@ fn reached_positions(
 }
 
 /// Whether a nonlinear step that reaches `reached` of the `loaded` positions (those no
-/// clamp holds) is kept. The `first` nonlinear step must reach them all (but the tolerated
-/// failures): a position it leaves would have no range at all. A deeper one is kept while
-/// it reaches [`SecantSettings::min_reached_share`] of them.
-fn kept(reached: usize, (loaded, first): (usize, bool), settings: &SecantSettings) -> bool {
-    match first {
-        true => reached == loaded,
-        false => reached as f64 >= settings.min_reached_share * loaded as f64,
-    }
+/// clamp holds) is kept: while it reaches [`SecantSettings::min_reached_share`] of them.
+/// A position the first nonlinear step leaves has no range: a patch of such positions alone
+/// answers linearly, and the trainer says it is beyond the range.
+fn kept(reached: usize, loaded: usize, settings: &SecantSettings) -> bool {
+    reached as f64 >= settings.min_reached_share * loaded as f64
 }
 
 /// Per position, how deep (m) a unit force along its inward normal presses the patch centred

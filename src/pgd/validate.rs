@@ -174,13 +174,13 @@ pub fn validate(
     );
     let mut samples = Vec::with_capacity(settings.samples);
     for _ in 0..settings.samples {
-        let at = random_point(&mut rng, &areas, total_area);
+        let at = point_in_range(&mut rng, (&areas, total_area), vademecum)?;
         samples.push(sample(model, vademecum, &kernel, &at, &mut rng, settings)?);
         progress.advance(1);
     }
     let mut curves = Vec::with_capacity(settings.curves);
     for _ in 0..settings.curves {
-        let at = random_point(&mut rng, &areas, total_area);
+        let at = point_in_range(&mut rng, (&areas, total_area), vademecum)?;
         curves.push(force_depth_curve(model, vademecum, &kernel, &at, settings)?);
         progress.advance(1);
     }
@@ -211,6 +211,30 @@ pub fn force_depth_curve_at(
         vademecum.header.settings.tool_tip_radius_m,
     )?;
     force_depth_curve(model, vademecum, &kernel, at, settings)
+}
+
+/// Draws of [`point_in_range`] before it gives up.
+const MAX_DRAWS: usize = 10_000;
+
+/// A uniformly distributed point of the accessible surface where the vademecum's range is not
+/// empty (every point of a linear one): a patch of positions the first nonlinear step did not
+/// reach answers linearly from the start, and there is no nonlinear answer there to check.
+fn point_in_range(
+    rng: &mut fastrand::Rng,
+    (areas, total): (&[f64], f64),
+    vademecum: &Vademecum,
+) -> Result<SurfacePoint, FemError> {
+    for _ in 0..MAX_DRAWS {
+        let at = random_point(rng, areas, total);
+        if vademecum.range_force_n(&vademecum.patch(&at)) > 0.0 {
+            return Ok(at);
+        }
+    }
+    Err(FemError::InvalidInput {
+        what: "vademecum: surface points drawn with a range",
+        value: 0.0,
+        problem: "none; its first nonlinear step reached no position under them",
+    })
 }
 
 /// A uniformly distributed point of the accessible surface.

@@ -322,7 +322,8 @@ fn a_position_whose_load_fails_ends_its_range_alone() {
     assert!(report.failed_step.is_none(), "{:?}", report.failed_step);
     assert_eq!(vademecum.valid_indentation_m(), 2e-3);
     let deepest = report.steps.last().unwrap();
-    let loaded = report.steps[1].positions_reached;
+    let loaded = report.positions_loaded;
+    assert_eq!(report.steps[1].positions_reached, loaded);
     let short: Vec<usize> = (0..vademecum.positions.len())
         .filter(|&m| vademecum.range_level_m[m] < 2e-3_f32)
         .collect();
@@ -362,6 +363,68 @@ fn a_position_whose_load_fails_ends_its_range_alone() {
         held_sooner += usize::from(holds_short);
     }
     assert!(held_sooner > 0);
+}
+
+/// A first nonlinear step whose load fails at some positions is kept for the others: the KSV
+/// block pressed straight to 2 mm leaves a few loads no solve reaches. Those positions have no
+/// range at all: a patch that holds one is held sooner than with every range at 2 mm, and a
+/// patch of such positions alone (none here; made by clearing every range) answers linearly,
+/// its range edge at zero force and the whole press beyond it. Before, such a step was left
+/// out, and with it the whole nonlinear law.
+#[test]
+fn a_position_whose_first_load_fails_has_no_range() {
+    let model = block_model_of(block_mesh([6, 4, 3]), Law::KirchhoffSaintVenant);
+    let (vademecum, report) = build(&organ(&model), &ksv_settings(vec![2e-3]), &Silent).unwrap();
+    assert!(report.failed_step.is_none(), "{:?}", report.failed_step);
+    assert_eq!(vademecum.steps.len(), 2);
+    let loaded = report.positions_loaded;
+    let unranged: Vec<usize> = (0..vademecum.positions.len())
+        .filter(|&m| vademecum.reference_compliance_m_per_n[m] > 0.0)
+        .filter(|&m| vademecum.range_level_m[m] == 0.0)
+        .collect();
+    assert!(!unranged.is_empty(), "every load converged at 2 mm");
+    assert_eq!(report.steps[1].positions_reached + unranged.len(), loaded);
+
+    let mut everywhere = vademecum.clone();
+    everywhere.range_level_m.fill(2e-3);
+    // A patch of positions none of whose loads converged, as where a clamp squeezes them all.
+    let mut nowhere = vademecum.clone();
+    nowhere.range_level_m.fill(0.0);
+    for m in unranged {
+        let at = at_position(&vademecum, m);
+        let mut patch = vademecum.patch(&at);
+        let edge_n = vademecum.range_force_n(&patch);
+        assert!(
+            edge_n > 0.0 && edge_n < everywhere.range_force_n(&patch),
+            "{at:?}"
+        );
+
+        assert_eq!(nowhere.range_force_n(&patch), 0.0);
+        let inward = -vademecum.triangle_facing(at.triangle).normalize() * 1e-3;
+        let (force, _, beyond) = nowhere.patch_press_in_range(&mut patch, &inward);
+        let linear = vademecum.step_compliance(0, &patch).try_inverse().unwrap() * inward;
+        assert!((force - linear).norm() < 1e-12 * linear.norm(), "{at:?}");
+        assert_eq!(beyond, 1.0);
+    }
+}
+
+/// The tool centred on position `m`, at a corner of an accessible triangle.
+fn at_position(vademecum: &Vademecum, m: usize) -> SurfacePoint {
+    let (triangle, corner) = vademecum
+        .triangles
+        .iter()
+        .enumerate()
+        .find_map(|(t, corners)| {
+            let corner = corners.iter().position(|&c| c as usize == m)?;
+            Some((t, corner))
+        })
+        .expect("a loaded position is a corner of an accessible triangle");
+    let mut barycentric = [0.0; 3];
+    barycentric[corner] = 1.0;
+    SurfacePoint {
+        triangle,
+        barycentric,
+    }
 }
 
 /// Pressed along the patch's inward facing at `at` 1.05 and 1.5 times as deep as its range
