@@ -231,9 +231,9 @@ fn point_in_range(
         }
     }
     Err(FemError::InvalidInput {
-        what: "vademecum: surface points drawn with a range",
+        what: "vademecum: surface points in its nonlinear range among those drawn",
         value: 0.0,
-        problem: "none; its first nonlinear step reached no position under them",
+        problem: "too few to validate; its first nonlinear step reached almost no position",
     })
 }
 
