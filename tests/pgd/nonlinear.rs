@@ -335,16 +335,8 @@ fn a_position_whose_load_fails_ends_its_range_alone() {
     let mut everywhere = vademecum.clone();
     everywhere.range_level_m.fill(2e-3);
     // The tool at each corner of the accessible triangles.
-    let corners = (0..vademecum.triangles.len()).flat_map(|triangle| {
-        (0..3).map(move |corner| {
-            let mut barycentric = [0.0; 3];
-            barycentric[corner] = 1.0;
-            SurfacePoint {
-                triangle,
-                barycentric,
-            }
-        })
-    });
+    let corners = (0..vademecum.triangles.len())
+        .flat_map(|triangle| (0..3).map(move |corner| at_corner(triangle, corner)));
     let mut held_sooner = 0;
     for at in corners {
         let patch = vademecum.patch(&at);
@@ -419,6 +411,11 @@ fn at_position(vademecum: &Vademecum, m: usize) -> SurfacePoint {
             Some((t, corner))
         })
         .expect("a loaded position is a corner of an accessible triangle");
+    at_corner(triangle, corner)
+}
+
+/// The tool centred on corner `corner` (0–2) of accessible triangle `triangle`.
+fn at_corner(triangle: usize, corner: usize) -> SurfacePoint {
     let mut barycentric = [0.0; 3];
     barycentric[corner] = 1.0;
     SurfacePoint {
