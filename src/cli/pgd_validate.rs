@@ -68,8 +68,8 @@ pub fn print_validation(report: &ValidationReport) {
             .fold(f64::INFINITY, f64::min);
         println!(
             "  the load steps answer the tool's linear depth to {:.1} mm at these points (p50; \
-             {:.1} mm at the least, {:.1} mm at the most); deeper, the tissue stiffens no more \
-             (the trainer extrapolates at the edge's secant stiffness)",
+             {:.1} mm at the least, {:.1} mm at the most); deeper, the felt force is \
+             extrapolated from the last load-step interval (--beyond-range measures it)",
             edge.p50 * 1e3,
             least_m * 1e3,
             edge.max * 1e3

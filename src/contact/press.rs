@@ -45,17 +45,27 @@ pub struct ToolContact {
     /// How far the tip reaches below the rest surface, along the normal (m).
     pub depth_m: f64,
     /// How much of that depth lies beyond what the vademecum's load steps cover (m); zero
-    /// within the range. The tissue stops stiffening there, its force growing on at the
-    /// range edge's secant stiffness ([`Vademecum::patch_press_in_range`]), and the run's
-    /// report says so.
+    /// within the range. The organ answers at the range edge's secant stiffness there, what
+    /// the trainee feels at the stiffness of its last load-step interval
+    /// ([`Vademecum::patch_press_in_range`]), and the run's report says so.
     pub beyond_range_m: f64,
     /// The displacement the tool's load adds to the surface under it (m): into the surface by
     /// the depth, and back sideways by what the other loads moved it.
     pub indentation_m: Vector3<f64>,
     /// How the force changes with the indentation (N/m): the inverse of the patch compliance.
     pub stiffness_n_per_m: Matrix3<f64>,
-    /// The force on the organ (N); the device renders its opposite.
+    /// The force on the organ (N): its load.
     pub force_n: Vector3<f64>,
+    /// What the tissue's stiffening beyond its range adds to the force felt (N; zero within
+    /// the range): the device renders the opposite of [`Self::felt_n`].
+    pub stiffening_n: Vector3<f64>,
+}
+
+impl ToolContact {
+    /// The force whose opposite the device renders (N).
+    pub fn felt_n(&self) -> Vector3<f64> {
+        self.force_n + self.stiffening_n
+    }
 }
 
 /// What the tool presses: an organ's vademecum, its contact surface, how far each load
@@ -93,14 +103,14 @@ where
         load.release();
         return None;
     };
-    let (force_n, stiffness_n_per_m, beyond) =
-        vademecum.patch_press_in_range(patch, &contact.indentation_m);
+    let press = vademecum.patch_press_in_range(patch, &contact.indentation_m);
     load.shares.clone_from(&patch.shares);
-    load.force_n = force_n;
+    load.force_n = press.force_n;
     Some(ToolContact {
-        force_n,
-        stiffness_n_per_m,
-        beyond_range_m: contact.depth_m * beyond,
+        force_n: press.force_n,
+        stiffening_n: press.felt_n - press.force_n,
+        stiffness_n_per_m: press.stiffness_n_per_m,
+        beyond_range_m: contact.depth_m * press.beyond,
         ..contact
     })
 }
@@ -162,6 +172,7 @@ where
         indentation_m: -hit.normal * depth_m - sideways_m,
         stiffness_n_per_m: Matrix3::zeros(),
         force_n: Vector3::zeros(),
+        stiffening_n: Vector3::zeros(),
     })
 }
 

@@ -45,7 +45,9 @@ pub use settings::{
 pub use statistics::Statistics;
 pub use stiffness::RestStiffness;
 pub use surface_modes::SurfaceModes;
-pub use vademecum::{Header, MAX_STEPS, Patch, Step, StepLoads, SurfacePoint, Vademecum};
+pub use vademecum::{
+    Header, MAX_STEPS, Patch, RangePress, Step, StepLoads, SurfacePoint, Vademecum,
+};
 pub use validate::{
     ForceDepthCurve, Sample, ValidationReport, ValidationSettings, force_depth_curve_at, validate,
 };

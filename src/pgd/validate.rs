@@ -37,6 +37,11 @@ pub struct ValidationSettings {
     /// Force levels per curve, up to the deepest indentation of the range (linear), or the
     /// vademecum's range at the curve's point if shallower.
     pub curve_levels: usize,
+    /// Press beyond the vademecum's range instead: each load's linear depth drawn between
+    /// its point's range edge and the deepest indentation (at points whose edge lies
+    /// shallower), the curves drawn to the deepest indentation. What the trainer
+    /// extrapolates past its load steps is measured so.
+    pub beyond_range: bool,
 }
 
 impl Default for ValidationSettings {
@@ -62,6 +67,7 @@ impl ValidationSettings {
             newton_load_steps: 4,
             curves: 2,
             curve_levels: 8,
+            beyond_range: false,
         }
     }
 
@@ -126,6 +132,9 @@ pub struct ForceDepthCurve {
     pub point_m: [f64; 3],
     /// Full FEM's indentation under the tool along the press (m), per force level.
     pub depth_m: Vec<f64>,
+    /// Full FEM's whole displacement under the tool (m), per force level: the indentation
+    /// the vademecum answers (sideways too).
+    pub indentation_m: Vec<[f64; 3]>,
     pub fem_force_n: Vec<f64>,
     /// The vademecum's force along the press (N) for full FEM's indentation.
     pub vademecum_force_n: Vec<f64>,
@@ -173,14 +182,16 @@ pub fn validate(
         (settings.samples + settings.curves) as u64,
     );
     let mut samples = Vec::with_capacity(settings.samples);
+    let drawn =
+        |rng: &mut fastrand::Rng| point_to_press(rng, (&areas, total_area), vademecum, settings);
     for _ in 0..settings.samples {
-        let at = point_in_range(&mut rng, (&areas, total_area), vademecum)?;
+        let at = drawn(&mut rng)?;
         samples.push(sample(model, vademecum, &kernel, &at, &mut rng, settings)?);
         progress.advance(1);
     }
     let mut curves = Vec::with_capacity(settings.curves);
     for _ in 0..settings.curves {
-        let at = point_in_range(&mut rng, (&areas, total_area), vademecum)?;
+        let at = drawn(&mut rng)?;
         curves.push(force_depth_curve(model, vademecum, &kernel, &at, settings)?);
         progress.advance(1);
     }
@@ -213,27 +224,49 @@ pub fn force_depth_curve_at(
     force_depth_curve(model, vademecum, &kernel, at, settings)
 }
 
-/// Draws of [`point_in_range`] before it gives up.
+/// Draws of [`point_to_press`] before it gives up.
 const MAX_DRAWS: usize = 10_000;
 
 /// A uniformly distributed point of the accessible surface where the vademecum's range is not
 /// empty (every point of a linear one): a patch of positions the first nonlinear step did not
 /// reach answers linearly from the start, and there is no nonlinear answer there to check.
-fn point_in_range(
+/// Pressing beyond the range, the range's edge along the inward normal must also lie
+/// shallower than the deepest indentation.
+fn point_to_press(
     rng: &mut fastrand::Rng,
     (areas, total): (&[f64], f64),
     vademecum: &Vademecum,
+    settings: &ValidationSettings,
 ) -> Result<SurfacePoint, FemError> {
+    let deepest_m = settings.indentation_range_m.1;
+    let pressable = |at: &SurfacePoint| {
+        let edge_n = vademecum.range_force_n(&vademecum.patch(at));
+        edge_n > 0.0
+            && (!settings.beyond_range || {
+                let inward = -vademecum.triangle_facing(at.triangle).normalize();
+                range_edge_m(vademecum, at, &inward) < deepest_m
+            })
+    };
     for _ in 0..MAX_DRAWS {
         let at = random_point(rng, areas, total);
-        if vademecum.range_force_n(&vademecum.patch(&at)) > 0.0 {
+        if pressable(&at) {
             return Ok(at);
         }
     }
+    let (what, problem) = match settings.beyond_range {
+        false => (
+            "vademecum: surface points in its nonlinear range among those drawn",
+            "too few to validate; its first nonlinear step reached almost no position",
+        ),
+        true => (
+            "vademecum: surface points whose range ends shallower than the deepest indentation",
+            "too few to press beyond the range; ask for a deeper indentation",
+        ),
+    };
     Err(FemError::InvalidInput {
-        what: "vademecum: surface points in its nonlinear range among those drawn",
+        what,
         value: 0.0,
-        problem: "too few to validate; its first nonlinear step reached almost no position",
+        problem,
     })
 }
 
@@ -290,9 +323,9 @@ fn linear_compliance(vademecum: &Vademecum, at: &SurfacePoint, direction: &Vecto
 }
 
 /// The deepest linear indentation (m) along `direction` at `at` that the vademecum answers,
-/// `wanted_m` or its range's edge there if shallower: beyond it the tissue stiffens no more
-/// (the trainer extrapolates at the edge's secant stiffness), so that is not what the
-/// validation measures.
+/// `wanted_m` or its range's edge there if shallower: beyond it the felt force is
+/// extrapolated from the last load-step interval, which the validation measures only when
+/// asked to ([`ValidationSettings::beyond_range`]).
 fn within_range_m(
     vademecum: &Vademecum,
     at: &SurfacePoint,
@@ -300,6 +333,24 @@ fn within_range_m(
     wanted_m: f64,
 ) -> f64 {
     wanted_m.min(range_edge_m(vademecum, at, direction))
+}
+
+/// The shallowest and deepest linear indentations (m) along `direction` at `at` that
+/// `settings` press: within the range ([`within_range_m`]), or beyond it, from the range's
+/// edge there to the deepest indentation.
+fn indentations_m(
+    vademecum: &Vademecum,
+    at: &SurfacePoint,
+    direction: &Vector3<f64>,
+    settings: &ValidationSettings,
+) -> (f64, f64) {
+    let (shallowest_m, deepest_m) = settings.indentation_range_m;
+    if settings.beyond_range {
+        let edge_m = range_edge_m(vademecum, at, direction);
+        return (edge_m, deepest_m.max(edge_m));
+    }
+    let high = within_range_m(vademecum, at, direction, deepest_m);
+    (shallowest_m.min(high), high)
 }
 
 /// The linear indentation (m) along `direction` at `at` at the edge of the vademecum's range.
@@ -344,8 +395,7 @@ fn sample(
     let mesh = model.mesh();
     let (point, inward) = point_and_inward(mesh, vademecum, at);
     let direction = tilted_inward(rng, inward, settings);
-    let high = within_range_m(vademecum, at, &direction, settings.indentation_range_m.1);
-    let low = settings.indentation_range_m.0.min(high);
+    let (low, high) = indentations_m(vademecum, at, &direction, settings);
     let indentation_m = low + (high - low) * rng.f64();
     // The linear compliance along the direction sets the force for the wanted indentation.
     let force = linear_force(vademecum, at, &direction, indentation_m);
@@ -358,8 +408,10 @@ fn sample(
     let reference = model.solve_static(&loads, &newton)?.displacement_m;
     let under_tool = under_tool(&reference, &shares);
 
-    let rendered = vademecum.force_for_indentation(at, &under_tool);
-    let field = vademecum.field(at, &rendered);
+    let press = vademecum.patch_press_in_range(&mut vademecum.patch(at), &under_tool);
+    let rendered = press.felt_n;
+    // The field drawn follows the organ's load (beyond the range, the edge's secant answer).
+    let field = vademecum.field(at, &press.force_n);
     let near = |n: usize| (mesh.nodes()[n] - point).norm() <= settings.near_radius_m;
     let (along, across) = normal_and_across(&rendered, &force, &inward);
     Ok(Sample {
@@ -403,7 +455,7 @@ fn force_depth_curve(
 ) -> Result<ForceDepthCurve, FemError> {
     let mesh = model.mesh();
     let (point, inward) = point_and_inward(mesh, vademecum, at);
-    let deepest_m = within_range_m(vademecum, at, &inward, settings.indentation_range_m.1);
+    let deepest_m = indentations_m(vademecum, at, &inward, settings).1;
     let force = linear_force(vademecum, at, &inward, deepest_m);
     let facing = vademecum.triangle_facing(at.triangle);
     let (loads, shares) = patch_loads(mesh, kernel, (point, &facing), &force)?;
@@ -414,6 +466,7 @@ fn force_depth_curve(
     let mut curve = ForceDepthCurve {
         point_m: point.coords.into(),
         depth_m: Vec::new(),
+        indentation_m: Vec::new(),
         fem_force_n: Vec::new(),
         vademecum_force_n: Vec::new(),
         stopped: None,
@@ -422,6 +475,7 @@ fn force_depth_curve(
         let indentation = under_tool(displacement_m, &shares);
         let rendered = vademecum.force_for_indentation(at, &indentation);
         curve.depth_m.push(indentation.dot(&inward));
+        curve.indentation_m.push(indentation.into());
         curve.fem_force_n.push(factor * force.norm());
         curve.vademecum_force_n.push(rendered.dot(&inward));
     });

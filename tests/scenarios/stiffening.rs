@@ -1,9 +1,9 @@
 //! The trainer's felt force over a scripted 30 mm press into the coarse liver: under the
 //! exponential law it firms up as the tool goes deeper (the slope of force against depth
 //! grows from one stretch of the press to the next) until the press leaves the range its load
-//! steps answer; from there on it stiffens no more, its force growing on at the range edge's
-//! secant stiffness, and the report says how far beyond the tool went. Under the linear law,
-//! pressed the same way, the slope stays put.
+//! steps answer, and beyond it goes on at the stiffness of the last load-step interval, the
+//! report saying how far beyond the tool went. Under the linear law, pressed the same way, the
+//! slope stays put.
 
 use std::path::Path;
 
@@ -107,14 +107,12 @@ fn slopes(felt: &[(f64, f64)], edge_m: f64) -> [f64; 3] {
 /// depths its slope grows from stretch to stretch, by over 30 %
 /// from the first to the last, where the linear liver's slope changes by under 1 % over the
 /// same depths. Deeper, the report counts the ticks beyond the range, and the force grows on
-/// with each tick at the range edge's secant stiffness, under the last stretch's slope: its
-/// magnitude over the depth stays within 3 % of the edge's (2.8 % measured; held, it would
-/// fall 18 % below). The vademecum's own answer there is in exact proportion to the
-/// indentation (`tests/pgd/nonlinear.rs`); what drifts is the patch: the point under the tip
-/// slides across a triangle of the coarse mesh as the surface moves, and the patch's four
-/// positions' shares with it.
+/// with each tick, firming up still: its magnitude over the depth grows past the edge's by
+/// over 5 % by the press's end (11 % measured; at the edge's secant stiffness it stayed within
+/// 2.8 % of it), and its slope there is the last load-step interval's chord stiffness, no
+/// softer than the last stretch's slope within the range (85.5 against 78.3 N/m measured).
 #[test]
-fn a_30_mm_press_on_the_exponential_liver_firms_up_then_stiffens_no_more() {
+fn a_30_mm_press_on_the_exponential_liver_firms_up_beyond_its_range_too() {
     let (report, felt, magnitudes) = press_deep(&liver_scene("Exponential"));
     let (linear_report, linear_felt, _) = press_deep(&liver_scene("Linear"));
     assert!(felt.iter().all(|(_, f)| f.is_finite()));
@@ -141,23 +139,17 @@ range edge {:.2} mm; slopes (N/m) exponential {stiffening:?}, linear {linear:?}"
         .collect();
     assert!(beyond.windows(2).all(|w| w[1].1 > w[0].1), "{beyond:?}");
     let secant = |(depth_m, force_n): (f64, f64)| force_n / depth_m;
-    let edge = secant(beyond[0]);
-    let drift = beyond
-        .iter()
-        .map(|&point| (secant(point) / edge - 1.0).abs())
-        .fold(0.0, f64::max);
-    eprintln!(
-        "secant beyond the range: at most {:.2} % off the edge's",
-        drift * 100.0
-    );
-    // A force held at the edge's would fall 18 % below it by the press's end.
-    assert!(
-        drift < 0.03,
-        "{drift} off {edge} N/m at the edge: {beyond:?}"
-    );
+    let growth = secant(*beyond.last().unwrap()) / secant(beyond[0]) - 1.0;
     let beyond_slope = slope(&felt, (edge_m + 0.1e-3, DEPTH_M + 1e-3));
-    eprintln!("slope beyond the range {beyond_slope:.1} N/m");
-    assert!(beyond_slope < stiffening[2], "{beyond_slope} N/m beyond");
+    eprintln!(
+        "beyond the range: force over depth {:+.2} % from the edge's, slope {beyond_slope:.1} N/m",
+        growth * 100.0
+    );
+    assert!(growth > 0.05, "{growth}: {beyond:?}");
+    assert!(
+        beyond_slope >= stiffening[2],
+        "{beyond_slope} N/m beyond against {stiffening:?}"
+    );
 }
 
 /// The scored attempt says so too: pressed 30 mm into the exponential liver, its feedback

@@ -251,7 +251,7 @@ pub fn compute_force(
     let at_tip = grasp.0
         - touches
             .iter()
-            .filter_map(|t| t.contact.map(|c| c.force_n))
+            .filter_map(|t| t.contact.map(|c| c.felt_n()))
             .sum::<Vector3<f64>>();
     force.desired_n = match &tool.pose {
         Some(pose) => Fulcrum::hand_force(pose, &at_tip),

@@ -96,6 +96,11 @@ pub enum Command {
         /// (FILE.force-depth.png beside the vademecum).
         #[arg(long, default_value_t = ValidationSettings::default().curves)]
         curves: usize,
+        /// Press beyond the vademecum's range: each load between its point's range edge and
+        /// --max-indentation-mm, the curves to --max-indentation-mm, measuring what the
+        /// trainer extrapolates past the load steps (a nonlinear vademecum).
+        #[arg(long)]
+        beyond_range: bool,
         /// Check the cut section instead, on cut patterns drawn at random, each incision made
         /// in three segments: `radial:N` (the cornea), N radial incisions at random angles,
         /// optical zones of 3–5 mm and depths of 60–95 %, under 15 mmHg; `straight:N`, N

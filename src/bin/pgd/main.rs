@@ -88,6 +88,7 @@ fn main() -> ExitCode {
             max_indentation_mm,
             max_tilt_deg,
             curves,
+            beyond_range,
             cuts,
             exact_response,
             cut_patch_mm,
@@ -122,6 +123,7 @@ fn main() -> ExitCode {
                     seed: sample_seed,
                     curves,
                     max_tilt_deg,
+                    beyond_range,
                     ..defaults
                 };
                 match max_indentation_mm {
