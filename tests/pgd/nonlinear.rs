@@ -309,11 +309,12 @@ fn a_load_step_beyond_stability_is_left_out() {
 /// A position whose load fails at a step past the first ends its range at the step before,
 /// and the step is kept for the others: pushed along the normal, the KSV block's 1.5 and 2 mm
 /// steps leave a few loads that neither the fixed point nor Newton solves (KSV loses
-/// stability under compression; an equilibrium with an element inside out does not count). A press whose patch
-/// holds such a position is held sooner than with every range at 2 mm; one whose patch
-/// holds none is held where it was. Beyond its edge, a patch that holds one answers in
-/// proportion to the indentation, its other positions, whose ranges reach deeper, stiffening
-/// no more either.
+/// stability under compression; an equilibrium with an element inside out does not count).
+/// A press whose patch holds such a position is held sooner than with every range at 2 mm;
+/// one whose patch holds none is held where it was. Beyond its edge, a patch that holds one
+/// answers in proportion to the indentation, its other positions, whose ranges reach deeper,
+/// stiffening no more either: the KSV block gives way under the tool, so the felt force goes
+/// on at the edge's secant too.
 #[test]
 fn a_position_whose_load_fails_ends_its_range_alone() {
     let model = block_model_of(block_mesh([6, 4, 3]), Law::KirchhoffSaintVenant);
