@@ -26,6 +26,8 @@ pub struct SweepFigures {
     pub pressed: String,
     pub ticks: u64,
     pub contact_ticks: u64,
+    /// Ticks whose press went beyond a nonlinear vademecum's range (first run).
+    pub beyond_range_ticks: u64,
     /// Medians over the repeats of each run's quantiles (µs).
     pub compute_p50_us: f64,
     pub compute_p99_us: f64,
@@ -45,6 +47,8 @@ pub struct FemContact {
 #[derive(Clone, Debug, Serialize)]
 pub struct HapticBenchReport {
     pub organs: Vec<String>,
+    /// How deep the sweep presses each organ (mm).
+    pub depth_mm: f64,
     pub repeats: usize,
     pub sweeps: Vec<SweepFigures>,
     pub fem_contact: FemContact,
@@ -56,17 +60,19 @@ pub struct HapticBenchReport {
     pub realtime_seconds: f64,
 }
 
-/// Runs the benchmark on `scene` (the four organs), `repeats` times per sweep and
-/// `realtime_seconds` per timer.
+/// Runs the benchmark on `scene` (the four organs), each organ pressed as `motion` says,
+/// `repeats` times per sweep and `realtime_seconds` per timer.
 pub fn run(
     scene: &HapticScene,
+    motion: &PressMotion,
     repeats: usize,
     realtime_seconds: f64,
 ) -> Result<HapticBenchReport, FemError> {
     let targets = press_targets(scene);
-    let mut sweeps = vec![sweep(scene, "all", &targets, repeats)];
+    let mut sweeps = vec![sweep(scene, ("all", &targets), motion, repeats)];
     for ((name, _), target) in scene.organs.iter().zip(&targets) {
-        sweeps.push(sweep(scene, name, std::slice::from_ref(target), repeats));
+        let pressed = (name.as_str(), std::slice::from_ref(target));
+        sweeps.push(sweep(scene, pressed, motion, repeats));
     }
     let fem_contact = fem_contact(&targets[0], repeats, sweeps[0].compute_p50_us)?;
     let render_cpu_ms = render_cpu(scene, &targets, repeats);
@@ -76,10 +82,14 @@ pub fn run(
         (TimerMode::default(), Scheduling::RealTime),
     ]
     .into_iter()
-    .map(|(timer, scheduling)| realtime(scene, &targets, timer, scheduling, realtime_seconds))
+    .map(|(timer, scheduling)| {
+        let device = device(&targets, motion);
+        realtime(scene, device, (timer, scheduling), realtime_seconds)
+    })
     .collect();
     Ok(HapticBenchReport {
         organs: scene.organs.iter().map(|o| o.0.clone()).collect(),
+        depth_mm: motion.depth_m * 1e3,
         repeats,
         sweeps,
         fem_contact,
@@ -89,21 +99,22 @@ pub fn run(
     })
 }
 
-fn device(targets: &[PressTarget]) -> Box<dyn HapticDevice> {
-    let trajectory = press_and_slide(targets, &PressMotion::default());
+fn device(targets: &[PressTarget], motion: &PressMotion) -> Box<dyn HapticDevice> {
+    let trajectory = press_and_slide(targets, motion);
     Box::new(Scripted::new("benchmark sweep", trajectory))
 }
 
 fn sweep(
     scene: &HapticScene,
-    pressed: &str,
-    targets: &[PressTarget],
+    (pressed, targets): (&str, &[PressTarget]),
+    motion: &PressMotion,
     repeats: usize,
 ) -> SweepFigures {
-    let ticks = (press_and_slide(targets, &PressMotion::default()).duration_s() / TICK_S) as u64;
+    let ticks = (press_and_slide(targets, motion).duration_s() / TICK_S) as u64;
     let runs: Vec<_> = (0..repeats.max(1))
         .map(|_| {
-            let mut haptic = HapticLoop::new(scene, device(targets)).expect("scene was built");
+            let device = device(targets, motion);
+            let mut haptic = HapticLoop::new(scene, device).expect("scene was built");
             haptic.run_simulated(ticks)
         })
         .collect();
@@ -116,6 +127,7 @@ fn sweep(
         pressed: pressed.to_owned(),
         ticks,
         contact_ticks: runs[0].force.contact_ticks,
+        beyond_range_ticks: runs[0].range.beyond_ticks,
         compute_p50_us: median(&|t| t.p50_us),
         compute_p99_us: median(&|t| t.p99_us),
         compute_max_us: median(&|t| t.max_us),
@@ -173,16 +185,16 @@ fn render_cpu(scene: &HapticScene, targets: &[PressTarget], repeats: usize) -> f
         .p50_ms
 }
 
-/// The real-time loop for `seconds` with `timer`, while this thread does what a renderer does
-/// on the CPU each 60 Hz frame: read the latest snapshot and form every organ's surface.
+/// The real-time loop driven by `device` for `seconds` with `timer`, while this thread does
+/// what a renderer does on the CPU each 60 Hz frame: read the latest snapshot and form every
+/// organ's surface.
 fn realtime(
     scene: &HapticScene,
-    targets: &[PressTarget],
-    timer: TimerMode,
-    scheduling: Scheduling,
+    device: Box<dyn HapticDevice>,
+    (timer, scheduling): (TimerMode, Scheduling),
     seconds: f64,
 ) -> RealTimeReport {
-    let mut haptic = HapticLoop::new(scene, device(targets)).expect("scene was built");
+    let mut haptic = HapticLoop::new(scene, device).expect("scene was built");
     let mut snapshots = haptic.publish();
     let thread = HapticThread::spawn(haptic, timer, scheduling).expect("a thread can be spawned");
     let mut surfaces: Vec<(SurfaceModes, Vec<f64>)> = scene
@@ -213,22 +225,24 @@ impl fmt::Display for HapticBenchReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "haptic loop: {} (medians of {} runs)",
+            "haptic loop: {}, each pressed {} mm (medians of {} runs)",
             self.organs.join(", "),
+            self.depth_mm,
             self.repeats
         )?;
         writeln!(
             f,
-            "{:<14} {:>7} {:>8} {:>9} {:>9} {:>9}",
-            "pressed", "ticks", "contact", "p50 µs", "p99 µs", "max µs"
+            "{:<14} {:>7} {:>8} {:>8} {:>9} {:>9} {:>9}",
+            "pressed", "ticks", "contact", "beyond", "p50 µs", "p99 µs", "max µs"
         )?;
         for s in &self.sweeps {
             writeln!(
                 f,
-                "{:<14} {:>7} {:>8} {:>9.1} {:>9.1} {:>9.1}",
+                "{:<14} {:>7} {:>8} {:>8} {:>9.1} {:>9.1} {:>9.1}",
                 s.pressed,
                 s.ticks,
                 s.contact_ticks,
+                s.beyond_range_ticks,
                 s.compute_p50_us,
                 s.compute_p99_us,
                 s.compute_max_us

@@ -7,6 +7,7 @@ use clap::{Args, Parser, Subcommand};
 use pgd_surgery::contact::{CouplingSettings, PenaltySettings, PointshellDensity};
 use pgd_surgery::cutting::CutPattern;
 use pgd_surgery::cutting::keratotomy::REFERENCE_MESH;
+use pgd_surgery::devices::PressMotion;
 use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
 use pgd_surgery::mesh::TetMesh;
 use pgd_surgery::mesh::io::ImportOptions;
@@ -532,6 +533,10 @@ pub enum BenchTarget {
         /// The coarse organs and their 12 mm tool (vademecums that build in minutes).
         #[arg(long)]
         coarse: bool,
+        /// How deep the sweep presses each organ, in millimetres (deeper than a nonlinear
+        /// vademecum's range to time the presses beyond it).
+        #[arg(long, default_value_t = PressMotion::default().depth_m * 1e3)]
+        depth_mm: f64,
         /// Print the report as JSON instead of a table.
         #[arg(long)]
         json: bool,

@@ -13,6 +13,7 @@ use pgd_surgery::cli::{self, fail, print_json, print_report};
 use pgd_surgery::contact::CouplingSettings;
 use pgd_surgery::cutting::CutValidationSettings;
 use pgd_surgery::cutting::keratotomy::{Cornea, Keratotomy};
+use pgd_surgery::devices::PressMotion;
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::organs::Organ;
 use pgd_surgery::pgd::ValidationSettings;
@@ -328,8 +329,16 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             dynamic,
             law,
             coarse,
+            depth_mm,
             json,
         } => {
+            let motion = match args::millimetres("depth-mm", Some(depth_mm), 0.0) {
+                Ok(depth_m) => PressMotion {
+                    depth_m,
+                    ..PressMotion::default()
+                },
+                Err(e) => return fail("pgd bench haptics", &e),
+            };
             let organs = SCENE_ORGANS.map(|organ| SceneOrgan {
                 dynamic,
                 law: law.map_or(default_law(Some(organ), false, dynamic), |l| l.law()),
@@ -342,7 +351,7 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             };
             print_report(
                 "pgd bench haptics",
-                app::bench::run(&scene, repeats, realtime_seconds),
+                app::bench::run(&scene, &motion, repeats, realtime_seconds),
                 json,
             )
         }
