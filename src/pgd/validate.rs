@@ -161,6 +161,13 @@ pub fn validate(
     settings: &ValidationSettings,
     progress: &dyn Progress,
 ) -> Result<ValidationReport, FemError> {
+    if settings.beyond_range && vademecum.steps.len() == 1 {
+        return Err(FemError::InvalidInput {
+            what: "vademecum: nonlinear load steps to press beyond",
+            value: 0.0,
+            problem: "too few; --beyond-range needs a nonlinear vademecum",
+        });
+    }
     let mesh = model.mesh();
     let surface = Surface::extract(mesh);
     let kernel = PatchKernel::new(mesh, &surface, vademecum.header.settings.tool_tip_radius_m)?;

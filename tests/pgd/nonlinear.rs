@@ -535,6 +535,25 @@ fn beyond_its_range_the_felt_force_firms_up_as_full_fem_does() {
     }
 }
 
+/// A linear vademecum has no range to press beyond: validating beyond it is refused, saying
+/// why, rather than drawing no point.
+#[test]
+fn pressing_beyond_a_linear_vademecums_range_is_refused() {
+    let model = block_model_of(block_mesh([4, 3, 2]), Law::Linear);
+    let (linear, _) = build(&organ(&model), &settings(20, 1e-2), &Silent).unwrap();
+    let beyond = ValidationSettings {
+        beyond_range: true,
+        ..ValidationSettings::default()
+    };
+    let error = validate(&model, &linear, &beyond, &Silent).unwrap_err();
+    assert!(
+        error
+            .to_string()
+            .contains("--beyond-range needs a nonlinear vademecum"),
+        "{error}"
+    );
+}
+
 /// The accessible triangles of the block's vademecum whose corners lie at least a centimetre
 /// inside the loaded face's sides.
 fn interior_triangles(vademecum: &Vademecum) -> impl Iterator<Item = usize> + '_ {
