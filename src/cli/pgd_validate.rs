@@ -39,9 +39,13 @@ pub fn validate_vademecum(
 
 /// The validation's errors as a table: felt force, whole field, near field.
 pub fn print_validation(report: &ValidationReport) {
+    if report.beyond_range {
+        println!("pressed beyond the vademecum's range, from each point's edge (--beyond-range)");
+    }
+    let title = format!("{} random loads against full FEM", report.samples.len());
     println!(
-        "{} random loads against full FEM       mean       p50       p95       max",
-        report.samples.len()
+        "{title:<38}{:>8}{:>10}{:>10}{:>10}",
+        "mean", "p50", "p95", "max"
     );
     let near = format!(
         "displacement field, within {} mm",

@@ -112,6 +112,9 @@ pub struct Sample {
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ValidationReport {
+    /// Whether the loads pressed beyond the vademecum's range
+    /// ([`ValidationSettings::beyond_range`]) rather than within it.
+    pub beyond_range: bool,
     /// The radius (m) of the "near the tool" region `near_field_error` is measured over.
     pub near_radius_m: f64,
     pub force_error: Statistics,
@@ -203,6 +206,7 @@ pub fn validate(
         progress.advance(1);
     }
     Ok(ValidationReport {
+        beyond_range: settings.beyond_range,
         near_radius_m: settings.near_radius_m,
         force_error: Statistics::of(samples.iter().map(|s| s.force_error)),
         field_error: Statistics::of(samples.iter().map(|s| s.field_error)),
