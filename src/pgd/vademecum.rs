@@ -539,80 +539,49 @@ impl Vademecum {
     /// edge ([`Self::range_force_n`]) every position keeps the level it had there
     /// ([`Self::level_force_n`]), so the organ answers at the edge's secant compliance: its
     /// load and the field drawn follow the tool. What the trainee feels goes on stiffening
-    /// there ([`PastEdge::Chord`]), a second iteration from the first's force.
+    /// there: a second iteration from the organ's force, blended from the edge's secant
+    /// compliance to the last load-step interval's chord ([`Self::chord_compliance`]) as the
+    /// force grows past the edge, `δ = C_e F_e + C_chord (F − F_e)` along the force. Pressed
+    /// along the normal past the full-resolution liver's range, the felt force is 10.0 % off
+    /// full FEM at the median and 26.3 % at p95, against 12.8 and 29.6 % at the secant
+    /// (docs/pgd.md, "Beyond the range").
     pub fn patch_press_in_range(
         &self,
         patch: &mut Patch,
         indentation_m: &Vector3<f64>,
     ) -> RangePress {
-        let solve = |c: Matrix3<f64>| solve_press(c, indentation_m);
         if self.steps.len() == 1 {
-            let (force_n, stiffness_n_per_m) = solve(self.linear_compliance(patch));
+            let (force_n, stiffness_n_per_m) =
+                solve_press(self.linear_compliance(patch), indentation_m);
             return RangePress::within(force_n, stiffness_n_per_m);
         }
         let edge_n = self.range_force_n(patch);
         patch.reset_columns(self.steps.len());
-        let linear = solve(self.column_compliance(patch, 0.0));
-        let (force_n, stiffness_n_per_m) =
-            self.secant_iteration(patch, (indentation_m, edge_n), PastEdge::Secant, linear);
+        let linear = solve_press(self.column_compliance(patch, 0.0), indentation_m);
+        let (force_n, stiffness_n_per_m) = secant_iteration(linear, indentation_m, |force| {
+            self.column_compliance(patch, force.norm().min(edge_n))
+        });
         let f = force_n.norm();
         if f <= edge_n {
             return RangePress::within(force_n, stiffness_n_per_m);
         }
-        let from = (force_n, stiffness_n_per_m);
-        let felt_n = self
-            .secant_iteration(patch, (indentation_m, edge_n), PastEdge::Chord, from)
-            .0;
+        let at_edge = self.column_compliance(patch, edge_n);
+        let felt_n = match self.chord_compliance(patch, (edge_n, &at_edge)) {
+            Some(chord) => {
+                let from = (force_n, stiffness_n_per_m);
+                let blend = |force: &Vector3<f64>| {
+                    let w = (edge_n / force.norm()).min(1.0);
+                    at_edge * w + chord * (1.0 - w)
+                };
+                secant_iteration(from, indentation_m, blend).0
+            }
+            None => force_n,
+        };
         RangePress {
             force_n,
             stiffness_n_per_m,
             felt_n,
             beyond: 1.0 - edge_n / f,
-        }
-    }
-
-    /// The secant iteration from the press `press` (force, stiffness) to the force whose
-    /// compliance ([`Self::press_compliance`]) carries it to `indentation_m`, the patch's range
-    /// edge at `edge_n` (N); it stops once the force changes by less than
-    /// [`SECANT_TOLERANCE`].
-    fn secant_iteration(
-        &self,
-        patch: &mut Patch,
-        (indentation_m, edge_n): (&Vector3<f64>, f64),
-        past: PastEdge,
-        mut press: (Vector3<f64>, Matrix3<f64>),
-    ) -> (Vector3<f64>, Matrix3<f64>) {
-        for _ in 0..SECANT_ITERATIONS {
-            let compliance = self.press_compliance(patch, (&press.0, edge_n), past);
-            let next = solve_press(compliance, indentation_m);
-            let settled = (next.0 - press.0).norm() <= SECANT_TOLERANCE * next.0.norm();
-            press = next;
-            if settled {
-                break;
-            }
-        }
-        press
-    }
-
-    /// The compliance of `patch` under `force_n`, its range edge at `edge_n` (N): within the
-    /// range the blended steps' secant compliance at the force's level; beyond it as `past`
-    /// says.
-    fn press_compliance(
-        &self,
-        patch: &mut Patch,
-        (force_n, edge_n): (&Vector3<f64>, f64),
-        past: PastEdge,
-    ) -> Matrix3<f64> {
-        let f = force_n.norm();
-        let at_edge = self.column_compliance(patch, f.min(edge_n));
-        match past {
-            PastEdge::Chord if f > edge_n => self
-                .chord_compliance(patch, (edge_n, &at_edge))
-                .map_or(at_edge, |chord| {
-                    let w = edge_n / f;
-                    at_edge * w + chord * (1.0 - w)
-                }),
-            _ => at_edge,
         }
     }
 
@@ -923,22 +892,6 @@ const SHARE_CHUNK: usize = 128;
 /// share of it is the same level.
 const LEVEL_TOLERANCE: f64 = 1e-6;
 
-/// How a press past its patch's range edge goes on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum PastEdge {
-    /// At the edge's secant compliance: the organ's own answer, which keeps its surface under
-    /// the tool.
-    Secant,
-    /// Blended from the edge's secant compliance to the chord compliance of the patch's last
-    /// load-step interval along its normal as the force grows past the edge (`δ = C_e F_e +
-    /// C_chord (F − F_e)`, both along the force; [`Vademecum::chord_compliance`]): a tissue
-    /// that firms up goes on firming up, where the secant alone feels too soft. Pressed along
-    /// the normal past the full-resolution liver's range, the felt force is 10.0 % off full
-    /// FEM at the median and 26.3 % at p95, against 12.8 and 29.6 % at the secant
-    /// (docs/pgd.md, "Beyond the range").
-    Chord,
-}
-
 /// A press of a patch, within or beyond its range.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RangePress {
@@ -949,7 +902,7 @@ pub struct RangePress {
     pub stiffness_n_per_m: Matrix3<f64>,
     /// The force the trainee feels the opposite of (N): `force_n` within the range; beyond it
     /// stiffer, as the tissue goes on firming up past its last load step
-    /// ([`PastEdge::Chord`]).
+    /// ([`Vademecum::patch_press_in_range`]).
     pub felt_n: Vector3<f64>,
     /// The share of the indentation that lies beyond the range (zero within it).
     pub beyond: f64,
@@ -974,6 +927,25 @@ fn solve_press(
 ) -> (Vector3<f64>, Matrix3<f64>) {
     let stiffness = compliance.try_inverse().unwrap_or_else(Matrix3::zeros);
     (stiffness * indentation_m, stiffness)
+}
+
+/// The secant iteration from the press `press` (force, stiffness) to the force whose
+/// `compliance` carries it to `indentation_m`; it stops once the force changes by less than
+/// [`SECANT_TOLERANCE`], or after [`SECANT_ITERATIONS`].
+fn secant_iteration(
+    mut press: (Vector3<f64>, Matrix3<f64>),
+    indentation_m: &Vector3<f64>,
+    mut compliance: impl FnMut(&Vector3<f64>) -> Matrix3<f64>,
+) -> (Vector3<f64>, Matrix3<f64>) {
+    for _ in 0..SECANT_ITERATIONS {
+        let next = solve_press(compliance(&press.0), indentation_m);
+        let settled = (next.0 - press.0).norm() <= SECANT_TOLERANCE * next.0.norm();
+        press = next;
+        if settled {
+            break;
+        }
+    }
+    press
 }
 
 /// Secant iterations of [`Vademecum::force_for_indentation`] over load steps, at most.
