@@ -536,8 +536,8 @@ impl Scenario {
     }
 
     /// The scenario as the web page runs it: linear tissue where it names no law. A scene's
-    /// nonlinear vademecums are seven times the size of its linear ones, one load step each
-    /// (the coarse gallbladder's 146 MB against 20 MB), too much for a page to download.
+    /// nonlinear vademecums are five to nine times the size of its linear ones, one load step
+    /// a depth (the coarse liver's 20 MB against 2.3 MB), too much for a page to download.
     pub fn for_the_web(&self) -> Scenario {
         let mut scenario = self.clone();
         for organ in &mut scenario.organs {
