@@ -552,9 +552,9 @@ impl Scenario {
 /// tool as liver does, where the organ is pressed; the linear law where a scalpel cuts it
 /// (the cut state is linear X-FEM), where it moves (its reduced dynamics run the KSV energy
 /// on its linear vademecum's modes), on the cornea, which only the keratotomy's blade cuts,
-/// and on the gallbladder: its thin wall's loads fail past the first load steps over much of
-/// it (at the fundus its range ends 1.3 mN in), so its exponential vademecum is little more
-/// than a linear one there, and softer than it.
+/// and on the gallbladder: where trainees press its fundus its exponential vademecum is past
+/// its range (which ends about a millinewton in), so it would only extrapolate there, at four
+/// times the linear tick (`docs/fem.md`, "which law to pick").
 pub fn default_law(organ: Option<Organ>, cut: bool, dynamic: bool) -> Law {
     let linear_organ = matches!(organ, Some(Organ::Cornea | Organ::Gallbladder));
     match linear_organ || cut || dynamic {
