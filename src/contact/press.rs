@@ -59,6 +59,9 @@ pub struct ToolContact {
     /// What the tissue's stiffening beyond its range adds to the force felt (N; zero within
     /// the range): the device renders the opposite of [`Self::felt_n`].
     pub stiffening_n: Vector3<f64>,
+    /// How that stiffening changes with the indentation (N/m; zero within the range): the
+    /// felt force's stiffness less the organ's.
+    pub stiffening_n_per_m: Matrix3<f64>,
 }
 
 impl ToolContact {
@@ -109,6 +112,7 @@ where
     Some(ToolContact {
         force_n: press.force_n,
         stiffening_n: press.felt_n - press.force_n,
+        stiffening_n_per_m: press.felt_stiffness_n_per_m - press.stiffness_n_per_m,
         stiffness_n_per_m: press.stiffness_n_per_m,
         beyond_range_m: contact.depth_m * press.beyond,
         ..contact
@@ -173,14 +177,16 @@ where
         stiffness_n_per_m: Matrix3::zeros(),
         force_n: Vector3::zeros(),
         stiffening_n: Vector3::zeros(),
+        stiffening_n_per_m: Matrix3::zeros(),
     })
 }
 
 /// The tool, where it is, answers the contact forces of the tick moving the surface under it
 /// by `moved_m` ([`super::ToolHold`]): it takes the move back, so its depth grows by the move
 /// along the normal, and its load by the hold's stiffness times the move (exact for a linear
-/// vademecum; for a KSV one the next tick's press takes the secant and its range again). A
-/// depth that reaches zero lets go.
+/// vademecum; for a KSV one the next tick's press takes the secant and its range again).
+/// Beyond the range what the trainee feels follows at its own, stiffer chord, so the
+/// tissue's stiffening answers the move in the same tick. A depth that reaches zero lets go.
 pub fn follow(contact: &mut Option<ToolContact>, load: &mut PatchLoad, moved_m: &Vector3<f64>) {
     let Some(touch) = contact else {
         return;
@@ -198,5 +204,6 @@ pub fn follow(contact: &mut Option<ToolContact>, load: &mut PatchLoad, moved_m: 
     touch.moved_m += moved_m;
     touch.indentation_m -= moved_m;
     touch.force_n += change_n;
+    touch.stiffening_n += touch.stiffening_n_per_m * -moved_m;
     load.force_n += change_n;
 }

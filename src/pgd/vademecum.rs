@@ -566,21 +566,24 @@ impl Vademecum {
             return RangePress::within(force_n, stiffness_n_per_m);
         }
         let at_edge = self.column_compliance(patch, edge_n);
-        let felt_n = match self.chord_compliance(patch, (edge_n, &at_edge)) {
-            Some(chord) => {
-                let from = (force_n, stiffness_n_per_m);
-                let blend = |force: &Vector3<f64>| {
-                    let w = (edge_n / force.norm()).min(1.0);
-                    at_edge * w + chord * (1.0 - w)
-                };
-                secant_iteration(from, indentation_m, blend).0
-            }
-            None => force_n,
-        };
+        let (felt_n, felt_stiffness_n_per_m) =
+            match self.chord_compliance(patch, (edge_n, &at_edge)) {
+                Some(chord) => {
+                    let from = (force_n, stiffness_n_per_m);
+                    let blend = |force: &Vector3<f64>| {
+                        let w = (edge_n / force.norm()).min(1.0);
+                        at_edge * w + chord * (1.0 - w)
+                    };
+                    let felt_n = secant_iteration(from, indentation_m, blend).0;
+                    (felt_n, solve_press(chord, indentation_m).1)
+                }
+                None => (force_n, stiffness_n_per_m),
+            };
         RangePress {
             force_n,
             stiffness_n_per_m,
             felt_n,
+            felt_stiffness_n_per_m,
             beyond: 1.0 - edge_n / f,
         }
     }
@@ -904,6 +907,10 @@ pub struct RangePress {
     /// stiffer, as the tissue goes on firming up past its last load step
     /// ([`Vademecum::patch_press_in_range`]).
     pub felt_n: Vector3<f64>,
+    /// How the felt force changes with the indentation (N/m): `stiffness_n_per_m` within the
+    /// range; beyond it the inverse of the last load-step interval's chord compliance, along
+    /// which the felt force grows there.
+    pub felt_stiffness_n_per_m: Matrix3<f64>,
     /// The share of the indentation that lies beyond the range (zero within it).
     pub beyond: f64,
 }
@@ -914,6 +921,7 @@ impl RangePress {
             force_n,
             stiffness_n_per_m,
             felt_n: force_n,
+            felt_stiffness_n_per_m: stiffness_n_per_m,
             beyond: 0.0,
         }
     }
