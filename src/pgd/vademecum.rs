@@ -541,10 +541,8 @@ impl Vademecum {
     /// load and the field drawn follow the tool. What the trainee feels goes on stiffening
     /// there: a second iteration from the organ's force, blended from the edge's secant
     /// compliance to the last load-step interval's chord ([`Self::chord_compliance`]) as the
-    /// force grows past the edge, `δ = C_e F_e + C_chord (F − F_e)` along the force. Pressed
-    /// along the normal past the full-resolution liver's range, the felt force is 10.0 % off
-    /// full FEM at the median and 26.3 % at p95, against 12.8 and 29.6 % at the secant
-    /// (docs/pgd.md, "Beyond the range").
+    /// force grows past the edge, `δ = C_e F_e + C_chord (F − F_e)` along the force: closer
+    /// to full FEM than the edge's secant alone (docs/pgd.md, "Beyond the range").
     pub fn patch_press_in_range(
         &self,
         patch: &mut Patch,
