@@ -8,8 +8,7 @@ use pgd_surgery::app::haptic::{ForceTrace, HapticLoop, HapticScene};
 use pgd_surgery::app::scene::press_targets;
 use pgd_surgery::contact::Probe;
 use pgd_surgery::devices::{
-    HapticDevice, Instrument, PressMotion, PressTarget, SafetySettings, Scripted, Trajectory,
-    Workspace, press_and_slide,
+    HapticDevice, PressMotion, PressTarget, SafetySettings, Scripted, Trajectory, press_and_slide,
 };
 use pgd_surgery::fem::{FemModel, Law};
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate, region};
@@ -53,19 +52,13 @@ pub fn liver() -> &'static Liver {
 }
 
 pub fn scene(safety: SafetySettings) -> HapticScene {
+    let probe = Probe {
+        tip_radius_m: TIP_RADIUS_M,
+    };
+    let organs = vec![("liver".into(), liver().vademecum.clone())];
     HapticScene {
-        coupling: None,
-        dynamics: None,
-        cutting: None,
-        instruments: vec![Instrument::default()],
-        scope: None,
-        organs: vec![("liver".into(), liver().vademecum.clone())],
-        probe: Probe {
-            tip_radius_m: TIP_RADIUS_M,
-        },
-        workspace: Workspace::default(),
         safety,
-        meanwhile: Vec::new(),
+        ..HapticScene::pressing(organs, probe)
     }
 }
 

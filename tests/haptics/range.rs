@@ -8,9 +8,7 @@ use std::sync::Arc;
 use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{ForceTrace, HapticLoop, HapticScene, HeadlessReport};
 use pgd_surgery::contact::{ContactSurface, Probe, Target, ToolContact, follow, press};
-use pgd_surgery::devices::{
-    Instrument, PressMotion, PressTarget, SafetySettings, Scripted, Workspace, press_and_slide,
-};
+use pgd_surgery::devices::{PressMotion, PressTarget, Scripted, press_and_slide};
 use pgd_surgery::fem::{Dirichlet, FemModel, Law, Material};
 use pgd_surgery::mesh::box_mesh;
 use pgd_surgery::pgd::{
@@ -45,20 +43,10 @@ fn block_vademecum(law: Law, load_steps_m: Vec<f64>) -> Vademecum {
 /// A scripted press `depth_m` deep at the middle of the block's top face, held, no slide:
 /// the report and the force trace.
 fn scripted_press(vademecum: &Arc<Vademecum>, depth_m: f64) -> (HeadlessReport, ForceTrace) {
-    let scene = HapticScene {
-        organs: vec![("block".into(), vademecum.clone())],
-        probe: Probe {
-            tip_radius_m: TIP_RADIUS_M,
-        },
-        workspace: Workspace::default(),
-        safety: SafetySettings::default(),
-        coupling: None,
-        dynamics: None,
-        cutting: None,
-        instruments: vec![Instrument::default()],
-        scope: None,
-        meanwhile: Vec::new(),
+    let probe = Probe {
+        tip_radius_m: TIP_RADIUS_M,
     };
+    let scene = HapticScene::pressing(vec![("block".into(), vademecum.clone())], probe);
     let target = PressTarget {
         point_m: Vector3::new(0.03, 0.02, 0.03),
         normal: Vector3::z(),

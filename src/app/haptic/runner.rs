@@ -55,15 +55,13 @@ pub struct HapticScene {
     pub meanwhile: Vec<PathBuf>,
 }
 
-#[cfg(test)]
 impl HapticScene {
-    /// A 6 mm probe over no organ, with the default workspace and safety.
-    pub fn without_organs() -> Self {
+    /// `organs` pressed by `probe` in open surgery and nothing more: the organs apart, still
+    /// and uncut, no laparoscope, the default workspace and safety.
+    pub fn pressing(organs: Vec<(String, Arc<Vademecum>)>, probe: Probe) -> Self {
         Self {
-            organs: Vec::new(),
-            probe: Probe {
-                tip_radius_m: 0.006,
-            },
+            organs,
+            probe,
             workspace: Workspace::default(),
             safety: SafetySettings::default(),
             coupling: None,
@@ -74,9 +72,16 @@ impl HapticScene {
             meanwhile: Vec::new(),
         }
     }
-}
 
-impl HapticScene {
+    /// A 6 mm probe over no organ.
+    #[cfg(test)]
+    pub fn without_organs() -> Self {
+        let probe = Probe {
+            tip_radius_m: 0.006,
+        };
+        Self::pressing(Vec::new(), probe)
+    }
+
     /// The ports of the instruments that go through one.
     pub fn ports(&self) -> impl Iterator<Item = Fulcrum> + '_ {
         self.instruments.iter().filter_map(|i| i.port)
