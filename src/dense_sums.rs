@@ -3,7 +3,7 @@
 //!
 //! A sum written as one running total (`iter().map(…).sum()`) is a chain: each addition waits
 //! for the one before, a few cycles each, because floating-point addition is not associative
-//! and the compiler may not reorder it. Here every sum keeps [`LANES`] totals side by side,
+//! and the compiler may not reorder it. Here every sum keeps `LANES` totals side by side,
 //! which the compiler maps onto vector registers, and adds them up at the end. The result
 //! differs from the chained sum only by rounding.
 //!

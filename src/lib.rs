@@ -5,7 +5,7 @@
 //!   vademecum is checked against), [`pgd`] (the vademecums), [`contact`], [`cutting`],
 //!   [`dynamics`] (organs that move),
 //!   [`devices`] (the device layer), [`scenario`] (exercises), [`dense_sums`],
-//!   [`parry_interop`], and [`bench`], which times them;
+//!   [`parry_interop`], and [`bench`](mod@bench), which times them;
 //! - services: [`store`] (organs and vademecums on disk) and [`report`] (files for people);
 //! - [`app`], the Bevy layer: the 1 kHz haptic loop, the scene, the trainer window;
 //! - [`cli`], what the binaries' commands do and print; the binaries in `src/bin` stay thin.

@@ -1,7 +1,7 @@
 //! The Bevy layer over the numerical core: the haptic loop's world and its 1 kHz thread
 //! ([`haptic`]), the default scene ([`scene`]), one attempt at a scenario ([`attempt`]), a
 //! run of the trainer, headless or in its window ([`launch`]), the trainer window
-//! ([`window`]) and the benchmark of the whole loop ([`bench`]).
+//! ([`window`]) and the benchmark of the whole loop ([`bench`](mod@bench)).
 
 pub mod attempt;
 #[cfg(not(target_arch = "wasm32"))]

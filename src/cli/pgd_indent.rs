@@ -23,7 +23,7 @@ pub struct IndentRequest<'a> {
     /// The press point (mm), moved to the nearest accessible surface node; by default the
     /// accessible node nearest the accessible face's centroid.
     pub at_mm: Option<[f64; 3]>,
-    /// Deepest depth (mm); by default the organ's [`DEPTH_OVER_TOOL_RADIUS`].
+    /// Deepest depth (mm); by default the organ's `DEPTH_OVER_TOOL_RADIUS`.
     pub depth_mm: Option<f64>,
     pub steps: usize,
 }

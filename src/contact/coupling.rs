@@ -229,7 +229,7 @@ impl Coupling {
     }
 
     /// How far (m) this tick's contact forces move the surface under the tool holding organ
-    /// `index`: the tool's load follows it in the same tick ([`super::hold`]).
+    /// `index`: the tool's load follows it in the same tick (`super::hold`).
     pub fn tool_moved_m(&self, index: usize) -> Vector3<f64> {
         self.organs[index].hold.moved_m()
     }

@@ -61,7 +61,7 @@ pub struct PenaltySettings {
     pub stiffness_ratio: f64,
     pub convergence: Convergence,
     /// Skip nodes measured clear of the master while nothing has moved far enough since to
-    /// close the gap ([`Clearance`]). Off, every node within reach is measured every tick:
+    /// close the gap (`Clearance`). Off, every node within reach is measured every tick:
     /// the same forces, more work (tests compare the two).
     pub skip_clear_nodes: bool,
 }

@@ -166,7 +166,7 @@ pub struct ForceDimension {
 }
 
 impl ForceDimension {
-    /// Opens the first device through the dhd library at `library` (or the one [`LIBRARY`]
+    /// Opens the first device through the dhd library at `library` (or the one `LIBRARY`
     /// finds) and starts its servo thread.
     pub fn open(library: Option<&Path>) -> Result<Self, DeviceError> {
         let path = library.map_or_else(|| LIBRARY.path(), Path::to_path_buf);

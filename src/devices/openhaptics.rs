@@ -219,7 +219,7 @@ pub struct OpenHaptics {
 
 impl OpenHaptics {
     /// Opens the device named `device` (the vendor's default without one) through the HD
-    /// library at `library` (or the one [`LIBRARY`] finds).
+    /// library at `library` (or the one `LIBRARY` finds).
     pub fn open(library: Option<&Path>, device: Option<&str>) -> Result<Self, DeviceError> {
         let path = library.map_or_else(|| LIBRARY.path(), Path::to_path_buf);
         let hd = Arc::new(Hd::load(&path)?);

@@ -159,7 +159,7 @@ impl ServoLink {
     }
 
     /// Loop side: waits for the servo's first sample, so that the loop's first read has one;
-    /// whether it came within [`FIRST_SAMPLE_WITHIN`].
+    /// whether it came within `FIRST_SAMPLE_WITHIN`.
     pub fn await_first_sample(&self) -> bool {
         let give_up = Instant::now() + FIRST_SAMPLE_WITHIN;
         while self.samples() == 0 {

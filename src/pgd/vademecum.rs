@@ -184,7 +184,7 @@ pub struct Vademecum {
     /// Lumped surface area (m²) of each load position: its weight in a tool patch.
     pub position_areas_m2: Vec<f32>,
     /// Unit outward normal of each load position: a patch loads only the positions on its
-    /// own side of a thin wall ([`on_pressed_side`]).
+    /// own side of a thin wall (`on_pressed_side`).
     pub position_normals: Vec<[f32; 3]>,
     /// The accessible triangles, as position indices.
     pub triangles: Vec<[u32; 3]>,
@@ -479,7 +479,7 @@ impl Vademecum {
 
     /// The compliance for a force `force_n` on `patch`: the linear step's plus the blended
     /// corrections of the steps the patch's positions reach, and (a law whose modulus grows
-    /// with the strain) their share across the normal ([`across_the_normal`]), summed block
+    /// with the strain) their share across the normal (`across_the_normal`), summed block
     /// by block: the reference the haptic tick's columns must agree with for the force on the
     /// organ ([`Self::patch_press_in_range`]).
     pub fn compliance(&self, patch: &Patch, force_n: &Vector3<f64>) -> Matrix3<f64> {
@@ -537,10 +537,10 @@ impl Vademecum {
     /// filled once. The patch's level is the share-weighted level of the patches centred on
     /// its positions (close to the linear depth of the tool's own patch); past the range's
     /// edge ([`Self::range_force_n`]) every position keeps the level it had there
-    /// ([`Self::level_force_n`]), so the organ answers at the edge's secant compliance: its
+    /// (`Self::level_force_n`), so the organ answers at the edge's secant compliance: its
     /// load and the field drawn follow the tool. What the trainee feels goes on stiffening
     /// there: a second iteration from the organ's force, blended from the edge's secant
-    /// compliance to the last load-step interval's chord ([`Self::chord_compliance`]) as the
+    /// compliance to the last load-step interval's chord (`Self::chord_compliance`) as the
     /// force grows past the edge, `δ = C_e F_e + C_chord (F − F_e)` along the force: closer
     /// to full FEM than the edge's secant alone (docs/pgd.md, "Beyond the range").
     pub fn patch_press_in_range(

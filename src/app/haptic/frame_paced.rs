@@ -42,7 +42,7 @@ impl FramePaced {
     }
 
     /// Runs the ticks due after `elapsed` of real time since the first frame (skipping those
-    /// beyond [`MAX_BURST`]); returns how many ran.
+    /// beyond `MAX_BURST`); returns how many ran.
     pub fn advance(&mut self, elapsed: Duration) -> u64 {
         let due = (elapsed.as_secs_f64() / TICK_S).floor() as u64;
         let behind = due.saturating_sub(self.ticks + self.skipped);

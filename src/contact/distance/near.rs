@@ -101,7 +101,7 @@ impl SurfaceEntries {
 
 /// The near-field displacement (m) of the master's surface positions under its loads of this
 /// tick, summed by [`NearField::gather`] on ticks where a load presses the master, and relaxed
-/// ([`RELAXATION`]). Allocates nothing once grown.
+/// (`RELAXATION`). Allocates nothing once grown.
 #[derive(Clone, Debug)]
 pub struct NearField {
     vademecum: Arc<Vademecum>,
