@@ -573,7 +573,7 @@ impl Vademecum {
                         at_edge * w + chord * (1.0 - w)
                     };
                     let felt_n = secant_iteration(from, indentation_m, blend).0;
-                    (felt_n, solve_press(chord, indentation_m).1)
+                    (felt_n, stiffness_of(chord))
                 }
                 None => (force_n, stiffness_n_per_m),
             };
@@ -931,8 +931,13 @@ fn solve_press(
     compliance: Matrix3<f64>,
     indentation_m: &Vector3<f64>,
 ) -> (Vector3<f64>, Matrix3<f64>) {
-    let stiffness = compliance.try_inverse().unwrap_or_else(Matrix3::zeros);
+    let stiffness = stiffness_of(compliance);
     (stiffness * indentation_m, stiffness)
+}
+
+/// The stiffness (N/m) of `compliance` (m/N): its inverse, zero where it is singular.
+fn stiffness_of(compliance: Matrix3<f64>) -> Matrix3<f64> {
+    compliance.try_inverse().unwrap_or_else(Matrix3::zeros)
 }
 
 /// The secant iteration from the press `press` (force, stiffness) to the force whose
