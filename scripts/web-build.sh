@@ -42,7 +42,7 @@ if [ "$("$tools/bin/wasm-bindgen" --version 2>/dev/null)" != "wasm-bindgen $bind
 fi
 
 rm -rf "$dist"
-mkdir -p "$dist/vademecums" "$dist/tests"
+mkdir -p "$dist/vademecums" "$dist/scenarios"
 for renderer in "${renderers[@]}"; do
   echo "web-build: compiling the trainer for the browser, drawn by $renderer"
   cargo build --release --target wasm32-unknown-unknown --bin trainer-web --features "$renderer"
@@ -54,7 +54,7 @@ for renderer in "${renderers[@]}"; do
 done
 cp web/index.html "$dist/"
 # The scripted runs, for the browser test and for replaying an exercise in the page.
-cp -r tests/scenarios "$dist/tests/"
+cp -r scenarios/runs "$dist/scenarios/"
 
 echo "web-build: the vademecums of every shipped scenario ($detail organs)"
 detail_flag=()

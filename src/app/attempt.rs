@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::time::Duration;
 
 use nalgebra::Vector3;
 
@@ -12,7 +13,7 @@ use super::haptic::{
 };
 use super::scene::{Detail, SceneOrgan, scene_files, scene_of};
 use crate::contact::{ContactSurface, CouplingSettings};
-use crate::devices::{HapticDevice, Instrument, ScopeHandle, TICK_S};
+use crate::devices::{HapticDevice, Instrument, ScopeHandle, TICK_S, stop_requested};
 use crate::mesh::organs::Organ;
 use crate::scenario::{
     self, CutMade, Exercise, Keratometer, LaparoscopeEntry, Nodule, NoduleSite, OrganEntry, Port,
@@ -146,16 +147,31 @@ pub fn run_simulated(
     device: Box<dyn HapticDevice>,
     max_ticks: u64,
 ) -> Result<Outcome, String> {
+    run_observed(scenario, scene, device, max_ticks, |_, _| {})
+}
+
+/// [`run_simulated`], handing `observe` the loop and its compute time after every tick.
+pub fn run_observed(
+    scenario: Scenario,
+    scene: &HapticScene,
+    device: Box<dyn HapticDevice>,
+    max_ticks: u64,
+    mut observe: impl FnMut(&HapticLoop, Duration),
+) -> Result<Outcome, String> {
     let mut haptic = HapticLoop::new(scene, device).map_err(|e| e.to_string())?;
     haptic.world_mut().insert_resource(SettleCuts);
     let sites = sites_on(scene, &scenario);
     prepare(&mut haptic, Exercise::new(scenario, sites)).start();
     for tick in 0..max_ticks {
-        haptic.tick(TickClock {
+        if stop_requested() {
+            break;
+        }
+        let compute = haptic.tick(TickClock {
             tick,
             time_s: tick as f64 * TICK_S,
             overruns_in_a_row: 0,
         });
+        observe(&haptic, compute);
         if haptic.world().resource::<ExerciseRun>().exercise.is_none() {
             break;
         }

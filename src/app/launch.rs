@@ -3,7 +3,7 @@
 //! what it reports.
 
 use std::path::PathBuf;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
@@ -20,7 +20,7 @@ use super::window::{
 };
 use crate::devices::{
     DeviceSpec, ForceDimension, HapticDevice, OpenHaptics, PressMotion, Recorder, Scripted, TICK_S,
-    TimerMode, Trajectory, press_and_slide,
+    TimerMode, Trajectory, press_and_slide, stop_requested,
 };
 use crate::scenario::Scenario;
 use crate::store::OnStale;
@@ -343,6 +343,13 @@ fn scripted(spec: &Option<DeviceSpec>, trajectory: Trajectory) -> Box<dyn Haptic
 /// Headless ticks on a hardware device when `--ticks` does not say: ten seconds.
 const HARDWARE_TICKS: u64 = 10_000;
 
+/// Installs the panic hook and the SIGINT/SIGTERM handler that release every open device at
+/// zero force ([`crate::devices::install_exit_guards`]); a signal closes the window as its
+/// close button would.
+pub fn install_exit_guards() -> Result<(), String> {
+    crate::devices::install_exit_guards(bevy::app::TerminalCtrlCHandlerPlugin::gracefully_exit)
+}
+
 /// The hardware device `spec` names, opened (`None` when it names none): a Geomagic device
 /// through OpenHaptics, or a Force Dimension one through its SDK.
 fn open_hardware(spec: &Option<DeviceSpec>) -> Option<Result<Box<dyn HapticDevice>, String>> {
@@ -372,6 +379,9 @@ fn run_realtime(
 ) -> Result<RealTimeReport, String> {
     let thread =
         HapticThread::spawn(haptic, timer, Scheduling::RealTime).map_err(|e| e.to_string())?;
-    std::thread::sleep(Duration::from_secs_f64(ticks as f64 * TICK_S));
+    let until = Instant::now() + Duration::from_secs_f64(ticks as f64 * TICK_S);
+    while Instant::now() < until && !stop_requested() {
+        std::thread::sleep(Duration::from_millis(20).min(until - Instant::now()));
+    }
     Ok(thread.stop().0)
 }

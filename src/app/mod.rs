@@ -13,6 +13,8 @@ pub mod haptic;
 pub mod launch;
 pub mod scene;
 pub mod shipped;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod soak;
 #[cfg(target_arch = "wasm32")]
 pub mod web;
 pub mod window;

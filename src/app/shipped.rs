@@ -28,6 +28,50 @@ pub const SHIPPED_SCENARIOS: &[(&str, &str)] = shipped!(
     "pancreas-tour",
 );
 
+/// A shipped scenario with its two scripted runs (`scenarios/runs/<stem>.competent.csv` and
+/// `.careless.csv`, written for the coarse organs), built in for `trainer soak`.
+#[cfg(not(target_arch = "wasm32"))]
+pub struct ShippedRun {
+    pub file: &'static str,
+    pub scenario: &'static str,
+    pub competent_file: &'static str,
+    pub competent: &'static str,
+    pub careless_file: &'static str,
+    pub careless: &'static str,
+}
+
+/// Each stem's [`ShippedRun`].
+#[cfg(not(target_arch = "wasm32"))]
+macro_rules! shipped_runs {
+    ($($stem:literal),* $(,)?) => {
+        &[$(ShippedRun {
+            file: concat!("scenarios/", $stem, ".scenario.ron"),
+            scenario: include_str!(concat!("../../scenarios/", $stem, ".scenario.ron")),
+            competent_file: concat!("scenarios/runs/", $stem, ".competent.csv"),
+            competent: include_str!(concat!("../../scenarios/runs/", $stem, ".competent.csv")),
+            careless_file: concat!("scenarios/runs/", $stem, ".careless.csv"),
+            careless: include_str!(concat!("../../scenarios/runs/", $stem, ".careless.csv")),
+        }),*]
+    };
+}
+
+/// Every shipped scenario's runs, in the menu's order.
+#[cfg(not(target_arch = "wasm32"))]
+pub const SHIPPED_RUNS: &[ShippedRun] = shipped_runs!(
+    "liver-steady-press",
+    "abdomen-tour",
+    "cornea-radial-keratotomy",
+    "duodenum-navigation",
+    "gallbladder-gentle-press",
+    "gallbladder-grasp-retract",
+    "gallbladder-liver-two-ports",
+    "gallbladder-retraction",
+    "liver-capsule-incision",
+    "liver-laparoscopic-press",
+    "pancreas-palpation",
+    "pancreas-tour",
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -51,5 +95,9 @@ mod tests {
             .collect();
         built_in.sort();
         assert_eq!(built_in, on_disk);
+        let mut with_runs: Vec<&str> = SHIPPED_RUNS.iter().map(|run| run.file).collect();
+        with_runs.sort();
+        let files: Vec<&str> = built_in.iter().map(|(file, _)| file.as_str()).collect();
+        assert_eq!(with_runs, files, "every shipped scenario has its runs");
     }
 }

@@ -6,11 +6,13 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use pgd_surgery::app::launch::WindowLesson;
 use pgd_surgery::app::scene::Detail;
+use pgd_surgery::app::soak::SoakPlan;
 use pgd_surgery::app::window::{Opening, ScreenshotPlan};
 use pgd_surgery::app::{self, DEFAULT_SCENARIO, launch};
 use pgd_surgery::cli::{
-    HistoryRequest, HistoryTarget, debrief, list_devices, numbered, prepare_scenarios,
-    show_history, validate_scenarios,
+    HistoryRequest, HistoryTarget, debrief, list_devices, numbered, parse_force_limit_n,
+    parse_positive_seconds, parse_seconds, prepare_scenarios, run_soak, show_history,
+    validate_scenarios,
 };
 use pgd_surgery::devices::{DeviceSpec, TimerMode};
 use pgd_surgery::scenario;
@@ -50,12 +52,13 @@ struct Cli {
     /// Real-time pacing: `hybrid` sleeps then spins to the deadline, `sleep` only sleeps.
     #[arg(long, global = true, default_value = "hybrid", value_parser = parse_timer)]
     timer: TimerMode,
-    /// The largest force (N) sent to the device (also capped by the device's own limit).
-    #[arg(long, global = true, default_value_t = 3.3)]
+    /// The largest force (N) sent to the device, 0 to 20 (also capped by the device's own
+    /// limit).
+    #[arg(long, global = true, default_value = "3.3", value_parser = parse_force_limit_n)]
     max_force_n: f64,
     /// Close the window after this many seconds and report how the haptic loop kept time
     /// while the renderer ran.
-    #[arg(long, global = true)]
+    #[arg(long, global = true, value_parser = parse_positive_seconds)]
     exit_after_s: Option<f64>,
     /// Save the window to this PNG after `--frames` frames, then close it.
     #[arg(long, global = true)]
@@ -65,7 +68,7 @@ struct Cli {
     frames: u32,
     /// Nor take the screenshot before the haptic loop has run this many seconds (a scripted
     /// device's trajectory played that far, however fast the frames come).
-    #[arg(long, global = true, default_value_t = 0.0)]
+    #[arg(long, global = true, default_value = "0", value_parser = parse_seconds)]
     screenshot_after_s: f64,
     /// Where the organs' vademecums are kept.
     #[arg(long, global = true, default_value = "vademecums")]
@@ -134,6 +137,18 @@ enum Command {
     /// List the haptic device backends, which of them can be used on this machine, and why
     /// the others cannot.
     Devices,
+    /// An hour of use on the simulated clock: every shipped scenario in turn, attempted
+    /// carelessly then competently by its scripted runs, each attempt scored and kept; reports
+    /// the resident memory, the tick times at the start and the end, the forces' NaNs and
+    /// largest step (with --json as JSON).
+    Soak {
+        /// Simulated seconds of use.
+        #[arg(long, default_value = "3600", value_parser = parse_positive_seconds)]
+        duration_s: f64,
+        /// The history database the soak's attempts are kept in, apart from the trainees'.
+        #[arg(long, default_value = "reports/soak-history.sqlite")]
+        keep_in: PathBuf,
+    },
     /// The attempts kept so far (all, or --trainee's), as a table and a learning-curve plot,
     /// or as CSV.
     History {
@@ -178,12 +193,31 @@ fn parse_timer(s: &str) -> Result<TimerMode, String> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Before any device opens: a panic or a signal from here on releases it at zero force.
+    if let Err(e) = launch::install_exit_guards() {
+        eprintln!("trainer: {e}; a device is still zeroed by its watchdog if the trainer dies");
+    }
     match &cli.command {
         Some(Command::Validate { files }) => return validate_scenarios(files),
         Some(Command::Prepare { files, web }) => {
             return prepare_scenarios(files, &cli.vademecums, detail_of(&cli), web.as_deref());
         }
         Some(Command::Devices) => return list_devices(),
+        Some(Command::Soak {
+            duration_s,
+            keep_in,
+        }) => {
+            return run_soak(
+                &SoakPlan {
+                    duration_s: *duration_s,
+                    vademecums: cli.vademecums.clone(),
+                    detail: detail_of(&cli),
+                    history: keep_in.clone(),
+                    trainee: cli.trainee.clone().unwrap_or_else(|| "soak".into()),
+                },
+                cli.json,
+            );
+        }
         Some(Command::History {
             scenario,
             csv,

@@ -14,10 +14,12 @@ mod pgd_validate;
 mod trainer_commands;
 mod trainer_devices;
 mod trainer_history;
+mod trainer_soak;
 
 pub use output::{fail, print_json, print_report};
 pub use parse::{
-    parse_cut_pattern, parse_inclusion, parse_point_mm, parse_spacing, parse_stiffness_ratio,
+    parse_cut_pattern, parse_force_limit_n, parse_inclusion, parse_point_mm,
+    parse_positive_seconds, parse_seconds, parse_spacing, parse_stiffness_ratio,
     parse_subdivisions,
 };
 pub use pgd_bench_dynamics::{DynamicsRequest, bench_dynamics, plot_energy};
@@ -34,3 +36,4 @@ pub use pgd_validate::{
 pub use trainer_commands::{debrief, numbered, prepare_scenarios, validate_scenarios};
 pub use trainer_devices::list_devices;
 pub use trainer_history::{HistoryRequest, HistoryTarget, keep_scored, show_history};
+pub use trainer_soak::run_soak;

@@ -16,6 +16,35 @@ pub fn parse_spacing(text: &str) -> Result<u8, String> {
     check_spacing(mm)
 }
 
+/// A force limit in newtons (`--max-force-n`): finite, from 0 to
+/// [`crate::devices::MAX_FORCE_LIMIT_N`]. A negative one would turn the force against the hand.
+pub fn parse_force_limit_n(text: &str) -> Result<f64, String> {
+    let force_n: f64 = text.trim().parse().map_err(|e| format!("`{text}`: {e}"))?;
+    crate::devices::check_force_limit(force_n)
+}
+
+/// A duration in seconds that must be more than zero and finite (`--exit-after-s`).
+pub fn parse_positive_seconds(text: &str) -> Result<f64, String> {
+    let seconds: f64 = text.trim().parse().map_err(|e| format!("`{text}`: {e}"))?;
+    match seconds.is_finite() && seconds > 0.0 {
+        true => Ok(seconds),
+        false => Err(format!(
+            "{seconds} is not a duration: seconds, more than 0 and finite"
+        )),
+    }
+}
+
+/// A duration in seconds that may be zero, finite (`--screenshot-after-s`).
+pub fn parse_seconds(text: &str) -> Result<f64, String> {
+    let seconds: f64 = text.trim().parse().map_err(|e| format!("`{text}`: {e}"))?;
+    match seconds.is_finite() && seconds >= 0.0 {
+        true => Ok(seconds),
+        false => Err(format!(
+            "{seconds} is not a duration: seconds, 0 or more and finite"
+        )),
+    }
+}
+
 /// A penalty's stiffness ratio: positive and finite.
 pub fn parse_stiffness_ratio(text: &str) -> Result<f64, String> {
     let ratio: f64 = text.parse().map_err(|e| format!("`{text}`: {e}"))?;

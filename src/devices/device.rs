@@ -80,6 +80,65 @@ pub enum DeviceError {
     Failed { device: String, message: String },
     #[error("{device}: disconnected")]
     Disconnected { device: String },
+    /// The device's own guard refused a force the loop commanded (it rendered the guarded one).
+    #[error("{device}: {refusal}")]
+    Refused {
+        device: String,
+        refusal: EdgeRefusal,
+    },
+}
+
+/// Why the device's edge guard did not pass a commanded force as it was.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum EdgeRefusal {
+    /// A component was not a number: zero was rendered instead.
+    #[error("a force that is not finite was commanded; zero was rendered")]
+    NonFinite,
+    /// More than the device's peak: the peak was rendered, along the force.
+    #[error(
+        "{asked_n:.3} N was commanded, over the device's {peak_n:.3} N peak; the peak was rendered"
+    )]
+    OverPeak { asked_n: f64, peak_n: f64 },
+}
+
+/// A force (N) that has passed a device's edge guard: finite and within the device's peak.
+/// Backends render only these, so that no arithmetic before them, and no caller that skips
+/// the safety filter, can put a NaN or more than the peak on the motors.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeForce(Vector3<f64>);
+
+/// Rounding slack over the peak before a force counts as over it: the safety filter's clamp
+/// lands on the peak to within a few ulps.
+const PEAK_SLACK: f64 = 1e-9;
+
+impl EdgeForce {
+    pub const ZERO: Self = Self(Vector3::new(0.0, 0.0, 0.0));
+
+    /// `force_n` as a device whose peak is `peak_force_n` may render it: zero for a force
+    /// that is not finite, the peak along it for one above the peak (a peak that is not a
+    /// positive number renders nothing), with the refusal when it was not passed as asked.
+    pub fn guard(force_n: &Vector3<f64>, peak_force_n: f64) -> (Self, Option<EdgeRefusal>) {
+        let peak_n = match peak_force_n.is_finite() && peak_force_n > 0.0 {
+            true => peak_force_n,
+            false => 0.0,
+        };
+        if !force_n.iter().all(|c| c.is_finite()) {
+            return (Self::ZERO, Some(EdgeRefusal::NonFinite));
+        }
+        let asked_n = force_n.norm();
+        match asked_n > peak_n * (1.0 + PEAK_SLACK) {
+            true => (
+                Self(force_n.cap_magnitude(peak_n)),
+                Some(EdgeRefusal::OverPeak { asked_n, peak_n }),
+            ),
+            false => (Self(force_n.cap_magnitude(peak_n)), None),
+        }
+    }
+
+    /// The force (N), in the scene's axes.
+    pub fn newtons(&self) -> &Vector3<f64> {
+        &self.0
+    }
 }
 
 /// A haptic device, served by the 1 kHz loop: read at the start of a tick, written at its end.
@@ -88,6 +147,21 @@ pub trait HapticDevice: Send + Sync {
     fn limits(&self) -> DeviceLimits;
     /// The device's state at `time_s` seconds into the run.
     fn read(&mut self, time_s: f64) -> Result<DeviceSample, DeviceError>;
-    /// Sets the force (N) the device renders: already clamped and made safe by the caller.
-    fn write_force(&mut self, force_n: &Vector3<f64>) -> Result<(), DeviceError>;
+    /// Renders a force that has passed the edge guard: what a backend implements.
+    fn render(&mut self, force: EdgeForce) -> Result<(), DeviceError>;
+    /// Sets the force (N) the device renders. The caller's safety filter has already clamped
+    /// and rate-limited it; this is the last guard, independent of the filter: the force is
+    /// clamped to the device's own peak and a non-finite one rendered as zero, each with the
+    /// refusal as an error (a fault of the loop's next tick). Backends do not override it.
+    fn write_force(&mut self, force_n: &Vector3<f64>) -> Result<(), DeviceError> {
+        let (force, refusal) = EdgeForce::guard(force_n, self.limits().peak_force_n);
+        self.render(force)?;
+        match refusal {
+            None => Ok(()),
+            Some(refusal) => Err(DeviceError::Refused {
+                device: self.name().to_owned(),
+                refusal,
+            }),
+        }
+    }
 }

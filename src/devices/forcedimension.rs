@@ -9,17 +9,20 @@
 
 use std::ffi::{CStr, c_char, c_int, c_uint};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
 use libloading::Library;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 
+use super::release::Release;
 use super::servo::ServoLink;
 use super::vendor::VendorLibrary;
-use super::{DeviceError, DeviceLimits, DeviceSample, HapticDevice, Metronome, TICK_S, TimerMode};
+use super::{
+    DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice, Metronome, TICK_S, TimerMode,
+};
 
 /// The dhd library, and what to install when it is missing.
 pub const LIBRARY: VendorLibrary = VendorLibrary {
@@ -154,20 +157,61 @@ fn servo_frame(dhd: &Dhd, id: c_char, link: &ServoLink) {
     }
 }
 
-/// A Force Dimension device served by a servo thread of ours.
-pub struct ForceDimension {
-    name: String,
+/// An open device and its servo thread: what must be released, once, whichever way the program
+/// leaves (see [`super::release`]).
+struct Session {
     dhd: Arc<Dhd>,
     id: c_char,
     link: Arc<ServoLink>,
     running: Arc<AtomicBool>,
-    servo: Option<JoinHandle<()>>,
+    servo: Mutex<Option<JoinHandle<()>>>,
+    released: AtomicBool,
+}
+
+impl Release for Session {
+    /// Zero force at once (the link halted), the servo stopped (not waited for from its own
+    /// thread), zero sent, the device closed.
+    fn release(&self) {
+        if self.released.swap(true, Ordering::AcqRel) {
+            return;
+        }
+        self.link.halt();
+        self.running.store(false, Ordering::Relaxed);
+        let servo = self
+            .servo
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+            .take();
+        if let Some(servo) = servo
+            && servo.thread().id() != std::thread::current().id()
+        {
+            let _ = servo.join();
+        }
+        // SAFETY: the servo has stopped; the ID is the one opened.
+        unsafe {
+            (self.dhd.set_force)(0.0, 0.0, 0.0, self.id);
+            (self.dhd.close)(self.id);
+        }
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        self.release();
+    }
+}
+
+/// A Force Dimension device served by a servo thread of ours.
+pub struct ForceDimension {
+    name: String,
+    session: Arc<Session>,
     limits: DeviceLimits,
 }
 
 impl ForceDimension {
     /// Opens the first device through the dhd library at `library` (or the one `LIBRARY`
-    /// finds) and starts its servo thread.
+    /// finds) and starts its servo thread. On any error after the device was opened, it is
+    /// closed before the error is returned.
     pub fn open(library: Option<&Path>) -> Result<Self, DeviceError> {
         let path = library.map_or_else(|| LIBRARY.path(), Path::to_path_buf);
         let dhd = Arc::new(Dhd::load(&path)?);
@@ -183,56 +227,48 @@ impl ForceDimension {
                 dhd.last_error(),
             ));
         }
-        let id = id as c_char;
+        let session = Arc::new(Session {
+            dhd: dhd.clone(),
+            id: id as c_char,
+            link: Arc::new(ServoLink::default()),
+            running: Arc::new(AtomicBool::new(true)),
+            servo: Mutex::new(None),
+            released: AtomicBool::new(false),
+        });
+        super::register(&(session.clone() as Arc<dyn Release>));
         // SAFETY: the ID was just returned by `dhdOpen`.
-        let (model, max_force) =
-            unsafe { (c_text((dhd.get_system_name)(id)), (dhd.get_max_force)(id)) };
+        let (model, max_force) = unsafe {
+            (
+                c_text((dhd.get_system_name)(session.id)),
+                (dhd.get_max_force)(session.id),
+            )
+        };
         let limits = device_limits(max_force);
         // SAFETY: the ID is open.
-        if unsafe { (dhd.enable_force)(1, id) } < 0 {
-            let error = dhd.last_error();
-            // SAFETY: closing the ID just opened.
-            unsafe { (dhd.close)(id) };
-            return Err(failed("cannot enable force output", error));
+        if unsafe { (dhd.enable_force)(1, session.id) } < 0 {
+            return Err(failed("cannot enable force output", dhd.last_error()));
         }
-        let link = Arc::new(ServoLink::default());
-        let running = Arc::new(AtomicBool::new(true));
-        let servo = {
-            let (dhd, link, running) = (dhd.clone(), link.clone(), running.clone());
-            std::thread::Builder::new()
-                .name("force dimension servo".into())
-                .spawn(move || {
-                    let mut metronome =
-                        Metronome::new(Duration::from_secs_f64(TICK_S), TimerMode::default());
-                    while running.load(Ordering::Relaxed) {
-                        metronome.wait();
-                        servo_frame(&dhd, id, &link);
-                    }
-                })
-                .map_err(|e| failed("cannot start the servo thread", (0, e.to_string())))?
-        };
-        let device = Self {
-            name: format!(
-                "Force Dimension {}",
-                model.unwrap_or_else(|| "device".into())
-            ),
-            dhd,
-            id,
-            link,
-            running,
-            servo: Some(servo),
-            limits,
-        };
-        if !device.link.await_first_sample() {
-            let (code, text) = device.dhd.last_error();
+        let servo = spawn_servo(&session)
+            .map_err(|e| failed("cannot start the servo thread", (0, e.to_string())))?;
+        *session.servo.lock().unwrap_or_else(|p| p.into_inner()) = Some(servo);
+        let name = format!(
+            "Force Dimension {}",
+            model.unwrap_or_else(|| "device".into())
+        );
+        if !session.link.await_first_sample() {
+            let (code, text) = dhd.last_error();
             return Err(DeviceError::Failed {
-                device: device.name.clone(),
+                device: name,
                 message: format!(
                     "the servo read no position within a second: {text} (dhd error {code})"
                 ),
             });
         }
-        Ok(device)
+        Ok(Self {
+            name,
+            session,
+            limits,
+        })
     }
 
     /// The dhd library this machine would load, or why there is none (what to install).
@@ -243,8 +279,28 @@ impl ForceDimension {
 
     /// What the haptic loop and the servo share.
     pub fn link(&self) -> &Arc<ServoLink> {
-        &self.link
+        &self.session.link
     }
+}
+
+/// The servo thread, paced at 1 kHz, until the session stops it.
+fn spawn_servo(session: &Session) -> std::io::Result<JoinHandle<()>> {
+    let (dhd, link, running) = (
+        session.dhd.clone(),
+        session.link.clone(),
+        session.running.clone(),
+    );
+    let id = session.id;
+    std::thread::Builder::new()
+        .name("force dimension servo".into())
+        .spawn(move || {
+            let mut metronome =
+                Metronome::new(Duration::from_secs_f64(TICK_S), TimerMode::default());
+            while running.load(Ordering::Relaxed) {
+                metronome.wait();
+                servo_frame(&dhd, id, &link);
+            }
+        })
 }
 
 /// The SDK states one force limit, the one it enforces (`dhdGetMaxForce`; negative when none
@@ -267,36 +323,21 @@ impl HapticDevice for ForceDimension {
     }
 
     fn read(&mut self, _time_s: f64) -> Result<DeviceSample, DeviceError> {
-        if let Some((code, _)) = self.link.take_error() {
+        let session = &self.session;
+        if let Some((code, _)) = session.link.take_error() {
             return Err(DeviceError::Failed {
                 device: self.name.clone(),
-                message: format!("{} (dhd error {code})", self.dhd.error_text(code)),
+                message: format!("{} (dhd error {code})", session.dhd.error_text(code)),
             });
         }
-        self.link.latest().ok_or_else(|| DeviceError::Failed {
+        session.link.latest().ok_or_else(|| DeviceError::Failed {
             device: self.name.clone(),
             message: "the servo has read no position yet".into(),
         })
     }
 
-    fn write_force(&mut self, force_n: &Vector3<f64>) -> Result<(), DeviceError> {
-        self.link.command(force_n);
+    fn render(&mut self, force: EdgeForce) -> Result<(), DeviceError> {
+        self.session.link.command(&force);
         Ok(())
-    }
-}
-
-impl Drop for ForceDimension {
-    /// Zero force, the servo stopped, the device closed.
-    fn drop(&mut self) {
-        self.link.command(&Vector3::zeros());
-        self.running.store(false, Ordering::Relaxed);
-        if let Some(servo) = self.servo.take() {
-            let _ = servo.join();
-        }
-        // SAFETY: the servo has stopped; the ID is the one opened.
-        unsafe {
-            (self.dhd.set_force)(0.0, 0.0, 0.0, self.id);
-            (self.dhd.close)(self.id);
-        }
     }
 }

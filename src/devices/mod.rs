@@ -14,6 +14,7 @@ mod laparoscope;
 mod openhaptics;
 mod rack;
 mod recorder;
+mod release;
 mod safety;
 mod scripted;
 mod servo;
@@ -26,7 +27,7 @@ mod vendor;
 mod virtual_device;
 mod workspace;
 
-pub use device::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
+pub use device::{DeviceError, DeviceLimits, DeviceSample, EdgeForce, EdgeRefusal, HapticDevice};
 #[cfg(not(target_arch = "wasm32"))]
 pub use forcedimension::ForceDimension;
 pub use fulcrum::{Fulcrum, HANDLE_AXIS, MIN_OUTSIDE_M, Pose};
@@ -37,7 +38,10 @@ pub use laparoscope::{
 pub use openhaptics::OpenHaptics;
 pub use rack::{Action, CHANGE_BUTTON, Instrument, MAX_INSTRUMENTS, Rack};
 pub use recorder::Recorder;
-pub use safety::{Fault, SafetyFilter, SafetySettings};
+#[cfg(not(target_arch = "wasm32"))]
+pub use release::install_exit_guards;
+pub use release::{Release, register, release_all, stop_requested};
+pub use safety::{Fault, MAX_FORCE_LIMIT_N, SafetyFilter, SafetySettings, check_force_limit};
 pub use scripted::Scripted;
 pub use servo::{ServoLink, WATCHDOG_S};
 pub use spec::DeviceSpec;

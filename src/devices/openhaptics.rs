@@ -11,13 +11,15 @@
 use std::ffi::{CString, c_char, c_int, c_uint, c_ulong, c_ushort, c_void};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use libloading::Library;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 
+use super::release::Release;
 use super::servo::ServoLink;
 use super::vendor::VendorLibrary;
-use super::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
+use super::{DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice};
 
 /// The HD library, and what to install when it is missing.
 pub const LIBRARY: VendorLibrary = VendorLibrary {
@@ -205,13 +207,51 @@ extern "C" fn servo_frame(data: *mut c_void) -> c_uint {
     HD_CALLBACK_CONTINUE
 }
 
+/// An initialized device and its scheduled servo: what must be released, once, whichever way
+/// the program leaves (see [`super::release`]).
+struct Session {
+    hd: Arc<Hd>,
+    handle: c_uint,
+    /// The servo callback's handle once scheduled (with the scheduler started).
+    scheduled: Option<c_ulong>,
+    servo: Box<Servo>,
+    released: AtomicBool,
+}
+
+impl Release for Session {
+    /// Zero force at once (the link halted), the scheduler stopped (no callback runs after it
+    /// returns) and the callback unscheduled, zero written in a last frame, the device disabled.
+    fn release(&self) {
+        if self.released.swap(true, Ordering::AcqRel) {
+            return;
+        }
+        self.servo.link.halt();
+        // SAFETY: the handle is the one initialized; the callback's data (`servo`) lives as long
+        // as the session, past the scheduler's stop.
+        unsafe {
+            if let Some(scheduled) = self.scheduled {
+                (self.hd.stop_scheduler)();
+                (self.hd.unschedule)(scheduled);
+            }
+            let zero = [0.0f64; 3];
+            (self.hd.begin_frame)(self.handle);
+            (self.hd.set_doublev)(HD_CURRENT_FORCE, zero.as_ptr());
+            (self.hd.end_frame)(self.handle);
+            (self.hd.disable_device)(self.handle);
+        }
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        self.release();
+    }
+}
+
 /// A Geomagic device served by the HD scheduler.
 pub struct OpenHaptics {
     name: String,
-    hd: Arc<Hd>,
-    handle: c_uint,
-    scheduled: c_ulong,
-    servo: Box<Servo>,
+    session: Arc<Session>,
     limits: DeviceLimits,
     /// The usable workspace's box (m, the scene's axes): its lower and upper corners.
     pub workspace_m: (Vector3<f64>, Vector3<f64>),
@@ -219,7 +259,8 @@ pub struct OpenHaptics {
 
 impl OpenHaptics {
     /// Opens the device named `device` (the vendor's default without one) through the HD
-    /// library at `library` (or the one `LIBRARY` finds).
+    /// library at `library` (or the one `LIBRARY` finds). On any error after the device was
+    /// initialized, it is released before the error is returned.
     pub fn open(library: Option<&Path>, device: Option<&str>) -> Result<Self, DeviceError> {
         let path = library.map_or_else(|| LIBRARY.path(), Path::to_path_buf);
         let hd = Arc::new(Hd::load(&path)?);
@@ -237,11 +278,27 @@ impl OpenHaptics {
         // SAFETY: a null name asks for the default device, as `hd.h` documents.
         let handle =
             unsafe { (hd.init_device)(c_name.as_ref().map_or(std::ptr::null(), |n| n.as_ptr())) };
-        if let Some(error) = hd.error() {
-            return Err(failed("cannot initialize the device", error));
-        }
+        let init_error = hd.error();
         if handle == HD_INVALID_HANDLE {
-            return Err(failed("cannot initialize the device", (0x0104, 0)));
+            return Err(failed(
+                "cannot initialize the device",
+                init_error.unwrap_or((0x0104, 0)),
+            ));
+        }
+        let mut session = Session {
+            hd: hd.clone(),
+            handle,
+            scheduled: None,
+            servo: Box::new(Servo {
+                hd: hd.clone(),
+                handle,
+                link: Arc::new(ServoLink::default()),
+            }),
+            released: AtomicBool::new(false),
+        };
+        if let Some(error) = init_error {
+            drop(session);
+            return Err(failed("cannot initialize the device", error));
         }
         // SAFETY: the handle was just returned by `hdInitDevice`.
         unsafe { (hd.make_current)(handle) };
@@ -252,48 +309,36 @@ impl OpenHaptics {
             to_scene(&Vector3::new(workspace[3], workspace[4], workspace[5])),
         );
         let workspace_m = (corners.0.inf(&corners.1), corners.0.sup(&corners.1));
-        // SAFETY: a model string is static in the library, or null.
-        let model = unsafe { (hd.get_string)(HD_DEVICE_MODEL_TYPE) };
-        let model = match model.is_null() {
-            true => "Geomagic device".to_owned(),
-            // SAFETY: non-null strings from `hdGetString` are NUL-terminated.
-            false => unsafe { std::ffi::CStr::from_ptr(model) }
-                .to_string_lossy()
-                .into_owned(),
-        };
-        let servo = Box::new(Servo {
-            hd: hd.clone(),
-            handle,
-            link: Arc::new(ServoLink::default()),
-        });
-        // SAFETY: the callback's data outlives its scheduling (unscheduled in `drop` first).
-        let scheduled = unsafe {
+        let model = model_name(&hd);
+        // SAFETY: the callback's data outlives its scheduling (the session unschedules it
+        // before the box is freed).
+        unsafe {
             (hd.enable)(HD_FORCE_OUTPUT);
-            let data = &*servo as *const Servo as *mut c_void;
-            let scheduled =
-                (hd.schedule_asynchronous)(servo_frame, data, HD_DEFAULT_SCHEDULER_PRIORITY);
+            let data = &*session.servo as *const Servo as *mut c_void;
+            session.scheduled = Some((hd.schedule_asynchronous)(
+                servo_frame,
+                data,
+                HD_DEFAULT_SCHEDULER_PRIORITY,
+            ));
             (hd.start_scheduler)();
-            scheduled
-        };
-        let device = Self {
-            name: format!("OpenHaptics {model} ({name})"),
-            hd,
-            handle,
-            scheduled,
-            servo,
-            limits,
-            workspace_m,
-        };
-        if let Some(error) = device.hd.error() {
+        }
+        let session = Arc::new(session);
+        super::register(&(session.clone() as Arc<dyn Release>));
+        if let Some(error) = hd.error() {
             return Err(failed("cannot start the servo loop", error));
         }
-        match device.servo.link.await_first_sample() {
-            true => Ok(device),
-            false => Err(failed(
+        if !session.servo.link.await_first_sample() {
+            return Err(failed(
                 "the servo loop ran no frame within a second of starting",
                 (0x0402, 0),
-            )),
+            ));
         }
+        Ok(Self {
+            name: format!("OpenHaptics {model} ({name})"),
+            session,
+            limits,
+            workspace_m,
+        })
     }
 
     /// The HD library this machine would load, or why there is none (what to install).
@@ -304,7 +349,20 @@ impl OpenHaptics {
 
     /// What the haptic loop and the servo share (for its figures: samples, expired frames).
     pub fn link(&self) -> &Arc<ServoLink> {
-        &self.servo.link
+        &self.session.servo.link
+    }
+}
+
+/// The device's model, as the library names it.
+fn model_name(hd: &Hd) -> String {
+    // SAFETY: a model string is static in the library, or null.
+    let model = unsafe { (hd.get_string)(HD_DEVICE_MODEL_TYPE) };
+    match model.is_null() {
+        true => "Geomagic device".to_owned(),
+        // SAFETY: non-null strings from `hdGetString` are NUL-terminated.
+        false => unsafe { std::ffi::CStr::from_ptr(model) }
+            .to_string_lossy()
+            .into_owned(),
     }
 }
 
@@ -339,7 +397,7 @@ impl HapticDevice for OpenHaptics {
     }
 
     fn read(&mut self, _time_s: f64) -> Result<DeviceSample, DeviceError> {
-        let link = &self.servo.link;
+        let link = &self.session.servo.link;
         if let Some((code, internal)) = link.take_error() {
             return Err(DeviceError::Failed {
                 device: self.name.clone(),
@@ -355,26 +413,8 @@ impl HapticDevice for OpenHaptics {
         })
     }
 
-    fn write_force(&mut self, force_n: &Vector3<f64>) -> Result<(), DeviceError> {
-        self.servo.link.command(force_n);
+    fn render(&mut self, force: EdgeForce) -> Result<(), DeviceError> {
+        self.session.servo.link.command(&force);
         Ok(())
-    }
-}
-
-impl Drop for OpenHaptics {
-    /// Zero force, the servo stopped, the device released: whatever the loop last commanded.
-    fn drop(&mut self) {
-        self.servo.link.command(&Vector3::zeros());
-        // SAFETY: the scheduler stops (no callback runs after it returns) before the callback
-        // is unscheduled and its data freed; the handle is the one initialized.
-        unsafe {
-            (self.hd.stop_scheduler)();
-            (self.hd.unschedule)(self.scheduled);
-            let zero = [0.0f64; 3];
-            (self.hd.begin_frame)(self.handle);
-            (self.hd.set_doublev)(HD_CURRENT_FORCE, zero.as_ptr());
-            (self.hd.end_frame)(self.handle);
-            (self.hd.disable_device)(self.handle);
-        }
     }
 }

@@ -4,10 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-use nalgebra::Vector3;
-
 use super::{
-    DeviceError, DeviceLimits, DeviceSample, HapticDevice, Trajectory, TrajectoryError,
+    DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice, Trajectory, TrajectoryError,
     TrajectoryRow,
 };
 
@@ -54,8 +52,9 @@ impl HapticDevice for Recorder {
         Ok(sample)
     }
 
-    fn write_force(&mut self, force_n: &Vector3<f64>) -> Result<(), DeviceError> {
-        self.inner.write_force(force_n)
+    /// The wrapped device guards the force again against its own peak.
+    fn render(&mut self, force: EdgeForce) -> Result<(), DeviceError> {
+        self.inner.write_force(force.newtons())
     }
 }
 

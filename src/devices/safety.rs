@@ -30,6 +30,47 @@ pub struct SafetySettings {
     pub recovery_ticks: u32,
 }
 
+/// The largest force limit (N) a setting may ask for: more than any haptic device renders.
+pub const MAX_FORCE_LIMIT_N: f64 = 20.0;
+
+impl SafetySettings {
+    /// Whether every setting is one the filter can honour: a force limit from 0 to
+    /// [`MAX_FORCE_LIMIT_N`], a rate limit above zero and finite, a fade of at least one tick.
+    /// A negative limit would reverse every force, so it is refused rather than mended.
+    pub fn check(&self) -> Result<(), String> {
+        check_force_limit(self.max_force_n).map_err(|e| format!("max_force_n: {e}"))?;
+        let rate = self.max_change_n_per_tick;
+        if !(rate.is_finite() && rate > 0.0 && rate <= MAX_FORCE_LIMIT_N) {
+            return Err(format!(
+                "max_change_n_per_tick: {rate} is not a rate limit: more than 0 and at most \
+                 {MAX_FORCE_LIMIT_N} N a tick"
+            ));
+        }
+        if self.fade_ticks == 0 {
+            return Err("fade_ticks: 0 is not a fade: at least 1 tick".into());
+        }
+        Ok(())
+    }
+}
+
+/// A force limit (N) a person may set: finite, from 0 to [`MAX_FORCE_LIMIT_N`].
+pub fn check_force_limit(force_n: f64) -> Result<f64, String> {
+    match force_n.is_finite() && (0.0..=MAX_FORCE_LIMIT_N).contains(&force_n) {
+        true => Ok(force_n),
+        false => Err(format!(
+            "{force_n} is not a force limit: from 0 to {MAX_FORCE_LIMIT_N} N (a firm press on \
+             the liver is about 0.3 N; the Geomagic Touch renders 3.3 N at most)"
+        )),
+    }
+}
+
+/// The limit a filter applies: the smaller of the settings' and the device's peak, and zero for
+/// either that is not a force limit, so that no setting can turn the force round.
+fn applied_limit_n(settings: &SafetySettings, limits: &DeviceLimits) -> f64 {
+    let usable = |f: f64| if f.is_finite() && f > 0.0 { f } else { 0.0 };
+    usable(settings.max_force_n).min(usable(limits.peak_force_n))
+}
+
 impl Default for SafetySettings {
     /// 3.3 N: the Geomagic Touch's peak force. 20 mN a tick (20 N/s) is ten times what a
     /// fast jab into liver asks for, and a fade over 5 ticks (5 ms) is quicker than a hand
@@ -52,6 +93,8 @@ pub enum Fault {
     NonFiniteDevice,
     /// The physics produced a force that is not a number.
     NonFiniteForce,
+    /// The filter's own output was not a number (it sends the fade instead).
+    NonFiniteOutput,
     /// The device reported an error.
     Device(String),
     /// Ticks overran their period this many times in a row.
@@ -65,6 +108,7 @@ impl std::fmt::Display for Fault {
         match self {
             Fault::NonFiniteDevice => write!(f, "the device reported a non-finite position"),
             Fault::NonFiniteForce => write!(f, "the computed force is not finite"),
+            Fault::NonFiniteOutput => write!(f, "the safety filter's output is not finite"),
             Fault::Device(message) => write!(f, "device error: {message}"),
             Fault::Overruns(n) => write!(f, "{n} ticks in a row overran the 1 ms period"),
             Fault::Physics(message) => write!(f, "the physics failed: {message}"),
@@ -94,18 +138,21 @@ pub struct SafetyFilter {
     /// The exponential average of the squared force sent (N²) over the thermal window.
     heat_n2: f64,
     state: State,
+    /// Whether the last output computed was not finite (and the fade sent instead).
+    refused_output: bool,
 }
 
 impl SafetyFilter {
     /// A filter for a device with `limits`.
     pub fn new(settings: SafetySettings, limits: DeviceLimits) -> Self {
         Self {
-            max_force_n: settings.max_force_n.min(limits.peak_force_n),
+            max_force_n: applied_limit_n(&settings, &limits),
             settings,
             limits,
             output: Vector3::zeros(),
             heat_n2: 0.0,
             state: State::Rendering,
+            refused_output: false,
         }
     }
 
@@ -116,7 +163,7 @@ impl SafetyFilter {
     /// New settings (another scene's), keeping the force being sent and any fault: the force
     /// then moves from what the hand feels now at the allowed rate, as it would within a scene.
     pub fn retune(&mut self, settings: SafetySettings, limits: DeviceLimits) {
-        self.max_force_n = settings.max_force_n.min(limits.peak_force_n);
+        self.max_force_n = applied_limit_n(&settings, &limits);
         self.settings = settings;
         self.limits = limits;
     }
@@ -136,6 +183,9 @@ impl SafetyFilter {
     /// (below it beyond, so that an overshoot is paid back).
     fn thermal_cap_n(&self) -> f64 {
         let continuous = self.limits.continuous_force_n;
+        if !(continuous.is_finite() && continuous > 0.0) {
+            return 0.0;
+        }
         let spare = 1.0 - self.heat_n2 / (continuous * continuous);
         (continuous + (self.max_force_n - continuous).max(0.0) * spare).max(0.0)
     }
@@ -146,11 +196,33 @@ impl SafetyFilter {
     }
 
     /// The force to send this tick for the `desired` one, given the faults seen this tick.
+    /// Whatever comes in, what comes out is finite and within the peak limit: an output that
+    /// is not finite (arithmetic gone wrong) is itself a fault, and the fade is sent instead.
     pub fn filter(&mut self, desired: &Vector3<f64>, faults: &[Fault]) -> Vector3<f64> {
-        let faulted = !faults.is_empty() || !desired.iter().all(|c| c.is_finite());
-        self.state = match (self.state, faulted) {
+        let faulted = !faults.is_empty() || !is_finite(desired);
+        self.state = self.next_state(faulted);
+        let mut output = self.output_for(desired);
+        self.refused_output = !is_finite(&output);
+        if self.refused_output {
+            self.state = self.next_state(true);
+            output = self.output_for(desired);
+        }
+        self.output = output;
+        let window = (self.limits.thermal_window_s / TICK_S).max(1.0);
+        self.heat_n2 += (self.output.norm_squared() - self.heat_n2) / window;
+        self.output
+    }
+
+    /// Whether the last [`Self::filter`] found its own output not finite and faded instead.
+    pub fn refused_output(&self) -> bool {
+        self.refused_output
+    }
+
+    /// The state after this tick's faults (or their absence).
+    fn next_state(&self, faulted: bool) -> State {
+        match (self.state, faulted) {
             (State::Rendering, true) => State::Fading {
-                from: self.output,
+                from: finite_or_zero(self.output),
                 tick: 0,
             },
             (State::Fading { from, tick }, _) => State::Fading {
@@ -163,28 +235,61 @@ impl SafetyFilter {
             }
             (State::Held { clean }, false) => State::Held { clean: clean + 1 },
             (State::Rendering, false) => State::Rendering,
-        };
-        self.output = match self.state {
+        }
+    }
+
+    /// The force the state gives for `desired`; a fade that ends holds at zero.
+    fn output_for(&mut self, desired: &Vector3<f64>) -> Vector3<f64> {
+        match self.state {
             State::Rendering => self.limited(desired),
             State::Fading { from, tick } => {
-                let left = self.settings.fade_ticks.saturating_sub(tick + 1);
+                let fade_ticks = self.settings.fade_ticks.max(1);
+                let left = fade_ticks.saturating_sub(tick + 1);
                 if left == 0 {
                     self.state = State::Held { clean: 0 };
                 }
-                from * (left as f64 / self.settings.fade_ticks.max(1) as f64)
+                from * (left as f64 / fade_ticks as f64)
             }
             State::Held { .. } => Vector3::zeros(),
-        };
-        let window = (self.limits.thermal_window_s / TICK_S).max(1.0);
-        self.heat_n2 += (self.output.norm_squared() - self.heat_n2) / window;
-        self.output
+        }
     }
 
     /// `desired` clamped to the peak and thermal limits, then moved towards from the last
     /// output by at most the change allowed per tick.
     fn limited(&self, desired: &Vector3<f64>) -> Vector3<f64> {
         let clamped = desired.cap_magnitude(self.max_force_n.min(self.thermal_cap_n()));
-        let change = (clamped - self.output).cap_magnitude(self.settings.max_change_n_per_tick);
+        let rate = self.settings.max_change_n_per_tick.max(0.0);
+        let change = (clamped - self.output).cap_magnitude(rate);
         self.output + change
+    }
+}
+
+fn is_finite(force_n: &Vector3<f64>) -> bool {
+    force_n.iter().all(|c| c.is_finite())
+}
+
+fn finite_or_zero(force_n: Vector3<f64>) -> Vector3<f64> {
+    match is_finite(&force_n) {
+        true => force_n,
+        false => Vector3::zeros(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Whatever state the filter is in (here its last output made NaN, as a bug elsewhere
+    /// could), what it sends is finite: the non-finite output is refused, counted as a fault,
+    /// and the fade is sent instead.
+    #[test]
+    fn a_non_finite_output_is_refused_and_faded() {
+        let mut filter = SafetyFilter::new(SafetySettings::default(), DeviceLimits::touch());
+        filter.output = Vector3::new(f64::NAN, 0.0, 0.0);
+        let sent = filter.filter(&Vector3::new(0.0, 0.0, 0.5), &[]);
+        assert!(filter.refused_output());
+        assert_eq!(sent, Vector3::zeros());
+        assert!(filter.is_faulted());
+        assert!(filter.heat_n2.is_finite());
     }
 }

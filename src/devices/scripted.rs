@@ -2,9 +2,7 @@
 //! benchmarks. It has no motors: the forces it is sent are the haptic world's to keep (its
 //! force trace), so that two runs can be compared.
 
-use nalgebra::Vector3;
-
-use super::{DeviceError, DeviceLimits, DeviceSample, HapticDevice, Trajectory};
+use super::{DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice, Trajectory};
 
 pub struct Scripted {
     name: String,
@@ -40,7 +38,7 @@ impl HapticDevice for Scripted {
         Ok(self.trajectory.sample(time_s))
     }
 
-    fn write_force(&mut self, _force_n: &Vector3<f64>) -> Result<(), DeviceError> {
+    fn render(&mut self, _force: EdgeForce) -> Result<(), DeviceError> {
         Ok(())
     }
 }

@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-use super::DeviceSample;
+use super::{DeviceSample, EdgeForce};
 
 /// How long a commanded force stays valid without a new command: ten missed 1 ms ticks.
 pub const WATCHDOG_S: f64 = 0.010;
@@ -43,6 +43,13 @@ pub struct ServoLink {
     internal_error: AtomicU32,
     /// Servo frames that rendered zero because the command had expired.
     expired_frames: AtomicU64,
+    /// Set when the device is being released: zero from then on, whatever is commanded.
+    halted: AtomicBool,
+    /// The command's age (ns) at the latest servo frame that rendered it, and at the first
+    /// frame that found it expired (0 until one has): the watchdog measured in the servo's own
+    /// frames, whatever the machine's load does to their spacing.
+    rendered_age_ns: AtomicU64,
+    expired_age_ns: AtomicU64,
 }
 
 impl Default for ServoLink {
@@ -67,6 +74,9 @@ impl ServoLink {
             error: AtomicU32::new(0),
             internal_error: AtomicU32::new(0),
             expired_frames: AtomicU64::new(0),
+            halted: AtomicBool::new(false),
+            rendered_age_ns: AtomicU64::new(0),
+            expired_age_ns: AtomicU64::new(0),
         }
     }
 
@@ -101,17 +111,24 @@ impl ServoLink {
     /// Servo side: the force to render this frame: the last command, or zero once it is older
     /// than the watchdog allows (or before any).
     pub fn force_to_render(&self) -> Vector3<f64> {
-        let fresh = self.commanded.load(Ordering::Acquire)
-            && self
-                .now_ns()
-                .saturating_sub(self.commanded_at_ns.load(Ordering::Acquire))
-                <= self.watchdog.as_nanos() as u64;
-        if !fresh {
-            if self.commanded.load(Ordering::Relaxed) {
-                self.expired_frames.fetch_add(1, Ordering::Relaxed);
-            }
+        if self.halted.load(Ordering::Acquire) {
             return Vector3::zeros();
         }
+        if !self.commanded.load(Ordering::Acquire) {
+            return Vector3::zeros();
+        }
+        let age_ns = (self.now_ns()).saturating_sub(self.commanded_at_ns.load(Ordering::Acquire));
+        if age_ns > self.watchdog.as_nanos() as u64 {
+            self.expired_frames.fetch_add(1, Ordering::Relaxed);
+            let _ = self.expired_age_ns.compare_exchange(
+                0,
+                age_ns,
+                Ordering::Relaxed,
+                Ordering::Relaxed,
+            );
+            return Vector3::zeros();
+        }
+        self.rendered_age_ns.store(age_ns, Ordering::Relaxed);
         Vector3::from_fn(|c, _| f64::from_bits(self.force[c].load(Ordering::Relaxed)))
     }
 
@@ -136,13 +153,35 @@ impl ServoLink {
         })
     }
 
-    /// Loop side: the force (N) to render until the next command.
-    pub fn command(&self, force_n: &Vector3<f64>) {
-        for (slot, v) in self.force.iter().zip(force_n.iter()) {
+    /// Loop side: the force to render until the next command (one that has passed the
+    /// device's edge guard).
+    pub fn command(&self, force: &EdgeForce) {
+        for (slot, v) in self.force.iter().zip(force.newtons().iter()) {
             slot.store(v.to_bits(), Ordering::Relaxed);
         }
         self.commanded_at_ns.store(self.now_ns(), Ordering::Release);
+        self.expired_age_ns.store(0, Ordering::Relaxed);
         self.commanded.store(true, Ordering::Release);
+    }
+
+    /// The last command's age (s) at the latest servo frame that rendered it, and at the first
+    /// frame that rendered zero instead (`None` while none has): the watchdog holds when the
+    /// first is within [`Self::watchdog_s`] and the second past it.
+    pub fn watchdog_ages_s(&self) -> (f64, Option<f64>) {
+        let rendered = self.rendered_age_ns.load(Ordering::Relaxed) as f64 * 1e-9;
+        let expired = self.expired_age_ns.load(Ordering::Relaxed);
+        (rendered, (expired > 0).then(|| expired as f64 * 1e-9))
+    }
+
+    /// Zero force from now on, whatever the loop commands: the device is being released (its
+    /// backend closing, a panic, a signal).
+    pub fn halt(&self) {
+        self.halted.store(true, Ordering::Release);
+    }
+
+    /// Whether [`Self::halt`] has been called.
+    pub fn is_halted(&self) -> bool {
+        self.halted.load(Ordering::Acquire)
     }
 
     /// Loop side: the servo's last error and the vendor's code with it, clearing it.

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use super::{DeviceError, DeviceLimits, DeviceSample, HapticDevice};
+use super::{DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice};
 
 /// Three f64 in atomics: each component is consistent, the triple may mix two writes for one
 /// tick, which a tool moved by hand cannot tell.
@@ -103,8 +103,8 @@ impl HapticDevice for VirtualDevice {
         })
     }
 
-    fn write_force(&mut self, force_n: &Vector3<f64>) -> Result<(), DeviceError> {
-        self.handle.force_n.store(force_n);
+    fn render(&mut self, force: EdgeForce) -> Result<(), DeviceError> {
+        self.handle.force_n.store(force.newtons());
         Ok(())
     }
 }

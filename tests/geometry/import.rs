@@ -8,7 +8,7 @@ use pgd_surgery::mesh::organs::{self, Organ, OrganSettings};
 use pgd_surgery::mesh::{QualityReport, box_mesh};
 
 /// Writes `contents` to a fresh file with this name in a per-test directory.
-fn file(name: &str, contents: &[u8]) -> PathBuf {
+pub fn file(name: &str, contents: &[u8]) -> PathBuf {
     let dir = std::env::temp_dir().join(format!(
         "pgd-import-{}-{}",
         std::process::id(),
@@ -26,7 +26,7 @@ fn import(name: &str, contents: &str) -> Result<pgd_surgery::mesh::TetMesh, Impo
 
 /// Two tetrahedra sharing the face (1, 0, 0), (0, 1, 0), (0, 0, 1); the face z = 0 is the
 /// physical surface "clamped".
-const MSH2: &str = r#"$MeshFormat
+pub const MSH2: &str = r#"$MeshFormat
 2.2 0 8
 $EndMeshFormat
 $PhysicalNames
@@ -49,7 +49,7 @@ $Elements
 $EndElements
 "#;
 
-const MSH4: &str = r#"$MeshFormat
+pub const MSH4: &str = r#"$MeshFormat
 4.1 0 8
 $EndMeshFormat
 $PhysicalNames
@@ -102,12 +102,15 @@ fn gmsh_v2_and_v4_read_with_physical_surfaces() {
     }
 }
 
+/// The two tetrahedra in legacy VTK's classic cell layout, and in version 5's offsets and
+/// connectivity.
+pub const VTK_CLASSIC: &str = "# vtk DataFile Version 3.0\ntwo tets\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 5 double\n0 0 0 1 0 0 0 1 0\n0 0 1 1 1 1\nCELLS 2 10\n4 0 1 2 3\n4 1 2 3 4\nCELL_TYPES 2\n10\n10\n";
+pub const VTK_V5: &str = "# vtk DataFile Version 5.1\ntwo tets\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 5 double\n0 0 0 1 0 0 0 1 0\n0 0 1 1 1 1\nCELLS 3 8\nOFFSETS vtktypeint64\n0 4 8\nCONNECTIVITY vtktypeint64\n0 1 2 3 1 2 3 4\nCELL_TYPES 2\n10\n10\n";
+
 #[test]
 fn vtk_legacy_reads_both_cell_layouts() {
-    let classic = "# vtk DataFile Version 3.0\ntwo tets\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 5 double\n0 0 0 1 0 0 0 1 0\n0 0 1 1 1 1\nCELLS 2 10\n4 0 1 2 3\n4 1 2 3 4\nCELL_TYPES 2\n10\n10\n";
-    check_two_tets(&import("classic.vtk", classic).unwrap());
-    let v5 = "# vtk DataFile Version 5.1\ntwo tets\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 5 double\n0 0 0 1 0 0 0 1 0\n0 0 1 1 1 1\nCELLS 3 8\nOFFSETS vtktypeint64\n0 4 8\nCONNECTIVITY vtktypeint64\n0 1 2 3 1 2 3 4\nCELL_TYPES 2\n10\n10\n";
-    check_two_tets(&import("v5.vtk", v5).unwrap());
+    check_two_tets(&import("classic.vtk", VTK_CLASSIC).unwrap());
+    check_two_tets(&import("v5.vtk", VTK_V5).unwrap());
 }
 
 #[test]
@@ -154,7 +157,7 @@ fn vtu_round_trip_keeps_face_sets() {
 }
 
 /// A cube of side 4 cm written in millimetres, as CAD tools do.
-const CUBE_OBJ: &str = "# cube, mm\nv 0 0 0\nv 40 0 0\nv 40 40 0\nv 0 40 0\nv 0 0 40\nv 40 0 40\nv 40 40 40\nv 0 40 40\n\
+pub const CUBE_OBJ: &str = "# cube, mm\nv 0 0 0\nv 40 0 0\nv 40 40 0\nv 0 40 0\nv 0 0 40\nv 40 0 40\nv 40 40 40\nv 0 40 40\n\
 f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
 
 #[test]
@@ -202,8 +205,8 @@ fn tetra_facets() -> [[[f32; 3]; 3]; 4] {
     ]
 }
 
-#[test]
-fn ascii_and_binary_stl_read_the_same_solid() {
+/// A tetrahedron as an ASCII and as a binary STL file.
+pub fn tetra_stl() -> (String, Vec<u8>) {
     let mut ascii = String::from("solid tetra\n");
     let mut binary = vec![0u8; 80];
     binary.extend(4u32.to_le_bytes());
@@ -218,6 +221,12 @@ fn ascii_and_binary_stl_read_the_same_solid() {
         binary.extend([0u8; 2]);
     }
     ascii.push_str("endsolid tetra\n");
+    (ascii, binary)
+}
+
+#[test]
+fn ascii_and_binary_stl_read_the_same_solid() {
+    let (ascii, binary) = tetra_stl();
     let options = ImportOptions {
         scale: 1.0,
         surface_nodes: 800,

@@ -4,9 +4,10 @@
 use std::time::Duration;
 
 use nalgebra::Vector3;
+use pgd_surgery::app::haptic::{HapticLoop, HapticScene};
 use pgd_surgery::devices::{
-    DeviceLimits, DeviceSpec, Fault, Histogram, SafetyFilter, SafetySettings, TICK_S, Trajectory,
-    TrajectoryError,
+    DeviceLimits, DeviceSpec, EdgeForce, EdgeRefusal, Fault, HapticDevice, Histogram, Recorder,
+    SafetyFilter, SafetySettings, Scripted, TICK_S, Trajectory, TrajectoryError, VirtualDevice,
 };
 
 fn write(name: &str, text: &str) -> std::path::PathBuf {
@@ -185,6 +186,131 @@ fn the_safety_filter_fades_holds_and_recovers() {
         settings.max_change_n_per_tick * (settings.fade_ticks - 1) as f64
             / settings.fade_ticks as f64
     );
+}
+
+/// No force limit can turn the force against the hand: a negative, non-finite or too large
+/// limit is refused by the settings' check (naming the field, the value and the range) and by
+/// a haptic loop built on it; a filter given one anyway (bypassing the check) sends nothing,
+/// never a reversed force or a NaN, whatever is asked of it.
+#[test]
+fn no_force_limit_can_reverse_the_force() {
+    for bad in [-1.0, -1e-9, f64::NAN, f64::INFINITY, 20.5] {
+        let settings = SafetySettings {
+            max_force_n: bad,
+            ..SafetySettings::default()
+        };
+        let e = settings.check().unwrap_err();
+        assert!(e.contains("max_force_n") && e.contains("0 to 20 N"), "{e}");
+        let scene = HapticScene {
+            safety: settings,
+            ..HapticScene::without_organs()
+        };
+        let device = Box::new(Scripted::new("still", Trajectory::default()));
+        let refused = HapticLoop::new(&scene, device).err().unwrap().to_string();
+        assert!(refused.contains("max_force_n"), "{refused}");
+        let mut filter = SafetyFilter::new(settings, DeviceLimits::touch());
+        for desired in [Vector3::new(10.0, 0.0, 0.0), Vector3::zeros()] {
+            for _ in 0..500 {
+                let sent = filter.filter(&desired, &[]);
+                assert!(sent.iter().all(|c| c.is_finite()), "limit {bad}: {sent:?}");
+                assert!(sent.dot(&desired) >= 0.0, "limit {bad} reversed: {sent:?}");
+                match bad > 0.0 && bad.is_finite() {
+                    // Too large to set, yet not one to reverse: the device's peak holds.
+                    true => assert!(sent.norm() <= DeviceLimits::touch().peak_force_n),
+                    false => assert_eq!(sent, Vector3::zeros(), "limit {bad}: {sent:?}"),
+                }
+            }
+        }
+    }
+    let rate = SafetySettings {
+        max_change_n_per_tick: -0.02,
+        ..SafetySettings::default()
+    };
+    assert!(rate.check().unwrap_err().contains("max_change_n_per_tick"));
+    assert!(SafetySettings::default().check().is_ok());
+}
+
+/// The command line refuses a force limit or a duration that is not one before anything runs:
+/// exit 2, no panic, the option, the value and the range named.
+#[test]
+fn the_trainer_refuses_limits_that_are_not_ones() {
+    let cases = [
+        ("--max-force-n=-1", "0 to 20 N"),
+        ("--max-force-n=NaN", "0 to 20 N"),
+        ("--max-force-n=25", "0 to 20 N"),
+        ("--exit-after-s=-1", "more than 0"),
+        ("--screenshot-after-s=inf", "0 or more"),
+    ];
+    for (option, range) in cases {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_trainer"))
+            .args(["--headless", "--coarse", option, "--json"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let (name, value) = option.split_once('=').unwrap();
+        assert_eq!(out.status.code(), Some(2), "{option}: {stderr}");
+        assert!(stderr.contains(name) && stderr.contains(value), "{stderr}");
+        assert!(
+            stderr.contains(range) && !stderr.contains("panicked"),
+            "{stderr}"
+        );
+        assert!(out.stdout.is_empty(), "{option} ran");
+    }
+}
+
+/// The guard at the device's edge, apart from the filter: a force within the peak passes as
+/// it is; one over it is brought to the peak along itself and refused; a non-finite one is
+/// zero and refused; a device whose peak is not a positive number renders nothing.
+#[test]
+fn the_edge_guard_passes_clamps_or_zeroes() {
+    let within = Vector3::new(0.0, 0.6, 0.8);
+    assert_eq!(
+        EdgeForce::guard(&within, 3.3),
+        (EdgeForce::guard(&within, 3.3).0, None)
+    );
+    assert_eq!(*EdgeForce::guard(&within, 3.3).0.newtons(), within);
+    let (clamped, refusal) = EdgeForce::guard(&(within * 100.0), 3.3);
+    assert!((clamped.newtons() - within * 3.3).norm() < 1e-12);
+    assert_eq!(
+        refusal,
+        Some(EdgeRefusal::OverPeak {
+            asked_n: 100.0,
+            peak_n: 3.3
+        })
+    );
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let (zero, refusal) = EdgeForce::guard(&Vector3::new(0.1, bad, 0.0), 3.3);
+        assert_eq!(
+            (zero, refusal),
+            (EdgeForce::ZERO, Some(EdgeRefusal::NonFinite))
+        );
+    }
+    for peak in [-3.3, f64::NAN, 0.0] {
+        let (sent, _) = EdgeForce::guard(&within, peak);
+        assert_eq!(*sent.newtons(), Vector3::zeros(), "peak {peak}");
+    }
+}
+
+/// The recorder guards what it passes on too, and the device it wraps again: 100 N asked of
+/// a recorded mouse (3.3 N peak) reaches it as 3.3 N, a NaN as zero, each with its refusal.
+#[test]
+fn the_recorder_guards_what_it_passes_on() {
+    let (mouse, handle) = VirtualDevice::new(&Vector3::zeros());
+    let path = std::env::temp_dir().join(format!("{}-guarded.csv", std::process::id()));
+    let mut recorded = Recorder::new(Box::new(mouse), &path);
+    let over = recorded
+        .write_force(&Vector3::new(0.0, 0.0, 100.0))
+        .unwrap_err();
+    assert!(
+        over.to_string().contains("over the device's 3.300 N peak"),
+        "{over}"
+    );
+    assert!((handle.force_n() - Vector3::new(0.0, 0.0, 3.3)).norm() < 1e-12);
+    let nan = recorded
+        .write_force(&Vector3::new(f64::NAN, 0.0, 0.0))
+        .unwrap_err();
+    assert!(nan.to_string().contains("not finite"), "{nan}");
+    assert_eq!(handle.force_n(), Vector3::zeros());
 }
 
 #[test]

@@ -3,6 +3,7 @@
  * z up, m), the forces sent recorded, errors injected. The `fake_dhd_*` functions are the
  * test's controls. Built by the test with the system C compiler. */
 
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <string.h>
@@ -11,6 +12,9 @@ static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
 static double position_m[3];
 static unsigned int buttons;
 static double last_force[3];
+/* What reached the "motors": the largest force magnitude sent, and how many non-finite. */
+static double largest_force;
+static long nonfinite_forces;
 static atomic_int pending_error;
 static int last_error;
 static atomic_long frames;
@@ -53,6 +57,9 @@ int dhdSetForce(double fx, double fy, double fz, char id) {
     last_force[0] = fx;
     last_force[1] = fy;
     last_force[2] = fz;
+    double norm = sqrt(fx * fx + fy * fy + fz * fz);
+    if (!isfinite(norm)) nonfinite_forces++;
+    else if (norm > largest_force) largest_force = norm;
     pthread_mutex_unlock(&lock);
     atomic_fetch_add(&frames, 1);
     return 0;
@@ -87,5 +94,17 @@ void fake_dhd_last_force(double *out) {
 }
 void fake_dhd_inject_error(int code) { atomic_store(&pending_error, code); }
 long fake_dhd_frames(void) { return atomic_load(&frames); }
+double fake_dhd_largest_force(void) {
+    pthread_mutex_lock(&lock);
+    double largest = largest_force;
+    pthread_mutex_unlock(&lock);
+    return largest;
+}
+long fake_dhd_nonfinite_forces(void) {
+    pthread_mutex_lock(&lock);
+    long count = nonfinite_forces;
+    pthread_mutex_unlock(&lock);
+    return count;
+}
 int fake_dhd_closed(void) { return closed; }
 int fake_dhd_force_enabled(void) { return force_enabled; }

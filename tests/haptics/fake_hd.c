@@ -3,6 +3,7 @@
  * the test places, and a record of the forces the callback renders. The `fake_hd_*` functions
  * are the test's controls. Built by the test with the system C compiler. */
 
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <string.h>
@@ -19,6 +20,9 @@ typedef struct {
 static double position_mm[3];
 static int buttons;
 static double last_force[3];
+/* What reached the "motors": the largest force magnitude rendered, and how many non-finite. */
+static double largest_force;
+static long nonfinite_forces;
 static atomic_uint pending_error;
 static atomic_long frames;
 static atomic_int running;
@@ -39,6 +43,13 @@ HHD hdInitDevice(const char *name) {
     if (name && strcmp(name, "absent") == 0) {
         init_error = 0x0303;
         return 0xFFFFFFFF;
+    }
+    /* A device that opens but reports an error with its handle: it must still be released. */
+    if (name && strcmp(name, "half-open") == 0) {
+        initialized = 1;
+        disabled = 0;
+        init_error = 0x0301;
+        return 1;
     }
     initialized = 1;
     disabled = 0;
@@ -95,7 +106,11 @@ const char *hdGetString(unsigned int parameter) {
 }
 
 void hdSetDoublev(unsigned int parameter, const double *values) {
-    if (parameter == 0x2700 && in_frame) memcpy(last_force, values, sizeof last_force);
+    if (parameter != 0x2700 || !in_frame) return;
+    memcpy(last_force, values, sizeof last_force);
+    double norm = sqrt(values[0] * values[0] + values[1] * values[1] + values[2] * values[2]);
+    if (!isfinite(norm)) nonfinite_forces++;
+    else if (norm > largest_force) largest_force = norm;
 }
 
 static void *run_scheduler(void *unused) {
@@ -147,6 +162,18 @@ void fake_hd_last_force(double *out) {
 
 void fake_hd_inject_error(unsigned int code) { atomic_store(&pending_error, code); }
 long fake_hd_frames(void) { return atomic_load(&frames); }
+double fake_hd_largest_force(void) {
+    pthread_mutex_lock(&lock);
+    double largest = largest_force;
+    pthread_mutex_unlock(&lock);
+    return largest;
+}
+long fake_hd_nonfinite_forces(void) {
+    pthread_mutex_lock(&lock);
+    long count = nonfinite_forces;
+    pthread_mutex_unlock(&lock);
+    return count;
+}
 int fake_hd_running(void) { return atomic_load(&running); }
 int fake_hd_disabled(void) { return disabled; }
 int fake_hd_force_output(void) { return force_output; }

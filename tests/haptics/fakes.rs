@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use libloading::{Library, Symbol};
 use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{DeviceForce, FaultLog, HapticLoop, TickClock};
-use pgd_surgery::devices::{HapticDevice, SafetySettings, TICK_S};
+use pgd_surgery::devices::{HapticDevice, SafetySettings, ServoLink, TICK_S, WATCHDOG_S};
 
 use crate::common::{TIP_RADIUS_M, scene, target};
 
@@ -28,6 +28,7 @@ fn built(source: &str) -> PathBuf {
         .args(["-shared", "-fPIC", "-O1", "-pthread", "-o"])
         .arg(&out)
         .arg(&file)
+        .arg("-lm")
         .status()
         .expect("a C compiler (cc) builds the fake vendor library");
     assert!(status.success(), "cc failed on {}", file.display());
@@ -67,6 +68,12 @@ impl VendorFake {
     pub fn long(&self, name: &str) -> i64 {
         // SAFETY: as named.
         unsafe { self.call::<unsafe extern "C" fn() -> i64>(name)() }
+    }
+
+    /// A control without arguments returning a double.
+    pub fn double(&self, name: &str) -> f64 {
+        // SAFETY: as named.
+        unsafe { self.call::<unsafe extern "C" fn() -> f64>(name)() }
     }
 
     /// A control that writes three doubles.
@@ -154,5 +161,66 @@ pub fn assert_faded(run: &FaultRun, says: &str) {
         run.faults.iter().any(|(_, f)| f.contains(says)),
         "{:?}",
         run.faults
+    );
+}
+
+/// The servo rendered the last command while it was within the watchdog and zero from the
+/// first frame past it, as the link measured the command's age; zero came no sooner than the
+/// watchdog in wall time either (`zeroed_after_s`, from just before the command).
+pub fn assert_watchdog_held(link: &ServoLink, zeroed_after_s: f64) {
+    let (rendered_s, expired_s) = link.watchdog_ages_s();
+    let expired_s = expired_s.expect("a servo frame found the command expired");
+    eprintln!(
+        "zeroed {:.1} ms after the last command (watchdog {:.0} ms): rendered at {:.1} ms of \
+         age, zero from {:.1} ms; {} expired frames",
+        zeroed_after_s * 1e3,
+        WATCHDOG_S * 1e3,
+        rendered_s * 1e3,
+        expired_s * 1e3,
+        link.expired_frames()
+    );
+    assert!(
+        rendered_s <= WATCHDOG_S,
+        "rendered at {rendered_s} s of age"
+    );
+    assert!(expired_s > WATCHDOG_S, "zeroed early, at {expired_s} s");
+    assert!(
+        zeroed_after_s >= WATCHDOG_S,
+        "zeroed early: {zeroed_after_s} s"
+    );
+}
+
+/// The guard at `device`'s edge, apart from the safety filter, as the vendor library saw it:
+/// a NaN commanded renders zero and a 100 N one the device's own peak (`peak_n`), each refused
+/// with an error (a fault of the loop's next tick); neither reaches the library's force call
+/// (`fake` prefixes the fake's controls: `fake_hd`, `fake_dhd`).
+pub fn assert_edge_guarded(device: &mut dyn HapticDevice, fake: &VendorFake, prefix: &str) {
+    let peak_n = device.limits().peak_force_n;
+    let frames = format!("{prefix}_frames");
+    device.write_force(&Vector3::new(0.0, 0.0, 1.0)).unwrap();
+    fake.wait(&frames, 3);
+    assert_ne!(
+        fake.vector(&format!("{prefix}_last_force")),
+        Vector3::zeros()
+    );
+    let nan = device.write_force(&Vector3::new(f64::NAN, 0.0, 1.0));
+    let nan = nan.unwrap_err().to_string();
+    assert!(nan.contains("not finite"), "{nan}");
+    fake.wait(&frames, 3);
+    assert_eq!(
+        fake.vector(&format!("{prefix}_last_force")),
+        Vector3::zeros()
+    );
+    let over = device.write_force(&Vector3::new(0.0, 0.0, 100.0));
+    let over = over.unwrap_err().to_string();
+    assert!(over.contains("100.000 N was commanded"), "{over}");
+    fake.wait(&frames, 3);
+    let rendered = fake.vector(&format!("{prefix}_last_force"));
+    assert!((rendered.norm() - peak_n).abs() < 1e-12, "{rendered:?}");
+    assert_eq!(fake.long(&format!("{prefix}_nonfinite_forces")), 0);
+    let largest = fake.double(&format!("{prefix}_largest_force"));
+    assert!(
+        largest <= peak_n * (1.0 + 1e-12),
+        "{largest} N reached the motors"
     );
 }

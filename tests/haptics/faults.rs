@@ -4,7 +4,8 @@
 use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{FaultLog, TickClock};
 use pgd_surgery::devices::{
-    DeviceError, DeviceLimits, DeviceSample, HapticDevice, PressMotion, SafetySettings, Scripted,
+    DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice, PressMotion, SafetySettings,
+    Scripted,
 };
 
 use crate::common::{haptic, press, run, scripted, tick_at};
@@ -47,8 +48,8 @@ impl HapticDevice for Faulty {
         }
     }
 
-    fn write_force(&mut self, force_n: &Vector3<f64>) -> Result<(), DeviceError> {
-        self.inner.write_force(force_n)?;
+    fn render(&mut self, force: EdgeForce) -> Result<(), DeviceError> {
+        self.inner.write_force(force.newtons())?;
         if matches!(self.kind, Kind::WriteError) && self.now_s >= self.from_s {
             return Err(DeviceError::Failed {
                 device: "faulty".into(),

@@ -5,9 +5,12 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
-use pgd_surgery::devices::{ForceDimension, HapticDevice, WATCHDOG_S};
+use pgd_surgery::devices::{ForceDimension, HapticDevice};
 
-use crate::fakes::{VendorFake, assert_faded, press_then_fault, pressing_tip_m};
+use crate::fakes::{
+    VendorFake, assert_edge_guarded, assert_faded, assert_watchdog_held, press_then_fault,
+    pressing_tip_m,
+};
 
 /// This test's own copy of the fake dhd library, and its controls.
 struct Fake(VendorFake);
@@ -101,9 +104,17 @@ fn an_sdk_error_mid_run_fades_the_force_to_zero() {
     assert_faded(&run, "communication error");
 }
 
+/// No NaN and nothing over the device's 9.5 N peak reaches `dhdSetForce`.
+#[test]
+fn the_last_guard_keeps_nan_and_excess_from_the_device() {
+    let fake = Fake::new("edge");
+    let mut device = fake.open().unwrap();
+    assert_edge_guarded(&mut device, &fake.0, "fake_dhd");
+}
+
 /// The loop stops commanding: the servo sends zero once the last command is older than the
-/// watchdog's 10 ms (within the watchdog and 25 ms of scheduling); closed, the device is left at
-/// zero force and closed.
+/// watchdog's 10 ms, measured in the servo's own frames (their spacing is the machine's
+/// business); closed, the device is left at zero force and closed.
 #[test]
 fn a_stalled_loop_and_closing_leave_zero_force() {
     let fake = Fake::new("stall");
@@ -114,12 +125,10 @@ fn a_stalled_loop_and_closing_leave_zero_force() {
     let commanded = Instant::now();
     device.write_force(&Vector3::new(0.0, 0.0, 1.0)).unwrap();
     while fake.last_force() != Vector3::zeros() {
-        assert!(commanded.elapsed() < Duration::from_secs(1), "never zeroed");
+        assert!(commanded.elapsed() < Duration::from_secs(5), "never zeroed");
         std::thread::sleep(Duration::from_micros(100));
     }
-    let zeroed_after = commanded.elapsed().as_secs_f64();
-    eprintln!("zeroed {:.1} ms after the last command", zeroed_after * 1e3);
-    assert!((WATCHDOG_S..WATCHDOG_S + 0.025).contains(&zeroed_after));
+    assert_watchdog_held(device.link(), commanded.elapsed().as_secs_f64());
     device.write_force(&Vector3::new(1.0, 0.0, 0.0)).unwrap();
     fake.wait_frames(3);
     assert_ne!(fake.last_force(), Vector3::zeros());

@@ -4,6 +4,7 @@
 mod common;
 mod deformed;
 mod devices;
+mod exits;
 mod fakes;
 mod faults;
 mod forcedimension;

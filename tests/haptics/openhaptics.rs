@@ -6,10 +6,13 @@ use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{FaultLog, HapticLoop, HapticThread, Scheduling};
-use pgd_surgery::devices::{HapticDevice, OpenHaptics, SafetySettings, TimerMode, WATCHDOG_S};
+use pgd_surgery::devices::{HapticDevice, OpenHaptics, SafetySettings, TimerMode};
 
 use crate::common::{TIP_RADIUS_M, scene, target};
-use crate::fakes::{VendorFake, assert_faded, press_then_fault, pressing_tip_m};
+use crate::fakes::{
+    VendorFake, assert_edge_guarded, assert_faded, assert_watchdog_held, press_then_fault,
+    pressing_tip_m,
+};
 
 /// This test's own copy of the fake HD library, and its controls.
 struct Fake(VendorFake);
@@ -85,9 +88,9 @@ fn a_device_that_fails_to_initialize_says_why() {
 }
 
 /// The stylus at (10, 20, 30) mm in the device's frame (x right, y up, z towards the user) is
-/// the tool at (10, −30, 20) mm in the scene's (z up); a force of (1, 2, 3) N in the scene is
-/// rendered as (1, 3, −2) N in the device's frame; the limits are the device's own (the fake
-/// says 3.0 N peak and 0.75 N continuous).
+/// the tool at (10, −30, 20) mm in the scene's (z up); a force of (0.5, 1, 1.5) N in the scene
+/// is rendered as (0.5, 1.5, −1) N in the device's frame; the limits are the device's own (the
+/// fake says 3.0 N peak and 0.75 N continuous).
 #[test]
 fn the_servo_reads_the_stylus_and_renders_the_force_in_the_devices_frame() {
     let fake = Fake::new("frames");
@@ -104,9 +107,30 @@ fn the_servo_reads_the_stylus_and_renders_the_force_in_the_devices_frame() {
         (limits.peak_force_n, limits.continuous_force_n),
         (3.0, 0.75)
     );
-    device.write_force(&Vector3::new(1.0, 2.0, 3.0)).unwrap();
+    device.write_force(&Vector3::new(0.5, 1.0, 1.5)).unwrap();
     fake.wait_frames(3);
-    assert_eq!(fake.last_force(), Vector3::new(1.0, 3.0, -2.0));
+    assert_eq!(fake.last_force(), Vector3::new(0.5, 1.5, -1.0));
+}
+
+/// No NaN and nothing over the device's 3.0 N peak reaches the HD library's force call.
+#[test]
+fn the_last_guard_keeps_nan_and_excess_from_the_device() {
+    let fake = Fake::new("edge");
+    let mut device = fake.open();
+    assert_edge_guarded(&mut device, &fake.0, "fake_hd");
+}
+
+/// A device the library initializes but reports an error for is released before the error
+/// is returned, not left open.
+#[test]
+fn a_device_that_opens_with_an_error_is_released() {
+    let fake = Fake::new("half-open");
+    let error = OpenHaptics::open(Some(fake.path()), Some("half-open"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(error.contains("HD_DEVICE_ALREADY_INITIATED"), "{error}");
+    assert_eq!(fake.flag("fake_hd_disabled"), 1);
 }
 
 /// The haptic loop over the fake, its stylus 4 mm into the liver: the trainee is pushed back,
@@ -130,8 +154,8 @@ fn an_hd_error_mid_run_fades_the_force_to_zero() {
 }
 
 /// The loop stops commanding (a stall, a panic, a hang): the servo renders zero once the last
-/// command is older than the watchdog's 10 ms; measured from the last command, within the
-/// watchdog and a few of the fake's frames (its scheduler sleeps 1 ms between them).
+/// command is older than the watchdog's 10 ms, measured in the servo's own frames (their
+/// spacing is the machine's business, so a loaded machine cannot fail this).
 #[test]
 fn a_stalled_loop_leaves_the_device_at_zero_force() {
     let fake = Fake::new("stall");
@@ -142,18 +166,10 @@ fn a_stalled_loop_leaves_the_device_at_zero_force() {
     let commanded = Instant::now();
     device.write_force(&Vector3::new(0.0, 0.0, 1.0)).unwrap();
     while fake.last_force() != Vector3::zeros() {
-        assert!(commanded.elapsed() < Duration::from_secs(1), "never zeroed");
+        assert!(commanded.elapsed() < Duration::from_secs(5), "never zeroed");
         std::thread::sleep(Duration::from_micros(100));
     }
-    let zeroed_after = commanded.elapsed().as_secs_f64();
-    eprintln!(
-        "zeroed {:.1} ms after the last command (watchdog {:.0} ms); {} expired frames",
-        zeroed_after * 1e3,
-        WATCHDOG_S * 1e3,
-        device.link().expired_frames()
-    );
-    assert!(zeroed_after >= WATCHDOG_S);
-    assert!(zeroed_after < WATCHDOG_S + 0.025);
+    assert_watchdog_held(device.link(), commanded.elapsed().as_secs_f64());
 }
 
 /// Dropped (the trainer closing, or unwinding from a panic) while commanding 1 N: the servo is

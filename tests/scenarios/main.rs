@@ -1,12 +1,19 @@
 //! Scenarios: every shipped file validates; each has a competent and a careless scripted run
-//! (`tests/scenarios/<name>.competent.csv`, `.careless.csv`, written for the coarse organs: the
+//! (`scenarios/runs/<name>.competent.csv`, `.careless.csv`, written for the coarse organs: the
 //! abdominal ones with their 12 mm tool, the cornea with its 0.5 mm knife) — the competent one passes, the careless one fails, and the score orders
 //! them; broken files each give their expected error at the right line and field; and the
 //! `trainer` binary validates, runs and reports.
 
+mod allocations;
+#[path = "../support/counting.rs"]
+mod counting;
 mod cutting;
+#[path = "../support/fuzz.rs"]
+mod fuzz;
+mod fuzz_files;
 mod history;
 mod motion;
+mod soak;
 mod stiffening;
 
 use std::path::{Path, PathBuf};
@@ -27,6 +34,11 @@ use pgd_surgery::scenario::{Scenario, Scorecard, Task, load, parse};
 use pgd_surgery::store::OnStale;
 
 const TRAINER: &str = env!("CARGO_BIN_EXE_trainer");
+
+/// Counts the haptic thread's allocations (`allocations.rs`) and a reader's (`fuzz.rs`); the
+/// system allocator otherwise.
+#[global_allocator]
+static ALLOCATOR: counting::Counting = counting::Counting;
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -62,7 +74,7 @@ fn run_without_nodules(name: &str, script: &str) -> Outcome {
 
 fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     let scene = scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Refuse).unwrap();
-    let path = root().join(format!("tests/scenarios/{name}.{script}.csv"));
+    let path = root().join(format!("scenarios/runs/{name}.{script}.csv"));
     let trajectory = Trajectory::load(&path).unwrap();
     let ticks = ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64;
     let device = Box::new(Scripted::new("test", trajectory));
@@ -474,7 +486,7 @@ fn a_missing_file_is_named() {
 /// `script` (competent or careless), its report and history in `dir`, with `extra` options;
 /// the scorecard as JSON on standard output.
 fn run_steady_press(script: &str, dir: &Path, extra: &[&str]) -> std::process::Output {
-    let trajectory = root().join(format!("tests/scenarios/liver-steady-press.{script}.csv"));
+    let trajectory = root().join(format!("scenarios/runs/liver-steady-press.{script}.csv"));
     Command::new(TRAINER)
         .args([
             "run",
@@ -896,7 +908,7 @@ fn two_instruments_changed_and_changed_back_press_as_one() {
         },
         Instrument { tool, port: left },
     ];
-    let script = root().join(format!("tests/scenarios/{name}.competent.csv"));
+    let script = root().join(format!("scenarios/runs/{name}.competent.csv"));
     let held_still = |presses: &[f64]| {
         let mut trajectory = Trajectory::load(&script).unwrap();
         let start = trajectory.rows[0];

@@ -65,7 +65,7 @@ async function testRenderer(renderer) {
   // Loads `name` with its competent script and requires the scorecard to pass.
   const scoredRun = async (name) => {
     const started = Date.now();
-    const script = `tests/scenarios/${name}.competent.csv`;
+    const script = `scenarios/runs/${name}.competent.csv`;
     await page.goto(`${base}?renderer=${renderer}&scenario=${name}&script=${script}`);
     await page.waitForFunction(
       () => window.trainer?.scorecard !== undefined || window.trainer?.error !== undefined,

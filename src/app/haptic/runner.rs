@@ -23,7 +23,7 @@ use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
 use crate::cutting::{Blade, CutError, CutWorker, LatestCut, Scalpel};
 use crate::devices::{
     Fulcrum, HapticDevice, Histogram, Instrument, Rack, SafetyFilter, SafetySettings, TICK_S,
-    Workspace,
+    Workspace, stop_requested,
 };
 use crate::dynamics::{DynamicModel, GraspSettings};
 use crate::fem::FemModel;
@@ -73,8 +73,7 @@ impl HapticScene {
         }
     }
 
-    /// A 6 mm probe over no organ.
-    #[cfg(test)]
+    /// A 6 mm probe over no organ: a loop that serves a device and nothing else.
     pub fn without_organs() -> Self {
         let probe = Probe {
             tip_radius_m: 0.006,
@@ -140,6 +139,9 @@ pub enum SceneError {
     Contact(#[from] ContactError),
     #[error(transparent)]
     Cut(#[from] CutError),
+    /// Safety settings the filter cannot honour (a negative force limit would reverse the force).
+    #[error("the scene's safety settings: {0}")]
+    Safety(String),
 }
 
 /// The safety settings of a loop that has no device yet.
@@ -168,6 +170,7 @@ impl HapticLoop {
     /// contact surfaces take milliseconds) and then take over a running loop's device with
     /// [`HapticLoop::take_device`]. Ticked without one, it would panic.
     pub fn parked(scene: &HapticScene) -> Result<Self, SceneError> {
+        scene.safety.check().map_err(SceneError::Safety)?;
         let mut world = World::new();
         for (index, (name, vademecum)) in scene.organs.iter().enumerate() {
             let mut organ = world.spawn((
@@ -294,7 +297,12 @@ impl HapticLoop {
         let mut compute = Histogram::default();
         let mut forces = ForceSummary::default();
         let mut range = RangeSummary::default();
+        let mut ran = 0;
         for tick in 0..ticks {
+            if stop_requested() {
+                break;
+            }
+            ran += 1;
             let time = self.tick(TickClock {
                 tick,
                 time_s: tick as f64 * TICK_S,
@@ -319,7 +327,7 @@ impl HapticLoop {
         }
         let names = (self.device_name(), self.organ_names());
         let log = self.world.resource::<FaultLog>();
-        HeadlessReport::new(names, log, ticks, (forces, range), &compute)
+        HeadlessReport::new(names, log, ran, (forces, range), &compute)
     }
 
     pub(super) fn device_name(&self) -> String {

@@ -272,6 +272,9 @@ pub fn apply_safety(
         faults.this_tick.push(Fault::NonFiniteForce);
     }
     force.sent_n = safety.0.filter(&force.desired_n, &faults.this_tick);
+    if safety.0.refused_output() {
+        faults.this_tick.push(Fault::NonFiniteOutput);
+    }
     if faults.this_tick.is_empty() {
         return;
     }

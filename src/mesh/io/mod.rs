@@ -154,13 +154,17 @@ impl Default for ImportOptions {
 
 /// Reads a mesh file, choosing the format by extension.
 pub fn load(path: &Path, options: &ImportOptions) -> Result<TetMesh, ImportError> {
+    let bytes = std::fs::read(path).map_err(|source| ImportError::Io {
+        file: path.display().to_string(),
+        source,
+    })?;
+    parse(path, bytes, options)
+}
+
+/// Reads the `bytes` of the mesh file `path` (which names it in errors and gives the format
+/// by its extension).
+pub fn parse(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<TetMesh, ImportError> {
     let file = path.display().to_string();
-    let read = || {
-        std::fs::read(path).map_err(|source| ImportError::Io {
-            file: file.clone(),
-            source,
-        })
-    };
     let text = |bytes: Vec<u8>| {
         String::from_utf8(bytes).map_err(|e| ImportError::Unsupported {
             file: file.clone(),
@@ -175,16 +179,16 @@ pub fn load(path: &Path, options: &ImportOptions) -> Result<TetMesh, ImportError
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
-    let raw = match extension.as_str() {
-        "msh" => msh::read(&file, &text(read()?)?)?,
-        "vtk" => vtk::read(&file, &text(read()?)?)?,
-        "vtu" => vtu::read(&file, &text(read()?)?)?,
+    let mut raw = match extension.as_str() {
+        "msh" => msh::read(&file, &text(bytes)?)?,
+        "vtk" => vtk::read(&file, &text(bytes)?)?,
+        "vtu" => vtu::read(&file, &text(bytes)?)?,
         "obj" => {
-            let surface = read_obj(&file, &text(read()?)?)?;
+            let surface = read_obj(&file, &text(bytes)?)?;
             return tetrahedralize(&file, surface.scaled(options.scale), options.surface_nodes);
         }
         "stl" => {
-            let surface = read_stl(&file, &read()?)?;
+            let surface = read_stl(&file, &bytes)?;
             return tetrahedralize(&file, surface.scaled(options.scale), options.surface_nodes);
         }
         _ => {
@@ -196,7 +200,6 @@ pub fn load(path: &Path, options: &ImportOptions) -> Result<TetMesh, ImportError
             });
         }
     };
-    let mut raw = raw;
     for p in &mut raw.nodes {
         *p = Point3::from(p.coords * options.scale);
     }

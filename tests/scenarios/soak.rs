@@ -1,0 +1,58 @@
+//! Five simulated minutes of `trainer soak` (the hour is a benchmark): every attempt scored and
+//! kept, no force that is not finite, no step of the force the safety filter does not allow,
+//! and the resident memory flat once every scene has been loaded.
+
+use std::process::Command;
+
+use pgd_surgery::devices::SafetySettings;
+
+use crate::{TRAINER, root, vademecums};
+
+#[test]
+fn five_minutes_of_use_lose_nothing_and_leak_nothing() {
+    let dir = std::env::temp_dir().join(format!("pgd-soak-{}", std::process::id()));
+    let history = dir.join("soak.sqlite");
+    let out = Command::new(TRAINER)
+        .args([
+            "soak",
+            "--duration-s",
+            "300",
+            "--coarse",
+            "--no-rebuild",
+            "--json",
+        ])
+        .arg("--vademecums")
+        .arg(vademecums())
+        .arg("--keep-in")
+        .arg(&history)
+        .current_dir(root())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    eprintln!("{stderr}");
+    assert!(out.status.success(), "{stderr}");
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    eprintln!("{report:#}");
+    let number = |key: &str| report[key].as_f64().unwrap_or_else(|| panic!("{key}"));
+    assert_eq!(number("ticks"), 300_000.0);
+    assert_eq!(number("nan_count"), 0.0);
+    let scored = number("attempts_scored");
+    assert!(
+        scored >= 24.0,
+        "{scored} attempts: every scenario twice at least"
+    );
+    assert_eq!(number("attempts_kept"), scored);
+    let growth = number("rss_end_bytes") / number("rss_start_bytes") - 1.0;
+    assert!(
+        growth < 0.01,
+        "resident memory grew {:.2} %",
+        growth * 100.0
+    );
+    // The filter moves the force by its rate limit a tick, or fades it from the device's peak
+    // over its fade ticks: no step between ticks can be larger.
+    let safety = SafetySettings::default();
+    let largest_allowed =
+        (safety.max_force_n / safety.fade_ticks as f64).max(safety.max_change_n_per_tick);
+    assert!(number("max_force_step_n") <= largest_allowed * (1.0 + 1e-9));
+    std::fs::remove_dir_all(&dir).ok();
+}
