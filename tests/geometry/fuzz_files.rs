@@ -8,11 +8,11 @@ use std::path::Path;
 use pgd_surgery::mesh::box_mesh;
 use pgd_surgery::mesh::io::{ImportOptions, parse, read_obj, read_stl, write_vtu};
 
-use crate::fuzz::{Format, fuzz, in_proportion};
+use crate::fuzz::{Format, assert_refused_within, fuzz, in_proportion};
 use crate::import::{CUBE_OBJ, MSH2, MSH4, VTK_CLASSIC, VTK_V5, file, tetra_stl};
 
-/// Cases per format in `cargo test`.
-const CASES: u32 = 256;
+/// Cases per format in `cargo test`: each reads in microseconds.
+const CASES: u32 = 2048;
 
 /// Fuzzes the volume-mesh reader for files named `name` from `seeds`.
 fn fuzz_volume(name: &'static str, seeds: Vec<Vec<u8>>) {
@@ -78,4 +78,29 @@ fn surface_files_are_fuzzed() {
         },
         CASES,
     );
+}
+
+/// Files whose counts claim 10¹² cells or tags are refused before anything that size is
+/// allocated.
+#[test]
+fn claimed_counts_are_not_allocated() {
+    let claims = [
+        (
+            "fuzz.vtk",
+            VTK_CLASSIC,
+            "CELLS 2 10",
+            "CELLS 1000000000000 10",
+        ),
+        ("fuzz.vtk", VTK_CLASSIC, "POINTS 5", "POINTS 1000000000000"),
+        ("fuzz.msh", MSH4, "0 1 7 0", "0 1000000000000 7 0"),
+        ("fuzz.msh", MSH2, "$Nodes\n5", "$Nodes\n1000000000000"),
+    ];
+    for (name, seed, count, claim) in claims {
+        assert!(seed.contains(count), "{count}");
+        let text = seed.replace(count, claim);
+        assert_refused_within(name, text.as_bytes(), in_proportion, |bytes| {
+            let refused = parse(Path::new(name), bytes.to_vec(), &ImportOptions::default());
+            assert!(refused.is_err(), "{name}: read a file claiming 10^12");
+        });
+    }
 }

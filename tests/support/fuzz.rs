@@ -119,29 +119,62 @@ const CHECKSUM_BYTES: usize = 32;
 
 /// `file` (a valid container) with `edits` in its `part`, its lengths and checksum made anew.
 fn edited_container(file: &[u8], part: Part, edits: &[Edit]) -> Vec<u8> {
-    let length = |at: usize| u64::from_le_bytes(file[at..at + 8].try_into().unwrap()) as usize;
-    let (header_len, payload_len) = (length(12), length(20));
-    let mut header = file[PREFIX_BYTES..PREFIX_BYTES + header_len].to_vec();
-    let body_end = PREFIX_BYTES + header_len + payload_len;
-    let mut payload = file[PREFIX_BYTES + header_len..body_end].to_vec();
     match part {
-        Part::Header => apply(&mut header, edits),
-        Part::Payload => apply(&mut payload, edits),
+        Part::Header => rebuilt(file, |header| apply(header, edits), |_| {}),
+        Part::Payload => rebuilt(file, |_| {}, |payload| apply(payload, edits)),
         Part::Whole => {
             let mut whole = file.to_vec();
             apply(&mut whole, edits);
-            return whole;
+            whole
         }
     }
+}
+
+/// `file` (a valid container) with its header and payload changed by `header` and `payload`,
+/// its lengths and checksum made anew: a file that gets past the checksum to what it claims.
+pub fn rebuilt(
+    file: &[u8],
+    header: impl FnOnce(&mut Vec<u8>),
+    payload: impl FnOnce(&mut Vec<u8>),
+) -> Vec<u8> {
+    let length = |at: usize| u64::from_le_bytes(file[at..at + 8].try_into().unwrap()) as usize;
+    let (header_len, payload_len) = (length(12), length(20));
+    let mut new_header = file[PREFIX_BYTES..PREFIX_BYTES + header_len].to_vec();
+    let body_end = PREFIX_BYTES + header_len + payload_len;
+    let mut new_payload = file[PREFIX_BYTES + header_len..body_end].to_vec();
+    header(&mut new_header);
+    payload(&mut new_payload);
     let mut out = file[..12].to_vec();
-    out.extend((header.len() as u64).to_le_bytes());
-    out.extend((payload.len() as u64).to_le_bytes());
-    out.extend(&header);
-    out.extend(&payload);
+    out.extend((new_header.len() as u64).to_le_bytes());
+    out.extend((new_payload.len() as u64).to_le_bytes());
+    out.extend(&new_header);
+    out.extend(&new_payload);
     let checksum = blake3::hash(&out);
+    assert_eq!(checksum.as_bytes().len(), CHECKSUM_BYTES);
     out.extend(checksum.as_bytes());
-    debug_assert_eq!(CHECKSUM_BYTES, checksum.as_bytes().len());
     out
+}
+
+/// `read`'s largest single allocation for `bytes`, which must stay within `bound` of their
+/// length.
+pub fn assert_refused_within(
+    name: &str,
+    bytes: &[u8],
+    bound: fn(usize) -> usize,
+    read: impl FnOnce(&[u8]),
+) {
+    let ((), allocated) = counting::measure(|| read(bytes));
+    eprintln!(
+        "{name}: largest allocation {} bytes for a {} byte file",
+        allocated.largest_bytes,
+        bytes.len()
+    );
+    assert!(
+        allocated.largest_bytes <= bound(bytes.len()),
+        "{name}: a {} byte allocation for a {} byte file",
+        allocated.largest_bytes,
+        bytes.len()
+    );
 }
 
 /// A reader under fuzzing.

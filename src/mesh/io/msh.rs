@@ -89,7 +89,8 @@ impl Reader {
                     t.parse::<f64>("a coordinate")?;
                 }
                 let physical_count: usize = t.parse("the number of physical tags")?;
-                let mut physicals = Vec::with_capacity(physical_count);
+                // Not reserved from the file's count: a damaged one would claim anything.
+                let mut physicals = Vec::new();
                 for _ in 0..physical_count {
                     physicals.push(t.parse::<i64>("a physical tag")?.unsigned_abs() as usize);
                 }

@@ -107,7 +107,8 @@ fn read_cells(t: &mut Tokens) -> Result<Vec<Vec<usize>>, ImportError> {
             })
             .collect();
     }
-    let mut cells = Vec::with_capacity(first);
+    // Not reserved from the file's count: a damaged one would claim anything.
+    let mut cells = Vec::new();
     let mut count: usize = next
         .parse()
         .map_err(|_| t.error(format!("expected a point count, found '{next}'")))?;
