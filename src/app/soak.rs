@@ -237,8 +237,11 @@ fn kept_count(history: &History, trainee: &str) -> Result<u64, String> {
     Ok(attempts.len() as u64)
 }
 
-/// This process's resident memory (bytes), from `/proc/self/status`.
+/// This process's resident memory (bytes), from `/proc/self/status`, once the allocator has
+/// handed its free pages back to the system: what is live, not what the allocator keeps
+/// cached for threads that have ended (each attempt's cut worker gets an arena of its own).
 fn resident_bytes() -> Result<u64, String> {
+    release_free_memory();
     let status = std::fs::read_to_string("/proc/self/status")
         .map_err(|e| format!("cannot read /proc/self/status for the resident memory: {e}"))?;
     status
@@ -288,3 +291,16 @@ impl std::fmt::Display for SoakReport {
         )
     }
 }
+
+/// Hands the allocator's free pages, in every arena, back to the system (glibc's `malloc_trim`).
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+fn release_free_memory() {
+    unsafe extern "C" {
+        fn malloc_trim(pad: usize) -> std::ffi::c_int;
+    }
+    // SAFETY: `malloc_trim` takes a byte count and only returns free memory to the system.
+    unsafe { malloc_trim(0) };
+}
+
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+fn release_free_memory() {}

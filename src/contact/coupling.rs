@@ -68,6 +68,21 @@ pub struct Coupling {
 }
 
 impl Coupling {
+    /// A copy whose buffers have room for what the tick puts in them (a plain clone keeps
+    /// only their contents), so that the haptic thread never grows them.
+    /// `organs` are the scene's, in the coupling's order.
+    pub fn clone_reserved(&self, organs: &[(String, Arc<Vademecum>)]) -> Self {
+        let mut coupling = self.clone();
+        coupling.pairs.iter_mut().for_each(ContactPair::reserve);
+        let shells: usize = coupling.pairs.iter().map(ContactPair::node_count).sum();
+        for (organ, (_, vademecum)) in coupling.organs.iter_mut().zip(organs) {
+            organ.alpha.reserve(vademecum.total_modes());
+            organ.coupling_points.reserve(shells);
+            organ.hold.reserve(vademecum.positions.len());
+        }
+        coupling
+    }
+
     /// Sets up the coupling of `organs` (names and vademecums, the scene's order): the master's
     /// distance field, a pair with every organ not attached to it whose boundary comes within
     /// the field's lattice, and the attachments. No master in the scene: no contact pairs.

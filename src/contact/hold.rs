@@ -46,6 +46,11 @@ pub struct ToolHold {
 }
 
 impl ToolHold {
+    /// Room for a load on `positions` positions.
+    pub(super) fn reserve(&mut self, positions: usize) {
+        self.load.shares.reserve(positions);
+    }
+
     /// Whether the tool holds the organ and the rows are ready.
     pub fn is_ready(&self) -> bool {
         self.held && self.ready

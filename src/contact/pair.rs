@@ -143,6 +143,18 @@ pub struct PairOutput<'a> {
 }
 
 impl ContactPair {
+    /// Room for every pointshell node in the lists the tick fills (a clone keeps none).
+    pub(super) fn reserve(&mut self) {
+        let count = self.node_count();
+        self.active.reserve(count);
+        self.candidates.reserve(count);
+    }
+
+    /// The pointshell's nodes tested against the master.
+    pub(super) fn node_count(&self) -> usize {
+        self.force_n.len()
+    }
+
     /// Sets up the pair: each node's penalty from the stiffer organ's compliance there.
     pub fn new(
         (master, master_vademecum): (usize, Arc<Vademecum>),

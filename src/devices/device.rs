@@ -1,6 +1,7 @@
 //! One trait for every haptic device. Hardware backends (OpenHaptics for the Geomagic Touch,
-//! Haply, Force Dimension) implement it in their own modules and map their workspace into the
-//! scene's frame, so the rest of the loop never knows which device it serves.
+//! Force Dimension) implement it in their own modules and map their workspace into the scene's
+//! frame, so the rest of the loop never knows which device it serves; every force reaches them
+//! through the edge guard of [`HapticDevice::write_force`].
 
 use nalgebra::{UnitQuaternion, Vector3};
 

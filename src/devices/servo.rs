@@ -170,7 +170,7 @@ impl ServoLink {
     pub fn watchdog_ages_s(&self) -> (f64, Option<f64>) {
         let rendered = self.rendered_age_ns.load(Ordering::Relaxed) as f64 * 1e-9;
         let expired = self.expired_age_ns.load(Ordering::Relaxed);
-        (rendered, (expired > 0).then(|| expired as f64 * 1e-9))
+        (rendered, (expired > 0).then_some(expired as f64 * 1e-9))
     }
 
     /// Zero force from now on, whatever the loop commands: the device is being released (its

@@ -31,6 +31,15 @@ impl Clone for PatchLoad {
 }
 
 impl PatchLoad {
+    /// No load, its buffer room for `positions` shares: a patch can hold no more, so the
+    /// haptic tick never grows it.
+    pub fn reserved(positions: usize) -> Self {
+        Self {
+            shares: Vec::with_capacity(positions),
+            force_n: Vector3::zeros(),
+        }
+    }
+
     pub fn is_active(&self) -> bool {
         self.force_n != Vector3::zeros() && !self.shares.is_empty()
     }
@@ -130,7 +139,9 @@ impl Deformation {
             .map(|k| vec![0.0; vademecum.modes(k)])
             .collect();
         Self {
-            loads: vec![PatchLoad::default(); load_slots],
+            loads: (0..load_slots)
+                .map(|_| PatchLoad::reserved(vademecum.positions.len()))
+                .collect(),
             coefficients: zeros.clone(),
             coupling: zeros,
             coupling_points: Vec::new(),

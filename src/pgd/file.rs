@@ -210,6 +210,12 @@ fn read_cuts(r: &mut Reader, header: &Header) -> Result<Option<RegionResponse>, 
     ))
 }
 
+/// The product of a header's sizes, `None` where it overflows: whatever a file claims, the
+/// check against the arrays it holds (which its length bounds) cannot panic or wrap.
+fn product(factors: &[usize]) -> Option<usize> {
+    factors.iter().try_fold(1usize, |p, &f| p.checked_mul(f))
+}
+
 /// The cut arrays agree with the header and with each other.
 fn check_cuts(
     r: &Reader,
@@ -224,7 +230,9 @@ fn check_cuts(
     }
     let m = positions.len();
     let modes = header.cuts.as_ref().map_or(0, |c| c.report.modes);
-    if spatial.len() != modes * 3 * node_count || parametric.len() != modes * 3 * m {
+    if product(&[modes, 3, node_count]) != Some(spatial.len())
+        || product(&[modes, 3, m]) != Some(parametric.len())
+    {
         return Err(r.malformed("cut modes (sizes differ from the header)"));
     }
     let rows_ok = offsets.len() == m + 1
@@ -337,8 +345,8 @@ fn validate(path: &Path, v: &Vademecum) -> Result<(), VademecumError> {
             .get(k)
             .copied()
             .unwrap_or(usize::MAX);
-        if step.spatial.len() != modes * v.dof_count()
-            || step.parametric.len() != modes * v.parameter_count()
+        if product(&[modes, 3, v.header.node_count]) != Some(step.spatial.len())
+            || product(&[modes, v.parameter_count()]) != Some(step.parametric.len())
         {
             return fail(&format!("modes of step {k} (sizes differ from the header)"));
         }

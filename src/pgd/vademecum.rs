@@ -94,6 +94,22 @@ pub struct Patch {
     columns: StepColumns,
 }
 
+impl Patch {
+    /// An empty patch with room for every position of `vademecum` and its load steps'
+    /// columns: the haptic tick then never grows it.
+    pub fn reserved(vademecum: &Vademecum) -> Self {
+        let positions = vademecum.positions.len();
+        Self {
+            shares: Vec::with_capacity(positions),
+            slot_of: Vec::with_capacity(positions),
+            columns: StepColumns {
+                columns: Vec::with_capacity(positions * vademecum.steps.len()),
+                ..StepColumns::default()
+            },
+        }
+    }
+}
+
 /// The most load steps a vademecum holds, the linear one included: a press marks the steps
 /// whose columns it filled in one word.
 pub const MAX_STEPS: usize = 64;

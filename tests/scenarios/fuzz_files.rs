@@ -15,7 +15,7 @@ use pgd_surgery::pgd::{container, decode, web_form};
 use pgd_surgery::scenario::parse;
 use pgd_surgery::store::{AttemptRecord, History, HistoryFilter};
 
-use crate::fuzz::{Format, fuzz, in_proportion};
+use crate::fuzz::{Format, assert_refused_within, fuzz, in_proportion, rebuilt};
 use crate::vademecums;
 
 /// Cases per format in `cargo test`.
@@ -174,4 +174,70 @@ fn history_databases_are_fuzzed() {
         HEAVY_CASES,
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `file` with its JSON header's `field` set to `value`, past the checksum.
+fn claiming(file: &[u8], field: &str, value: serde_json::Value) -> Vec<u8> {
+    rebuilt(
+        file,
+        |header| {
+            let mut json: serde_json::Value = serde_json::from_slice(header).unwrap();
+            assert!(json.get(field).is_some(), "no field {field} in the header");
+            json[field] = value;
+            *header = serde_json::to_vec(&json).unwrap();
+        },
+        |_| {},
+    )
+}
+
+/// `file` with the length of its payload's first array claiming 10¹² values.
+fn first_array_claiming(file: &[u8]) -> Vec<u8> {
+    let claim = 1_000_000_000_000u64.to_le_bytes();
+    rebuilt(file, |_| {}, |payload| payload[..8].copy_from_slice(&claim))
+}
+
+/// Vademecums and distance fields whose header or first array claims 10¹² nodes, modes or
+/// values are refused before anything that size is allocated, and without overflowing.
+#[test]
+fn claimed_sizes_are_not_allocated() {
+    let vdm = smallest("vdm");
+    let vdf = smallest("vdf");
+    let huge = serde_json::json!(1_000_000_000_000u64);
+    let read_vdm = |bytes: &[u8]| {
+        assert!(
+            decode(Path::new("claim.vdm"), bytes).is_err(),
+            "read a claim"
+        );
+    };
+    let read_vdf = |bytes: &[u8]| {
+        container::provide(Path::new(FIELD), Arc::from(bytes));
+        assert!(
+            DistanceField::load(Path::new(FIELD)).is_err(),
+            "read a claim"
+        );
+    };
+    let vdm_claims = [
+        claiming(&vdm, "node_count", huge.clone()),
+        claiming(
+            &vdm,
+            "modes_per_step",
+            serde_json::json!([1_000_000_000_000u64]),
+        ),
+        first_array_claiming(&vdm),
+    ];
+    for claim in &vdm_claims {
+        assert_refused_within("vademecum claim", claim, in_proportion, read_vdm);
+    }
+    let vdf_claims = [
+        claiming(
+            &vdf,
+            "dims",
+            serde_json::json!([1_000_000u64, 1_000_000u64, 1_000_000u64]),
+        ),
+        claiming(&vdf, "modes", huge),
+        first_array_claiming(&vdf),
+    ];
+    for claim in &vdf_claims {
+        assert_refused_within("distance field claim", claim, in_proportion, read_vdf);
+    }
 }

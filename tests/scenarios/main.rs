@@ -109,33 +109,6 @@ fn every_shipped_scenario_validates() {
     assert!(found >= SHIPPED.len(), "{found} scenarios");
 }
 
-/// A scoring that cannot tell a competent run from a careless one is broken.
-#[test]
-fn competent_runs_pass_careless_runs_fail_and_the_score_orders_them() {
-    for name in SHIPPED {
-        let competent = run(name, "competent").card;
-        let careless = run(name, "careless").card;
-        assert!(
-            competent.passed,
-            "{name}: the competent run failed: {competent:#?}"
-        );
-        assert!(
-            !careless.passed,
-            "{name}: the careless run passed: {careless:#?}"
-        );
-        assert!(
-            competent.score > careless.score + 20.0,
-            "{name}: {} vs {}",
-            competent.score,
-            careless.score
-        );
-        assert!(
-            !careless.feedback.is_empty(),
-            "{name}: a failure must say why"
-        );
-    }
-}
-
 /// The careless liver press is scored on what it did: pressed too hard, more than once, and
 /// never held the band; the competent one held it and finished early.
 #[test]

@@ -39,6 +39,17 @@ pub struct ToolTouch {
     pub next_load: PatchLoad,
 }
 
+impl ToolTouch {
+    /// No contact, its buffers with room for the largest patch on `vademecum`.
+    pub fn reserved(vademecum: &Vademecum) -> Self {
+        Self {
+            contact: None,
+            patch: Patch::reserved(vademecum),
+            next_load: PatchLoad::reserved(vademecum.positions.len()),
+        }
+    }
+}
+
 /// The loads on the organ and their modal coefficients. Load slot [`Self::TOOL`] is the tool's.
 #[derive(Component, Clone, Debug)]
 pub struct OrganDeformation(pub Deformation);

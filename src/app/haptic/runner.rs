@@ -180,7 +180,7 @@ impl HapticLoop {
                     vademecum: vademecum.clone(),
                 },
                 OrganIndex(index),
-                ToolTouch::default(),
+                ToolTouch::reserved(vademecum),
                 OrganDeformation(Deformation::new(vademecum, 1)),
             ));
             if let Some(dynamics) = &scene.dynamics
@@ -210,7 +210,7 @@ impl HapticLoop {
         world.insert_resource(FaultLog::default());
         world.insert_resource(Parked(scene.safety));
         if let Some(coupling) = &scene.coupling {
-            world.insert_resource(OrganCoupling(Coupling::clone(coupling)));
+            world.insert_resource(OrganCoupling(coupling.clone_reserved(&scene.organs)));
         }
         if let Some(scope) = &scene.scope {
             world.insert_resource(Scope::new(scope.clone()));

@@ -180,12 +180,20 @@ impl DistanceField {
         let corners: Vec<u32> = reader.take("closest points' corners")?;
         let weights: Vec<f32> = reader.take("closest points' weights")?;
         reader.finish()?;
-        let nodes: usize = header.dims.iter().product();
-        if rest.len() != nodes * HEAD
-            || modal.len() != nodes * 3 * header.modes
+        // The header's sizes are checked against the arrays read (which the file's length
+        // bounds), in arithmetic that cannot overflow whatever the header claims.
+        let nodes = header
+            .dims
+            .iter()
+            .try_fold(1usize, |n, &d| n.checked_mul(d));
+        let sized = |len: usize, per_node: Option<usize>| {
+            nodes.zip(per_node).and_then(|(n, k)| n.checked_mul(k)) == Some(len)
+        };
+        if !sized(rest.len(), Some(HEAD))
+            || !sized(modal.len(), header.modes.checked_mul(3))
             || mode_bounds.len() != header.modes
-            || corners.len() != 3 * nodes
-            || weights.len() != 3 * nodes
+            || !sized(corners.len(), Some(3))
+            || !sized(weights.len(), Some(3))
             || header.dims.iter().any(|&n| n < 2)
         {
             return Err(reader.malformed("lattice (its size does not match its header)"));
