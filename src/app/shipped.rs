@@ -12,25 +12,32 @@ macro_rules! shipped {
     };
 }
 
+/// Calls `$then!` with every shipped scenario's stem, in the menu's order; the first is the
+/// trainer's default exercise.
+macro_rules! with_shipped_stems {
+    ($then:ident) => {
+        $then!(
+            "liver-steady-press",
+            "abdomen-tour",
+            "cornea-radial-keratotomy",
+            "duodenum-navigation",
+            "gallbladder-gentle-press",
+            "gallbladder-grasp-retract",
+            "gallbladder-liver-two-ports",
+            "gallbladder-retraction",
+            "liver-capsule-incision",
+            "liver-laparoscopic-press",
+            "pancreas-palpation",
+            "pancreas-tour",
+        )
+    };
+}
+
 /// Each shipped scenario's file name and text; the first is the trainer's default exercise.
-pub const SHIPPED_SCENARIOS: &[(&str, &str)] = shipped!(
-    "liver-steady-press",
-    "abdomen-tour",
-    "cornea-radial-keratotomy",
-    "duodenum-navigation",
-    "gallbladder-gentle-press",
-    "gallbladder-grasp-retract",
-    "gallbladder-liver-two-ports",
-    "gallbladder-retraction",
-    "liver-capsule-incision",
-    "liver-laparoscopic-press",
-    "pancreas-palpation",
-    "pancreas-tour",
-);
+pub const SHIPPED_SCENARIOS: &[(&str, &str)] = with_shipped_stems!(shipped);
 
 /// A shipped scenario with its two scripted runs (`scenarios/runs/<stem>.competent.csv` and
 /// `.careless.csv`, written for the coarse organs), built in for `trainer soak`.
-#[cfg(not(target_arch = "wasm32"))]
 pub struct ShippedRun {
     pub file: &'static str,
     pub scenario: &'static str,
@@ -41,7 +48,6 @@ pub struct ShippedRun {
 }
 
 /// Each stem's [`ShippedRun`].
-#[cfg(not(target_arch = "wasm32"))]
 macro_rules! shipped_runs {
     ($($stem:literal),* $(,)?) => {
         &[$(ShippedRun {
@@ -56,21 +62,7 @@ macro_rules! shipped_runs {
 }
 
 /// Every shipped scenario's runs, in the menu's order.
-#[cfg(not(target_arch = "wasm32"))]
-pub const SHIPPED_RUNS: &[ShippedRun] = shipped_runs!(
-    "liver-steady-press",
-    "abdomen-tour",
-    "cornea-radial-keratotomy",
-    "duodenum-navigation",
-    "gallbladder-gentle-press",
-    "gallbladder-grasp-retract",
-    "gallbladder-liver-two-ports",
-    "gallbladder-retraction",
-    "liver-capsule-incision",
-    "liver-laparoscopic-press",
-    "pancreas-palpation",
-    "pancreas-tour",
-);
+pub const SHIPPED_RUNS: &[ShippedRun] = with_shipped_stems!(shipped_runs);
 
 #[cfg(test)]
 mod tests {

@@ -14,7 +14,7 @@ use pgd_surgery::devices::{HapticDevice, SafetySettings, ServoLink, TICK_S, WATC
 
 use crate::common::{TIP_RADIUS_M, scene, target};
 
-/// The shared library built from `tests/haptics/<source>.c`, once per run.
+/// The shared library built from `tests/haptics/<source>.c`, once per process.
 fn built(source: &str) -> PathBuf {
     static BUILT: Mutex<Option<HashMap<String, PathBuf>>> = Mutex::new(None);
     let mut built = BUILT.lock().unwrap();
@@ -23,7 +23,10 @@ fn built(source: &str) -> PathBuf {
         return path.clone();
     }
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/haptics/{source}.c"));
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("lib{source}.so"));
+    // Named after the process too: the exit tests run this binary again in child processes,
+    // which build their own while this one copies its.
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("lib{source}.{}.so", std::process::id()));
     let status = std::process::Command::new("cc")
         .args(["-shared", "-fPIC", "-O1", "-pthread", "-o"])
         .arg(&out)
