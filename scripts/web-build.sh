@@ -45,7 +45,8 @@ rm -rf "$dist"
 mkdir -p "$dist/vademecums" "$dist/scenarios"
 for renderer in "${renderers[@]}"; do
   echo "web-build: compiling the trainer for the browser, drawn by $renderer"
-  cargo build --release --target wasm32-unknown-unknown --bin trainer-web --features "$renderer"
+  cargo build --release --target wasm32-unknown-unknown -p pgd-surgery --bin trainer-web \
+    --features "$renderer"
   "$tools/bin/wasm-bindgen" --target web --no-typescript --remove-name-section \
     --remove-producers-section --out-dir "$dist" --out-name "trainer_$renderer" \
     "$CARGO_TARGET_DIR/wasm32-unknown-unknown/release/trainer-web.wasm"

@@ -11,7 +11,7 @@ use super::haptic::{
     ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SceneScope,
     SettleCuts, TickClock,
 };
-use super::scene::{Detail, SceneOrgan, scene_files, scene_of};
+use super::scene::{Detail, SceneOrgan, scene_files, scene_of, scene_vademecums};
 use crate::contact::{ContactSurface, CouplingSettings};
 use crate::devices::{HapticDevice, Instrument, ScopeHandle, TICK_S, stop_requested};
 use crate::mesh::organs::Organ;
@@ -19,7 +19,7 @@ use crate::scenario::{
     self, CutMade, Exercise, Keratometer, LaparoscopeEntry, Nodule, NoduleSite, OrganEntry, Port,
     RegionSite, Scenario, Scorecard, Sites, Task, score,
 };
-use crate::store::{OnStale, OrganSource};
+use crate::store::{OnStale, OrganSource, VademecumSpec};
 
 /// The scene a scenario asks for, its vademecums from `dir`.
 pub fn scenario_scene(
@@ -68,6 +68,18 @@ pub fn scenario_files(
         dir,
         detail,
     ))
+}
+
+/// The vademecums [`scenario_scene`] loads from `dir`, one per organ in the scenario's order
+/// (see [`scene_vademecums`]).
+pub fn scenario_vademecums(
+    scenario: &Scenario,
+    dir: &Path,
+    detail: Detail,
+) -> Result<Vec<VademecumSpec>, String> {
+    let organs = scenario_organs(scenario)?;
+    let tip = Some(scenario.tip_radius_m());
+    Ok(scene_vademecums(&organs, tip, dir, detail))
 }
 
 fn scenario_organs(scenario: &Scenario) -> Result<Vec<SceneOrgan>, String> {

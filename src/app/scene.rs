@@ -232,16 +232,32 @@ pub fn scene_files(
     dir: &Path,
     detail: Detail,
 ) -> Vec<PathBuf> {
-    let tip = scene_tip_m(organs, tip_radius_m, detail);
     let mut files = Vec::new();
-    for organ in organs {
-        let spec = organ.vademecum(dir, detail, tip);
+    for (organ, spec) in organs
+        .iter()
+        .zip(scene_vademecums(organs, tip_radius_m, dir, detail))
+    {
         if organ.name == coupling.master {
             files.push(spec.field_file());
         }
         files.push(spec.file);
     }
     files
+}
+
+/// The vademecums [`scene_of`] loads for the same arguments, one per organ in order: what
+/// each is built from and with, and where it is kept.
+pub fn scene_vademecums(
+    organs: &[SceneOrgan],
+    tip_radius_m: Option<f64>,
+    dir: &Path,
+    detail: Detail,
+) -> Vec<VademecumSpec> {
+    let tip = scene_tip_m(organs, tip_radius_m, detail);
+    organs
+        .iter()
+        .map(|organ| organ.vademecum(dir, detail, tip))
+        .collect()
 }
 
 /// A scene of `organs` felt through a tool tip of `tip_radius_m` (the organs' own when

@@ -15,8 +15,9 @@ use super::haptic::{DeviceForce, HapticLoop, HapticScene, TickTimes};
 use super::scene::Detail;
 use super::shipped::SHIPPED_RUNS;
 use crate::devices::{Histogram, Scripted, TICK_S, Trajectory, stop_requested};
+use crate::history::{AttemptRecord, History, now_unix_s};
 use crate::scenario::{self, Scenario};
-use crate::store::{AttemptRecord, History, OnStale, now_unix_s};
+use crate::store::OnStale;
 
 /// What a soak runs.
 pub struct SoakPlan {
@@ -229,7 +230,7 @@ fn soak_scenarios(plan: &SoakPlan) -> Result<Vec<SoakScenario>, String> {
 
 /// How many attempts the history holds for `trainee`.
 fn kept_count(history: &History, trainee: &str) -> Result<u64, String> {
-    let filter = crate::store::HistoryFilter {
+    let filter = crate::history::HistoryFilter {
         trainee: Some(trainee.to_owned()),
         scenario: None,
     };

@@ -15,8 +15,9 @@ use pgd_surgery::cli::{
     validate_scenarios,
 };
 use pgd_surgery::devices::{DeviceSpec, TimerMode};
+use pgd_surgery::history::HistoryFilter;
 use pgd_surgery::scenario;
-use pgd_surgery::store::{HistoryFilter, OnStale};
+use pgd_surgery::store::OnStale;
 
 #[derive(Parser)]
 #[command(

@@ -4,9 +4,11 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use crate::history::{
+    AttemptRecord, History, HistoryError, HistoryFilter, keep_attempt, now_unix_s,
+};
 use crate::report::{CurvePoint, learning_curve};
 use crate::scenario::Scorecard;
-use crate::store::{AttemptRecord, History, HistoryError, HistoryFilter, keep_attempt, now_unix_s};
 
 /// Where attempts are kept, and whose they are.
 #[derive(Clone, Debug)]

@@ -1,7 +1,7 @@
 //! The coarse abdominal scene (all four organs, coupled, linear), built once per test run,
 //! and a scripted push run through the haptic schedule with what each tick left recorded.
 
-use std::path::Path;
+use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use nalgebra::Vector3;
@@ -24,10 +24,16 @@ pub fn linear(organ: Organ) -> SceneOrgan {
     }
 }
 
+/// Where the linear coarse organs are kept: a folder of the tests' shared cache, apart from
+/// the scenarios' organs of the same names and other settings.
+pub fn vademecums() -> PathBuf {
+    crate::cache::vademecum_cache().join("contact")
+}
+
 pub fn scene() -> &'static HapticScene {
     static SCENE: OnceLock<HapticScene> = OnceLock::new();
     SCENE.get_or_init(|| {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("contact-vademecums");
+        let dir = vademecums();
         let organs = Organ::ABDOMEN.map(linear);
         let coupling = CouplingSettings::default();
         scene_of(
@@ -171,7 +177,7 @@ pub fn measuring_every_node_scene() -> &'static HapticScene {
 
 /// The coarse scene with other coupling settings, on the same vademecums.
 fn scene_with(settings: &CouplingSettings) -> HapticScene {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("contact-vademecums");
+    let dir = vademecums();
     scene(); // builds the vademecums if they are missing
     let organs = Organ::ABDOMEN.map(linear);
     scene_of(

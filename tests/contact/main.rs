@@ -2,6 +2,8 @@
 //! the liver through the whole haptic schedule, the distance field against the exact distance
 //! to the deformed gallbladder, and the attachments.
 
+#[path = "../../crates/pgd-surgery-core/tests/support/cache.rs"]
+mod cache;
 mod clearance;
 mod common;
 mod deep_press;

@@ -15,12 +15,12 @@ use pgd_surgery::mesh::organs::Organ;
 use pgd_surgery::pgd::Vademecum;
 use pgd_surgery::store::OnStale;
 
-use crate::common::{carrier_point_near, organ, scene};
+use crate::common::{carrier_point_near, organ, scene, vademecums};
 use crate::exact_distance;
 
 /// The coarse scene with `moving` under reduced dynamics, on the shared vademecums.
 fn scene_moving(moving: Organ) -> HapticScene {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("contact-vademecums");
+    let dir = vademecums();
     scene(); // builds the vademecums if they are missing
     let organs = Organ::ABDOMEN.map(|o| SceneOrgan {
         dynamic: o == moving,

@@ -22,8 +22,8 @@ use crate::counting;
 use crate::vademecums;
 
 thread_local! {
-    /// Each allocating place in the project's code (the innermost frame under `src/`), and how
-    /// many allocations it made.
+    /// Each allocating place in the project's code (the innermost frame under the trainer's or
+    /// the core's `src/`), and how many allocations it made.
     static SITES: RefCell<BTreeMap<String, u64>> = const { RefCell::new(BTreeMap::new()) };
 }
 
@@ -31,7 +31,10 @@ fn trace() {
     let trace = std::backtrace::Backtrace::force_capture().to_string();
     let lines: Vec<&str> = trace.lines().collect();
     let site = (1..lines.len())
-        .find(|&k| lines[k].trim_start().starts_with("at ./src/"))
+        .find(|&k| {
+            let line = lines[k].trim_start();
+            line.starts_with("at ./src/") || line.starts_with("at ./crates/pgd-surgery-core/src/")
+        })
         .map_or_else(
             || "outside the project's code".to_owned(),
             |k| format!("{} {}", lines[k - 1].trim(), lines[k].trim()),

@@ -11,9 +11,9 @@ use pgd_surgery::app::SHIPPED_SCENARIOS;
 use pgd_surgery::app::shipped::SHIPPED_RUNS;
 use pgd_surgery::contact::DistanceField;
 use pgd_surgery::devices::Trajectory;
+use pgd_surgery::history::{AttemptRecord, History, HistoryFilter};
 use pgd_surgery::pgd::{container, decode, web_form};
 use pgd_surgery::scenario::parse;
-use pgd_surgery::store::{AttemptRecord, History, HistoryFilter};
 
 use crate::fuzz::{Format, assert_refused_within, fuzz, in_proportion, rebuilt};
 use crate::vademecums;

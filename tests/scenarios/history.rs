@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use pgd_surgery::store::{AttemptRecord, History, HistoryError, HistoryFilter, keep_attempt};
+use pgd_surgery::history::{AttemptRecord, History, HistoryError, HistoryFilter, keep_attempt};
 
 use crate::{TRAINER, run_steady_press};
 

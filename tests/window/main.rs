@@ -8,6 +8,8 @@
 //! cornea and an open incision are checked on their own shipped scenarios, and every shipped
 //! scenario's start shows its organs.
 
+#[path = "../../crates/pgd-surgery-core/tests/support/cache.rs"]
+mod cache;
 mod cornea;
 mod incision;
 mod laparoscope;
@@ -37,8 +39,8 @@ const FRAMES: &str = "12";
 fn vademecums() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        // The scenario tests' folder: the coarse nonlinear organs are built once for both.
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenario-vademecums");
+        // The scenario tests' organs: the coarse nonlinear organs are built once for both.
+        let dir = cache::vademecum_cache().to_owned();
         default_scene(&dir, Detail::Coarse, OnStale::Rebuild).unwrap();
         dir
     })

@@ -1,6 +1,10 @@
 //! Every shipped scenario opens on its organs: its start, drawn offscreen, shows each of its
 //! organs somewhere in the image (through a laparoscope, at least the one it is aimed at), and
-//! the image is not one colour.
+//! the image is not one colour. A screenshot of each, on software Vulkan, is the slow tier's
+//! (docs/development.md): the fast tier draws four shipped scenarios' windows (free play on the
+//! default organs, the laparoscope, the keratotomy, an incision) and runs every scenario's
+//! scene through its scripted attempts, so what only this test sees is one scenario whose
+//! start frames none of its organs.
 
 use std::path::Path;
 
@@ -10,6 +14,7 @@ use pgd_surgery::scenario::load;
 use super::{distance, held_at, scenario_shot};
 
 #[test]
+#[ignore = "slow tier: a screenshot of every shipped scenario (docs/development.md)"]
 fn every_shipped_scenario_opens_on_its_organs() {
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
     let mut files: Vec<_> = std::fs::read_dir(&shipped)

@@ -1,0 +1,362 @@
+//! Import of small hand-written files in each format, export round trip, and the errors that
+//! malformed files must produce (with file and line).
+
+use std::path::PathBuf;
+
+use pgd_surgery_core::mesh::io::{ImportError, ImportOptions, load, write_vtu};
+use pgd_surgery_core::mesh::organs::{self, Organ, OrganSettings};
+use pgd_surgery_core::mesh::{QualityReport, box_mesh};
+
+/// Writes `contents` to a fresh file with this name in a per-test directory.
+pub fn file(name: &str, contents: &[u8]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "pgd-import-{}-{}",
+        std::process::id(),
+        name.replace('.', "-")
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, contents).unwrap();
+    path
+}
+
+fn import(name: &str, contents: &str) -> Result<pgd_surgery_core::mesh::TetMesh, ImportError> {
+    load(&file(name, contents.as_bytes()), &ImportOptions::default())
+}
+
+/// Two tetrahedra sharing the face (1, 0, 0), (0, 1, 0), (0, 0, 1); the face z = 0 is the
+/// physical surface "clamped".
+pub const MSH2: &str = r#"$MeshFormat
+2.2 0 8
+$EndMeshFormat
+$PhysicalNames
+1
+2 7 "clamped"
+$EndPhysicalNames
+$Nodes
+5
+1 0 0 0
+2 1 0 0
+3 0 1 0
+4 0 0 1
+5 1 1 1
+$EndNodes
+$Elements
+3
+1 2 2 7 1 1 3 2
+2 4 2 0 1 1 2 3 4
+3 4 2 0 1 2 3 4 5
+$EndElements
+"#;
+
+pub const MSH4: &str = r#"$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$PhysicalNames
+1
+2 7 "clamped"
+$EndPhysicalNames
+$Entities
+0 0 1 1
+1 0 0 0 1 1 0 1 7 0
+1 0 0 0 1 1 1 0 1 1
+$EndEntities
+$Nodes
+1 5 1 5
+3 1 0 5
+1
+2
+3
+4
+5
+0 0 0
+1 0 0
+0 1 0
+0 0 1
+1 1 1
+$EndNodes
+$Elements
+2 3 1 3
+2 1 2 1
+1 1 3 2
+3 1 4 2
+2 1 2 3 4
+3 2 3 4 5
+$EndElements
+"#;
+
+fn check_two_tets(mesh: &pgd_surgery_core::mesh::TetMesh) {
+    assert_eq!((mesh.node_count(), mesh.tet_count()), (5, 2));
+    assert!((mesh.volume() - (1.0 / 6.0 + 2.0 / 6.0)).abs() < 1e-12);
+}
+
+#[test]
+fn gmsh_v2_and_v4_read_with_physical_surfaces() {
+    for (name, text) in [("two.msh", MSH2), ("two4.msh", MSH4)] {
+        let mesh = import(name, text).unwrap_or_else(|e| panic!("{name}: {e}"));
+        check_two_tets(&mesh);
+        assert_eq!(mesh.face_set("clamped").unwrap().len(), 1, "{name}");
+        let mut clamped = mesh.node_set("clamped").unwrap().to_vec();
+        clamped.sort();
+        assert_eq!(clamped, vec![0, 1, 2], "{name}");
+    }
+}
+
+/// The two tetrahedra in legacy VTK's classic cell layout, and in version 5's offsets and
+/// connectivity.
+pub const VTK_CLASSIC: &str = "# vtk DataFile Version 3.0\ntwo tets\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 5 double\n0 0 0 1 0 0 0 1 0\n0 0 1 1 1 1\nCELLS 2 10\n4 0 1 2 3\n4 1 2 3 4\nCELL_TYPES 2\n10\n10\n";
+pub const VTK_V5: &str = "# vtk DataFile Version 5.1\ntwo tets\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 5 double\n0 0 0 1 0 0 0 1 0\n0 0 1 1 1 1\nCELLS 3 8\nOFFSETS vtktypeint64\n0 4 8\nCONNECTIVITY vtktypeint64\n0 1 2 3 1 2 3 4\nCELL_TYPES 2\n10\n10\n";
+
+#[test]
+fn vtk_legacy_reads_both_cell_layouts() {
+    check_two_tets(&import("classic.vtk", VTK_CLASSIC).unwrap());
+    check_two_tets(&import("v5.vtk", VTK_V5).unwrap());
+}
+
+#[test]
+fn vtu_round_trip_keeps_geometry_and_node_sets() {
+    let mesh = box_mesh([0.04, 0.03, 0.02], [4, 3, 2]).unwrap();
+    let path = file("box.vtu", b"");
+    let displacement = vec![1e-3; 3 * mesh.node_count()];
+    write_vtu(&path, &mesh, &[("displacement_m", &displacement)]).unwrap();
+    let back = load(&path, &ImportOptions::default()).unwrap();
+    assert_eq!(back.tets(), mesh.tets());
+    for (a, b) in back.nodes().iter().zip(mesh.nodes()) {
+        assert!((a - b).norm() < 1e-15);
+    }
+    assert_eq!(back.node_set("x0").unwrap(), mesh.node_set("x0").unwrap());
+}
+
+/// A face set (the generated liver's `accessible` surface) travels through .vtu as its nodes
+/// and reads back as the same faces: the boundary triangles whose corners all lie in it.
+#[test]
+fn vtu_round_trip_keeps_face_sets() {
+    let settings = OrganSettings {
+        resolution: 0.25,
+        ..OrganSettings::default()
+    };
+    let mesh = organs::generate(Organ::Liver, &settings).unwrap();
+    let path = file("liver.vtu", b"");
+    write_vtu(&path, &mesh, &[]).unwrap();
+    let back = load(&path, &ImportOptions::default()).unwrap();
+    let faces = |m: &pgd_surgery_core::mesh::TetMesh| {
+        let mut faces: Vec<[usize; 3]> = m
+            .face_set("accessible")
+            .unwrap()
+            .iter()
+            .map(|f| {
+                let mut f = *f;
+                f.sort_unstable();
+                f
+            })
+            .collect();
+        faces.sort_unstable();
+        faces
+    };
+    assert_eq!(faces(&back), faces(&mesh));
+}
+
+/// A cube of side 4 cm written in millimetres, as CAD tools do.
+pub const CUBE_OBJ: &str = "# cube, mm\nv 0 0 0\nv 40 0 0\nv 40 40 0\nv 0 40 0\nv 0 0 40\nv 40 0 40\nv 40 40 40\nv 0 40 40\n\
+f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+
+#[test]
+fn a_closed_obj_surface_becomes_a_valid_tet_mesh() {
+    let options = ImportOptions {
+        scale: 1e-3,
+        surface_nodes: 1500,
+    };
+    let mesh = load(&file("cube.obj", CUBE_OBJ.as_bytes()), &options).unwrap();
+    let q = QualityReport::measure(mesh.nodes(), mesh.tets());
+    assert!(q.refusal().is_none(), "{q}");
+    // Stuffing rounds the cube's edges by less than a lattice cell: measured −2 % at this size.
+    let exact = 0.04f64.powi(3);
+    assert!(
+        (q.volume_m3 - exact).abs() < 0.04 * exact,
+        "volume {} vs {exact}",
+        q.volume_m3
+    );
+    assert!(
+        (mesh.node_count() as f64 - 1500.0).abs() < 0.25 * 1500.0,
+        "{} nodes",
+        mesh.node_count()
+    );
+    // Without the scale, a 40 m "organ" is refused with a hint about millimetres.
+    let err = load(
+        &file("cube_m.obj", CUBE_OBJ.as_bytes()),
+        &ImportOptions::default(),
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("millimetres"), "{err}");
+}
+
+fn tetra_facets() -> [[[f32; 3]; 3]; 4] {
+    let p = [
+        [0.0, 0.0, 0.0],
+        [0.03, 0.0, 0.0],
+        [0.0, 0.03, 0.0],
+        [0.0, 0.0, 0.03],
+    ];
+    [
+        [p[0], p[2], p[1]],
+        [p[0], p[1], p[3]],
+        [p[0], p[3], p[2]],
+        [p[1], p[2], p[3]],
+    ]
+}
+
+/// A tetrahedron as an ASCII and as a binary STL file.
+pub fn tetra_stl() -> (String, Vec<u8>) {
+    let mut ascii = String::from("solid tetra\n");
+    let mut binary = vec![0u8; 80];
+    binary.extend(4u32.to_le_bytes());
+    for facet in tetra_facets() {
+        ascii.push_str("facet normal 0 0 0\nouter loop\n");
+        binary.extend([0u8; 12]);
+        for v in facet {
+            ascii.push_str(&format!("vertex {} {} {}\n", v[0], v[1], v[2]));
+            binary.extend(v.iter().flat_map(|c| c.to_le_bytes()));
+        }
+        ascii.push_str("endloop\nendfacet\n");
+        binary.extend([0u8; 2]);
+    }
+    ascii.push_str("endsolid tetra\n");
+    (ascii, binary)
+}
+
+#[test]
+fn ascii_and_binary_stl_read_the_same_solid() {
+    let (ascii, binary) = tetra_stl();
+    let options = ImportOptions {
+        scale: 1.0,
+        surface_nodes: 800,
+    };
+    let a = load(&file("t.stl", ascii.as_bytes()), &options).unwrap();
+    let b = load(&file("tb.stl", &binary), &options).unwrap();
+    let exact = 0.03f64.powi(3) / 6.0;
+    for mesh in [&a, &b] {
+        let v = mesh.volume();
+        assert!((v - exact).abs() < 0.1 * exact, "volume {v} vs {exact}");
+    }
+    let truncated = load(&file("cut.stl", &binary[..binary.len() - 7]), &options).unwrap_err();
+    assert!(truncated.to_string().contains("truncated"), "{truncated}");
+}
+
+fn syntax_line(err: ImportError) -> (String, usize) {
+    match err {
+        ImportError::Syntax {
+            file,
+            line,
+            message,
+        } => (format!("{file}: {message}"), line),
+        other => panic!("expected a syntax error, got {other}"),
+    }
+}
+
+#[test]
+fn malformed_files_name_file_and_line() {
+    let bad_number = MSH2.replace("3 0 1 0", "3 0 one 0");
+    let (message, line) = syntax_line(import("bad.msh", &bad_number).unwrap_err());
+    assert_eq!(line, 12, "{message}");
+    assert!(
+        message.contains("bad.msh") && message.contains("'one'"),
+        "{message}"
+    );
+
+    let missing_node = MSH2.replace("3 4 2 0 1 2 3 4 5", "3 4 2 0 1 2 3 4 9");
+    let (message, line) = syntax_line(import("missing.msh", &missing_node).unwrap_err());
+    assert_eq!(line, 20, "{message}");
+    assert!(message.contains("node 9"), "{message}");
+
+    let (message, line) =
+        syntax_line(import("range.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n").unwrap_err());
+    assert_eq!(line, 3, "{message}");
+
+    let stl = "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendfacet\nendsolid x\n";
+    let (message, line) = syntax_line(import("loop.stl", stl).unwrap_err());
+    assert_eq!(line, 7, "{message}");
+    assert!(message.contains("endloop"), "{message}");
+
+    let misspelled = "solid x\nfacett normal 0 0 1\n";
+    let (message, line) = syntax_line(import("typo.stl", misspelled).unwrap_err());
+    assert_eq!(line, 2, "{message}");
+    assert!(message.contains("'facett'"), "{message}");
+
+    let vtu = "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"1\" NumberOfCells=\"0\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"binary\">AAAA</DataArray>\n";
+    let (message, line) = syntax_line(import("bin.vtu", vtu).unwrap_err());
+    assert_eq!(line, 6, "{message}");
+    assert!(message.contains("ASCII"), "{message}");
+
+    let vtk = "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 2 double\n0 0 0\n1 0 nan?\n";
+    let (_, line) = syntax_line(import("bad.vtk", vtk).unwrap_err());
+    assert_eq!(line, 7);
+}
+
+#[test]
+fn unusable_meshes_are_refused_with_the_reason() {
+    let inverted = MSH2.replace("3 4 2 0 1 2 3 4 5", "3 4 2 0 1 3 2 4 5");
+    let err = import("inv.msh", &inverted).unwrap_err();
+    assert!(
+        matches!(err, ImportError::Unusable { .. }) && err.to_string().contains("inverted"),
+        "{err}"
+    );
+
+    let open_cube = CUBE_OBJ.replace("f 4 1 5 8\n", "");
+    let err = load(
+        &file("open.obj", open_cube.as_bytes()),
+        &ImportOptions {
+            scale: 1e-3,
+            surface_nodes: 500,
+        },
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("holes"), "{err}");
+
+    let err = import("mesh.ply", "ply").unwrap_err();
+    assert!(err.to_string().contains("unknown mesh format"), "{err}");
+}
+
+/// A real organ surface: the generated liver's boundary, written as binary STL in millimetres,
+/// comes back as a valid tet mesh of the same volume.
+#[test]
+fn an_organ_surface_in_stl_becomes_a_valid_tet_mesh() {
+    use pgd_surgery_core::mesh::Surface;
+    use pgd_surgery_core::mesh::organs::{Organ, OrganSettings, generate};
+    let liver = generate(
+        Organ::Liver,
+        &OrganSettings {
+            resolution: 0.5,
+            seed: 1,
+            ..OrganSettings::default()
+        },
+    )
+    .unwrap();
+    let surface = Surface::extract(&liver);
+    let mut stl = vec![0u8; 80];
+    stl.extend((surface.triangles.len() as u32).to_le_bytes());
+    for f in &surface.triangles {
+        stl.extend([0u8; 12]);
+        for &n in f {
+            let p = liver.nodes()[n] * 1000.0;
+            stl.extend(
+                [p.x, p.y, p.z]
+                    .iter()
+                    .flat_map(|&c| (c as f32).to_le_bytes()),
+            );
+        }
+        stl.extend([0u8; 2]);
+    }
+    let options = ImportOptions {
+        scale: 1e-3,
+        surface_nodes: 3000,
+    };
+    let mesh = load(&file("liver.stl", &stl), &options).unwrap();
+    let q = QualityReport::measure(mesh.nodes(), mesh.tets());
+    assert!(q.refusal().is_none(), "{q}");
+    let error = (mesh.volume() - liver.volume()).abs() / liver.volume();
+    assert!(
+        error < 0.03,
+        "re-meshed liver volume off by {:.1} %",
+        error * 100.0
+    );
+}
