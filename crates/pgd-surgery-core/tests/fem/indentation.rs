@@ -317,7 +317,10 @@ fn the_exponential_law_firms_up_beyond_hertz_as_it_is_pressed() {
     let (ratios, stiffness) = firming(9);
     assert_rising("F/δ^1.5", &stiffness);
     assert_rising("exponential over neo-Hookean force", &ratios);
-    assert!(ratios[7] > 1.05, "{ratios:?}: expected it to grow past 1.05");
+    assert!(
+        ratios[7] > 1.05,
+        "{ratios:?}: expected it to grow past 1.05"
+    );
 }
 
 /// The fast tier's stand-in on 6 cells a side: `F / δ^{3/2}` still grows at every depth and
