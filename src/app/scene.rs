@@ -271,17 +271,18 @@ pub fn scene_of(
     on_stale: OnStale,
 ) -> Result<HapticScene, String> {
     let tip = scene_tip_m(organs, tip_radius_m, detail);
+    let specs = scene_vademecums(organs, tip_radius_m, dir, detail);
     let mut field_file = None;
     let loaded = organs
         .iter()
-        .map(|organ| {
-            let spec = organ.vademecum(dir, detail, tip);
+        .zip(&specs)
+        .map(|(organ, spec)| {
             let (vademecum, mesh) = match on_stale {
                 #[cfg(not(target_arch = "wasm32"))]
                 OnStale::Meanwhile if organ.law != Law::Linear => {
                     linear_meanwhile(organ, spec.clone(), (dir, detail, tip))?
                 }
-                _ => ensure_vademecum(&spec, on_stale)?,
+                _ => ensure_vademecum(spec, on_stale)?,
             };
             if organ.name == coupling.master {
                 field_file = Some(spec.field_file());
@@ -293,8 +294,9 @@ pub fn scene_of(
     let meanwhile = organs
         .iter()
         .zip(&loaded)
-        .filter(|(organ, (_, vademecum, _))| vademecum.header.material.law != organ.law)
-        .map(|(organ, _)| organ.vademecum(dir, detail, tip).file)
+        .zip(specs)
+        .filter(|((organ, (_, vademecum, _)), _)| vademecum.header.material.law != organ.law)
+        .map(|(_, spec)| spec.file)
         .collect();
     let dynamics = scene_dynamics(organs, &loaded)?;
     let cutting = scene_cutting(organs, &loaded)?;

@@ -4,13 +4,7 @@ use pgd_surgery::cli::plot_force_depth;
 use pgd_surgery::fem::Law;
 use pgd_surgery::pgd::{Silent, ValidationSettings, validate};
 
-use crate::common::{block_mesh, block_model, build_block};
-
-fn temp_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("pgd-commands-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::common::{block_mesh, block_model, build_block, temp_dir};
 
 /// `pgd indent` on a block with `clamped` and `accessible` regions: one curve per law, rising
 /// with depth, the linear law's per-element volumes stiffer than the neo-Hookean nodal ones at

@@ -1,4 +1,5 @@
-//! A 6 × 4 × 3 cm block of liver tissue clamped underneath, loadable on its top face.
+//! A 6 × 4 × 3 cm block of liver tissue clamped underneath, loadable on its top face; and a
+//! folder for a test's files.
 
 use pgd_surgery_core::fem::{Dirichlet, FemModel, Law, Material};
 use pgd_surgery_core::mesh::{TetMesh, box_mesh};
@@ -45,4 +46,11 @@ pub fn build_block(model: &FemModel, max_modes: usize) -> Vademecum {
     build(&organ(model), &settings(max_modes, 1e-9), &Silent)
         .unwrap()
         .0
+}
+
+/// A folder of its own for the files of the test `name`, in the system's temporary folder.
+pub fn temp_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("pgd-outputs-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
 }

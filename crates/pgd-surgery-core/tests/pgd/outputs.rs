@@ -8,13 +8,7 @@ use pgd_surgery_core::pgd::save;
 use pgd_surgery_core::report::{self, StepCurve};
 use pgd_surgery_core::store::{self, OnStale, VademecumSpec};
 
-use crate::common::{block_mesh, block_model, build_block};
-
-fn temp_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("pgd-outputs-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::common::{block_mesh, block_model, build_block, temp_dir};
 
 /// One CSV row per mode with the curve's own numbers, and a real PNG beside the vademecum.
 #[test]
