@@ -6,8 +6,9 @@ use std::time::Duration;
 use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{HapticLoop, HapticScene};
 use pgd_surgery::devices::{
-    DeviceLimits, DeviceSpec, EdgeForce, EdgeRefusal, Fault, HapticDevice, Histogram, Recorder,
-    SafetyFilter, SafetySettings, Scripted, TICK_S, Trajectory, TrajectoryError, VirtualDevice,
+    DeviceLimits, DeviceSpec, EdgeForce, EdgeRefusal, Fault, HapticDevice, Histogram,
+    MAX_FORCE_LIMIT_N, Recorder, SafetyFilter, SafetySettings, Scripted, TICK_S, Trajectory,
+    TrajectoryError, VirtualDevice,
 };
 
 fn write(name: &str, text: &str) -> std::path::PathBuf {
@@ -105,6 +106,59 @@ fn the_safety_filter_clamps_and_limits_the_rate() {
         SafetyFilter::new(settings, DeviceLimits::peak_only(1.0)).max_force_n(),
         1.0
     );
+}
+
+/// A driver's figure over the product's 20 N ceiling is held to it, with a warning naming the
+/// device and both figures; one within it passes as it is, without a warning.
+#[test]
+fn a_reported_peak_is_held_to_the_ceiling() {
+    let (held, warning) = DeviceLimits::peak_only(100.0).within_ceiling("Fake Touch");
+    assert_eq!(held.peak_force_n, MAX_FORCE_LIMIT_N);
+    assert_eq!(held.continuous_force_n, MAX_FORCE_LIMIT_N);
+    let warning = warning.unwrap();
+    assert!(
+        warning.contains("Fake Touch") && warning.contains("100.0 N"),
+        "{warning}"
+    );
+    assert!(warning.contains("20 N"), "{warning}");
+    let touch = DeviceLimits::touch();
+    assert_eq!(touch.within_ceiling("Touch"), (touch, None));
+}
+
+/// The filter at `force_n` along z, reached at the rate limit under `settings`.
+fn filter_at(settings: SafetySettings, force_n: f64) -> SafetyFilter {
+    let mut filter = SafetyFilter::new(settings, DeviceLimits::peak_only(10.0));
+    let desired = Vector3::new(0.0, 0.0, force_n);
+    (0..1000).for_each(|_| {
+        filter.filter(&desired, &[]);
+    });
+    filter
+}
+
+/// A scene with a 0.5 N limit after one sending 3 N: the first tick under the new settings
+/// sends no more than 0.5 N (not 140 ms of 20 mN steps down); a fade begun above the new limit
+/// fades from the limit. A raised limit moves at the rate limit, as within a scene.
+#[test]
+fn a_lowered_limit_bites_within_one_tick() {
+    let strong = SafetySettings::default();
+    let weak = SafetySettings {
+        max_force_n: 0.5,
+        ..strong
+    };
+    let pressing = Vector3::new(0.0, 0.0, 3.0);
+    let mut filter = filter_at(strong, 3.0);
+    filter.retune(weak, DeviceLimits::peak_only(10.0));
+    let sent = filter.filter(&pressing, &[]);
+    assert!(sent.norm() <= 0.5 * (1.0 + 1e-12), "{sent:?}");
+    let mut fading = filter_at(strong, 3.0);
+    fading.filter(&pressing, &[Fault::NonFiniteDevice]);
+    fading.retune(weak, DeviceLimits::peak_only(10.0));
+    let sent = fading.filter(&pressing, &[Fault::NonFiniteDevice]);
+    assert!(sent.norm() <= 0.5 * (1.0 + 1e-12), "{sent:?}");
+    let mut raised = filter_at(weak, 3.0);
+    raised.retune(strong, DeviceLimits::peak_only(10.0));
+    let sent = raised.filter(&pressing, &[]);
+    assert!((sent.norm() - (0.5 + strong.max_change_n_per_tick)).abs() < 1e-12);
 }
 
 /// A Touch (3.3 N peak, 0.88 N continuous over a 2 s window) asked for 2 N for 10 s: the force

@@ -18,7 +18,10 @@ static long nonfinite_forces;
 static atomic_int pending_error;
 static int last_error;
 static atomic_long frames;
-static int opened, closed, force_enabled, absent;
+static int opened, closed, force_enabled, absent, refuse_force;
+static double max_force = 9.5;
+/* An error code the next dhdSetForce fails with (0: none). */
+static atomic_int set_force_error;
 
 int dhdOpen(void) {
     if (absent) { last_error = 3; return -1; }
@@ -28,7 +31,12 @@ int dhdOpen(void) {
 }
 
 int dhdClose(char id) { (void)id; closed = 1; return 0; }
-int dhdEnableForce(unsigned char on, char id) { (void)id; force_enabled = on; return 0; }
+int dhdEnableForce(unsigned char on, char id) {
+    (void)id;
+    if (refuse_force) { last_error = 7; return -1; }
+    force_enabled = on;
+    return 0;
+}
 
 int dhdGetPosition(double *x, double *y, double *z, char id) {
     (void)id;
@@ -53,6 +61,8 @@ unsigned int dhdGetButtonMask(char id) { (void)id; return buttons; }
 
 int dhdSetForce(double fx, double fy, double fz, char id) {
     (void)id;
+    int error = atomic_exchange(&set_force_error, 0);
+    if (error) { last_error = error; atomic_fetch_add(&frames, 1); return -1; }
     pthread_mutex_lock(&lock);
     last_force[0] = fx;
     last_force[1] = fy;
@@ -65,7 +75,7 @@ int dhdSetForce(double fx, double fy, double fz, char id) {
     return 0;
 }
 
-double dhdGetMaxForce(char id) { (void)id; return 9.5; }
+double dhdGetMaxForce(char id) { (void)id; return max_force; }
 const char *dhdGetSystemName(char id) { (void)id; return "fake omega.3"; }
 int dhdErrorGetLast(void) { return last_error; }
 const char *dhdErrorGetStr(int error) {
@@ -108,3 +118,6 @@ long fake_dhd_nonfinite_forces(void) {
 }
 int fake_dhd_closed(void) { return closed; }
 int fake_dhd_force_enabled(void) { return force_enabled; }
+void fake_dhd_set_max_force(double newtons) { max_force = newtons; }
+void fake_dhd_refuse_force(int yes) { refuse_force = yes; }
+void fake_dhd_fail_set_force(int code) { atomic_store(&set_force_error, code); }

@@ -177,3 +177,5 @@ long fake_hd_nonfinite_forces(void) {
 int fake_hd_running(void) { return atomic_load(&running); }
 int fake_hd_disabled(void) { return disabled; }
 int fake_hd_force_output(void) { return force_output; }
+/* The peak force the device reports (HD_NOMINAL_MAX_FORCE), for the next device opened. */
+void fake_hd_set_nominal_max_force(double newtons) { nominal_max_force = newtons; }

@@ -168,25 +168,37 @@ pub fn assert_faded(run: &FaultRun, says: &str) {
 }
 
 /// The servo rendered the last command while it was within the watchdog and zero from the
-/// first frame past it, as the link measured the command's age; zero came no sooner than the
-/// watchdog in wall time either (`zeroed_after_s`, from just before the command).
+/// very next servo frame, past it: on the servo's own clock, the force reached zero no later
+/// than the watchdog's 10 ms plus one servo period (that frame's spacing, whatever the
+/// machine's load made it). Zero came no sooner than the watchdog in wall time either
+/// (`zeroed_after_s`, from just before the command).
 pub fn assert_watchdog_held(link: &ServoLink, zeroed_after_s: f64) {
-    let (rendered_s, expired_s) = link.watchdog_ages_s();
-    let expired_s = expired_s.expect("a servo frame found the command expired");
+    let record = link.watchdog_record();
+    let (expired_s, expired_frame) = record.expired.expect("a servo frame found it expired");
+    let period_s = expired_s - record.rendered_age_s;
     eprintln!(
-        "zeroed {:.1} ms after the last command (watchdog {:.0} ms): rendered at {:.1} ms of \
-         age, zero from {:.1} ms; {} expired frames",
+        "zeroed {:.1} ms after the last command (watchdog {:.0} ms): rendered at {:.2} ms of \
+         age in servo frame {}, zero from {:.2} ms in frame {expired_frame} ({:.2} ms later); \
+         {} expired frames",
         zeroed_after_s * 1e3,
         WATCHDOG_S * 1e3,
-        rendered_s * 1e3,
+        record.rendered_age_s * 1e3,
+        record.rendered_frame,
         expired_s * 1e3,
+        period_s * 1e3,
         link.expired_frames()
     );
     assert!(
-        rendered_s <= WATCHDOG_S,
-        "rendered at {rendered_s} s of age"
+        record.rendered_age_s <= WATCHDOG_S,
+        "rendered at {} s of age",
+        record.rendered_age_s
     );
     assert!(expired_s > WATCHDOG_S, "zeroed early, at {expired_s} s");
+    assert_eq!(
+        expired_frame,
+        record.rendered_frame + 1,
+        "frames between the last one rendering the command and the first rendering zero"
+    );
     assert!(
         zeroed_after_s >= WATCHDOG_S,
         "zeroed early: {zeroed_after_s} s"

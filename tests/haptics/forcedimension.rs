@@ -5,7 +5,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
-use pgd_surgery::devices::{ForceDimension, HapticDevice};
+use pgd_surgery::devices::{ForceDimension, HapticDevice, MAX_FORCE_LIMIT_N};
 
 use crate::fakes::{
     VendorFake, assert_edge_guarded, assert_faded, assert_watchdog_held, press_then_fault,
@@ -40,6 +40,12 @@ impl Fake {
     fn wait_frames(&self, frames: i64) {
         self.0.wait("fake_dhd_frames", frames);
     }
+
+    /// A control taking one int.
+    fn control(&self, name: &str, value: i32) {
+        // SAFETY: a plain value.
+        unsafe { self.0.call::<unsafe extern "C" fn(i32)>(name)(value) };
+    }
 }
 
 /// No library, or no device: one message each, naming what is missing.
@@ -53,10 +59,7 @@ fn a_missing_library_or_device_is_named() {
     assert!(error.contains("PGD_FORCEDIMENSION_LIB"), "{error}");
     let fake = Fake::new("absent");
     // SAFETY: a plain value.
-    unsafe {
-        fake.0
-            .call::<unsafe extern "C" fn(i32)>("fake_dhd_set_absent")(1)
-    };
+    fake.control("fake_dhd_set_absent", 1);
     let error = fake.open().err().unwrap();
     eprintln!("{error}");
     assert!(error.contains("no device found"), "{error}");
@@ -89,13 +92,7 @@ fn an_sdk_error_mid_run_fades_the_force_to_zero() {
     let tip = pressing_tip_m();
     // The scene's (x, y, z) is the device's (−y, x, z).
     fake.set_effector([-tip.y, tip.x, tip.z], 0);
-    let inject = || {
-        // SAFETY: a plain value.
-        unsafe {
-            fake.0
-                .call::<unsafe extern "C" fn(i32)>("fake_dhd_inject_error")(7)
-        };
-    };
+    let inject = || fake.control("fake_dhd_inject_error", 7);
     let run = press_then_fault(
         Box::new(fake.open().unwrap()),
         || fake.wait_frames(1),
@@ -135,4 +132,51 @@ fn a_stalled_loop_and_closing_leave_zero_force() {
     drop(device);
     assert_eq!(fake.last_force(), Vector3::zeros());
     assert_eq!(fake.0.int("fake_dhd_closed"), 1);
+}
+
+/// The SDK cannot enable force output: the error gives the SDK's words, and the device opened
+/// is closed before it is returned.
+#[test]
+fn a_device_whose_force_cannot_be_enabled_is_closed() {
+    let fake = Fake::new("refuse-force");
+    fake.control("fake_dhd_refuse_force", 1);
+    let error = fake.open().err().unwrap();
+    eprintln!("{error}");
+    assert!(error.contains("cannot enable force output"), "{error}");
+    assert!(error.contains("communication error"), "{error}");
+    assert_eq!(fake.0.int("fake_dhd_closed"), 1);
+}
+
+/// `dhdSetForce` failing mid-run is a device fault: the force fades to zero within 5 ticks and
+/// the log gives the SDK's words.
+#[test]
+fn a_failed_send_mid_run_fades_the_force_to_zero() {
+    let fake = Fake::new("send-error");
+    let tip = pressing_tip_m();
+    fake.set_effector([-tip.y, tip.x, tip.z], 0);
+    let run = press_then_fault(
+        Box::new(fake.open().unwrap()),
+        || fake.wait_frames(1),
+        || fake.control("fake_dhd_fail_set_force", 7),
+    );
+    assert_faded(&run, "communication error");
+}
+
+/// A driver reporting a 100 N limit is held to the product's 20 N ceiling: the device's peak
+/// is 20 N, and a 100 N command reaches `dhdSetForce` as 20 N.
+#[test]
+fn a_driver_reporting_100_n_is_held_to_the_ceiling() {
+    let fake = Fake::new("100-newtons");
+    // SAFETY: a plain value.
+    unsafe {
+        fake.0
+            .call::<unsafe extern "C" fn(f64)>("fake_dhd_set_max_force")(100.0)
+    };
+    let mut device = fake.open().unwrap();
+    assert_eq!(device.limits().peak_force_n, MAX_FORCE_LIMIT_N);
+    let refused = device.write_force(&Vector3::new(0.0, 0.0, 100.0));
+    assert!(refused.is_err());
+    fake.wait_frames(3);
+    assert!((fake.last_force().norm() - MAX_FORCE_LIMIT_N).abs() < 1e-9);
+    assert!(fake.0.double("fake_dhd_largest_force") <= MAX_FORCE_LIMIT_N * (1.0 + 1e-12));
 }

@@ -6,7 +6,9 @@ use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{FaultLog, HapticLoop, HapticThread, Scheduling};
-use pgd_surgery::devices::{HapticDevice, OpenHaptics, SafetySettings, TimerMode};
+use pgd_surgery::devices::{
+    HapticDevice, MAX_FORCE_LIMIT_N, OpenHaptics, SafetySettings, TimerMode,
+};
 
 use crate::common::{TIP_RADIUS_M, scene, target};
 use crate::fakes::{
@@ -118,6 +120,25 @@ fn the_last_guard_keeps_nan_and_excess_from_the_device() {
     let fake = Fake::new("edge");
     let mut device = fake.open();
     assert_edge_guarded(&mut device, &fake.0, "fake_hd");
+}
+
+/// A driver reporting a 100 N peak is held to the product's 20 N ceiling: the device's peak is
+/// 20 N, and a 100 N command reaches the HD library as 20 N.
+#[test]
+fn a_driver_reporting_100_n_is_held_to_the_ceiling() {
+    let fake = Fake::new("100-newtons");
+    // SAFETY: a plain value.
+    unsafe {
+        fake.0
+            .call::<unsafe extern "C" fn(f64)>("fake_hd_set_nominal_max_force")(100.0)
+    };
+    let mut device = fake.open();
+    assert_eq!(device.limits().peak_force_n, MAX_FORCE_LIMIT_N);
+    let refused = device.write_force(&Vector3::new(0.0, 0.0, 100.0));
+    assert!(refused.is_err());
+    fake.wait_frames(3);
+    assert!((fake.last_force().norm() - MAX_FORCE_LIMIT_N).abs() < 1e-9);
+    assert!(fake.0.double("fake_hd_largest_force") <= MAX_FORCE_LIMIT_N * (1.0 + 1e-12));
 }
 
 /// A device the library initializes but reports an error for is released before the error

@@ -5,6 +5,8 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
+use super::MAX_FORCE_LIMIT_N;
+
 /// What a device reports at one tick.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DeviceSample {
@@ -65,6 +67,28 @@ impl DeviceLimits {
             continuous_force_n: 0.88,
             thermal_window_s: 2.0,
         }
+    }
+}
+
+impl DeviceLimits {
+    /// The limits a driver reported, held to the product's ceiling ([`MAX_FORCE_LIMIT_N`]):
+    /// no device this trainer serves renders more, so a driver reporting more is wrong, and
+    /// believing it would switch the edge guard off. With the warning to show when it did.
+    pub fn within_ceiling(self, device: &str) -> (Self, Option<String>) {
+        if self.peak_force_n <= MAX_FORCE_LIMIT_N {
+            return (self, None);
+        }
+        let warning = format!(
+            "warning: {device} reports a {:.1} N peak force, more than any haptic device this \
+             trainer serves; its forces are held to {MAX_FORCE_LIMIT_N} N",
+            self.peak_force_n
+        );
+        let capped = Self {
+            peak_force_n: MAX_FORCE_LIMIT_N,
+            continuous_force_n: self.continuous_force_n.min(MAX_FORCE_LIMIT_N),
+            ..self
+        };
+        (capped, Some(warning))
     }
 }
 

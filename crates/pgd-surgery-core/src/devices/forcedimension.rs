@@ -22,6 +22,7 @@ use super::servo::ServoLink;
 use super::vendor::VendorLibrary;
 use super::{
     DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice, Metronome, TICK_S, TimerMode,
+    held_to_ceiling,
 };
 
 /// The dhd library, and what to install when it is missing.
@@ -243,7 +244,8 @@ impl ForceDimension {
                 (dhd.get_max_force)(session.id),
             )
         };
-        let limits = device_limits(max_force);
+        let limits = held_to_ceiling(device_limits(max_force), "Force Dimension");
+        session.link.set_peak_force_n(limits.peak_force_n);
         // SAFETY: the ID is open.
         if unsafe { (dhd.enable_force)(1, session.id) } < 0 {
             return Err(failed("cannot enable force output", dhd.last_error()));

@@ -17,6 +17,7 @@ mod recorder;
 mod release;
 mod safety;
 mod scripted;
+mod seqlock;
 mod servo;
 mod spec;
 mod sweep;
@@ -40,14 +41,16 @@ pub use rack::{Action, CHANGE_BUTTON, Instrument, MAX_INSTRUMENTS, Rack};
 pub use recorder::Recorder;
 #[cfg(not(target_arch = "wasm32"))]
 pub use release::install_exit_guards;
-pub use release::{Release, register, release_all, stop_requested};
+pub use release::{Release, hold_registry_for, register, release_all, stop_requested};
 pub use safety::{Fault, MAX_FORCE_LIMIT_N, SafetyFilter, SafetySettings, check_force_limit};
 pub use scripted::Scripted;
-pub use servo::{ServoLink, WATCHDOG_S};
+pub use servo::{ServoLink, WATCHDOG_S, WatchdogRecord, halt_every_link};
 pub use spec::DeviceSpec;
 pub use sweep::{PressMotion, PressTarget, press_and_slide};
 pub use timing::{Histogram, Metronome, TimerMode};
 pub use trajectory::{Trajectory, TrajectoryError, TrajectoryRow};
+#[cfg(not(target_arch = "wasm32"))]
+use vendor::held_to_ceiling;
 pub use virtual_device::{VirtualDevice, VirtualHandle};
 pub use workspace::Workspace;
 

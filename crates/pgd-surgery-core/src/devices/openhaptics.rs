@@ -19,7 +19,7 @@ use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use super::release::Release;
 use super::servo::ServoLink;
 use super::vendor::VendorLibrary;
-use super::{DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice};
+use super::{DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice, held_to_ceiling};
 
 /// The HD library, and what to install when it is missing.
 pub const LIBRARY: VendorLibrary = VendorLibrary {
@@ -302,7 +302,8 @@ impl OpenHaptics {
         }
         // SAFETY: the handle was just returned by `hdInitDevice`.
         unsafe { (hd.make_current)(handle) };
-        let limits = device_limits(&hd);
+        let limits = held_to_ceiling(device_limits(&hd), &format!("OpenHaptics {name}"));
+        session.servo.link.set_peak_force_n(limits.peak_force_n);
         let workspace: [f64; 6] = hd.doubles(HD_USABLE_WORKSPACE_DIMENSIONS);
         let corners = (
             to_scene(&Vector3::new(workspace[0], workspace[1], workspace[2])),

@@ -4,11 +4,18 @@
 //! and a backend's own `Drop` releases it on the ordinary ways out (the window closing, the
 //! run ending, an error returned). Releasing is idempotent: whichever comes first does it.
 //!
-//! The servo's watchdog zeroes a stale command within 10 ms whatever the program does; this
-//! is what stops the motors at once and hands the device back to its driver.
+//! On a panic or a signal every servo link is halted first, without any lock
+//! ([`super::halt_every_link`]): from its next frame no servo renders force, even while
+//! another thread holds the registry. The release proper (servo stopped, device closed)
+//! follows as soon as the registry is free, waiting for it a bounded time. The servo's
+//! watchdog zeroes a stale command within 10 ms whatever the program does; the release is what
+//! hands the device back to its driver.
 
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex, TryLockError, Weak};
+use std::sync::{Arc, Mutex, MutexGuard, TryLockError, Weak};
+use std::time::{Duration, Instant};
+
+use super::halt_every_link;
 
 /// What releases one open device: zero force, its servo stopped, the device closed. Called
 /// from any thread, possibly while the haptic loop is still using the device; every call after
@@ -31,19 +38,46 @@ pub fn register(device: &Arc<dyn Release>) {
     open.push(Arc::downgrade(device));
 }
 
-/// Releases every registered device that is still open; how many there were.
-pub fn release_all() -> usize {
-    // A panic inside a release would find the list locked by this very thread: it is skipped
-    // then (the watchdog still zeroes the force), rather than deadlocking.
-    let open = match OPEN.try_lock() {
-        Ok(open) => open,
-        Err(TryLockError::Poisoned(poisoned)) => poisoned.into_inner(),
-        Err(TryLockError::WouldBlock) => return 0,
-    };
+/// How long a panic or a signal waits for another thread to let go of the registry before it
+/// gives the release up (the links are halted already).
+const REGISTRY_WAIT: Duration = Duration::from_millis(200);
+
+/// Releases every registered device that is still open; how many there were. Waits for the
+/// registry up to [`REGISTRY_WAIT`] while another thread holds it (`None` if it never came
+/// free: a panic inside a release, on the thread holding it, must not deadlock).
+pub fn release_all() -> Option<usize> {
+    let open = registry_within(REGISTRY_WAIT)?;
     let devices: Vec<Arc<dyn Release>> = open.iter().filter_map(Weak::upgrade).collect();
     drop(open);
     devices.iter().for_each(|device| device.release());
-    devices.len()
+    Some(devices.len())
+}
+
+/// The registry, once it is free, if that is within `wait`.
+fn registry_within(wait: Duration) -> Option<MutexGuard<'static, Vec<Weak<dyn Release>>>> {
+    let give_up = Instant::now() + wait;
+    loop {
+        match OPEN.try_lock() {
+            Ok(open) => return Some(open),
+            Err(TryLockError::Poisoned(poisoned)) => return Some(poisoned.into_inner()),
+            Err(TryLockError::WouldBlock) if Instant::now() >= give_up => return None,
+            Err(TryLockError::WouldBlock) => std::thread::sleep(Duration::from_micros(100)),
+        }
+    }
+}
+
+/// Holds the registry for `duration` on the calling thread: how the tests show that a panic
+/// or a signal zeroes every device while another thread holds it.
+#[doc(hidden)]
+pub fn hold_registry_for(duration: Duration) {
+    let _open = OPEN.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    std::thread::sleep(duration);
+}
+
+/// Every link halted at once, then every device released: what a panic and a signal do.
+fn halt_and_release_all() -> Option<usize> {
+    halt_every_link();
+    release_all()
 }
 
 /// Whether a termination signal asked the run to end.
@@ -63,7 +97,12 @@ pub fn install_exit_guards(on_stop: fn()) -> Result<(), String> {
     INSTALLED.call_once(|| {
         let previous = std::panic::take_hook();
         std::panic::set_hook(Box::new(move |info| {
-            release_all();
+            if halt_and_release_all().is_none() {
+                eprintln!(
+                    "trainer: the device registry stayed locked: every servo halted at zero \
+                     force, the devices not released"
+                );
+            }
             previous(info);
         }));
         result = ctrlc::set_handler(move || on_termination_signal(on_stop))
@@ -75,14 +114,20 @@ pub fn install_exit_guards(on_stop: fn()) -> Result<(), String> {
 /// The signal handler (ctrlc runs it on a thread of its own, not in the signal's context).
 #[cfg(not(target_arch = "wasm32"))]
 fn on_termination_signal(on_stop: fn()) {
-    let released = release_all();
+    let released = halt_and_release_all();
     if STOP_REQUESTED.swap(true, Ordering::AcqRel) {
         eprintln!("trainer: a second signal: stopping at once");
         std::process::exit(130);
     }
-    eprintln!(
-        "trainer: signal received: {released} device(s) released at zero force; stopping \
-         (a second signal stops at once)"
-    );
+    match released {
+        Some(released) => eprintln!(
+            "trainer: signal received: {released} device(s) released at zero force; stopping \
+             (a second signal stops at once)"
+        ),
+        None => eprintln!(
+            "trainer: signal received: every servo halted at zero force (the device registry \
+             stayed locked); stopping (a second signal stops at once)"
+        ),
+    }
     on_stop();
 }

@@ -160,12 +160,21 @@ impl SafetyFilter {
         &self.settings
     }
 
-    /// New settings (another scene's), keeping the force being sent and any fault: the force
-    /// then moves from what the hand feels now at the allowed rate, as it would within a scene.
+    /// New settings (another scene's), keeping any fault. A limit raised leaves the force
+    /// being sent, which then moves at the allowed rate as it would within a scene; a limit
+    /// lowered bites at once: the force being sent, and a fade's starting force, are clamped
+    /// to it, so that the very next tick sends no more than the new limit.
     pub fn retune(&mut self, settings: SafetySettings, limits: DeviceLimits) {
         self.max_force_n = applied_limit_n(&settings, &limits);
         self.settings = settings;
         self.limits = limits;
+        self.output = self.output.cap_magnitude(self.max_force_n);
+        if let State::Fading { from, tick } = self.state {
+            self.state = State::Fading {
+                from: from.cap_magnitude(self.max_force_n),
+                tick,
+            };
+        }
     }
 
     /// The peak limit actually applied (N): the smaller of the settings' and the device's.

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use libloading::Library;
 
-use super::DeviceError;
+use super::{DeviceError, DeviceLimits};
 
 /// A vendor library the trainer can load.
 pub struct VendorLibrary {
@@ -66,4 +66,14 @@ impl VendorLibrary {
             ))
         })
     }
+}
+
+/// The limits a vendor's driver reported, held to the product's ceiling; the warning, when
+/// the driver reported more, goes to the error stream as the device opens.
+pub fn held_to_ceiling(reported: DeviceLimits, device: &str) -> DeviceLimits {
+    let (limits, warning) = reported.within_ceiling(device);
+    if let Some(warning) = warning {
+        eprintln!("{warning}");
+    }
+    limits
 }
