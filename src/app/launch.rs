@@ -243,14 +243,18 @@ pub fn open_window(
     let (report, mut haptic) = haptic.stop();
     let attempts = attempts(&lessons, &mut haptic);
     match exit {
-        AppExit::Success => Ok((
+        // A signal closes the window through Bevy's Ctrl-C exit, which carries an error code:
+        // it was closed as its close button would, and its attempts are kept.
+        AppExit::Error(code) if !crate::devices::stop_requested() => {
+            Err(format!("the window closed with error code {code}"))
+        }
+        _ => Ok((
             Report::Window {
                 haptic: report,
                 frames,
             },
             attempts,
         )),
-        AppExit::Error(code) => Err(format!("the window closed with error code {code}")),
     }
 }
 

@@ -18,7 +18,7 @@ use pgd_surgery::devices::{
     TimerMode, hold_registry_for, install_exit_guards, stop_requested,
 };
 
-use crate::fakes::VendorFake;
+use crate::vendor_fake::VendorFake;
 
 /// The environment variable naming the one test a child process runs for real.
 const CHILD: &str = "PGD_EXIT_TEST_CHILD";

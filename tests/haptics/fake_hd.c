@@ -6,6 +6,8 @@
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -134,6 +136,15 @@ unsigned long hdScheduleAsynchronous(Callback cb, void *data, unsigned short pri
 void hdStartScheduler(void) {
     atomic_store(&running, 1);
     pthread_create(&scheduler, 0, run_scheduler, 0);
+    /* For a test running the trainer itself: a file `<FAKE_HD_REPORT>.started` says the servo
+     * runs. */
+    const char *report = getenv("FAKE_HD_REPORT");
+    if (report) {
+        char started[4096];
+        snprintf(started, sizeof started, "%s.started", report);
+        FILE *file = fopen(started, "w");
+        if (file) fclose(file);
+    }
 }
 
 void hdStopScheduler(void) {
@@ -179,3 +190,22 @@ int fake_hd_disabled(void) { return disabled; }
 int fake_hd_force_output(void) { return force_output; }
 /* The peak force the device reports (HD_NOMINAL_MAX_FORCE), for the next device opened. */
 void fake_hd_set_nominal_max_force(double newtons) { nominal_max_force = newtons; }
+
+/* For a test running the trainer itself, which cannot call the controls: the stylus placed
+ * from `FAKE_HD_STYLUS` ("x,y,z" in mm) when the library loads, and what the device was left
+ * in written to the file `FAKE_HD_REPORT` names when the process lets the library go. */
+__attribute__((constructor)) static void place_stylus_from_environment(void) {
+    const char *stylus = getenv("FAKE_HD_STYLUS");
+    if (stylus) sscanf(stylus, "%lf,%lf,%lf", &position_mm[0], &position_mm[1], &position_mm[2]);
+}
+
+__attribute__((destructor)) static void report_to_environment(void) {
+    const char *report = getenv("FAKE_HD_REPORT");
+    FILE *file = report ? fopen(report, "w") : 0;
+    if (!file) return;
+    fprintf(file, "{\"last_force\": [%g, %g, %g], \"largest_force\": %g, \"frames\": %ld, "
+                  "\"running\": %d, \"disabled\": %d}\n",
+            last_force[0], last_force[1], last_force[2], largest_force, atomic_load(&frames),
+            atomic_load(&running), disabled);
+    fclose(file);
+}

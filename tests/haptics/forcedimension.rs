@@ -8,9 +8,9 @@ use nalgebra::Vector3;
 use pgd_surgery::devices::{ForceDimension, HapticDevice, MAX_FORCE_LIMIT_N};
 
 use crate::fakes::{
-    VendorFake, assert_edge_guarded, assert_faded, assert_watchdog_held, press_then_fault,
-    pressing_tip_m,
+    assert_edge_guarded, assert_faded, assert_watchdog_held, press_then_fault, pressing_tip_m,
 };
+use crate::vendor_fake::VendorFake;
 
 /// This test's own copy of the fake dhd library, and its controls.
 struct Fake(VendorFake);

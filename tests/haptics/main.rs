@@ -17,4 +17,5 @@ mod press;
 mod range;
 mod replay;
 mod superposition;
+mod vendor_fake;
 mod workspace;

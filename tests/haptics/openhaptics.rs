@@ -12,9 +12,9 @@ use pgd_surgery::devices::{
 
 use crate::common::{TIP_RADIUS_M, scene, target};
 use crate::fakes::{
-    VendorFake, assert_edge_guarded, assert_faded, assert_watchdog_held, press_then_fault,
-    pressing_tip_m,
+    assert_edge_guarded, assert_faded, assert_watchdog_held, press_then_fault, pressing_tip_m,
 };
+use crate::vendor_fake::VendorFake;
 
 /// This test's own copy of the fake HD library, and its controls.
 struct Fake(VendorFake);

@@ -4,16 +4,22 @@
 //! against the legends the trainer writes beside them: each organ's tissue colour shows where
 //! its surface is in sight, and the pressed frame differs from the rest frame around the tool
 //! and nowhere far from it. The window itself, under Xvfb, is not blank. A missing display is
-//! reported plainly, without a panic. The laparoscopic view, the keratotomy's view of the
+//! reported plainly, without a panic. Closing the window, and SIGINT, release a hardware
+//! device (the fake HD library) at zero force. The laparoscopic view, the keratotomy's view of the
 //! cornea and an open incision are checked on their own shipped scenarios, and every shipped
 //! scenario's start shows its organs.
 
 #[path = "../../crates/pgd-surgery-core/tests/support/cache.rs"]
 mod cache;
+mod closing;
 mod cornea;
 mod incision;
 mod laparoscope;
 mod scenarios;
+// The haptics tests' fakes; these tests only load one into the trainer, not its controls.
+#[allow(dead_code)]
+#[path = "../haptics/vendor_fake.rs"]
+mod vendor_fake;
 mod xvfb;
 
 use std::path::{Path, PathBuf};
