@@ -267,7 +267,7 @@ impl AttemptRecord {
             time_s: tasks().map(|m| m.time_s).sum(),
             path_mm: tasks().map(|m| m.motion.path_length_mm).sum(),
             peak_force_n: tasks().map(|m| m.peak_force_n).fold(0.0, f64::max),
-            errors: tasks().map(|m| m.errors.len() as i64).sum(),
+            errors: tasks().map(|m| m.error_count() as i64).sum(),
             report: report.map_or_else(String::new, |p| p.display().to_string()),
         }
     }

@@ -68,14 +68,17 @@ pub struct OrganMotion {
     pub organ: GraspedOrgan,
     pub correction: Vec<f64>,
     pub in_vademecum_modes: Vec<f64>,
-    /// The jaws' patch on the surface while they hold.
+    /// The jaws' patch on the surface while they hold (load positions), and its mesh nodes;
+    /// both with room for every load position.
     pub shares: Vec<(usize, f64)>,
+    pub patch_nodes: Vec<(usize, f64)>,
     /// Whether the jaws tore the tissue this tick (what the scenario's tasks score).
     pub tore: bool,
 }
 
 impl OrganMotion {
-    pub fn new(model: Arc<DynamicModel>, settings: GraspSettings) -> Self {
+    /// `positions`: the organ's load positions, the most a patch holds.
+    pub fn new(model: Arc<DynamicModel>, settings: GraspSettings, positions: usize) -> Self {
         let organ = model.at_rest(TICK_S, settings);
         let correction = vec![0.0; model.basis.len()];
         let in_vademecum_modes = vec![0.0; model.fit.modes()];
@@ -84,7 +87,8 @@ impl OrganMotion {
             organ,
             correction,
             in_vademecum_modes,
-            shares: Vec::new(),
+            shares: Vec::with_capacity(positions),
+            patch_nodes: Vec::with_capacity(positions),
             tore: false,
         }
     }

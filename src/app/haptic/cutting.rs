@@ -5,12 +5,12 @@
 //! deterministic.
 
 use bevy::prelude::*;
-use nalgebra::{Point3, Unit, Vector3};
+use nalgebra::{Matrix3, Point3, Unit, Vector3};
 
 use super::components::{OrganBody, OrganDeformation, ToolTouch};
 use super::resources::Tool;
 use crate::contact::ToolContact;
-use crate::cutting::{BladeContact, CutView, CutWorker, Scalpel};
+use crate::cutting::{BladeContact, CutWorker, Scalpel};
 use crate::devices::Action;
 
 /// An organ a scalpel cuts: the blade on it, and its cut state on a worker thread (whose
@@ -20,20 +20,20 @@ use crate::devices::Action;
 pub struct OrganCut {
     pub scalpel: Scalpel,
     pub worker: CutWorker,
-    /// Scratch space kept from tick to tick: the patch's nodes and shares, and `Y`'s rows.
+    /// Scratch kept from tick to tick: the patch's nodes and shares, room for every load
+    /// position.
     nodes: Vec<(usize, f64)>,
-    y: [Vec<f64>; 3],
     /// The exercise's attempt the tissue was cut in (0 before the first).
     pub(super) attempt: u32,
 }
 
 impl OrganCut {
-    pub fn new(scalpel: Scalpel, worker: CutWorker) -> Self {
+    /// `positions`: the organ's load positions, the most a patch holds.
+    pub fn new(scalpel: Scalpel, worker: CutWorker, positions: usize) -> Self {
         Self {
             scalpel,
             worker,
-            nodes: Vec::new(),
-            y: Default::default(),
+            nodes: Vec::with_capacity(positions),
             attempt: 0,
         }
     }
@@ -61,10 +61,9 @@ pub fn cut(
             scalpel,
             worker,
             nodes,
-            y,
             ..
         } = &mut *cut;
-        let view = match settle {
+        match settle {
             Some(_) => worker.settle(),
             None => worker.poll(),
         };
@@ -74,7 +73,7 @@ pub fn cut(
             let positions = &body.vademecum.positions;
             let shares = touch.patch.shares.iter();
             nodes.extend(shares.map(|&(m, share)| (positions[m] as usize, share)));
-            soften(contact, view, (nodes, y));
+            soften(contact, worker.added_compliance(nodes));
             if let Some(parted_m) = scalpel.parted_depth_m().filter(|_| cuts) {
                 give(contact, parted_m);
             }
@@ -94,15 +93,10 @@ pub fn cut(
     }
 }
 
-/// The press's stiffness as the cut organ answers it: the patch compliance the cut adds
-/// ([`CutView::added_compliance`]) on top of the vademecum's, inverted.
-fn soften(
-    contact: &mut ToolContact,
-    view: &CutView,
-    (nodes, y): (&[(usize, f64)], &mut [Vec<f64>; 3]),
-) {
-    let added = view.added_compliance(nodes, y);
-    if added == nalgebra::Matrix3::zeros() {
+/// The press's stiffness as the cut organ answers it: the patch compliance the cut `added`
+/// ([`CutWorker::added_compliance`]) on top of the vademecum's, inverted.
+fn soften(contact: &mut ToolContact, added: Matrix3<f64>) {
+    if added == Matrix3::zeros() {
         return;
     }
     let Some(stiffness) = contact

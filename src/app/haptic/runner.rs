@@ -186,14 +186,15 @@ impl HapticLoop {
             if let Some(dynamics) = &scene.dynamics
                 && let Some(model) = dynamics.model(index)
             {
-                organ.insert(OrganMotion::new(model.clone(), dynamics.grasp));
+                let positions = vademecum.positions.len();
+                organ.insert(OrganMotion::new(model.clone(), dynamics.grasp, positions));
             }
             if let Some(cutting) = &scene.cutting
                 && let Some(cut) = cutting.organ(index)
             {
                 let scalpel = Scalpel::new(cutting.blade, cut.toughness_j_per_m2);
                 let worker = CutWorker::spawn(cut.model.clone(), name, cut.drawn.clone())?;
-                organ.insert(OrganCut::new(scalpel, worker));
+                organ.insert(OrganCut::new(scalpel, worker, vademecum.positions.len()));
             }
         }
         world.insert_resource(GraspForce::default());
@@ -210,7 +211,12 @@ impl HapticLoop {
         world.insert_resource(FaultLog::default());
         world.insert_resource(Parked(scene.safety));
         if let Some(coupling) = &scene.coupling {
-            world.insert_resource(OrganCoupling(coupling.clone_reserved(&scene.organs)));
+            let coupling = coupling.clone_reserved(&scene.organs);
+            let mut deformations = world.query::<&mut OrganDeformation>();
+            for mut deformation in deformations.iter_mut(&mut world) {
+                coupling.reserve_output(&mut deformation.0);
+            }
+            world.insert_resource(OrganCoupling(coupling));
         }
         if let Some(scope) = &scene.scope {
             world.insert_resource(Scope::new(scope.clone()));

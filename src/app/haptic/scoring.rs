@@ -407,10 +407,8 @@ mod tests {
         let mut worker = CutWorker::spawn(Arc::new(model), "block", Default::default()).unwrap();
         stroke().into_iter().for_each(|step| worker.submit(step));
         assert!(worker.settle().unknowns > 0, "the stroke cut nothing");
-        OrganCut::new(
-            Scalpel::new(Blade::default(), LIVER_TOUGHNESS_J_PER_M2),
-            worker,
-        )
+        let scalpel = Scalpel::new(Blade::default(), LIVER_TOUGHNESS_J_PER_M2);
+        OrganCut::new(scalpel, worker, 0)
     }
 
     /// The first attempt keeps the tissue as it is; once a retry is started, the cut organs

@@ -11,7 +11,6 @@ use super::resources::{
 use super::snapshot::{InstrumentsView, LoopTiming, SnapshotPublisher};
 use crate::contact::{Target, follow, press};
 use crate::devices::{Action, Fault, Fulcrum};
-use crate::dynamics::GraspPoint;
 use crate::pgd::SurfacePoint;
 
 /// Reads the device into [`Tool::hand`], mapped onto the scene. A non-finite sample or a
@@ -183,15 +182,14 @@ pub fn grasp(
 /// compliance there), starting from the press's force.
 fn take_hold(body: &OrganBody, touch: &ToolTouch, motion: &mut OrganMotion, hand_m: &Vector3<f64>) {
     let vademecum = &body.vademecum;
-    let nodes: Vec<(usize, f64)> = touch
-        .patch
-        .shares
-        .iter()
-        .map(|&(position, share)| (vademecum.positions[position] as usize, share))
-        .collect();
+    let shares = touch.patch.shares.iter();
+    motion.patch_nodes.clear();
+    (motion.patch_nodes)
+        .extend(shares.map(|&(position, share)| (vademecum.positions[position] as usize, share)));
     let compliance = vademecum.compliance(&touch.patch, &Vector3::zeros());
     let centre = touch.contact.map_or(Vector3::zeros(), |c| c.hit.point_m);
-    motion.organ.point = GraspPoint::at_patch(&motion.model.basis, &nodes, centre, &compliance);
+    let basis = &motion.model.basis;
+    (motion.organ.point).move_to(basis, &motion.patch_nodes, centre, &compliance);
     motion.shares.clone_from(&touch.patch.shares);
     let pressing = touch.contact.map_or(Vector3::zeros(), |c| c.force_n);
     motion.organ.close(hand_m, &pressing);

@@ -78,7 +78,7 @@ impl Coupling {
         for (organ, (_, vademecum)) in coupling.organs.iter_mut().zip(organs) {
             organ.alpha.reserve(vademecum.total_modes());
             organ.coupling_points.reserve(shells);
-            organ.hold.reserve(vademecum.positions.len());
+            organ.hold.reserve(vademecum);
         }
         coupling
     }
@@ -247,6 +247,13 @@ impl Coupling {
     /// `index`: the tool's load follows it in the same tick (`super::hold`).
     pub fn tool_moved_m(&self, index: usize) -> Vector3<f64> {
         self.organs[index].hold.moved_m()
+    }
+
+    /// Room in `deformation` (an organ's of this coupling) for every contact load the tick
+    /// can hand it.
+    pub fn reserve_output(&self, deformation: &mut Deformation) {
+        let points: usize = self.pairs.iter().map(ContactPair::node_count).sum();
+        deformation.coupling_points.reserve(points);
     }
 
     /// Hands organ `index` its coupling of this tick.

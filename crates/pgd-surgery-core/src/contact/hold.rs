@@ -46,9 +46,17 @@ pub struct ToolHold {
 }
 
 impl ToolHold {
-    /// Room for a load on `positions` positions.
-    pub(super) fn reserve(&mut self, positions: usize) {
-        self.load.shares.reserve(positions);
+    /// Room for a load on every position of `vademecum` and for its rows, so that holding
+    /// it allocates nothing.
+    pub(super) fn reserve(&mut self, vademecum: &Vademecum) {
+        self.load.shares.reserve(vademecum.positions.len());
+        let modes = vademecum.total_modes();
+        for a in 0..3 {
+            self.coefficients_per_m[a].reserve(modes);
+            self.moved_per_coefficient_m[a].reserve(modes);
+        }
+        let most = (0..vademecum.steps.len()).map(|k| vademecum.modes(k));
+        self.scratch.reserve(most.max().unwrap_or(0));
     }
 
     /// Whether the tool holds the organ and the rows are ready.

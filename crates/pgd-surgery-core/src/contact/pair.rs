@@ -148,6 +148,8 @@ impl ContactPair {
         let count = self.node_count();
         self.active.reserve(count);
         self.candidates.reserve(count);
+        self.relaxation.reserve();
+        self.compliance.local_mut().reserve();
     }
 
     /// The pointshell's nodes tested against the master.

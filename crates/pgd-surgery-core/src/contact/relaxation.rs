@@ -35,9 +35,15 @@ impl Relaxation {
         Self {
             omega: 1.0,
             last_n: vec![0.0; count],
-            last_nodes: Vec::new(),
+            last_nodes: Vec::with_capacity(count),
             in_set: vec![false; count],
         }
+    }
+
+    /// The room [`Self::new`] made (a clone keeps only the contents).
+    pub fn reserve(&mut self) {
+        self.last_nodes
+            .reserve(self.last_n.len() - self.last_nodes.len());
     }
 
     /// The share of `change_n` (per node of `set`, the change the solve asked for) to take

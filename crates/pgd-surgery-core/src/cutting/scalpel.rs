@@ -132,6 +132,10 @@ impl Sweep {
     }
 }
 
+/// Strokes a scalpel has room for from the start: an attempt making more grows the list (a
+/// radial keratotomy makes 4 to 8, an incision one or a few).
+pub const STROKES_RESERVED: usize = 64;
+
 /// A scalpel on one organ: the tissue's threshold, the stroke under way and the strokes made.
 #[derive(Clone, Debug)]
 pub struct Scalpel {
@@ -148,7 +152,7 @@ impl Scalpel {
             blade,
             threshold_n: blade.threshold_n(toughness_j_per_m2),
             sweep: None,
-            strokes: Vec::new(),
+            strokes: Vec::with_capacity(STROKES_RESERVED),
         }
     }
 

@@ -17,6 +17,8 @@ mod threaded;
 use std::borrow::Borrow;
 use std::sync::{Arc, Mutex, PoisonError};
 
+use nalgebra::Matrix3;
+
 #[cfg(target_arch = "wasm32")]
 use inline::Backend;
 #[cfg(not(target_arch = "wasm32"))]
@@ -30,19 +32,24 @@ use super::state::CutState;
 use super::view::CutView;
 use crate::fem::FemModel;
 
-/// What the haptic side hands the worker: a step to apply, or a view it no longer reads, to
-/// be freed by the worker rather than on the haptic thread (a view holds megabytes).
+/// The scratch of `Yᵀ Y` over a view's unknowns ([`CutView::added_compliance`]): made by the
+/// worker with each view, with room for all its unknowns, so that the tick never grows it.
+type Rows = [Vec<f64>; 3];
+
+/// What the haptic side hands the worker: a step to apply, or a view it no longer reads with
+/// its scratch, to be freed by the worker rather than on the haptic thread (a view holds
+/// megabytes).
 enum Job {
     Step(CutStep),
     /// Undo every incision (a new attempt at the exercise starts on uncut tissue).
     Heal,
-    Retire(Arc<CutView>),
+    Retire(Arc<CutView>, Rows),
 }
 
 /// What the worker answers a step or a heal with.
 enum Outcome {
-    /// The cut grew, or was healed: the state as it now stands.
-    Changed(Arc<CutView>),
+    /// The cut grew, or was healed: the state as it now stands, and its scratch.
+    Changed(Arc<CutView>, Rows),
     /// Nothing to publish (an incision set on the surface has cut nothing yet).
     Unchanged,
     /// The cut state refused the step and stands as it was.
@@ -102,8 +109,8 @@ impl<M: Borrow<FemModel>> Cutter<M> {
                 };
                 Ok(true)
             }
-            Job::Retire(view) => {
-                drop(view);
+            Job::Retire(view, rows) => {
+                drop((view, rows));
                 return (cutter, None);
             }
         };
@@ -111,7 +118,8 @@ impl<M: Borrow<FemModel>> Cutter<M> {
             Ok(true) => {
                 let view = Arc::new(cutter.state.view());
                 latest.set(view.clone());
-                Outcome::Changed(view)
+                let rows = std::array::from_fn(|_| Vec::with_capacity(view.unknowns));
+                Outcome::Changed(view, rows)
             }
             Ok(false) => Outcome::Unchanged,
             Err(error) => Outcome::Refused(error),
@@ -134,11 +142,17 @@ impl<M: Borrow<FemModel>> Cutter<M> {
     }
 }
 
+/// How many refusals a worker keeps; past that they are counted.
+const REFUSALS_KEPT: usize = 32;
+
 /// An organ's cut state on its worker.
 pub struct CutWorker {
     backend: Backend,
     view: Arc<CutView>,
+    rows: Rows,
+    /// The first [`REFUSALS_KEPT`] refusals, and how many more there were.
     refused: Vec<CutError>,
+    more_refused: usize,
 }
 
 impl CutWorker {
@@ -155,7 +169,9 @@ impl CutWorker {
         Ok(Self {
             backend: Backend::start(model, response, name, latest)?,
             view: Arc::new(empty),
-            refused: Vec::new(),
+            rows: Rows::default(),
+            refused: Vec::with_capacity(REFUSALS_KEPT),
+            more_refused: 0,
         })
     }
 
@@ -191,14 +207,31 @@ impl CutWorker {
         &self.view
     }
 
+    /// What the cut adds to the uncut compliance (m/N) of the patch `patch` (mesh nodes and
+    /// their shares) in the latest view taken: allocates nothing.
+    pub fn added_compliance(&mut self, patch: &[(usize, f64)]) -> Matrix3<f64> {
+        self.view.added_compliance(patch, &mut self.rows)
+    }
+
     /// Steps handed over and not yet answered.
     pub fn pending(&self) -> u64 {
         self.backend.pending()
     }
 
-    /// The steps the cut state refused, in order.
+    /// The steps the cut state refused, in order (the first [`REFUSALS_KEPT`])...
     pub fn refused(&self) -> &[CutError] {
         &self.refused
+    }
+
+    /// ...and how many more it refused.
+    pub fn more_refused(&self) -> usize {
+        self.more_refused
+    }
+
+    /// Steps dropped because the worker had fallen a queue's length behind (stalled for
+    /// seconds): the cut goes on from the next step taken.
+    pub fn dropped_steps(&self) -> u64 {
+        self.backend.dropped()
     }
 
     /// How long each job done so far (a step, or a heal) took the worker (s), in order (a
@@ -209,12 +242,16 @@ impl CutWorker {
 
     fn take(&mut self, outcome: Outcome) {
         match outcome {
-            Outcome::Changed(view) => {
+            Outcome::Changed(view, rows) => {
                 let old = std::mem::replace(&mut self.view, view);
-                self.backend.send(Job::Retire(old));
+                let old_rows = std::mem::replace(&mut self.rows, rows);
+                self.backend.send(Job::Retire(old, old_rows));
             }
             Outcome::Unchanged => {}
-            Outcome::Refused(error) => self.refused.push(error),
+            Outcome::Refused(error) if self.refused.len() < REFUSALS_KEPT => {
+                self.refused.push(error);
+            }
+            Outcome::Refused(_) => self.more_refused += 1,
         }
     }
 }

@@ -84,27 +84,40 @@ impl GraspPoint {
         rest_m: Vector3<f64>,
         compliance: &Matrix3<f64>,
     ) -> Self {
-        let modes: Vec<Vector3<f64>> = (0..basis.len())
-            .map(|k| {
-                let mode = basis.mode(k);
-                shares
-                    .iter()
-                    .map(|&(node, share)| {
-                        Vector3::from_column_slice(&mode[3 * node..3 * node + 3]) * share
-                    })
-                    .sum()
-            })
-            .collect();
-        let kept: Matrix3<f64> = modes
-            .iter()
+        let mut point = Self {
+            rest_m,
+            modes: Vec::with_capacity(basis.len()),
+            remainder_m_per_n: Matrix3::zeros(),
+        };
+        point.move_to(basis, shares, rest_m, compliance);
+        point
+    }
+
+    /// Moves the point to another patch of the same basis, as [`Self::at_patch`] makes it,
+    /// in the room it has: the grasper closing its jaws allocates nothing.
+    pub fn move_to(
+        &mut self,
+        basis: &ModalBasis,
+        shares: &[(usize, f64)],
+        rest_m: Vector3<f64>,
+        compliance: &Matrix3<f64>,
+    ) {
+        self.modes.clear();
+        self.modes.extend((0..basis.len()).map(|k| {
+            let mode = basis.mode(k);
+            shares
+                .iter()
+                .map(|&(node, share)| {
+                    Vector3::from_column_slice(&mode[3 * node..3 * node + 3]) * share
+                })
+                .sum::<Vector3<f64>>()
+        }));
+        let kept: Matrix3<f64> = (self.modes.iter())
             .zip(&basis.omega2)
             .map(|(phi, w2)| phi * phi.transpose() / *w2)
             .sum();
-        Self {
-            rest_m,
-            modes,
-            remainder_m_per_n: compliance - kept,
-        }
+        self.rest_m = rest_m;
+        self.remainder_m_per_n = compliance - kept;
     }
 
     /// Where the kept modes put the point, and how fast it moves with them.

@@ -15,11 +15,12 @@ pub struct PatchLoad {
 }
 
 /// `clone_from` reuses the buffers: the haptic tick copies loads into its snapshot every
-/// millisecond, and a derived `Clone` would allocate each time.
+/// millisecond, and a derived `Clone` would allocate each time. A clone keeps the room as well
+/// as the contents, so that a copy made once (a snapshot) never grows either.
 impl Clone for PatchLoad {
     fn clone(&self) -> Self {
         Self {
-            shares: self.shares.clone(),
+            shares: with_room_of(&self.shares),
             force_n: self.force_n,
         }
     }
@@ -116,7 +117,7 @@ impl Clone for Deformation {
             loads: self.loads.clone(),
             coefficients: self.coefficients.clone(),
             coupling: self.coupling.clone(),
-            coupling_points: self.coupling_points.clone(),
+            coupling_points: with_room_of(&self.coupling_points),
             coupling_force_n: self.coupling_force_n,
             carry: self.carry,
         }
@@ -130,6 +131,13 @@ impl Clone for Deformation {
         self.coupling_force_n = source.coupling_force_n;
         self.carry = source.carry;
     }
+}
+
+/// A copy of `items` with the same room.
+fn with_room_of<T: Clone>(items: &Vec<T>) -> Vec<T> {
+    let mut copy = Vec::with_capacity(items.capacity());
+    copy.extend_from_slice(items);
+    copy
 }
 
 impl Deformation {

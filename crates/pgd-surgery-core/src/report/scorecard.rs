@@ -58,7 +58,7 @@ pub fn summary(card: &Scorecard) -> String {
             m.mean_force_n,
             m.time_over_limit_s,
             m.force_limit_n,
-            m.errors.len(),
+            m.error_count(),
             task.score
         );
         let motion = &m.motion;

@@ -6,11 +6,11 @@ use std::mem::take;
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use super::format::{OrganEntry, Scenario, Spot, Task, TaskKind, metres, spot_name};
+use super::format::{OrganEntry, Scenario, Spot, Task, TaskKind, metres};
 use super::incision::{BladeSample, IncisionMetrics, IncisionTracker};
 use super::keratotomy::{Keratometer, KeratotomyMetrics, KeratotomyPlan, KeratotomyTracker};
+use super::mistakes::{Mistake, Mistakes, task_organ};
 use super::motion::{MotionMetrics, MotionTracker};
-use super::units::Newtons;
 use crate::pgd::SurfacePoint;
 
 /// What the haptic loop knows of one tick, for scoring.
@@ -179,8 +179,11 @@ pub struct TaskMetrics {
     pub surrounding_limit_n: Option<f64>,
     pub surrounding_peak_n: f64,
     pub surrounding_over_limit_s: f64,
-    /// Each error, with the time it was made.
+    /// Each error, with the time it was made (the first [`super::MISTAKES_LISTED`])...
     pub errors: Vec<String>,
+    /// ...and how many more were made, counted but not listed.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub more_errors: usize,
     /// The tool tip's motion over the task: path, economy, movements, idle time, jerk.
     pub motion: MotionMetrics,
     /// Incision: the cut against the marked line.
@@ -201,10 +204,25 @@ pub struct TaskMetrics {
     pub complication: Option<String>,
 }
 
+fn is_zero(count: &usize) -> bool {
+    *count == 0
+}
+
+impl TaskMetrics {
+    /// Every error made, listed or not.
+    pub fn error_count(&self) -> usize {
+        self.errors.len() + self.more_errors
+    }
+}
+
 /// One task's running state.
 #[derive(Clone)]
 struct Running {
     metrics: TaskMetrics,
+    /// The mistakes made, put into words when the attempt is scored.
+    mistakes: Mistakes,
+    /// Radial keratotomy: when the cut went through the whole thickness (a complication).
+    perforated_s: Option<f64>,
     force_sum: f64,
     /// Force control and palpation: the organ's index in the scenario's organs.
     organ: Option<usize>,
@@ -233,11 +251,14 @@ pub struct Exercise {
     scenario: Scenario,
     sites: Sites,
     /// Each task's description, made up front and moved into its metrics when it starts, so
-    /// that the real-time thread formats nothing then.
+    /// that the real-time thread formats nothing then; and the room for its mistakes.
     descriptions: Vec<String>,
+    mistakes: Vec<Mistakes>,
     current: usize,
     running: Option<Running>,
-    done: Vec<TaskMetrics>,
+    /// The tasks ended, room for all made up front: their metrics are completed (motion, cut,
+    /// words) when the attempt is scored.
+    done: Vec<Running>,
     first_time_s: Option<f64>,
     last_time_s: Option<f64>,
     ticks: u64,
@@ -253,11 +274,16 @@ impl Exercise {
         let samples = (total_s / (PLOT_EVERY as f64 * crate::devices::TICK_S)).ceil() as usize;
         Self {
             descriptions: scenario.tasks.iter().map(Task::description).collect(),
+            mistakes: scenario
+                .tasks
+                .iter()
+                .map(|_| Mistakes::reserved())
+                .collect(),
+            done: Vec::with_capacity(scenario.tasks.len()),
             scenario,
             sites,
             current: 0,
             running: None,
-            done: Vec::new(),
             first_time_s: None,
             last_time_s: None,
             ticks: 0,
@@ -310,7 +336,13 @@ impl Exercise {
         let task = &self.scenario.tasks[self.current];
         let running = self.running.get_or_insert_with(|| {
             let description = take(&mut self.descriptions[self.current]);
-            Running::start(task, description, &self.scenario.organs, sample.time_s)
+            let mistakes = take(&mut self.mistakes[self.current]);
+            Running::start(
+                task,
+                (description, mistakes),
+                &self.scenario.organs,
+                sample.time_s,
+            )
         });
         let nodules = Nodules {
             scenario: &self.scenario,
@@ -323,18 +355,12 @@ impl Exercise {
         }
     }
 
+    /// Ends the task under way at `time_s` (allocating nothing: the ended task's metrics are
+    /// completed when the attempt is scored).
     fn end_task(&mut self, time_s: f64) {
         if let Some(mut running) = self.running.take() {
             running.metrics.time_s = time_s - running.metrics.started_s;
-            running.metrics.motion = running.motion.metrics();
-            running.metrics.incision = running.incision.as_ref().map(IncisionTracker::metrics);
-            running.metrics.keratotomy = running.keratotomy.as_ref().map(|k| k.metrics());
-            running.metrics.mean_force_n = if running.metrics.contact_s > 0.0 {
-                running.force_sum / running.metrics.contact_s
-            } else {
-                0.0
-            };
-            self.done.push(running.metrics);
+            self.done.push(running);
         }
         self.current += 1;
     }
@@ -346,28 +372,39 @@ impl Exercise {
             let task = &self.scenario.tasks[self.current];
             self.running.get_or_insert_with(|| {
                 let description = take(&mut self.descriptions[self.current]);
-                Running::start(task, description, &self.scenario.organs, now)
+                let mistakes = take(&mut self.mistakes[self.current]);
+                Running::start(task, (description, mistakes), &self.scenario.organs, now)
             });
             self.end_task(now);
         }
-        self.predict_corrections();
-        (self.scenario, self.done, self.force_trace)
+        let tasks = self.scenario.tasks.iter();
+        let mut done: Vec<TaskMetrics> = (self.done.into_iter().zip(tasks))
+            .map(|(running, task)| running.into_metrics(task))
+            .collect();
+        predict_corrections(&mut done, &self.sites.keratometers);
+        (self.scenario, done, self.force_trace)
     }
+}
 
-    /// Each keratotomy's predicted correction: a full solve of the cut cornea, which is why
-    /// it is made here, when the attempt is scored, and not on the haptic thread.
-    fn predict_corrections(&mut self) {
-        for (metrics, keratometer) in self.done.iter_mut().zip(&self.sites.keratometers) {
-            if let (Some(keratotomy), Some(keratometer)) = (&mut metrics.keratotomy, keratometer) {
-                keratotomy.predicted_correction_d = keratometer.correction_d(keratotomy);
-            }
+/// Each keratotomy's predicted correction: a full solve of the cut cornea, which is why it is
+/// made when the attempt is scored, and not on the haptic thread.
+fn predict_corrections(done: &mut [TaskMetrics], keratometers: &[Option<Keratometer>]) {
+    for (metrics, keratometer) in done.iter_mut().zip(keratometers) {
+        if let (Some(keratotomy), Some(keratometer)) = (&mut metrics.keratotomy, keratometer) {
+            keratotomy.predicted_correction_d = keratometer.correction_d(keratotomy);
         }
     }
 }
 
 impl Running {
-    /// The task starting at `time_s`, told to the trainee as `description`.
-    fn start(task: &Task, description: String, organs: &[OrganEntry], time_s: f64) -> Self {
+    /// The task starting at `time_s`, told to the trainee as `description`, noting its
+    /// mistakes in `mistakes`.
+    fn start(
+        task: &Task,
+        (description, mistakes): (String, Mistakes),
+        organs: &[OrganEntry],
+        time_s: f64,
+    ) -> Self {
         let (force_limit_n, targets, band_min_n) = match task {
             Task::ForceControl {
                 min_force_n,
@@ -467,6 +504,8 @@ impl Running {
                 hold_s,
                 ..TaskMetrics::default()
             },
+            mistakes,
+            perforated_s: None,
             force_sum: 0.0,
             organ,
             incision,
@@ -479,6 +518,26 @@ impl Running {
             inside_zone: None,
             motion: MotionTracker::default(),
         }
+    }
+
+    /// The ended task's metrics, completed: its motion, its cut, its mistakes in words.
+    fn into_metrics(self, task: &Task) -> TaskMetrics {
+        let mut m = self.metrics;
+        m.motion = self.motion.metrics();
+        m.incision = self.incision.as_ref().map(IncisionTracker::metrics);
+        m.keratotomy = self.keratotomy.as_ref().map(|k| k.metrics());
+        m.mean_force_n = match m.contact_s > 0.0 {
+            true => self.force_sum / m.contact_s,
+            false => 0.0,
+        };
+        (m.errors, m.more_errors) = self.mistakes.describe(task);
+        m.complication = self.perforated_s.map(|time_s| {
+            format!(
+                "{time_s:.2} s: cut through the whole thickness of the {}: a perforation",
+                task_organ(task)
+            )
+        });
+        m
     }
 
     fn step(&mut self, task: &Task, sample: &Sample, dt: f64, nodules: Nodules) {
@@ -505,16 +564,10 @@ impl Running {
             .over_limit
             .crossed(force, m.force_limit_n, dt, &mut m.time_over_limit_s)
         {
-            let verb = match m.kind {
-                TaskKind::Grasp => "pulled",
-                _ => "pressed",
-            };
-            let error = format!(
-                "{:.2} s: {verb} harder than {} N",
-                sample.time_s,
-                Newtons(m.force_limit_n)
-            );
-            m.errors.push(error);
+            self.mistakes.note(Mistake::OverLimit {
+                time_s: sample.time_s,
+                limit_n: m.force_limit_n,
+            });
         }
         match task {
             Task::ForceControl {
@@ -549,50 +602,42 @@ impl Running {
                 self.hold(moved_mm >= move_mm.0, hold_s.0, sample.time_s);
             }
             Task::Grasp {
-                organ,
-                move_mm,
-                hold_s,
-                ..
-            } => self.grasp(organ, (move_mm.0, hold_s.0), sample),
-            Task::Incision { organ, .. } => self.cut(organ, sample),
-            Task::RadialKeratotomy { organ, .. } => self.keratotomy(organ, sample),
+                move_mm, hold_s, ..
+            } => self.grasp((move_mm.0, hold_s.0), sample),
+            Task::Incision { .. } => self.cut(sample),
+            Task::RadialKeratotomy { .. } => self.keratotomy(sample),
         }
     }
 
     /// Radial keratotomy: the task is done when the plan's incisions are made and the blade
     /// is lifted. A cut through the whole thickness is a complication: the task cannot be
     /// done any more and the attempt fails.
-    fn keratotomy(&mut self, organ: &str, sample: &Sample) {
+    fn keratotomy(&mut self, sample: &Sample) {
         let Some(tracker) = self.keratotomy.as_mut() else {
             return;
         };
         if tracker.step(sample.blade.as_ref()) {
-            self.metrics.complication = Some(format!(
-                "{:.2} s: cut through the whole thickness of the {organ}: a perforation",
-                sample.time_s
-            ));
+            self.perforated_s.get_or_insert(sample.time_s);
         }
         self.metrics.completed = !tracker.cutting()
             && tracker.made() >= tracker.planned()
-            && self.metrics.complication.is_none();
+            && self.perforated_s.is_none();
     }
 
     /// Incision: the cut follows the line; the task is done when nine tenths of it are cut
     /// and the blade is lifted. Straying farther than twice the tolerance off the line is an
     /// error (once).
-    fn cut(&mut self, organ: &str, sample: &Sample) {
+    fn cut(&mut self, sample: &Sample) {
         let Some(tracker) = self.incision.as_mut() else {
             return;
         };
         let strayed_before = tracker.strayed();
         tracker.step(sample.blade.as_ref());
         if !strayed_before && tracker.strayed() {
-            let error = format!(
-                "{:.2} s: cut the {organ} more than {:.0} mm off the line",
-                sample.time_s,
-                tracker.stray_limit_m() * 1e3
-            );
-            self.metrics.errors.push(error);
+            self.mistakes.note(Mistake::OffTheLine {
+                time_s: sample.time_s,
+                limit_mm: tracker.stray_limit_m() * 1e3,
+            });
         }
         let lifted = sample.blade.is_none_or(|b| Some(b.organ) != self.organ);
         self.metrics.completed = lifted && tracker.covered_share() >= COVERED_TO_FINISH;
@@ -608,12 +653,13 @@ impl Running {
 
     /// Grasp: held in the jaws and drawn far enough for the hold, then let go; a damaged
     /// tissue is an error and the task can no longer be done.
-    fn grasp(&mut self, organ: &str, (move_mm, hold_s): (f64, f64), sample: &Sample) {
+    fn grasp(&mut self, (move_mm, hold_s): (f64, f64), sample: &Sample) {
         let grasped = self.organ.is_some_and(|k| sample.grasps(k));
         if sample.tore && !self.damaged {
             self.damaged = true;
-            let error = format!("{:.2} s: tore the {organ}", sample.time_s);
-            self.metrics.errors.push(error);
+            self.mistakes.note(Mistake::Tore {
+                time_s: sample.time_s,
+            });
         }
         let moved_mm = self.region_moved_mm(sample);
         if self.metrics.longest_hold_s < hold_s {
@@ -644,12 +690,10 @@ impl Running {
             .over_surrounding
             .crossed(force, limit_n, dt, &mut m.surrounding_over_limit_s)
         {
-            let error = format!(
-                "{:.2} s: loaded the organs around harder than {} N",
-                sample.time_s,
-                Newtons(limit_n)
-            );
-            m.errors.push(error);
+            self.mistakes.note(Mistake::OverSurrounding {
+                time_s: sample.time_s,
+                limit_n,
+            });
         }
     }
 
@@ -682,7 +726,7 @@ impl Running {
     /// ended by a complication.
     fn over(&self) -> bool {
         let m = &self.metrics;
-        m.completed || m.localization_error_mm.is_some() || m.complication.is_some()
+        m.completed || m.localization_error_mm.is_some() || self.perforated_s.is_some()
     }
 
     fn navigate(&mut self, targets: &[Spot], forbidden: &[Spot], sample: &Sample) {
@@ -711,11 +755,10 @@ impl Running {
             None => {
                 if let Some(k) = forbidden.iter().position(|z| z.contains(&tip)) {
                     self.inside_zone = Some(k);
-                    m.errors.push(format!(
-                        "{:.2} s: entered the forbidden {}",
-                        sample.time_s,
-                        spot_name(&forbidden[k], k)
-                    ));
+                    self.mistakes.note(Mistake::Forbidden {
+                        time_s: sample.time_s,
+                        zone: k,
+                    });
                 }
             }
         }

@@ -1,6 +1,7 @@
 //! Training exercises: the scenario file educators write (`format`, `units`), reading it with
 //! errors that point at the line and field (`load`), its tasks as they run, fed by the haptic
-//! loop one tick at a time (`exercise`), the tool's motion metrics (`motion`), the cut against
+//! loop one tick at a time (`exercise`), the mistakes they note (`mistakes`), put into words
+//! only when scored, the tool's motion metrics (`motion`), the cut against
 //! an incision's line (`incision`), the incisions of a radial keratotomy (`keratotomy`), and
 //! the rubric's
 //! score (`score`). No Bevy here: the app layer runs an [`Exercise`] inside the haptic schedule.
@@ -10,6 +11,7 @@ mod format;
 mod incision;
 mod keratotomy;
 mod load;
+mod mistakes;
 mod motion;
 mod score;
 mod units;
@@ -27,6 +29,7 @@ pub use keratotomy::{
     RadialIncision,
 };
 pub use load::{ScenarioError, load, parse};
+pub use mistakes::{MISTAKES_LISTED, Mistake, Mistakes};
 pub use motion::{IDLE_M_PER_S, MOVING_M_PER_S, MotionMetrics, MotionTracker, STRIDE};
 pub use score::{CutMade, Scorecard, TaskScore, score};
 pub use units::{

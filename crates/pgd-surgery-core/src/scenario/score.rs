@@ -102,7 +102,7 @@ fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
     ];
     let weights: f64 = terms.iter().map(|(w, _)| w).sum();
     let weighted = terms.iter().map(|(w, v)| w * v).sum::<f64>() / weights.max(f64::MIN_POSITIVE);
-    (100.0 * weighted - rubric.error_penalty * m.errors.len() as f64).clamp(0.0, 100.0)
+    (100.0 * weighted - rubric.error_penalty * m.error_count() as f64).clamp(0.0, 100.0)
 }
 
 /// Economy of motion as a share: the shortest path needed over the path taken (1 when the tip
@@ -282,6 +282,9 @@ fn task_feedback(task: &TaskScore) -> Vec<String> {
         ));
     }
     lines.extend(m.errors.iter().map(|e| format!("{}: {e}", m.kind)));
+    if m.more_errors > 0 {
+        lines.push(format!("{}: {} more errors", m.kind, m.more_errors));
+    }
     lines
 }
 

@@ -137,7 +137,25 @@ impl LocalCompliance {
             ..Self::default()
         };
         part.own_m_per_n = (0..count).map(|i| part.own(i, shell_directions)).collect();
+        part.reserve();
         part
+    }
+
+    /// Room in every work list for all the nodes and directions at once (a clone keeps only
+    /// the contents), so that a tick allocates nothing however many nodes push.
+    pub fn reserve(&mut self) {
+        let count = self.spread_n.len();
+        self.spread_nodes.reserve(count);
+        for scattered in [
+            &mut self.moves_m,
+            &mut self.changes_n,
+            &mut self.loads_n,
+            &mut self.move_changes_m,
+            &mut self.block_shifts_m,
+        ] {
+            scattered.reserve();
+        }
+        self.block.reserve(count, &self.reads, &self.compliance);
     }
 
     /// Node `i`'s `a_ii` in each organ: `Σ_de G_id S_de G_ie` over the organ's directions

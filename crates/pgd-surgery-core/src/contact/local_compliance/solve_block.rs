@@ -48,6 +48,19 @@ impl SolveBlock {
         block
     }
 
+    /// Room for the largest set: every one of `nodes` nodes, reading every direction, with
+    /// `reads` and `compliance` whole (their entries), so that preparing allocates nothing.
+    pub(super) fn reserve(&mut self, nodes: usize, reads: &SparseRows, compliance: &SparseRows) {
+        let directions = self.slot.len();
+        self.set.reserve(nodes);
+        self.directions.reserve(directions);
+        self.next_directions.reserve(directions);
+        self.reads.reserve(nodes, reads.entries());
+        self.compliance.reserve(directions, compliance.entries());
+        self.loads_n.reserve(directions);
+        self.moves_m.reserve(directions);
+    }
+
     /// Sets up the block for the nodes of `set`, given `G` (`reads`, per node) and `S`
     /// (`compliance`, per direction). `S` is gathered anew only where the directions changed.
     pub(super) fn prepare(&mut self, set: &[u32], reads: &SparseRows, compliance: &SparseRows) {

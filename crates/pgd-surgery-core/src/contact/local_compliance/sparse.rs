@@ -20,6 +20,19 @@ impl SparseRows {
         sparse
     }
 
+    /// Room for `rows` rows holding `entries` entries in all, so that filling it up to that
+    /// allocates nothing.
+    pub(super) fn reserve(&mut self, rows: usize, entries: usize) {
+        self.offsets.reserve(rows + 1);
+        self.columns.reserve(entries);
+        self.values.reserve(entries);
+    }
+
+    /// Entries in all rows.
+    pub(super) fn entries(&self) -> usize {
+        self.columns.len()
+    }
+
     /// Drops every row, keeping the storage.
     pub(super) fn clear(&mut self) {
         self.offsets.clear();
@@ -71,12 +84,18 @@ pub(super) struct Scattered {
 }
 
 impl Scattered {
+    /// Room for every entry in its list of touched ones, so that adding allocates nothing.
     pub(super) fn new(len: usize) -> Self {
         Self {
             values: vec![0.0; len],
             marked: vec![false; len],
-            touched: Vec::new(),
+            touched: Vec::with_capacity(len),
         }
+    }
+
+    /// The room [`Self::new`] made, again (a clone keeps only the contents).
+    pub(super) fn reserve(&mut self) {
+        self.touched.reserve(self.values.len() - self.touched.len());
     }
 
     pub(super) fn add(&mut self, i: usize, value: f64) {

@@ -1,6 +1,8 @@
-//! The worker as a thread of its own, with a pool for the cut state's parallel work.
+//! The worker as a thread of its own, with a pool for the cut state's parallel work. Jobs and
+//! answers cross through bounded channels, whose slots are made when the worker starts: the
+//! haptic side hands a job over and takes an answer without allocating or waiting.
 
-use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::sync::{Arc, Mutex};
 use std::thread;
 
@@ -11,13 +13,23 @@ use crate::cutting::CutError;
 use crate::cutting::response::ExactResponse;
 use crate::fem::FemModel;
 
+/// Jobs waiting for the worker at most: with a step every 30 ms or more, a worker this far
+/// behind has been stalled for seconds.
+const JOBS_QUEUED: usize = 256;
+
+/// Answers waiting for the haptic side at most (it takes them every tick; the worker waits
+/// for room past that).
+const ANSWERS_QUEUED: usize = 64;
+
 pub(super) struct Backend {
-    jobs: Sender<Job>,
+    jobs: SyncSender<Job>,
     /// Behind a mutex only so that the worker's handle may be shared between threads (as an
     /// ECS component is): its owner reaches it through `get_mut`, never locking.
     answers: Mutex<Receiver<Outcome>>,
     submitted: u64,
     answered: u64,
+    /// Steps and heals dropped because the worker's queue was full.
+    dropped: u64,
     /// Written by the worker, so that the haptic side never grows it.
     step_seconds: Arc<Mutex<Vec<f64>>>,
 }
@@ -30,8 +42,8 @@ impl Backend {
         name: &str,
         latest: Arc<LatestCut>,
     ) -> Result<Self, CutError> {
-        let (jobs, job_queue) = channel();
-        let (answers, answered) = channel();
+        let (jobs, job_queue) = sync_channel(JOBS_QUEUED);
+        let (answers, answered) = sync_channel(ANSWERS_QUEUED);
         let step_seconds = Arc::new(Mutex::new(Vec::new()));
         let timings = step_seconds.clone();
         let pool = rayon::ThreadPoolBuilder::new()
@@ -55,16 +67,28 @@ impl Backend {
             answers: Mutex::new(answered),
             submitted: 0,
             answered: 0,
+            dropped: 0,
             step_seconds,
         })
     }
 
-    /// Hands a job to the thread; never waits.
+    /// Hands a job to the thread; never waits. With the queue full (a worker stalled for
+    /// seconds), a step is dropped and counted, and a view to retire is freed here.
     pub(super) fn send(&mut self, job: Job) {
-        let answered = !matches!(job, Job::Retire(_));
-        if self.jobs.send(job).is_ok() && answered {
-            self.submitted += 1;
+        let answered = !matches!(job, Job::Retire(..));
+        match self.jobs.try_send(job) {
+            Ok(()) if answered => self.submitted += 1,
+            Ok(()) | Err(TrySendError::Disconnected(_)) => {}
+            Err(TrySendError::Full(job)) => {
+                self.dropped += u64::from(answered);
+                drop(job);
+            }
         }
+    }
+
+    /// Steps and heals dropped because the worker's queue was full.
+    pub(super) fn dropped(&self) -> u64 {
+        self.dropped
     }
 
     /// An answer the thread has given, if any; never waits.
@@ -112,7 +136,7 @@ fn worker_threads() -> usize {
 /// Where the worker's answers go: to the haptic side, each job's time, and the latest view
 /// for the window.
 struct Replies<'a> {
-    answers: Sender<Outcome>,
+    answers: SyncSender<Outcome>,
     timings: &'a Mutex<Vec<f64>>,
     latest: &'a LatestCut,
 }
