@@ -168,9 +168,21 @@ pub fn run_observed(
     scene: &HapticScene,
     device: Box<dyn HapticDevice>,
     max_ticks: u64,
-    mut observe: impl FnMut(&HapticLoop, Duration),
+    observe: impl FnMut(&HapticLoop, Duration),
 ) -> Result<Outcome, String> {
-    let mut haptic = HapticLoop::new(scene, device).map_err(|e| e.to_string())?;
+    let haptic = HapticLoop::new(scene, device).map_err(|e| e.to_string())?;
+    observe_attempt(scenario, scene, haptic, max_ticks, observe).map(|(outcome, _)| outcome)
+}
+
+/// [`run_observed`] in a world already built (one that has taken another's device), handing
+/// the world back when the attempt has been scored.
+pub fn observe_attempt(
+    scenario: Scenario,
+    scene: &HapticScene,
+    mut haptic: HapticLoop,
+    max_ticks: u64,
+    mut observe: impl FnMut(&HapticLoop, Duration),
+) -> Result<(Outcome, HapticLoop), String> {
     haptic.world_mut().insert_resource(SettleCuts);
     let sites = sites_on(scene, &scenario);
     prepare(&mut haptic, Exercise::new(scenario, sites)).start();
@@ -188,7 +200,8 @@ pub fn run_observed(
             break;
         }
     }
-    Ok(end(&mut haptic).expect("started above"))
+    let outcome = end(&mut haptic).ok_or("the exercise was never begun")?;
+    Ok((outcome, haptic))
 }
 
 /// Puts `exercise` into the haptic world; it is scored from the tick after the link returned

@@ -140,8 +140,9 @@ enum Command {
     Devices,
     /// An hour of use on the simulated clock: every shipped scenario in turn, attempted
     /// carelessly then competently by its scripted runs, each attempt scored and kept; reports
-    /// the resident memory, the tick times at the start and the end, the forces' NaNs and
-    /// largest step (with --json as JSON).
+    /// the resident memory (every simulated minute, and its growth per attempt), the tick
+    /// times at the start and the end, the forces' NaNs, largest steps and faults (with --json
+    /// as JSON).
     Soak {
         /// Simulated seconds of use.
         #[arg(long, default_value = "3600", value_parser = parse_positive_seconds)]
@@ -149,6 +150,9 @@ enum Command {
         /// The history database the soak's attempts are kept in, apart from the trainees'.
         #[arg(long, default_value = "reports/soak-history.sqlite")]
         keep_in: PathBuf,
+        /// Also plot the resident memory, sampled every simulated minute, into this PNG.
+        #[arg(long)]
+        plot: Option<PathBuf>,
     },
     /// The attempts kept so far (all, or --trainee's), as a table and a learning-curve plot,
     /// or as CSV.
@@ -192,6 +196,10 @@ fn parse_timer(s: &str) -> Result<TimerMode, String> {
     }
 }
 
+/// Set (to anything), `trainer soak` leaks each attempt's haptic world: a defect planted so
+/// that the tests can show the soak's growth check failing on a leak.
+const PLANT_LEAK: &str = "PGD_SOAK_PLANT_LEAK";
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     // Before any device opens: a panic or a signal from here on releases it at zero force.
@@ -207,6 +215,7 @@ fn main() -> ExitCode {
         Some(Command::Soak {
             duration_s,
             keep_in,
+            plot,
         }) => {
             return run_soak(
                 &SoakPlan {
@@ -215,8 +224,10 @@ fn main() -> ExitCode {
                     detail: detail_of(&cli),
                     history: keep_in.clone(),
                     trainee: cli.trainee.clone().unwrap_or_else(|| "soak".into()),
+                    leak_each_attempt: std::env::var_os(PLANT_LEAK).is_some(),
                 },
                 cli.json,
+                plot.as_deref(),
             );
         }
         Some(Command::History {

@@ -26,8 +26,8 @@ pub use cutting::{OrganCut, SettleCuts};
 pub use frame_paced::FramePaced;
 pub use report::{ForceSummary, HeadlessReport, RangeSummary, TickTimes};
 pub use resources::{
-    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, SceneScope, Scope,
-    TickClock, Tool,
+    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, Safety, SceneScope,
+    Scope, TickClock, Tool,
 };
 pub use runner::{CutOrgan, HapticLoop, HapticScene, SceneCutting, SceneDynamics, SceneError};
 pub use scoring::{ExerciseLink, ExerciseRun};

@@ -103,6 +103,20 @@ pub enum Fault {
     Physics(String),
 }
 
+impl Fault {
+    /// The fault's kind, without its details: what a count of faults is kept by.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Fault::NonFiniteDevice => "non-finite device",
+            Fault::NonFiniteForce => "non-finite force",
+            Fault::NonFiniteOutput => "non-finite output",
+            Fault::Device(_) => "device error",
+            Fault::Overruns(_) => "overruns",
+            Fault::Physics(_) => "physics",
+        }
+    }
+}
+
 impl std::fmt::Display for Fault {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {

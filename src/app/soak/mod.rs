@@ -4,20 +4,30 @@
 //! history, while the resident memory, the tick's compute time, the forces sent and their
 //! steps are watched for what only long use shows: leaks, drift, a NaN, a jump.
 
-use std::path::{Path, PathBuf};
-use std::time::Duration;
+mod memory;
+mod watch;
 
-use nalgebra::Vector3;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, PoisonError};
+
 use serde::Serialize;
 
-use super::attempt::{Outcome, run_observed, scenario_scene};
-use super::haptic::{DeviceForce, HapticLoop, HapticScene, TickTimes};
+use super::attempt::{Outcome, observe_attempt, scenario_scene};
+use super::haptic::{HapticLoop, HapticScene, TickTimes};
 use super::scene::Detail;
 use super::shipped::SHIPPED_RUNS;
-use crate::devices::{Histogram, Scripted, TICK_S, Trajectory, stop_requested};
+use crate::devices::{
+    DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice, Scripted, TICK_S, Trajectory,
+    stop_requested,
+};
 use crate::history::{AttemptRecord, History, now_unix_s};
 use crate::scenario::{self, Scenario};
 use crate::store::OnStale;
+use memory::resident_bytes;
+pub use memory::{Growth, MemorySample};
+pub use watch::StepPlace;
+use watch::Watch;
 
 /// What a soak runs.
 pub struct SoakPlan {
@@ -29,6 +39,9 @@ pub struct SoakPlan {
     pub history: PathBuf,
     /// Whom the attempts are kept under.
     pub trainee: String,
+    /// Leak each attempt's haptic world (a scene's worth of memory): a defect planted for the
+    /// tests to show that the growth check fails on it.
+    pub leak_each_attempt: bool,
 }
 
 /// What a soak measured.
@@ -42,6 +55,10 @@ pub struct SoakReport {
     pub rss_end_bytes: u64,
     /// `rss_end_bytes` over `rss_start_bytes`, minus one.
     pub rss_growth: f64,
+    /// The resident memory every simulated minute.
+    pub memory: Vec<MemorySample>,
+    /// Its growth per attempt after the first round, fitted to a sample after every attempt.
+    pub growth: Growth,
     /// The simulated seconds at the start and at the end whose ticks the first and last
     /// figures are taken over (ten minutes, or a third of a shorter soak).
     pub window_s: f64,
@@ -51,8 +68,15 @@ pub struct SoakReport {
     pub tick_p99_last_us: f64,
     /// Ticks whose computed or sent force was not finite.
     pub nan_count: u64,
-    /// The largest change (N) of the force sent from one tick to the next.
+    /// The largest change (N) of the force the device was sent from one tick to the next, the
+    /// device and its safety filter passing from each attempt to the next as between scenes.
     pub max_force_step_n: f64,
+    /// The largest such change outside a fault's fade and a lowered limit's clamp, and where.
+    pub largest_plain_step: StepPlace,
+    /// Scene changes to a lower force limit whose first tick clamped the force.
+    pub lowered_limit_steps: u64,
+    /// Faults by kind over every attempt.
+    pub faults: BTreeMap<&'static str, u64>,
     pub attempts_scored: u64,
     /// Attempts the history took (its count of the trainee's attempts grew by this much).
     pub attempts_kept: u64,
@@ -69,54 +93,38 @@ struct SoakScenario {
     competent: Trajectory,
 }
 
-/// What the ticks of a soak have shown so far.
-struct Watch {
-    ticks: u64,
-    window_ticks: u64,
-    total_ticks: u64,
-    first: Histogram,
-    last: Histogram,
-    nan_count: u64,
-    last_sent_n: Vector3<f64>,
-    max_force_step_n: f64,
+/// The soak's one device: each attempt hands it the script to play, and it passes, with the
+/// safety filter behind it, from each attempt's world to the next, as a device passes from
+/// scene to scene in the window; so what it is sent is watched as one device receives it.
+#[derive(Clone, Default)]
+struct Hand(Arc<Mutex<Option<Scripted>>>);
+
+impl Hand {
+    fn play(&self, script: &Trajectory) {
+        let scripted = Scripted::new("soak", script.clone());
+        *self.0.lock().unwrap_or_else(PoisonError::into_inner) = Some(scripted);
+    }
 }
 
-impl Watch {
-    fn new(total_ticks: u64, window_ticks: u64) -> Self {
-        Self {
-            ticks: 0,
-            window_ticks,
-            total_ticks,
-            first: Histogram::default(),
-            last: Histogram::default(),
-            nan_count: 0,
-            last_sent_n: Vector3::zeros(),
-            max_force_step_n: 0.0,
+impl HapticDevice for Hand {
+    fn name(&self) -> &str {
+        "soak"
+    }
+
+    fn limits(&self) -> DeviceLimits {
+        DeviceLimits::default()
+    }
+
+    fn read(&mut self, time_s: f64) -> Result<DeviceSample, DeviceError> {
+        let mut script = self.0.lock().unwrap_or_else(PoisonError::into_inner);
+        match script.as_mut() {
+            Some(script) => script.read(time_s),
+            None => Ok(DeviceSample::at(nalgebra::Vector3::zeros())),
         }
     }
 
-    fn left(&self) -> u64 {
-        self.total_ticks.saturating_sub(self.ticks)
-    }
-
-    /// One tick's compute time and forces.
-    fn record(&mut self, haptic: &HapticLoop, compute: Duration) {
-        if self.ticks < self.window_ticks {
-            self.first.record(compute);
-        }
-        if self.ticks >= self.total_ticks.saturating_sub(self.window_ticks) {
-            self.last.record(compute);
-        }
-        let force = haptic.world().resource::<DeviceForce>();
-        let finite = |f: &Vector3<f64>| f.iter().all(|c| c.is_finite());
-        if !finite(&force.desired_n) || !finite(&force.sent_n) {
-            self.nan_count += 1;
-        } else {
-            let step = (force.sent_n - self.last_sent_n).norm();
-            self.max_force_step_n = self.max_force_step_n.max(step);
-            self.last_sent_n = force.sent_n;
-        }
-        self.ticks += 1;
+    fn render(&mut self, _force: EdgeForce) -> Result<(), DeviceError> {
+        Ok(())
     }
 }
 
@@ -138,7 +146,9 @@ pub fn soak(
     let total_ticks = (plan.duration_s / TICK_S).round() as u64;
     let window_ticks = (total_ticks / 3).min((600.0 / TICK_S) as u64);
     let mut watch = Watch::new(total_ticks, window_ticks);
-    let (mut scored, mut rss_start) = (0u64, None);
+    let hand = Hand::default();
+    let mut previous: Option<HapticLoop> = None;
+    let mut after_attempts = Vec::new();
     for (attempt, entry) in (0..).zip(scenarios.iter().cycle()) {
         if watch.left() == 0 || stop_requested() {
             break;
@@ -147,27 +157,28 @@ pub fn soak(
             0 => &entry.careless,
             _ => &entry.competent,
         };
-        let outcome = attempt_once(entry, script, &mut watch)?;
-        scored += 1;
-        let record = AttemptRecord::of(
-            &outcome.card,
-            Path::new(entry.file),
-            &plan.trainee,
-            None,
-            now_unix_s(),
-        );
-        history.record(&record).map_err(|e| e.to_string())?;
+        hand.play(script);
+        let haptic = next_world(&entry.scene, &hand, previous.take(), plan.leak_each_attempt)?;
+        let (outcome, haptic) = attempt_once(entry, haptic, script, &mut watch)?;
+        previous = Some(haptic);
+        keep(&history, &outcome, entry.file, &plan.trainee)?;
+        after_attempts.push(MemorySample {
+            simulated_s: watch.ticks as f64 * TICK_S,
+            attempts: watch.attempts,
+            bytes: resident_bytes()?,
+        });
         progress(
             watch.ticks as f64 * TICK_S,
             &entry.scenario.title,
             outcome.card.score,
         );
-        if attempt + 1 == scenarios.len() {
-            rss_start = Some(resident_bytes()?);
-        }
     }
+    drop(previous);
     let rss_end_bytes = resident_bytes()?;
-    let rss_start_bytes = rss_start.unwrap_or(rss_end_bytes);
+    let first_round = scenarios.len() as u64;
+    let rss_start_bytes = (after_attempts.iter())
+        .find(|s| s.attempts == first_round)
+        .map_or(rss_end_bytes, |s| s.bytes);
     let (first, last) = (TickTimes::of(&watch.first), TickTimes::of(&watch.last));
     Ok(SoakReport {
         duration_s: plan.duration_s,
@@ -175,6 +186,8 @@ pub fn soak(
         rss_start_bytes,
         rss_end_bytes,
         rss_growth: rss_end_bytes as f64 / rss_start_bytes as f64 - 1.0,
+        growth: Growth::of(&after_attempts, first_round),
+        memory: watch.memory,
         window_s: window_ticks as f64 * TICK_S,
         tick_p50_first_us: first.p50_us,
         tick_p99_first_us: first.p99_us,
@@ -182,27 +195,60 @@ pub fn soak(
         tick_p99_last_us: last.p99_us,
         nan_count: watch.nan_count,
         max_force_step_n: watch.max_force_step_n,
-        attempts_scored: scored,
+        largest_plain_step: watch.largest_plain_step,
+        lowered_limit_steps: watch.lowered_limit_steps,
+        faults: watch.faults,
+        attempts_scored: watch.attempts,
         attempts_kept: kept_count(&history, &plan.trainee)? - kept_before,
         scenarios: scenarios.iter().map(|s| s.file.to_owned()).collect(),
     })
 }
 
-/// One attempt at `entry` with `script`, cut short where the soak's time runs out.
+/// The world of `scene`, with the hand and its filter taken from the `previous` attempt's
+/// world (the first: a new filter on the hand), which is then dropped, or leaked when the
+/// plan plants that defect.
+fn next_world(
+    scene: &HapticScene,
+    hand: &Hand,
+    previous: Option<HapticLoop>,
+    leak: bool,
+) -> Result<HapticLoop, String> {
+    let Some(mut previous) = previous else {
+        return HapticLoop::new(scene, Box::new(hand.clone())).map_err(|e| e.to_string());
+    };
+    let mut haptic = HapticLoop::parked(scene).map_err(|e| e.to_string())?;
+    haptic.take_device(&mut previous);
+    if leak {
+        std::mem::forget(previous);
+    }
+    Ok(haptic)
+}
+
+/// Keeps `outcome` in `history`.
+fn keep(history: &History, outcome: &Outcome, file: &str, trainee: &str) -> Result<(), String> {
+    let record = AttemptRecord::of(&outcome.card, Path::new(file), trainee, None, now_unix_s());
+    history.record(&record).map(drop).map_err(|e| e.to_string())
+}
+
+/// One attempt at `entry` with `script` in `haptic`, cut short where the soak's time runs
+/// out; the world is handed back for the next attempt to take its device.
 fn attempt_once(
     entry: &SoakScenario,
+    haptic: HapticLoop,
     script: &Trajectory,
     watch: &mut Watch,
-) -> Result<Outcome, String> {
+) -> Result<(Outcome, HapticLoop), String> {
     let ticks = (((script.duration_s() + 0.1) / TICK_S).ceil() as u64).min(watch.left());
-    let device = Box::new(Scripted::new("soak", script.clone()));
-    run_observed(
+    watch.begin(entry.file);
+    let (outcome, haptic) = observe_attempt(
         entry.scenario.clone(),
         &entry.scene,
-        device,
+        haptic,
         ticks,
         |haptic, compute| watch.record(haptic, compute),
-    )
+    )?;
+    watch.end(&haptic);
+    Ok((outcome, haptic))
 }
 
 /// Every shipped scenario with a shipped run, its scene built once (its vademecums built
@@ -238,21 +284,6 @@ fn kept_count(history: &History, trainee: &str) -> Result<u64, String> {
     Ok(attempts.len() as u64)
 }
 
-/// This process's resident memory (bytes), from `/proc/self/status`, once the allocator has
-/// handed its free pages back to the system: what is live, not what the allocator keeps
-/// cached for threads that have ended (each attempt's cut worker gets an arena of its own).
-fn resident_bytes() -> Result<u64, String> {
-    release_free_memory();
-    let status = std::fs::read_to_string("/proc/self/status")
-        .map_err(|e| format!("cannot read /proc/self/status for the resident memory: {e}"))?;
-    status
-        .lines()
-        .find_map(|line| line.strip_prefix("VmRSS:"))
-        .and_then(|kb| kb.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
-        .map(|kb| kb * 1024)
-        .ok_or_else(|| "no VmRSS line in /proc/self/status".into())
-}
-
 impl std::fmt::Display for SoakReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
@@ -272,6 +303,14 @@ impl std::fmt::Display for SoakReport {
         )?;
         writeln!(
             f,
+            "  memory growth     {:+.0} kB an attempt after the first round ({:+.0} kB over the \
+             second half of those {} attempts)",
+            self.growth.per_attempt_bytes / 1e3,
+            self.growth.late_per_attempt_bytes / 1e3,
+            self.growth.attempts
+        )?;
+        writeln!(
+            f,
             "  tick p50 / p99    first {:.0} s: {:.0} / {:.0} µs; last {:.0} s: {:.0} / {:.0} µs",
             self.window_s,
             self.tick_p50_first_us,
@@ -282,9 +321,16 @@ impl std::fmt::Display for SoakReport {
         )?;
         writeln!(
             f,
-            "  forces            {} not finite; largest step between ticks {:.3} N",
-            self.nan_count, self.max_force_step_n
+            "  forces            {} not finite; largest step between ticks {:.3} N; outside \
+             faults and lowered limits {:.3} N ({}, tick {}); {} lowered-limit clamps",
+            self.nan_count,
+            self.max_force_step_n,
+            self.largest_plain_step.step_n,
+            self.largest_plain_step.scenario,
+            self.largest_plain_step.tick,
+            self.lowered_limit_steps
         )?;
+        writeln!(f, "  faults            {:?}", self.faults)?;
         writeln!(
             f,
             "  attempts          {} scored, {} kept in the history",
@@ -292,16 +338,3 @@ impl std::fmt::Display for SoakReport {
         )
     }
 }
-
-/// Hands the allocator's free pages, in every arena, back to the system (glibc's `malloc_trim`).
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-fn release_free_memory() {
-    unsafe extern "C" {
-        fn malloc_trim(pad: usize) -> std::ffi::c_int;
-    }
-    // SAFETY: `malloc_trim` takes a byte count and only returns free memory to the system.
-    unsafe { malloc_trim(0) };
-}
-
-#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-fn release_free_memory() {}
