@@ -55,7 +55,8 @@ pub struct SoakReport {
     pub rss_end_bytes: u64,
     /// `rss_end_bytes` over `rss_start_bytes`, minus one.
     pub rss_growth: f64,
-    /// The resident memory every simulated minute.
+    /// The resident memory every simulated minute, from the start (every scene built, no
+    /// attempt made).
     pub memory: Vec<MemorySample>,
     /// Its growth per attempt after the first round, fitted to a sample after every attempt.
     pub growth: Growth,
@@ -146,6 +147,11 @@ pub fn soak(
     let total_ticks = (plan.duration_s / TICK_S).round() as u64;
     let window_ticks = (total_ticks / 3).min((600.0 / TICK_S) as u64);
     let mut watch = Watch::new(total_ticks, window_ticks);
+    watch.memory.push(MemorySample {
+        simulated_s: 0.0,
+        attempts: 0,
+        bytes: resident_bytes()?,
+    });
     let hand = Hand::default();
     let mut previous: Option<HapticLoop> = None;
     let mut after_attempts = Vec::new();
