@@ -153,6 +153,10 @@ enum Command {
         /// Also plot the resident memory, sampled every simulated minute, into this PNG.
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// Only this shipped scenario, over and over (`scenarios/NAME.scenario.ron`): its
+        /// memory per attempt then shows a leak within a minute.
+        #[arg(long)]
+        scenario: Option<String>,
     },
     /// The attempts kept so far (all, or --trainee's), as a table and a learning-curve plot,
     /// or as CSV.
@@ -216,6 +220,7 @@ fn main() -> ExitCode {
             duration_s,
             keep_in,
             plot,
+            scenario,
         }) => {
             return run_soak(
                 &SoakPlan {
@@ -225,6 +230,7 @@ fn main() -> ExitCode {
                     history: keep_in.clone(),
                     trainee: cli.trainee.clone().unwrap_or_else(|| "soak".into()),
                     leak_each_attempt: std::env::var_os(PLANT_LEAK).is_some(),
+                    only: scenario.clone(),
                 },
                 cli.json,
                 plot.as_deref(),

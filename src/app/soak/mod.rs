@@ -39,6 +39,9 @@ pub struct SoakPlan {
     pub history: PathBuf,
     /// Whom the attempts are kept under.
     pub trainee: String,
+    /// Only this shipped scenario (its file, as `scenarios/NAME.scenario.ron`), over and
+    /// over: with one scene, the memory after each attempt varies only by what leaks.
+    pub only: Option<String>,
     /// Leak each attempt's haptic world (a scene's worth of memory): a defect planted for the
     /// tests to show that the growth check fails on it.
     pub leak_each_attempt: bool,
@@ -260,8 +263,18 @@ fn attempt_once(
 /// Every shipped scenario with a shipped run, its scene built once (its vademecums built
 /// where missing).
 fn soak_scenarios(plan: &SoakPlan) -> Result<Vec<SoakScenario>, String> {
-    SHIPPED_RUNS
-        .iter()
+    let runs: Vec<_> = (SHIPPED_RUNS.iter())
+        .filter(|run| plan.only.as_deref().is_none_or(|only| run.file == only))
+        .collect();
+    if runs.is_empty() {
+        let shipped: Vec<&str> = SHIPPED_RUNS.iter().map(|run| run.file).collect();
+        return Err(format!(
+            "--scenario {}: not a shipped scenario with scripted runs; one of: {}",
+            plan.only.as_deref().unwrap_or(""),
+            shipped.join(", ")
+        ));
+    }
+    runs.into_iter()
         .map(|run| {
             let scenario =
                 scenario::parse(Path::new(run.file), run.scenario).map_err(|e| e.to_string())?;
