@@ -5,7 +5,9 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use super::MAX_FORCE_LIMIT_N;
+/// The largest force (N) the product sends any device, and the largest limit a setting may
+/// ask for: more than any haptic device it serves renders.
+pub const MAX_FORCE_LIMIT_N: f64 = 20.0;
 
 /// What a device reports at one tick.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -28,7 +28,10 @@ mod vendor;
 mod virtual_device;
 mod workspace;
 
-pub use device::{DeviceError, DeviceLimits, DeviceSample, EdgeForce, EdgeRefusal, HapticDevice};
+pub use device::{
+    DeviceError, DeviceLimits, DeviceSample, EdgeForce, EdgeRefusal, HapticDevice,
+    MAX_FORCE_LIMIT_N,
+};
 #[cfg(not(target_arch = "wasm32"))]
 pub use forcedimension::ForceDimension;
 pub use fulcrum::{Fulcrum, HANDLE_AXIS, MIN_OUTSIDE_M, Pose};
@@ -42,7 +45,7 @@ pub use recorder::Recorder;
 #[cfg(not(target_arch = "wasm32"))]
 pub use release::install_exit_guards;
 pub use release::{Release, hold_registry_for, register, release_all, stop_requested};
-pub use safety::{Fault, MAX_FORCE_LIMIT_N, SafetyFilter, SafetySettings, check_force_limit};
+pub use safety::{Fault, SafetyFilter, SafetySettings, check_force_limit};
 pub use scripted::Scripted;
 pub use servo::{ServoLink, WATCHDOG_S, WatchdogRecord, halt_every_link};
 pub use spec::DeviceSpec;

@@ -14,7 +14,7 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use super::{DeviceLimits, TICK_S};
+use super::{DeviceLimits, MAX_FORCE_LIMIT_N, TICK_S};
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SafetySettings {
@@ -29,9 +29,6 @@ pub struct SafetySettings {
     /// Ticks without a fault before the force is rendered again (ramped by the rate limit).
     pub recovery_ticks: u32,
 }
-
-/// The largest force limit (N) a setting may ask for: more than any haptic device renders.
-pub const MAX_FORCE_LIMIT_N: f64 = 20.0;
 
 impl SafetySettings {
     /// Whether every setting is one the filter can honour: a force limit from 0 to
