@@ -60,8 +60,8 @@ impl ForceSummary {
 
 /// How often and how far the tool pressed beyond what an organ's nonlinear vademecum covers
 /// (until a position of the tool's patch carries a load deeper than the last load step):
-/// there the tissue stops stiffening, its force growing on at the range edge's secant
-/// stiffness.
+/// there the felt force goes on at the stiffness of the last load-step interval, so a tissue
+/// that firms up goes on firming up, but no longer as the law computed.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct RangeSummary {
     pub beyond_ticks: u64,
