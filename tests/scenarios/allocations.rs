@@ -1,5 +1,5 @@
 //! Every shipped scenario's competent and careless runs, once each: they score as they should,
-//! and the 1 kHz tick allocates nothing once warm — the counting allocator counts the
+//! their debriefs print in the shipped font, and the 1 kHz tick allocates nothing once warm — the counting allocator counts the
 //! allocations made on the thread that ticks, while it ticks, through presses, slides,
 //! palpation, grasps, cuts, organ contact, instrument changes, the laparoscope, force limits
 //! passed and scoring. Each allocation is traced to the function in the project's code that
@@ -118,6 +118,14 @@ fn shipped_runs_score_as_they_should_and_their_ticks_allocate_only_what_is_named
         let (careless, ticks, count) = counted_run(name, run.scenario, run.careless);
         misplaced.extend(report(&format!("{name} (careless)"), ticks, count));
         let (competent, careless) = (competent.card, careless.card);
+        for card in [&competent, &careless] {
+            let debrief = pgd_surgery::report::summary(card);
+            let missing = crate::glyphs::without_glyph(&debrief);
+            assert!(
+                missing.is_empty(),
+                "{name}: no glyph for {missing:?} in {debrief}"
+            );
+        }
         assert!(
             competent.passed,
             "{name}: the competent run failed: {competent:#?}"

@@ -13,6 +13,7 @@ mod cutting;
 #[path = "../../crates/pgd-surgery-core/tests/support/fuzz.rs"]
 mod fuzz;
 mod fuzz_files;
+mod glyphs;
 mod history;
 mod motion;
 mod soak;

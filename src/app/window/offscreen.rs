@@ -35,6 +35,27 @@ pub(super) fn plugins(app: &mut App, size: Option<(u32, u32)>, assets: AssetPlug
         ..default()
     };
     let plugins = DefaultPlugins.set(assets);
+    add_plugins(app, plugins, window, size);
+    install_font(app);
+}
+
+/// DejaVu Sans as the text's default font, in place of Bevy's built-in subset, which lacks
+/// signs the HUD and the debrief print (×, ³, µ).
+fn install_font(app: &mut App) {
+    let font = Font::from_bytes(crate::report::FONT_DATA.to_vec());
+    let mut fonts = app.world_mut().resource_mut::<Assets<Font>>();
+    if fonts.insert(AssetId::default(), font).is_err() {
+        warn!("the text keeps Bevy's built-in font: DejaVu Sans could not replace it");
+    }
+}
+
+/// `plugins` with `window`, or without one (drawing into an image) when `size` is given.
+fn add_plugins(
+    app: &mut App,
+    plugins: bevy::app::PluginGroupBuilder,
+    window: WindowPlugin,
+    size: Option<(u32, u32)>,
+) {
     match size {
         None => {
             app.add_plugins(plugins.set(window));

@@ -5,9 +5,9 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-/// The plots' font, shipped with the crate so that plots need nothing from the system.
-#[cfg(not(target_arch = "wasm32"))]
-const FONT: &[u8] = include_bytes!("../../../../assets/fonts/DejaVuSans.ttf");
+/// DejaVu Sans, shipped with the product so that its text needs nothing from the system: the
+/// plots' font, and the trainer window's.
+pub const FONT_DATA: &[u8] = include_bytes!("../../../../assets/fonts/DejaVuSans.ttf");
 
 /// A whole plot's drawing area.
 pub type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
@@ -44,7 +44,7 @@ pub fn save_png(
 ) -> PlotResult {
     // Plotters draws text with a registered font only off the web; the page draws no plots.
     #[cfg(not(target_arch = "wasm32"))]
-    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT_DATA)
         .map_err(|_| "the embedded font could not be read")?;
     let (width, height) = size;
     let mut pixels = vec![0u8; (width * height * 3) as usize];
