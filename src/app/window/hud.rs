@@ -1,7 +1,10 @@
-//! What the trainee reads: the force the device renders against its limit, the haptic rate,
-//! the frame time, faults, how to drive the virtual tool and steer the laparoscope, and a
-//! warning while the instrument is out of the laparoscope's view.
+//! What the trainee reads: the task and its clock, the force the device renders against its
+//! limit, what the tool touches, faults, how to drive the virtual tool and steer the
+//! laparoscope, and a warning while the instrument is out of the laparoscope's view. The
+//! device's name, the loop's timing and the tissue's laws are behind F3: a trainee has no use
+//! for them, a developer does.
 
+use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
 use super::FrameSet;
@@ -14,9 +17,26 @@ use crate::devices::Action;
 #[derive(Component)]
 struct Hud;
 
+/// Whether the HUD shows the device, the loop's timing and the tissue (F3 toggles it).
+#[derive(Resource, Clone, Copy, Debug, Default)]
+struct Details(bool);
+
+/// The key that shows and hides the details.
+const DETAILS_KEY: KeyCode = KeyCode::F3;
+
 pub(super) fn setup(app: &mut App) {
-    app.add_systems(Startup, spawn_hud)
-        .add_systems(Update, update_hud.in_set(FrameSet::Draw));
+    app.init_resource::<Details>()
+        .add_systems(Startup, spawn_hud)
+        .add_systems(
+            Update,
+            (toggle_details, update_hud).chain().in_set(FrameSet::Draw),
+        );
+}
+
+fn toggle_details(keys: Res<ButtonInput<KeyCode>>, mut details: ResMut<Details>) {
+    if keys.just_pressed(DETAILS_KEY) {
+        details.0 = !details.0;
+    }
 }
 
 fn spawn_hud(mut commands: Commands) {
@@ -44,12 +64,19 @@ struct Rate {
     hz: f64,
 }
 
+/// How the trainee has set the view: the camera, and whether the details show.
+#[derive(SystemParam)]
+struct ViewChoices<'w> {
+    mode: Res<'w, CameraMode>,
+    details: Res<'w, Details>,
+}
+
 fn update_hud(
     link: Res<HapticLink>,
     snapshot: Res<Snapshot>,
     time: Res<Time<Real>>,
     lesson: Option<Res<Lesson>>,
-    mode: Res<CameraMode>,
+    view: ViewChoices,
     mut rate: Local<Rate>,
     mut hud: Query<&mut Text, With<Hud>>,
 ) {
@@ -102,21 +129,60 @@ fn update_hud(
     } else {
         ""
     };
-    let task = lesson.map_or_else(String::new, |lesson| task_line(&lesson, &snapshot));
-    let camera = camera_line(&link, &snapshot.0, *mode);
-    let instruments = instrument_line(&link, &snapshot.0);
-    let tissue = tissue_line(&link);
     let timing = &snapshot.0.timing;
-    text.0 = format!(
-        "{task}device: {}\nforce {force_n:.3} N {gauge} limit {limit_n:.1} N\n{status}\n\
-         haptic {:.0} Hz | tick p99 {:.0} us, late p99 {:.0} us, {} skipped | frame {:.1} ms\n{tissue}{help}{instruments}{camera}",
-        link.device_name,
-        rate.hz,
-        timing.compute_p99_us,
-        timing.lateness_p99_us,
-        timing.skipped,
-        dt * 1e3
-    );
+    let lines = HudLines {
+        task: lesson.map_or_else(String::new, |lesson| task_line(&lesson, &snapshot)),
+        force: format!("force {force_n:.3} N {gauge} limit {limit_n:.1} N"),
+        status,
+        guidance: format!(
+            "{}{help}{}{}",
+            building_line(),
+            instrument_line(&link, &snapshot.0),
+            camera_line(&link, &snapshot.0, *view.mode)
+        ),
+        details: format!(
+            "device: {}\nhaptic {:.0} Hz | tick p99 {:.0} us, late p99 {:.0} us, {} skipped | \
+             frame {:.1} ms\n{}",
+            link.device_name,
+            rate.hz,
+            timing.compute_p99_us,
+            timing.lateness_p99_us,
+            timing.skipped,
+            dt * 1e3,
+            tissue_line(&link)
+        ),
+    };
+    text.0 = lines.compose(view.details.0);
+}
+
+/// The HUD's parts: what the trainee reads first, then the details behind F3.
+struct HudLines {
+    /// The task and its clock (with a blank line after it), or nothing.
+    task: String,
+    force: String,
+    status: String,
+    /// Each line beginning with a line break: builds, keys, instruments, the laparoscope.
+    guidance: String,
+    /// The device, the loop's timing, the tissue.
+    details: String,
+}
+
+impl HudLines {
+    /// The HUD's text, with the details or the key that shows them.
+    fn compose(&self, details: bool) -> String {
+        let HudLines {
+            task,
+            force,
+            status,
+            guidance,
+            ..
+        } = self;
+        let last = match details {
+            true => format!("{}\nF3: hide these", self.details),
+            false => "F3: the device, the loop's timing, the tissue".to_owned(),
+        };
+        format!("{task}{force}\n{status}{guidance}\n\n{last}")
+    }
 }
 
 /// Each organ's tissue law, and the nonlinear vademecum building in the background, if any
@@ -128,7 +194,7 @@ fn tissue_line(link: &HapticLink) -> String {
         .iter()
         .map(|(name, vademecum)| organ_with_law(name, vademecum))
         .collect();
-    format!("tissue: {}{}", laws.join(", "), building_line())
+    format!("tissue: {}", laws.join(", "))
 }
 
 /// What the background builder is doing, on its own line, and which of its builds failed
@@ -243,5 +309,38 @@ fn beyond_range(snapshot: &HapticSnapshot) -> String {
         )
     } else {
         String::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lines() -> HudLines {
+        HudLines {
+            task: "task 1 of 1: hold the force\n2.0 s of 20 s\n\n".into(),
+            force: "force 0.210 N [#---] limit 3.3 N".into(),
+            status: "touching liver".into(),
+            guidance: "\nmouse: move the tool".into(),
+            details: "device: mouse\nhaptic 1000 Hz | tick p99 77 us\ntissue: liver (linear)"
+                .into(),
+        }
+    }
+
+    /// The trainee reads the task, the force and what the tool touches first, and the loop's
+    /// figures only after pressing F3, which hides them again.
+    #[test]
+    fn the_loop_figures_wait_behind_f3() {
+        let plain = lines().compose(false);
+        assert!(plain.starts_with("task 1 of 1"), "{plain}");
+        assert!(plain.contains("force 0.210 N") && plain.contains("touching liver"));
+        assert!(
+            !plain.contains("tick p99") && !plain.contains("device:"),
+            "{plain}"
+        );
+        assert!(plain.ends_with("F3: the device, the loop's timing, the tissue"));
+        let detailed = lines().compose(true);
+        assert!(detailed.contains("tick p99 77 us") && detailed.contains("tissue: liver"));
+        assert!(detailed.ends_with("F3: hide these"), "{detailed}");
     }
 }
