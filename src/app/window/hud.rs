@@ -10,7 +10,7 @@ use bevy::prelude::*;
 use super::FrameSet;
 use super::bridge::{HapticLink, Snapshot};
 use super::laparoscope::CameraMode;
-use super::lesson::Lesson;
+use super::lesson::{Lesson, Stage};
 use crate::app::haptic::{HapticSnapshot, organ_with_law};
 use crate::devices::Action;
 
@@ -29,8 +29,22 @@ pub(super) fn setup(app: &mut App) {
         .add_systems(Startup, spawn_hud)
         .add_systems(
             Update,
-            (toggle_details, update_hud).chain().in_set(FrameSet::Draw),
+            (toggle_details, update_hud, hide_under_panels)
+                .chain()
+                .in_set(FrameSet::Draw),
         );
+}
+
+/// The HUD is for the exercise and free play: under the menu's, the briefing's and the
+/// debrief's panels it is hidden, so that no text is drawn over theirs at any window size.
+fn hide_under_panels(stage: Option<Res<State<Stage>>>, mut hud: Query<&mut Visibility, With<Hud>>) {
+    let shown = stage.is_none_or(|stage| matches!(stage.get(), Stage::FreePlay | Stage::Exercise));
+    for mut visibility in &mut hud {
+        visibility.set_if_neq(match shown {
+            true => Visibility::Inherited,
+            false => Visibility::Hidden,
+        });
+    }
 }
 
 fn toggle_details(keys: Res<ButtonInput<KeyCode>>, mut details: ResMut<Details>) {

@@ -161,7 +161,9 @@ pub(super) fn spawn_panel(commands: &mut Commands, stage: Stage, text: String) -
                 .spawn((
                     Node {
                         max_width: px(720),
+                        max_height: percent(96),
                         padding: UiRect::all(px(24)),
+                        overflow: Overflow::clip(),
                         ..default()
                     },
                     BackgroundColor(Color::srgba(0.02, 0.03, 0.05, 0.88)),

@@ -8,11 +8,13 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, BoxedFuture, Task, block_on, poll_once};
 
 use super::bridge::HapticLink;
 use super::lesson::{Lesson, Lessons, Stage, spawn_panel};
+use super::offscreen::Offscreen;
 use super::{FrameSet, SceneChanged};
 use crate::app::haptic::{HapticLoop, HapticScene, HapticSnapshot, SceneSwap};
 use crate::scenario::{self, Scenario};
@@ -135,6 +137,7 @@ fn show_menu(
     mut commands: Commands,
     plan: Res<MenuPlan>,
     lesson: Res<Lesson>,
+    screen: ScreenHeight,
     mut menu: ResMut<Menu>,
 ) {
     menu.entries = entries(&plan);
@@ -144,32 +147,60 @@ fn show_menu(
         .iter()
         .position(|e| e.file.file_name() == current)
         .unwrap_or(0);
-    let text = spawn_panel(&mut commands, Stage::Menu, menu_text(&menu));
+    let rows = screen.entry_rows();
+    let text = spawn_panel(&mut commands, Stage::Menu, menu_text(&menu, rows));
     commands.entity(text).insert(MenuText);
 }
 
-fn menu_text(menu: &Menu) -> String {
-    let lines: Vec<String> = menu
-        .entries
-        .iter()
-        .enumerate()
-        .map(|(k, entry)| {
-            let mark = if k == menu.selected { ">" } else { " " };
-            let name = file_name(&entry.file);
-            match &entry.scenario {
-                Ok(s) => format!(
-                    "{mark} {}  ({}; {})\n      {name}",
-                    s.title,
-                    s.difficulty.name(),
-                    s.organ_names()
-                ),
-                Err(e) => {
-                    let first = e.lines().next().unwrap_or_default();
-                    format!("{mark} {name}: cannot be run\n      {first}")
-                }
-            }
-        })
-        .collect();
+/// The height (pixels) the menu has: the window's, or the offscreen image's.
+#[derive(SystemParam)]
+struct ScreenHeight<'w, 's> {
+    window: Query<'w, 's, &'static Window>,
+    offscreen: Option<Res<'w, Offscreen>>,
+}
+
+/// A line of the panel's text (pixels): its 17 px font and the line spacing.
+const LINE_PX: f32 = 21.0;
+
+/// The lines of the panel that are not entries: its padding and margins, the header, the
+/// selected entry's second line, the scroll marks and a failed choice's message.
+const OTHER_LINES: usize = 11;
+
+impl ScreenHeight<'_, '_> {
+    /// How many entries, a line each, the menu shows at once: what the height leaves, three
+    /// at least.
+    fn entry_rows(&self) -> usize {
+        let height_px = match (self.window.iter().next(), &self.offscreen) {
+            (Some(window), _) => window.height(),
+            (None, Some(offscreen)) => offscreen.size.y as f32,
+            (None, None) => 600.0,
+        };
+        ((height_px / LINE_PX) as usize)
+            .saturating_sub(OTHER_LINES)
+            .max(3)
+    }
+}
+
+/// The menu's text with at most `rows` entries, a line each, scrolled to keep the selected
+/// one in sight (with its file on a second line); marks say how many are above and below.
+fn menu_text(menu: &Menu, rows: usize) -> String {
+    let count = menu.entries.len();
+    let rows = rows.max(1).min(count.max(1));
+    let first = menu
+        .selected
+        .saturating_sub(rows / 2)
+        .min(count.saturating_sub(rows));
+    let mut lines: Vec<String> = Vec::new();
+    if first > 0 {
+        lines.push(format!("  ↑ {first} more"));
+    }
+    for (k, entry) in menu.entries.iter().enumerate().skip(first).take(rows) {
+        lines.push(entry_text(entry, k == menu.selected));
+    }
+    let below = count.saturating_sub(first + rows);
+    if below > 0 {
+        lines.push(format!("  ↓ {below} more"));
+    }
     let problem = match &menu.problem {
         Some(problem) => format!("\n\nThe last choice could not be loaded:\n{problem}"),
         None => String::new(),
@@ -186,6 +217,28 @@ fn menu_text(menu: &Menu) -> String {
     )
 }
 
+/// One entry: its title, difficulty and organs (or why it cannot be run); the selected one
+/// marked, with its file below.
+fn entry_text(entry: &Entry, selected: bool) -> String {
+    let name = file_name(&entry.file);
+    let line = match &entry.scenario {
+        Ok(s) => format!(
+            "{}  ({}; {})",
+            s.title,
+            s.difficulty.name(),
+            s.organ_names()
+        ),
+        Err(e) => format!(
+            "{name}: cannot be run: {}",
+            e.lines().next().unwrap_or_default()
+        ),
+    };
+    match selected {
+        true => format!("> {line}\n      {name}"),
+        false => format!("  {line}"),
+    }
+}
+
 fn file_name(file: &Path) -> String {
     file.file_name().map_or_else(
         || file.display().to_string(),
@@ -195,6 +248,7 @@ fn file_name(file: &Path) -> String {
 
 fn move_selection(
     keys: Res<ButtonInput<KeyCode>>,
+    screen: ScreenHeight,
     mut menu: ResMut<Menu>,
     mut text: Single<&mut Text, With<MenuText>>,
 ) {
@@ -207,7 +261,7 @@ fn move_selection(
         return;
     };
     menu.selected = (menu.selected + step) % count;
-    text.0 = menu_text(&menu);
+    text.0 = menu_text(&menu, screen.entry_rows());
 }
 
 /// Enter on a scenario that reads: its scene is loaded as a task.
@@ -369,6 +423,43 @@ mod tests {
                 tasks: [ForceControl(organ: "{organ}", min_force_n: 0.1, max_force_n: 0.3,
                                      hold_s: 1.0, time_limit_s: 5.0)])"#
         )
+    }
+
+    /// Thirty scenarios in eight rows: the menu shows eight entries around the selected one,
+    /// says how many are above and below, and scrolls as the selection moves; at the ends it
+    /// shows the first or the last eight.
+    #[test]
+    fn a_long_menu_scrolls_to_keep_the_selection_in_sight() {
+        let entries = (0..30)
+            .map(|k| Entry {
+                file: PathBuf::from(format!("s{k:02}.scenario.ron")),
+                scenario: Err("not read".into()),
+            })
+            .collect();
+        let mut menu = Menu {
+            entries,
+            selected: 15,
+            problem: None,
+        };
+        let text = menu_text(&menu, 8);
+        assert!(
+            text.contains("↑ 11 more") && text.contains("↓ 11 more"),
+            "{text}"
+        );
+        assert!(text.contains("> s15.scenario.ron") && text.contains("  s11.scenario.ron"));
+        assert!(!text.contains("s10.scenario.ron") && !text.contains("s19.scenario.ron"));
+        menu.selected = 0;
+        let top = menu_text(&menu, 8);
+        assert!(
+            !top.contains('↑') && top.contains("↓ 22 more") && top.contains("s07"),
+            "{top}"
+        );
+        menu.selected = 29;
+        let bottom = menu_text(&menu, 8);
+        assert!(
+            bottom.contains("↑ 22 more") && !bottom.contains('↓'),
+            "{bottom}"
+        );
     }
 
     struct Fixture {
