@@ -3,7 +3,9 @@
 
 use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{DeviceForce, FaultLog, HapticLoop, TickClock};
-use pgd_surgery::devices::{HapticDevice, SafetySettings, ServoLink, TICK_S, WATCHDOG_S};
+use pgd_surgery::devices::{
+    HapticDevice, MAX_FORCE_LIMIT_N, SafetySettings, ServoLink, TICK_S, WATCHDOG_S,
+};
 
 use crate::common::{TIP_RADIUS_M, scene, target};
 use crate::vendor_fake::VendorFake;
@@ -149,4 +151,21 @@ pub fn assert_edge_guarded(device: &mut dyn HapticDevice, fake: &VendorFake, pre
         largest <= peak_n * (1.0 + 1e-12),
         "{largest} N reached the motors"
     );
+}
+
+/// A driver reporting a 100 N peak (the fake told so before `device` opened): the device's peak
+/// is the product's 20 N ceiling, and a 100 N command reaches the library's force call as 20 N
+/// (`prefix` names the fake's controls).
+pub fn assert_held_to_ceiling(device: &mut dyn HapticDevice, fake: &VendorFake, prefix: &str) {
+    assert_eq!(device.limits().peak_force_n, MAX_FORCE_LIMIT_N);
+    let refused = device.write_force(&Vector3::new(0.0, 0.0, 100.0));
+    assert!(refused.is_err());
+    fake.wait(&format!("{prefix}_frames"), 3);
+    let rendered = fake.vector(&format!("{prefix}_last_force"));
+    assert!(
+        (rendered.norm() - MAX_FORCE_LIMIT_N).abs() < 1e-9,
+        "{rendered:?}"
+    );
+    let largest = fake.double(&format!("{prefix}_largest_force"));
+    assert!(largest <= MAX_FORCE_LIMIT_N * (1.0 + 1e-12), "{largest} N");
 }

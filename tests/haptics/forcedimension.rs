@@ -5,10 +5,11 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
-use pgd_surgery::devices::{ForceDimension, HapticDevice, MAX_FORCE_LIMIT_N};
+use pgd_surgery::devices::{ForceDimension, HapticDevice};
 
 use crate::fakes::{
-    assert_edge_guarded, assert_faded, assert_watchdog_held, press_then_fault, pressing_tip_m,
+    assert_edge_guarded, assert_faded, assert_held_to_ceiling, assert_watchdog_held,
+    press_then_fault, pressing_tip_m,
 };
 use crate::vendor_fake::VendorFake;
 
@@ -173,10 +174,5 @@ fn a_driver_reporting_100_n_is_held_to_the_ceiling() {
             .call::<unsafe extern "C" fn(f64)>("fake_dhd_set_max_force")(100.0)
     };
     let mut device = fake.open().unwrap();
-    assert_eq!(device.limits().peak_force_n, MAX_FORCE_LIMIT_N);
-    let refused = device.write_force(&Vector3::new(0.0, 0.0, 100.0));
-    assert!(refused.is_err());
-    fake.wait_frames(3);
-    assert!((fake.last_force().norm() - MAX_FORCE_LIMIT_N).abs() < 1e-9);
-    assert!(fake.0.double("fake_dhd_largest_force") <= MAX_FORCE_LIMIT_N * (1.0 + 1e-12));
+    assert_held_to_ceiling(&mut device, &fake.0, "fake_dhd");
 }

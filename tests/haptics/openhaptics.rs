@@ -6,13 +6,12 @@ use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{FaultLog, HapticLoop, HapticThread, Scheduling};
-use pgd_surgery::devices::{
-    HapticDevice, MAX_FORCE_LIMIT_N, OpenHaptics, SafetySettings, TimerMode,
-};
+use pgd_surgery::devices::{HapticDevice, OpenHaptics, SafetySettings, TimerMode};
 
 use crate::common::{TIP_RADIUS_M, scene, target};
 use crate::fakes::{
-    assert_edge_guarded, assert_faded, assert_watchdog_held, press_then_fault, pressing_tip_m,
+    assert_edge_guarded, assert_faded, assert_held_to_ceiling, assert_watchdog_held,
+    press_then_fault, pressing_tip_m,
 };
 use crate::vendor_fake::VendorFake;
 
@@ -133,12 +132,7 @@ fn a_driver_reporting_100_n_is_held_to_the_ceiling() {
             .call::<unsafe extern "C" fn(f64)>("fake_hd_set_nominal_max_force")(100.0)
     };
     let mut device = fake.open();
-    assert_eq!(device.limits().peak_force_n, MAX_FORCE_LIMIT_N);
-    let refused = device.write_force(&Vector3::new(0.0, 0.0, 100.0));
-    assert!(refused.is_err());
-    fake.wait_frames(3);
-    assert!((fake.last_force().norm() - MAX_FORCE_LIMIT_N).abs() < 1e-9);
-    assert!(fake.0.double("fake_hd_largest_force") <= MAX_FORCE_LIMIT_N * (1.0 + 1e-12));
+    assert_held_to_ceiling(&mut device, &fake.0, "fake_hd");
 }
 
 /// A device the library initializes but reports an error for is released before the error

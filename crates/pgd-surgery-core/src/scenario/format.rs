@@ -839,6 +839,19 @@ impl Task {
         }
     }
 
+    /// The organ the task works on (none for navigation, which works among them all).
+    pub fn organ(&self) -> Option<&str> {
+        match self {
+            Task::ForceControl { organ, .. }
+            | Task::Palpation { organ, .. }
+            | Task::Retraction { organ, .. }
+            | Task::Grasp { organ, .. }
+            | Task::Incision { organ, .. }
+            | Task::RadialKeratotomy { organ, .. } => Some(organ),
+            Task::SafeNavigation { .. } => None,
+        }
+    }
+
     pub fn time_limit_s(&self) -> f64 {
         match self {
             Task::ForceControl { time_limit_s, .. }

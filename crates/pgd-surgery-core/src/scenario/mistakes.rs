@@ -58,15 +58,7 @@ impl Mistake {
 
 /// The organ a task works on, for its mistakes' words ("organ" for navigation, on none).
 pub fn task_organ(task: &Task) -> &str {
-    match task {
-        Task::ForceControl { organ, .. }
-        | Task::Palpation { organ, .. }
-        | Task::Retraction { organ, .. }
-        | Task::Grasp { organ, .. }
-        | Task::Incision { organ, .. }
-        | Task::RadialKeratotomy { organ, .. } => organ,
-        Task::SafeNavigation { .. } => "organ",
-    }
+    task.organ().unwrap_or("organ")
 }
 
 /// A task's mistakes: the first [`MISTAKES_LISTED`] in detail, the others counted.
