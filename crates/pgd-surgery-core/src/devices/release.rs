@@ -15,8 +15,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, TryLockError, Weak};
 use std::time::{Duration, Instant};
 
-use super::halt_every_link;
-
 /// What releases one open device: zero force, its servo stopped, the device closed. Called
 /// from any thread, possibly while the haptic loop is still using the device; every call after
 /// the first does nothing.
@@ -75,8 +73,9 @@ pub fn hold_registry_for(duration: Duration) {
 }
 
 /// Every link halted at once, then every device released: what a panic and a signal do.
+#[cfg(not(target_arch = "wasm32"))]
 fn halt_and_release_all() -> Option<usize> {
-    halt_every_link();
+    super::halt_every_link();
     release_all()
 }
 
