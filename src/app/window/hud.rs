@@ -341,6 +341,39 @@ mod tests {
         }
     }
 
+    /// Under the menu's, the briefing's and the debrief's panels the HUD is hidden; during the
+    /// exercise and in free play (and with no lesson at all) it shows.
+    #[test]
+    fn the_hud_hides_under_the_panels() {
+        use bevy::state::app::StatesPlugin;
+        let mut app = App::new();
+        app.add_plugins((MinimalPlugins, StatesPlugin))
+            .add_systems(Update, hide_under_panels);
+        let hud = app.world_mut().spawn((Hud, Visibility::Inherited)).id();
+        app.update();
+        let visibility = |app: &App| *app.world().get::<Visibility>(hud).unwrap();
+        assert_eq!(visibility(&app), Visibility::Inherited, "no lesson");
+        app.init_state::<Stage>();
+        for (stage, shown) in [
+            (Stage::Menu, false),
+            (Stage::Briefing, false),
+            (Stage::Exercise, true),
+            (Stage::Debrief, false),
+            (Stage::FreePlay, true),
+        ] {
+            app.world_mut()
+                .resource_mut::<NextState<Stage>>()
+                .set(stage);
+            app.update();
+            app.update();
+            let expected = match shown {
+                true => Visibility::Inherited,
+                false => Visibility::Hidden,
+            };
+            assert_eq!(visibility(&app), expected, "{stage:?}");
+        }
+    }
+
     /// The trainee reads the task, the force and what the tool touches first, and the loop's
     /// figures only after pressing F3, which hides them again.
     #[test]
