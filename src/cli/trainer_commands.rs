@@ -35,13 +35,16 @@ pub fn validate_scenarios(files: &[PathBuf]) -> ExitCode {
     let mut failed = false;
     for file in files {
         match scenario::load(file) {
-            Ok(s) => println!(
-                "{}: ok ({}, {} task{})",
-                file.display(),
-                s.title,
-                s.tasks.len(),
-                if s.tasks.len() == 1 { "" } else { "s" }
-            ),
+            Ok(s) => {
+                println!(
+                    "{}: ok ({}, {} task{})",
+                    file.display(),
+                    s.title,
+                    s.tasks.len(),
+                    if s.tasks.len() == 1 { "" } else { "s" }
+                );
+                warn_of_missing_glyphs(file, &s);
+            }
             Err(e) => {
                 eprintln!("{e}");
                 failed = true;
@@ -49,6 +52,26 @@ pub fn validate_scenarios(files: &[PathBuf]) -> ExitCode {
         }
     }
     verdict(failed)
+}
+
+/// A warning on the error stream when the scenario's words (its title, briefing and tasks)
+/// hold characters the trainer's font cannot draw: they would show as boxes.
+fn warn_of_missing_glyphs(file: &Path, scenario: &scenario::Scenario) {
+    let tasks = scenario.tasks.iter().map(scenario::Task::description);
+    let words: Vec<String> = [scenario.title.clone(), scenario.briefing.clone()]
+        .into_iter()
+        .chain(tasks)
+        .collect();
+    let missing = crate::report::without_glyph(&words.join("\n"));
+    if !missing.is_empty() {
+        let listed: Vec<String> = missing.iter().map(|c| format!("{c:?}")).collect();
+        eprintln!(
+            "warning: {}: the trainer's font (DejaVu Sans) has no glyph for {}: they show as \
+             boxes in the window and the web page",
+            file.display(),
+            listed.join(", ")
+        );
+    }
 }
 
 /// `trainer prepare`: the vademecums and distance fields the scenario files need, built under

@@ -120,7 +120,7 @@ fn shipped_runs_score_as_they_should_and_their_ticks_allocate_only_what_is_named
         let (competent, careless) = (competent.card, careless.card);
         for card in [&competent, &careless] {
             let debrief = pgd_surgery::report::summary(card);
-            let missing = crate::glyphs::without_glyph(&debrief);
+            let missing = pgd_surgery::report::without_glyph(&debrief);
             assert!(
                 missing.is_empty(),
                 "{name}: no glyph for {missing:?} in {debrief}"

@@ -389,5 +389,7 @@ mod tests {
         let detailed = lines().compose(true);
         assert!(detailed.contains("tick p99 77 us") && detailed.contains("tissue: liver"));
         assert!(detailed.ends_with("F3: hide these"), "{detailed}");
+        let drawn = crate::report::without_glyph(&format!("{plain}{detailed}"));
+        assert!(drawn.is_empty(), "{drawn:?}");
     }
 }

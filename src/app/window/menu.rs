@@ -460,6 +460,7 @@ mod tests {
             bottom.contains("↑ 22 more") && !bottom.contains('↓'),
             "{bottom}"
         );
+        assert_eq!(crate::report::without_glyph(&text), Vec::<char>::new());
     }
 
     struct Fixture {

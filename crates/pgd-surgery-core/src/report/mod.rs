@@ -11,5 +11,5 @@ pub use convergence::{
     StepCurve, write as write_convergence, write_of_header as write_convergence_of,
 };
 pub use learning_curve::{CurvePoint, learning_curve};
-pub use plot::{FONT_DATA, LineChart, Series, line_chart, save_png};
+pub use plot::{FONT_DATA, LineChart, Series, line_chart, save_png, without_glyph};
 pub use scorecard::{summary, write_report};

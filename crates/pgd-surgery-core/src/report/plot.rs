@@ -9,6 +9,22 @@ use plotters::prelude::*;
 /// plots' font, and the trainer window's.
 pub const FONT_DATA: &[u8] = include_bytes!("../../../../assets/fonts/DejaVuSans.ttf");
 
+/// The characters of `text` the shipped font has no glyph for (each once, in order; line
+/// breaks aside): the window and the web page would draw them as boxes.
+pub fn without_glyph(text: &str) -> Vec<char> {
+    use ab_glyph::Font;
+    let Ok(font) = ab_glyph::FontRef::try_from_slice(FONT_DATA) else {
+        return Vec::new();
+    };
+    let mut missing: Vec<char> = Vec::new();
+    for c in text.chars() {
+        if c != '\n' && font.glyph_id(c).0 == 0 && !missing.contains(&c) {
+            missing.push(c);
+        }
+    }
+    missing
+}
+
 /// A whole plot's drawing area.
 pub type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
