@@ -1,21 +1,9 @@
 //! `pgd fit`: a uniaxial test read from CSV and fitted, or refused naming the file and line.
 //! (The fit itself against full FEM is the core's, `fem` tests.)
 
-use pgd_surgery::fem::{Law, Material, uniaxial_nominal_stress_pa};
+use pgd_surgery::fem::uniaxial_nominal_stress_pa;
 
-const STIFFENING: f64 = 3.0;
-const POISSON: f64 = 0.45;
-
-/// Exponential tissue of 3 kPa stiffening at 3, compressed to 70 % in six stretches.
-fn tissue() -> Material {
-    Material::new(Law::Exponential, 3.0e3, POISSON, 1000.0)
-        .and_then(|m| m.with_stiffening(STIFFENING))
-        .unwrap()
-}
-
-fn stretches() -> Vec<f64> {
-    (1..=6).map(|i| 1.0 - 0.05 * i as f64).collect()
-}
+use crate::uniaxial::{POISSON, STIFFENING, stretches, tissue};
 
 /// `pgd fit` reads a test from CSV and fits it; a bad row is refused naming the file and line.
 #[test]

@@ -8,3 +8,5 @@ mod common;
 mod fit;
 mod option_values;
 mod outputs;
+#[path = "../../crates/pgd-surgery-core/tests/support/uniaxial.rs"]
+mod uniaxial;

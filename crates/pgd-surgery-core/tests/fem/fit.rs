@@ -1,26 +1,10 @@
 //! The exponential law's fit to uniaxial tests: stresses from full FEM of a compressed cube
 //! give back the modulus and stiffening they were made with.
 
-use pgd_surgery_core::fem::{
-    FemError, Law, Material, UniaxialPoint, fit_exponential, uniaxial_nominal_stress_pa,
-};
+use pgd_surgery_core::fem::{FemError, UniaxialPoint, fit_exponential, uniaxial_nominal_stress_pa};
 
 use crate::hyperelastic::end_stress_pa;
-
-const YOUNG_PA: f64 = 3.0e3;
-const STIFFENING: f64 = 3.0;
-const POISSON: f64 = 0.45;
-
-fn tissue() -> Material {
-    Material::new(Law::Exponential, YOUNG_PA, POISSON, 1000.0)
-        .and_then(|m| m.with_stiffening(STIFFENING))
-        .unwrap()
-}
-
-/// Compression to 30 %, as tissue tests go, in six stretches.
-fn stretches() -> Vec<f64> {
-    (1..=6).map(|i| 1.0 - 0.05 * i as f64).collect()
-}
+use crate::uniaxial::{POISSON, STIFFENING, YOUNG_PA, stretches, tissue};
 
 /// The closed-form uniaxial stress (lateral stretch by bisection) is what full FEM of a cube on
 /// rollers carries, to 1e-8.

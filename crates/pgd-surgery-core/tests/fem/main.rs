@@ -13,3 +13,5 @@ mod loads_and_mass;
 mod patch;
 mod surface;
 mod tangent_solver;
+#[path = "../support/uniaxial.rs"]
+mod uniaxial;
