@@ -18,6 +18,7 @@ mod thread;
 
 use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
+use snapshot::SnapshotPublisher;
 
 pub use components::{
     OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, organ_with_law,
@@ -57,7 +58,9 @@ pub enum HapticSet {
 }
 
 /// The tick's systems, chained through [`HapticSet`], on one thread: a tick is a few tens of
-/// microseconds of work, which a multi-threaded executor would only slow down.
+/// microseconds of work, which a multi-threaded executor would only slow down. The optional
+/// stages (organ contact, scoring, the trace, publishing) run under a condition on the
+/// resource they serve.
 pub fn haptic_schedule() -> Schedule {
     let mut schedule = Schedule::new(HapticTick);
     schedule.set_executor(SingleThreadedExecutor::new());
@@ -87,16 +90,21 @@ pub fn haptic_schedule() -> Schedule {
             .chain()
             .in_set(HapticSet::ToolContact),
         systems::evaluate_modes.in_set(HapticSet::EvaluateModes),
-        systems::organ_contact.in_set(HapticSet::OrganContact),
+        systems::organ_contact
+            .run_if(resource_exists::<OrganCoupling>)
+            .in_set(HapticSet::OrganContact),
         systems::compute_force.in_set(HapticSet::ComputeForce),
         systems::apply_safety.in_set(HapticSet::Safety),
         systems::write_device.in_set(HapticSet::WriteDevice),
         (scoring::score_tick, scoring::heal_on_retry)
             .chain()
+            .run_if(resource_exists::<ExerciseRun>)
             .in_set(HapticSet::Score),
         (
-            systems::trace_force,
-            (scoring::publish_progress, systems::publish_snapshot).chain(),
+            systems::trace_force.run_if(resource_exists::<ForceTrace>),
+            (scoring::publish_progress, systems::publish_snapshot)
+                .chain()
+                .run_if(resource_exists::<SnapshotPublisher>),
         )
             .in_set(HapticSet::Publish),
     ));

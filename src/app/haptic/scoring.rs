@@ -182,12 +182,9 @@ pub fn score_tick(
     tool: Res<Tool>,
     force: Res<DeviceForce>,
     organs: Query<Organ>,
-    run: Option<ResMut<ExerciseRun>>,
+    mut run: ResMut<ExerciseRun>,
     scope: Option<ResMut<Scope>>,
 ) {
-    let Some(mut run) = run else {
-        return;
-    };
     if !run.link.started() {
         return;
     }
@@ -281,22 +278,15 @@ fn blade_sample(index: &OrganIndex, cut: &OrganCut) -> Option<BladeSample> {
     })
 }
 
-/// Where the exercise stands, into the snapshot about to be published.
-pub fn publish_progress(
-    run: Option<Res<ExerciseRun>>,
-    publisher: Option<ResMut<SnapshotPublisher>>,
-) {
-    if let Some(mut publisher) = publisher {
-        publisher.0.input_buffer_mut().exercise = run.and_then(|run| run.progress());
-    }
+/// Where the exercise stands (none without one), into the snapshot about to be published.
+pub fn publish_progress(run: Option<Res<ExerciseRun>>, mut publisher: ResMut<SnapshotPublisher>) {
+    publisher.0.input_buffer_mut().exercise = run.and_then(|run| run.progress());
 }
 
 /// A new attempt at the exercise starts on uncut tissue: once the run has taken its next
 /// attempt, each cut organ's worker undoes its incisions and its scalpel forgets its strokes.
-pub fn heal_on_retry(run: Option<Res<ExerciseRun>>, mut organs: Query<&mut OrganCut>) {
-    let Some(attempts) = run.map(|r| r.attempts()) else {
-        return;
-    };
+pub fn heal_on_retry(run: Res<ExerciseRun>, mut organs: Query<&mut OrganCut>) {
+    let attempts = run.attempts();
     for mut cut in &mut organs {
         if cut.attempt == attempts {
             continue;

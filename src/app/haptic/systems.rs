@@ -207,7 +207,7 @@ pub fn evaluate_modes(mut organs: Query<(&OrganBody, &mut OrganDeformation)>) {
 /// organ its coupling loads and carry. The tool's load follows the contact's push in the same
 /// tick, so the trainee feels the organ behind at once.
 pub fn organ_contact(
-    coupling: Option<ResMut<OrganCoupling>>,
+    mut coupling: ResMut<OrganCoupling>,
     mut organs: Query<(
         &OrganIndex,
         &mut ToolTouch,
@@ -215,9 +215,6 @@ pub fn organ_contact(
         Option<&OrganMotion>,
     )>,
 ) {
-    let Some(mut coupling) = coupling else {
-        return;
-    };
     let coupling = &mut coupling.0;
     for (index, touch, deformation, motion) in &organs {
         let deformation = &deformation.0;
@@ -300,12 +297,10 @@ pub fn write_device(
     }
 }
 
-/// Keeps the tick's forces when a trace was asked for.
-pub fn trace_force(force: Res<DeviceForce>, trace: Option<ResMut<ForceTrace>>) {
-    if let Some(mut trace) = trace {
-        trace.desired_n.push(force.desired_n);
-        trace.sent_n.push(force.sent_n);
-    }
+/// Keeps the tick's forces (run when a trace was asked for).
+pub fn trace_force(force: Res<DeviceForce>, mut trace: ResMut<ForceTrace>) {
+    trace.desired_n.push(force.desired_n);
+    trace.sent_n.push(force.sent_n);
 }
 
 /// What the snapshot takes of an organ entity.
@@ -325,11 +320,8 @@ pub fn publish_snapshot(
     safety: Res<Safety>,
     organs: Query<Published>,
     timing: Option<Res<LoopTiming>>,
-    publisher: Option<ResMut<SnapshotPublisher>>,
+    mut publisher: ResMut<SnapshotPublisher>,
 ) {
-    let Some(mut publisher) = publisher else {
-        return;
-    };
     let snapshot = publisher.0.input_buffer_mut();
     snapshot.tick = clock.tick;
     snapshot.time_s = clock.time_s;
