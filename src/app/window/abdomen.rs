@@ -109,8 +109,13 @@ fn parts() -> Vec<Part> {
     parts
 }
 
-pub(super) fn setup(app: &mut App) {
-    super::spawn_with_scene(app, spawn_abdomen);
+/// The abdomen around the organs.
+pub(super) struct AbdomenPlugin;
+
+impl Plugin for AbdomenPlugin {
+    fn build(&self, app: &mut App) {
+        super::spawn_with_scene(app, spawn_abdomen);
+    }
 }
 
 fn laparoscopic(link: &HapticLink) -> bool {

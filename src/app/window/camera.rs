@@ -52,13 +52,18 @@ impl Orbit {
     }
 }
 
-pub(super) fn setup(app: &mut App) {
-    app.add_systems(
-        Update,
-        orbit
-            .in_set(FrameSet::Input)
-            .run_if(resource_equals(CameraMode::Free)),
-    );
+/// The free camera.
+pub(super) struct CameraPlugin;
+
+impl Plugin for CameraPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(
+            Update,
+            orbit
+                .in_set(FrameSet::Input)
+                .run_if(resource_equals(CameraMode::Free)),
+        );
+    }
 }
 
 fn orbit(

@@ -24,15 +24,20 @@ struct Details(bool);
 /// The key that shows and hides the details.
 const DETAILS_KEY: KeyCode = KeyCode::F3;
 
-pub(super) fn setup(app: &mut App) {
-    app.init_resource::<Details>()
-        .add_systems(Startup, spawn_hud)
-        .add_systems(
-            Update,
-            (toggle_details, update_hud, hide_under_panels)
-                .chain()
-                .in_set(FrameSet::Draw),
-        );
+/// The HUD.
+pub(super) struct HudPlugin;
+
+impl Plugin for HudPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<Details>()
+            .add_systems(Startup, spawn_hud)
+            .add_systems(
+                Update,
+                (toggle_details, update_hud, hide_under_panels)
+                    .chain()
+                    .in_set(FrameSet::Draw),
+            );
+    }
 }
 
 /// The HUD is for the exercise and free play: under the menu's, the briefing's and the

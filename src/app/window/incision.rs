@@ -17,11 +17,16 @@ const EDGE_HALF_RADII: f32 = 1.33;
 /// The colour of a line marked on the tissue.
 const MARKER: Color = Color::srgb(0.2, 0.9, 0.3);
 
-pub(super) fn setup(app: &mut App) {
-    app.add_systems(
-        Update,
-        (draw_marked_lines, draw_optical_zones, draw_cuts, draw_edge).in_set(FrameSet::Draw),
-    );
+/// The incisions drawn.
+pub(super) struct IncisionPlugin;
+
+impl Plugin for IncisionPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(
+            Update,
+            (draw_marked_lines, draw_optical_zones, draw_cuts, draw_edge).in_set(FrameSet::Draw),
+        );
+    }
 }
 
 /// Each incision task's line, in green.

@@ -22,11 +22,16 @@ const PIXELS_PER_NOTCH: f32 = 20.0;
 /// How fast Q/E turn the handle (rad/s).
 const TURN_RAD_PER_S: f64 = std::f64::consts::FRAC_PI_2;
 
-pub(super) fn setup(app: &mut App) {
-    app.add_systems(
-        Update,
-        (drive_virtual_device, turn_and_press).in_set(FrameSet::Input),
-    );
+/// The mouse and keys driving the virtual device.
+pub(super) struct InputPlugin;
+
+impl Plugin for InputPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(
+            Update,
+            (drive_virtual_device, turn_and_press).in_set(FrameSet::Input),
+        );
+    }
 }
 
 fn drive_virtual_device(

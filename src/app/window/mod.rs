@@ -155,14 +155,15 @@ pub fn run(mut window: WindowScene) -> (AppExit, Option<FrameReport>) {
     menu::setup(&mut app, window.menu.clone());
     paced::setup(&mut app, window.paced.take());
     bridge::setup(&mut app, window);
-    organs::setup(&mut app);
-    abdomen::setup(&mut app);
+    app.add_plugins((organs::OrganPlugin, abdomen::AbdomenPlugin));
     laparoscope::setup(&mut app, free_camera);
-    camera::setup(&mut app);
-    tool::setup(&mut app);
-    incision::setup(&mut app);
-    input::setup(&mut app);
-    hud::setup(&mut app);
+    app.add_plugins((
+        camera::CameraPlugin,
+        tool::ToolPlugin,
+        incision::IncisionPlugin,
+        input::InputPlugin,
+        hud::HudPlugin,
+    ));
     frames::setup(&mut app, log.clone());
     #[cfg(target_arch = "wasm32")]
     web_page::setup(&mut app);

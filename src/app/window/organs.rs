@@ -62,9 +62,14 @@ struct CutWalls {
 /// The colour of cut tissue's inside (sRGB).
 const INSIDE: Color = Color::srgb(0.45, 0.07, 0.08);
 
-pub(super) fn setup(app: &mut App) {
-    super::spawn_with_scene(app, (spawn_organs, spawn_camera_and_light));
-    app.add_systems(Update, deform.in_set(FrameSet::Draw));
+/// The organs drawn and deformed.
+pub(super) struct OrganPlugin;
+
+impl Plugin for OrganPlugin {
+    fn build(&self, app: &mut App) {
+        super::spawn_with_scene(app, (spawn_organs, spawn_camera_and_light));
+        app.add_systems(Update, deform.in_set(FrameSet::Draw));
+    }
 }
 
 fn spawn_organs(

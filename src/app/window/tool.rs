@@ -22,12 +22,17 @@ const SHAFT_RADIUS_M: f32 = 0.0025;
 /// Arrow length per newton (m/N): 0.3 N, a firm press on the liver, draws 6 cm.
 const ARROW_M_PER_N: f32 = 0.2;
 
-pub(super) fn setup(app: &mut App) {
-    super::spawn_with_scene(app, spawn_tool);
-    app.add_systems(
-        Update,
-        (follow_device, draw_force, draw_shaft).in_set(FrameSet::Draw),
-    );
+/// The tool, its force arrow and the instruments.
+pub(super) struct ToolPlugin;
+
+impl Plugin for ToolPlugin {
+    fn build(&self, app: &mut App) {
+        super::spawn_with_scene(app, spawn_tool);
+        app.add_systems(
+            Update,
+            (follow_device, draw_force, draw_shaft).in_set(FrameSet::Draw),
+        );
+    }
 }
 
 fn spawn_tool(
