@@ -52,9 +52,15 @@ impl FrameLog {
     }
 }
 
-pub(super) fn setup(app: &mut App, log: FrameLog) {
-    app.insert_resource(log)
-        .add_systems(Update, record.in_set(super::FrameSet::Input));
+/// Every frame's time, kept in the run's log.
+pub(super) struct FramesPlugin(pub FrameLog);
+
+impl Plugin for FramesPlugin {
+    fn build(&self, app: &mut App) {
+        let log = self.0.clone();
+        app.insert_resource(log)
+            .add_systems(Update, record.in_set(super::FrameSet::Input));
+    }
 }
 
 /// Real time, not virtual: virtual time caps a slow frame's step.

@@ -54,23 +54,33 @@ const MASK_TEXELS: usize = 256;
 #[derive(Resource, Clone, Copy, Debug)]
 struct OpenThroughOptic(bool);
 
-pub(super) fn setup(app: &mut App, free_camera: bool) {
-    app.init_resource::<CameraMode>()
-        .insert_resource(OpenThroughOptic(!free_camera));
-    super::spawn_with_scene(app, (choose_mode, spawn_tip_light, spawn_vignette));
-    app.add_systems(
-        Update,
-        (
-            switch_mode,
-            steer_optic.run_if(resource_equals(CameraMode::Laparoscope)),
+/// The laparoscope: the view through its optic, its light and steering, and the free camera
+/// it gives way to.
+pub(super) struct LaparoscopePlugin {
+    /// Open on the free camera even where the scene has a laparoscope.
+    pub free_camera: bool,
+}
+
+impl Plugin for LaparoscopePlugin {
+    fn build(&self, app: &mut App) {
+        let free_camera = self.free_camera;
+        app.init_resource::<CameraMode>()
+            .insert_resource(OpenThroughOptic(!free_camera));
+        super::spawn_with_scene(app, (choose_mode, spawn_tip_light, spawn_vignette));
+        app.add_systems(
+            Update,
+            (
+                switch_mode,
+                steer_optic.run_if(resource_equals(CameraMode::Laparoscope)),
+            )
+                .chain()
+                .in_set(FrameSet::Input),
         )
-            .chain()
-            .in_set(FrameSet::Input),
-    )
-    .add_systems(
-        Update,
-        (look_through_optic, light_for_mode).in_set(FrameSet::Draw),
-    );
+        .add_systems(
+            Update,
+            (look_through_optic, light_for_mode).in_set(FrameSet::Draw),
+        );
+    }
 }
 
 /// A scene with a laparoscope opens looking through it, unless told otherwise.

@@ -148,7 +148,9 @@ pub fn run(mut window: WindowScene) -> (AppExit, Option<FrameReport>) {
                 .in_set(FrameSet::Receive),
         );
     let free_camera = window.free_camera;
-    offscreen::setup(&mut app, window.offscreen);
+    app.add_plugins(offscreen::OffscreenPlugin {
+        size: window.offscreen,
+    });
     screenshot::setup(&mut app, window.screenshot.clone());
     reload::setup(&mut app, folder.as_deref());
     lesson::setup(&mut app, window.lesson.clone(), window.lessons.clone());
@@ -156,7 +158,7 @@ pub fn run(mut window: WindowScene) -> (AppExit, Option<FrameReport>) {
     paced::setup(&mut app, window.paced.take());
     bridge::setup(&mut app, window);
     app.add_plugins((organs::OrganPlugin, abdomen::AbdomenPlugin));
-    laparoscope::setup(&mut app, free_camera);
+    app.add_plugins(laparoscope::LaparoscopePlugin { free_camera });
     app.add_plugins((
         camera::CameraPlugin,
         tool::ToolPlugin,
@@ -164,9 +166,9 @@ pub fn run(mut window: WindowScene) -> (AppExit, Option<FrameReport>) {
         input::InputPlugin,
         hud::HudPlugin,
     ));
-    frames::setup(&mut app, log.clone());
+    app.add_plugins(frames::FramesPlugin(log.clone()));
     #[cfg(target_arch = "wasm32")]
-    web_page::setup(&mut app);
+    app.add_plugins(web_page::WebPagePlugin);
     let exit = app.run();
     (exit, log.report())
 }

@@ -75,24 +75,34 @@ fn add_plugins(
     }
 }
 
-pub(super) fn setup(app: &mut App, size: Option<(u32, u32)>) {
-    let Some((width, height)) = size else {
-        return;
-    };
-    let mut target = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
-    // Read back by the screenshot.
-    target.texture_descriptor.usage |= TextureUsages::COPY_SRC;
-    let image = app.world_mut().resource_mut::<Assets<Image>>().add(target);
-    app.insert_resource(Offscreen {
-        image,
-        size: UVec2::new(width, height),
-    })
-    .add_systems(
-        Update,
-        render_into_image
-            .after(FrameSet::Respawn)
-            .before(FrameSet::Draw),
-    );
+/// Drawing into an image of `size` instead of the window, when a size is given.
+pub(super) struct OffscreenPlugin {
+    /// The image's size (pixels); none draws into the window.
+    pub size: Option<(u32, u32)>,
+}
+
+impl Plugin for OffscreenPlugin {
+    fn build(&self, app: &mut App) {
+        let size = self.size;
+        let Some((width, height)) = size else {
+            return;
+        };
+        let mut target =
+            Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
+        // Read back by the screenshot.
+        target.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+        let image = app.world_mut().resource_mut::<Assets<Image>>().add(target);
+        app.insert_resource(Offscreen {
+            image,
+            size: UVec2::new(width, height),
+        })
+        .add_systems(
+            Update,
+            render_into_image
+                .after(FrameSet::Respawn)
+                .before(FrameSet::Draw),
+        );
+    }
 }
 
 /// Every camera spawned (at start-up, or with another scene) draws into the image, and the

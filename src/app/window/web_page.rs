@@ -9,12 +9,17 @@ use wasm_bindgen::JsValue;
 use super::frames::FrameLog;
 use super::lesson::{Debriefed, Stage, show_debrief};
 
-pub(super) fn setup(app: &mut App) {
-    app.add_systems(Update, publish_stage.run_if(state_changed::<Stage>))
-        .add_systems(
-            OnEnter(Stage::Debrief),
-            publish_scorecard.after(show_debrief),
-        );
+/// What the web page around the window reads: the stage, and the scorecard at the debrief.
+pub(super) struct WebPagePlugin;
+
+impl Plugin for WebPagePlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(Update, publish_stage.run_if(state_changed::<Stage>))
+            .add_systems(
+                OnEnter(Stage::Debrief),
+                publish_scorecard.after(show_debrief),
+            );
+    }
 }
 
 fn publish_stage(stage: Res<State<Stage>>) {
