@@ -27,28 +27,28 @@ fn validate_warns_of_words_the_font_cannot_draw() {
         tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3, hold_s: 1.0,
                              time_limit_s: 5.0)])"#;
     std::fs::write(&file, text).unwrap();
-    let out = Command::new(TRAINER)
-        .arg("validate")
-        .arg(&file)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let (passed, stderr) = validate(std::slice::from_ref(&file));
+    assert!(passed, "{stderr}");
     assert!(stderr.contains("no glyph for '肝'"), "{stderr}");
     let shipped: Vec<_> = std::fs::read_dir(root().join("scenarios"))
         .unwrap()
         .map(|entry| entry.unwrap().path())
         .filter(|path| path.to_string_lossy().ends_with(".scenario.ron"))
         .collect();
+    let (passed, stderr) = validate(&shipped);
+    assert!(passed && !stderr.contains("no glyph"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `trainer validate FILES`: whether it passed them, and its error stream.
+fn validate(files: &[std::path::PathBuf]) -> (bool, String) {
     let out = Command::new(TRAINER)
         .arg("validate")
-        .args(&shipped)
+        .args(files)
         .output()
         .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        out.status.success() && !stderr.contains("no glyph"),
-        "{stderr}"
-    );
-    std::fs::remove_dir_all(&dir).ok();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
 }

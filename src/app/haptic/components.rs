@@ -50,6 +50,14 @@ impl ToolTouch {
     }
 }
 
+/// `patch`'s shares by mesh node rather than by load position, into `nodes` (emptied first;
+/// its room kept, so that a buffer made for every position never grows).
+pub fn patch_nodes(patch: &Patch, vademecum: &Vademecum, nodes: &mut Vec<(usize, f64)>) {
+    nodes.clear();
+    let shares = patch.shares.iter();
+    nodes.extend(shares.map(|&(position, share)| (vademecum.positions[position] as usize, share)));
+}
+
 /// The loads on the organ and their modal coefficients. Load slot [`Self::TOOL`] is the tool's.
 #[derive(Component, Clone, Debug)]
 pub struct OrganDeformation(pub Deformation);

@@ -7,7 +7,7 @@
 use bevy::prelude::*;
 use nalgebra::{Matrix3, Point3, Unit, Vector3};
 
-use super::components::{OrganBody, OrganDeformation, ToolTouch};
+use super::components::{OrganBody, OrganDeformation, ToolTouch, patch_nodes};
 use super::resources::Tool;
 use crate::contact::ToolContact;
 use crate::cutting::{BladeContact, CutWorker, Scalpel};
@@ -69,10 +69,7 @@ pub fn cut(
         };
         let touch = &mut *touch;
         if let Some(contact) = touch.contact.as_mut() {
-            nodes.clear();
-            let positions = &body.vademecum.positions;
-            let shares = touch.patch.shares.iter();
-            nodes.extend(shares.map(|&(m, share)| (positions[m] as usize, share)));
+            patch_nodes(&touch.patch, &body.vademecum, nodes);
             soften(contact, worker.added_compliance(nodes));
             if let Some(parted_m) = scalpel.parted_depth_m().filter(|_| cuts) {
                 give(contact, parted_m);

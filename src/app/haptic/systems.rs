@@ -3,7 +3,9 @@
 use bevy::prelude::*;
 use nalgebra::Vector3;
 
-use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
+use super::components::{
+    OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, patch_nodes,
+};
 use super::cutting::OrganCut;
 use super::resources::{
     Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, Safety, TickClock, Tool,
@@ -182,10 +184,7 @@ pub fn grasp(
 /// compliance there), starting from the press's force.
 fn take_hold(body: &OrganBody, touch: &ToolTouch, motion: &mut OrganMotion, hand_m: &Vector3<f64>) {
     let vademecum = &body.vademecum;
-    let shares = touch.patch.shares.iter();
-    motion.patch_nodes.clear();
-    (motion.patch_nodes)
-        .extend(shares.map(|&(position, share)| (vademecum.positions[position] as usize, share)));
+    patch_nodes(&touch.patch, vademecum, &mut motion.patch_nodes);
     let compliance = vademecum.compliance(&touch.patch, &Vector3::zeros());
     let centre = touch.contact.map_or(Vector3::zeros(), |c| c.hit.point_m);
     let basis = &motion.model.basis;

@@ -150,9 +150,9 @@ pub struct CutWorker {
     backend: Backend,
     view: Arc<CutView>,
     rows: Rows,
-    /// The first [`REFUSALS_KEPT`] refusals, and how many more there were.
+    /// The first [`REFUSALS_KEPT`] refusals (later ones are not kept: the list never grows
+    /// on the haptic thread).
     refused: Vec<CutError>,
-    more_refused: usize,
 }
 
 impl CutWorker {
@@ -171,7 +171,6 @@ impl CutWorker {
             view: Arc::new(empty),
             rows: Rows::default(),
             refused: Vec::with_capacity(REFUSALS_KEPT),
-            more_refused: 0,
         })
     }
 
@@ -218,20 +217,9 @@ impl CutWorker {
         self.backend.pending()
     }
 
-    /// The steps the cut state refused, in order (the first [`REFUSALS_KEPT`])...
+    /// The steps the cut state refused, in order (the first [`REFUSALS_KEPT`]).
     pub fn refused(&self) -> &[CutError] {
         &self.refused
-    }
-
-    /// ...and how many more it refused.
-    pub fn more_refused(&self) -> usize {
-        self.more_refused
-    }
-
-    /// Steps dropped because the worker had fallen a queue's length behind (stalled for
-    /// seconds): the cut goes on from the next step taken.
-    pub fn dropped_steps(&self) -> u64 {
-        self.backend.dropped()
     }
 
     /// How long each job done so far (a step, or a heal) took the worker (s), in order (a
@@ -251,7 +239,7 @@ impl CutWorker {
             Outcome::Refused(error) if self.refused.len() < REFUSALS_KEPT => {
                 self.refused.push(error);
             }
-            Outcome::Refused(_) => self.more_refused += 1,
+            Outcome::Refused(_) => {}
         }
     }
 }

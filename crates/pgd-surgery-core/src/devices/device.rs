@@ -9,6 +9,15 @@ use nalgebra::{UnitQuaternion, Vector3};
 /// ask for: more than any haptic device it serves renders.
 pub const MAX_FORCE_LIMIT_N: f64 = 20.0;
 
+/// A force limit (N) as the guards apply it: itself when it is a positive number, zero
+/// otherwise, so that no limit can turn a force round or let one through unbounded.
+pub(super) fn usable_limit_n(limit_n: f64) -> f64 {
+    match limit_n.is_finite() && limit_n > 0.0 {
+        true => limit_n,
+        false => 0.0,
+    }
+}
+
 /// What a device reports at one tick.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DeviceSample {
@@ -70,9 +79,7 @@ impl DeviceLimits {
             thermal_window_s: 2.0,
         }
     }
-}
 
-impl DeviceLimits {
     /// The limits a driver reported, held to the product's ceiling ([`MAX_FORCE_LIMIT_N`]):
     /// no device this trainer serves renders more, so a driver reporting more is wrong, and
     /// believing it would switch the edge guard off. With the warning to show when it did.
@@ -145,10 +152,7 @@ impl EdgeForce {
     /// that is not finite, the peak along it for one above the peak (a peak that is not a
     /// positive number renders nothing), with the refusal when it was not passed as asked.
     pub fn guard(force_n: &Vector3<f64>, peak_force_n: f64) -> (Self, Option<EdgeRefusal>) {
-        let peak_n = match peak_force_n.is_finite() && peak_force_n > 0.0 {
-            true => peak_force_n,
-            false => 0.0,
-        };
+        let peak_n = usable_limit_n(peak_force_n);
         if !force_n.iter().all(|c| c.is_finite()) {
             return (Self::ZERO, Some(EdgeRefusal::NonFinite));
         }

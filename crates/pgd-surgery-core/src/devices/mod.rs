@@ -28,6 +28,7 @@ mod vendor;
 mod virtual_device;
 mod workspace;
 
+use device::usable_limit_n;
 pub use device::{
     DeviceError, DeviceLimits, DeviceSample, EdgeForce, EdgeRefusal, HapticDevice,
     MAX_FORCE_LIMIT_N,

@@ -14,7 +14,7 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use super::{DeviceLimits, MAX_FORCE_LIMIT_N, TICK_S};
+use super::{DeviceLimits, MAX_FORCE_LIMIT_N, TICK_S, usable_limit_n};
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SafetySettings {
@@ -64,8 +64,7 @@ pub fn check_force_limit(force_n: f64) -> Result<f64, String> {
 /// The limit a filter applies: the smaller of the settings' and the device's peak, and zero for
 /// either that is not a force limit, so that no setting can turn the force round.
 fn applied_limit_n(settings: &SafetySettings, limits: &DeviceLimits) -> f64 {
-    let usable = |f: f64| if f.is_finite() && f > 0.0 { f } else { 0.0 };
-    usable(settings.max_force_n).min(usable(limits.peak_force_n))
+    usable_limit_n(settings.max_force_n).min(usable_limit_n(limits.peak_force_n))
 }
 
 impl Default for SafetySettings {

@@ -22,7 +22,7 @@ use std::time::{Duration, Instant};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 use super::seqlock::SeqWords;
-use super::{DeviceSample, EdgeForce};
+use super::{DeviceSample, EdgeForce, usable_limit_n};
 
 /// Set once by [`halt_every_link`]: every link renders zero from then on.
 static EVERY_LINK_HALTED: AtomicBool = AtomicBool::new(false);
@@ -122,10 +122,7 @@ impl ServoLink {
     /// The device's peak force (N): the servo clamps every command to it. A peak that is not
     /// a positive number renders nothing.
     pub fn set_peak_force_n(&self, peak_force_n: f64) {
-        let peak = match peak_force_n.is_finite() && peak_force_n > 0.0 {
-            true => peak_force_n,
-            false => 0.0,
-        };
+        let peak = usable_limit_n(peak_force_n);
         self.peak_force_n.store(peak.to_bits(), Ordering::Release);
     }
 

@@ -339,7 +339,8 @@ impl Exercise {
             let mistakes = take(&mut self.mistakes[self.current]);
             Running::start(
                 task,
-                (description, mistakes),
+                description,
+                mistakes,
                 &self.scenario.organs,
                 sample.time_s,
             )
@@ -373,7 +374,7 @@ impl Exercise {
             self.running.get_or_insert_with(|| {
                 let description = take(&mut self.descriptions[self.current]);
                 let mistakes = take(&mut self.mistakes[self.current]);
-                Running::start(task, (description, mistakes), &self.scenario.organs, now)
+                Running::start(task, description, mistakes, &self.scenario.organs, now)
             });
             self.end_task(now);
         }
@@ -401,7 +402,8 @@ impl Running {
     /// mistakes in `mistakes`.
     fn start(
         task: &Task,
-        (description, mistakes): (String, Mistakes),
+        description: String,
+        mistakes: Mistakes,
         organs: &[OrganEntry],
         time_s: f64,
     ) -> Self {

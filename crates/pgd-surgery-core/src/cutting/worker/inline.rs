@@ -56,11 +56,6 @@ impl Backend {
         self.answers.pop_front()
     }
 
-    /// Nothing is dropped: each job is done where it is handed over.
-    pub(super) fn dropped(&self) -> u64 {
-        0
-    }
-
     pub(super) fn pending(&self) -> u64 {
         self.answers.len() as u64
     }

@@ -28,8 +28,6 @@ pub(super) struct Backend {
     answers: Mutex<Receiver<Outcome>>,
     submitted: u64,
     answered: u64,
-    /// Steps and heals dropped because the worker's queue was full.
-    dropped: u64,
     /// Written by the worker, so that the haptic side never grows it.
     step_seconds: Arc<Mutex<Vec<f64>>>,
 }
@@ -67,28 +65,19 @@ impl Backend {
             answers: Mutex::new(answered),
             submitted: 0,
             answered: 0,
-            dropped: 0,
             step_seconds,
         })
     }
 
     /// Hands a job to the thread; never waits. With the queue full (a worker stalled for
-    /// seconds), a step is dropped and counted, and a view to retire is freed here.
+    /// seconds) the job is dropped: a step's cut goes on from the next step taken, and a
+    /// view to retire is freed here.
     pub(super) fn send(&mut self, job: Job) {
         let answered = !matches!(job, Job::Retire(..));
         match self.jobs.try_send(job) {
             Ok(()) if answered => self.submitted += 1,
-            Ok(()) | Err(TrySendError::Disconnected(_)) => {}
-            Err(TrySendError::Full(job)) => {
-                self.dropped += u64::from(answered);
-                drop(job);
-            }
+            Ok(()) | Err(TrySendError::Disconnected(_) | TrySendError::Full(_)) => {}
         }
-    }
-
-    /// Steps and heals dropped because the worker's queue was full.
-    pub(super) fn dropped(&self) -> u64 {
-        self.dropped
     }
 
     /// An answer the thread has given, if any; never waits.
