@@ -15,6 +15,7 @@ use super::scene::{Detail, SceneOrgan, scene_files, scene_of, scene_vademecums};
 use crate::contact::{ContactSurface, CouplingSettings};
 use crate::devices::{HapticDevice, Instrument, ScopeHandle, TICK_S, stop_requested};
 use crate::mesh::organs::Organ;
+use crate::scenario::tasks::RadialKeratotomy;
 use crate::scenario::{
     self, CutMade, Exercise, Keratometer, LaparoscopeEntry, Nodule, NoduleSite, OrganEntry, Port,
     RegionSite, Scenario, Scorecard, Sites, Task, score,
@@ -239,10 +240,9 @@ pub fn sites_on(scene: &HapticScene, scenario: &Scenario) -> Sites {
 /// The cut cornea's model a keratotomy `task` predicts its correction with (`None` for other
 /// tasks, or a cornea the scene does not cut, which validation refuses).
 fn keratometer(scene: &HapticScene, scenario: &Scenario, task: &Task) -> Option<Keratometer> {
-    let Task::RadialKeratotomy { organ, .. } = task else {
-        return None;
-    };
-    let index = scenario.organs.iter().position(|o| &o.name == organ)?;
+    task.get::<RadialKeratotomy>()?;
+    let organ = task.organ()?;
+    let index = scenario.organs.iter().position(|o| o.name == organ)?;
     scene.cutting.as_ref()?.organ(index)?.keratometer.clone()
 }
 

@@ -33,7 +33,10 @@ use pgd_surgery::mesh::io::write_vtu;
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate};
 use pgd_surgery::pgd::BuildSettings;
 use pgd_surgery::report::write_report;
-use pgd_surgery::scenario::{Scenario, Scorecard, Task, load, parse};
+use pgd_surgery::scenario::tasks::{
+    Incision, IncisionResult, PalpationResult, RadialKeratotomyResult, RetractionResult,
+};
+use pgd_surgery::scenario::{Scenario, Scorecard, TaskMetrics, load, parse};
 use pgd_surgery::store::{OnStale, VademecumSpec, ensure_vademecum};
 
 const TRAINER: &str = env!("CARGO_BIN_EXE_trainer");
@@ -167,7 +170,12 @@ fn the_report_is_written_as_json_text_and_plot() {
 #[test]
 fn a_keratotomy_is_scored_on_its_incisions_and_a_perforation_fails_it() {
     let competent = run("cornea-radial-keratotomy", "competent");
-    let rk = competent.card.tasks[0].metrics.keratotomy.clone().unwrap();
+    let rk = (competent.card.tasks[0]
+        .metrics
+        .result::<RadialKeratotomyResult>())
+    .unwrap()
+    .keratotomy
+    .clone();
     assert_eq!(rk.incisions.len(), 4, "{rk:?}");
     assert!(rk.spacing_error_deg < 2.0, "{rk:?}");
     assert_eq!(rk.zone_intrusion_mm, 0.0);
@@ -191,7 +199,12 @@ fn a_keratotomy_is_scored_on_its_incisions_and_a_perforation_fails_it() {
 
     let careless = run("cornea-radial-keratotomy", "careless");
     let m = &careless.card.tasks[0].metrics;
-    assert!(m.keratotomy.as_ref().unwrap().perforated);
+    assert!(
+        m.result::<RadialKeratotomyResult>()
+            .unwrap()
+            .keratotomy
+            .perforated
+    );
     assert!(m.complication.is_some() && !m.completed);
     assert!(!careless.card.passed);
     assert!(said(&careless.card, &["perforation", "the attempt fails"]));
@@ -210,10 +223,11 @@ fn a_keratotomy_is_scored_on_its_incisions_and_a_perforation_fails_it() {
 fn the_incision_report_draws_the_cuts_over_the_line() {
     let outcome = run("liver-capsule-incision", "competent");
     let scenario = load(&root().join("scenarios/liver-capsule-incision.scenario.ron")).unwrap();
-    let Some(Task::Incision { from_mm, to_mm, .. }) = scenario.tasks.first() else {
+    let Some(Incision { from_mm, to_mm, .. }) = scenario.tasks[0].get::<Incision>() else {
         panic!("not an incision");
     };
-    let incision = outcome.card.tasks[0].metrics.incision.as_ref().unwrap();
+    let metrics = &outcome.card.tasks[0].metrics;
+    let incision = &metrics.result::<IncisionResult>().unwrap().incision;
     assert_eq!(incision.from_mm, [from_mm.0, from_mm.1, from_mm.2]);
     assert_eq!(incision.to_mm, [to_mm.0, to_mm.1, to_mm.2]);
     assert!(!outcome.card.cuts.is_empty());
@@ -520,11 +534,12 @@ fn the_trainer_validates_runs_and_reports() {
 fn palpation_scores_the_mark_and_the_nodule_is_felt() {
     let competent = run("pancreas-palpation", "competent");
     let metrics = &competent.card.tasks[0].metrics;
-    let error_mm = metrics.localization_error_mm.expect("marked");
+    let mark_mm = |m: &TaskMetrics| m.result::<PalpationResult>().unwrap().localization_error_mm;
+    let error_mm = mark_mm(metrics).expect("marked");
     assert!(metrics.completed && error_mm < 10.0, "{metrics:#?}");
     let careless = &run("pancreas-palpation", "careless").card.tasks[0].metrics;
     assert!(!careless.completed, "{careless:#?}");
-    assert!(careless.localization_error_mm.expect("marked") > 20.0);
+    assert!(mark_mm(careless).expect("marked") > 20.0);
     assert!(careless.peak_force_n > 0.6 && !careless.errors.is_empty());
 
     let plain = run_without_nodules("pancreas-palpation", "competent");
@@ -552,17 +567,20 @@ fn palpation_scores_the_mark_and_the_nodule_is_felt() {
 /// fundus, which the probe grips sideways, but 19 mm out and over the force limit, and fails.
 #[test]
 fn retraction_measures_the_region_and_the_organs_around() {
-    let competent = &run("gallbladder-retraction", "competent").card.tasks[0].metrics;
-    let (target_mm, limit_n) = (competent.move_target_mm.unwrap(), 0.05);
-    assert!(competent.completed, "{competent:#?}");
-    assert!(competent.moved_mm.unwrap() >= target_mm);
-    assert!(competent.longest_hold_s >= competent.hold_s.unwrap());
-    assert!(competent.surrounding_peak_n < limit_n, "{competent:#?}");
-    assert_eq!(competent.surrounding_limit_n, Some(limit_n));
+    let retraction = |m: &TaskMetrics| m.result::<RetractionResult>().unwrap().clone();
+    let metrics = &run("gallbladder-retraction", "competent").card.tasks[0].metrics;
+    let competent = retraction(metrics);
+    let (target_mm, limit_n) = (competent.region.move_target_mm, 0.05);
+    assert!(metrics.completed, "{metrics:#?}");
+    assert!(competent.region.moved_mm.unwrap() >= target_mm);
+    assert!(competent.region.longest_hold_s >= competent.region.hold_s);
+    assert!(competent.surrounding_peak_n < limit_n, "{metrics:#?}");
+    assert_eq!(competent.surrounding_limit_n, limit_n);
     let careless_card = run("gallbladder-retraction", "careless").card;
     assert!(!careless_card.passed, "{careless_card:#?}");
     let careless = &careless_card.tasks[0].metrics;
-    assert!(careless.surrounding_peak_n > limit_n && careless.surrounding_over_limit_s > 1.0);
+    let around = retraction(careless);
+    assert!(around.surrounding_peak_n > limit_n && around.surrounding_over_limit_s > 1.0);
     assert!(
         careless.errors.iter().any(|e| e.contains("organs around")),
         "{:?}",

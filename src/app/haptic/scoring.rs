@@ -172,6 +172,7 @@ impl ExerciseRun {
                 task: self.tasks,
                 tasks: self.tasks,
                 task_elapsed_s: 0.0,
+                step: None,
             }),
         }
     }

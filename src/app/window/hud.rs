@@ -13,6 +13,7 @@ use super::laparoscope::CameraMode;
 use super::lesson::{Lesson, Stage};
 use crate::app::haptic::{HapticSnapshot, organ_with_law};
 use crate::devices::Action;
+use crate::scenario::{Progress, Scenario};
 
 #[derive(Component)]
 struct Hud;
@@ -150,7 +151,9 @@ fn update_hud(
     };
     let timing = &snapshot.0.timing;
     let lines = HudLines {
-        task: lesson.map_or_else(String::new, |lesson| task_line(&lesson, &snapshot)),
+        task: lesson.map_or_else(String::new, |lesson| {
+            task_line(&lesson.scenario, snapshot.0.exercise)
+        }),
         force: format!("force {force_n:.3} N {gauge} limit {limit_n:.1} N"),
         status,
         guidance: format!(
@@ -294,17 +297,20 @@ fn camera_line(link: &HapticLink, snapshot: &HapticSnapshot, mode: CameraMode) -
     format!("{keys}{warning}")
 }
 
-/// The task under way and its clock, above the rest of the HUD (nothing before the exercise
-/// begins or after it ends).
-fn task_line(lesson: &Lesson, snapshot: &Snapshot) -> String {
-    let Some(progress) = snapshot.0.exercise.filter(|p| !p.finished()) else {
+/// The task under way, its clock and how far it has come, above the rest of the HUD (nothing
+/// before the exercise begins or after it ends).
+fn task_line(scenario: &Scenario, progress: Option<Progress>) -> String {
+    let Some(progress) = progress.filter(|p| !p.finished()) else {
         return String::new();
     };
-    let Some(task) = lesson.scenario.tasks.get(progress.task) else {
+    let Some(task) = scenario.tasks.get(progress.task) else {
         return String::new();
     };
+    let step = progress
+        .step
+        .map_or(String::new(), |step| format!(" | {step}"));
     format!(
-        "task {} of {}: {}\n{:.1} s of {:.0} s\n\n",
+        "task {} of {}: {}\n{:.1} s of {:.0} s{step}\n\n",
         progress.task + 1,
         progress.tasks,
         task.description(),
@@ -377,6 +383,44 @@ mod tests {
             };
             assert_eq!(visibility(&app), expected, "{stage:?}");
         }
+    }
+
+    /// The task's line says how far the task has come, in the type's own words, under its
+    /// description and clock; before the start and after the end there is none.
+    #[test]
+    fn the_task_line_says_how_far_the_task_has_come() {
+        let scenario = crate::scenario::parse(
+            std::path::Path::new("t.scenario.ron"),
+            r#"Scenario(title: "t", briefing: "b", organs: ["liver"],
+                tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3,
+                                     hold_s: 3.0, time_limit_s: 20.0)])"#,
+        )
+        .unwrap();
+        let step = crate::scenario::task::TaskProgress {
+            what: "held",
+            done: 1.24,
+            of: 3.0,
+            unit: "s",
+        };
+        let progress = Progress {
+            task: 0,
+            tasks: 1,
+            task_elapsed_s: 2.0,
+            step: Some(step),
+        };
+        let line = task_line(&scenario, Some(progress));
+        assert!(
+            line.starts_with("task 1 of 1: hold 0.10 to 0.30 N"),
+            "{line}"
+        );
+        assert!(line.contains("2.0 s of 20 s | held 1.2 of 3.0 s"), "{line}");
+        assert!(crate::report::without_glyph(&line).is_empty());
+        let ended = Progress {
+            task: 1,
+            ..progress
+        };
+        assert_eq!(task_line(&scenario, Some(ended)), "");
+        assert_eq!(task_line(&scenario, None), "");
     }
 
     /// The trainee reads the task, the force and what the tool touches first, and the loop's

@@ -10,7 +10,8 @@ use super::bridge::{HapticLink, Snapshot};
 use super::lesson::Lesson;
 use super::{FrameSet, to_bevy};
 use crate::cutting::keratotomy::anterior_point;
-use crate::scenario::{Task, metres};
+use crate::scenario::metres;
+use crate::scenario::tasks::{Incision, RadialKeratotomy};
 
 /// The blade's edge is drawn this many tool radii either side of the tip.
 const EDGE_HALF_RADII: f32 = 1.33;
@@ -36,8 +37,8 @@ fn draw_marked_lines(lesson: Option<Res<Lesson>>, link: Res<HapticLink>, mut giz
     };
     let lift = Lift::of(&link);
     for task in &lesson.scenario.tasks {
-        if let Task::Incision { from_mm, to_mm, .. } = task {
-            let (from, to) = (metres(*from_mm), metres(*to_mm));
+        if let Some(incision) = task.get::<Incision>() {
+            let (from, to) = (metres(incision.from_mm), metres(incision.to_mm));
             gizmos.line(lift.up(&from, 1.0), lift.up(&to, 1.0), MARKER);
         }
     }
@@ -50,11 +51,8 @@ fn draw_optical_zones(lesson: Option<Res<Lesson>>, link: Res<HapticLink>, mut gi
     };
     let lift = Lift::of(&link);
     for task in &lesson.scenario.tasks {
-        if let Task::RadialKeratotomy {
-            optical_zone_mm, ..
-        } = task
-        {
-            let radius_m = optical_zone_mm.metres() / 2.0;
+        if let Some(keratotomy) = task.get::<RadialKeratotomy>() {
+            let radius_m = keratotomy.optical_zone_mm.metres() / 2.0;
             let ring = (0..=72).map(|k| {
                 let at = anterior_point(std::f64::consts::TAU * f64::from(k) / 72.0, radius_m);
                 lift.up(&at.coords, 1.0)

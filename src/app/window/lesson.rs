@@ -349,6 +349,7 @@ mod tests {
             task: 1,
             tasks: 1,
             task_elapsed_s: 0.0,
+            step: None,
         });
         app.update();
         app.update();

@@ -11,6 +11,7 @@ use plotters::prelude::*;
 use nalgebra::Vector3;
 
 use super::plot::{Area, PlotResult, draw_legend, legend_stroke, save_png};
+use crate::scenario::tasks::{IncisionResult, RadialKeratotomyResult};
 use crate::scenario::{CutMade, IncisionMetrics, KeratotomyMetrics, Scorecard};
 
 const SIZE: (u32, u32) = (1200, 500);
@@ -92,47 +93,8 @@ pub fn summary(card: &Scorecard) -> String {
         if let Some(out_s) = m.target_out_of_view_s {
             let _ = writeln!(out, "  the point to keep in view: out of view {out_s:.1} s");
         }
-        if m.targets > 0 {
-            let path = m.path_ratio.map_or(String::new(), |r| {
-                format!(", path {r:.2}× the straight line")
-            });
-            let _ = writeln!(
-                out,
-                "  targets reached: {} of {}{path}",
-                m.targets_reached, m.targets
-            );
-        }
-        if let (Some(error), Some(within)) = (m.localization_error_mm, m.found_within_mm) {
-            let _ = writeln!(
-                out,
-                "  mark: {error:.1} mm from the nodule across the surface (found within {within:.0} mm)"
-            );
-        }
-        if let Some(rk) = &m.keratotomy {
-            let correction = rk
-                .predicted_correction_d
-                .map_or("none predicted".to_owned(), |d| format!("{d:.1} D"));
-            let _ = writeln!(
-                out,
-                "  incisions: {} of {}, spacing off by up to {:.0}°, {:.1} mm into the optical zone, {:.0} % deep on average (target {:.0} %){}; correction {correction} (target {:.1} D)",
-                rk.incisions.len(),
-                rk.planned,
-                rk.spacing_error_deg,
-                rk.zone_intrusion_mm,
-                100.0 * rk.mean_depth_fraction,
-                100.0 * rk.target_depth_fraction,
-                if rk.perforated { ", PERFORATED" } else { "" },
-                rk.target_correction_d
-            );
-        }
-        if let (Some(moved), Some(target), Some(limit)) =
-            (m.moved_mm, m.move_target_mm, m.surrounding_limit_n)
-        {
-            let _ = writeln!(
-                out,
-                "  region moved up to {moved:.1} mm (of {target:.0}), held {:.1} s; organs around: peak {:.2} N, {:.1} s above {limit:.2} N",
-                m.longest_hold_s, m.surrounding_peak_n, m.surrounding_over_limit_s
-            );
+        for line in m.outcome.iter().flat_map(|o| o.summary()) {
+            let _ = writeln!(out, "  {line}");
         }
     }
     if !card.feedback.is_empty() {
@@ -145,11 +107,12 @@ pub fn summary(card: &Scorecard) -> String {
 }
 
 fn plot(path: &Path, card: &Scorecard, trace: &[(f64, f64)]) -> PlotResult {
-    let incision = card.tasks.iter().find_map(|t| t.metrics.incision.as_ref());
-    let keratotomy = card
-        .tasks
-        .iter()
-        .find_map(|t| t.metrics.keratotomy.as_ref());
+    let incision = (card.tasks.iter())
+        .find_map(|t| t.metrics.result::<IncisionResult>())
+        .map(|r| &r.incision);
+    let keratotomy = (card.tasks.iter())
+        .find_map(|t| t.metrics.result::<RadialKeratotomyResult>())
+        .map(|r| &r.keratotomy);
     if incision.is_none() && keratotomy.is_none() {
         return save_png(path, SIZE, |root| force_plot(root, card, trace));
     }
@@ -335,7 +298,7 @@ fn force_plot(root: &Area, card: &Scorecard, trace: &[(f64, f64)]) -> PlotResult
         let m = &task.metrics;
         let span = (m.started_s, m.started_s + m.time_s.max(1e-3));
         let mut bounds = vec![m.force_limit_n];
-        bounds.extend(m.band_min_n);
+        bounds.extend(m.outcome.as_ref().and_then(|o| o.lower_force_n()));
         for level in bounds {
             chart.draw_series(LineSeries::new(
                 [(span.0, level), (span.1, level)],

@@ -4,58 +4,17 @@
 //! located in the text by the field it is about. Every error names the file, the line and
 //! column, the field path, the problem and a hint.
 
-use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use super::format::{LaparoscopeEntry, OrganEntry, Scenario, Task, metres};
-use super::keratotomy::MIN_INCISION_M;
+use super::format::{LaparoscopeEntry, Scenario};
+use super::problem::{Problem, REFERENCE, ScenarioError};
+use super::scene::{OrganEntry, metres};
+use super::task::{SceneFacts, Task, TaskCheck};
+use super::tasks;
 use crate::contact::PointshellDensity;
 use crate::devices::{DeviceSpec, MAX_INSTRUMENTS};
 use crate::fem::Law;
-use crate::mesh::Surface;
-use crate::mesh::organs::{Organ, OrganSettings, region};
-use parry3d::query::PointQuery;
-
-/// Where every reference of the scenario format is explained.
-const REFERENCE: &str = "docs/scenarios.md";
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct ScenarioError {
-    pub file: PathBuf,
-    /// 1-based, as editors count.
-    pub line: usize,
-    pub column: usize,
-    /// The field path, e.g. `tasks[1].max_force_n` (empty for the file as a whole).
-    pub field: String,
-    pub message: String,
-    pub hint: String,
-}
-
-impl fmt::Display for ScenarioError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}:{}: ", self.file.display(), self.line, self.column)?;
-        if !self.field.is_empty() {
-            write!(f, "{}: ", self.field)?;
-        }
-        write!(f, "{}\n  hint: {}", self.message, self.hint)
-    }
-}
-
-impl std::error::Error for ScenarioError {}
-
-impl ScenarioError {
-    /// `file` could not be read as text, for the reason `why`.
-    pub fn unreadable(file: &Path, why: impl fmt::Display) -> Self {
-        Self {
-            file: file.to_owned(),
-            line: 1,
-            column: 1,
-            field: String::new(),
-            message: format!("cannot read it: {why}"),
-            hint: "check the path; shipped scenarios are in scenarios/".into(),
-        }
-    }
-}
+use crate::mesh::organs::{Organ, region};
 
 /// Reads and checks the scenario in `file`.
 pub fn load(file: &Path) -> Result<Scenario, ScenarioError> {
@@ -104,8 +63,16 @@ pub fn parse(file: &Path, text: &str) -> Result<Scenario, ScenarioError> {
 fn hint_for(code: &ron::Error) -> String {
     use ron::Error as E;
     match code {
-        E::NoSuchStructField { expected, .. } => {
-            format!("the fields here are: {}", expected.join(", "))
+        E::NoSuchStructField {
+            expected, outer, ..
+        } => {
+            let mut fields = expected.to_vec();
+            // A task's own fields are its type's; the shared ones are read beside them.
+            if let Some(task) = outer.as_deref().and_then(tasks::find) {
+                fields.extend(["organ", "max_force_n", "time_limit_s"]);
+                fields.retain(|f| task.on_an_organ || *f != "organ");
+            }
+            format!("the fields here are: {}", fields.join(", "))
         }
         E::MissingStructField { field, .. } => format!("add `{field}: …` ({REFERENCE})"),
         E::NoSuchEnumVariant { expected, .. } => {
@@ -115,41 +82,6 @@ fn hint_for(code: &ron::Error) -> String {
         _ => format!(
             "RON syntax: `Name(field: value, …)`, lists in `[…]`, text in \"…\" ({REFERENCE})"
         ),
-    }
-}
-
-/// A problem found after parsing: the field path, and what to look for in the text to put
-/// the cursor on it (each key or quoted value in turn, from the start of the file; the same
-/// anchor twice in a row, the next occurrence).
-struct Problem {
-    field: String,
-    anchors: Vec<String>,
-    message: String,
-    hint: String,
-}
-
-impl Problem {
-    fn locate(self, file: &Path, text: &str) -> ScenarioError {
-        let mut at = 0;
-        let mut previous: Option<&String> = None;
-        for anchor in &self.anchors {
-            // An anchor repeated finds the next occurrence (the k-th item of a list).
-            let from = at + previous.filter(|p| *p == anchor).map_or(0, |p| p.len());
-            if let Some(found) = text.get(from..).and_then(|rest| rest.find(anchor.as_str())) {
-                at = from + found;
-            }
-            previous = Some(anchor);
-        }
-        let line = text[..at].matches('\n').count() + 1;
-        let column = at - text[..at].rfind('\n').map_or(0, |n| n + 1) + 1;
-        ScenarioError {
-            file: file.to_owned(),
-            line,
-            column,
-            field: self.field,
-            message: self.message,
-            hint: self.hint,
-        }
     }
 }
 
@@ -352,311 +284,27 @@ fn check_backend(scenario: &Scenario, problems: &mut Vec<Problem>) {
     }
 }
 
+/// The `k`th task: its organ in the scene (every type that works on one), then what its type
+/// checks of its own fields.
 fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Problem>) {
-    let field = |name: &str| format!("tasks[{k}].{name}");
-    let anchors = |name: &str| vec!["tasks".to_owned(), name.to_owned()];
-    let device_limit = scenario.device.max_force_n.0;
-    match task {
-        Task::ForceControl {
+    if let Some(organ) = task.organ() {
+        problems.extend(not_in_scene(
+            scenario,
             organ,
-            min_force_n,
-            max_force_n,
-            hold_s,
-            time_limit_s,
-        } => {
-            problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
-            if min_force_n.0 >= max_force_n.0 {
-                problems.push(Problem {
-                    field: field("min_force_n"),
-                    anchors: anchors("min_force_n"),
-                    message: format!(
-                        "the band is empty: {} N is not below max_force_n {} N",
-                        min_force_n.0, max_force_n.0
-                    ),
-                    hint: "min_force_n must be below max_force_n".into(),
-                });
-            }
-            if max_force_n.0 > device_limit {
-                problems.push(Problem {
-                    field: field("max_force_n"),
-                    anchors: anchors("max_force_n"),
-                    message: format!(
-                        "{} N is above the device's limit of {device_limit} N: the band cannot be reached",
-                        max_force_n.0
-                    ),
-                    hint: "lower it, or raise device.max_force_n".into(),
-                });
-            }
-            problems.extend(hold_fits(hold_s.0, time_limit_s.0, field("hold_s")));
-        }
-        Task::Retraction {
-            organ,
-            towards,
-            hold_s,
-            time_limit_s,
-            ..
-        }
-        | Task::Grasp {
-            organ,
-            towards,
-            hold_s,
-            time_limit_s,
-            ..
-        } => {
-            problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
-            if matches!(task, Task::Grasp { .. }) && !scenario.grasps() {
-                problems.push(Problem {
-                    field: field("organ"),
-                    anchors: anchors("organ"),
-                    message: "a Grasp task needs a grasper to grasp with".into(),
-                    hint: "set tool: Grasper(tip_radius_mm: 6.0)".into(),
-                });
-            }
-            let (x, y, z) = *towards;
-            if !(x * x + y * y + z * z).is_normal() {
-                problems.push(Problem {
-                    field: field("towards"),
-                    anchors: anchors("towards"),
-                    message: "the direction to move the region in has no length".into(),
-                    hint: "give a direction such as (0.0, 0.0, 1.0) (towards the head)".into(),
-                });
-            }
-            problems.extend(hold_fits(hold_s.0, time_limit_s.0, field("hold_s")));
-        }
-        Task::Palpation { organ, .. } => {
-            problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
-            if !scenario.nodules.iter().any(|n| &n.organ == organ) {
-                problems.push(Problem {
-                    field: field("organ"),
-                    anchors: vec!["tasks".into(), "Palpation".into(), format!("\"{organ}\"")],
-                    message: format!("the {organ} has no nodule to find"),
-                    hint: format!(
-                        "add `nodules: [Nodule(organ: \"{organ}\", at_mm: (x, y, z), radius_mm: …, stiffness_ratio: …)]` ({REFERENCE})"
-                    ),
-                });
-            }
-        }
-        Task::Incision {
-            organ,
-            from_mm,
-            to_mm,
-            depth_mm,
-            max_force_n,
-            ..
-        } => {
-            problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
-            problems.extend(check_incision(
-                scenario,
-                organ,
-                (from_mm, to_mm),
-                depth_mm.0,
-                &field,
-            ));
-            problems.extend(within_device(max_force_n.0, device_limit, &field));
-        }
-        Task::RadialKeratotomy {
-            organ,
-            optical_zone_mm,
-            max_force_n,
-            ..
-        } => {
-            problems.extend(not_in_scene(scenario, organ, field("organ"), "tasks"));
-            problems.extend(check_keratotomy(scenario, organ, optical_zone_mm.0, &field));
-            problems.extend(within_device(max_force_n.0, device_limit, &field));
-        }
-        Task::SafeNavigation { targets, .. } => {
-            if targets.is_empty() {
-                problems.push(Problem {
-                    field: field("targets"),
-                    anchors: anchors("targets"),
-                    message: "there are no targets to reach".into(),
-                    hint: "add Spot(name: …, at_mm: (x, y, z), radius_mm: …) targets".into(),
-                });
-            }
-        }
+            format!("tasks[{k}].organ"),
+            "tasks",
+        ));
     }
-}
-
-/// A task's force limit must be one the device can send.
-fn within_device(
-    max_force_n: f64,
-    device_limit: f64,
-    field: &dyn Fn(&str) -> String,
-) -> Option<Problem> {
-    (max_force_n > device_limit).then(|| Problem {
-        field: field("max_force_n"),
-        anchors: vec!["tasks".into(), "max_force_n".into()],
-        message: format!("{max_force_n} N is above the device's limit of {device_limit} N"),
-        hint: "lower it, or raise device.max_force_n".into(),
-    })
-}
-
-/// A cutting task (`Incision`, `RadialKeratotomy`) needs a scalpel and an organ whose
-/// toughness under a blade is known.
-fn check_blade(
-    scenario: &Scenario,
-    organ: &str,
-    task: &str,
-    field: &dyn Fn(&str) -> String,
-) -> Vec<Problem> {
-    let anchors = || vec!["tasks".to_owned(), task.to_owned(), "organ".into()];
-    let mut problems = Vec::new();
-    if scenario.blade().is_none() {
-        problems.push(Problem {
-            field: field("organ"),
-            anchors: anchors(),
-            message: format!("an {task} task needs a scalpel to cut with"),
-            hint: "set tool: Scalpel(tip_radius_mm: 6.0)".into(),
-        });
-    }
-    if let Some(entry) = scenario.organ(organ)
-        && entry.toughness_j_per_m2().is_none()
-    {
-        problems.push(Problem {
-            field: field("organ"),
-            anchors: anchors(),
-            message: format!("the {organ}'s toughness under a blade is not known: it cannot be cut"),
-            hint: format!(
-                "give it one: Organ(name: \"{organ}\", toughness_j_per_m2: 190.0) (the liver's is known)"
-            ),
-        });
-    }
-    problems
-}
-
-/// A keratotomy cuts the generated cornea, with room for its incisions between the optical
-/// zone and the limbus.
-fn check_keratotomy(
-    scenario: &Scenario,
-    organ: &str,
-    optical_zone_mm: f64,
-    field: &dyn Fn(&str) -> String,
-) -> Vec<Problem> {
-    let mut problems = check_blade(scenario, organ, "RadialKeratotomy", field);
-    let anchors = |name: &str| vec!["tasks".into(), "RadialKeratotomy".into(), name.to_owned()];
-    let cornea = scenario
-        .organ(organ)
-        .is_some_and(|e| e.mesh.is_none() && Organ::from_name(&e.name) == Some(Organ::Cornea));
-    if scenario.organ(organ).is_some() && !cornea {
-        problems.push(Problem {
-            field: field("organ"),
-            anchors: anchors("organ"),
-            message: format!("radial keratotomy cuts the cornea, not the {organ}"),
-            hint: "put \"cornea\" in organs and name it here".into(),
-        });
-    }
-    let outer_mm = crate::cutting::keratotomy::INCISION_END_M * 1e3;
-    let room_mm = outer_mm - optical_zone_mm / 2.0;
-    if room_mm < MIN_INCISION_M * 1e3 {
-        problems.push(Problem {
-            field: field("optical_zone_mm"),
-            anchors: anchors("optical_zone_mm"),
-            message: format!(
-                "a {optical_zone_mm} mm optical zone leaves no room for incisions: they end \
-                 {outer_mm:.2} mm off the axis, {:.1} mm inside the {:.1} mm cornea's limbus",
-                crate::mesh::organs::CORNEA_RIM_M * 1e3 - outer_mm,
-                2.0 * crate::mesh::organs::CORNEA_RIM_M * 1e3,
-            ),
-            hint: format!(
-                "an optical zone is 3 to 4 mm across; at most {:.1} mm here",
-                2.0 * (outer_mm - MIN_INCISION_M * 1e3)
-            ),
-        });
-    }
-    problems
-}
-
-/// An incision needs a scalpel, an organ a scalpel can part, a line of some length and a
-/// depth the organs' thickness allows.
-fn check_incision(
-    scenario: &Scenario,
-    organ: &str,
-    (from_mm, to_mm): (&(f64, f64, f64), &(f64, f64, f64)),
-    depth_mm: f64,
-    field: &dyn Fn(&str) -> String,
-) -> Vec<Problem> {
-    let anchors = |name: &str| vec!["tasks".to_owned(), "Incision".into(), name.to_owned()];
-    let mut problems = check_blade(scenario, organ, "Incision", field);
-    let length_mm = (metres(*to_mm) - metres(*from_mm)).norm() * 1e3;
-    if length_mm < 5.0 {
-        problems.push(Problem {
-            field: field("to_mm"),
-            anchors: anchors("to_mm"),
-            message: format!("the line is {length_mm:.1} mm long: too short to cut and score"),
-            hint: "mark a line at least 5 mm long, from_mm to to_mm in the scene's frame".into(),
-        });
-    }
-    if let Some(entry) = scenario.organ(organ)
-        && let Some((end, distance_mm)) = farthest_off_surface(entry, [from_mm, to_mm])
-    {
-        let name = ["from_mm", "to_mm"][end];
-        problems.push(Problem {
-            field: field(name),
-            anchors: anchors(name),
-            message: format!("the line's end is {distance_mm:.0} mm off the {organ}'s surface"),
-            hint: format!(
-                "mark the line on the {organ}'s surface (within {LINE_ON_SURFACE_MM} mm); \
-                 `pgd mesh {organ} --out FILE.vtu` writes its mesh to look at"
-            ),
-        });
-    }
-    if depth_mm > MAX_INCISION_DEPTH_MM {
-        problems.push(Problem {
-            field: field("depth_mm"),
-            anchors: anchors("depth_mm"),
-            message: format!("{depth_mm} mm is deeper than a scalpel's incision goes here"),
-            hint: format!("at most {MAX_INCISION_DEPTH_MM} mm"),
-        });
-    }
-    problems
-}
-
-/// The deepest incision a task may ask for (mm).
-const MAX_INCISION_DEPTH_MM: f64 = 30.0;
-
-/// How far (mm) a line's end may lie from the organ's surface as the check meshes it (the
-/// coarse organ, whose surface is within a few millimetres of the full one's).
-const LINE_ON_SURFACE_MM: f64 = 5.0;
-
-/// The end of `points_mm` farthest from the organ's surface (0 or 1) and its distance (mm), if
-/// more than [`LINE_ON_SURFACE_MM`]; `None` also when the organ's mesh cannot be had (its own
-/// check says why).
-fn farthest_off_surface(
-    entry: &OrganEntry,
-    points_mm: [&(f64, f64, f64); 2],
-) -> Option<(usize, f64)> {
-    let mesh = match (&entry.mesh, Organ::from_name(&entry.name)) {
-        (Some(path), _) => crate::mesh::io::load(path, &Default::default()).ok()?,
-        (None, Some(organ)) => {
-            let coarse = OrganSettings {
-                resolution: 0.25,
-                ..OrganSettings::default()
-            };
-            crate::mesh::organs::generate(organ, &coarse).ok()?
-        }
-        (None, None) => return None,
+    let scene = SceneFacts {
+        organs: &scenario.organs,
+        nodules: &scenario.nodules,
+        blade: scenario.blade().is_some(),
+        grasps: scenario.grasps(),
+        device_max_force_n: scenario.device.max_force_n.0,
     };
-    let surface = Surface::extract(&mesh);
-    let positions: Vec<[f32; 3]> = mesh
-        .nodes()
-        .iter()
-        .map(|p| p.cast::<f32>().into())
-        .collect();
-    let triangles: Vec<[u32; 3]> = surface
-        .triangles
-        .iter()
-        .map(|t| t.map(|n| n as u32))
-        .collect();
-    let trimesh = crate::parry_interop::trimesh(&positions, &triangles)?;
-    let distance_mm = |p: &(f64, f64, f64)| {
-        let point = nalgebra::Point3::from(metres(*p));
-        let query = crate::parry_interop::to_parry(&point);
-        let projected = trimesh.project_local_point(query, false).point;
-        (crate::parry_interop::from_parry(projected) - point).norm() * 1e3
-    };
-    let distances = points_mm.map(distance_mm);
-    let end = usize::from(distances[1] > distances[0]);
-    (distances[end] > LINE_ON_SURFACE_MM).then_some((end, distances[end]))
+    let mut check = TaskCheck::new(scene, &task.shared, k, task.name());
+    task.check(&mut check);
+    problems.extend(check.problems);
 }
 
 fn generated_organs() -> String {
@@ -721,16 +369,6 @@ fn check_stiffening(k: usize, organ: &OrganEntry, law: Law) -> Option<Problem> {
         ],
         message: format!("the {} law has no stiffening", law.name()),
         hint: "set `law: Exponential` with it, or leave it out".into(),
-    })
-}
-
-/// A problem if holding for `hold_s` (at `field`) cannot fit in the task's time limit.
-fn hold_fits(hold_s: f64, time_limit_s: f64, field: String) -> Option<Problem> {
-    (hold_s >= time_limit_s).then(|| Problem {
-        field,
-        anchors: vec!["tasks".into(), "hold_s".into()],
-        message: format!("holding {hold_s} s cannot fit in the time limit of {time_limit_s} s"),
-        hint: "make time_limit_s longer than hold_s".into(),
     })
 }
 

@@ -1,37 +1,44 @@
-//! Training exercises: the scenario file educators write (`format`, `units`), reading it with
-//! errors that point at the line and field (`load`), its tasks as they run, fed by the haptic
-//! loop one tick at a time (`exercise`), the mistakes they note (`mistakes`), put into words
-//! only when scored, the tool's motion metrics (`motion`), the cut against
-//! an incision's line (`incision`), the incisions of a radial keratotomy (`keratotomy`), and
-//! the rubric's
-//! score (`score`). No Bevy here: the app layer runs an [`Exercise`] inside the haptic schedule.
+//! Training exercises. The scenario file educators write, as types (`format`, `scene`,
+//! `units`), read with errors that point at the line and field (`load`, `problem`); its tasks,
+//! each of a type that implements the task trait (`task`; the built-in types, their registry
+//! and their reader in `tasks`), run one after another fed by the haptic loop one tick at a
+//! time (`exercise`, `sample`), with the tool's motion (`motion`), the cut against an
+//! incision's line (`incision`) and the incisions of a radial keratotomy (`keratotomy`)
+//! measured; and the rubric's score (`score`). No Bevy here: the app layer runs an
+//! [`Exercise`] inside the haptic schedule.
 
 mod exercise;
 mod format;
 mod incision;
 mod keratotomy;
 mod load;
-mod mistakes;
 mod motion;
+mod problem;
+mod sample;
+mod scene;
 mod score;
+pub mod task;
+pub mod tasks;
 mod units;
 
-pub use exercise::{
-    COVERED_TO_FINISH, Exercise, NoduleSite, Progress, RegionSite, Sample, Sites, TaskMetrics,
-};
+pub use exercise::{Exercise, Progress, Sites};
 pub use format::{
-    Contact, Device, Difficulty, Instrument, LaparoscopeEntry, Nodule, OrganEntry, Port, Rubric,
-    Scenario, ScopeKey, Spot, Task, TaskKind, Tool, default_law, metres,
+    Contact, Device, Difficulty, Instrument, LaparoscopeEntry, Port, Rubric, Scenario, ScopeKey,
+    Tool, default_law,
 };
 pub use incision::{BladeSample, IncisionMetrics, IncisionTracker};
 pub use keratotomy::{
     Keratometer, KeratotomyMetrics, KeratotomyPlan, KeratotomyTracker, MIN_INCISION_M,
     RadialIncision,
 };
-pub use load::{ScenarioError, load, parse};
-pub use mistakes::{MISTAKES_LISTED, Mistake, Mistakes};
+pub use load::{load, parse};
 pub use motion::{IDLE_M_PER_S, MOVING_M_PER_S, MotionMetrics, MotionTracker, STRIDE};
+pub use problem::ScenarioError;
+pub use sample::{NoduleSite, RegionSite, Sample};
+pub use scene::{Nodule, OrganEntry, Spot, metres};
 pub use score::{CutMade, Scorecard, TaskScore, score};
+pub use task::{MISTAKES_LISTED, Mistake, Mistakes, Task, TaskMetrics, TaskShared, TaskType};
+pub use tasks::{COVERED_TO_FINISH, register, registered_names};
 pub use units::{
     DepthFraction, Dioptres, EdgeLength, FieldOfView, IncisionCount, Millimetres, ModeCount,
     Newtons, Pascals, PoissonRatio, Ratio, Scale, ScopeAngle, Seconds, Stiffening, Toughness,

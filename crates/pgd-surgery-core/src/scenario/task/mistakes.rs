@@ -2,8 +2,8 @@
 //! into room made before the attempt, and they are put into words (with the task's organ and
 //! zone names) only when the attempt is scored, away from it.
 
-use super::format::{Task, TaskKind, spot_name};
-use super::units::Newtons;
+use super::Task;
+use crate::scenario::units::Newtons;
 
 /// How many mistakes a task keeps in detail; past that they are counted, not listed.
 pub const MISTAKES_LISTED: usize = 64;
@@ -11,54 +11,29 @@ pub const MISTAKES_LISTED: usize = 64;
 /// One mistake, and when it was made.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Mistake {
-    /// The tool's force went over the task's limit.
+    /// The tool's force went over the task's limit (every task watches it).
     OverLimit { time_s: f64, limit_n: f64 },
-    /// The load on the organs around the retracted one went over its limit.
-    OverSurrounding { time_s: f64, limit_n: f64 },
-    /// The cut strayed farther off the line than allowed.
-    OffTheLine { time_s: f64, limit_mm: f64 },
-    /// The grasper tore the task's organ.
-    Tore { time_s: f64 },
-    /// The tip entered the task's forbidden zone number `zone`.
-    Forbidden { time_s: f64, zone: usize },
+    /// A mistake of the task's type's own, numbered `code` by it, with an amount to say (a
+    /// limit, a zone's number); its type puts it into words.
+    Own { time_s: f64, code: u16, amount: f64 },
 }
 
 impl Mistake {
     /// The mistake in words, for `task` (the one that noted it).
     pub fn describe(&self, task: &Task) -> String {
-        let organ = task_organ(task);
         match *self {
-            Mistake::OverLimit { time_s, limit_n } => {
-                let verb = match task.kind() {
-                    TaskKind::Grasp => "pulled",
-                    _ => "pressed",
-                };
-                format!("{time_s:.2} s: {verb} harder than {} N", Newtons(limit_n))
-            }
-            Mistake::OverSurrounding { time_s, limit_n } => format!(
-                "{time_s:.2} s: loaded the organs around harder than {} N",
+            Mistake::OverLimit { time_s, limit_n } => format!(
+                "{time_s:.2} s: {} harder than {} N",
+                task.force_verb(),
                 Newtons(limit_n)
             ),
-            Mistake::OffTheLine { time_s, limit_mm } => {
-                format!("{time_s:.2} s: cut the {organ} more than {limit_mm:.0} mm off the line")
-            }
-            Mistake::Tore { time_s } => format!("{time_s:.2} s: tore the {organ}"),
-            Mistake::Forbidden { time_s, zone } => {
-                let name = match task {
-                    Task::SafeNavigation { forbidden, .. } => forbidden
-                        .get(zone)
-                        .map_or_else(|| format!("zone {}", zone + 1), |s| spot_name(s, zone)),
-                    _ => format!("zone {}", zone + 1),
-                };
-                format!("{time_s:.2} s: entered the forbidden {name}")
-            }
+            Mistake::Own {
+                time_s,
+                code,
+                amount,
+            } => format!("{time_s:.2} s: {}", task.describe_mistake(code, amount)),
         }
     }
-}
-
-/// The organ a task works on, for its mistakes' words ("organ" for navigation, on none).
-pub fn task_organ(task: &Task) -> &str {
-    task.organ().unwrap_or("organ")
 }
 
 /// A task's mistakes: the first [`MISTAKES_LISTED`] in detail, the others counted.
@@ -102,7 +77,10 @@ mod tests {
         let mut mistakes = Mistakes::reserved();
         let room = mistakes.listed.capacity();
         for k in 0..MISTAKES_LISTED + 6 {
-            mistakes.note(Mistake::Tore { time_s: k as f64 });
+            mistakes.note(Mistake::OverLimit {
+                time_s: k as f64,
+                limit_n: 1.0,
+            });
         }
         assert_eq!(mistakes.listed.capacity(), room);
         assert_eq!(

@@ -1,0 +1,79 @@
+//! What the haptic loop tells the tasks of one tick, and where the scenario's points lie on
+//! the scene's organs.
+
+use nalgebra::Vector3;
+
+use super::incision::BladeSample;
+use crate::pgd::SurfacePoint;
+
+/// What the haptic loop knows of one tick, for scoring.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Sample {
+    pub time_s: f64,
+    pub tip_m: Option<Vector3<f64>>,
+    /// The force sent to the device (N).
+    pub force_n: f64,
+    /// The organs the tool touches: bit `k` for the scenario's `organs[k]`.
+    pub touching: u64,
+    /// Whether the device's first button is held (the mark in palpation).
+    pub button: bool,
+    /// The instrument in hand, in the scenario's order (0 with one).
+    pub instrument: usize,
+    /// Retraction: how far (m) the watched region ([`Exercise::watched_region`]) has moved
+    /// along its direction; 0 when nothing is watched.
+    pub region_moved_m: f64,
+    /// Retraction: the force (N) on the organs other than the watched region's, from the tool
+    /// and from the organs they touch.
+    pub surrounding_force_n: f64,
+    /// The organs the grasper's jaws hold: bit `k` for the scenario's `organs[k]`.
+    pub grasping: u64,
+    /// Whether the grasper tore tissue this tick (a tear before the task began, in an
+    /// earlier attempt, does not count against it).
+    pub tore: bool,
+    /// The scalpel's cut under way, if it is cutting.
+    pub blade: Option<BladeSample>,
+    /// Under a laparoscope: whether the tool's tip is in the camera's view...
+    pub tip_in_view: Option<bool>,
+    /// ...and whether the point the scenario has the trainee keep in view is.
+    pub target_in_view: Option<bool>,
+    /// How far (m) the tool pressed beyond the depth the tissue model covers (the deepest
+    /// load step of the organ's nonlinear vademecum), on the organ it presses deepest so;
+    /// zero within range.
+    pub beyond_range_m: f64,
+}
+
+impl Sample {
+    pub fn touches(&self, organ: usize) -> bool {
+        organ < 64 && self.touching & (1 << organ) != 0
+    }
+
+    pub fn grasps(&self, organ: usize) -> bool {
+        organ < 64 && self.grasping & (1 << organ) != 0
+    }
+}
+
+/// Where a nodule of the scenario lies: its centre, and the outward normal of the organ's
+/// surface nearest to it, along which a mark right above it lies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoduleSite {
+    pub centre_m: Vector3<f64>,
+    pub outward: Vector3<f64>,
+}
+
+impl NoduleSite {
+    /// How far (m) `point_m` is from the nodule across the surface: its distance from the
+    /// line through the centre along the outward normal, so that depth does not count.
+    pub fn lateral_distance_m(&self, point_m: &Vector3<f64>) -> f64 {
+        let offset = point_m - self.centre_m;
+        (offset - self.outward * offset.dot(&self.outward)).norm()
+    }
+}
+
+/// Where a retraction task's region lies: the surface point of its organ (the scene's
+/// `organ`-th) nearest the scenario's point, and the unit direction it is to move in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RegionSite {
+    pub organ: usize,
+    pub at: SurfacePoint,
+    pub towards: Vector3<f64>,
+}
