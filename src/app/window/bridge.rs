@@ -88,16 +88,30 @@ impl HapticLink {
 #[derive(Resource, Default)]
 pub struct Snapshot(pub HapticSnapshot);
 
-pub(super) fn setup(app: &mut App, window: WindowScene) {
-    app.insert_resource(HapticLink {
-        scene: window.scene,
-        virtual_device: window.virtual_device,
-        device_name: window.device_name,
-        snapshots: Mutex::new(window.snapshots),
-        exit_after: window.exit_after_s.map(Duration::from_secs_f64),
-    })
-    .init_resource::<Snapshot>()
-    .add_systems(Update, (receive, exit_when_due).in_set(FrameSet::Receive));
+/// The link to the haptic side (moved into the app when the plugin is built) and each
+/// frame's copy of its latest snapshot.
+pub(super) struct BridgePlugin(pub Mutex<Option<HapticLink>>);
+
+impl BridgePlugin {
+    pub fn new(window: WindowScene) -> Self {
+        Self(Mutex::new(Some(HapticLink {
+            scene: window.scene,
+            virtual_device: window.virtual_device,
+            device_name: window.device_name,
+            snapshots: Mutex::new(window.snapshots),
+            exit_after: window.exit_after_s.map(Duration::from_secs_f64),
+        })))
+    }
+}
+
+impl Plugin for BridgePlugin {
+    fn build(&self, app: &mut App) {
+        if let Some(link) = self.0.lock().ok().and_then(|mut link| link.take()) {
+            app.insert_resource(link);
+        }
+        app.init_resource::<Snapshot>()
+            .add_systems(Update, (receive, exit_when_due).in_set(FrameSet::Receive));
+    }
 }
 
 /// Copies the latest complete tick (the triple buffer's reader never blocks the writer; the

@@ -100,22 +100,32 @@ pub enum Opening {
     Lesson,
 }
 
-pub(super) fn setup(app: &mut App, lesson: Option<(Lesson, Opening)>, lessons: Lessons) {
-    app.init_state::<Stage>()
-        .add_systems(OnEnter(Stage::Briefing), show_briefing)
-        .add_systems(OnEnter(Stage::Debrief), show_debrief)
-        .add_systems(
-            Update,
-            (
-                begin_on_space.run_if(in_state(Stage::Briefing)),
-                debrief_when_done.run_if(in_state(Stage::Exercise)),
-                retry_on_r.run_if(in_state(Stage::Debrief)),
-                close_on_escape.run_if(in_state(Stage::Debrief).or_else(in_state(Stage::Menu))),
-                menu_on_m.run_if(in_state(Stage::Briefing).or_else(in_state(Stage::Debrief))),
-            )
-                .in_set(FrameSet::Input),
-        );
-    if let Some((lesson, opening)) = lesson {
+/// The lesson's stages (menu, briefing, exercise, debrief) and the keys between them; the
+/// lesson to open, if any, and where.
+pub(super) struct LessonPlugin {
+    pub lesson: Option<(Lesson, Opening)>,
+    pub lessons: Lessons,
+}
+
+impl Plugin for LessonPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_state::<Stage>()
+            .add_systems(OnEnter(Stage::Briefing), show_briefing)
+            .add_systems(OnEnter(Stage::Debrief), show_debrief)
+            .add_systems(
+                Update,
+                (
+                    begin_on_space.run_if(in_state(Stage::Briefing)),
+                    debrief_when_done.run_if(in_state(Stage::Exercise)),
+                    retry_on_r.run_if(in_state(Stage::Debrief)),
+                    close_on_escape.run_if(in_state(Stage::Debrief).or_else(in_state(Stage::Menu))),
+                    menu_on_m.run_if(in_state(Stage::Briefing).or_else(in_state(Stage::Debrief))),
+                )
+                    .in_set(FrameSet::Input),
+            );
+        let Some((lesson, opening)) = self.lesson.clone() else {
+            return;
+        };
         // An exercise begun already (a scripted device has no one to press Space) skips the
         // briefing.
         let first = match (lesson.link.started(), opening) {
@@ -123,9 +133,9 @@ pub(super) fn setup(app: &mut App, lesson: Option<(Lesson, Opening)>, lessons: L
             (false, Opening::Menu) => Stage::Menu,
             (false, Opening::Lesson) => Stage::Briefing,
         };
-        lessons.add(&lesson);
+        self.lessons.add(&lesson);
         app.insert_resource(lesson)
-            .insert_resource(lessons)
+            .insert_resource(self.lessons.clone())
             .add_systems(Startup, move |mut next: ResMut<NextState<Stage>>| {
                 next.set(first)
             });
@@ -318,11 +328,10 @@ mod tests {
             scene: scene_without_organs(),
             link: link.clone(),
         };
-        setup(
-            &mut app,
-            Some((lesson, Opening::Lesson)),
-            Lessons::default(),
-        );
+        app.add_plugins(LessonPlugin {
+            lesson: Some((lesson, Opening::Lesson)),
+            lessons: Lessons::default(),
+        });
         (app, link)
     }
 

@@ -76,25 +76,30 @@ struct Prepared {
     snapshots: triple_buffer::Output<HapticSnapshot>,
 }
 
-pub(super) fn setup(app: &mut App, plan: Option<MenuPlan>) {
-    let Some(plan) = plan else {
-        return;
-    };
-    app.insert_resource(plan)
-        .init_resource::<Menu>()
-        .add_systems(OnEnter(Stage::Menu), show_menu)
-        .add_systems(OnEnter(Stage::Loading), show_loading)
-        .add_systems(
-            Update,
-            (
-                (move_selection, choose_on_enter)
-                    .chain()
-                    .run_if(in_state(Stage::Menu)),
-                finish_loading.run_if(in_state(Stage::Loading)),
-                reload_when_built.run_if(in_state(Stage::Briefing)),
-            )
-                .in_set(FrameSet::Input),
-        );
+/// The menu of scenarios, when there is one (not in free play).
+pub(super) struct MenuPlugin(pub Option<MenuPlan>);
+
+impl Plugin for MenuPlugin {
+    fn build(&self, app: &mut App) {
+        let Some(plan) = self.0.clone() else {
+            return;
+        };
+        app.insert_resource(plan)
+            .init_resource::<Menu>()
+            .add_systems(OnEnter(Stage::Menu), show_menu)
+            .add_systems(OnEnter(Stage::Loading), show_loading)
+            .add_systems(
+                Update,
+                (
+                    (move_selection, choose_on_enter)
+                        .chain()
+                        .run_if(in_state(Stage::Menu)),
+                    finish_loading.run_if(in_state(Stage::Loading)),
+                    reload_when_built.run_if(in_state(Stage::Briefing)),
+                )
+                    .in_set(FrameSet::Input),
+            );
+    }
 }
 
 /// The scenarios on offer, read afresh (an educator may have edited or added one).
@@ -523,8 +528,13 @@ mod tests {
             .insert_resource(HapticLink::headless(scene, snapshots))
             .add_message::<AppExit>()
             .add_message::<SceneChanged>();
-        lesson::setup(&mut app, Some((lesson, Opening::Menu)), lessons.clone());
-        setup(&mut app, Some(plan));
+        app.add_plugins((
+            lesson::LessonPlugin {
+                lesson: Some((lesson, Opening::Menu)),
+                lessons: lessons.clone(),
+            },
+            MenuPlugin(Some(plan)),
+        ));
         Fixture {
             app,
             folder,

@@ -117,20 +117,12 @@ fn spawn_with_scene<M>(
     );
 }
 
-/// Opens the trainer window (or draws into an image, offscreen) and returns, when it closes,
-/// how it closed and how fast it drew.
-pub fn run(mut window: WindowScene) -> (AppExit, Option<FrameReport>) {
-    let log = frames::FrameLog::default();
-    let mut app = App::new();
-    // The scenarios folder is watched: an edit of the lesson's file reloads it.
-    let folder = window.menu.as_ref().and_then(|m| m.folder.clone());
-    offscreen::plugins(
-        &mut app,
-        window.offscreen,
-        reload::asset_plugin(folder.as_deref()),
-    );
-    app.insert_resource(ClearColor(Color::srgb(0.05, 0.06, 0.08)))
-        .configure_sets(
+/// The frame's stages in order, and the despawning of what was drawn of a scene that changed.
+struct FrameStagesPlugin;
+
+impl Plugin for FrameStagesPlugin {
+    fn build(&self, app: &mut App) {
+        app.configure_sets(
             Update,
             (
                 FrameSet::Input,
@@ -147,28 +139,73 @@ pub fn run(mut window: WindowScene) -> (AppExit, Option<FrameReport>) {
                 .run_if(on_message::<SceneChanged>)
                 .in_set(FrameSet::Receive),
         );
-    let free_camera = window.free_camera;
-    app.add_plugins(offscreen::OffscreenPlugin {
-        size: window.offscreen,
-    });
-    screenshot::setup(&mut app, window.screenshot.clone());
-    reload::setup(&mut app, folder.as_deref());
-    lesson::setup(&mut app, window.lesson.clone(), window.lessons.clone());
-    menu::setup(&mut app, window.menu.clone());
-    paced::setup(&mut app, window.paced.take());
-    bridge::setup(&mut app, window);
-    app.add_plugins((organs::OrganPlugin, abdomen::AbdomenPlugin));
-    app.add_plugins(laparoscope::LaparoscopePlugin { free_camera });
-    app.add_plugins((
-        camera::CameraPlugin,
-        tool::ToolPlugin,
-        incision::IncisionPlugin,
-        input::InputPlugin,
-        hud::HudPlugin,
-    ));
-    app.add_plugins(frames::FramesPlugin(log.clone()));
-    #[cfg(target_arch = "wasm32")]
-    app.add_plugins(web_page::WebPagePlugin);
+    }
+}
+
+/// The trainer window's concerns, a plugin each, from the run's data.
+struct TrainerWindowPlugins {
+    window: WindowScene,
+    log: frames::FrameLog,
+    /// The scenarios folder watched for edits.
+    folder: Option<std::path::PathBuf>,
+}
+
+impl PluginGroup for TrainerWindowPlugins {
+    fn build(mut self) -> bevy::app::PluginGroupBuilder {
+        let window = &mut self.window;
+        let group = bevy::app::PluginGroupBuilder::start::<Self>()
+            .add(FrameStagesPlugin)
+            .add(offscreen::OffscreenPlugin {
+                size: window.offscreen,
+            })
+            .add(screenshot::ScreenshotPlugin(window.screenshot.take()))
+            .add(reload::ReloadPlugin {
+                folder: self.folder,
+            })
+            .add(lesson::LessonPlugin {
+                lesson: window.lesson.take(),
+                lessons: window.lessons.clone(),
+            })
+            .add(menu::MenuPlugin(window.menu.take()))
+            .add(paced::PacedPlugin(std::sync::Mutex::new(
+                window.paced.take(),
+            )))
+            .add(laparoscope::LaparoscopePlugin {
+                free_camera: window.free_camera,
+            })
+            .add(bridge::BridgePlugin::new(self.window))
+            .add(organs::OrganPlugin)
+            .add(abdomen::AbdomenPlugin)
+            .add(camera::CameraPlugin)
+            .add(tool::ToolPlugin)
+            .add(incision::IncisionPlugin)
+            .add(input::InputPlugin)
+            .add(hud::HudPlugin)
+            .add(frames::FramesPlugin(self.log));
+        #[cfg(target_arch = "wasm32")]
+        let group = group.add(web_page::WebPagePlugin);
+        group
+    }
+}
+
+/// Opens the trainer window (or draws into an image, offscreen) and returns, when it closes,
+/// how it closed and how fast it drew.
+pub fn run(window: WindowScene) -> (AppExit, Option<FrameReport>) {
+    let log = frames::FrameLog::default();
+    let mut app = App::new();
+    // The scenarios folder is watched: an edit of the lesson's file reloads it.
+    let folder = window.menu.as_ref().and_then(|m| m.folder.clone());
+    offscreen::plugins(
+        &mut app,
+        window.offscreen,
+        reload::asset_plugin(folder.as_deref()),
+    );
+    app.insert_resource(ClearColor(Color::srgb(0.05, 0.06, 0.08)))
+        .add_plugins(TrainerWindowPlugins {
+            window,
+            log: log.clone(),
+            folder,
+        });
     let exit = app.run();
     (exit, log.report())
 }

@@ -82,30 +82,37 @@ struct Notice;
 
 /// Watches the scenarios in `folder`, if there is one (the asset plugin must come from
 /// [`asset_plugin`] with the same folder): the lesson's file, whichever it is.
-pub(super) fn setup(app: &mut App, folder: Option<&Path>) {
-    let Some(folder) = folder.map(absolute) else {
-        return;
-    };
-    app.init_asset::<ScenarioAsset>()
-        .register_asset_loader(ScenarioLoader {
-            dir: folder.clone(),
-        })
-        .insert_resource(Watched {
-            folder,
-            file: PathBuf::new(),
-            handle: None,
-        })
-        .add_systems(Startup, spawn_notice)
-        .add_systems(
-            Update,
-            (
-                follow_lesson.run_if(resource_exists_and_changed::<Lesson>),
-                apply_edits,
-                report_failures,
-            )
-                .chain()
-                .in_set(FrameSet::Input),
-        );
+/// Watches the scenarios folder: an edit of the lesson's file reloads it.
+pub(super) struct ReloadPlugin {
+    pub folder: Option<PathBuf>,
+}
+
+impl Plugin for ReloadPlugin {
+    fn build(&self, app: &mut App) {
+        let Some(folder) = self.folder.as_deref().map(absolute) else {
+            return;
+        };
+        app.init_asset::<ScenarioAsset>()
+            .register_asset_loader(ScenarioLoader {
+                dir: folder.clone(),
+            })
+            .insert_resource(Watched {
+                folder,
+                file: PathBuf::new(),
+                handle: None,
+            })
+            .add_systems(Startup, spawn_notice)
+            .add_systems(
+                Update,
+                (
+                    follow_lesson.run_if(resource_exists_and_changed::<Lesson>),
+                    apply_edits,
+                    report_failures,
+                )
+                    .chain()
+                    .in_set(FrameSet::Input),
+            );
+    }
 }
 
 /// Watches the lesson's file when it lies in the watched folder (the built-in scenario run
@@ -234,9 +241,16 @@ mod tests {
             .init_resource::<ButtonInput<KeyCode>>()
             .init_resource::<Snapshot>()
             .add_message::<AppExit>();
-        setup(&mut app, folder);
         let opening = super::super::lesson::Opening::Lesson;
-        super::super::lesson::setup(&mut app, Some((lesson, opening)), Default::default());
+        app.add_plugins((
+            ReloadPlugin {
+                folder: folder.map(Path::to_path_buf),
+            },
+            super::super::lesson::LessonPlugin {
+                lesson: Some((lesson, opening)),
+                lessons: Default::default(),
+            },
+        ));
         (app, link)
     }
 

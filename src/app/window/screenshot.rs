@@ -40,8 +40,14 @@ impl ScreenshotPlan {
     }
 }
 
-pub(super) fn setup(app: &mut App, plan: Option<ScreenshotPlan>) {
-    if let Some(plan) = plan {
+/// A screenshot of the window after some frames, when planned.
+pub(super) struct ScreenshotPlugin(pub Option<ScreenshotPlan>);
+
+impl Plugin for ScreenshotPlugin {
+    fn build(&self, app: &mut App) {
+        let Some(plan) = self.0.clone() else {
+            return;
+        };
         app.insert_resource(plan)
             .init_resource::<Progress>()
             .init_resource::<PipelinesReady>()
