@@ -9,6 +9,7 @@
 
 mod clip;
 mod enrichment;
+mod factor;
 mod incision;
 pub mod keratotomy;
 mod local;

@@ -28,10 +28,11 @@ use rayon::prelude::*;
 
 use super::CutError;
 use super::enrichment::{Enriched, Enrichment, Front, Supports};
+use super::factor::GrowingCholesky;
 use super::incision::{CutFace, Incision};
 use super::local::{LocalResponse, PatchSolver};
 use super::response::{Response, UncutResponse, sparse_load};
-use super::view::{CutView, add_surface_part, backward, gram, surface_dof};
+use super::view::{CutView, add_surface_part, gram, surface_dof};
 use super::xfem::{CutSolution, element_functions, piece_weights};
 use crate::fem::{FemModel, PRESCRIBED};
 use crate::mesh::Surface;
@@ -81,8 +82,8 @@ pub struct CutState<M: Borrow<FemModel>, R: UncutResponse> {
     /// The patch solves behind a compressed response's enriched functions; `None` for an
     /// exact response.
     local: Option<PatchSolver>,
-    /// The lower Cholesky factor of `S`, row by row (row `i` holds `i + 1` entries).
-    factor: Vec<Vec<f64>>,
+    /// The lower Cholesky factor of `S`.
+    factor: GrowingCholesky,
     /// Where the cut's front falls between element faces.
     front: Front,
     /// The mesh's supports, which every segment's enrichment reads.
@@ -120,7 +121,7 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
             rows: Vec::new(),
             residual_modes: Vec::new(),
             local,
-            factor: Vec::new(),
+            factor: GrowingCholesky::default(),
             front: Front::Inward,
             supports,
         }
@@ -258,14 +259,16 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
         let rhs: Vec<f64> = (0..self.unknowns())
             .map(|p| -self.product(p, &response.modal, &u))
             .collect();
-        let y = self.forward(rhs);
+        let mut y = rhs;
+        self.factor.forward(&mut y);
         // An uncut field known exactly has no modal part; `Z`'s may still have one.
         let mut modal = response.modal;
         modal.resize(self.response.modes(), 0.0);
         for (z, &yj) in self.z_modal.iter().zip(&y) {
             modal.iter_mut().zip(z).for_each(|(m, a)| *m -= yj * a);
         }
-        let q = self.backward(y);
+        let mut q = y;
+        self.factor.backward(&mut q);
         for (ud, entries) in u.iter_mut().zip(&self.z_near) {
             *ud -= entries.iter().map(|&(p, v)| q[p as usize] * v).sum::<f64>();
         }
@@ -450,7 +453,9 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
             .map(|b| self.response.spatial_products(b))
             .collect();
         let columns = self.condensed_columns(&coupling, &a, &local);
-        self.border(&columns)?;
+        self.factor.border(&columns).map_err(|_| {
+            CutError::Solve("the condensed system lost positive definiteness".into())
+        })?;
         self.functions.extend(added);
         self.coupling.extend(coupling);
         let mut z = Vec::with_capacity(local.len());
@@ -541,9 +546,9 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
         let hatted = |value: f64, entries: &[(u32, f64)], p: usize| {
             let reached: f64 = entries
                 .iter()
-                .map(|&(j, v)| factor[p][j as usize] * v)
+                .map(|&(j, v)| factor.at(p, j as usize) * v)
                 .sum();
-            (value - reached) / factor[p][p]
+            (value - reached) / factor.at(p, p)
         };
         let mut dense = vec![vec![0.0; z.len()]; self.z_hat_surface.len()];
         for (r, response) in z.iter().enumerate() {
@@ -568,10 +573,11 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
         for (r, response) in z.into_iter().enumerate() {
             let p = first + r;
             let mut modal = response.modal;
-            for (zj, &l) in self.z_modal.iter().zip(&factor[p]) {
+            for (j, zj) in self.z_modal.iter().enumerate() {
+                let l = factor.at(p, j);
                 modal.iter_mut().zip(zj).for_each(|(m, a)| *m -= l * a);
             }
-            modal.iter_mut().for_each(|m| *m /= factor[p][p]);
+            modal.iter_mut().for_each(|m| *m /= factor.at(p, p));
             self.z_modal.push(modal);
         }
     }
@@ -637,44 +643,6 @@ impl<M: Borrow<FemModel>, R: UncutResponse> CutState<M, R> {
             }
         }
         (coupling, a)
-    }
-
-    /// Extends the lower factor `L` of `S` by the new columns `[C; D]` (each holding every
-    /// row, old then new): `L X = C`, then `L_D L_Dᵀ = D − Xᵀ X`.
-    fn border(&mut self, columns: &[Vec<f64>]) -> Result<(), CutError> {
-        let old = self.factor.len();
-        for (r, column) in columns.iter().enumerate() {
-            let row_index = old + r;
-            let mut row = vec![0.0; row_index + 1];
-            for k in 0..row_index {
-                let known: f64 = (0..k).map(|m| row[m] * self.factor[k][m]).sum();
-                row[k] = (column[k] - known) / self.factor[k][k];
-            }
-            let diagonal = column[row_index] - row[..row_index].iter().map(|x| x * x).sum::<f64>();
-            if !(diagonal.is_finite() && diagonal > 0.0) {
-                self.factor.truncate(old);
-                return Err(CutError::Solve(
-                    "the condensed system lost positive definiteness".into(),
-                ));
-            }
-            row[row_index] = diagonal.sqrt();
-            self.factor.push(row);
-        }
-        Ok(())
-    }
-
-    /// `L⁻¹ x` (forward substitution through the factor's rows).
-    fn forward(&self, mut x: Vec<f64>) -> Vec<f64> {
-        for (i, row) in self.factor.iter().enumerate() {
-            let s: f64 = row[..i].iter().zip(&x[..i]).map(|(l, v)| l * v).sum();
-            x[i] = (x[i] - s) / row[i];
-        }
-        x
-    }
-
-    /// `L⁻ᵀ y` (backward substitution).
-    fn backward(&self, x: Vec<f64>) -> Vec<f64> {
-        backward(&self.factor, x)
     }
 }
 

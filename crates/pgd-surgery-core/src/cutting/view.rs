@@ -5,6 +5,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::enrichment::Enriched;
+use super::factor::GrowingCholesky;
 use super::incision::CutFace;
 use crate::mesh::NOT_ON_SURFACE;
 
@@ -23,8 +24,8 @@ pub struct CutView {
     pub functions: Vec<Enriched>,
     pub(super) surface_index_of: Vec<usize>,
     pub(super) z_hat_surface: Vec<Vec<(u32, f64)>>,
-    /// The lower Cholesky factor of the condensed system, row by row.
-    pub(super) factor: Vec<Vec<f64>>,
+    /// The lower Cholesky factor of the condensed system.
+    pub(super) factor: GrowingCholesky,
 }
 
 /// The cut's part of an organ's answer to a load on its surface.
@@ -43,7 +44,8 @@ impl CutView {
         let mut y = vec![0.0; self.unknowns];
         add_surface_part(&self.surface_index_of, &self.z_hat_surface, load, &mut y);
         y.iter_mut().for_each(|v| *v = -*v);
-        let q = backward(&self.factor, y.clone());
+        let mut q = y.clone();
+        self.factor.backward(&mut q);
         CutAnswer { y, q }
     }
 
@@ -103,16 +105,6 @@ pub(super) fn add_surface_part(
             y[p as usize] += share * v;
         }
     }
-}
-
-/// `L⁻ᵀ x` for the lower Cholesky factor `factor` given row by row (backward substitution).
-pub(super) fn backward(factor: &[Vec<f64>], mut x: Vec<f64>) -> Vec<f64> {
-    let n = x.len();
-    for i in (0..n).rev() {
-        let s: f64 = (i + 1..n).map(|k| factor[k][i] * x[k]).sum();
-        x[i] = (x[i] - s) / factor[i][i];
-    }
-    x
 }
 
 /// `Yᵀ Y` for the three rows `y` (one per axis).
