@@ -3,6 +3,7 @@
 //! what it reports.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use serde::Serialize;
@@ -20,7 +21,7 @@ use super::window::{
 };
 use crate::devices::{
     DeviceSpec, ForceDimension, HapticDevice, OpenHaptics, PressMotion, Recorder, Scripted, TICK_S,
-    TimerMode, Trajectory, press_and_slide, stop_requested,
+    TimerMode, Trajectory, VirtualHandle, press_and_slide, stop_requested,
 };
 use crate::scenario::Scenario;
 use crate::store::OnStale;
@@ -185,17 +186,7 @@ pub fn open_window(
         Some(lesson) => scenario_scene_capped(options, &lesson.scenario)?,
         None => scene(options)?,
     };
-    let (device, virtual_device) = match (open_hardware(&spec), &spec) {
-        (Some(device), _) => (device?, None),
-        (None, Some(DeviceSpec::Scripted(path))) => {
-            let trajectory = Trajectory::load(path).map_err(|e| e.to_string())?;
-            (scripted(&spec, trajectory), None)
-        }
-        (None, _) => {
-            let (device, handle) = mouse_device(&scene);
-            (device, Some(handle))
-        }
-    };
+    let WindowDevice { device, mouse } = window_device(&spec, &scene)?;
     let device = recorded(device, &options.record);
     let device_name = device.name().to_owned();
     let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
@@ -223,13 +214,13 @@ pub fn open_window(
         built_in: super::SHIPPED_SCENARIOS,
         scenes: scene_source(options),
         swap: haptic.swap(),
-        built: std::sync::Arc::new(|| crate::store::background_status().built),
+        built: Arc::new(|| crate::store::background_status().built),
     });
     let lessons = Lessons::default();
     let (exit, frames) = super::window::run(WindowScene {
         scene,
         snapshots,
-        virtual_device,
+        virtual_device: mouse,
         device_name,
         exit_after_s,
         screenshot,
@@ -258,10 +249,40 @@ pub fn open_window(
     }
 }
 
+/// The window's device, and the mouse's handle when the mouse drives it.
+struct WindowDevice {
+    device: Box<dyn HapticDevice>,
+    mouse: Option<Arc<VirtualHandle>>,
+}
+
+/// The hardware or scripted device `spec` asks for, else the mouse.
+fn window_device(spec: &Option<DeviceSpec>, scene: &HapticScene) -> Result<WindowDevice, String> {
+    Ok(match (open_hardware(spec), spec) {
+        (Some(device), _) => WindowDevice {
+            device: device?,
+            mouse: None,
+        },
+        (None, Some(DeviceSpec::Scripted(path))) => {
+            let trajectory = Trajectory::load(path).map_err(|e| e.to_string())?;
+            WindowDevice {
+                device: scripted(spec, trajectory),
+                mouse: None,
+            }
+        }
+        (None, _) => {
+            let (device, handle) = mouse_device(scene);
+            WindowDevice {
+                device,
+                mouse: Some(handle),
+            }
+        }
+    })
+}
+
 /// How the window's menu builds the scene of the scenario chosen.
 fn scene_source(options: &Options) -> SceneSource {
     let options = options.clone();
-    std::sync::Arc::new(move |scenario: &Scenario| {
+    Arc::new(move |scenario: &Scenario| {
         let (options, scenario) = (options.clone(), scenario.clone());
         Box::pin(async move { scenario_scene_capped(&options, &scenario) })
     })
@@ -277,10 +298,7 @@ fn attempts(lessons: &Lessons, haptic: &mut HapticLoop) -> Attempts {
     let mut attempts = Attempts::new();
     for (file, link) in lessons.take() {
         let mut ended = link.take_earlier();
-        if running
-            .as_ref()
-            .is_some_and(|r| std::sync::Arc::ptr_eq(r, &link))
-        {
+        if running.as_ref().is_some_and(|r| Arc::ptr_eq(r, &link)) {
             // An attempt never begun (the window closed on the briefing) has nothing to score.
             if link.started() {
                 let run = haptic.world_mut().remove_resource::<ExerciseRun>();

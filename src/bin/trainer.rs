@@ -16,7 +16,7 @@ use pgd_surgery::cli::{
 };
 use pgd_surgery::devices::{DeviceSpec, TimerMode};
 use pgd_surgery::history::HistoryFilter;
-use pgd_surgery::scenario;
+use pgd_surgery::scenario::{self, Scenario};
 use pgd_surgery::store::OnStale;
 
 #[derive(Parser)]
@@ -210,48 +210,8 @@ fn main() -> ExitCode {
     if let Err(e) = launch::install_exit_guards() {
         eprintln!("trainer: {e}; a device is still zeroed by its watchdog if the trainer dies");
     }
-    match &cli.command {
-        Some(Command::Validate { files }) => return validate_scenarios(files),
-        Some(Command::Prepare { files, web }) => {
-            return prepare_scenarios(files, &cli.vademecums, detail_of(&cli), web.as_deref());
-        }
-        Some(Command::Devices) => return list_devices(),
-        Some(Command::Soak {
-            duration_s,
-            keep_in,
-            plot,
-            scenario,
-        }) => {
-            return run_soak(
-                &SoakPlan {
-                    duration_s: *duration_s,
-                    vademecums: cli.vademecums.clone(),
-                    detail: detail_of(&cli),
-                    history: keep_in.clone(),
-                    trainee: cli.trainee.clone().unwrap_or_else(|| "soak".into()),
-                    leak_each_attempt: std::env::var_os(PLANT_LEAK).is_some(),
-                    only: scenario.clone(),
-                },
-                cli.json,
-                plot.as_deref(),
-            );
-        }
-        Some(Command::History {
-            scenario,
-            csv,
-            plot,
-        }) => {
-            return show_history(&HistoryRequest {
-                database: &cli.history,
-                filter: HistoryFilter {
-                    trainee: cli.trainee.clone(),
-                    scenario: scenario.as_ref().map(|s| s.display().to_string()),
-                },
-                csv: *csv,
-                plot,
-            });
-        }
-        _ => {}
+    if let Some(code) = run_command(&cli) {
+        return code;
     }
     let history = HistoryTarget {
         database: cli.history.clone(),
@@ -268,6 +228,76 @@ fn main() -> ExitCode {
         );
         return ExitCode::from(2);
     }
+    let options = launch_options(&cli);
+    let exercise = match chosen_exercise(&cli) {
+        Ok(exercise) => exercise,
+        Err(code) => return code,
+    };
+    if cli.headless {
+        return match exercise {
+            Some(chosen) => {
+                let outcome = launch::run_scenario_headless(&options, chosen.scenario);
+                debrief(
+                    outcome,
+                    chosen.file,
+                    None,
+                    chosen.report_dir,
+                    cli.json,
+                    &history,
+                )
+            }
+            None => finish(launch::run_headless(&options), cli.json),
+        };
+    }
+    run_window(&cli, &options, exercise, &history)
+}
+
+/// The commands that are not a run of the trainer (validate, prepare, devices, soak,
+/// history): their exit code, or `None` for a run.
+fn run_command(cli: &Cli) -> Option<ExitCode> {
+    Some(match cli.command.as_ref()? {
+        Command::Validate { files } => validate_scenarios(files),
+        Command::Prepare { files, web } => {
+            prepare_scenarios(files, &cli.vademecums, detail_of(cli), web.as_deref())
+        }
+        Command::Devices => list_devices(),
+        Command::Soak {
+            duration_s,
+            keep_in,
+            plot,
+            scenario,
+        } => run_soak(
+            &SoakPlan {
+                duration_s: *duration_s,
+                vademecums: cli.vademecums.clone(),
+                detail: detail_of(cli),
+                history: keep_in.clone(),
+                trainee: cli.trainee.clone().unwrap_or_else(|| "soak".into()),
+                leak_each_attempt: std::env::var_os(PLANT_LEAK).is_some(),
+                only: scenario.clone(),
+            },
+            cli.json,
+            plot.as_deref(),
+        ),
+        Command::History {
+            scenario,
+            csv,
+            plot,
+        } => show_history(&HistoryRequest {
+            database: &cli.history,
+            filter: HistoryFilter {
+                trainee: cli.trainee.clone(),
+                scenario: scenario.as_ref().map(|s| s.display().to_string()),
+            },
+            csv: *csv,
+            plot,
+        }),
+        Command::Run { .. } => return None,
+    })
+}
+
+/// How the trainer runs, from the command line.
+fn launch_options(cli: &Cli) -> launch::Options {
     // The window opens at once on a first run: nonlinear tissue comes as its vademecums are
     // built in the background. A headless run builds them first, to be the same every time.
     let on_stale = match (cli.no_rebuild, cli.headless) {
@@ -279,9 +309,9 @@ fn main() -> ExitCode {
         true => cli.realtime.then_some(cli.timer),
         false => Some(cli.timer),
     };
-    let options = launch::Options {
+    launch::Options {
         vademecums: cli.vademecums.clone(),
-        detail: detail_of(&cli),
+        detail: detail_of(cli),
         on_stale,
         device: cli.device.clone(),
         record: cli.record.clone(),
@@ -290,37 +320,53 @@ fn main() -> ExitCode {
         max_force_n: cli.max_force_n,
         free_camera: cli.free_camera,
         offscreen: cli.offscreen.then_some(cli.size),
-    };
-    let exercise = match &cli.command {
+    }
+}
+
+/// The scenario a run opens, its file, and where its reports go.
+struct Chosen<'a> {
+    scenario: Scenario,
+    file: &'a Path,
+    report_dir: &'a Path,
+}
+
+/// The scenario to run: `trainer run FILE`'s, none for free play or a headless run without
+/// one, else the built-in one. The exit code when it does not read.
+fn chosen_exercise(cli: &Cli) -> Result<Option<Chosen<'_>>, ExitCode> {
+    match &cli.command {
         Some(Command::Run { file, report_dir }) => match scenario::load(file) {
-            Ok(scenario) => Some((scenario, file.as_path(), report_dir.as_path())),
+            Ok(scenario) => Ok(Some(Chosen {
+                scenario,
+                file,
+                report_dir,
+            })),
             Err(e) => {
                 eprintln!("{e}");
-                return ExitCode::from(2);
+                Err(ExitCode::from(2))
             }
         },
-        _ if cli.headless || cli.free_play => None,
+        _ if cli.headless || cli.free_play => Ok(None),
         _ => match scenario::parse(Path::new(DEFAULT_SCENARIO.0), DEFAULT_SCENARIO.1) {
-            Ok(scenario) => Some((
+            Ok(scenario) => Ok(Some(Chosen {
                 scenario,
-                Path::new(DEFAULT_SCENARIO.0),
-                Path::new(DEFAULT_REPORT_DIR),
-            )),
+                file: Path::new(DEFAULT_SCENARIO.0),
+                report_dir: Path::new(DEFAULT_REPORT_DIR),
+            })),
             Err(e) => {
                 eprintln!("trainer: the built-in scenario does not read: {e}");
-                return ExitCode::FAILURE;
+                Err(ExitCode::FAILURE)
             }
         },
-    };
-    if cli.headless {
-        return match exercise {
-            Some((scenario, file, report_dir)) => {
-                let outcome = launch::run_scenario_headless(&options, scenario);
-                debrief(outcome, file, None, report_dir, cli.json, &history)
-            }
-            None => finish(launch::run_headless(&options), cli.json),
-        };
     }
+}
+
+/// Opens the window on the exercise (or free play), then debriefs every attempt made.
+fn run_window(
+    cli: &Cli,
+    options: &launch::Options,
+    exercise: Option<Chosen<'_>>,
+    history: &HistoryTarget,
+) -> ExitCode {
     let screenshot = cli.screenshot.clone().map(|path| ScreenshotPlan {
         path,
         after_frames: cli.frames.max(1),
@@ -329,8 +375,10 @@ fn main() -> ExitCode {
     // `trainer run FILE` opens FILE's briefing, its menu offering FILE's folder; the plain
     // trainer opens the menu of `scenarios/`, the built-in scenario chosen.
     let run_file = matches!(cli.command, Some(Command::Run { .. }));
-    let report_dir = exercise.as_ref().map(|(_, _, dir)| dir.to_path_buf());
-    let lesson = exercise.map(|(scenario, file, _)| WindowLesson {
+    let report_dir = exercise
+        .as_ref()
+        .map(|chosen| chosen.report_dir.to_path_buf());
+    let lesson = exercise.map(|Chosen { scenario, file, .. }| WindowLesson {
         scenario,
         file: file.to_owned(),
         opening: match run_file {
@@ -340,33 +388,35 @@ fn main() -> ExitCode {
         folder: Some(file.parent().unwrap_or(Path::new(".")).to_owned())
             .filter(|folder| folder.is_dir()),
     });
-    match launch::open_window(&options, cli.exit_after_s, screenshot, lesson) {
-        Ok((report, attempts)) => match report_dir {
-            Some(dir) if !attempts.is_empty() => {
-                // With --json, stdout carries the scorecards alone.
-                if !cli.json {
-                    report.print(false);
-                }
-                let codes: Vec<ExitCode> = numbered(attempts)
-                    .into_iter()
-                    .map(|(file, attempt, outcome)| {
-                        debrief(Ok(outcome), &file, attempt, &dir, cli.json, &history)
-                    })
-                    .collect();
-                codes
-                    .into_iter()
-                    .find(|code| *code != ExitCode::SUCCESS)
-                    .unwrap_or(ExitCode::SUCCESS)
+    let (report, attempts) =
+        match launch::open_window(options, cli.exit_after_s, screenshot, lesson) {
+            Ok(ran) => ran,
+            Err(e) => return finish(Err(e), cli.json),
+        };
+    match report_dir {
+        Some(dir) if !attempts.is_empty() => {
+            // With --json, stdout carries the scorecards alone.
+            if !cli.json {
+                report.print(false);
             }
-            Some(_) => {
-                eprintln!(
-                    "trainer: no exercise was begun (Space on a briefing begins it): nothing scored, no report"
-                );
-                finish(Ok(report), cli.json)
-            }
-            None => finish(Ok(report), cli.json),
-        },
-        Err(e) => finish(Err(e), cli.json),
+            let codes: Vec<ExitCode> = numbered(attempts)
+                .into_iter()
+                .map(|(file, attempt, outcome)| {
+                    debrief(Ok(outcome), &file, attempt, &dir, cli.json, history)
+                })
+                .collect();
+            codes
+                .into_iter()
+                .find(|code| *code != ExitCode::SUCCESS)
+                .unwrap_or(ExitCode::SUCCESS)
+        }
+        Some(_) => {
+            eprintln!(
+                "trainer: no exercise was begun (Space on a briefing begins it): nothing scored, no report"
+            );
+            finish(Ok(report), cli.json)
+        }
+        None => finish(Ok(report), cli.json),
     }
 }
 

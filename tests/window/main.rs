@@ -16,6 +16,7 @@ mod cornea;
 mod incision;
 mod laparoscope;
 mod scenarios;
+mod text;
 // The haptics tests' fakes; these tests only load one into the trainer, not its controls.
 #[allow(dead_code)]
 #[path = "../haptics/vendor_fake.rs"]

@@ -4,6 +4,7 @@
 //! on a simulated clock ([`SettleCuts`]), where each step is waited for so that a run is
 //! deterministic.
 
+use bevy::ecs::query::QueryData;
 use bevy::prelude::*;
 use nalgebra::{Matrix3, Point3, Unit, Vector3};
 
@@ -45,24 +46,16 @@ pub struct SettleCuts;
 
 /// Reads each cut organ's latest cut, softens the tool's press for it, and hands the blade's
 /// step, if any, to the organ's cut state.
-pub fn cut(
-    tool: Res<Tool>,
-    settle: Option<Res<SettleCuts>>,
-    mut organs: Query<(
-        &OrganBody,
-        &mut ToolTouch,
-        &mut OrganDeformation,
-        &mut OrganCut,
-    )>,
-) {
+pub fn cut(tool: Res<Tool>, settle: Option<Res<SettleCuts>>, mut organs: Query<CutOrgan>) {
     let cuts = tool.action() == Action::Cut;
-    for (body, mut touch, mut deformation, mut cut) in &mut organs {
+    for organ in &mut organs {
+        let (body, mut touch, mut deformation) = (organ.body, organ.touch, organ.deformation);
         let OrganCut {
             scalpel,
             worker,
             nodes,
             ..
-        } = &mut *cut;
+        } = organ.cut.into_inner();
         match settle {
             Some(_) => worker.settle(),
             None => worker.poll(),
@@ -88,6 +81,16 @@ pub fn cut(
             worker.submit(step);
         }
     }
+}
+
+/// An organ a scalpel cuts, as the cut stage reads and feeds it.
+#[derive(QueryData)]
+#[query_data(mutable)]
+pub struct CutOrgan {
+    body: &'static OrganBody,
+    touch: &'static mut ToolTouch,
+    deformation: &'static mut OrganDeformation,
+    cut: &'static mut OrganCut,
 }
 
 /// The press's stiffness as the cut organ answers it: the patch compliance the cut `added`

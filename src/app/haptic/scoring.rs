@@ -10,6 +10,7 @@ use std::mem::take;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
+use bevy::ecs::query::QueryData;
 use bevy::prelude::*;
 
 use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
@@ -19,14 +20,15 @@ use super::snapshot::SnapshotPublisher;
 use crate::scenario::{BladeSample, Exercise, Progress, RegionSite, Sample};
 
 /// What scoring reads of an organ entity.
-type Organ = (
-    &'static OrganIndex,
-    &'static ToolTouch,
-    &'static OrganBody,
-    &'static OrganDeformation,
-    Option<&'static OrganMotion>,
-    Option<&'static OrganCut>,
-);
+#[derive(QueryData)]
+pub struct ScoredOrgan {
+    index: &'static OrganIndex,
+    touch: &'static ToolTouch,
+    body: &'static OrganBody,
+    deformation: &'static OrganDeformation,
+    motion: Option<&'static OrganMotion>,
+    cut: Option<&'static OrganCut>,
+}
 
 /// Between the haptic thread and whoever started the exercise: whether it has begun, the
 /// exercise once it has ended, and a fresh one for another attempt.
@@ -182,7 +184,7 @@ pub fn score_tick(
     clock: Res<TickClock>,
     tool: Res<Tool>,
     force: Res<DeviceForce>,
-    organs: Query<Organ>,
+    organs: Query<ScoredOrgan>,
     mut run: ResMut<ExerciseRun>,
     scope: Option<ResMut<Scope>>,
 ) {
@@ -195,26 +197,21 @@ pub fn score_tick(
     let Some(exercise) = run.exercise.as_mut() else {
         return;
     };
-    let touching = organs
-        .iter()
-        .filter(|(index, touch, ..)| touch.contact.is_some() && index.0 < 64)
-        .fold(0, |bits, (index, ..)| bits | 1 << index.0);
-    let grasping = organs
-        .iter()
-        .filter(|(index, .., motion, _)| motion.is_some_and(|m| m.organ.holding()) && index.0 < 64)
-        .fold(0, |bits, (index, ..)| bits | 1 << index.0);
-    let tore = organs
-        .iter()
-        .any(|(.., motion, _)| motion.is_some_and(|m| m.tore));
-    let blade = organs
-        .iter()
-        .find_map(|(index, .., cut)| blade_sample(index, cut?));
+    let bits = |of: &dyn Fn(&ScoredOrganItem) -> bool| {
+        (organs.iter())
+            .filter(|o| o.index.0 < 64 && of(o))
+            .fold(0, |bits, o| bits | 1 << o.index.0)
+    };
+    let touching = bits(&|o| o.touch.contact.is_some());
+    let grasping = bits(&|o| o.motion.is_some_and(|m| m.organ.holding()));
+    let tore = organs.iter().any(|o| o.motion.is_some_and(|m| m.tore));
+    let blade = organs.iter().find_map(|o| blade_sample(o.index, o.cut?));
     let (region_moved_m, surrounding_force_n) = exercise
         .watched_region()
         .map_or((0.0, 0.0), |region| watch(region, &organs));
     let beyond_range_m = organs
         .iter()
-        .filter_map(|(_, touch, ..)| touch.contact.map(|c| c.beyond_range_m))
+        .filter_map(|o| o.touch.contact.map(|c| c.beyond_range_m))
         .fold(0.0, f64::max);
     let tip_m = tool.sample.map(|s| s.tip_m);
     let elapsed_s = exercise.elapsed_s(clock.time_s);
@@ -246,14 +243,14 @@ pub fn score_tick(
 
 /// How far the region has moved along its direction (m), and the force on every other organ
 /// (N): the tool's on it, and what the organs it touches or hangs from put on it.
-fn watch(region: &RegionSite, organs: &Query<Organ>) -> (f64, f64) {
+fn watch(region: &RegionSite, organs: &Query<ScoredOrgan>) -> (f64, f64) {
     let mut moved_m = 0.0;
     let mut surrounding_n = 0.0;
-    for (index, _, body, deformation, ..) in organs {
-        let deformation = &deformation.0;
-        if index.0 == region.organ {
+    for organ in organs {
+        let deformation = &organ.deformation.0;
+        if organ.index.0 == region.organ {
             moved_m = deformation
-                .displacement(&body.vademecum, &region.at)
+                .displacement(&organ.body.vademecum, &region.at)
                 .dot(&region.towards);
         } else {
             let tool = deformation.loads[OrganDeformation::TOOL].force_n;

@@ -1,5 +1,6 @@
 //! The systems of a haptic tick, one stage each, in [`super::HapticSet`] order.
 
+use bevy::ecs::query::QueryData;
 use bevy::prelude::*;
 use nalgebra::Vector3;
 
@@ -128,12 +129,7 @@ pub fn grasp(
     mut was_closed: Local<bool>,
     mut grasp_force: ResMut<GraspForce>,
     mut faults: ResMut<FaultLog>,
-    mut organs: Query<(
-        &OrganBody,
-        &mut ToolTouch,
-        &mut OrganDeformation,
-        &mut OrganMotion,
-    )>,
+    mut organs: Query<MovingOrgan>,
 ) {
     grasp_force.0 = Vector3::zeros();
     let Some(sample) = tool.sample else {
@@ -145,13 +141,14 @@ pub fn grasp(
     // escaped a closed grasper is not taken again until the trainee opens and closes it.
     let closing = closed && !*was_closed;
     *was_closed = closed;
-    let mut held_elsewhere = organs.iter().any(|(_, _, _, m)| m.organ.holding());
-    for (body, mut touch, mut deformation, mut motion) in &mut organs {
-        let motion = &mut *motion;
+    let mut held_elsewhere = organs.iter().any(|o| o.motion.organ.holding());
+    for organ in &mut organs {
+        let (mut touch, mut deformation) = (organ.touch, organ.deformation);
+        let motion = &mut *organ.motion.into_inner();
         let holding = motion.organ.holding();
         let grasping = closing && !holding && !held_elsewhere && touch.contact.is_some();
         if grasping {
-            take_hold(body, &touch, motion, &sample.tip_m);
+            take_hold(organ.body, &touch, motion, &sample.tip_m);
             held_elsewhere = true;
         }
         motion.tore = false;
@@ -162,7 +159,7 @@ pub fn grasp(
             }
             Err(e) => faults
                 .this_tick
-                .push(Fault::Physics(format!("{}: {e}", body.name))),
+                .push(Fault::Physics(format!("{}: {e}", organ.body.name))),
         }
         motion
             .organ
@@ -178,6 +175,16 @@ pub fn grasp(
             load.force_n = motion.organ.applied_n();
         }
     }
+}
+
+/// A moving organ as the grasp stage steps it.
+#[derive(QueryData)]
+#[query_data(mutable)]
+pub struct MovingOrgan {
+    body: &'static OrganBody,
+    touch: &'static mut ToolTouch,
+    deformation: &'static mut OrganDeformation,
+    motion: &'static mut OrganMotion,
 }
 
 /// Closes the jaws on the patch the tool touches (its shares, its centre and the vademecum's
@@ -205,33 +212,36 @@ pub fn evaluate_modes(mut organs: Query<(&OrganBody, &mut OrganDeformation)>) {
 /// and the tool's hold on it to the coupling, ticks its pairs and attachments, and gives each
 /// organ its coupling loads and carry. The tool's load follows the contact's push in the same
 /// tick, so the trainee feels the organ behind at once.
-pub fn organ_contact(
-    mut coupling: ResMut<OrganCoupling>,
-    mut organs: Query<(
-        &OrganIndex,
-        &mut ToolTouch,
-        &mut OrganDeformation,
-        Option<&OrganMotion>,
-    )>,
-) {
+pub fn organ_contact(mut coupling: ResMut<OrganCoupling>, mut organs: Query<CoupledOrgan>) {
     let coupling = &mut coupling.0;
-    for (index, touch, deformation, motion) in &organs {
-        let deformation = &deformation.0;
-        let moved = motion.map_or(&[][..], |m| &m.in_vademecum_modes);
-        coupling.read(index.0, deformation, moved);
+    for organ in &organs {
+        let deformation = &organ.deformation.0;
+        let moved = organ.motion.map_or(&[][..], |m| &m.in_vademecum_modes);
+        coupling.read(organ.index.0, deformation, moved);
         let load = &deformation.loads[OrganDeformation::TOOL];
-        coupling.hold(index.0, touch.contact.as_ref(), load);
+        coupling.hold(organ.index.0, organ.touch.contact.as_ref(), load);
     }
     coupling.tick();
-    for (index, mut touch, mut deformation, _) in &mut organs {
-        let deformation = &mut deformation.0;
-        coupling.write(index.0, deformation);
+    for mut organ in &mut organs {
+        let index = organ.index.0;
+        let deformation = &mut organ.deformation.0;
+        coupling.write(index, deformation);
         follow(
-            &mut touch.contact,
+            &mut organ.touch.contact,
             &mut deformation.loads[OrganDeformation::TOOL],
-            &coupling.tool_moved_m(index.0),
+            &coupling.tool_moved_m(index),
         );
     }
+}
+
+/// An organ as the organ/organ contact stage reads and loads it.
+#[derive(QueryData)]
+#[query_data(mutable)]
+pub struct CoupledOrgan {
+    index: &'static OrganIndex,
+    touch: &'static mut ToolTouch,
+    deformation: &'static mut OrganDeformation,
+    motion: Option<&'static OrganMotion>,
 }
 
 /// The force on the tool: the opposite of what it applies to the organs; through a port, as
@@ -303,13 +313,14 @@ pub fn trace_force(force: Res<DeviceForce>, mut trace: ResMut<ForceTrace>) {
 }
 
 /// What the snapshot takes of an organ entity.
-type Published = (
-    &'static OrganIndex,
-    &'static ToolTouch,
-    &'static OrganDeformation,
-    Option<&'static OrganMotion>,
-    Option<&'static OrganCut>,
-);
+#[derive(QueryData)]
+pub struct PublishedOrgan {
+    index: &'static OrganIndex,
+    touch: &'static ToolTouch,
+    deformation: &'static OrganDeformation,
+    motion: Option<&'static OrganMotion>,
+    cut: Option<&'static OrganCut>,
+}
 
 /// Hands the render side the tick's state, when one is listening; never waits.
 pub fn publish_snapshot(
@@ -317,7 +328,7 @@ pub fn publish_snapshot(
     tool: Res<Tool>,
     force: Res<DeviceForce>,
     safety: Res<Safety>,
-    organs: Query<Published>,
+    organs: Query<PublishedOrgan>,
     timing: Option<Res<LoopTiming>>,
     mut publisher: ResMut<SnapshotPublisher>,
 ) {
@@ -333,20 +344,20 @@ pub fn publish_snapshot(
     snapshot.force_n = force.sent_n;
     snapshot.faulted = safety.0.is_faulted();
     snapshot.timing = timing.map_or_else(LoopTiming::default, |t| *t);
-    let cuts = organs.iter().any(|(.., cut)| cut.is_some()) && tool.action() == Action::Cut;
+    let cuts = organs.iter().any(|o| o.cut.is_some()) && tool.action() == Action::Cut;
     snapshot.blade_edge = tool
         .sample
         .filter(|_| cuts)
         .map(|s| s.orientation * Vector3::x());
-    for (index, touch, deformation, motion, cut) in &organs {
-        let organ = &mut snapshot.organs[index.0];
-        organ.contact = touch.contact;
-        organ.deformation.clone_from(&deformation.0);
-        if let Some(motion) = motion {
+    for published in &organs {
+        let organ = &mut snapshot.organs[published.index.0];
+        organ.contact = published.touch.contact;
+        organ.deformation.clone_from(&published.deformation.0);
+        if let Some(motion) = published.motion {
             organ.motion.clone_from(&motion.correction);
             organ.grasped = motion.organ.holding();
         }
-        if let Some(cut) = cut {
+        if let Some(cut) = published.cut {
             organ.strokes.clear();
             organ.strokes.extend_from_slice(cut.scalpel.strokes());
         }

@@ -115,34 +115,7 @@ fn update_hud(
     let force_n = snapshot.0.force_n.norm();
     let filled = ((force_n / limit_n).clamp(0.0, 1.0) * 20.0).round() as usize;
     let gauge = format!("[{}{}]", "#".repeat(filled), "-".repeat(20 - filled));
-    let touching: Vec<&str> = snapshot
-        .0
-        .organs
-        .iter()
-        .zip(&link.scene.organs)
-        .filter(|(o, _)| o.contact.is_some())
-        .map(|(_, (name, _))| name.as_str())
-        .collect();
-    let grasped = snapshot
-        .0
-        .organs
-        .iter()
-        .zip(&link.scene.organs)
-        .find(|(o, _)| o.grasped)
-        .map(|(_, (name, _))| name.as_str());
-    let status = if snapshot.0.faulted {
-        "FAULT: force faded to zero (see the log)".to_owned()
-    } else if let Some(name) = grasped {
-        format!("grasping {name}: release the button to let go")
-    } else if touching.is_empty() {
-        "no contact".to_owned()
-    } else {
-        format!(
-            "touching {}{}",
-            touching.join(", "),
-            beyond_range(&snapshot.0)
-        )
-    };
+    let status = status_line(&link, &snapshot.0);
     let help = if link.virtual_device.is_some() {
         "\nmouse: move the tool | wheel or W/S: push in / pull out | Q/E: turn the handle\n\
          right-drag: orbit | middle-drag: pan | Ctrl+wheel or +/-: zoom"
@@ -175,6 +148,31 @@ fn update_hud(
         ),
     };
     text.0 = lines.compose(view.details.0);
+}
+
+/// What the tool is doing: a fault, a grasp, the organs it touches, or nothing.
+fn status_line(link: &HapticLink, snapshot: &HapticSnapshot) -> String {
+    // A snapshot of the scene before a change may name organs the new one lacks.
+    let named = |organs: &mut dyn Iterator<Item = usize>| -> Vec<&str> {
+        let name = |k: usize| link.scene.organs.get(k).map(|(name, _)| name.as_str());
+        organs.filter_map(name).collect()
+    };
+    let organs = || snapshot.organs.iter().enumerate();
+    let touching = named(
+        &mut organs()
+            .filter(|(_, o)| o.contact.is_some())
+            .map(|(k, _)| k),
+    );
+    let grasped = named(&mut organs().filter(|(_, o)| o.grasped).map(|(k, _)| k));
+    if snapshot.faulted {
+        "FAULT: force faded to zero (see the log)".to_owned()
+    } else if let Some(name) = grasped.first() {
+        format!("grasping {name}: release the button to let go")
+    } else if touching.is_empty() {
+        "no contact".to_owned()
+    } else {
+        format!("touching {}{}", touching.join(", "), beyond_range(snapshot))
+    }
 }
 
 /// The HUD's parts: what the trainee reads first, then the details behind F3.

@@ -14,6 +14,18 @@ pub struct Legend {
     /// lips of an incision (none uncut).
     #[serde(default)]
     pub lips: Vec<LipLegend>,
+    /// Each text shown, and the rectangle it takes: a test can check that none overlaps
+    /// another or leaves the screen.
+    #[serde(default)]
+    pub texts: Vec<TextLegend>,
+}
+
+/// A text on the screen: its first words and the rectangle it takes (pixels, corners).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TextLegend {
+    pub words: String,
+    pub min_px: [f32; 2],
+    pub max_px: [f32; 2],
 }
 
 /// One split vertex of a cut organ's surface: its own lip and the copy on the other.
@@ -124,6 +136,7 @@ pub fn legend(
         organs,
         tool,
         lips: Vec::new(),
+        texts: Vec::new(),
     }
 }
 

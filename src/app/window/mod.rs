@@ -32,7 +32,7 @@ use bevy::prelude::*;
 
 pub use bridge::{HapticLink, Snapshot};
 pub use frames::FrameReport;
-pub use legend::{Legend, LipLegend, OrganLegend, ToolLegend};
+pub use legend::{Legend, LipLegend, OrganLegend, TextLegend, ToolLegend};
 pub use lesson::{Lesson, Lessons, Opening};
 pub use menu::{MenuPlan, SceneSource};
 pub use screenshot::ScreenshotPlan;

@@ -17,7 +17,7 @@ use bevy::window::PrimaryWindow;
 
 use super::bridge::Snapshot;
 use super::laparoscope::CameraMode;
-use super::legend::{Aperture, DrawnSurface, Legend, LipLegend, legend};
+use super::legend::{Aperture, DrawnSurface, Legend, LipLegend, TextLegend, legend};
 use super::offscreen::Offscreen;
 use super::organs::OrganView;
 use super::tool::ToolTip;
@@ -87,6 +87,16 @@ struct Frame<'w, 's> {
     link: Res<'w, HapticLink>,
     mode: Res<'w, CameraMode>,
     offscreen: Option<Res<'w, Offscreen>>,
+    texts: Query<
+        'w,
+        's,
+        (
+            &'static Text,
+            &'static ComputedNode,
+            &'static UiGlobalTransform,
+            &'static InheritedVisibility,
+        ),
+    >,
 }
 
 impl Frame<'_, '_> {
@@ -280,7 +290,29 @@ fn frame_legend(frame: &Frame) -> Result<Legend, String> {
         });
     let mut legend = legend(camera, scale_factor, &surfaces, tool, aperture);
     legend.lips = lips(frame, camera, scale_factor);
+    legend.texts = texts(frame);
     Ok(legend)
+}
+
+/// Each text shown and the rectangle its node takes (an empty one takes none).
+fn texts(frame: &Frame) -> Vec<TextLegend> {
+    let shown = frame.texts.iter().filter(|(.., visible)| visible.get());
+    shown
+        .filter_map(|(text, node, transform, _)| {
+            let size = node.size();
+            let centre = transform.affine().translation;
+            (size.x * size.y > 0.0).then(|| TextLegend {
+                words: text
+                    .0
+                    .chars()
+                    .take(40)
+                    .collect::<String>()
+                    .replace('\n', " "),
+                min_px: (centre - size / 2.0).to_array(),
+                max_px: (centre + size / 2.0).to_array(),
+            })
+        })
+        .collect()
 }
 
 /// Where each split vertex of a cut organ and its copy across the cut are drawn.
@@ -336,6 +368,7 @@ mod tests {
             }],
             tool: None,
             lips: Vec::new(),
+            texts: Vec::new(),
         }
     }
 

@@ -69,58 +69,7 @@ pub enum Command {
     /// Check a vademecum against full FEM on the same mesh at random loads it was not built on:
     /// felt-force and displacement errors (mean, p50, p95), and the build's convergence
     /// curves as CSV and PNG.
-    Validate {
-        #[command(flatten)]
-        mesh: MeshArgs,
-        /// The vademecum (default: vademecums/<source>.vdm, or <source>-<law>.vdm with --law).
-        #[arg(long, value_name = "FILE.vdm")]
-        vademecum: Option<PathBuf>,
-        /// The law of the default vademecum file (the file's own law is the one checked).
-        #[arg(long, value_enum, default_value = "linear")]
-        law: LawArg,
-        /// Number of random loads (default 60), or of cut patterns with --cuts (default 5).
-        #[arg(long)]
-        samples: Option<usize>,
-        /// Seed of the random loads.
-        #[arg(long, default_value_t = ValidationSettings::default().seed)]
-        sample_seed: u64,
-        /// Largest indentation of the random loads, in millimetres (default: 10/3 of the
-        /// organ's tool radius, 20 for the abdominal organs; the smallest is a tenth of it).
-        #[arg(long)]
-        max_indentation_mm: Option<f64>,
-        /// The random loads' directions lie within this angle of the inward normal, in
-        /// degrees (0: along it; less than 90).
-        #[arg(long, default_value_t = ValidationSettings::default().max_tilt_deg)]
-        max_tilt_deg: f64,
-        /// Presses along the normal at random points, full FEM against the vademecum from
-        /// zero to the largest indentation, printed and drawn as force–depth curves
-        /// (FILE.force-depth.png beside the vademecum).
-        #[arg(long, default_value_t = ValidationSettings::default().curves)]
-        curves: usize,
-        /// Press beyond the vademecum's range: each load between its point's range edge and
-        /// --max-indentation-mm, the curves to --max-indentation-mm, measuring what the
-        /// trainer extrapolates past the load steps (a nonlinear vademecum).
-        #[arg(long)]
-        beyond_range: bool,
-        /// Check the cut section instead, on cut patterns drawn at random, each incision made
-        /// in three segments: `radial:N` (the cornea), N radial incisions at random angles,
-        /// optical zones of 3–5 mm and depths of 60–95 %, under 15 mmHg; `straight:N`, N
-        /// incisions 20 mm long and 10 mm deep into the accessible face, under the tool
-        /// beside the first; --samples patterns (default 5 here).
-        #[arg(long, value_name = "PATTERN", value_parser = cli::parse_cut_pattern)]
-        cuts: Option<CutPattern>,
-        /// With --cuts: run the cut state on the factorized stiffness instead of the cut
-        /// section (the reference path; a sparse solve per enriched function).
-        #[arg(long, requires = "cuts")]
-        exact_response: bool,
-        /// With --cuts: how far from a segment's enriched functions the patch solved for
-        /// them reaches, in millimetres (default: three mean element edges).
-        #[arg(long, requires = "cuts", conflicts_with = "exact_response")]
-        cut_patch_mm: Option<f64>,
-        /// Print the report as JSON.
-        #[arg(long)]
-        json: bool,
-    },
+    Validate(ValidateArgs),
     /// Radial keratotomy on the cornea: N radial incisions from the optical zone's edge to
     /// 0.5 mm inside the limbus, under 15 mmHg of intraocular pressure, solved by full X-FEM;
     /// prints the change of central corneal power in dioptres.
@@ -199,6 +148,61 @@ pub enum Command {
         #[command(subcommand)]
         what: BenchTarget,
     },
+}
+
+/// `pgd validate`'s options.
+#[derive(clap::Args)]
+pub struct ValidateArgs {
+    #[command(flatten)]
+    pub mesh: MeshArgs,
+    /// The vademecum (default: vademecums/<source>.vdm, or <source>-<law>.vdm with --law).
+    #[arg(long, value_name = "FILE.vdm")]
+    pub vademecum: Option<PathBuf>,
+    /// The law of the default vademecum file (the file's own law is the one checked).
+    #[arg(long, value_enum, default_value = "linear")]
+    pub law: LawArg,
+    /// Number of random loads (default 60), or of cut patterns with --cuts (default 5).
+    #[arg(long)]
+    pub samples: Option<usize>,
+    /// Seed of the random loads.
+    #[arg(long, default_value_t = ValidationSettings::default().seed)]
+    pub sample_seed: u64,
+    /// Largest indentation of the random loads, in millimetres (default: 10/3 of the
+    /// organ's tool radius, 20 for the abdominal organs; the smallest is a tenth of it).
+    #[arg(long)]
+    pub max_indentation_mm: Option<f64>,
+    /// The random loads' directions lie within this angle of the inward normal, in
+    /// degrees (0: along it; less than 90).
+    #[arg(long, default_value_t = ValidationSettings::default().max_tilt_deg)]
+    pub max_tilt_deg: f64,
+    /// Presses along the normal at random points, full FEM against the vademecum from
+    /// zero to the largest indentation, printed and drawn as force–depth curves
+    /// (FILE.force-depth.png beside the vademecum).
+    #[arg(long, default_value_t = ValidationSettings::default().curves)]
+    pub curves: usize,
+    /// Press beyond the vademecum's range: each load between its point's range edge and
+    /// --max-indentation-mm, the curves to --max-indentation-mm, measuring what the
+    /// trainer extrapolates past the load steps (a nonlinear vademecum).
+    #[arg(long)]
+    pub beyond_range: bool,
+    /// Check the cut section instead, on cut patterns drawn at random, each incision made
+    /// in three segments: `radial:N` (the cornea), N radial incisions at random angles,
+    /// optical zones of 3–5 mm and depths of 60–95 %, under 15 mmHg; `straight:N`, N
+    /// incisions 20 mm long and 10 mm deep into the accessible face, under the tool
+    /// beside the first; --samples patterns (default 5 here).
+    #[arg(long, value_name = "PATTERN", value_parser = cli::parse_cut_pattern)]
+    pub cuts: Option<CutPattern>,
+    /// With --cuts: run the cut state on the factorized stiffness instead of the cut
+    /// section (the reference path; a sparse solve per enriched function).
+    #[arg(long, requires = "cuts")]
+    pub exact_response: bool,
+    /// With --cuts: how far from a segment's enriched functions the patch solved for
+    /// them reaches, in millimetres (default: three mean element edges).
+    #[arg(long, requires = "cuts", conflicts_with = "exact_response")]
+    pub cut_patch_mm: Option<f64>,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Where the mesh comes from.
@@ -513,34 +517,7 @@ pub enum BenchTarget {
     },
     /// The haptic loop on the four-organ scene: tick compute time over a scripted sweep (all
     /// organs, then each), the same press by full FEM, and real-time punctuality per timer.
-    Haptics {
-        /// Sweeps run per figure; the median is reported.
-        #[arg(long, default_value_t = 5)]
-        repeats: usize,
-        /// Seconds of real-time ticking per timer.
-        #[arg(long, default_value_t = 5.0)]
-        realtime_seconds: f64,
-        /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
-        #[arg(long, default_value = "vademecums")]
-        vademecums: PathBuf,
-        /// Every organ moves (reduced dynamics, stepped every tick), as with a grasper.
-        #[arg(long)]
-        dynamic: bool,
-        /// The organs' tissue law (each organ's vademecum is built under it; default: the
-        /// trainer's, exponential, or linear with --dynamic).
-        #[arg(long, value_enum)]
-        law: Option<LawArg>,
-        /// The coarse organs and their 12 mm tool (vademecums that build in minutes).
-        #[arg(long)]
-        coarse: bool,
-        /// How deep the sweep presses each organ, in millimetres (deeper than a nonlinear
-        /// vademecum's range to time the presses beyond it).
-        #[arg(long, default_value_t = PressMotion::default().depth_m * 1e3)]
-        depth_mm: f64,
-        /// Print the report as JSON instead of a table.
-        #[arg(long)]
-        json: bool,
-    },
+    Haptics(HapticsBenchArgs),
     /// Incisions added online to the cut state, segment by segment, over the exact uncut
     /// response and over a cut vademecum, against the full X-FEM solve of the same cut after
     /// each segment; the tool's felt force with 0, 4 and 16 segments (a 40 × 40 × 10 mm block).
@@ -604,6 +581,37 @@ pub enum BenchTarget {
         #[arg(long)]
         json: bool,
     },
+}
+
+/// `pgd bench haptics`'s options.
+#[derive(clap::Args)]
+pub struct HapticsBenchArgs {
+    /// Sweeps run per figure; the median is reported.
+    #[arg(long, default_value_t = 5)]
+    pub repeats: usize,
+    /// Seconds of real-time ticking per timer.
+    #[arg(long, default_value_t = 5.0)]
+    pub realtime_seconds: f64,
+    /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
+    #[arg(long, default_value = "vademecums")]
+    pub vademecums: PathBuf,
+    /// Every organ moves (reduced dynamics, stepped every tick), as with a grasper.
+    #[arg(long)]
+    pub dynamic: bool,
+    /// The organs' tissue law (each organ's vademecum is built under it; default: the
+    /// trainer's, exponential, or linear with --dynamic).
+    #[arg(long, value_enum)]
+    pub law: Option<LawArg>,
+    /// The coarse organs and their 12 mm tool (vademecums that build in minutes).
+    #[arg(long)]
+    pub coarse: bool,
+    /// How deep the sweep presses each organ, in millimetres (deeper than a nonlinear
+    /// vademecum's range to time the presses beyond it).
+    #[arg(long, default_value_t = PressMotion::default().depth_m * 1e3)]
+    pub depth_mm: f64,
+    /// Print the report as JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `pgd bench contact`: the scene and the contact settings it is timed on.

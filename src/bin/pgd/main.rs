@@ -6,7 +6,10 @@ mod args;
 use std::path::Path;
 use std::process::ExitCode;
 
-use args::{BenchTarget, BuildArgs, Cli, Command, ContactBenchArgs, MaterialArgs, MeshArgs};
+use args::{
+    BenchTarget, BuildArgs, Cli, Command, ContactBenchArgs, HapticsBenchArgs, MaterialArgs,
+    MeshArgs, ValidateArgs,
+};
 use clap::Parser;
 use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, press_targets, scene_of};
 use pgd_surgery::cli::{self, fail, print_json, print_report};
@@ -80,77 +83,7 @@ fn main() -> ExitCode {
                 Err(e) => fail("pgd build", &e),
             }
         }
-        Command::Validate {
-            mesh,
-            vademecum,
-            law,
-            samples,
-            sample_seed,
-            max_indentation_mm,
-            max_tilt_deg,
-            curves,
-            beyond_range,
-            cuts,
-            exact_response,
-            cut_patch_mm,
-            json,
-        } => {
-            let file = vademecum.unwrap_or_else(|| args::default_vademecum(&mesh, law.law()));
-            if let Some(pattern) = cuts {
-                let patch_radius_m = match cut_patch_mm {
-                    Some(mm) => match args::millimetres("cut-patch-mm", Some(mm), 0.0) {
-                        Ok(m) => Some(m),
-                        Err(e) => return fail("pgd validate --cuts", &e),
-                    },
-                    None => None,
-                };
-                let settings = CutValidationSettings {
-                    pattern,
-                    samples: samples.unwrap_or(CutValidationSettings::default().samples),
-                    seed: sample_seed,
-                    patch_radius_m,
-                    ..CutValidationSettings::default()
-                };
-                return validate_cut_section(&mesh, &file, (&settings, exact_response), json);
-            }
-            if !(0.0..90.0).contains(&max_tilt_deg) {
-                let problem = format!("--max-tilt-deg {max_tilt_deg}: not in 0 to 90 degrees");
-                return fail("pgd validate", &problem);
-            }
-            let settings = |organ| {
-                let defaults = ValidationSettings::for_organ(organ);
-                let defaults = ValidationSettings {
-                    samples: samples.unwrap_or(defaults.samples),
-                    seed: sample_seed,
-                    curves,
-                    max_tilt_deg,
-                    beyond_range,
-                    ..defaults
-                };
-                match max_indentation_mm {
-                    Some(mm) => defaults.deepest_indentation(mm * 1e-3),
-                    None => defaults,
-                }
-            };
-            let validated = mesh
-                .load()
-                .and_then(|loaded| cli::validate_vademecum(&mesh.source, loaded, &file, settings));
-            let report = match validated {
-                Ok(report) => report,
-                Err(e) => return fail("pgd validate", &e),
-            };
-            match cli::plot_force_depth(&report, &file) {
-                Ok(Some(png)) => eprintln!("force-depth curves: {}", png.display()),
-                Ok(None) => {}
-                Err(e) => return fail("pgd validate", &e),
-            }
-            if json {
-                return print_json(&report);
-            }
-            cli::print_validation(&report);
-            cli::print_force_depth(&report);
-            ExitCode::SUCCESS
-        }
+        Command::Validate(options) => validate_command(options),
         Command::Cut {
             organ,
             incisions,
@@ -193,6 +126,80 @@ fn main() -> ExitCode {
         } => fit_command(&data, poisson, plot, json),
         Command::Bench { what } => bench_command(what),
     }
+}
+
+/// `pgd validate`: a vademecum against full FEM, or its cut section against full X-FEM.
+fn validate_command(options: ValidateArgs) -> ExitCode {
+    let ValidateArgs {
+        mesh,
+        vademecum,
+        law,
+        samples,
+        sample_seed,
+        max_indentation_mm,
+        max_tilt_deg,
+        curves,
+        beyond_range,
+        cuts,
+        exact_response,
+        cut_patch_mm,
+        json,
+    } = options;
+    let file = vademecum.unwrap_or_else(|| args::default_vademecum(&mesh, law.law()));
+    if let Some(pattern) = cuts {
+        let patch_radius_m = match cut_patch_mm {
+            Some(mm) => match args::millimetres("cut-patch-mm", Some(mm), 0.0) {
+                Ok(m) => Some(m),
+                Err(e) => return fail("pgd validate --cuts", &e),
+            },
+            None => None,
+        };
+        let settings = CutValidationSettings {
+            pattern,
+            samples: samples.unwrap_or(CutValidationSettings::default().samples),
+            seed: sample_seed,
+            patch_radius_m,
+            ..CutValidationSettings::default()
+        };
+        return validate_cut_section(&mesh, &file, (&settings, exact_response), json);
+    }
+    if !(0.0..90.0).contains(&max_tilt_deg) {
+        let problem = format!("--max-tilt-deg {max_tilt_deg}: not in 0 to 90 degrees");
+        return fail("pgd validate", &problem);
+    }
+    let settings = |organ| {
+        let defaults = ValidationSettings::for_organ(organ);
+        let defaults = ValidationSettings {
+            samples: samples.unwrap_or(defaults.samples),
+            seed: sample_seed,
+            curves,
+            max_tilt_deg,
+            beyond_range,
+            ..defaults
+        };
+        match max_indentation_mm {
+            Some(mm) => defaults.deepest_indentation(mm * 1e-3),
+            None => defaults,
+        }
+    };
+    let validated = mesh
+        .load()
+        .and_then(|loaded| cli::validate_vademecum(&mesh.source, loaded, &file, settings));
+    let report = match validated {
+        Ok(report) => report,
+        Err(e) => return fail("pgd validate", &e),
+    };
+    match cli::plot_force_depth(&report, &file) {
+        Ok(Some(png)) => eprintln!("force-depth curves: {}", png.display()),
+        Ok(None) => {}
+        Err(e) => return fail("pgd validate", &e),
+    }
+    if json {
+        return print_json(&report);
+    }
+    cli::print_validation(&report);
+    cli::print_force_depth(&report);
+    ExitCode::SUCCESS
 }
 
 fn fit_command(
@@ -306,80 +313,14 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             coarse,
             vademecums,
             json,
-        } => {
-            let detail = if coarse { Detail::Coarse } else { Detail::Full };
-            let organs = SCENE_ORGANS.map(SceneOrgan::from);
-            let scene = match abdomen_scene(&organs, &vademecums, detail) {
-                Ok(scene) => scene,
-                Err(e) => return fail("pgd bench frame", &e),
-            };
-            let pressed: Vec<_> = scene
-                .organs
-                .iter()
-                .zip(press_targets(&scene))
-                .map(|((name, v), t)| (name.clone(), v.as_ref(), t.point_m, t.normal))
-                .collect();
-            let report = bench::frame::run(&pressed, FRAME_BENCH_PRESS_N, frames);
-            print_report("pgd bench frame", Ok::<_, String>(report), json)
-        }
-        BenchTarget::Haptics {
-            repeats,
-            realtime_seconds,
-            vademecums,
-            dynamic,
-            law,
-            coarse,
-            depth_mm,
-            json,
-        } => {
-            let motion = match args::millimetres("depth-mm", Some(depth_mm), 0.0) {
-                Ok(depth_m) => PressMotion {
-                    depth_m,
-                    ..PressMotion::default()
-                },
-                Err(e) => return fail("pgd bench haptics", &e),
-            };
-            let organs = SCENE_ORGANS.map(|organ| SceneOrgan {
-                dynamic,
-                law: law.map_or(default_law(Some(organ), false, dynamic), |l| l.law()),
-                ..SceneOrgan::from(organ)
-            });
-            let detail = if coarse { Detail::Coarse } else { Detail::Full };
-            let scene = match abdomen_scene(&organs, &vademecums, detail) {
-                Ok(scene) => scene,
-                Err(e) => return fail("pgd bench haptics", &e),
-            };
-            print_report(
-                "pgd bench haptics",
-                app::bench::run(&scene, &motion, repeats, realtime_seconds),
-                json,
-            )
-        }
+        } => bench_frame(frames, coarse, &vademecums, json),
+        BenchTarget::Haptics(options) => bench_haptics(options),
         BenchTarget::Scalpel {
             repeats,
             coarse,
             vademecums,
             json,
-        } => {
-            let organs = SCENE_ORGANS.map(|organ| SceneOrgan {
-                cut_toughness_j_per_m2: (organ == Organ::Liver)
-                    .then_some(pgd_surgery::cutting::LIVER_TOUGHNESS_J_PER_M2),
-                ..SceneOrgan::from(organ)
-            });
-            let detail = if coarse { Detail::Coarse } else { Detail::Full };
-            let mut scene = match abdomen_scene(&organs, &vademecums, detail) {
-                Ok(scene) => scene,
-                Err(e) => return fail("pgd bench scalpel", &e),
-            };
-            if let Some(cutting) = &mut scene.cutting {
-                cutting.blade.edge_m = 0.003;
-            }
-            print_report(
-                "pgd bench scalpel",
-                app::bench_scalpel::run(&scene, repeats),
-                json,
-            )
-        }
+        } => bench_scalpel(repeats, coarse, &vademecums, json),
         BenchTarget::Cutting { cells, json } => print_report(
             "pgd bench cutting",
             bench::cutting::run([cells[0], cells[1], cells[2]]),
@@ -394,6 +335,82 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             print_report("pgd bench fem", bench::fem::run(cells, repeats), json)
         }
     }
+}
+
+/// `pgd bench frame`: the window's per-frame work on the scene, without a window.
+fn bench_frame(frames: usize, coarse: bool, vademecums: &Path, json: bool) -> ExitCode {
+    let detail = if coarse { Detail::Coarse } else { Detail::Full };
+    let organs = SCENE_ORGANS.map(SceneOrgan::from);
+    let scene = match abdomen_scene(&organs, vademecums, detail) {
+        Ok(scene) => scene,
+        Err(e) => return fail("pgd bench frame", &e),
+    };
+    let pressed: Vec<_> = scene
+        .organs
+        .iter()
+        .zip(press_targets(&scene))
+        .map(|((name, v), t)| (name.clone(), v.as_ref(), t.point_m, t.normal))
+        .collect();
+    let report = bench::frame::run(&pressed, FRAME_BENCH_PRESS_N, frames);
+    print_report("pgd bench frame", Ok::<_, String>(report), json)
+}
+
+/// `pgd bench haptics`: the haptic loop's tick on the four-organ scene.
+fn bench_haptics(options: HapticsBenchArgs) -> ExitCode {
+    let HapticsBenchArgs {
+        repeats,
+        realtime_seconds,
+        vademecums,
+        dynamic,
+        law,
+        coarse,
+        depth_mm,
+        json,
+    } = options;
+    let motion = match args::millimetres("depth-mm", Some(depth_mm), 0.0) {
+        Ok(depth_m) => PressMotion {
+            depth_m,
+            ..PressMotion::default()
+        },
+        Err(e) => return fail("pgd bench haptics", &e),
+    };
+    let organs = SCENE_ORGANS.map(|organ| SceneOrgan {
+        dynamic,
+        law: law.map_or(default_law(Some(organ), false, dynamic), |l| l.law()),
+        ..SceneOrgan::from(organ)
+    });
+    let detail = if coarse { Detail::Coarse } else { Detail::Full };
+    let scene = match abdomen_scene(&organs, &vademecums, detail) {
+        Ok(scene) => scene,
+        Err(e) => return fail("pgd bench haptics", &e),
+    };
+    print_report(
+        "pgd bench haptics",
+        app::bench::run(&scene, &motion, repeats, realtime_seconds),
+        json,
+    )
+}
+
+/// `pgd bench scalpel`: the haptic loop's tick with a scalpel cutting the liver.
+fn bench_scalpel(repeats: usize, coarse: bool, vademecums: &Path, json: bool) -> ExitCode {
+    let organs = SCENE_ORGANS.map(|organ| SceneOrgan {
+        cut_toughness_j_per_m2: (organ == Organ::Liver)
+            .then_some(pgd_surgery::cutting::LIVER_TOUGHNESS_J_PER_M2),
+        ..SceneOrgan::from(organ)
+    });
+    let detail = if coarse { Detail::Coarse } else { Detail::Full };
+    let mut scene = match abdomen_scene(&organs, vademecums, detail) {
+        Ok(scene) => scene,
+        Err(e) => return fail("pgd bench scalpel", &e),
+    };
+    if let Some(cutting) = &mut scene.cutting {
+        cutting.blade.edge_m = 0.003;
+    }
+    print_report(
+        "pgd bench scalpel",
+        app::bench_scalpel::run(&scene, repeats),
+        json,
+    )
 }
 
 /// The press on each organ in `pgd bench frame` (N): the haptic benchmark's.
