@@ -17,6 +17,12 @@ mod trainer_history;
 mod trainer_soak;
 
 pub use output::{fail, print_json, print_report};
+
+/// A mesh read for a command, and the generated organ it is, if it is one.
+pub struct LoadedMesh {
+    pub organ: Option<crate::mesh::organs::Organ>,
+    pub mesh: crate::mesh::TetMesh,
+}
 pub use parse::{
     parse_cut_pattern, parse_force_limit_n, parse_inclusion, parse_point_mm,
     parse_positive_seconds, parse_seconds, parse_spacing, parse_stiffness_ratio,

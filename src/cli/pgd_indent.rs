@@ -7,8 +7,9 @@ use std::time::Instant;
 use nalgebra::Point3;
 use serde::Serialize;
 
+use super::LoadedMesh;
 use crate::fem::{FemModel, IndentationSettings, Material, SphereIndenter};
-use crate::mesh::organs::{Organ, region};
+use crate::mesh::organs::region;
 use crate::mesh::{Surface, TetMesh};
 use crate::pgd::{Progress, organ};
 use crate::report::{LineChart, Series, line_chart};
@@ -54,7 +55,7 @@ pub struct LawCurve {
 /// Presses the organ `mesh` (with `clamped` and `accessible` regions) with its tool, once per
 /// material, from rest to the requested depth in `request.steps` equal steps.
 pub fn indent_organ(
-    (organ, mesh): (Option<Organ>, TetMesh),
+    LoadedMesh { organ, mesh }: LoadedMesh,
     materials: &[Material],
     request: &IndentRequest,
     progress: &dyn Progress,

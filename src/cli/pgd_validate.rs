@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use super::LoadedMesh;
 use super::pgd_build::write_convergence;
 use crate::cutting::keratotomy::Cornea;
 use crate::cutting::{
@@ -10,7 +11,6 @@ use crate::cutting::{
     validate_incisions, validate_keratotomy,
 };
 use crate::fem::FemModel;
-use crate::mesh::TetMesh;
 use crate::mesh::organs::Organ;
 use crate::pgd::{self, ValidationReport, ValidationSettings};
 use crate::report::{LineChart, Series, line_chart};
@@ -21,7 +21,7 @@ use crate::store::Bar;
 /// curves beside it first.
 pub fn validate_vademecum(
     source: &str,
-    (organ, mesh): (Option<Organ>, TetMesh),
+    LoadedMesh { organ, mesh }: LoadedMesh,
     file: &Path,
     settings: impl Fn(Option<Organ>) -> ValidationSettings,
 ) -> Result<ValidationReport, String> {
@@ -159,7 +159,7 @@ pub fn plot_force_depth(
 /// path).
 pub fn validate_cuts(
     source: &str,
-    (organ, mesh): (Option<Organ>, TetMesh),
+    LoadedMesh { organ, mesh }: LoadedMesh,
     file: &Path,
     settings: &CutValidationSettings,
     exact: bool,

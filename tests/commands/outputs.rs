@@ -11,7 +11,7 @@ use crate::common::{block_mesh, block_model, build_block, temp_dir};
 /// ν = 0.48, and the curves drawn as a PNG; a request without steps is refused.
 #[test]
 fn pgd_indent_gives_a_force_depth_curve_per_law() {
-    use pgd_surgery::cli::{IndentRequest, indent_organ, plot_indentation};
+    use pgd_surgery::cli::{IndentRequest, LoadedMesh, indent_organ, plot_indentation};
     use pgd_surgery::fem::Material;
     use pgd_surgery::mesh::organs::region;
 
@@ -28,7 +28,16 @@ fn pgd_indent_gives_a_force_depth_curve_per_law() {
         steps: 4,
     };
     let silent = pgd_surgery::pgd::Silent;
-    let report = indent_organ((None, mesh.clone()), &materials, &request, &silent).unwrap();
+    let report = indent_organ(
+        LoadedMesh {
+            organ: None,
+            mesh: mesh.clone(),
+        },
+        &materials,
+        &request,
+        &silent,
+    )
+    .unwrap();
     assert_eq!(report.point_m, [0.03, 0.02, 0.03]);
     let [linear, neo_hookean] = [&report.curves[0], &report.curves[1]];
     for curve in [linear, neo_hookean] {
@@ -50,7 +59,13 @@ fn pgd_indent_gives_a_force_depth_curve_per_law() {
         steps: 0,
         ..request
     };
-    let refused = indent_organ((None, mesh), &materials, &no_steps, &silent).unwrap_err();
+    let refused = indent_organ(
+        LoadedMesh { organ: None, mesh },
+        &materials,
+        &no_steps,
+        &silent,
+    )
+    .unwrap_err();
     assert!(refused.contains("--steps"), "{refused}");
 }
 

@@ -4,12 +4,12 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, Parser, Subcommand};
+use pgd_surgery::cli::LoadedMesh;
 use pgd_surgery::contact::{CouplingSettings, PenaltySettings, PointshellDensity};
 use pgd_surgery::cutting::CutPattern;
 use pgd_surgery::cutting::keratotomy::REFERENCE_MESH;
 use pgd_surgery::devices::PressMotion;
 use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
-use pgd_surgery::mesh::TetMesh;
 use pgd_surgery::mesh::io::ImportOptions;
 use pgd_surgery::mesh::organs::{CORNEA_LAYERS, Organ, OrganSettings};
 use pgd_surgery::pgd::{
@@ -229,8 +229,8 @@ pub struct MeshArgs {
 }
 
 impl MeshArgs {
-    pub fn load(&self) -> Result<(Option<Organ>, TetMesh), String> {
-        store::load_source(&store::MeshSource {
+    pub fn load(&self) -> Result<LoadedMesh, String> {
+        let (organ, mesh) = store::load_source(&store::MeshSource {
             name: &self.source,
             organ: OrganSettings {
                 resolution: self.resolution,
@@ -241,7 +241,8 @@ impl MeshArgs {
                 scale: self.scale,
                 surface_nodes: self.nodes,
             },
-        })
+        })?;
+        Ok(LoadedMesh { organ, mesh })
     }
 
     /// The file name a vademecum of this source gets by default.

@@ -12,7 +12,7 @@ use args::{
 };
 use clap::Parser;
 use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, press_targets, scene_of};
-use pgd_surgery::cli::{self, fail, print_json, print_report};
+use pgd_surgery::cli::{self, LoadedMesh, fail, print_json, print_report};
 use pgd_surgery::contact::CouplingSettings;
 use pgd_surgery::cutting::CutValidationSettings;
 use pgd_surgery::cutting::keratotomy::{Cornea, Keratotomy};
@@ -39,10 +39,10 @@ fn indent_command(
         steps,
     };
     let plot = plot.unwrap_or_else(|| format!("{}-indentation.png", mesh.stem()).into());
-    let report = mesh.load().and_then(|(organ, m)| {
-        let base = material.material(organ)?;
+    let report = mesh.load().and_then(|loaded| {
+        let base = material.material(loaded.organ)?;
         let materials: Vec<_> = laws.iter().map(|law| base.with_law(law.law())).collect();
-        let report = cli::indent_organ((organ, m), &materials, &request, &Bar::default())?;
+        let report = cli::indent_organ(loaded, &materials, &request, &Bar::default())?;
         cli::plot_indentation(&report, &plot)?;
         Ok(report)
     });
@@ -60,7 +60,7 @@ fn indent_command(
 fn main() -> ExitCode {
     match Cli::parse().command {
         Command::Mesh { mesh, out, json } => match mesh.load() {
-            Ok((_, m)) => cli::report_mesh(&mesh.source, &m, out.as_deref(), json),
+            Ok(loaded) => cli::report_mesh(&mesh.source, &loaded.mesh, out.as_deref(), json),
             Err(e) => fail("pgd mesh", &e),
         },
         Command::Build {
@@ -248,7 +248,10 @@ fn job<'a>(
     material: &'a MaterialArgs,
     build: &BuildArgs,
 ) -> Result<BuildJob<'a>, String> {
-    let (organ, tet_mesh) = mesh.load()?;
+    let LoadedMesh {
+        organ,
+        mesh: tet_mesh,
+    } = mesh.load()?;
     Ok(BuildJob {
         source: &mesh.source,
         mesh: tet_mesh,
