@@ -69,10 +69,10 @@ pub fn run(
     realtime_seconds: f64,
 ) -> Result<HapticBenchReport, FemError> {
     let targets = press_targets(scene);
-    let mut sweeps = vec![sweep(scene, ("all", &targets), motion, repeats)];
+    let mut sweeps = vec![sweep(scene, "all", &targets, motion, repeats)];
     for ((name, _), target) in scene.organs.iter().zip(&targets) {
-        let pressed = (name.as_str(), std::slice::from_ref(target));
-        sweeps.push(sweep(scene, pressed, motion, repeats));
+        let pressed = std::slice::from_ref(target);
+        sweeps.push(sweep(scene, name, pressed, motion, repeats));
     }
     let fem_contact = fem_contact(&targets[0], repeats, sweeps[0].compute_p50_us)?;
     let render_cpu_ms = render_cpu(scene, &targets, repeats);
@@ -84,7 +84,7 @@ pub fn run(
     .into_iter()
     .map(|(timer, scheduling)| {
         let device = device(&targets, motion);
-        realtime(scene, device, (timer, scheduling), realtime_seconds)
+        realtime(scene, device, timer, scheduling, realtime_seconds)
     })
     .collect();
     Ok(HapticBenchReport {
@@ -106,7 +106,8 @@ fn device(targets: &[PressTarget], motion: &PressMotion) -> Box<dyn HapticDevice
 
 fn sweep(
     scene: &HapticScene,
-    (pressed, targets): (&str, &[PressTarget]),
+    pressed: &str,
+    targets: &[PressTarget],
     motion: &PressMotion,
     repeats: usize,
 ) -> SweepFigures {
@@ -150,7 +151,8 @@ fn fem_contact(
     loads.add_point_load(
         model.mesh(),
         &surface,
-        (nalgebra::Point3::from(target.point_m), target.normal),
+        nalgebra::Point3::from(target.point_m),
+        target.normal,
         force_n.into(),
         PressMotion::default().tip_radius_m,
     )?;
@@ -191,7 +193,8 @@ fn render_cpu(scene: &HapticScene, targets: &[PressTarget], repeats: usize) -> f
 fn realtime(
     scene: &HapticScene,
     device: Box<dyn HapticDevice>,
-    (timer, scheduling): (TimerMode, Scheduling),
+    timer: TimerMode,
+    scheduling: Scheduling,
     seconds: f64,
 ) -> RealTimeReport {
     let mut haptic = HapticLoop::new(scene, device).expect("scene was built");
@@ -213,7 +216,7 @@ fn realtime(
         {
             organ
                 .deformation
-                .deformed_surface(vademecum, (surface, u), &mut positions);
+                .deformed_surface(vademecum, surface, u, &mut positions);
         }
         std::hint::black_box(&positions);
         std::thread::sleep(frame.saturating_sub(started.elapsed()));

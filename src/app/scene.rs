@@ -280,7 +280,7 @@ pub fn scene_of(
             let (vademecum, mesh) = match on_stale {
                 #[cfg(not(target_arch = "wasm32"))]
                 OnStale::Meanwhile if organ.law != Law::Linear => {
-                    linear_meanwhile(organ, spec.clone(), (dir, detail, tip))?
+                    linear_meanwhile(organ, spec.clone(), dir, detail, tip)?
                 }
                 _ => ensure_vademecum(spec, on_stale)?,
             };
@@ -340,7 +340,9 @@ pub fn scene_of(
 fn linear_meanwhile(
     organ: &SceneOrgan,
     spec: VademecumSpec,
-    (dir, detail, tip_m): (&Path, Detail, f64),
+    dir: &Path,
+    detail: Detail,
+    tip_m: f64,
 ) -> Result<(Vademecum, TetMesh), String> {
     if let Ok(built) = ensure_vademecum(&spec, OnStale::Refuse) {
         return Ok(built);

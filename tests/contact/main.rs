@@ -346,7 +346,7 @@ fn deformed_gallbladder(modes_only: bool) -> Vec<[f32; 3]> {
     let surface = SurfaceModes::new(gallbladder);
     let mut at_vertices = vec![0.0; 3 * gallbladder.positions.len()];
     let mut positions = Vec::new();
-    deformation.deformed_surface(gallbladder, (&surface, &mut at_vertices), &mut positions);
+    deformation.deformed_surface(gallbladder, &surface, &mut at_vertices, &mut positions);
     if modes_only {
         let mut field = vec![0.0; gallbladder.dof_count()];
         for (step, coefficients) in deformation.coefficients.iter().enumerate() {

@@ -150,7 +150,7 @@ fn beyond_the_range_the_felt_force_follows_a_move_of_the_surface() {
     let pressed = |depth_m: f64| {
         let tip_m = Vector3::new(0.03, 0.02, 0.03 + TIP_RADIUS_M - depth_m);
         let (mut patch, mut load) = (Patch::default(), PatchLoad::default());
-        let contact = press(&target, &probe, (&tip_m, None), &mut patch, &mut load).unwrap();
+        let contact = press(&target, &probe, &tip_m, None, &mut patch, &mut load).unwrap();
         (contact, load)
     };
     let (depth_m, move_m) = (3.0 * range_m, 0.1 * range_m);

@@ -130,10 +130,12 @@ impl HeadlessReport {
     /// The report of `ticks` ticks that sent `force` from `device` to `organs`, with the
     /// faults of `log` and the compute times of `compute`.
     pub(super) fn new(
-        (device, organs): (String, Vec<String>),
+        device: String,
+        organs: Vec<String>,
         log: &FaultLog,
         ticks: u64,
-        (force, range): (ForceSummary, RangeSummary),
+        force: ForceSummary,
+        range: RangeSummary,
         compute: &Histogram,
     ) -> Self {
         let period = Duration::from_secs_f64(TICK_S);

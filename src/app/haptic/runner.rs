@@ -331,9 +331,9 @@ impl HapticLoop {
             }
             forces.record(&force, touching);
         }
-        let names = (self.device_name(), self.organ_names());
+        let (device, organs) = (self.device_name(), self.organ_names());
         let log = self.world.resource::<FaultLog>();
-        HeadlessReport::new(names, log, ran, (forces, range), &compute)
+        HeadlessReport::new(device, organs, log, ran, forces, range, &compute)
     }
 
     pub(super) fn device_name(&self) -> String {

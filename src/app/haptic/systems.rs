@@ -108,7 +108,8 @@ pub fn tool_contact(
         touch.contact = press(
             &target,
             &tool.probe,
-            (&sample.tip_m, previous.as_ref()),
+            &sample.tip_m,
+            previous.as_ref(),
             &mut touch.patch,
             &mut touch.next_load,
         );

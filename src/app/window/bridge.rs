@@ -3,6 +3,7 @@
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
 use super::{FrameSet, WindowScene};
@@ -82,6 +83,13 @@ impl HapticLink {
             exit_after: None,
         }
     }
+}
+
+/// The haptic side as a frame reads it: the link and this frame's snapshot.
+#[derive(SystemParam)]
+pub(super) struct HapticView<'w> {
+    pub link: Res<'w, HapticLink>,
+    pub snapshot: Res<'w, Snapshot>,
 }
 
 /// The haptic state this frame draws.

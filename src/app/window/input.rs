@@ -9,7 +9,7 @@
 use bevy::input::mouse::{MouseScrollUnit, MouseWheel};
 use bevy::prelude::*;
 
-use super::bridge::{HapticLink, Snapshot};
+use super::bridge::{HapticLink, HapticView};
 use super::{FrameSet, from_bevy, to_bevy};
 use crate::devices::CHANGE_BUTTON;
 
@@ -35,7 +35,7 @@ impl Plugin for InputPlugin {
 }
 
 fn drive_virtual_device(
-    (link, snapshot): (Res<HapticLink>, Res<Snapshot>),
+    haptic: HapticView,
     windows: Query<&Window>,
     cameras: Query<(&Camera, &GlobalTransform)>,
     mut wheel: MessageReader<MouseWheel>,
@@ -43,6 +43,7 @@ fn drive_virtual_device(
     buttons: Res<ButtonInput<MouseButton>>,
     time: Res<Time>,
 ) {
+    let (link, snapshot) = (&haptic.link, &haptic.snapshot);
     let Some(handle) = &link.virtual_device else {
         return;
     };

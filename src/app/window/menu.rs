@@ -296,7 +296,8 @@ fn choose_on_enter(
     };
     load(
         &mut commands,
-        (file.clone(), scenario.clone()),
+        file.clone(),
+        scenario.clone(),
         scene,
         &mut next,
     );
@@ -328,15 +329,16 @@ fn reload_when_built(
     }
     reloaded.extend(ready);
     let scene = (plan.scenes)(&lesson.scenario);
-    let chosen = (lesson.file.clone(), lesson.scenario.clone());
-    load(&mut commands, chosen, scene, &mut next);
+    let (file, scenario) = (lesson.file.clone(), lesson.scenario.clone());
+    load(&mut commands, file, scenario, scene, &mut next);
 }
 
 /// Reads `scene` for the scenario read from `file` as a task away from the frames; the
 /// briefing opens when it is ready.
 fn load(
     commands: &mut Commands,
-    (file, scenario): (PathBuf, Scenario),
+    file: PathBuf,
+    scenario: Scenario,
     scene: BoxedFuture<'static, Result<HapticScene, String>>,
     next: &mut NextState<Stage>,
 ) {

@@ -184,7 +184,8 @@ fn deform(
         let mut positions = Vec::with_capacity(view.vademecum.positions.len());
         organ.deformation.deformed_surface(
             &view.vademecum,
-            (&view.surface, &mut view.at_vertices),
+            &view.surface,
+            &mut view.at_vertices,
             &mut positions,
         );
         if let Some(motion) = &view.motion {

@@ -85,6 +85,7 @@ struct Frame<'w, 's> {
     tip: Query<'w, 's, (&'static Transform, &'static Visibility), With<ToolTip>>,
     meshes: Res<'w, Assets<Mesh>>,
     link: Res<'w, HapticLink>,
+    snapshot: Res<'w, Snapshot>,
     mode: Res<'w, CameraMode>,
     offscreen: Option<Res<'w, Offscreen>>,
     texts: Query<
@@ -140,14 +141,14 @@ const MAX_RETRIES: u32 = 30;
 
 fn take_screenshot(
     mut commands: Commands,
-    (plan, snapshot): (Res<ScreenshotPlan>, Res<Snapshot>),
+    plan: Res<ScreenshotPlan>,
     mut progress: ResMut<Progress>,
     frame: Frame,
     clear: Res<ClearColor>,
     ready: Res<PipelinesReady>,
     mut exit: MessageWriter<AppExit>,
 ) {
-    if snapshot.0.time_s < plan.after_haptic_s {
+    if frame.snapshot.0.time_s < plan.after_haptic_s {
         return;
     }
     progress.frames += 1;

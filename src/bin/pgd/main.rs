@@ -28,21 +28,15 @@ fn indent_command(
     mesh: &MeshArgs,
     material: &MaterialArgs,
     laws: &[args::LawArg],
-    (at_mm, depth_mm, steps): (Option<[f64; 3]>, Option<f64>, usize),
+    request: &cli::IndentRequest,
     plot: Option<std::path::PathBuf>,
     json: bool,
 ) -> ExitCode {
-    let request = cli::IndentRequest {
-        source: &mesh.source,
-        at_mm,
-        depth_mm,
-        steps,
-    };
     let plot = plot.unwrap_or_else(|| format!("{}-indentation.png", mesh.stem()).into());
     let report = mesh.load().and_then(|loaded| {
         let base = material.material(loaded.organ)?;
         let materials: Vec<_> = laws.iter().map(|law| base.with_law(law.law())).collect();
-        let report = cli::indent_organ(loaded, &materials, &request, &Bar::default())?;
+        let report = cli::indent_organ(loaded, &materials, request, &Bar::default())?;
         cli::plot_indentation(&report, &plot)?;
         Ok(report)
     });
@@ -117,7 +111,15 @@ fn main() -> ExitCode {
             steps,
             plot,
             json,
-        } => indent_command(&mesh, &material, &laws, (at, depth_mm, steps), plot, json),
+        } => {
+            let request = cli::IndentRequest {
+                source: &mesh.source,
+                at_mm: at,
+                depth_mm,
+                steps,
+            };
+            indent_command(&mesh, &material, &laws, &request, plot, json)
+        }
         Command::Fit {
             data,
             poisson,
@@ -161,7 +163,7 @@ fn validate_command(options: ValidateArgs) -> ExitCode {
             patch_radius_m,
             ..CutValidationSettings::default()
         };
-        return validate_cut_section(&mesh, &file, (&settings, exact_response), json);
+        return validate_cut_section(&mesh, &file, &settings, exact_response, json);
     }
     if !(0.0..90.0).contains(&max_tilt_deg) {
         let problem = format!("--max-tilt-deg {max_tilt_deg}: not in 0 to 90 degrees");
@@ -226,7 +228,8 @@ fn fit_command(
 fn validate_cut_section(
     mesh: &MeshArgs,
     file: &Path,
-    (settings, exact): (&CutValidationSettings, bool),
+    settings: &CutValidationSettings,
+    exact: bool,
     json: bool,
 ) -> ExitCode {
     let validated = mesh

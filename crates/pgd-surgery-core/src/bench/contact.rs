@@ -20,7 +20,7 @@ use serde::Serialize;
 
 use crate::contact::{
     ContactPair, ContactSurface, Coupling, CouplingSettings, DistanceField, OrganPose, PairOutput,
-    PairReport, Pointshell, ToolHold,
+    PairReport, PairSide, Pointshell, ToolHold,
 };
 use crate::parry_interop::{to_parry, trimesh};
 use crate::pgd::{PointLoad, RigidCarry, Vademecum};
@@ -208,8 +208,14 @@ fn held(
     let nodes = Pointshell::new(&shell.1, &rigid, &surface, &field, settings.pointshell);
     let rigid = Arc::new(rigid);
     let pair = ContactPair::new(
-        (pair.master, rigid.clone()),
-        (pair.shell, shell.1.clone()),
+        PairSide {
+            organ: pair.master,
+            vademecum: rigid.clone(),
+        },
+        PairSide {
+            organ: pair.shell,
+            vademecum: shell.1.clone(),
+        },
         Arc::new(field),
         nodes,
         &settings.penalty,

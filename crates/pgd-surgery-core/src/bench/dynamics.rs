@@ -270,7 +270,7 @@ fn energy_trace(organ: &DynamicsOrgan, modes: usize) -> Result<EnergyTrace, Dyna
                 }
                 Scheme::ImplicitEuler => implicit_euler(reduced, &mut state)?,
                 Scheme::Newmark { gamma, beta } => {
-                    acceleration = newmark(reduced, &mut state, &acceleration, (gamma, beta))?;
+                    acceleration = newmark(reduced, &mut state, &acceleration, gamma, beta)?;
                 }
             }
         }
@@ -357,7 +357,8 @@ fn newmark(
     reduced: &ReducedKsv,
     state: &mut ReducedState,
     a0: &[f64],
-    (gamma, beta): (f64, f64),
+    gamma: f64,
+    beta: f64,
 ) -> Result<Vec<f64>, DynamicsError> {
     let h = TICK_S;
     let (q0, v0) = (state.q.clone(), state.v.clone());

@@ -138,7 +138,8 @@ fn indentation_load(model: &FemModel) -> Result<Loads, FemError> {
     loads.add_point_load(
         mesh,
         &surface,
-        (Point3::new(0.09, 0.05, 0.08), Vector3::z()),
+        Point3::new(0.09, 0.05, 0.08),
+        Vector3::z(),
         [0.0, 0.0, -0.1],
         0.015,
     )?;

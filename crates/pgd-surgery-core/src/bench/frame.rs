@@ -95,7 +95,7 @@ impl<'a> Organ<'a> {
 
     fn surface_only(&mut self, positions: &mut Vec<[f32; 3]>) {
         let (v, d) = (self.vademecum, &self.deformation);
-        d.deformed_surface(v, (&self.surface, &mut self.at_positions), positions);
+        d.deformed_surface(v, &self.surface, &mut self.at_positions, positions);
     }
 }
 

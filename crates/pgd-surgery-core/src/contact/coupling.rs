@@ -10,7 +10,7 @@ use std::sync::Arc;
 use nalgebra::Vector3;
 
 use super::modal_rows::{concatenate, step_ranges};
-use super::pair::{PairOutput, PenaltySettings};
+use super::pair::{PairOutput, PairSide, PenaltySettings};
 use super::pose::OrganPose;
 use super::{
     Attachment, ContactError, ContactPair, ContactSurface, DistanceField, DistanceSettings,
@@ -141,9 +141,13 @@ impl Coupling {
                 if nodes.is_empty() {
                     continue;
                 }
+                let side = |organ: usize, vademecum: &Arc<Vademecum>| PairSide {
+                    organ,
+                    vademecum: vademecum.clone(),
+                };
                 pairs.push(ContactPair::new(
-                    (master, master_vademecum.clone()),
-                    (shell, shell_vademecum.clone()),
+                    side(master, master_vademecum),
+                    side(shell, shell_vademecum),
                     field.clone(),
                     nodes,
                     &settings.penalty,

@@ -46,7 +46,7 @@ pub use distance::{
 };
 pub use hold::ToolHold;
 pub use modal_rows::ModalRows;
-pub use pair::{ContactPair, PairOutput, PairReport, PenaltySettings};
+pub use pair::{ContactPair, PairOutput, PairReport, PairSide, PenaltySettings};
 pub use pointshell::{
     Pointshell, PointshellDensity, SPARSE_SPACINGS_MM, SUBDIVISIONS, check_spacing,
     check_subdivisions,

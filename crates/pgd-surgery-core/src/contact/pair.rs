@@ -93,6 +93,12 @@ pub struct PairReport {
     pub products: usize,
 }
 
+/// One organ of a pair: its place in the scene and its vademecum.
+pub struct PairSide {
+    pub organ: usize,
+    pub vademecum: Arc<Vademecum>,
+}
+
 #[derive(Clone)]
 pub struct ContactPair {
     pub master: usize,
@@ -159,12 +165,20 @@ impl ContactPair {
 
     /// Sets up the pair: each node's penalty from the stiffer organ's compliance there.
     pub fn new(
-        (master, master_vademecum): (usize, Arc<Vademecum>),
-        (shell, shell_vademecum): (usize, Arc<Vademecum>),
+        master: PairSide,
+        shell: PairSide,
         field: Arc<DistanceField>,
         nodes: Pointshell,
         settings: &PenaltySettings,
     ) -> Self {
+        let PairSide {
+            organ: master,
+            vademecum: master_vademecum,
+        } = master;
+        let PairSide {
+            organ: shell,
+            vademecum: shell_vademecum,
+        } = shell;
         let compliance = NormalCompliance::new(&nodes, &master_vademecum, &shell_vademecum);
         let stiffness_n_per_m = penalties(&compliance, nodes.len(), settings.stiffness_ratio);
         let count = nodes.len();

@@ -93,7 +93,8 @@ where
 pub fn press<F, G>(
     target: &Target<F, G>,
     probe: &Probe,
-    (tip_m, previous): (&Vector3<f64>, Option<&SurfacePoint>),
+    tip_m: &Vector3<f64>,
+    previous: Option<&SurfacePoint>,
     patch: &mut Patch,
     load: &mut PatchLoad,
 ) -> Option<ToolContact>
@@ -102,7 +103,7 @@ where
     G: Fn(&SurfacePoint) -> Vector3<f64>,
 {
     let vademecum = target.vademecum;
-    let Some(contact) = touch(target, probe, (tip_m, previous), patch) else {
+    let Some(contact) = touch(target, probe, tip_m, previous, patch) else {
         load.release();
         return None;
     };
@@ -139,7 +140,8 @@ const SWITCH_TIP_RADII: f64 = 0.25;
 fn touch<F, G>(
     target: &Target<F, G>,
     probe: &Probe,
-    (tip_m, previous): (&Vector3<f64>, Option<&SurfacePoint>),
+    tip_m: &Vector3<f64>,
+    previous: Option<&SurfacePoint>,
     patch: &mut Patch,
 ) -> Option<ToolContact>
 where

@@ -110,7 +110,7 @@ impl Enrichment {
                 if phi[node].abs() > reach[node] {
                     continue;
                 }
-                if cuts_support(mesh, (face, front), &phi, support, snap_m) {
+                if cuts_support(mesh, face, front, &phi, support, snap_m) {
                     functions.push(Enriched {
                         node,
                         face: k,
@@ -277,7 +277,8 @@ fn snapped(d: f64, snap_m: f64) -> f64 {
 /// on the smaller, and every point where an element of it meets the plane inside the face.
 fn cuts_support(
     mesh: &TetMesh,
-    (face, front): (&CutFace, Front),
+    face: &CutFace,
+    front: Front,
     phi: &[f64],
     support: &[usize],
     snap_m: f64,

@@ -103,7 +103,8 @@ impl CutFace {
         anterior_m: f64,
         axis: Unit<Vector3<f64>>,
         angle_rad: f64,
-        (from_m, to_m): (f64, f64),
+        from_m: f64,
+        to_m: f64,
         depth_m: f64,
     ) -> Result<Self, CutError> {
         check_depth(depth_m)?;

@@ -242,7 +242,8 @@ pub fn incision(
         ANTERIOR_RADIUS_M,
         Unit::new_unchecked(Vector3::z()),
         angle_rad,
-        reach,
+        reach.0,
+        reach.1,
         depth_fraction * CORNEA_THICKNESS_M,
     )
 }

@@ -239,7 +239,7 @@ impl GraspedOrgan {
             ) => {
                 let error = hand_m + offset_m - self.point.rest_m - moved;
                 let force = self.coupling(&error, &(hand_velocity - velocity));
-                let (force, escaped) = self.slip(force, (offset_m, slipped_m, from_m), &mut tick);
+                let (force, escaped) = self.slip(force, offset_m, slipped_m, from_m, &mut tick);
                 let point_m = self.point.rest_m + moved + self.point.remainder_m_per_n * force;
                 tick.point_m = Some(point_m);
                 self.check_damage(&force, &(point_m - from_m), &mut tick);
@@ -335,7 +335,9 @@ impl GraspedOrgan {
     fn slip(
         &mut self,
         force: Vector3<f64>,
-        (offset_m, slipped_m, from_m): (Vector3<f64>, f64, Vector3<f64>),
+        offset_m: Vector3<f64>,
+        slipped_m: f64,
+        from_m: Vector3<f64>,
         tick: &mut GraspTick,
     ) -> (Vector3<f64>, bool) {
         let limit = self.settings.slip_force_n;

@@ -76,7 +76,7 @@ impl ReducedKsv {
         let tets = model.mesh().tets();
         for first in (0..tets.len()).step_by(CHUNK_ELEMENTS) {
             let last = (first + CHUNK_ELEMENTS).min(tets.len());
-            let (lin, quad) = element_rows(model, basis, (first, last), &pairs[..p_count]);
+            let (lin, quad) = element_rows(model, basis, first..last, &pairs[..p_count]);
             k.gemm_tr(1.0, &lin, &lin, 1.0);
             if nonlinear {
                 a.gemm_tr(1.0, &lin, &quad, 1.0);
@@ -297,15 +297,16 @@ fn weight(j: usize, k: usize) -> f64 {
 fn element_rows(
     model: &FemModel,
     basis: &ModalBasis,
-    (first, last): (usize, usize),
+    elements: std::ops::Range<usize>,
     pairs: &[(usize, usize)],
 ) -> (DMatrix<f64>, DMatrix<f64>) {
     let r = basis.len();
-    let rows = ROW * (last - first);
+    let first = elements.start;
+    let rows = ROW * elements.len();
     let mut lin = DMatrix::zeros(rows, r);
     let mut quad = DMatrix::zeros(rows, pairs.len());
     let mut gradients = vec![Matrix3::zeros(); r];
-    for t in first..last {
+    for t in elements {
         let tet = &model.mesh().tets()[t];
         let geometry = &model.geometry()[t];
         for (i, h) in gradients.iter_mut().enumerate() {
@@ -317,21 +318,28 @@ fn element_rows(
                 .sum();
         }
         let (lambda, mu) = model.lame(t);
-        let weights = (
-            (2.0 * mu * geometry.volume_m3).sqrt(),
-            (lambda * geometry.volume_m3).sqrt(),
-        );
+        let shear = (2.0 * mu * geometry.volume_m3).sqrt();
+        let volume = (lambda * geometry.volume_m3).sqrt();
         let row = ROW * (t - first);
         for (i, h) in gradients.iter().enumerate() {
-            write_row(&mut lin, (row, i), &(0.5 * (h + h.transpose())), weights);
+            write_row(
+                &mut lin,
+                row,
+                i,
+                &(0.5 * (h + h.transpose())),
+                shear,
+                volume,
+            );
         }
         for (p, &(j, k)) in pairs.iter().enumerate() {
             let hjk = gradients[j].transpose() * gradients[k];
             write_row(
                 &mut quad,
-                (row, p),
+                row,
+                p,
                 &(0.25 * (hjk + hjk.transpose())),
-                weights,
+                shear,
+                volume,
             );
         }
     }
@@ -342,9 +350,11 @@ fn element_rows(
 /// (√2 on the shears) and `√(λV)` times its trace.
 fn write_row(
     m: &mut DMatrix<f64>,
-    (row, column): (usize, usize),
+    row: usize,
+    column: usize,
     x: &Matrix3<f64>,
-    (shear, volume): (f64, f64),
+    shear: f64,
+    volume: f64,
 ) {
     let s2 = std::f64::consts::SQRT_2;
     let components = [

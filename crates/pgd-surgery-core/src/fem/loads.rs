@@ -120,7 +120,8 @@ impl Loads {
         &mut self,
         mesh: &TetMesh,
         surface: &Surface,
-        (point, facing): (Point3<f64>, Vector3<f64>),
+        point: Point3<f64>,
+        facing: Vector3<f64>,
         force_n: [f64; 3],
         radius_m: f64,
     ) -> Result<(), FemError> {

@@ -66,12 +66,8 @@ impl FemModel {
             true => FreePattern::two_ring(&mesh, &dofs),
             false => FreePattern::new(&mesh, &dofs),
         };
-        let volumetric = nodal_volumes(
-            (&mesh, &geometry),
-            &material,
-            &modulus_scale,
-            (&pattern, &dofs),
-        );
+        let volumetric =
+            nodal_volumes(&mesh, &geometry, &material, &modulus_scale, &pattern, &dofs);
         Ok(Self {
             modulus_scale,
             volumetric,
@@ -93,10 +89,12 @@ impl FemModel {
     pub fn with_inclusions(mut self, inclusions: &[Inclusion]) -> Result<Self, FemError> {
         self.modulus_scale = modulus_scale(&self.mesh, inclusions)?;
         self.volumetric = nodal_volumes(
-            (&self.mesh, &self.geometry),
+            &self.mesh,
+            &self.geometry,
             &self.material,
             &self.modulus_scale,
-            (&self.pattern, &self.dofs),
+            &self.pattern,
+            &self.dofs,
         );
         self.inclusions = inclusions.to_vec();
         Ok(self)
@@ -179,7 +177,7 @@ impl FemModel {
         }
         if let Some(volumetric) = &self.volumetric {
             let tissue = |t| self.element_tissue(t);
-            volumetric.add_nonlinear_force((&self.mesh, &self.geometry), tissue, u_m, out);
+            volumetric.add_nonlinear_force(&self.mesh, &self.geometry, tissue, u_m, out);
             return;
         }
         for (t, (tet, geo)) in self.mesh.tets().iter().zip(&self.geometry).enumerate() {
@@ -200,7 +198,8 @@ impl FemModel {
         }
         if let Some(volumetric) = &self.volumetric {
             volumetric.add_force_and_tangent(
-                (&self.mesh, &self.geometry),
+                &self.mesh,
+                &self.geometry,
                 &self.pattern,
                 u_m,
                 &mut force,
@@ -235,15 +234,17 @@ impl FemModel {
 /// The law's nodal volumes, with each element's first Lamé constant scaled by its inclusion;
 /// `None` for a law whose elements carry all their energy.
 fn nodal_volumes(
-    (mesh, geometry): (&TetMesh, &[TetGeometry]),
+    mesh: &TetMesh,
+    geometry: &[TetGeometry],
     material: &Material,
     modulus_scale: &[f64],
-    (pattern, dofs): (&FreePattern, &DofMap),
+    pattern: &FreePattern,
+    dofs: &DofMap,
 ) -> Option<NodalVolumes> {
     material.law.has_nodal_volumes().then(|| {
         let (lambda, _) = material.lame();
         let lambdas: Vec<f64> = modulus_scale.iter().map(|s| s * lambda).collect();
-        NodalVolumes::new((mesh, geometry), &lambdas, (pattern, dofs))
+        NodalVolumes::new(mesh, geometry, &lambdas, pattern, dofs)
     })
 }
 

@@ -226,7 +226,7 @@ impl FemModel {
             let mut du = residual.clone();
             let forcing = relative.sqrt().min(MAX_FORCING);
             solver.solve(&self.pattern().matrix(tangent), &mut du, forcing)?;
-            let length = self.line_search(u, &du, (f_ext, extra), &residual, settings);
+            let length = self.line_search(u, &du, f_ext, extra, &residual, settings);
             report.step_lengths.push(length);
         }
         Err(FemError::NewtonNotConverged {
@@ -243,7 +243,8 @@ impl FemModel {
         &self,
         u: &mut [f64],
         du: &[f64],
-        (f_ext, extra): (&[f64], &dyn ExtraForce),
+        f_ext: &[f64],
+        extra: &dyn ExtraForce,
         r0: &[f64],
         settings: &NewtonSettings,
     ) -> f64 {

@@ -61,9 +61,11 @@ impl NodalVolumes {
     /// `lambda_pa[e]` is element `e`'s first Lamé constant; `pattern` is the model's two-ring
     /// pattern.
     pub(super) fn new(
-        (mesh, geometry): (&TetMesh, &[TetGeometry]),
+        mesh: &TetMesh,
+        geometry: &[TetGeometry],
         lambda_pa: &[f64],
-        (pattern, dofs): (&FreePattern, &DofMap),
+        pattern: &FreePattern,
+        dofs: &DofMap,
     ) -> Self {
         let n = mesh.node_count();
         let (mut reference_m3, mut weighted) = (vec![0.0; n], vec![0.0; n]);
@@ -159,7 +161,8 @@ impl NodalVolumes {
     /// Adds the volumetric force on every dof and its tangent over free dofs.
     pub(super) fn add_force_and_tangent(
         &self,
-        (mesh, geometry): (&TetMesh, &[TetGeometry]),
+        mesh: &TetMesh,
+        geometry: &[TetGeometry],
         pattern: &FreePattern,
         u_m: &[f64],
         force: &mut [f64],
@@ -213,7 +216,8 @@ impl NodalVolumes {
     /// response and iteration: it is the vademecum build's inner loop.
     pub(super) fn add_nonlinear_force(
         &self,
-        (mesh, geometry): (&TetMesh, &[TetGeometry]),
+        mesh: &TetMesh,
+        geometry: &[TetGeometry],
         tissue: impl Fn(usize) -> ElementTissue,
         u_m: &[f64],
         out: &mut [f64],

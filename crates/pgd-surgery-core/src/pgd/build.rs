@@ -23,7 +23,7 @@ use super::local::{
     AlongDirections, LocalPart, ParameterResponses, distance_neighbours, near_nodes,
 };
 use super::region::{CutHeader, RegionReport, RegionResponse, RegionSettings};
-use super::responses::{Responses, SecantReport, SecantSettings, Trend};
+use super::responses::{Responses, ScaledLoads, SecantReport, SecantSettings, StepStart, Trend};
 use super::separated::SeparatedField;
 use super::settings::BuildSettings;
 use super::snapshot_modes::SnapshotModes;
@@ -350,7 +350,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
             tool.positions.len() as u64,
         );
         let trend = before.take().map(|(responses, from_m)| {
-            Trend::new(&responses, &secant, (from_m, last_level_m, level_m))
+            Trend::new(&responses, &secant, from_m, last_level_m, level_m)
         });
         before = Some((secant.clone(), last_level_m));
         let last_level_before = last_level_m;
@@ -358,8 +358,14 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         let (fixed_point, unconverged);
         (secant, fixed_point, unconverged) = secant.secant(
             stiffness,
-            (&tool, &magnitudes),
-            (trend.as_ref(), last_level_before / level_m),
+            ScaledLoads {
+                unit: &tool,
+                magnitudes_n: &magnitudes,
+            },
+            StepStart {
+                trend: trend.as_ref(),
+                fraction_before: last_level_before / level_m,
+            },
             &context.settings.secant,
             &|n| progress.advance(n as u64),
         );
@@ -408,8 +414,8 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         secant.add_scaled(&linear, -1.0);
         let gram = secant.energy_gram(stiffness);
         progress.message("modes of the corrections");
-        let weights = (&gram[..], &patches.weights[..]);
-        let best = SnapshotModes::new(stiffness, &secant, weights, context.settings.pgd.max_modes);
+        let max_modes = context.settings.pgd.max_modes;
+        let best = SnapshotModes::new(stiffness, &secant, &gram, &patches.weights, max_modes);
         let separation = Separation::Snapshots {
             directions: &tool.inward,
             best,

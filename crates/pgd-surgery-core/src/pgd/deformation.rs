@@ -221,7 +221,8 @@ impl Deformation {
     pub fn deformed_surface(
         &self,
         vademecum: &Vademecum,
-        (surface, u): (&SurfaceModes, &mut [f64]),
+        surface: &SurfaceModes,
+        u: &mut [f64],
         positions: &mut Vec<[f32; 3]>,
     ) {
         self.surface_into(vademecum, surface, u);

@@ -37,7 +37,7 @@ pub use file::{FORMAT_VERSION, decode, encode, load, read_header, save};
 pub use load_patches::{LoadOperator, LoadPatches};
 pub use local::LocalPart;
 pub use region::{CutHeader, RegionReport, RegionResponse, RegionSettings, SparseDofs};
-pub use responses::{Responses, SecantReport, SecantSettings};
+pub use responses::{Responses, ScaledLoads, SecantReport, SecantSettings, StepStart};
 pub use separated::SeparatedField;
 pub use settings::{
     BuildSettings, DEFAULT_LOAD_STEPS_M, NEO_HOOKEAN_STEPS_TOOL_RADII, default_load_steps_m,

@@ -23,6 +23,28 @@ const SUBSTEPS: usize = 8;
 
 /// Some of a step's loads, renumbered from zero: what the substeps of those that diverged
 /// iterate on together.
+/// A load step's loads: the unit loads and the magnitude (N) each is applied at.
+pub struct ScaledLoads<'a, L> {
+    pub unit: &'a L,
+    pub magnitudes_n: &'a [f64],
+}
+
+impl<L> Clone for ScaledLoads<'_, L> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<L> Copy for ScaledLoads<'_, L> {}
+
+/// Where a step's iteration starts: the responses held at `fraction_before` of its
+/// magnitude (the step before's level), moved along the trend through the steps before.
+#[derive(Clone, Copy)]
+pub struct StepStart<'a> {
+    pub trend: Option<&'a Trend>,
+    pub fraction_before: f64,
+}
+
 struct Subset<'a, L> {
     loads: &'a L,
     parameters: &'a [usize],
@@ -153,11 +175,13 @@ impl Responses {
     pub fn secant(
         mut self,
         stiffness: &RestStiffness,
-        (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
-        (trend, fraction_before): (Option<&Trend>, f64),
+        loads: ScaledLoads<'_, impl UnitLoads>,
+        start: StepStart<'_>,
         settings: &SecantSettings,
         progress: &(dyn Fn(usize) + Sync),
     ) -> (Self, SecantReport, Vec<usize>) {
+        let (patches, magnitudes_n) = (loads.unit, loads.magnitudes_n);
+        let (trend, fraction_before) = (start.trend, start.fraction_before);
         let rows = self.rows;
         let (mut report, mut unconverged) = self
             .columns
@@ -166,11 +190,14 @@ impl Responses {
             .map(|(block, chunk)| {
                 let first = block * BLOCK_COLUMNS;
                 let trend = trend.map(|t| t.block(block, chunk.len()));
+                let magnitudes_n = &magnitudes_n[first..];
                 let done = secant_block(
                     stiffness,
                     patches,
-                    (first, &magnitudes_n[first..]),
-                    (chunk, trend),
+                    first,
+                    magnitudes_n,
+                    chunk,
+                    trend,
                     settings,
                 );
                 progress(chunk.len() / rows);
@@ -183,24 +210,16 @@ impl Responses {
                     (a.merge(b), failed)
                 },
             );
-        let rescued = self.continue_in_substeps(
-            stiffness,
-            (patches, magnitudes_n),
-            (&unconverged, fraction_before),
-            settings,
-        );
+        let rescued =
+            self.continue_in_substeps(stiffness, loads, &unconverged, fraction_before, settings);
         report.substep_solved = rescued.len();
         report.unconverged -= rescued.len();
         unconverged.retain(|p| rescued.binary_search(p).is_err());
         if settings.newton_budget > 0.0 && !unconverged.is_empty() {
             let start = Instant::now();
             let budget = settings.newton_budget * report.fixed_point_solves();
-            let newton = self.solve_by_newton(
-                stiffness,
-                (patches, magnitudes_n),
-                (&unconverged, fraction_before),
-                budget,
-            );
+            let newton =
+                self.solve_by_newton(stiffness, loads, &unconverged, fraction_before, budget);
             report.newton_seconds = start.elapsed().as_secs_f64();
             report.newton_solved = newton.solved.len();
             report.newton_solves = newton.solves;
@@ -221,10 +240,12 @@ impl Responses {
     fn continue_in_substeps(
         &mut self,
         stiffness: &RestStiffness,
-        (loads, magnitudes_n): (&impl UnitLoads, &[f64]),
-        (failed, fraction_before): (&[usize], f64),
+        step: ScaledLoads<'_, impl UnitLoads>,
+        failed: &[usize],
+        fraction_before: f64,
         settings: &SecantSettings,
     ) -> Vec<usize> {
+        let (loads, magnitudes_n) = (step.unit, step.magnitudes_n);
         let rows = self.rows;
         let solved: Vec<(usize, Vec<f64>)> = failed
             .par_chunks(BLOCK_COLUMNS)
@@ -245,8 +266,10 @@ impl Responses {
                     let (_, diverged) = secant_block(
                         stiffness,
                         &subset,
-                        (0, &magnitudes),
-                        (&mut chunk, None),
+                        0,
+                        &magnitudes,
+                        &mut chunk,
+                        None,
                         settings,
                     );
                     diverged.into_iter().for_each(|j| alive[j] = false);
@@ -288,8 +311,9 @@ impl Responses {
     fn solve_by_newton(
         &mut self,
         stiffness: &RestStiffness,
-        (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
-        (parameters, fraction_before): (&[usize], f64),
+        step: ScaledLoads<'_, impl UnitLoads>,
+        parameters: &[usize],
+        fraction_before: f64,
         budget_solves: f64,
     ) -> NewtonOutcome {
         let mut outcome = NewtonOutcome::default();
@@ -300,8 +324,7 @@ impl Responses {
                 outcome.left = parameters.len() - done;
                 break;
             }
-            let (solved, solves) =
-                self.newton_batch(stiffness, (patches, magnitudes_n), (loads, fraction_before));
+            let (solved, solves) = self.newton_batch(stiffness, step, loads, fraction_before);
             outcome.solved.extend(solved);
             outcome.solves = outcome.solves.merge(solves);
         }
@@ -314,9 +337,11 @@ impl Responses {
     fn newton_batch(
         &mut self,
         stiffness: &RestStiffness,
-        (patches, magnitudes_n): (&impl UnitLoads, &[f64]),
-        (parameters, fraction_before): (&[usize], f64),
+        step: ScaledLoads<'_, impl UnitLoads>,
+        parameters: &[usize],
+        fraction_before: f64,
     ) -> (Vec<usize>, KrylovStatistics) {
+        let (patches, magnitudes_n) = (step.unit, step.magnitudes_n);
         let model = stiffness.model;
         let settings = NewtonSettings {
             relative_tolerance: NEWTON_TOLERANCE,
@@ -401,11 +426,7 @@ pub struct Trend {
 
 impl Trend {
     /// From `before` to `after` (levels `from_m` and `at_m`), extended to `to_m`.
-    pub fn new(
-        before: &Responses,
-        after: &Responses,
-        (from_m, at_m, to_m): (f64, f64, f64),
-    ) -> Self {
+    pub fn new(before: &Responses, after: &Responses, from_m: f64, at_m: f64, to_m: f64) -> Self {
         let ratio = (to_m - at_m) / (at_m - from_m);
         let columns = after
             .columns
@@ -559,15 +580,17 @@ fn add_unit_load(stiffness: &RestStiffness, loads: &impl UnitLoads, p: usize, co
     }
 }
 
-/// The fixed point for the columns of one block (`first` is the first column's parameter),
-/// iterating only the columns still moving. Each column is accelerated by Anderson's method
+/// The fixed point for the columns of one block (`first` is the first column's parameter,
+/// `magnitudes_n` from it on), iterating only the columns still moving. Each column is accelerated by Anderson's method
 /// ([`Anderson`]): where the law stiffens or softens, the plain iteration with the rest
 /// stiffness overshoots or crawls.
 fn secant_block(
     stiffness: &RestStiffness,
     patches: &impl UnitLoads,
-    (first, magnitudes_n): (usize, &[f64]),
-    (chunk, trend): (&mut [f64], Option<&[f64]>),
+    first: usize,
+    magnitudes_n: &[f64],
+    chunk: &mut [f64],
+    trend: Option<&[f64]>,
     settings: &SecantSettings,
 ) -> (SecantReport, Vec<usize>) {
     let rows = stiffness.free_count();
@@ -596,7 +619,8 @@ fn secant_block(
             let span = j * rows..(j + 1) * rows;
             let begin = rhs.len();
             match work.finite_right_hand_side(
-                (&mut chunk[span.clone()], &previous[span]),
+                &mut chunk[span.clone()],
+                &previous[span],
                 magnitudes_n[j],
                 &mut rhs,
             ) {
@@ -702,7 +726,8 @@ impl<'a> NonlinearWork<'a> {
     /// taken, `None` if none gave a finite force.
     fn finite_right_hand_side(
         &mut self,
-        (column, previous): (&mut [f64], &[f64]),
+        column: &mut [f64],
+        previous: &[f64],
         lambda: f64,
         rhs: &mut Vec<f64>,
     ) -> Option<usize> {

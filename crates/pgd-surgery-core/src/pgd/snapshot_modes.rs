@@ -30,7 +30,8 @@ impl SnapshotModes {
     pub fn new(
         stiffness: &RestStiffness,
         responses: &Responses,
-        (gram, weights): (&[f64], &[f64]),
+        gram: &[f64],
+        weights: &[f64],
         max_modes: usize,
     ) -> Self {
         let n = weights.len();

@@ -65,7 +65,8 @@ impl SurfaceModes {
         load: (&[(usize, f64)], &Vector3<f64>),
         u: &mut [f64],
     ) {
-        vademecum.add_corrections_at(step, load, |node| self.position_of(node), u);
+        let (shares, force_n) = load;
+        vademecum.add_corrections_at(step, shares, force_n, |node| self.position_of(node), u);
     }
 
     /// Adds `Σ_k c_k X^k` of load step `step` at the positions to `u` (`3 × positions`).

@@ -580,19 +580,19 @@ impl Vademecum {
             return RangePress::within(force_n, stiffness_n_per_m);
         }
         let at_edge = self.column_compliance(patch, edge_n);
-        let (felt_n, felt_stiffness_n_per_m) =
-            match self.chord_compliance(patch, (edge_n, &at_edge)) {
-                Some(chord) => {
-                    let from = (force_n, stiffness_n_per_m);
-                    let blend = |force: &Vector3<f64>| {
-                        let w = (edge_n / force.norm()).min(1.0);
-                        at_edge * w + chord * (1.0 - w)
-                    };
-                    let felt_n = secant_iteration(from, indentation_m, blend).0;
-                    (felt_n, stiffness_of(chord))
-                }
-                None => (force_n, stiffness_n_per_m),
-            };
+        let (felt_n, felt_stiffness_n_per_m) = match self.chord_compliance(patch, edge_n, &at_edge)
+        {
+            Some(chord) => {
+                let from = (force_n, stiffness_n_per_m);
+                let blend = |force: &Vector3<f64>| {
+                    let w = (edge_n / force.norm()).min(1.0);
+                    at_edge * w + chord * (1.0 - w)
+                };
+                let felt_n = secant_iteration(from, indentation_m, blend).0;
+                (felt_n, stiffness_of(chord))
+            }
+            None => (force_n, stiffness_n_per_m),
+        };
         RangePress {
             force_n,
             stiffness_n_per_m,
@@ -615,7 +615,8 @@ impl Vademecum {
     fn chord_compliance(
         &self,
         patch: &mut Patch,
-        (edge_n, at_edge): (f64, &Matrix3<f64>),
+        edge_n: f64,
+        at_edge: &Matrix3<f64>,
     ) -> Option<Matrix3<f64>> {
         let before_n = edge_n * self.interval_start_share(&patch.shares);
         if !(before_n > 0.0 && before_n < edge_n) {
@@ -805,7 +806,7 @@ impl Vademecum {
         force_n: &Vector3<f64>,
         u: &mut [f64],
     ) {
-        self.add_corrections_at(step, (shares, force_n), Some, u);
+        self.add_corrections_at(step, shares, force_n, Some, u);
     }
 
     /// [`Self::add_corrections`] into `u` numbered by `slot` (a node's place in `u`, or
@@ -813,7 +814,8 @@ impl Vademecum {
     pub(crate) fn add_corrections_at(
         &self,
         step: usize,
-        (shares, force_n): (&[(usize, f64)], &Vector3<f64>),
+        shares: &[(usize, f64)],
+        force_n: &Vector3<f64>,
         slot: impl Fn(usize) -> Option<usize>,
         u: &mut [f64],
     ) {

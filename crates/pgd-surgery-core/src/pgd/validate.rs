@@ -193,7 +193,7 @@ pub fn validate(
     );
     let mut samples = Vec::with_capacity(settings.samples);
     let drawn =
-        |rng: &mut fastrand::Rng| point_to_press(rng, (&areas, total_area), vademecum, settings);
+        |rng: &mut fastrand::Rng| point_to_press(rng, &areas, total_area, vademecum, settings);
     for _ in 0..settings.samples {
         let at = drawn(&mut rng)?;
         samples.push(sample(model, vademecum, &kernel, &at, &mut rng, settings)?);
@@ -245,7 +245,8 @@ const MAX_DRAWS: usize = 10_000;
 /// shallower than the deepest indentation.
 fn point_to_press(
     rng: &mut fastrand::Rng,
-    (areas, total): (&[f64], f64),
+    areas: &[f64],
+    total: f64,
     vademecum: &Vademecum,
     settings: &ValidationSettings,
 ) -> Result<SurfacePoint, FemError> {
@@ -373,7 +374,8 @@ fn range_edge_m(vademecum: &Vademecum, at: &SurfacePoint, direction: &Vector3<f6
 fn patch_loads(
     mesh: &TetMesh,
     kernel: &PatchKernel,
-    (point, facing): (Point3<f64>, &Vector3<f64>),
+    point: Point3<f64>,
+    facing: &Vector3<f64>,
     force: &Vector3<f64>,
 ) -> Result<(Loads, Vec<(usize, f64)>), FemError> {
     let shares = kernel.shares(point, facing)?;
@@ -411,7 +413,7 @@ fn sample(
     // The linear compliance along the direction sets the force for the wanted indentation.
     let force = linear_force(vademecum, at, &direction, indentation_m);
     let facing = vademecum.triangle_facing(at.triangle);
-    let (loads, shares) = patch_loads(mesh, kernel, (point, &facing), &force)?;
+    let (loads, shares) = patch_loads(mesh, kernel, point, &facing, &force)?;
     let newton = NewtonSettings {
         load_steps: settings.newton_load_steps,
         ..NewtonSettings::default()
@@ -469,7 +471,7 @@ fn force_depth_curve(
     let deepest_m = indentations_m(vademecum, at, &inward, settings).1;
     let force = linear_force(vademecum, at, &inward, deepest_m);
     let facing = vademecum.triangle_facing(at.triangle);
-    let (loads, shares) = patch_loads(mesh, kernel, (point, &facing), &force)?;
+    let (loads, shares) = patch_loads(mesh, kernel, point, &facing, &force)?;
     let newton = NewtonSettings {
         load_steps: settings.curve_levels,
         ..NewtonSettings::default()

@@ -67,7 +67,8 @@ impl IncisionTracker {
     /// the scene, nothing is counted), cut within `tolerance_m` of it, `target_depth_m` deep.
     pub fn new(
         organ: Option<usize>,
-        (from_m, to_m): (Vector3<f64>, Vector3<f64>),
+        from_m: Vector3<f64>,
+        to_m: Vector3<f64>,
         tolerance_m: f64,
         target_depth_m: f64,
     ) -> Self {

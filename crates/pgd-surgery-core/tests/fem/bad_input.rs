@@ -155,7 +155,8 @@ fn a_point_load_radius_below_the_mesh_spacing_is_refused() {
         .add_point_load(
             &mesh,
             &surface,
-            (Point3::new(0.025, 0.025, 0.1), Vector3::z()),
+            Point3::new(0.025, 0.025, 0.1),
+            Vector3::z(),
             [0.0, 0.0, -1.0],
             1e-3,
         )

@@ -67,7 +67,7 @@ fn a_regularized_point_load_keeps_its_total_and_stays_local() {
     let radius = 0.012;
     let mut loads = Loads::new(mesh.node_count());
     loads
-        .add_point_load(&mesh, &surface, (point, Vector3::z()), force, radius)
+        .add_point_load(&mesh, &surface, point, Vector3::z(), force, radius)
         .unwrap();
     assert!((loads.total_force_n() - Vector3::from(force)).norm() < 1e-14);
     // Only nodes within the radius carry load, and their load-weighted centroid is the point.
@@ -110,7 +110,8 @@ fn a_point_load_on_a_thin_wall_loads_only_the_pressed_face() {
         .add_point_load(
             &mesh,
             &surface,
-            (Point3::new(0.03, 0.025, wall[2]), Vector3::z()),
+            Point3::new(0.03, 0.025, wall[2]),
+            Vector3::z(),
             force,
             0.012,
         )

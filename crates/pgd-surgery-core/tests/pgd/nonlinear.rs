@@ -8,9 +8,9 @@ use nalgebra::Vector3;
 use pgd_surgery_core::fem::{FemModel, Law, Loads, NewtonSettings, PatchKernel};
 use pgd_surgery_core::mesh::Surface;
 use pgd_surgery_core::pgd::{
-    BuildSettings, LoadPatches, Responses, RestStiffness, Sample, SecantReport, SecantSettings,
-    Silent, SurfacePoint, Vademecum, ValidationReport, ValidationSettings, build,
-    force_depth_curve_at, newton_baseline, validate,
+    BuildSettings, LoadPatches, Responses, RestStiffness, Sample, ScaledLoads, SecantReport,
+    SecantSettings, Silent, StepStart, SurfacePoint, Vademecum, ValidationReport,
+    ValidationSettings, build, force_depth_curve_at, newton_baseline, validate,
 };
 
 use crate::common::{block_mesh, block_model_of, organ, settings};
@@ -63,8 +63,14 @@ fn secant_responses_are_equilibria(
     let before = linear.columns.clone();
     let (secant, report, _) = linear.secant(
         &stiffness,
-        (&patches, &magnitudes),
-        (None, 0.0),
+        ScaledLoads {
+            unit: &patches,
+            magnitudes_n: &magnitudes,
+        },
+        StepStart {
+            trend: None,
+            fraction_before: 0.0,
+        },
         fixed_point,
         &|_| {},
     );
@@ -183,8 +189,14 @@ fn newton_stops_at_its_budget() {
     };
     let (_, report, unconverged) = linear.secant(
         &stiffness,
-        (&patches, &magnitudes),
-        (None, 0.0),
+        ScaledLoads {
+            unit: &patches,
+            magnitudes_n: &magnitudes,
+        },
+        StepStart {
+            trend: None,
+            fraction_before: 0.0,
+        },
         &stingy,
         &|_| {},
     );

@@ -97,7 +97,8 @@ impl TaskType for Incision {
             organ: setup.organ,
             tracker: IncisionTracker::new(
                 setup.organ,
-                (metres(self.from_mm), metres(self.to_mm)),
+                metres(self.from_mm),
+                metres(self.to_mm),
                 self.tolerance_mm.metres(),
                 self.depth_mm.metres(),
             ),
