@@ -8,7 +8,7 @@ use std::path::Path;
 use super::container::{self, Kind, Reader, put};
 use super::error::VademecumError;
 use super::local::LocalPart;
-use super::region::RegionResponse;
+use super::region::{RegionArrays, RegionResponse};
 use super::responses::SecantSettings;
 use super::settings::BuildSettings;
 use super::vademecum::{Header, MAX_STEPS, Step, StepLoads, Vademecum};
@@ -187,26 +187,19 @@ fn read_cuts(r: &mut Reader, header: &Header) -> Result<Option<RegionResponse>, 
     if header.cuts.is_none() {
         return Ok(None);
     }
-    let positions = r.take("cut positions")?;
-    let held = r.take("held nodes")?;
-    let spatial = r.take("cut spatial modes")?;
-    let parametric = r.take("cut parametric modes")?;
-    let near = (
-        r.take("cut near-field offsets")?,
-        r.take("cut near-field nodes")?,
-        r.take("cut near fields")?,
-    );
-    check_cuts(r, header, (&positions, &held, &spatial, &parametric), &near)?;
+    let arrays = RegionArrays {
+        positions: r.take("cut positions")?,
+        held: r.take("held nodes")?,
+        spatial: r.take("cut spatial modes")?,
+        parametric: r.take("cut parametric modes")?,
+        near_offsets: r.take("cut near-field offsets")?,
+        near_nodes: r.take("cut near-field nodes")?,
+        near: r.take("cut near fields")?,
+    };
+    check_cuts(r, header, &arrays)?;
+    let patch_radius_m = header.cuts.as_ref().and_then(|c| c.settings.patch_radius_m);
     Ok(Some(
-        RegionResponse::new(
-            positions,
-            spatial,
-            parametric,
-            held,
-            near,
-            header.node_count,
-        )
-        .with_patch_radius(header.cuts.as_ref().and_then(|c| c.settings.patch_radius_m)),
+        RegionResponse::new(arrays, header.node_count).with_patch_radius(patch_radius_m),
     ))
 }
 
@@ -217,12 +210,16 @@ fn product(factors: &[usize]) -> Option<usize> {
 }
 
 /// The cut arrays agree with the header and with each other.
-fn check_cuts(
-    r: &Reader,
-    header: &Header,
-    (positions, held, spatial, parametric): (&[u32], &[u32], &[f32], &[f32]),
-    (offsets, nodes, near): &(Vec<u32>, Vec<u32>, Vec<f32>),
-) -> Result<(), VademecumError> {
+fn check_cuts(r: &Reader, header: &Header, arrays: &RegionArrays) -> Result<(), VademecumError> {
+    let RegionArrays {
+        positions,
+        held,
+        spatial,
+        parametric,
+        near_offsets: offsets,
+        near_nodes: nodes,
+        near,
+    } = arrays;
     let node_count = header.node_count;
     let beyond = |list: &[u32]| list.iter().any(|&n| n as usize >= node_count);
     if beyond(positions) || beyond(held) || beyond(nodes) {

@@ -36,7 +36,9 @@ pub use error_curve::{EnergyError, ErrorCurve, optimal_errors};
 pub use file::{FORMAT_VERSION, decode, encode, load, read_header, save};
 pub use load_patches::{LoadOperator, LoadPatches};
 pub use local::LocalPart;
-pub use region::{CutHeader, RegionReport, RegionResponse, RegionSettings, SparseDofs};
+pub use region::{
+    CutHeader, RegionArrays, RegionReport, RegionResponse, RegionSettings, SparseDofs,
+};
 pub use responses::{Responses, ScaledLoads, SecantReport, SecantSettings, StepStart};
 pub use separated::SeparatedField;
 pub use settings::{

@@ -78,6 +78,19 @@ pub struct CutHeader {
 /// A sparse load or response over full dofs: `(dof, value)`.
 pub type SparseDofs = Vec<(usize, f64)>;
 
+/// A cut section's arrays, as its file holds them: the positions it serves, the nodes held
+/// fixed, its modes, and each position's near field (its nodes `near_offsets[m]..
+/// near_offsets[m + 1]` of `near_nodes`, a 3 × 3 block each in `near`).
+pub struct RegionArrays {
+    pub positions: Vec<u32>,
+    pub held: Vec<u32>,
+    pub spatial: Vec<f32>,
+    pub parametric: Vec<f32>,
+    pub near_offsets: Vec<u32>,
+    pub near_nodes: Vec<u32>,
+    pub near: Vec<f32>,
+}
+
 /// The compressed responses. Spatial modes are mode-major over all dofs; parametric modes
 /// mode-major over three parameters per position; the near field per position in CSR rows of
 /// 3 × 3 blocks (`block[3c + d]`: component `c` of the node under a unit force along `d`).
@@ -201,20 +214,19 @@ impl RegionResponse {
             near_values.extend(values);
             errors.extend(sampled);
         }
-        let response = Self::new(
-            region.positions.iter().map(|&n| n as u32).collect(),
-            field.spatial.iter().flatten().map(|&v| v as f32).collect(),
-            field
-                .parametric
-                .iter()
-                .flatten()
+        let arrays = RegionArrays {
+            positions: region.positions.iter().map(|&n| n as u32).collect(),
+            held: held_nodes(&stiffness.model.dofs().free_index),
+            spatial: field.spatial.iter().flatten().map(|&v| v as f32).collect(),
+            parametric: (field.parametric.iter().flatten())
                 .map(|&v| v as f32)
                 .collect(),
-            held_nodes(&stiffness.model.dofs().free_index),
-            (near_offsets, near.concat(), near_values),
-            mesh.node_count(),
-        )
-        .with_patch_radius(settings.patch_radius_m);
+            near_offsets,
+            near_nodes: near.concat(),
+            near: near_values,
+        };
+        let response =
+            Self::new(arrays, mesh.node_count()).with_patch_radius(settings.patch_radius_m);
         let report = RegionReport {
             positions: region.positions.len(),
             modes: field.modes(),
@@ -228,16 +240,17 @@ impl RegionResponse {
         Ok((response, report))
     }
 
-    /// Assembles a response from its arrays (as read from a file, checked there): `near` is
-    /// `(offsets, nodes, blocks)`.
-    pub fn new(
-        positions: Vec<u32>,
-        spatial: Vec<f32>,
-        parametric: Vec<f32>,
-        held: Vec<u32>,
-        (near_offsets, near_nodes, near): (Vec<u32>, Vec<u32>, Vec<f32>),
-        node_count: usize,
-    ) -> Self {
+    /// Assembles a response from its arrays (as read from a file, checked there).
+    pub fn new(arrays: RegionArrays, node_count: usize) -> Self {
+        let RegionArrays {
+            positions,
+            held,
+            spatial,
+            parametric,
+            near_offsets,
+            near_nodes,
+            near,
+        } = arrays;
         let mut slot = vec![OUTSIDE; node_count];
         for &n in &held {
             slot[n as usize] = HELD;
