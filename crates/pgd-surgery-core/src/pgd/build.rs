@@ -205,34 +205,10 @@ pub fn build(
     let near_field_share = steps[0].local.correction_nodes.len() as f64
         / (patches.positions.len() * mesh.node_count()) as f64;
     if near_field_share > WIDE_NEAR_FIELD_SHARE {
-        progress.message(&format!(
-            "the near field ({:.1} mm) holds {:.0} % of the organ's nodes for an average load: \
-             the file is large and the modes carry little; an organ this size wants a smaller \
-             --local-radius-mm (and a tool to match, --tool-radius-mm)",
-            settings.local_radius_m * 1e3,
-            100.0 * near_field_share
-        ));
+        progress.message(&wide_near_field(settings, near_field_share));
     }
-    let header = Header {
-        source: organ.source.clone(),
-        mesh_hash: mesh_hash(mesh),
-        node_count: mesh.node_count(),
-        tet_count: mesh.tet_count(),
-        material: *model.material(),
-        inclusions: model.inclusions().to_vec(),
-        clamped_region: organ.clamped_region.clone(),
-        accessible_region: organ.accessible_region.clone(),
-        load_directions: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-        settings: settings.clone(),
-        indentation_levels_m: reports.iter().map(|r| r.indentation_m).collect(),
-        step_loads: StepLoads::InwardToolPatch,
-        modes_per_step: reports.iter().map(|r| r.modes_kept).collect(),
-        convergence: reports.iter().map(|r| r.curve.clone()).collect(),
-        build_seconds: started.elapsed().as_secs_f64(),
-        cuts: None,
-    };
     let vademecum = Vademecum {
-        header,
+        header: header(organ, settings, &reports, started),
         positions: patches.positions.iter().map(|&n| n as u32).collect(),
         position_coords_m: coords,
         position_areas_m2: areas,
@@ -257,6 +233,45 @@ pub fn build(
         file_bytes: 0,
     };
     Ok((vademecum, report))
+}
+
+/// The warning for a near field holding `share` of the organ's nodes for an average load.
+fn wide_near_field(settings: &BuildSettings, share: f64) -> String {
+    format!(
+        "the near field ({:.1} mm) holds {:.0} % of the organ's nodes for an average load: the \
+         file is large and the modes carry little; an organ this size wants a smaller \
+         --local-radius-mm (and a tool to match, --tool-radius-mm)",
+        settings.local_radius_m * 1e3,
+        100.0 * share
+    )
+}
+
+/// The vademecum's header: what it was built from and with, and its steps' figures.
+fn header(
+    organ: &OrganModel,
+    settings: &BuildSettings,
+    reports: &[StepReport],
+    started: Instant,
+) -> Header {
+    let (model, mesh) = (organ.model, organ.model.mesh());
+    Header {
+        source: organ.source.clone(),
+        mesh_hash: mesh_hash(mesh),
+        node_count: mesh.node_count(),
+        tet_count: mesh.tet_count(),
+        material: *model.material(),
+        inclusions: model.inclusions().to_vec(),
+        clamped_region: organ.clamped_region.clone(),
+        accessible_region: organ.accessible_region.clone(),
+        load_directions: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        settings: settings.clone(),
+        indentation_levels_m: reports.iter().map(|r| r.indentation_m).collect(),
+        step_loads: StepLoads::InwardToolPatch,
+        modes_per_step: reports.iter().map(|r| r.modes_kept).collect(),
+        convergence: reports.iter().map(|r| r.curve.clone()).collect(),
+        build_seconds: started.elapsed().as_secs_f64(),
+        cuts: None,
+    }
 }
 
 /// What every load step is built with.
@@ -329,21 +344,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
     let loaded = reference.iter().filter(|&&per_n| per_n > 0.0).count();
     for &level_m in &context.settings.load_steps_m {
         let clock = Instant::now();
-        // Each patch's push is sized so that its linear displacement is `level_m` long; a
-        // position whose range ended (short of the last step's level, stored as the same f32)
-        // is not pushed.
-        let magnitudes: Vec<f64> = reference
-            .iter()
-            .zip(&range_level_m)
-            .map(|(&per_n, &range_m)| {
-                let reaching = per_n > 0.0 && range_m == last_level_m as f32;
-                if reaching {
-                    level_m / f64::from(per_n)
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let magnitudes = step_magnitudes(&reference, &range_level_m, last_level_m, level_m);
         let law = stiffness.model.material().law.name();
         progress.start(
             &format!("{law} step {:.1} mm", level_m * 1e3),
@@ -370,17 +371,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
             &|n| progress.advance(n as u64),
         );
         drop(trend); // a full copy of the responses: freed before the step's PGD
-        progress.message(&format!(
-            "{law} step {:.1} mm: {} loads, {:.1} fixed-point iterations each on average, \
-             {} through substeps, {} by Newton, {} left ({:.0} s)",
-            level_m * 1e3,
-            fixed_point.responses,
-            fixed_point.mean_iterations(),
-            fixed_point.substep_solved,
-            fixed_point.newton_solved,
-            fixed_point.unconverged,
-            clock.elapsed().as_secs_f64()
-        ));
+        progress.message(&fixed_point_words(law, level_m, &fixed_point, clock));
         let secant_settings = &context.settings.secant;
         let reached = reached_positions(&magnitudes, &unconverged, &fixed_point, secant_settings);
         if !kept(reached.len(), loaded, secant_settings) {
@@ -410,19 +401,7 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         reached
             .iter()
             .for_each(|&m| range_level_m[m] = level_m as f32);
-        // The step keeps the correction `Ũ − U_lin`, restored after.
-        secant.add_scaled(&linear, -1.0);
-        let gram = secant.energy_gram(stiffness);
-        progress.message("modes of the corrections");
-        let max_modes = context.settings.pgd.max_modes;
-        let best = SnapshotModes::new(stiffness, &secant, &gram, &patches.weights, max_modes);
-        let separation = Separation::Snapshots {
-            directions: &tool.inward,
-            best,
-        };
-        let built = separated_step(context, &secant, separation, gram, clock);
-        secant.add_scaled(&linear, 1.0);
-        let (step, mut report) = built?;
+        let (step, mut report) = correction_step(context, &tool, &mut secant, &linear, clock)?;
         report.indentation_m = level_m;
         report.fixed_point = Some(fixed_point);
         report.positions_reached = reached.len();
@@ -437,6 +416,72 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
         range_level_m,
         loaded,
     })
+}
+
+/// Each patch's push at the step to `level_m`, sized so that its linear displacement
+/// (`reference` m/N) is `level_m` long; a position whose range ended (short of the last
+/// step's level, stored as the same f32) is not pushed.
+fn step_magnitudes(
+    reference: &[f32],
+    range_level_m: &[f32],
+    last_level_m: f64,
+    level_m: f64,
+) -> Vec<f64> {
+    (reference.iter().zip(range_level_m))
+        .map(|(&per_n, &range_m)| {
+            let reaching = per_n > 0.0 && range_m == last_level_m as f32;
+            if reaching {
+                level_m / f64::from(per_n)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// What a step's fixed point did, in words for the build's progress.
+fn fixed_point_words(
+    law: &str,
+    level_m: f64,
+    fixed_point: &SecantReport,
+    clock: Instant,
+) -> String {
+    format!(
+        "{law} step {:.1} mm: {} loads, {:.1} fixed-point iterations each on average, \
+         {} through substeps, {} by Newton, {} left ({:.0} s)",
+        level_m * 1e3,
+        fixed_point.responses,
+        fixed_point.mean_iterations(),
+        fixed_point.substep_solved,
+        fixed_point.newton_solved,
+        fixed_point.unconverged,
+        clock.elapsed().as_secs_f64()
+    )
+}
+
+/// The step of a nonlinear level: the PGD of the corrections `Ũ − U_lin` the secant
+/// responses make to the linear ones (`secant` holds `Ũ`, and holds it again after).
+fn correction_step(
+    context: &StepContext,
+    tool: &ToolPatchLoads,
+    secant: &mut Responses,
+    linear: &Responses,
+    clock: Instant,
+) -> Result<(Step, StepReport), FemError> {
+    let stiffness = context.stiffness;
+    secant.add_scaled(linear, -1.0);
+    let gram = secant.energy_gram(stiffness);
+    context.progress.message("modes of the corrections");
+    let max_modes = context.settings.pgd.max_modes;
+    let weights = &context.patches.weights;
+    let best = SnapshotModes::new(stiffness, secant, &gram, weights, max_modes);
+    let separation = Separation::Snapshots {
+        directions: &tool.inward,
+        best,
+    };
+    let built = separated_step(context, secant, separation, gram, clock);
+    secant.add_scaled(linear, 1.0);
+    built
 }
 
 /// The positions a step reaches: those pushed at it whose load converged, or all those
