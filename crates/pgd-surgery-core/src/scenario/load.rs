@@ -10,7 +10,6 @@ use super::format::{LaparoscopeEntry, Scenario};
 use super::problem::{Problem, REFERENCE, ScenarioError};
 use super::scene::{OrganEntry, metres};
 use super::task::{SceneFacts, Task, TaskCheck};
-use super::tasks;
 use crate::contact::PointshellDensity;
 use crate::devices::{DeviceSpec, MAX_INSTRUMENTS};
 use crate::fem::Law;
@@ -63,16 +62,8 @@ pub fn parse(file: &Path, text: &str) -> Result<Scenario, ScenarioError> {
 fn hint_for(code: &ron::Error) -> String {
     use ron::Error as E;
     match code {
-        E::NoSuchStructField {
-            expected, outer, ..
-        } => {
-            let mut fields = expected.to_vec();
-            // A task's own fields are its type's; the shared ones are read beside them.
-            if let Some(task) = outer.as_deref().and_then(tasks::find) {
-                fields.extend(["organ", "max_force_n", "time_limit_s"]);
-                fields.retain(|f| task.on_an_organ || *f != "organ");
-            }
-            format!("the fields here are: {}", fields.join(", "))
+        E::NoSuchStructField { expected, .. } => {
+            format!("the fields here are: {}", expected.join(", "))
         }
         E::MissingStructField { field, .. } => format!("add `{field}: …` ({REFERENCE})"),
         E::NoSuchEnumVariant { expected, .. } => {

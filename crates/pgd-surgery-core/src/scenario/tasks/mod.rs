@@ -21,7 +21,6 @@ pub use region::RegionResult;
 pub use retraction::{Retraction, RetractionResult};
 pub use safe_navigation::{SafeNavigation, SafeNavigationResult};
 
-pub(super) use registry::find;
 pub use registry::{register, registered_names};
 
 use registry::Entry;

@@ -7,6 +7,7 @@
 //! says which field is unknown or missing, and where.
 
 use std::fmt;
+use std::sync::Mutex;
 
 use serde::de::{
     self, DeserializeSeed, Deserializer, EnumAccess, IntoDeserializer, MapAccess, VariantAccess,
@@ -85,6 +86,7 @@ impl<'de> Visitor<'de> for FieldsVisitor {
         let mut failure = None;
         let own = OwnFields {
             map,
+            on_an_organ: self.entry.on_an_organ,
             shared: &mut shared,
             failure: &mut failure,
         };
@@ -124,6 +126,7 @@ impl SharedFields {
 /// The task's fields as a deserializer of the type's own struct, the shared ones taken out.
 struct OwnFields<'a, A, E> {
     map: A,
+    on_an_organ: bool,
     shared: &'a mut SharedFields,
     failure: &'a mut Option<E>,
 }
@@ -164,6 +167,7 @@ impl<'de, A: MapAccess<'de>> OwnFields<'_, A, A::Error> {
         let split = Split {
             map: self.map,
             fields,
+            on_an_organ: self.on_an_organ,
             shared: self.shared,
             failure: &mut *self.failure,
         };
@@ -171,6 +175,23 @@ impl<'de, A: MapAccess<'de>> OwnFields<'_, A, A::Error> {
             .visit_map(split)
             .map_err(|e| keep_first(self.failure, e))
     }
+}
+
+/// A type's own fields and the shared ones it takes, in one list for an error's "expected":
+/// made once per type (serde wants the list `'static`), when a file first misspells one.
+fn with_shared(own: &'static [&'static str], on_an_organ: bool) -> &'static [&'static str] {
+    type Lists = Vec<(usize, bool, &'static [&'static str])>;
+    static LISTS: Mutex<Lists> = Mutex::new(Vec::new());
+    let key = own.as_ptr() as usize;
+    let mut lists = LISTS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(&(.., list)) = (lists.iter()).find(|(k, o, _)| *k == key && *o == on_an_organ) {
+        return list;
+    }
+    let shared = (["organ", "max_force_n", "time_limit_s"].into_iter())
+        .filter(|field| on_an_organ || *field != "organ");
+    let list: &'static [&'static str] = Vec::leak(own.iter().copied().chain(shared).collect());
+    lists.push((key, on_an_organ, list));
+    list
 }
 
 /// Keeps `error` aside if it is the first, and returns a stand-in for the erased layers.
@@ -184,6 +205,7 @@ fn keep_first<E: de::Error>(failure: &mut Option<E>, error: E) -> E {
 struct Split<'a, A, E> {
     map: A,
     fields: &'static [&'static str],
+    on_an_organ: bool,
     shared: &'a mut SharedFields,
     failure: &'a mut Option<E>,
 }
@@ -225,7 +247,8 @@ impl<'de, A: MapAccess<'de>> MapAccess<'de> for Split<'_, A, A::Error> {
                 "max_force_n" => self.shared_value("max_force_n", |s| &mut s.max_force_n)?,
                 "time_limit_s" => self.shared_value("time_limit_s", |s| &mut s.time_limit_s)?,
                 own if !self.fields.is_empty() && !self.fields.contains(&own) => {
-                    return self.keep(Err(de::Error::unknown_field(own, self.fields)));
+                    let expected = with_shared(self.fields, self.on_an_organ);
+                    return self.keep(Err(de::Error::unknown_field(own, expected)));
                 }
                 _ => {
                     let key: de::value::StringDeserializer<A::Error> = key.into_deserializer();
