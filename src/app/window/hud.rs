@@ -153,20 +153,16 @@ fn update_hud(
 /// What the tool is doing: a fault, a grasp, the organs it touches, or nothing.
 fn status_line(link: &HapticLink, snapshot: &HapticSnapshot) -> String {
     // A snapshot of the scene before a change may name organs the new one lacks.
-    let named = |organs: &mut dyn Iterator<Item = usize>| -> Vec<&str> {
-        let name = |k: usize| link.scene.organs.get(k).map(|(name, _)| name.as_str());
-        organs.filter_map(name).collect()
-    };
+    let name = |k: usize| link.scene.organs.get(k).map(|(name, _)| name.as_str());
     let organs = || snapshot.organs.iter().enumerate();
-    let touching = named(
-        &mut organs()
-            .filter(|(_, o)| o.contact.is_some())
-            .map(|(k, _)| k),
-    );
-    let grasped = named(&mut organs().filter(|(_, o)| o.grasped).map(|(k, _)| k));
+    let touching: Vec<&str> = organs()
+        .filter(|(_, o)| o.contact.is_some())
+        .filter_map(|(k, _)| name(k))
+        .collect();
+    let grasped = organs().find(|(_, o)| o.grasped).and_then(|(k, _)| name(k));
     if snapshot.faulted {
         "FAULT: force faded to zero (see the log)".to_owned()
-    } else if let Some(name) = grasped.first() {
+    } else if let Some(name) = grasped {
         format!("grasping {name}: release the button to let go")
     } else if touching.is_empty() {
         "no contact".to_owned()

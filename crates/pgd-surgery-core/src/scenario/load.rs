@@ -10,6 +10,7 @@ use super::format::{LaparoscopeEntry, Scenario};
 use super::problem::{Problem, REFERENCE, ScenarioError};
 use super::scene::{OrganEntry, metres};
 use super::task::{SceneFacts, Task, TaskCheck};
+use super::tasks::registered_names;
 use crate::contact::PointshellDensity;
 use crate::devices::{DeviceSpec, MAX_INSTRUMENTS};
 use crate::fem::Law;
@@ -135,12 +136,20 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
             anchors: vec!["tasks".into()],
             message: "the scenario has no tasks".into(),
             hint: format!(
-                "add a ForceControl(…), SafeNavigation(…), Palpation(…), Retraction(…) or Grasp(…) task ({REFERENCE})"
+                "add a task, one of: {} ({REFERENCE})",
+                registered_names().join(", ")
             ),
         });
     }
+    let scene = SceneFacts {
+        organs: &scenario.organs,
+        nodules: &scenario.nodules,
+        blade: scenario.blade().is_some(),
+        grasps: scenario.grasps(),
+        device_max_force_n: scenario.device.max_force_n.0,
+    };
     for (k, task) in scenario.tasks.iter().enumerate() {
-        check_task(scenario, k, task, &mut problems);
+        check_task(scenario, scene, k, task, &mut problems);
     }
     check_rubric(scenario, &mut problems);
     check_laparoscope(scenario, &mut problems);
@@ -277,7 +286,13 @@ fn check_backend(scenario: &Scenario, problems: &mut Vec<Problem>) {
 
 /// The `k`th task: its organ in the scene (every type that works on one), then what its type
 /// checks of its own fields.
-fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Problem>) {
+fn check_task(
+    scenario: &Scenario,
+    scene: SceneFacts<'_>,
+    k: usize,
+    task: &Task,
+    problems: &mut Vec<Problem>,
+) {
     if let Some(organ) = task.organ() {
         problems.extend(not_in_scene(
             scenario,
@@ -286,13 +301,6 @@ fn check_task(scenario: &Scenario, k: usize, task: &Task, problems: &mut Vec<Pro
             "tasks",
         ));
     }
-    let scene = SceneFacts {
-        organs: &scenario.organs,
-        nodules: &scenario.nodules,
-        blade: scenario.blade().is_some(),
-        grasps: scenario.grasps(),
-        device_max_force_n: scenario.device.max_force_n.0,
-    };
     let mut check = TaskCheck::new(scene, &task.shared, k, task.name());
     task.check(&mut check);
     problems.extend(check.problems);

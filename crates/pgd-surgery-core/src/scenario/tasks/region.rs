@@ -58,7 +58,9 @@ impl RegionMove {
 
     /// Takes whether the hold holds at `time_s`; true once it has held long enough.
     pub fn hold(&mut self, holding: bool, time_s: f64) -> bool {
-        holding && self.hold.step(holding, time_s) >= self.hold_s
+        // Stepped whatever `holding` is: a break must end the hold under way.
+        let longest_s = self.hold.step(holding, time_s);
+        holding && longest_s >= self.hold_s
     }
 
     pub fn progress(&self) -> TaskProgress {
@@ -108,5 +110,24 @@ impl RegionResult {
             ),
             _ => held(self.longest_hold_s, self.hold_s),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two holds of 0.6 s with a break between do not make a hold of 1 s; one unbroken does.
+    #[test]
+    fn a_break_ends_the_hold() {
+        let mut region = RegionMove::new(20.0, 1.0);
+        let held = |region: &mut RegionMove, from_s: f64, to_s: f64| {
+            (0..=6).any(|k| region.hold(true, from_s + (to_s - from_s) * f64::from(k) / 6.0))
+        };
+        assert!(!held(&mut region, 0.0, 0.6));
+        assert!(!region.hold(false, 0.7));
+        assert!(!held(&mut region, 0.8, 1.4));
+        assert!((region.hold.longest_s - 0.6).abs() < 1e-12);
+        assert!(held(&mut region, 1.5, 2.5));
     }
 }
