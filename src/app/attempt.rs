@@ -40,7 +40,7 @@ pub fn scenario_scene(
         on_stale,
     )?;
     scene.safety.max_force_n = scenario.device.max_force_n.0;
-    scene.instruments = (scenario.instruments_in_hand().iter())
+    scene.right_hand_mut().instruments = (scenario.instruments_in_hand().iter())
         .map(|(tool, port)| Instrument {
             action: tool.action(),
             port: port.as_ref().map(Port::fulcrum),
@@ -50,7 +50,7 @@ pub fn scenario_scene(
     if let (Some(cutting), Some(blade)) = (&mut scene.cutting, scenario.blade()) {
         cutting.blade = blade;
     }
-    scene.workspace.scale = scenario.device.workspace_scale.0;
+    scene.right_hand_mut().workspace.scale = scenario.device.workspace_scale.0;
     Ok(scene)
 }
 

@@ -7,7 +7,7 @@ use std::sync::{Arc, OnceLock};
 
 use nalgebra::Vector3;
 
-use super::haptic::{CutOrgan, HapticScene, SceneCutting, SceneDynamics};
+use super::haptic::{CutOrgan, HapticScene, SceneCutting, SceneDynamics, SceneHand};
 use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, FieldOrigin, Probe};
 use crate::cutting::keratotomy::{Cornea, REFERENCE_MESH};
 use crate::cutting::{Blade, CutError};
@@ -323,12 +323,14 @@ pub fn scene_of(
     Ok(HapticScene {
         organs,
         probe: Probe { tip_radius_m: tip },
-        workspace: Workspace::default(),
+        hands: vec![SceneHand {
+            instruments: vec![Instrument { action, port: None }],
+            workspace: Workspace::default(),
+        }],
         safety: SafetySettings::default(),
         coupling: (!coupling.is_empty()).then(|| Arc::new(coupling)),
         dynamics,
         cutting,
-        instruments: vec![Instrument { action, port: None }],
         scope: None,
         meanwhile,
     })
@@ -506,7 +508,8 @@ pub fn mouse_device(scene: &HapticScene) -> (Box<dyn HapticDevice>, Arc<VirtualH
     let start = press_targets(scene)
         .first()
         .map_or_else(Vector3::zeros, |t| t.point_m + t.normal * 0.03);
-    let (device, handle) = VirtualDevice::new(&scene.workspace.to_device(&start));
+    let workspace = scene.hands[0].workspace;
+    let (device, handle) = VirtualDevice::new(&workspace.to_device(&start));
     (Box::new(device), handle)
 }
 

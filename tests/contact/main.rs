@@ -521,7 +521,7 @@ fn the_trainee_feels_the_liver_behind_the_gallbladder() {
         let device = Box::new(Scripted::new("push", push(&target, 0.012, PUSH_S, 0.5)));
         let mut haptic = HapticLoop::new(scene, device).unwrap();
         haptic.run_simulated(TICKS);
-        haptic.world().resource::<DeviceForce>().desired_n.norm()
+        haptic.hand::<DeviceForce>(0).unwrap().desired_n.norm()
     };
     let mut without_contact = scene().clone();
     if let Some(coupling) = &mut without_contact.coupling {
@@ -552,7 +552,7 @@ fn pressed_where_the_tool_touches_the_gallbladder_alone_the_liver_stays_out() {
 #[test]
 fn the_tool_holds_the_surface_under_it_while_the_contact_pushes() {
     use pgd_surgery::app::haptic::{
-        OrganBody, OrganCoupling, OrganDeformation, OrganIndex, TickClock, Tool, ToolTouch,
+        HandTouches, OrganBody, OrganCoupling, OrganDeformation, OrganIndex, TickClock, Tool,
     };
     use pgd_surgery::devices::TICK_S;
     let target = facing_clear_of("gallbladder", -Vector3::z(), "duodenum");
@@ -566,6 +566,8 @@ fn the_tool_holds_the_surface_under_it_while_the_contact_pushes() {
             time_s: tick as f64 * TICK_S,
             overruns_in_a_row: 0,
         });
+        let tool = haptic.hand::<Tool>(0).unwrap();
+        let (tip, radius) = (tool.sample.unwrap().tip_m, tool.probe.tip_radius_m);
         let world = haptic.world_mut();
         let pushing = world
             .resource::<OrganCoupling>()
@@ -576,13 +578,11 @@ fn the_tool_holds_the_surface_under_it_while_the_contact_pushes() {
         if !pushing || tick % 50 != 0 {
             continue;
         }
-        let tip = world.resource::<Tool>().sample.unwrap().tip_m;
-        let radius = world.resource::<Tool>().probe.tip_radius_m;
         let (body, touch, deformation) = world
-            .query::<(&OrganIndex, &OrganBody, &ToolTouch, &OrganDeformation)>()
+            .query::<(&OrganIndex, &OrganBody, &HandTouches, &OrganDeformation)>()
             .iter(world)
             .find(|(i, ..)| i.0 == g)
-            .map(|(_, b, t, d)| (b.clone(), t.clone(), d.0.clone()))
+            .map(|(_, b, t, d)| (b.clone(), t.0[0].clone(), d.0.clone()))
             .unwrap();
         let contact = touch.contact.expect("the tool presses the gallbladder");
         let vademecum = &body.vademecum;

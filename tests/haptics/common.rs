@@ -90,7 +90,7 @@ pub fn scripted(trajectory: Trajectory) -> Box<dyn HapticDevice> {
 /// Runs `ticks` simulated ticks and returns the force trace.
 pub fn run(haptic: &mut HapticLoop, ticks: u64) -> ForceTrace {
     haptic.run_simulated(ticks);
-    std::mem::take(&mut *haptic.world_mut().resource_mut::<ForceTrace>())
+    std::mem::take(&mut *haptic.hand_mut::<ForceTrace>(0).unwrap())
 }
 
 /// The tick (1 ms each) at time `s`.

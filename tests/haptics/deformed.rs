@@ -1,7 +1,7 @@
 //! The tool touches the surface as the organ's other loads have moved it, not the rest surface.
 
 use nalgebra::Vector3;
-use pgd_surgery::app::haptic::{OrganDeformation, ToolTouch};
+use pgd_surgery::app::haptic::{HandTouches, OrganDeformation};
 use pgd_surgery::contact::ContactSurface;
 use pgd_surgery::devices::{DeviceSample, SafetySettings, Trajectory, TrajectoryRow};
 use pgd_surgery::pgd::{Deformation, PatchLoad, SurfacePoint, Vademecum};
@@ -19,8 +19,8 @@ fn depth_with(held: &PatchLoad, tip_m: Vector3<f64>) -> Option<(f64, Vector3<f64
     organs.single_mut(world).unwrap().0.loads.push(held.clone());
     run(&mut haptic, 1);
     let world = haptic.world_mut();
-    let touch = world.query::<&ToolTouch>().single(world).unwrap();
-    touch.contact.map(|c| (c.depth_m, c.moved_m))
+    let touches = world.query::<&HandTouches>().single(world).unwrap();
+    touches.0[0].contact.map(|c| (c.depth_m, c.moved_m))
 }
 
 /// A held load pushes the liver in by millimetres where the tool comes. A tip 2 mm into the

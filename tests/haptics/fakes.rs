@@ -32,7 +32,7 @@ pub fn press_then_fault(
             time_s: n as f64 * TICK_S,
             overruns_in_a_row: 0,
         });
-        sent.push(haptic.world().resource::<DeviceForce>().sent_n);
+        sent.push(haptic.hand::<DeviceForce>(0).unwrap().sent_n);
         frame();
     };
     (0..400).for_each(|n| tick(&mut haptic, n));
@@ -40,7 +40,7 @@ pub fn press_then_fault(
     frame();
     frame();
     (400..420).for_each(|n| tick(&mut haptic, n));
-    let faults = haptic.world().resource::<FaultLog>().log.iter();
+    let faults = haptic.hand::<FaultLog>(0).unwrap().log.iter();
     FaultRun {
         pressing: sent[399],
         faults: faults.map(|(t, f)| (*t, f.to_string())).collect(),

@@ -84,7 +84,7 @@ fn fade(kind: Kind) -> (usize, bool, Vec<(u64, String)>) {
     let stays = trace.sent_n[start + zero..]
         .iter()
         .all(|f| *f == Vector3::zeros());
-    let log = haptic.world().resource::<FaultLog>();
+    let log = haptic.hand::<FaultLog>(0).unwrap();
     let faults = log.log.iter().map(|(t, f)| (*t, f.to_string())).collect();
     (zero, stays, faults)
 }
@@ -131,17 +131,15 @@ fn a_streak_of_overruns_fades_the_force() {
             overruns_in_a_row: overruns,
         });
     }
-    let log = haptic.world().resource::<FaultLog>();
+    let log = haptic.hand::<FaultLog>(0).unwrap();
     assert_eq!(log.log.len(), 1, "{:?}", log.log);
     assert_eq!(
         log.log[0].0,
         pressed + 3,
         "the third overrun in a row is the fault"
     );
-    let sent = haptic
-        .world()
-        .resource::<pgd_surgery::app::haptic::DeviceForce>()
-        .sent_n;
+    let force = haptic.hand::<pgd_surgery::app::haptic::DeviceForce>(0);
+    let sent = force.unwrap().sent_n;
     assert_eq!(sent, Vector3::zeros());
 }
 

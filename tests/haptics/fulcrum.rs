@@ -130,7 +130,7 @@ fn the_shaft_stays_in_its_port() {
 #[test]
 fn the_trainer_moves_the_handle_and_sends_the_lever_force() {
     use crate::common::{TIP_RADIUS_M, run, scene, scripted, target};
-    use pgd_surgery::app::haptic::{DeviceForce, HapticLoop, HapticScene, Tool, ToolTouch};
+    use pgd_surgery::app::haptic::{DeviceForce, HandTouches, HapticLoop, Tool};
     use pgd_surgery::devices::{DeviceSample, SafetySettings, Trajectory, TrajectoryRow};
 
     let target = target();
@@ -151,20 +151,17 @@ fn the_trainer_moves_the_handle_and_sends_the_lever_force() {
             row(2.0, handle(pressing, 0.01)),
         ],
     };
-    let ported = HapticScene {
-        instruments: vec![Instrument {
-            port: Some(fulcrum),
-            ..Instrument::default()
-        }],
-        ..scene(SafetySettings::default())
-    };
+    let mut ported = scene(SafetySettings::default());
+    ported.right_hand_mut().instruments = vec![Instrument {
+        port: Some(fulcrum),
+        ..Instrument::default()
+    }];
     let mut haptic = HapticLoop::new(&ported, scripted(trajectory)).unwrap();
     haptic.keep_trace();
     run(&mut haptic, 2000);
     let on_axis = fulcrum.pose(&handle(pressing, 0.0)).unwrap().tip_m;
     assert!((on_axis - (target.point_m + n * (TIP_RADIUS_M - 0.004))).norm() < 1e-12);
-    let world = haptic.world_mut();
-    let tool = world.resource::<Tool>();
+    let tool = haptic.hand::<Tool>(0).unwrap();
     let (pose, tip) = (tool.pose.unwrap(), tool.sample.unwrap().tip_m);
     let expected = fulcrum.pose(&handle(pressing, 0.01)).unwrap();
     assert!((tip - expected.tip_m).norm() < 1e-12);
@@ -179,13 +176,14 @@ fn the_trainer_moves_the_handle_and_sends_the_lever_force() {
         (swing + 0.01 * ratio).abs() < 0.1 * 0.01 * ratio,
         "the tip swung {swing} m for the hand's 0.01 m, inside/outside {ratio}"
     );
-    let mut touches = world.query::<&ToolTouch>();
+    let desired = haptic.hand::<DeviceForce>(0).unwrap().desired_n;
+    let world = haptic.world_mut();
+    let mut touches = world.query::<&HandTouches>();
     let at_tip: Vector3<f64> = -touches
         .iter(world)
-        .filter_map(|t| t.contact.map(|c| c.force_n))
+        .filter_map(|t| t.0[0].contact.map(|c| c.force_n))
         .sum::<Vector3<f64>>();
     assert!(at_tip.norm() > 0.01, "the tip does not press: {at_tip:?}");
-    let desired = world.resource::<DeviceForce>().desired_n;
     let lever = Fulcrum::hand_force(&pose, &at_tip);
     assert!((desired - lever).norm() < 1e-12 * at_tip.norm());
     let across = at_tip - pose.along * at_tip.dot(&pose.along);

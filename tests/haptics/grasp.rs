@@ -29,17 +29,18 @@ fn moving_scene() -> HapticScene {
     )
     .unwrap();
     let dynamic = DynamicModel::new(&model, &liver.vademecum, TRAINER_MODES).unwrap();
-    HapticScene {
+    let mut scene = HapticScene {
         dynamics: Some(SceneDynamics {
             organs: vec![(0, Arc::new(dynamic))],
             grasp: GraspSettings::default(),
         }),
-        instruments: vec![Instrument {
-            action: Action::Grasp,
-            port: None,
-        }],
         ..scene(SafetySettings::default())
-    }
+    };
+    scene.right_hand_mut().instruments = vec![Instrument {
+        action: Action::Grasp,
+        port: None,
+    }];
+    scene
 }
 
 /// Down onto the liver, 4 mm in; jaws closed at 1.0 s; out along the normal to 15 mm above
@@ -98,9 +99,9 @@ fn grasped_pulled_and_released_through_the_loop() {
             overruns_in_a_row: 0,
         });
         largest_motion = largest_motion.max(motion(&mut haptic));
-        faulted |= haptic.world().resource::<FaultLog>().faulted_ticks > 0;
+        faulted |= haptic.hand::<FaultLog>(0).unwrap().faulted_ticks > 0;
     }
-    let trace = std::mem::take(&mut *haptic.world_mut().resource_mut::<ForceTrace>());
+    let trace = std::mem::take(&mut *haptic.hand_mut::<ForceTrace>(0).unwrap());
     let sent = &trace.desired_n;
     let normal = target().normal;
     let largest_change = sent

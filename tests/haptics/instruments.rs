@@ -88,7 +88,7 @@ fn one_instrument_is_never_changed() {
 #[test]
 fn the_trainer_changes_instruments_only_off_the_tissue() {
     use crate::common::{TIP_RADIUS_M, run, scene, scripted, target};
-    use pgd_surgery::app::haptic::{DeviceForce, HapticLoop, HapticScene, Tool, ToolTouch};
+    use pgd_surgery::app::haptic::{DeviceForce, HandTouches, HapticLoop, Tool};
     use pgd_surgery::devices::{DeviceSample, SafetySettings, Trajectory, TrajectoryRow};
 
     let target = target();
@@ -125,10 +125,8 @@ fn the_trainer_changes_instruments_only_off_the_tissue() {
             row(3.0, lifted + side * 0.01, 0),
         ],
     };
-    let scene = HapticScene {
-        instruments: instruments.to_vec(),
-        ..scene(SafetySettings::default())
-    };
+    let mut scene = scene(SafetySettings::default());
+    scene.right_hand_mut().instruments = instruments.to_vec();
     // The loop runs from the script's start at each call: one run to each moment looked at.
     let after = |ticks: u64| {
         let mut haptic = HapticLoop::new(&scene, scripted(trajectory.clone())).unwrap();
@@ -138,11 +136,11 @@ fn the_trainer_changes_instruments_only_off_the_tissue() {
     };
     let touching = |haptic: &mut HapticLoop| {
         let world = haptic.world_mut();
-        let mut touches = world.query::<&ToolTouch>();
-        touches.iter(world).any(|t| t.contact.is_some())
+        let mut touches = world.query::<&HandTouches>();
+        touches.iter(world).any(|t| t.any())
     };
-    let in_hand = |haptic: &mut HapticLoop| haptic.world_mut().resource::<Tool>().rack.in_hand().0;
-    let tip = |haptic: &mut HapticLoop| haptic.world_mut().resource::<Tool>().sample.unwrap().tip_m;
+    let in_hand = |haptic: &mut HapticLoop| haptic.hand::<Tool>(0).unwrap().rack.in_hand().0;
+    let tip = |haptic: &mut HapticLoop| haptic.hand::<Tool>(0).unwrap().sample.unwrap().tip_m;
 
     let mut pressed = after(1300);
     assert!(touching(&mut pressed), "A does not press the liver");
@@ -158,7 +156,7 @@ fn the_trainer_changes_instruments_only_off_the_tissue() {
         "B's tip is at {tip_b:?}"
     );
     assert!(!touching(&mut changed), "B's tip starts in the tissue");
-    let force = changed.world_mut().resource::<DeviceForce>().desired_n;
+    let force = changed.hand::<DeviceForce>(0).unwrap().desired_n;
     assert_eq!(
         force,
         Vector3::zeros(),

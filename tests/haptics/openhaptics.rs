@@ -303,8 +303,8 @@ fn the_force_answers_the_stylus_through_the_real_schedule() {
     );
     // Should a step go unanswered, the faults and the thread's timing say why.
     let faults: Vec<String> = haptic
-        .world()
-        .resource::<FaultLog>()
+        .hand::<FaultLog>(0)
+        .unwrap()
         .log
         .iter()
         .map(|(tick, fault)| format!("tick {tick}: {fault}"))

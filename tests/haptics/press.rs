@@ -2,7 +2,7 @@
 //! does not make it jump.
 
 use nalgebra::{Matrix3, Point3, Vector3};
-use pgd_surgery::app::haptic::ToolTouch;
+use pgd_surgery::app::haptic::HandTouches;
 use pgd_surgery::devices::{PressMotion, SafetySettings};
 use pgd_surgery::fem::{Loads, NewtonSettings, PatchKernel};
 use pgd_surgery::mesh::Surface;
@@ -52,10 +52,7 @@ fn a_scripted_press_matches_full_fem() {
     let hold = tick_at(motion.approach_s + motion.press_s + 0.5 * motion.slide_s);
     let trace = run(&mut haptic, hold + 1);
     let world = haptic.world_mut();
-    let contact = world
-        .query::<&ToolTouch>()
-        .single(world)
-        .unwrap()
+    let contact = world.query::<&HandTouches>().single(world).unwrap().0[0]
         .contact
         .expect("the tool presses the liver");
     assert!(

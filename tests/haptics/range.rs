@@ -63,7 +63,7 @@ fn scripted_press(vademecum: &Arc<Vademecum>, depth_m: f64) -> (HeadlessReport, 
     let mut haptic = HapticLoop::new(&scene, device).unwrap();
     haptic.keep_trace();
     let report = haptic.run_simulated(ticks);
-    let trace = std::mem::take(&mut *haptic.world_mut().resource_mut::<ForceTrace>());
+    let trace = std::mem::take(&mut *haptic.hand_mut::<ForceTrace>(0).unwrap());
     (report, trace)
 }
 

@@ -7,10 +7,8 @@ use crate::common::{press, run, scene, scripted, tick_at};
 
 /// The force sent, tick by tick, for `trajectory` on a device whose workspace is scaled.
 fn sent_n(trajectory: Trajectory, scale: f64, ticks: u64) -> Vec<f64> {
-    let scene = pgd_surgery::app::haptic::HapticScene {
-        workspace: Workspace { scale },
-        ..scene(SafetySettings::default())
-    };
+    let mut scene = scene(SafetySettings::default());
+    scene.right_hand_mut().workspace = Workspace { scale };
     let mut haptic = HapticLoop::new(&scene, scripted(trajectory)).unwrap();
     haptic.keep_trace();
     run(&mut haptic, ticks)

@@ -35,8 +35,8 @@ fn cut_with(trajectory: Trajectory) -> Cutting {
     let mut haptic = HapticLoop::new(&scene, device).unwrap();
     haptic.keep_trace();
     haptic.run_simulated(ticks);
+    let trace = std::mem::take(&mut *haptic.hand_mut::<ForceTrace>(0).unwrap());
     let world = haptic.world_mut();
-    let trace = std::mem::take(&mut *world.resource_mut::<ForceTrace>());
     let mut organs = world.query::<(&OrganBody, &OrganCut)>();
     let (body, liver) = organs
         .iter(world)

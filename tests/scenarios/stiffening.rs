@@ -69,7 +69,7 @@ fn press_deep(scene: &HapticScene) -> (HeadlessReport, Vec<(f64, f64)>, Vec<f64>
     let mut haptic = HapticLoop::new(scene, device).unwrap();
     haptic.keep_trace();
     let report = haptic.run_simulated(depths.len() as u64);
-    let trace = std::mem::take(&mut *haptic.world_mut().resource_mut::<ForceTrace>());
+    let trace = std::mem::take(&mut *haptic.hand_mut::<ForceTrace>(0).unwrap());
     let felt: Vec<(f64, f64)> = depths
         .iter()
         .zip(&trace.desired_n)

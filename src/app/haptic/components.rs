@@ -1,5 +1,6 @@
 //! What an organ entity of the haptic world holds: its vademecum and contact surface (shared
-//! through `Arc`, never copied), the tool's contact with it, and its deformation state.
+//! through `Arc`, never copied), each hand's tool's contact with it, and its deformation
+//! state.
 
 use std::sync::Arc;
 
@@ -29,10 +30,10 @@ pub fn organ_with_law(name: &str, vademecum: &Vademecum) -> String {
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OrganIndex(pub usize);
 
-/// The tool's contact with the organ this tick, if it touches, the patch under it and the
-/// tool's next load (scratch space kept from tick to tick: the press reads the organ's loads,
-/// the last tick's tool load included, while it writes the next one).
-#[derive(Component, Clone, Debug, Default)]
+/// A hand's tool's contact with the organ this tick, if it touches, the patch under it and
+/// the tool's next load (scratch space kept from tick to tick: the press reads the organ's
+/// loads, the last tick's tool load included, while it writes the next one).
+#[derive(Clone, Debug, Default)]
 pub struct ToolTouch {
     pub contact: Option<ToolContact>,
     pub patch: Patch,
@@ -50,6 +51,27 @@ impl ToolTouch {
     }
 }
 
+/// Each hand's touch of the organ, by hand index ([`super::HandIndex`]).
+#[derive(Component, Clone, Debug, Default)]
+pub struct HandTouches(pub Vec<ToolTouch>);
+
+impl HandTouches {
+    /// `hands` hands' touches, none touching, each with room for the largest patch.
+    pub fn reserved(vademecum: &Vademecum, hands: usize) -> Self {
+        Self(vec![ToolTouch::reserved(vademecum); hands])
+    }
+
+    /// Whether any hand's tool touches the organ.
+    pub fn any(&self) -> bool {
+        self.pressing().is_some()
+    }
+
+    /// The first hand whose tool touches the organ.
+    pub fn pressing(&self) -> Option<usize> {
+        self.0.iter().position(|t| t.contact.is_some())
+    }
+}
+
 /// `patch`'s shares by mesh node rather than by load position, into `nodes` (emptied first;
 /// its room kept, so that a buffer made for every position never grows).
 pub fn patch_nodes(patch: &Patch, vademecum: &Vademecum, nodes: &mut Vec<(usize, f64)>) {
@@ -58,13 +80,10 @@ pub fn patch_nodes(patch: &Patch, vademecum: &Vademecum, nodes: &mut Vec<(usize,
     nodes.extend(shares.map(|&(position, share)| (vademecum.positions[position] as usize, share)));
 }
 
-/// The loads on the organ and their modal coefficients. Load slot [`Self::TOOL`] is the tool's.
+/// The loads on the organ and their modal coefficients. Load slot `h` is hand `h`'s tool's
+/// ([`super::HandIndex`]): the hands' loads superpose through the vademecum.
 #[derive(Component, Clone, Debug)]
 pub struct OrganDeformation(pub Deformation);
-
-impl OrganDeformation {
-    pub const TOOL: usize = 0;
-}
 
 /// An organ that moves: its dynamic model (shared with the window, which draws its modes),
 /// its state with the grasper's jaws on it, and the kept modes' correction to the static
@@ -82,6 +101,8 @@ pub struct OrganMotion {
     pub patch_nodes: Vec<(usize, f64)>,
     /// Whether the jaws tore the tissue this tick (what the scenario's tasks score).
     pub tore: bool,
+    /// The hand whose jaws hold it (or held it last).
+    pub hand: usize,
 }
 
 impl OrganMotion {
@@ -98,6 +119,7 @@ impl OrganMotion {
             shares: Vec::with_capacity(positions),
             patch_nodes: Vec::with_capacity(positions),
             tore: false,
+            hand: 0,
         }
     }
 }

@@ -8,8 +8,8 @@ use bevy::ecs::query::QueryData;
 use bevy::prelude::*;
 use nalgebra::{Matrix3, Point3, Unit, Vector3};
 
-use super::components::{OrganBody, OrganDeformation, ToolTouch, patch_nodes};
-use super::resources::Tool;
+use super::components::{HandTouches, OrganBody, OrganDeformation, patch_nodes};
+use super::hand::{HandIndex, Tool};
 use crate::contact::ToolContact;
 use crate::cutting::{BladeContact, CutWorker, Scalpel};
 use crate::devices::Action;
@@ -44,12 +44,18 @@ impl OrganCut {
 #[derive(Resource, Clone, Copy, Debug, Default)]
 pub struct SettleCuts;
 
-/// Reads each cut organ's latest cut, softens the tool's press for it, and hands the blade's
-/// step, if any, to the organ's cut state.
-pub fn cut(tool: Res<Tool>, settle: Option<Res<SettleCuts>>, mut organs: Query<CutOrgan>) {
-    let cuts = tool.action() == Action::Cut;
+/// Reads each cut organ's latest cut, softens every hand's press on it, and hands the blade's
+/// step, if any, to the organ's cut state: the blade is the first hand's whose instrument
+/// cuts, its press on tissue the other hand may hold taut (that hand's load is among the
+/// organ's loads the press answers).
+pub fn cut(
+    tools: Query<(&HandIndex, &Tool)>,
+    settle: Option<Res<SettleCuts>>,
+    mut organs: Query<CutOrgan>,
+) {
+    let blade = tools.iter().find(|(_, tool)| tool.action() == Action::Cut);
     for organ in &mut organs {
-        let (body, mut touch, mut deformation) = (organ.body, organ.touch, organ.deformation);
+        let (body, mut touches, mut deformation) = (organ.body, organ.touch, organ.deformation);
         let OrganCut {
             scalpel,
             worker,
@@ -60,24 +66,28 @@ pub fn cut(tool: Res<Tool>, settle: Option<Res<SettleCuts>>, mut organs: Query<C
             Some(_) => worker.settle(),
             None => worker.poll(),
         };
-        let touch = &mut *touch;
-        if let Some(contact) = touch.contact.as_mut() {
+        for (slot, touch) in touches.0.iter_mut().enumerate() {
+            let Some(contact) = touch.contact.as_mut() else {
+                continue;
+            };
             patch_nodes(&touch.patch, &body.vademecum, nodes);
             soften(contact, worker.added_compliance(nodes));
+            let cuts = blade.is_some_and(|(hand, _)| hand.0 == slot);
             if let Some(parted_m) = scalpel.parted_depth_m().filter(|_| cuts) {
                 give(contact, parted_m);
             }
             contact.force_n = contact.stiffness_n_per_m * contact.indentation_m;
-            deformation.0.loads[OrganDeformation::TOOL].force_n = contact.force_n;
+            deformation.0.loads[slot].force_n = contact.force_n;
         }
-        let edge = tool
-            .sample
-            .map_or_else(Vector3::x, |s| s.orientation * Vector3::x());
         // The cut organ answers any instrument softer, but only a blade parts it.
-        let blade = (touch.contact.as_ref())
-            .filter(|_| cuts)
-            .map(|c| blade_contact(c, edge));
-        if let Some(step) = scalpel.tick(blade.as_ref()) {
+        let pressed = blade.and_then(|(hand, tool)| {
+            let contact = touches.0[hand.0].contact.as_ref()?;
+            let edge = tool
+                .sample
+                .map_or_else(Vector3::x, |s| s.orientation * Vector3::x());
+            Some(blade_contact(contact, edge))
+        });
+        if let Some(step) = scalpel.tick(pressed.as_ref()) {
             worker.submit(step);
         }
     }
@@ -88,7 +98,7 @@ pub fn cut(tool: Res<Tool>, settle: Option<Res<SettleCuts>>, mut organs: Query<C
 #[query_data(mutable)]
 pub struct CutOrgan {
     body: &'static OrganBody,
-    touch: &'static mut ToolTouch,
+    touch: &'static mut HandTouches,
     deformation: &'static mut OrganDeformation,
     cut: &'static mut OrganCut,
 }

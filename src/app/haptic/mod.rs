@@ -6,6 +6,7 @@
 mod components;
 mod cutting;
 mod frame_paced;
+mod hand;
 mod report;
 mod resources;
 mod runner;
@@ -21,18 +22,20 @@ use bevy::prelude::*;
 use snapshot::SnapshotPublisher;
 
 pub use components::{
-    OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, organ_with_law,
+    HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, organ_with_law,
 };
 pub use cutting::{OrganCut, SettleCuts};
 pub use frame_paced::FramePaced;
-pub use report::{ForceSummary, HeadlessReport, RangeSummary, TickTimes};
-pub use resources::{
-    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, Safety, SceneScope,
-    Scope, TickClock, Tool,
+pub use hand::{
+    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, HandIndex, MAX_HANDS, Safety, Tool,
 };
-pub use runner::{CutOrgan, HapticLoop, HapticScene, SceneCutting, SceneDynamics, SceneError};
+pub use report::{FaultSummary, ForceSummary, HeadlessReport, RangeSummary, TickTimes};
+pub use resources::{OrganCoupling, SceneScope, Scope, TickClock};
+pub use runner::{
+    CutOrgan, HapticLoop, HapticScene, SceneCutting, SceneDynamics, SceneError, SceneHand,
+};
 pub use scoring::{ExerciseLink, ExerciseRun};
-pub use snapshot::{HapticSnapshot, LoopTiming, OrganSnapshot};
+pub use snapshot::{HandSnapshot, HapticSnapshot, LoopTiming, OrganSnapshot};
 pub use swap::SceneSwap;
 #[cfg(not(target_arch = "wasm32"))]
 pub use thread::{HapticThread, RealTimeReport, Scheduling};
@@ -101,7 +104,7 @@ pub fn haptic_schedule() -> Schedule {
             .run_if(resource_exists::<ExerciseRun>)
             .in_set(HapticSet::Score),
         (
-            systems::trace_force.run_if(resource_exists::<ForceTrace>),
+            systems::trace_force.run_if(any_with_component::<ForceTrace>),
             (scoring::publish_progress, systems::publish_snapshot)
                 .chain()
                 .run_if(resource_exists::<SnapshotPublisher>),

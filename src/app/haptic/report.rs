@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use serde::Serialize;
 
-use super::resources::{DeviceForce, FaultLog};
+use super::hand::{DeviceForce, FaultLog};
 use crate::devices::{Histogram, TICK_S};
 
 /// Quantiles of a tick duration (µs).
@@ -55,6 +55,20 @@ impl ForceSummary {
             self.contact_ticks += 1;
         }
         self.final_n = force.sent_n.into();
+    }
+}
+
+impl fmt::Display for ForceSummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "max {:.3} N, mean in contact {:.3} N, largest change {:.4} N/tick \
+             (physics asked up to {:.3} N)",
+            self.max_sent_n,
+            self.mean_sent_in_contact_n,
+            self.max_change_n_per_tick,
+            self.max_desired_n
+        )
     }
 }
 
@@ -115,7 +129,11 @@ pub struct HeadlessReport {
     pub organs: Vec<String>,
     pub ticks: u64,
     pub simulated_s: f64,
+    /// What the right hand's device was sent (the only one of a one-hand run)...
     pub force: ForceSummary,
+    /// ...and the left hand's, in a bimanual run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub left_force: Option<ForceSummary>,
     pub range: RangeSummary,
     /// Wall-clock compute time of each tick.
     pub compute: TickTimes,
@@ -127,31 +145,61 @@ pub struct HeadlessReport {
 }
 
 impl HeadlessReport {
-    /// The report of `ticks` ticks that sent `force` from `device` to `organs`, with the
-    /// faults of `log` and the compute times of `compute`.
+    /// The report of `ticks` ticks that sent `forces` (a hand's each) from `device` to
+    /// `organs`, with `faults` and the compute times of `compute`.
     pub(super) fn new(
         device: String,
         organs: Vec<String>,
-        log: &FaultLog,
+        faults: FaultSummary,
         ticks: u64,
-        force: ForceSummary,
+        forces: Vec<ForceSummary>,
         range: RangeSummary,
         compute: &Histogram,
     ) -> Self {
         let period = Duration::from_secs_f64(TICK_S);
         let overruns = compute.count_above(period);
+        let mut forces = forces.into_iter();
         Self {
             device,
-            faulted_ticks: log.faulted_ticks,
-            faults: log.log.iter().map(|(t, f)| (*t, f.to_string())).collect(),
+            faulted_ticks: faults.faulted_ticks,
+            faults: faults.faults,
             organs,
             ticks,
             simulated_s: ticks as f64 * TICK_S,
-            force,
+            force: forces.next().unwrap_or_default(),
+            left_force: forces.next(),
             range,
             compute: TickTimes::of(compute),
             overruns,
         }
+    }
+}
+
+/// The faults of a run, every hand's.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FaultSummary {
+    /// The most ticks any one hand had a fault in.
+    pub faulted_ticks: u64,
+    /// (tick, fault) each time a fault started, in tick order, each named with its hand
+    /// where one is given.
+    pub faults: Vec<(u64, String)>,
+}
+
+impl FaultSummary {
+    /// The faults of `logs`, each with the name of its hand (`None`: one hand, unnamed).
+    pub fn of<'a>(logs: impl Iterator<Item = (Option<&'a str>, &'a FaultLog)>) -> Self {
+        let mut summary = Self::default();
+        for (hand, log) in logs {
+            summary.faulted_ticks = summary.faulted_ticks.max(log.faulted_ticks);
+            summary
+                .faults
+                .extend(log.log.iter().map(|(tick, fault)| match hand {
+                    Some(hand) => (*tick, format!("{hand}: {fault}")),
+                    None => (*tick, fault.to_string()),
+                }));
+        }
+        summary.faults.sort_by_key(|(tick, _)| *tick);
+        summary
     }
 }
 
@@ -164,15 +212,10 @@ impl fmt::Display for HeadlessReport {
             "ticks: {} ({:.3} s simulated), {} in contact",
             self.ticks, self.simulated_s, self.force.contact_ticks
         )?;
-        writeln!(
-            f,
-            "force sent: max {:.3} N, mean in contact {:.3} N, largest change {:.4} N/tick \
-             (physics asked up to {:.3} N)",
-            self.force.max_sent_n,
-            self.force.mean_sent_in_contact_n,
-            self.force.max_change_n_per_tick,
-            self.force.max_desired_n
-        )?;
+        writeln!(f, "force sent: {}", self.force)?;
+        if let Some(left) = &self.left_force {
+            writeln!(f, "left hand's force sent: {left}")?;
+        }
         writeln!(
             f,
             "tick compute: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; {} overruns of 1 ms",

@@ -1,50 +1,13 @@
-//! The haptic world's resources: the device, the tool, the clock, the force on its way to the
-//! device, and the fault log.
+//! The haptic world's resources, shared by every hand: the clock, the organs' coupling and
+//! the laparoscope.
 
-use bevy::prelude::*;
-
-use crate::contact::Coupling;
-use nalgebra::Vector3;
-
-use crate::contact::Probe;
 use std::sync::Arc;
 
-use crate::devices::{
-    Action, DeviceSample, Fault, Fulcrum, HapticDevice, Laparoscope, Pose, Rack, SafetyFilter,
-    ScopeHandle, ScopePose, ScopeScript, Workspace,
-};
+use bevy::prelude::*;
+use nalgebra::Vector3;
 
-#[derive(Resource)]
-pub struct Device(pub Box<dyn HapticDevice>);
-
-/// The tool as the last good device sample left it.
-#[derive(Resource, Default)]
-pub struct Tool {
-    pub probe: Probe,
-    /// How the device's motion maps onto the scene.
-    pub workspace: Workspace,
-    /// The instruments, one in hand; through a port the device moves its handle.
-    pub rack: Rack,
-    /// The device's last good sample, in the scene's frame.
-    pub hand: Option<DeviceSample>,
-    /// Through a port, where the instrument in hand is.
-    pub pose: Option<Pose>,
-    /// The instrument's tip, in the scene's frame; none until the device has reported a finite
-    /// position.
-    pub sample: Option<DeviceSample>,
-}
-
-impl Tool {
-    /// What the instrument in hand does besides pressing.
-    pub fn action(&self) -> Action {
-        self.rack.in_hand().1.action
-    }
-
-    /// The port of the instrument in hand, if it goes through one.
-    pub fn port(&self) -> Option<Fulcrum> {
-        self.rack.in_hand().1.port
-    }
-}
+use crate::contact::Coupling;
+use crate::devices::{Laparoscope, ScopeHandle, ScopePose, ScopeScript};
 
 /// The tick being run, set by the runner before each run of the schedule.
 #[derive(Resource, Clone, Copy, Debug, Default)]
@@ -55,43 +18,9 @@ pub struct TickClock {
     pub overruns_in_a_row: u32,
 }
 
-/// The force (N) on its way to the device: what the physics asks for, what is sent.
-#[derive(Resource, Clone, Copy, Debug, Default)]
-pub struct DeviceForce {
-    pub desired_n: Vector3<f64>,
-    pub sent_n: Vector3<f64>,
-}
-
-#[derive(Resource)]
-pub struct Safety(pub SafetyFilter);
-
-/// Faults: those of this tick (read by the safety filter), those found after it (a failed
-/// write, carried to the next tick), and a log of every change of fault.
-#[derive(Resource, Default)]
-pub struct FaultLog {
-    pub this_tick: Vec<Fault>,
-    pub next_tick: Vec<Fault>,
-    /// (tick, fault) each time a fault starts or changes kind.
-    pub log: Vec<(u64, Fault)>,
-    /// Ticks that had at least one fault.
-    pub faulted_ticks: u64,
-}
-
-/// Every tick's desired and sent force, kept when asked for (tests, `--json` traces).
-#[derive(Resource, Default)]
-pub struct ForceTrace {
-    pub desired_n: Vec<Vector3<f64>>,
-    pub sent_n: Vec<Vector3<f64>>,
-}
-
 /// The organs' contact and attachments, with their state from tick to tick.
 #[derive(Resource, Clone)]
 pub struct OrganCoupling(pub Coupling);
-
-/// The force the grasper's jaws pull the hand with this tick (N): the opposite of what they
-/// pull the organ with, and the release's fade.
-#[derive(Resource, Clone, Copy, Debug, Default)]
-pub struct GraspForce(pub Vector3<f64>);
 
 /// A scene's laparoscope: its optic, its pose (shared with the window, which steers it), and
 /// the point the trainee is to keep in view, if any.

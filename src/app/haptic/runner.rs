@@ -7,18 +7,19 @@ use std::time::Duration;
 // The browser's clock in a web page (std's has none there), the OS's elsewhere.
 use bevy::platform::time::Instant;
 
+use bevy::ecs::component::Mutable;
 use bevy::prelude::*;
 
 use super::components::{
-    OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, organ_with_law,
+    HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, organ_with_law,
 };
 use super::cutting::{OrganCut, SettleCuts};
-use super::report::{ForceSummary, HeadlessReport, RangeSummary};
-use super::resources::{
-    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, Safety, SceneScope,
-    Scope, TickClock, Tool,
+use super::hand::{
+    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, HandIndex, MAX_HANDS, Safety, Tool,
 };
-use super::snapshot::{HapticSnapshot, OrganSnapshot, SnapshotPublisher};
+use super::report::{FaultSummary, ForceSummary, HeadlessReport, RangeSummary};
+use super::resources::{OrganCoupling, SceneScope, Scope, TickClock};
+use super::snapshot::{HandSnapshot, HapticSnapshot, OrganSnapshot, SnapshotPublisher};
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
 use crate::cutting::{Blade, CutError, CutWorker, LatestCut, Scalpel};
 use crate::devices::{
@@ -36,7 +37,9 @@ pub struct HapticScene {
     /// Organ names and vademecums, in the scene's order.
     pub organs: Vec<(String, Arc<Vademecum>)>,
     pub probe: Probe,
-    pub workspace: Workspace,
+    /// The trainee's hands, the right hand first: one, or two for bimanual work, each with
+    /// its own device.
+    pub hands: Vec<SceneHand>,
     pub safety: SafetySettings,
     /// Organ/organ contact and attachments (set up, at rest); `None` leaves the organs apart.
     pub coupling: Option<Arc<Coupling>>,
@@ -45,9 +48,6 @@ pub struct HapticScene {
     pub dynamics: Option<SceneDynamics>,
     /// The organs the tool cuts, when it is a scalpel.
     pub cutting: Option<SceneCutting>,
-    /// The instruments, the first in hand at the start: through a port the device moves its
-    /// handle (laparoscopy); otherwise its tip (open surgery).
-    pub instruments: Vec<Instrument>,
     /// The laparoscope, if the trainee looks through one.
     pub scope: Option<SceneScope>,
     /// The nonlinear vademecums building in the background while their organs run linear
@@ -62,12 +62,11 @@ impl HapticScene {
         Self {
             organs,
             probe,
-            workspace: Workspace::default(),
+            hands: vec![SceneHand::default()],
             safety: SafetySettings::default(),
             coupling: None,
             dynamics: None,
             cutting: None,
-            instruments: vec![Instrument::default()],
             scope: None,
             meanwhile: Vec::new(),
         }
@@ -81,9 +80,34 @@ impl HapticScene {
         Self::pressing(Vec::new(), probe)
     }
 
-    /// The ports of the instruments that go through one.
+    /// The ports of the instruments that go through one, every hand's.
     pub fn ports(&self) -> impl Iterator<Item = Fulcrum> + '_ {
-        self.instruments.iter().filter_map(|i| i.port)
+        let instruments = self.hands.iter().flat_map(|h| &h.instruments);
+        instruments.filter_map(|i| i.port)
+    }
+
+    /// The right hand (the only one of a one-hand scene).
+    pub fn right_hand_mut(&mut self) -> &mut SceneHand {
+        &mut self.hands[0]
+    }
+}
+
+/// A hand of the scene: its instruments, and how its device's motion maps onto the scene.
+#[derive(Clone, Debug)]
+pub struct SceneHand {
+    /// The instruments, the first in hand at the start: through a port the device moves its
+    /// handle (laparoscopy); otherwise its tip (open surgery).
+    pub instruments: Vec<Instrument>,
+    pub workspace: Workspace,
+}
+
+impl Default for SceneHand {
+    /// A probe in open surgery, the device's motion one to one.
+    fn default() -> Self {
+        Self {
+            instruments: vec![Instrument::default()],
+            workspace: Workspace::default(),
+        }
     }
 }
 
@@ -142,35 +166,78 @@ pub enum SceneError {
     /// Safety settings the filter cannot honour (a negative force limit would reverse the force).
     #[error("the scene's safety settings: {0}")]
     Safety(String),
+    /// A device for each hand, no more and no fewer.
+    #[error(
+        "the scene has {hands} hand(s) and {devices} device(s) were opened for it: \
+         one device a hand (at most {MAX_HANDS} hands)"
+    )]
+    Hands { hands: usize, devices: usize },
+}
+
+/// Hand `index` of the scene, `hand`, into `world`, without its device.
+fn spawn_hand(world: &mut World, probe: Probe, index: usize, hand: &SceneHand) -> Entity {
+    let tool = Tool {
+        probe,
+        workspace: hand.workspace,
+        rack: Rack::new(&hand.instruments),
+        hand: None,
+        pose: None,
+        sample: None,
+    };
+    let parts = (HandIndex(index), tool, DeviceForce::default());
+    world
+        .spawn((parts, GraspForce::default(), FaultLog::default()))
+        .id()
 }
 
 /// The safety settings of a loop that has no device yet.
 #[derive(Resource, Clone, Copy)]
 struct Parked(SafetySettings);
 
-/// A haptic `World` of organ entities and the schedule that ticks it.
+/// A haptic `World` of organ and hand entities and the schedule that ticks it.
 pub struct HapticLoop {
     world: World,
     schedule: Schedule,
+    /// The hand entities, by hand index.
+    hands: Vec<Entity>,
 }
 
 impl HapticLoop {
+    /// The loop of a one-hand scene on `device`.
     pub fn new(scene: &HapticScene, device: Box<dyn HapticDevice>) -> Result<Self, SceneError> {
+        Self::with_devices(scene, vec![device])
+    }
+
+    /// The loop of `scene` on `devices`, one a hand, the right hand's first.
+    pub fn with_devices(
+        scene: &HapticScene,
+        devices: Vec<Box<dyn HapticDevice>>,
+    ) -> Result<Self, SceneError> {
+        if devices.len() != scene.hands.len() {
+            let (hands, devices) = (scene.hands.len(), devices.len());
+            return Err(SceneError::Hands { hands, devices });
+        }
         let mut haptic = Self::parked(scene)?;
         haptic.world.remove_resource::<Parked>();
-        let limits = device.limits();
-        haptic.world.insert_resource(Device(device));
-        haptic
-            .world
-            .insert_resource(Safety(SafetyFilter::new(scene.safety, limits)));
+        for (&entity, device) in haptic.hands.iter().zip(devices) {
+            let safety = Safety(SafetyFilter::new(scene.safety, device.limits()));
+            haptic
+                .world
+                .entity_mut(entity)
+                .insert((Device(device), safety));
+        }
         Ok(haptic)
     }
 
     /// A world for `scene` without a device, to be built away from the haptic thread (its
     /// contact surfaces take milliseconds) and then take over a running loop's device with
-    /// [`HapticLoop::take_device`]. Ticked without one, it would panic.
+    /// [`HapticLoop::take_devices`]. Ticked without them, its hands read and send nothing.
     pub fn parked(scene: &HapticScene) -> Result<Self, SceneError> {
         scene.safety.check().map_err(SceneError::Safety)?;
+        let hands = scene.hands.len();
+        if !(1..=MAX_HANDS).contains(&hands) {
+            return Err(SceneError::Hands { hands, devices: 0 });
+        }
         let mut world = World::new();
         for (index, (name, vademecum)) in scene.organs.iter().enumerate() {
             let mut organ = world.spawn((
@@ -180,8 +247,8 @@ impl HapticLoop {
                     vademecum: vademecum.clone(),
                 },
                 OrganIndex(index),
-                ToolTouch::reserved(vademecum),
-                OrganDeformation(Deformation::new(vademecum, 1)),
+                HandTouches::reserved(vademecum, hands),
+                OrganDeformation(Deformation::new(vademecum, hands)),
             ));
             if let Some(dynamics) = &scene.dynamics
                 && let Some(model) = dynamics.model(index)
@@ -197,18 +264,10 @@ impl HapticLoop {
                 organ.insert(OrganCut::new(scalpel, worker, vademecum.positions.len()));
             }
         }
-        world.insert_resource(GraspForce::default());
-        world.insert_resource(Tool {
-            probe: scene.probe,
-            workspace: scene.workspace,
-            rack: Rack::new(&scene.instruments),
-            hand: None,
-            pose: None,
-            sample: None,
-        });
+        let hands = (scene.hands.iter().enumerate())
+            .map(|(index, hand)| spawn_hand(&mut world, scene.probe, index, hand))
+            .collect();
         world.insert_resource(TickClock::default());
-        world.insert_resource(DeviceForce::default());
-        world.insert_resource(FaultLog::default());
         world.insert_resource(Parked(scene.safety));
         if let Some(coupling) = &scene.coupling {
             let coupling = coupling.clone_reserved(&scene.organs);
@@ -224,31 +283,56 @@ impl HapticLoop {
         Ok(Self {
             world,
             schedule: super::haptic_schedule(),
+            hands,
         })
     }
 
-    /// Takes `running`'s device and its safety filter (retuned to this scene's settings), so
-    /// that the force the hand feels carries over the change of scene at the allowed rate.
-    /// Does nothing if this loop has a device already or `running` has none.
-    pub fn take_device(&mut self, running: &mut HapticLoop) {
+    /// Takes `running`'s devices and their safety filters (retuned to this scene's settings),
+    /// hand by hand, so that the force each hand feels carries over the change of scene at
+    /// the allowed rate. Does nothing if this loop has its devices already; a hand `running`
+    /// has no device for stays without one (and a device of a hand this scene lacks stays
+    /// with `running`, which closes it when dropped).
+    pub fn take_devices(&mut self, running: &mut HapticLoop) {
         let Some(Parked(settings)) = self.world.get_resource::<Parked>().copied() else {
             return;
         };
-        let (Some(device), Some(mut safety)) = (
-            running.world.remove_resource::<Device>(),
-            running.world.remove_resource::<Safety>(),
-        ) else {
-            return;
-        };
-        safety.0.retune(settings, device.0.limits());
         self.world.remove_resource::<Parked>();
-        self.world.insert_resource(device);
-        self.world.insert_resource(safety);
+        for (&mine, &theirs) in self.hands.iter().zip(&running.hands) {
+            let mut theirs = running.world.entity_mut(theirs);
+            let (Some(device), Some(mut safety)) =
+                (theirs.take::<Device>(), theirs.take::<Safety>())
+            else {
+                continue;
+            };
+            safety.0.retune(settings, device.0.limits());
+            self.world.entity_mut(mine).insert((device, safety));
+        }
     }
 
-    /// Keeps every tick's forces in a [`ForceTrace`].
+    /// Keeps every tick's forces of every hand in its [`ForceTrace`].
     pub fn keep_trace(&mut self) {
-        self.world.insert_resource(ForceTrace::default());
+        for &hand in &self.hands {
+            self.world.entity_mut(hand).insert(ForceTrace::default());
+        }
+    }
+
+    /// How many hands the scene has.
+    pub fn hands(&self) -> usize {
+        self.hands.len()
+    }
+
+    /// Hand `index`'s component `T` (its [`Tool`], [`DeviceForce`], [`FaultLog`], …), if it
+    /// has one.
+    pub fn hand<T: Component>(&self, index: usize) -> Option<&T> {
+        self.world.get::<T>(*self.hands.get(index)?)
+    }
+
+    /// Hand `index`'s component `T`, to change.
+    pub fn hand_mut<T: Component<Mutability = Mutable>>(
+        &mut self,
+        index: usize,
+    ) -> Option<Mut<'_, T>> {
+        self.world.get_mut::<T>(*self.hands.get(index)?)
     }
 
     /// Starts publishing a snapshot every tick; the returned end reads the latest, and until
@@ -271,6 +355,7 @@ impl HapticLoop {
             .collect();
         organs.sort_by_key(|(index, _)| *index);
         let template = HapticSnapshot {
+            hands: vec![HandSnapshot::default(); self.hands.len()],
             organs: organs.into_iter().map(|(_, organ)| organ).collect(),
             ..HapticSnapshot::default()
         };
@@ -301,7 +386,7 @@ impl HapticLoop {
     pub fn run_simulated(&mut self, ticks: u64) -> HeadlessReport {
         self.world.insert_resource(SettleCuts);
         let mut compute = Histogram::default();
-        let mut forces = ForceSummary::default();
+        let mut forces = vec![ForceSummary::default(); self.hands.len()];
         let mut range = RangeSummary::default();
         let mut ran = 0;
         for tick in 0..ticks {
@@ -315,29 +400,51 @@ impl HapticLoop {
                 overruns_in_a_row: 0,
             });
             compute.record(time);
-            let force = *self.world.resource::<DeviceForce>();
+            self.record_tick(&mut forces, &mut range);
+        }
+        let (device, organs) = (self.device_name(), self.organ_names());
+        let faults = self.faults();
+        HeadlessReport::new(device, organs, faults, ran, forces, range, &compute)
+    }
+
+    /// Records the tick's force of each hand, and how far each tool pressed beyond its
+    /// organ's range.
+    fn record_tick(&mut self, forces: &mut [ForceSummary], range: &mut RangeSummary) {
+        let mut organs = self.world.query::<(&OrganBody, &HandTouches)>();
+        for (slot, summary) in forces.iter_mut().enumerate() {
             let mut touching = false;
-            for (body, touch) in self
-                .world
-                .query::<(&OrganBody, &ToolTouch)>()
-                .iter(&self.world)
-            {
-                let Some(contact) = &touch.contact else {
+            for (body, touches) in organs.iter(&self.world) {
+                let Some(contact) = &touches.0[slot].contact else {
                     continue;
                 };
                 touching = true;
                 let valid_m = body.vademecum.valid_indentation_m();
                 range.record(&body.name, contact.beyond_range_m, valid_m);
             }
-            forces.record(&force, touching);
+            let force = self.world.get::<DeviceForce>(self.hands[slot]);
+            summary.record(force.expect("every hand has its force"), touching);
         }
-        let (device, organs) = (self.device_name(), self.organ_names());
-        let log = self.world.resource::<FaultLog>();
-        HeadlessReport::new(device, organs, log, ran, forces, range, &compute)
     }
 
+    /// Every hand's device, named, joined by " + " (the right hand's first).
     pub(super) fn device_name(&self) -> String {
-        self.world.resource::<Device>().0.name().to_owned()
+        let names: Vec<&str> = (0..self.hands.len())
+            .map(|index| {
+                self.hand::<Device>(index)
+                    .map_or("no device", |d| d.0.name())
+            })
+            .collect();
+        names.join(" + ")
+    }
+
+    /// Every hand's faults, each named with its hand when there are two.
+    pub(super) fn faults(&self) -> FaultSummary {
+        let logs = (0..self.hands.len()).filter_map(|index| self.hand::<FaultLog>(index));
+        let named = self.hands.len() > 1;
+        FaultSummary::of(logs.enumerate().map(|(index, log)| {
+            let hand = named.then(|| HandIndex(index).name());
+            (hand, log)
+        }))
     }
 
     fn organ_names(&mut self) -> Vec<String> {

@@ -13,9 +13,10 @@ use std::sync::{Arc, Mutex};
 use bevy::ecs::query::QueryData;
 use bevy::prelude::*;
 
-use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch};
+use super::components::{HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion};
 use super::cutting::OrganCut;
-use super::resources::{DeviceForce, Scope, TickClock, Tool};
+use super::hand::{DeviceForce, HandIndex, Tool};
+use super::resources::{Scope, TickClock};
 use super::snapshot::SnapshotPublisher;
 use crate::scenario::{BladeSample, Exercise, Progress, RegionSite, Sample};
 
@@ -23,7 +24,7 @@ use crate::scenario::{BladeSample, Exercise, Progress, RegionSite, Sample};
 #[derive(QueryData)]
 pub struct ScoredOrgan {
     index: &'static OrganIndex,
-    touch: &'static ToolTouch,
+    touch: &'static HandTouches,
     body: &'static OrganBody,
     deformation: &'static OrganDeformation,
     motion: Option<&'static OrganMotion>,
@@ -182,8 +183,7 @@ impl ExerciseRun {
 
 pub fn score_tick(
     clock: Res<TickClock>,
-    tool: Res<Tool>,
-    force: Res<DeviceForce>,
+    hands: Query<(&HandIndex, &Tool, &DeviceForce)>,
     organs: Query<ScoredOrgan>,
     mut run: ResMut<ExerciseRun>,
     scope: Option<ResMut<Scope>>,
@@ -197,21 +197,23 @@ pub fn score_tick(
     let Some(exercise) = run.exercise.as_mut() else {
         return;
     };
+    let Some((_, tool, force)) = hands.iter().find(|(hand, ..)| hand.0 == 0) else {
+        return;
+    };
     let bits = |of: &dyn Fn(&ScoredOrganItem) -> bool| {
         (organs.iter())
             .filter(|o| o.index.0 < 64 && of(o))
             .fold(0, |bits, o| bits | 1 << o.index.0)
     };
-    let touching = bits(&|o| o.touch.contact.is_some());
+    let touching = bits(&|o| o.touch.0[0].contact.is_some());
     let grasping = bits(&|o| o.motion.is_some_and(|m| m.organ.holding()));
     let tore = organs.iter().any(|o| o.motion.is_some_and(|m| m.tore));
     let blade = organs.iter().find_map(|o| blade_sample(o.index, o.cut?));
     let (region_moved_m, surrounding_force_n) = exercise
         .watched_region()
         .map_or((0.0, 0.0), |region| watch(region, &organs));
-    let beyond_range_m = organs
-        .iter()
-        .filter_map(|o| o.touch.contact.map(|c| c.beyond_range_m))
+    let beyond_range_m = (organs.iter().flat_map(|o| &o.touch.0))
+        .filter_map(|touch| touch.contact.map(|c| c.beyond_range_m))
         .fold(0.0, f64::max);
     let tip_m = tool.sample.map(|s| s.tip_m);
     let elapsed_s = exercise.elapsed_s(clock.time_s);
@@ -242,7 +244,7 @@ pub fn score_tick(
 }
 
 /// How far the region has moved along its direction (m), and the force on every other organ
-/// (N): the tool's on it, and what the organs it touches or hangs from put on it.
+/// (N): the tools' on it, and what the organs it touches or hangs from put on it.
 fn watch(region: &RegionSite, organs: &Query<ScoredOrgan>) -> (f64, f64) {
     let mut moved_m = 0.0;
     let mut surrounding_n = 0.0;
@@ -253,8 +255,8 @@ fn watch(region: &RegionSite, organs: &Query<ScoredOrgan>) -> (f64, f64) {
                 .displacement(&organ.body.vademecum, &region.at)
                 .dot(&region.towards);
         } else {
-            let tool = deformation.loads[OrganDeformation::TOOL].force_n;
-            surrounding_n += tool.norm() + deformation.coupling_force_n.norm();
+            let tools: f64 = deformation.loads.iter().map(|l| l.force_n.norm()).sum();
+            surrounding_n += tools + deformation.coupling_force_n.norm();
         }
     }
     (moved_m, surrounding_n)
@@ -319,8 +321,7 @@ mod tests {
     fn world(link: &Arc<ExerciseLink>) -> World {
         let mut world = World::new();
         world.insert_resource(TickClock::default());
-        world.insert_resource(Tool::default());
-        world.insert_resource(DeviceForce::default());
+        world.spawn((HandIndex(0), Tool::default(), DeviceForce::default()));
         world.insert_resource(ExerciseRun::new(link.clone()));
         world
     }

@@ -28,6 +28,26 @@ pub struct OrganSnapshot {
 pub struct HapticSnapshot {
     pub tick: u64,
     pub time_s: f64,
+    /// Each hand's instrument and force, by hand index (the right hand first).
+    pub hands: Vec<HandSnapshot>,
+    /// In the scene's organ order.
+    pub organs: Vec<OrganSnapshot>,
+    /// How the real-time loop has kept time so far (refreshed once a second).
+    pub timing: LoopTiming,
+    /// Where the scenario's exercise stands, once started.
+    pub exercise: Option<Progress>,
+}
+
+impl HapticSnapshot {
+    /// The first hand's (the only one of a one-hand scene); a snapshot has one at least.
+    pub fn first_hand(&self) -> &HandSnapshot {
+        &self.hands[0]
+    }
+}
+
+/// A hand's instrument and force, as the window draws them.
+#[derive(Clone, Debug, Default)]
+pub struct HandSnapshot {
     /// The tool tip (m), once the device has reported one.
     pub tip_m: Option<Vector3<f64>>,
     /// Through a port, the instrument's handle (m): its shaft runs from there through the
@@ -41,12 +61,6 @@ pub struct HapticSnapshot {
     pub blade_edge: Option<Vector3<f64>>,
     /// Whether the force is faded or held after a fault.
     pub faulted: bool,
-    /// In the scene's organ order.
-    pub organs: Vec<OrganSnapshot>,
-    /// How the real-time loop has kept time so far (refreshed once a second).
-    pub timing: LoopTiming,
-    /// Where the scenario's exercise stands, once started.
-    pub exercise: Option<Progress>,
 }
 
 /// The instruments as the window draws and drives them (fixed-size: the loop allocates nothing).

@@ -39,7 +39,7 @@ impl SceneSwap {
         if let Ok(mut swap) = self.0.try_lock()
             && let Some(mut next) = swap.incoming.take()
         {
-            next.take_device(running);
+            next.take_devices(running);
             swap.retired = Some(std::mem::replace(running, next));
         }
     }
@@ -49,7 +49,8 @@ impl SceneSwap {
 mod tests {
     use super::*;
     use crate::app::haptic::HapticScene;
-    use crate::app::haptic::resources::{Device, Safety, TickClock};
+    use crate::app::haptic::hand::{Device, Safety};
+    use crate::app::haptic::resources::TickClock;
     use crate::devices::{DeviceSample, Scripted, Trajectory, TrajectoryRow};
     use nalgebra::Vector3;
 
@@ -72,9 +73,9 @@ mod tests {
         swap.take(&mut running);
         assert!(!swap.pending());
         assert_eq!(running.device_name(), "the hand");
-        assert_eq!(running.world().resource::<Safety>().0.max_force_n(), 1.0);
+        assert_eq!(running.hand::<Safety>(0).unwrap().0.max_force_n(), 1.0);
         running.tick(TickClock::default());
         let retired = swap.0.lock().unwrap().retired.take().unwrap();
-        assert!(!retired.world().contains_resource::<Device>());
+        assert!(retired.hand::<Device>(0).is_none());
     }
 }

@@ -5,65 +5,76 @@ use bevy::prelude::*;
 use nalgebra::Vector3;
 
 use super::components::{
-    OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, patch_nodes,
+    HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, patch_nodes,
 };
 use super::cutting::OrganCut;
-use super::resources::{
-    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, OrganCoupling, Safety, TickClock, Tool,
+use super::hand::{
+    DeviceForce, FaultLog, ForceTrace, GraspForce, HandIndex, HandState, MAX_HANDS, Safety, Tool,
 };
-use super::snapshot::{InstrumentsView, LoopTiming, SnapshotPublisher};
+use super::resources::{OrganCoupling, TickClock};
+use super::snapshot::{HandSnapshot, InstrumentsView, LoopTiming, SnapshotPublisher};
 use crate::contact::{Target, follow, press};
 use crate::devices::{Action, Fault, Fulcrum};
-use crate::pgd::SurfacePoint;
+use crate::pgd::{Deformation, SurfacePoint};
 
-/// Reads the device into [`Tool::hand`], mapped onto the scene. A non-finite sample or a
-/// device error is a fault and the tool keeps its last good position; so is a streak of
-/// overrun ticks.
-pub fn read_device(
-    clock: Res<TickClock>,
-    safety: Res<Safety>,
-    mut device: ResMut<Device>,
-    mut tool: ResMut<Tool>,
-    mut faults: ResMut<FaultLog>,
-) {
-    let faults = &mut *faults;
-    faults.this_tick.clear();
-    faults.this_tick.append(&mut faults.next_tick);
-    match device.0.read(clock.time_s) {
-        Ok(sample) if sample.is_finite() => tool.hand = Some(tool.workspace.to_scene(sample)),
-        Ok(_) => faults.this_tick.push(Fault::NonFiniteDevice),
-        Err(e) => faults.this_tick.push(Fault::Device(e.to_string())),
-    }
-    if clock.overruns_in_a_row >= safety.0.settings().overrun_streak {
-        faults
-            .this_tick
-            .push(Fault::Overruns(clock.overruns_in_a_row));
+/// Reads each hand's device into its [`Tool::hand`], mapped onto the scene. A non-finite
+/// sample or a device error is a fault of that hand, whose tool keeps its last good position;
+/// a streak of overrun ticks is a fault of every hand.
+pub fn read_device(clock: Res<TickClock>, mut hands: Query<HandState>) {
+    for hand in &mut hands {
+        let faults = hand.faults.into_inner();
+        faults.this_tick.clear();
+        faults.this_tick.append(&mut faults.next_tick);
+        let (Some(mut device), Some(safety)) = (hand.device, hand.safety) else {
+            continue;
+        };
+        let tool = hand.tool.into_inner();
+        match device.0.read(clock.time_s) {
+            Ok(sample) if sample.is_finite() => tool.hand = Some(tool.workspace.to_scene(sample)),
+            Ok(_) => faults.this_tick.push(Fault::NonFiniteDevice),
+            Err(e) => faults.this_tick.push(Fault::Device(e.to_string())),
+        }
+        if clock.overruns_in_a_row >= safety.0.settings().overrun_streak {
+            faults
+                .this_tick
+                .push(Fault::Overruns(clock.overruns_in_a_row));
+        }
     }
 }
 
-/// The device's change button puts the instrument in hand down and takes up the next, while
-/// the one in hand touches and holds nothing (so the hand feels no step of force).
+/// A hand's change button puts the instrument in it down and takes up the next, while the one
+/// in hand touches and holds nothing (so the hand feels no step of force).
 pub fn change_instrument(
-    mut tool: ResMut<Tool>,
-    touches: Query<&ToolTouch>,
-    motions: Query<&OrganMotion>,
+    mut tools: Query<(&HandIndex, &mut Tool)>,
+    organs: Query<(&HandTouches, Option<&OrganMotion>)>,
 ) {
-    let Some(hand) = tool.hand else {
-        return;
-    };
-    let free = || {
-        touches.iter().all(|t| t.contact.is_none()) && motions.iter().all(|m| !m.organ.holding())
-    };
-    let tip = tool.sample.map_or(hand.tip_m, |s| s.tip_m);
-    if tool.rack.take(hand.buttons, &hand.tip_m, &tip, free) {
-        tool.pose = None;
+    for (hand, mut tool) in &mut tools {
+        let Some(read) = tool.hand else {
+            continue;
+        };
+        let free = || {
+            organs.iter().all(|(touches, motion)| {
+                let holds = motion.is_some_and(|m| m.organ.holding() && m.hand == hand.0);
+                touches.0[hand.0].contact.is_none() && !holds
+            })
+        };
+        let tip = tool.sample.map_or(read.tip_m, |s| s.tip_m);
+        if tool.rack.take(read.buttons, &read.tip_m, &tip, free) {
+            tool.pose = None;
+        }
     }
 }
 
-/// Places the instrument in hand for the device's sample: its tip, or through a port, its
+/// Places each hand's instrument for its device's sample: its tip, or through a port, its
 /// handle, the tip then where the shaft through the port puts it and the instrument along the
 /// shaft, rolled as the hand rolls the handle (a handle on the port itself keeps the last pose).
-pub fn place_instrument(mut tool: ResMut<Tool>) {
+pub fn place_instrument(mut tools: Query<&mut Tool>) {
+    for mut tool in &mut tools {
+        place(&mut tool);
+    }
+}
+
+fn place(tool: &mut Tool) {
     let Some(mut sample) = tool.hand else {
         return;
     };
@@ -81,86 +92,125 @@ pub fn place_instrument(mut tool: ResMut<Tool>) {
     tool.sample = Some(sample);
 }
 
-/// Presses the tool into every organ it touches, on the surface as the organ's other loads have
-/// moved it, and sets the organ's tool load.
+/// Presses each hand's tool into every organ it touches, on the surface as the organ's other
+/// loads (the other hand's among them) have moved it, and sets the hand's load on the organ.
 pub fn tool_contact(
-    tool: Res<Tool>,
-    mut organs: Query<(&OrganBody, &mut ToolTouch, &mut OrganDeformation)>,
+    tools: Query<(&HandIndex, &Tool)>,
+    mut organs: Query<(&OrganBody, &mut HandTouches, &mut OrganDeformation)>,
 ) {
-    for (body, mut touch, mut deformation) in &mut organs {
-        let Some(sample) = &tool.sample else {
-            deformation.0.loads[OrganDeformation::TOOL].release();
-            touch.contact = None;
-            continue;
-        };
-        let deformation = &mut deformation.0;
-        let touch = &mut *touch;
-        let target = Target {
-            vademecum: &body.vademecum,
-            surface: &body.surface,
-            moved_by_others: |position: usize| {
-                let tool = OrganDeformation::TOOL;
-                deformation.position_displacement_without(&body.vademecum, position, tool)
-            },
-            moved_by_all: |at: &SurfacePoint| deformation.displacement(&body.vademecum, at),
-        };
-        let previous = touch.contact.map(|contact| contact.hit.at);
-        touch.contact = press(
-            &target,
-            &tool.probe,
-            &sample.tip_m,
-            previous.as_ref(),
-            &mut touch.patch,
-            &mut touch.next_load,
-        );
-        std::mem::swap(
-            &mut deformation.loads[OrganDeformation::TOOL],
-            &mut touch.next_load,
-        );
+    for (hand, tool) in &tools {
+        for (body, mut touches, mut deformation) in &mut organs {
+            press_organ(
+                hand.0,
+                tool,
+                body,
+                &mut touches.0[hand.0],
+                &mut deformation.0,
+            );
+        }
     }
 }
 
-/// The grasper on the organs that move: pressing the device's button closes the jaws on the
-/// organ the tool touches (one at a time), and every moving organ is stepped, held or swinging back.
-/// While the jaws hold, the organ's tool load is their pull at their patch (its static field
-/// the vademecum's, the kept modes' motion the correction) and the hand feels the grasp, not
-/// a press.
-pub fn grasp(
-    tool: Res<Tool>,
-    mut was_closed: Local<bool>,
-    mut grasp_force: ResMut<GraspForce>,
-    mut faults: ResMut<FaultLog>,
-    mut organs: Query<MovingOrgan>,
+/// Hand `slot`'s tool pressed into one organ.
+fn press_organ(
+    slot: usize,
+    tool: &Tool,
+    body: &OrganBody,
+    touch: &mut ToolTouch,
+    deformation: &mut Deformation,
 ) {
-    grasp_force.0 = Vector3::zeros();
-    let Some(sample) = tool.sample else {
+    let Some(sample) = &tool.sample else {
+        deformation.loads[slot].release();
+        touch.contact = None;
         return;
     };
-    // Only a grasper's jaws close; an organ let go swings back whatever is in hand.
-    let closed = sample.buttons & 1 != 0 && tool.action() == Action::Grasp;
-    // Jaws close on tissue when the button goes down, not while it stays down: tissue that
-    // escaped a closed grasper is not taken again until the trainee opens and closes it.
-    let closing = closed && !*was_closed;
-    *was_closed = closed;
-    let mut held_elsewhere = organs.iter().any(|o| o.motion.organ.holding());
-    for organ in &mut organs {
-        let (mut touch, mut deformation) = (organ.touch, organ.deformation);
-        let motion = &mut *organ.motion.into_inner();
-        let holding = motion.organ.holding();
-        let grasping = closing && !holding && !held_elsewhere && touch.contact.is_some();
-        if grasping {
-            take_hold(organ.body, &touch, motion, &sample.tip_m);
-            held_elsewhere = true;
+    let target = Target {
+        vademecum: &body.vademecum,
+        surface: &body.surface,
+        moved_by_others: |position: usize| {
+            deformation.position_displacement_without(&body.vademecum, position, slot)
+        },
+        moved_by_all: |at: &SurfacePoint| deformation.displacement(&body.vademecum, at),
+    };
+    let previous = touch.contact.map(|contact| contact.hit.at);
+    touch.contact = press(
+        &target,
+        &tool.probe,
+        &sample.tip_m,
+        previous.as_ref(),
+        &mut touch.patch,
+        &mut touch.next_load,
+    );
+    std::mem::swap(&mut deformation.loads[slot], &mut touch.next_load);
+}
+
+/// One hand's grasper jaws this tick.
+#[derive(Clone, Copy, Debug)]
+struct Jaws {
+    tip_m: Vector3<f64>,
+    closed: bool,
+    /// Closed this tick, open the last.
+    closing: bool,
+}
+
+/// The graspers on the organs that move: pressing a hand's button closes its jaws on the
+/// organ its tool touches (one organ a hand, one hand an organ), and every moving organ is
+/// stepped, held or swinging back. While the jaws hold, the holding hand's load on the organ
+/// is their pull at their patch (its static field the vademecum's, the kept modes' motion the
+/// correction) and that hand feels the grasp, not a press.
+pub fn grasp(
+    mut was_closed: Local<[bool; MAX_HANDS]>,
+    mut hands: Query<(&HandIndex, &Tool, &mut GraspForce, &mut FaultLog)>,
+    mut organs: Query<MovingOrgan>,
+) {
+    let mut jaws = [None; MAX_HANDS];
+    for (hand, tool, mut force, _) in &mut hands {
+        force.0 = Vector3::zeros();
+        let Some(sample) = tool.sample else {
+            continue;
+        };
+        // Only a grasper's jaws close; an organ let go swings back whatever is in hand.
+        let closed = sample.buttons & 1 != 0 && tool.action() == Action::Grasp;
+        // Jaws close on tissue when the button goes down, not while it stays down: tissue
+        // that escaped a closed grasper is not taken again until the trainee opens and
+        // closes it.
+        let closing = closed && !was_closed[hand.0];
+        was_closed[hand.0] = closed;
+        let tip_m = sample.tip_m;
+        jaws[hand.0] = Some(Jaws {
+            tip_m,
+            closed,
+            closing,
+        });
+    }
+    for (slot, hand) in jaws.iter().enumerate() {
+        if hand.is_some_and(|j| j.closing) {
+            take_first(slot, &hand.expect("closing").tip_m, &mut organs);
         }
+    }
+    for organ in &mut organs {
+        let (mut touches, mut deformation) = (organ.touch, organ.deformation);
+        let motion = &mut *organ.motion.into_inner();
+        // An organ not held swings back whichever hand is read.
+        let Some(hand) = jaws[motion.hand].or_else(|| jaws.iter().flatten().next().copied()) else {
+            continue;
+        };
         motion.tore = false;
-        match motion.organ.tick(&sample.tip_m, closed) {
+        match motion.organ.tick(&hand.tip_m, hand.closed) {
             Ok(outcome) => {
-                grasp_force.0 += outcome.hand_force_n;
+                let holder = hands.iter_mut().find(|h| h.0.0 == motion.hand);
+                if let Some((_, _, mut force, _)) = holder {
+                    force.0 += outcome.hand_force_n;
+                }
                 motion.tore = outcome.damaged_now;
             }
-            Err(e) => faults
-                .this_tick
-                .push(Fault::Physics(format!("{}: {e}", organ.body.name))),
+            Err(e) => {
+                let holder = hands.iter_mut().find(|h| h.0.0 == motion.hand);
+                if let Some((_, _, _, mut faults)) = holder {
+                    let fault = Fault::Physics(format!("{}: {e}", organ.body.name));
+                    faults.this_tick.push(fault);
+                }
+            }
         }
         motion
             .organ
@@ -170,11 +220,28 @@ pub fn grasp(
             .fit
             .coefficients_into(&motion.correction, &mut motion.in_vademecum_modes);
         if motion.organ.holding() {
-            touch.contact = None;
-            let load = &mut deformation.0.loads[OrganDeformation::TOOL];
+            touches.0[motion.hand].contact = None;
+            let load = &mut deformation.0.loads[motion.hand];
             load.shares.clone_from(&motion.shares);
             load.force_n = motion.organ.applied_n();
         }
+    }
+}
+
+/// Hand `slot`'s jaws, closing at `tip_m`, take hold of the first free organ its tool touches,
+/// unless they hold one already.
+fn take_first(slot: usize, tip_m: &Vector3<f64>, organs: &mut Query<MovingOrgan>) {
+    let holds = |m: &OrganMotion| m.organ.holding() && m.hand == slot;
+    if organs.iter().any(|o| holds(o.motion)) {
+        return;
+    }
+    let free = organs
+        .iter_mut()
+        .find(|o| !o.motion.organ.holding() && o.touch.0[slot].contact.is_some());
+    if let Some(organ) = free {
+        let motion = organ.motion.into_inner();
+        take_hold(organ.body, &organ.touch.0[slot], motion, tip_m);
+        motion.hand = slot;
     }
 }
 
@@ -183,7 +250,7 @@ pub fn grasp(
 #[query_data(mutable)]
 pub struct MovingOrgan {
     body: &'static OrganBody,
-    touch: &'static mut ToolTouch,
+    touch: &'static mut HandTouches,
     deformation: &'static mut OrganDeformation,
     motion: &'static mut OrganMotion,
 }
@@ -209,27 +276,32 @@ pub fn evaluate_modes(mut organs: Query<(&OrganBody, &mut OrganDeformation)>) {
     }
 }
 
-/// Organ against organ: hands every organ's coefficients (a moving organ's motion included)
-/// and the tool's hold on it to the coupling, ticks its pairs and attachments, and gives each
-/// organ its coupling loads and carry. The tool's load follows the contact's push in the same
-/// tick, so the trainee feels the organ behind at once.
+/// Organ against organ: hands every organ's coefficients (a moving organ's motion included,
+/// every hand's load in them) and the hold of the first hand that presses it to the coupling,
+/// ticks its pairs and attachments, and gives each organ its coupling loads and carry. The
+/// holding hand's load follows the contact's push in the same tick, so the trainee feels the
+/// organ behind at once; another hand's press on the same organ answers it next tick.
 pub fn organ_contact(mut coupling: ResMut<OrganCoupling>, mut organs: Query<CoupledOrgan>) {
     let coupling = &mut coupling.0;
     for organ in &organs {
         let deformation = &organ.deformation.0;
         let moved = organ.motion.map_or(&[][..], |m| &m.in_vademecum_modes);
         coupling.read(organ.index.0, deformation, moved);
-        let load = &deformation.loads[OrganDeformation::TOOL];
-        coupling.hold(organ.index.0, organ.touch.contact.as_ref(), load);
+        let slot = organ.touch.pressing().unwrap_or(0);
+        let contact = organ.touch.0[slot].contact.as_ref();
+        coupling.hold(organ.index.0, contact, &deformation.loads[slot]);
     }
     coupling.tick();
     for mut organ in &mut organs {
         let index = organ.index.0;
         let deformation = &mut organ.deformation.0;
         coupling.write(index, deformation);
+        let Some(slot) = organ.touch.pressing() else {
+            continue;
+        };
         follow(
-            &mut organ.touch.contact,
-            &mut deformation.loads[OrganDeformation::TOOL],
+            &mut organ.touch.0[slot].contact,
+            &mut deformation.loads[slot],
             &coupling.tool_moved_m(index),
         );
     }
@@ -240,46 +312,54 @@ pub fn organ_contact(mut coupling: ResMut<OrganCoupling>, mut organs: Query<Coup
 #[query_data(mutable)]
 pub struct CoupledOrgan {
     index: &'static OrganIndex,
-    touch: &'static mut ToolTouch,
+    touch: &'static mut HandTouches,
     deformation: &'static mut OrganDeformation,
     motion: Option<&'static OrganMotion>,
 }
 
-/// The force on the tool: the opposite of what it applies to the organs; through a port, as
-/// the hand feels it through the shaft's lever.
+/// The force on each hand's tool: the opposite of what it applies to the organs; through a
+/// port, as the hand feels it through the shaft's lever.
 pub fn compute_force(
-    tool: Res<Tool>,
-    touches: Query<&ToolTouch>,
-    grasp: Res<GraspForce>,
-    mut force: ResMut<DeviceForce>,
+    mut hands: Query<(&HandIndex, &Tool, &GraspForce, &mut DeviceForce)>,
+    touches: Query<&HandTouches>,
 ) {
-    let at_tip = grasp.0
-        - touches
+    for (hand, tool, grasp, mut force) in &mut hands {
+        let pressed: Vector3<f64> = touches
             .iter()
-            .filter_map(|t| t.contact.map(|c| c.felt_n()))
-            .sum::<Vector3<f64>>();
-    force.desired_n = match &tool.pose {
-        Some(pose) => Fulcrum::hand_force(pose, &at_tip),
-        None => at_tip,
-    };
+            .filter_map(|t| t.0[hand.0].contact.map(|c| c.felt_n()))
+            .sum();
+        let at_tip = grasp.0 - pressed;
+        force.desired_n = match &tool.pose {
+            Some(pose) => Fulcrum::hand_force(pose, &at_tip),
+            None => at_tip,
+        };
+    }
 }
 
-/// Clamps, rate-limits and, on a fault, fades the force; logs each fault as it starts (a fault
-/// of the same kind as the last logged one is counted, not logged again).
-pub fn apply_safety(
-    clock: Res<TickClock>,
-    mut safety: ResMut<Safety>,
-    mut force: ResMut<DeviceForce>,
-    mut faults: ResMut<FaultLog>,
-) {
-    let faults = &mut *faults;
-    if !force.desired_n.iter().all(|c| c.is_finite()) {
-        faults.this_tick.push(Fault::NonFiniteForce);
+/// Clamps, rate-limits and, on a fault, fades each hand's force; logs each fault as it starts
+/// (a fault of the same kind as the hand's last logged one is counted, not logged again),
+/// naming the hand when there are two. A fault of one hand fades that hand's force only.
+pub fn apply_safety(clock: Res<TickClock>, mut hands: Query<HandState>) {
+    let two_hands = hands.iter().len() > 1;
+    for hand in &mut hands {
+        let Some(mut safety) = hand.safety else {
+            continue;
+        };
+        let (force, faults) = (hand.force.into_inner(), hand.faults.into_inner());
+        if !force.desired_n.iter().all(|c| c.is_finite()) {
+            faults.this_tick.push(Fault::NonFiniteForce);
+        }
+        force.sent_n = safety.0.filter(&force.desired_n, &faults.this_tick);
+        if safety.0.refused_output() {
+            faults.this_tick.push(Fault::NonFiniteOutput);
+        }
+        let name = two_hands.then(|| hand.index.name());
+        log_faults(clock.tick, name, faults);
     }
-    force.sent_n = safety.0.filter(&force.desired_n, &faults.this_tick);
-    if safety.0.refused_output() {
-        faults.this_tick.push(Fault::NonFiniteOutput);
-    }
+}
+
+/// Counts a faulted tick and logs the faults that start in it.
+fn log_faults(tick: u64, hand: Option<&str>, faults: &mut FaultLog) {
     if faults.this_tick.is_empty() {
         return;
     }
@@ -289,46 +369,63 @@ pub fn apply_safety(
             .log
             .last()
             .is_some_and(|(_, last)| std::mem::discriminant(last) == std::mem::discriminant(fault));
-        if !known {
-            warn!("haptic tick {}: {fault}; fading the force", clock.tick);
-            faults.log.push((clock.tick, fault.clone()));
+        if known {
+            continue;
+        }
+        match hand {
+            Some(hand) => warn!("haptic tick {tick}: {hand}: {fault}; fading its force"),
+            None => warn!("haptic tick {tick}: {fault}; fading the force"),
+        }
+        faults.log.push((tick, fault.clone()));
+    }
+}
+
+/// Sends each hand's force; a failed write is a fault of the hand's next tick.
+pub fn write_device(mut hands: Query<HandState>) {
+    for hand in &mut hands {
+        let Some(mut device) = hand.device else {
+            continue;
+        };
+        if let Err(e) = device.0.write_force(&hand.force.sent_n) {
+            hand.faults
+                .into_inner()
+                .next_tick
+                .push(Fault::Device(e.to_string()));
         }
     }
 }
 
-/// Sends the force; a failed write is a fault of the next tick.
-pub fn write_device(
-    force: Res<DeviceForce>,
-    mut device: ResMut<Device>,
-    mut faults: ResMut<FaultLog>,
-) {
-    if let Err(e) = device.0.write_force(&force.sent_n) {
-        faults.next_tick.push(Fault::Device(e.to_string()));
+/// Keeps the tick's forces of each hand that keeps a trace.
+pub fn trace_force(mut hands: Query<(&DeviceForce, &mut ForceTrace)>) {
+    for (force, mut trace) in &mut hands {
+        trace.desired_n.push(force.desired_n);
+        trace.sent_n.push(force.sent_n);
     }
-}
-
-/// Keeps the tick's forces (run when a trace was asked for).
-pub fn trace_force(force: Res<DeviceForce>, mut trace: ResMut<ForceTrace>) {
-    trace.desired_n.push(force.desired_n);
-    trace.sent_n.push(force.sent_n);
 }
 
 /// What the snapshot takes of an organ entity.
 #[derive(QueryData)]
 pub struct PublishedOrgan {
     index: &'static OrganIndex,
-    touch: &'static ToolTouch,
+    touch: &'static HandTouches,
     deformation: &'static OrganDeformation,
     motion: Option<&'static OrganMotion>,
     cut: Option<&'static OrganCut>,
 }
 
+/// What the snapshot takes of a hand entity.
+#[derive(QueryData)]
+pub struct PublishedHand {
+    index: &'static HandIndex,
+    tool: &'static Tool,
+    force: &'static DeviceForce,
+    safety: Option<&'static Safety>,
+}
+
 /// Hands the render side the tick's state, when one is listening; never waits.
 pub fn publish_snapshot(
     clock: Res<TickClock>,
-    tool: Res<Tool>,
-    force: Res<DeviceForce>,
-    safety: Res<Safety>,
+    hands: Query<PublishedHand>,
     organs: Query<PublishedOrgan>,
     timing: Option<Res<LoopTiming>>,
     mut publisher: ResMut<SnapshotPublisher>,
@@ -336,23 +433,17 @@ pub fn publish_snapshot(
     let snapshot = publisher.0.input_buffer_mut();
     snapshot.tick = clock.tick;
     snapshot.time_s = clock.time_s;
-    snapshot.tip_m = tool.sample.map(|s| s.tip_m);
-    snapshot.handle_m = tool
-        .port()
-        .zip(tool.pose)
-        .map(|(port, pose)| port.port_m - pose.along * pose.outside_m);
-    snapshot.instruments = InstrumentsView::of(&tool.rack);
-    snapshot.force_n = force.sent_n;
-    snapshot.faulted = safety.0.is_faulted();
     snapshot.timing = timing.map_or_else(LoopTiming::default, |t| *t);
-    let cuts = organs.iter().any(|o| o.cut.is_some()) && tool.action() == Action::Cut;
-    snapshot.blade_edge = tool
-        .sample
-        .filter(|_| cuts)
-        .map(|s| s.orientation * Vector3::x());
+    let cut_organs = organs.iter().any(|o| o.cut.is_some());
+    for hand in &hands {
+        if let Some(published) = snapshot.hands.get_mut(hand.index.0) {
+            publish_hand(&hand, cut_organs, published);
+        }
+    }
     for published in &organs {
         let organ = &mut snapshot.organs[published.index.0];
-        organ.contact = published.touch.contact;
+        let touching = published.touch.pressing();
+        organ.contact = touching.and_then(|slot| published.touch.0[slot].contact);
         organ.deformation.clone_from(&published.deformation.0);
         if let Some(motion) = published.motion {
             organ.motion.clone_from(&motion.correction);
@@ -364,4 +455,22 @@ pub fn publish_snapshot(
         }
     }
     publisher.0.publish();
+}
+
+/// A hand's instrument and force as the window draws them.
+fn publish_hand(hand: &PublishedHandItem, cut_organs: bool, published: &mut HandSnapshot) {
+    let tool = hand.tool;
+    published.tip_m = tool.sample.map(|s| s.tip_m);
+    published.handle_m = tool
+        .port()
+        .zip(tool.pose)
+        .map(|(port, pose)| port.port_m - pose.along * pose.outside_m);
+    published.instruments = InstrumentsView::of(&tool.rack);
+    published.force_n = hand.force.sent_n;
+    published.faulted = hand.safety.is_some_and(|s| s.0.is_faulted());
+    let cuts = cut_organs && tool.action() == Action::Cut;
+    published.blade_edge = tool
+        .sample
+        .filter(|_| cuts)
+        .map(|s| s.orientation * Vector3::x());
 }

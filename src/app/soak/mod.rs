@@ -226,7 +226,7 @@ fn next_world(
         return HapticLoop::new(scene, Box::new(hand.clone())).map_err(|e| e.to_string());
     };
     let mut haptic = HapticLoop::parked(scene).map_err(|e| e.to_string())?;
-    haptic.take_device(&mut previous);
+    haptic.take_devices(&mut previous);
     if leak {
         std::mem::forget(previous);
     }

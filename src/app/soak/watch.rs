@@ -87,10 +87,10 @@ impl Watch {
 
     /// The attempt ended in `haptic`: its faults counted, its limit kept for the next.
     pub fn end(&mut self, haptic: &HapticLoop) {
-        for (_, fault) in &haptic.world().resource::<FaultLog>().log {
+        for (_, fault) in &haptic.hand::<FaultLog>(0).expect("the soak's one hand").log {
             *self.faults.entry(fault.kind()).or_default() += 1;
         }
-        self.limit_before_n = haptic.world().resource::<Safety>().0.max_force_n();
+        self.limit_before_n = haptic.hand::<Safety>(0).map_or(0.0, |s| s.0.max_force_n());
         self.attempts += 1;
     }
 
@@ -118,7 +118,7 @@ impl Watch {
 
     /// The force sent this tick against the last one, whichever attempt that was in.
     fn record_force(&mut self, haptic: &HapticLoop) {
-        let force = haptic.world().resource::<DeviceForce>();
+        let force = haptic.hand::<DeviceForce>(0).expect("the soak's one hand");
         let finite = |f: &Vector3<f64>| f.iter().all(|c| c.is_finite());
         if !finite(&force.desired_n) || !finite(&force.sent_n) {
             self.nan_count += 1;
@@ -127,7 +127,9 @@ impl Watch {
         let step_n = (force.sent_n - self.last_sent_n).norm();
         self.last_sent_n = force.sent_n;
         self.max_force_step_n = self.max_force_step_n.max(step_n);
-        let filter = &haptic.world().resource::<Safety>().0;
+        let Some(Safety(filter)) = haptic.hand::<Safety>(0) else {
+            return;
+        };
         let in_fault = filter.is_faulted() || self.faulted_before;
         self.faulted_before = filter.is_faulted();
         let lowered = self.attempt_tick == 0 && filter.max_force_n() < self.limit_before_n;

@@ -112,7 +112,7 @@ fn update_hud(
         rate.hz = rate.hz * (1.0 - k) + k * ticks as f64 / dt;
     }
     let limit_n = link.scene.safety.max_force_n;
-    let force_n = snapshot.0.force_n.norm();
+    let force_n = snapshot.0.first_hand().force_n.norm();
     let filled = ((force_n / limit_n).clamp(0.0, 1.0) * 20.0).round() as usize;
     let gauge = format!("[{}{}]", "#".repeat(filled), "-".repeat(20 - filled));
     let status = status_line(&link, &snapshot.0);
@@ -160,7 +160,7 @@ fn status_line(link: &HapticLink, snapshot: &HapticSnapshot) -> String {
         .filter_map(|(k, _)| name(k))
         .collect();
     let grasped = organs().find(|(_, o)| o.grasped).and_then(|(k, _)| name(k));
-    if snapshot.faulted {
+    if snapshot.first_hand().faulted {
         "FAULT: force faded to zero (see the log)".to_owned()
     } else if let Some(name) = grasped {
         format!("grasping {name}: release the button to let go")
@@ -250,11 +250,11 @@ fn building_line() -> String {
 
 /// With several instruments: the one in hand, and how to change it.
 fn instrument_line(link: &HapticLink, snapshot: &HapticSnapshot) -> String {
-    let instruments = &link.scene.instruments;
+    let instruments = &link.scene.hands[0].instruments;
     if instruments.len() < 2 {
         return String::new();
     }
-    let in_hand = snapshot.instruments.in_hand;
+    let in_hand = snapshot.first_hand().instruments.in_hand;
     let name = match instruments[in_hand].action {
         Action::Press => "probe",
         Action::Grasp => "grasper",
@@ -275,6 +275,7 @@ fn camera_line(link: &HapticLink, snapshot: &HapticSnapshot, mode: CameraMode) -
     };
     let pose = rig.pose.get();
     let out = snapshot
+        .first_hand()
         .tip_m
         .is_some_and(|tip| !rig.scope.sees(&pose, &tip));
     let warning = match out {

@@ -79,7 +79,10 @@ fn draw_cuts(snapshot: Res<Snapshot>, link: Res<HapticLink>, mut gizmos: Gizmos)
 
 /// The scalpel's edge through the tool tip, so the trainee sees which way it cuts.
 fn draw_edge(snapshot: Res<Snapshot>, link: Res<HapticLink>, mut gizmos: Gizmos) {
-    let (Some(tip), Some(edge)) = (snapshot.0.tip_m, snapshot.0.blade_edge) else {
+    let (Some(tip), Some(edge)) = (
+        snapshot.0.first_hand().tip_m,
+        snapshot.0.first_hand().blade_edge,
+    ) else {
         return;
     };
     let half_m = EDGE_HALF_RADII * link.scene.probe.tip_radius_m as f32;

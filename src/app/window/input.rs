@@ -54,9 +54,9 @@ fn drive_virtual_device(
     // The cursor places the tip of the instrument in hand in the scene; the device's handle
     // is in its own workspace, offset by the instrument's indexing and, through its port,
     // where the shaft to that tip puts it.
-    let workspace = link.scene.workspace;
-    let instruments = &snapshot.0.instruments;
-    let port = (link.scene.instruments.get(instruments.in_hand)).and_then(|i| i.port);
+    let workspace = link.scene.hands[0].workspace;
+    let instruments = &snapshot.0.first_hand().instruments;
+    let port = (link.scene.hands[0].instruments.get(instruments.in_hand)).and_then(|i| i.port);
     let offset_m = instruments.offset_m;
     let handle_m = workspace.to_scene_m(&handle.tip_m()) + offset_m;
     let tip_m = port

@@ -13,7 +13,6 @@ use bevy::prelude::*;
 use super::bridge::{HapticLink, Snapshot};
 use super::cut_surface::{SplitSurface, walls_mesh};
 use super::{FrameSet, SceneView, tissue};
-use crate::app::haptic::OrganDeformation;
 use crate::dynamics::DynamicModel;
 use crate::mesh::vertex_normals;
 use crate::pgd::{SurfaceModes, Vademecum};
@@ -191,7 +190,7 @@ fn deform(
         if let Some(motion) = &view.motion {
             motion.add_to_surface(&view.vademecum.positions, &organ.motion, &mut positions);
         }
-        let tool = &organ.deformation.loads[OrganDeformation::TOOL];
+        let tool = &organ.deformation.loads[0];
         if let Some(rebuilt) = refresh_split(view, &link) {
             if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
                 *mesh = rebuilt;

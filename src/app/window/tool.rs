@@ -61,7 +61,7 @@ fn spawn_tool(
         perceptual_roughness: 0.3,
         ..default()
     });
-    for (index, instrument) in link.scene.instruments.iter().enumerate() {
+    for (index, instrument) in link.scene.hands[0].instruments.iter().enumerate() {
         if instrument.port.is_some() {
             commands.spawn((
                 SceneView,
@@ -82,7 +82,7 @@ fn follow_device(
     let Ok((mut transform, mut visibility)) = tip.single_mut() else {
         return;
     };
-    match snapshot.0.tip_m {
+    match snapshot.0.first_hand().tip_m {
         Some(p) => {
             transform.translation = to_bevy(&p);
             *visibility = Visibility::Visible;
@@ -99,12 +99,16 @@ fn draw_shaft(
     snapshot: Res<Snapshot>,
     mut shafts: Query<(&Shaft, &mut Transform, &mut Visibility)>,
 ) {
-    let instruments = &snapshot.0.instruments;
+    let instruments = &snapshot.0.first_hand().instruments;
     for (shaft, mut transform, mut visibility) in &mut shafts {
         let ends = if shaft.0 == instruments.in_hand {
-            snapshot.0.handle_m.zip(snapshot.0.tip_m)
+            snapshot
+                .0
+                .first_hand()
+                .handle_m
+                .zip(snapshot.0.first_hand().tip_m)
         } else {
-            let port = link.scene.instruments[shaft.0].port;
+            let port = link.scene.hands[0].instruments[shaft.0].port;
             (instruments.put_down[shaft.0].zip(port))
                 .and_then(|(handle, port)| Some((handle, port.pose(&handle)?.tip_m)))
         };
@@ -125,7 +129,10 @@ fn draw_shaft(
 }
 
 fn draw_force(snapshot: Res<Snapshot>, mut gizmos: Gizmos) {
-    let (Some(tip), force) = (snapshot.0.tip_m, snapshot.0.force_n) else {
+    let (Some(tip), force) = (
+        snapshot.0.first_hand().tip_m,
+        snapshot.0.first_hand().force_n,
+    ) else {
         return;
     };
     if force.norm() < 1e-4 {
@@ -133,7 +140,7 @@ fn draw_force(snapshot: Res<Snapshot>, mut gizmos: Gizmos) {
     }
     let start = to_bevy(&tip);
     let arrow = to_bevy(&force) * ARROW_M_PER_N;
-    let colour = if snapshot.0.faulted {
+    let colour = if snapshot.0.first_hand().faulted {
         Color::srgb(1.0, 0.2, 0.2)
     } else {
         Color::srgb(1.0, 0.85, 0.2)
