@@ -4,13 +4,15 @@
 
 use std::sync::{Arc, OnceLock};
 
+use nalgebra::{Matrix3, Point3, Vector3};
 use pgd_surgery::app::haptic::{ForceTrace, HapticLoop, HapticScene};
 use pgd_surgery::app::scene::press_targets;
 use pgd_surgery::contact::Probe;
 use pgd_surgery::devices::{
     HapticDevice, PressMotion, PressTarget, SafetySettings, Scripted, Trajectory, press_and_slide,
 };
-use pgd_surgery::fem::{FemModel, Law};
+use pgd_surgery::fem::{FemModel, Law, Loads, NewtonSettings, PatchKernel};
+use pgd_surgery::mesh::Surface;
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate, region};
 use pgd_surgery::pgd::{BuildSettings, OrganModel, Silent, Vademecum, build, organ};
 
@@ -96,4 +98,37 @@ pub fn run(haptic: &mut HapticLoop, ticks: u64) -> ForceTrace {
 /// The tick (1 ms each) at time `s`.
 pub fn tick_at(s: f64) -> u64 {
     (s * 1000.0).round() as u64
+}
+
+/// The mesh nodes and shares of full FEM's patch load at `point`, on the side of the surface
+/// `facing` faces.
+pub fn fem_patch(point: Point3<f64>, facing: &Vector3<f64>) -> Vec<(usize, f64)> {
+    let mesh = liver().model.mesh();
+    let radius = liver().vademecum.header.settings.tool_tip_radius_m;
+    let kernel = PatchKernel::new(mesh, &Surface::extract(mesh), radius).unwrap();
+    kernel.shares(point, facing).unwrap()
+}
+
+/// Full FEM's 3 × 3 compliance (m/N) from the patch load `loaded` to the patch `read`: the
+/// displacement averaged over `read` under unit forces along each axis spread over `loaded`.
+pub fn fem_response(loaded: &[(usize, f64)], read: &[(usize, f64)]) -> Matrix3<f64> {
+    let model = &liver().model;
+    let mut c = Matrix3::zeros();
+    for d in 0..3 {
+        let mut loads = Loads::new(model.mesh().node_count());
+        for &(node, share) in loaded {
+            let mut f = [0.0; 3];
+            f[d] = share;
+            loads.add_nodal_force(node, f).unwrap();
+        }
+        let u = model
+            .solve_static(&loads, &NewtonSettings::default())
+            .unwrap()
+            .displacement_m;
+        let under = read.iter().fold(Vector3::zeros(), |acc, &(n, s)| {
+            acc + Vector3::new(u[3 * n], u[3 * n + 1], u[3 * n + 2]) * s
+        });
+        c.set_column(d, &under);
+    }
+    c
 }

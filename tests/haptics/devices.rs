@@ -32,6 +32,37 @@ fn a_trajectory_interpolates_between_its_rows() {
     assert_eq!(t.sample(-1.0).tip_m, Vector3::new(0.0, 0.1, 0.0));
 }
 
+/// A bimanual file: the right hand's columns and the left's (`left_…`, in any order, its
+/// orientation left out) on one time column; each hand interpolates its own. A one-hand
+/// reader refuses it, naming both counts; written back it reads the same.
+#[test]
+fn a_bimanual_trajectory_carries_both_hands() {
+    let path = write(
+        "hands.csv",
+        "time_s,x_m,left_buttons,y_m,z_m,buttons,left_x_m,left_y_m,left_z_m\n\
+         0.0,0.0,1,0.1,0.0,0,-0.05,0.1,0.0\n\
+         1.0,0.02,0,0.1,-0.04,1,-0.03,0.12,0.0\n",
+    );
+    let hands = Trajectory::load_hands(&path).unwrap();
+    assert_eq!(hands.len(), 2);
+    let (right, left) = (hands[0].sample(0.5), hands[1].sample(0.5));
+    assert!((right.tip_m - Vector3::new(0.01, 0.1, -0.02)).norm() < 1e-15);
+    assert!((left.tip_m - Vector3::new(-0.04, 0.11, 0.0)).norm() < 1e-15);
+    assert_eq!((right.buttons, left.buttons), (0, 1));
+    assert_eq!(hands[1].sample(1.0).buttons, 0);
+    let message = Trajectory::load(&path).unwrap_err().to_string();
+    assert!(message.contains("2 hand(s)") && message.contains("has 1"), "{message}");
+    let again = write("hands-again.csv", "");
+    Trajectory::save_hands(&again, &hands).unwrap();
+    assert_eq!(Trajectory::load_hands(&again).unwrap(), hands);
+    let bad = write(
+        "hands-bad.csv",
+        "time_s,x_m,y_m,z_m,left_x_m,left_y_m,left_z_m\n0,0,0,0,0,0,0\n0.5,0,0,0,0,nan,0\n",
+    );
+    let message = Trajectory::load_hands(&bad).unwrap_err().to_string();
+    assert!(message.contains("line 3") && message.contains("not finite"), "{message}");
+}
+
 #[test]
 fn a_bad_trajectory_is_refused_with_its_line() {
     let cases = [

@@ -11,7 +11,7 @@ use pgd_surgery::devices::{
 use crate::common::{haptic, press, run, scripted, tick_at};
 
 /// A scripted device that goes wrong from `from_s` on.
-struct Faulty {
+pub struct Faulty {
     inner: Box<dyn HapticDevice>,
     from_s: f64,
     kind: Kind,
@@ -19,8 +19,19 @@ struct Faulty {
     now_s: f64,
 }
 
+impl Faulty {
+    pub fn new(inner: Box<dyn HapticDevice>, from_s: f64, kind: Kind) -> Self {
+        Self {
+            inner,
+            from_s,
+            kind,
+            now_s: 0.0,
+        }
+    }
+}
+
 #[derive(Clone, Copy)]
-enum Kind {
+pub enum Kind {
     NanPosition,
     ReadError,
     WriteError,
@@ -64,12 +75,7 @@ impl HapticDevice for Faulty {
 fn fade(kind: Kind) -> (usize, bool, Vec<(u64, String)>) {
     let motion = PressMotion::default();
     let from_s = motion.approach_s + motion.press_s + 0.2;
-    let device = Box::new(Faulty {
-        inner: scripted(press(&motion)),
-        from_s,
-        kind,
-        now_s: 0.0,
-    });
+    let device = Box::new(Faulty::new(scripted(press(&motion)), from_s, kind));
     let mut haptic = haptic(device, SafetySettings::default());
     let trace = run(&mut haptic, tick_at(from_s + 0.1));
     let start = tick_at(from_s) as usize;

@@ -17,5 +17,6 @@ mod press;
 mod range;
 mod replay;
 mod superposition;
+mod two_hands;
 mod vendor_fake;
 mod workspace;

@@ -4,38 +4,15 @@
 use nalgebra::{Matrix3, Point3, Vector3};
 use pgd_surgery::app::haptic::HandTouches;
 use pgd_surgery::devices::{PressMotion, SafetySettings};
-use pgd_surgery::fem::{Loads, NewtonSettings, PatchKernel};
-use pgd_surgery::mesh::Surface;
 
-use crate::common::{haptic, liver, press, run, scripted, tick_at};
+use crate::common::{fem_patch, fem_response, haptic, liver, press, run, scripted, tick_at};
 
 /// The 3 × 3 compliance (m/N) of full FEM at `point` for the tool's patch load: the
 /// patch-averaged displacement under unit forces along each axis; the patch is on the side of
 /// the surface `facing` faces.
 fn fem_compliance(point: Point3<f64>, facing: &Vector3<f64>) -> Matrix3<f64> {
-    let model = &liver().model;
-    let mesh = model.mesh();
-    let radius = liver().vademecum.header.settings.tool_tip_radius_m;
-    let kernel = PatchKernel::new(mesh, &Surface::extract(mesh), radius).unwrap();
-    let shares = kernel.shares(point, facing).unwrap();
-    let mut c = Matrix3::zeros();
-    for d in 0..3 {
-        let mut loads = Loads::new(mesh.node_count());
-        for &(node, share) in &shares {
-            let mut f = [0.0; 3];
-            f[d] = share;
-            loads.add_nodal_force(node, f).unwrap();
-        }
-        let u = model
-            .solve_static(&loads, &NewtonSettings::default())
-            .unwrap()
-            .displacement_m;
-        let under = shares.iter().fold(Vector3::zeros(), |acc, &(n, s)| {
-            acc + Vector3::new(u[3 * n], u[3 * n + 1], u[3 * n + 2]) * s
-        });
-        c.set_column(d, &under);
-    }
-    c
+    let shares = fem_patch(point, facing);
+    fem_response(&shares, &shares)
 }
 
 /// Held 8 mm deep, the force the device renders is the opposite of the load whose full-FEM

@@ -1,0 +1,246 @@
+//! Two hands at once on the coarse liver: each through its own device, their loads superposed
+//! through the vademecum. Each hand feels what full FEM gives under both loads; each hand's
+//! force reaches its own device and nowhere else; a fault of one device fades that hand alone.
+
+use std::sync::{Arc, Mutex};
+
+use nalgebra::{Matrix3, Matrix6, Point3, Vector3, Vector6};
+use pgd_surgery::app::haptic::{
+    DeviceForce, ForceTrace, HandTouches, HapticLoop, HapticScene, SceneHand, Tool,
+};
+use pgd_surgery::contact::{ContactSurface, ToolContact};
+use pgd_surgery::devices::{
+    DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice, PressMotion, PressTarget,
+    SafetySettings, press_and_slide,
+};
+
+use crate::common::{
+    TIP_RADIUS_M, fem_patch, fem_response, liver, scene, scripted, target, tick_at,
+};
+use crate::faults::{Faulty, Kind};
+
+/// Where the left hand presses: the liver's surface `apart_m` across from the right hand's
+/// target.
+fn left_target(apart_m: f64) -> PressTarget {
+    let right = target();
+    let across = right.normal.cross(&Vector3::x()).normalize();
+    let surface = ContactSurface::new(&liver().vademecum).unwrap();
+    let hit = surface
+        .closest(&(right.point_m + across * apart_m))
+        .unwrap();
+    PressTarget {
+        point_m: hit.point_m,
+        normal: hit.normal,
+    }
+}
+
+/// Both hands press 8 mm deep, `apart_m` apart, and hold there (no slide).
+fn presses(apart_m: f64) -> [Box<dyn HapticDevice>; 2] {
+    let motion = PressMotion {
+        slide_m: 0.0,
+        tip_radius_m: TIP_RADIUS_M,
+        ..PressMotion::default()
+    };
+    [target(), left_target(apart_m)].map(|t| scripted(press_and_slide(&[t], &motion)))
+}
+
+/// The liver with two hands, each a probe in open surgery.
+fn two_hands() -> HapticScene {
+    let mut scene = scene(SafetySettings::default());
+    scene.hands.push(SceneHand::default());
+    scene
+}
+
+/// The time both hands reach their depth; they hold it for the next second.
+fn at_depth_s() -> f64 {
+    let motion = PressMotion::default();
+    motion.approach_s + motion.press_s
+}
+
+/// A moment both hands hold still at depth.
+fn holding_tick() -> u64 {
+    tick_at(at_depth_s() + 0.5)
+}
+
+/// Each hand's contact with the liver after `ticks`.
+fn contacts(haptic: &mut HapticLoop) -> [ToolContact; 2] {
+    let world = haptic.world_mut();
+    let touches = world.query::<&HandTouches>().single(world).unwrap();
+    [0, 1].map(|hand| {
+        touches.0[hand]
+            .contact
+            .expect("each hand presses the liver")
+    })
+}
+
+/// How far apart the hands press in the runs that are not about the distance (m).
+const APART_M: f64 = 0.035;
+
+/// Two presses `apart_m` apart hold their tips still; full FEM is given the same two tips: the
+/// forces whose patch loads move the surface under each tip to where the tip holds it (its
+/// depth below the rest surface, along the normal), the 6 × 6 system of the two patches'
+/// compliances solved. Returns each hand's felt-force error against it, and how far off each
+/// hand's press alone would be (what the other hand's load changes).
+fn felt_against_full_fem(apart_m: f64) -> [(f64, f64); 2] {
+    let mut haptic = HapticLoop::with_devices(&two_hands(), presses(apart_m).into()).unwrap();
+    haptic.run_simulated(holding_tick());
+    let contacts = contacts(&mut haptic);
+    let patches = contacts.map(|c| {
+        let facing = liver().vademecum.triangle_facing(c.hit.at.triangle);
+        fem_patch(Point3::from(c.hit.point_m), &facing)
+    });
+    let block = |read: usize, loaded: usize| fem_response(&patches[loaded], &patches[read]);
+    let mut compliance = Matrix6::zeros();
+    for (read, loaded) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+        let c: Matrix3<f64> = block(read, loaded);
+        (compliance.fixed_view_mut::<3, 3>(3 * read, 3 * loaded)).copy_from(&c);
+    }
+    let tips = [0, 1].map(|hand| haptic.hand::<Tool>(hand).unwrap().sample.unwrap().tip_m);
+    let held = [0, 1].map(|hand| {
+        let (hit, tip) = (&contacts[hand].hit, tips[hand]);
+        -hit.normal * (TIP_RADIUS_M - (tip - hit.point_m).dot(&hit.normal))
+    });
+    let targets = Vector6::from_iterator(held.iter().flat_map(|h| h.iter().copied()));
+    let reference = compliance.lu().solve(&targets).unwrap();
+    [0, 1].map(|hand| {
+        let full = reference.fixed_rows::<3>(3 * hand).into_owned();
+        let alone = block(hand, hand).try_inverse().unwrap() * held[hand];
+        let felt = contacts[hand].force_n;
+        let error = (felt - full).norm() / full.norm();
+        let coupling = (alone - full).norm() / full.norm();
+        eprintln!(
+            "{:.0} mm apart, hand {hand}: force {felt:?} N, full FEM {full:?} N, error {error:.2e}; \
+             alone {coupling:.2e} off",
+            apart_m * 1e3
+        );
+        let sent = haptic.hand::<DeviceForce>(hand).unwrap().sent_n;
+        assert!((sent + felt).norm() < 1e-12, "hand {hand} sent {sent:?}");
+        (error, coupling)
+    })
+}
+
+/// 30 and 45 mm apart (the 12 mm tips clear of each other), each hand moves the surface under
+/// the other partly or wholly through the vademecum's truncated modes, beyond its exact near
+/// field (25 mm here; within it a press is full FEM's to 0.1 %): each hand's felt force stays
+/// within the product's felt-force target, 7 % (physics.md; measured 1.9 to 4.3 %), at least
+/// twice as close to full FEM as a press that ignored the other hand's load (13 to 24 % off).
+#[test]
+fn two_hands_feel_full_fem_under_both_loads_within_the_felt_force_target() {
+    for apart_m in [0.030, 0.045] {
+        for (hand, (error, coupling)) in felt_against_full_fem(apart_m).into_iter().enumerate() {
+            assert!(
+                error < 0.07,
+                "hand {hand}'s felt force off full FEM by {error}"
+            );
+            assert!(
+                coupling > 2.0 * error,
+                "hand {hand}: a press alone is {coupling} off, the two {error}"
+            );
+        }
+    }
+}
+
+/// A device that keeps every force it is sent.
+struct Kept {
+    inner: Box<dyn HapticDevice>,
+    forces: Arc<Mutex<Vec<Vector3<f64>>>>,
+}
+
+impl HapticDevice for Kept {
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
+
+    fn limits(&self) -> DeviceLimits {
+        self.inner.limits()
+    }
+
+    fn read(&mut self, time_s: f64) -> Result<DeviceSample, DeviceError> {
+        self.inner.read(time_s)
+    }
+
+    fn render(&mut self, force: EdgeForce) -> Result<(), DeviceError> {
+        self.forces.lock().unwrap().push(*force.newtons());
+        self.inner.write_force(force.newtons())
+    }
+}
+
+/// Each device is sent its own hand's force, tick by tick, and the two differ.
+#[test]
+fn each_hand_s_force_reaches_its_own_device() {
+    let kept: [Arc<Mutex<Vec<Vector3<f64>>>>; 2] = Default::default();
+    let [right, left] = presses(APART_M);
+    let devices: Vec<Box<dyn HapticDevice>> = vec![
+        Box::new(Kept {
+            inner: right,
+            forces: kept[0].clone(),
+        }),
+        Box::new(Kept {
+            inner: left,
+            forces: kept[1].clone(),
+        }),
+    ];
+    let mut haptic = HapticLoop::with_devices(&two_hands(), devices).unwrap();
+    haptic.keep_trace();
+    let ticks = holding_tick();
+    haptic.run_simulated(ticks);
+    for (hand, kept) in kept.iter().enumerate() {
+        let trace = haptic.hand::<ForceTrace>(hand).unwrap();
+        assert_eq!(*kept.lock().unwrap(), trace.sent_n, "hand {hand}'s device");
+        assert!(
+            trace.sent_n.last().unwrap().norm() > 0.05,
+            "hand {hand} does not press"
+        );
+    }
+    let (right, left) = (kept[0].lock().unwrap(), kept[1].lock().unwrap());
+    assert!((right.last().unwrap() - left.last().unwrap()).norm() > 0.01);
+}
+
+/// The left device fails to read from 0.1 s after both reach their depth on: its hand's force fades to zero within the
+/// filter's ticks and the fault names the left hand; the right hand's force is, tick for tick,
+/// what it is in the same run without the fault (the left tool stays where it was last read,
+/// its load on the liver with it), to 1e-12 N.
+#[test]
+fn a_fault_of_one_device_fades_that_hand_only() {
+    let from_s = at_depth_s() + 0.1;
+    let ticks = tick_at(from_s + 0.2);
+    let run_with = |devices: Vec<Box<dyn HapticDevice>>| {
+        let mut haptic = HapticLoop::with_devices(&two_hands(), devices).unwrap();
+        haptic.keep_trace();
+        let report = haptic.run_simulated(ticks);
+        let traces = [0, 1].map(|hand| {
+            let trace = haptic.hand_mut::<ForceTrace>(hand);
+            std::mem::take(&mut trace.unwrap().sent_n)
+        });
+        (traces, report.faults)
+    };
+    let ([right_plain, _], none) = run_with(presses(APART_M).into());
+    let [right, left] = presses(APART_M);
+    let faulty = Box::new(Faulty::new(left, from_s, Kind::ReadError));
+    let ([right_faulted, left_faulted], faults) = run_with(vec![right, faulty]);
+    assert!(none.is_empty(), "{none:?}");
+    // The still tip of the plain run is interpolated between equal rows, to the last bit.
+    let changed =
+        (right_faulted.iter().zip(&right_plain)).position(|(a, b)| (a - b).norm() > 1e-12);
+    assert_eq!(
+        changed, None,
+        "the right hand's force changed (fault at {from_s} s)"
+    );
+    let start = tick_at(from_s) as usize;
+    assert!(
+        left_faulted[start - 1].norm() > 0.05,
+        "the left hand should press"
+    );
+    let fade = SafetySettings::default().fade_ticks as usize;
+    assert!(
+        left_faulted[start + fade..]
+            .iter()
+            .all(|f| *f == Vector3::zeros())
+    );
+    assert!(
+        faults
+            .iter()
+            .any(|(tick, f)| *tick >= start as u64 && f.starts_with("left hand: ")),
+        "{faults:?}"
+    );
+}
