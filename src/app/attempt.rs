@@ -8,17 +8,17 @@ use std::time::Duration;
 use nalgebra::Vector3;
 
 use super::haptic::{
-    ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SceneScope,
+    ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SceneHand, SceneScope,
     SettleCuts, TickClock,
 };
 use super::scene::{Detail, SceneOrgan, scene_files, scene_of, scene_vademecums};
 use crate::contact::{ContactSurface, CouplingSettings};
-use crate::devices::{HapticDevice, Instrument, ScopeHandle, TICK_S, stop_requested};
+use crate::devices::{HapticDevice, Instrument, ScopeHandle, TICK_S, Workspace, stop_requested};
 use crate::mesh::organs::Organ;
 use crate::scenario::tasks::RadialKeratotomy;
 use crate::scenario::{
     self, CutMade, Exercise, Keratometer, LaparoscopeEntry, Nodule, NoduleSite, OrganEntry, Port,
-    RegionSite, Scenario, Scorecard, Sites, Task, score,
+    RegionSite, Scenario, Scorecard, Sites, Task, Tool, score,
 };
 use crate::store::{OnStale, OrganSource, VademecumSpec};
 
@@ -40,18 +40,28 @@ pub fn scenario_scene(
         on_stale,
     )?;
     scene.safety.max_force_n = scenario.device.max_force_n.0;
-    scene.right_hand_mut().instruments = (scenario.instruments_in_hand().iter())
-        .map(|(tool, port)| Instrument {
-            action: tool.action(),
-            port: port.as_ref().map(Port::fulcrum),
+    let workspace = Workspace {
+        scale: scenario.device.workspace_scale.0,
+    };
+    scene.hands = (scenario.hands().iter())
+        .map(|instruments| SceneHand {
+            instruments: instruments.iter().map(instrument).collect(),
+            workspace,
         })
         .collect();
     scene.scope = scenario.laparoscope.as_ref().and_then(scene_scope);
     if let (Some(cutting), Some(blade)) = (&mut scene.cutting, scenario.blade()) {
         cutting.blade = blade;
     }
-    scene.right_hand_mut().workspace.scale = scenario.device.workspace_scale.0;
     Ok(scene)
+}
+
+/// An instrument of the scenario's as the haptic loop holds it.
+fn instrument((tool, port): &(Tool, Option<Port>)) -> Instrument {
+    Instrument {
+        action: tool.action(),
+        port: port.as_ref().map(Port::fulcrum),
+    }
 }
 
 /// The files [`scenario_scene`] reads from `dir` (see [`scene_files`]).
@@ -157,21 +167,21 @@ pub struct Outcome {
 pub fn run_simulated(
     scenario: Scenario,
     scene: &HapticScene,
-    device: Box<dyn HapticDevice>,
+    devices: Vec<Box<dyn HapticDevice>>,
     max_ticks: u64,
 ) -> Result<Outcome, String> {
-    run_observed(scenario, scene, device, max_ticks, |_, _| {})
+    run_observed(scenario, scene, devices, max_ticks, |_, _| {})
 }
 
 /// [`run_simulated`], handing `observe` the loop and its compute time after every tick.
 pub fn run_observed(
     scenario: Scenario,
     scene: &HapticScene,
-    device: Box<dyn HapticDevice>,
+    devices: Vec<Box<dyn HapticDevice>>,
     max_ticks: u64,
     observe: impl FnMut(&HapticLoop, Duration),
 ) -> Result<Outcome, String> {
-    let haptic = HapticLoop::new(scene, device).map_err(|e| e.to_string())?;
+    let haptic = HapticLoop::with_devices(scene, devices).map_err(|e| e.to_string())?;
     observe_attempt(scenario, scene, haptic, max_ticks, observe).map(|(outcome, _)| outcome)
 }
 

@@ -24,6 +24,8 @@ use crate::pgd::{self, SurfaceModes};
 pub struct SweepFigures {
     /// Which organs the script presses.
     pub pressed: String,
+    /// How many hands press.
+    pub hands: usize,
     pub ticks: u64,
     pub contact_ticks: u64,
     /// Ticks whose press went beyond a nonlinear vademecum's range (first run).
@@ -58,15 +60,46 @@ pub struct HapticBenchReport {
     /// Real-time runs while the render side's CPU work runs.
     pub realtime: Vec<RealTimeReport>,
     pub realtime_seconds: f64,
+    /// With `--hands 2`: the four-organ sweep with one hand...
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub one_hand: Option<HandsTick>,
+    /// ...and with two, the left hand sweeping the organs in the opposite order at once.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub two_hands: Option<HandsTick>,
+}
+
+/// The tick's compute with so many hands (µs; medians over the repeats of each run's
+/// quantiles).
+#[derive(Clone, Debug, Serialize)]
+pub struct HandsTick {
+    pub hands: usize,
+    pub contact_ticks: u64,
+    pub tick_p50_us: f64,
+    pub tick_p99_us: f64,
+    pub tick_max_us: f64,
+}
+
+impl From<&SweepFigures> for HandsTick {
+    fn from(sweep: &SweepFigures) -> Self {
+        Self {
+            hands: sweep.hands,
+            contact_ticks: sweep.contact_ticks,
+            tick_p50_us: sweep.compute_p50_us,
+            tick_p99_us: sweep.compute_p99_us,
+            tick_max_us: sweep.compute_max_us,
+        }
+    }
 }
 
 /// Runs the benchmark on `scene` (the four organs), each organ pressed as `motion` says,
-/// `repeats` times per sweep and `realtime_seconds` per timer.
+/// `repeats` times per sweep and `realtime_seconds` per timer; with `hands` 2, the four-organ
+/// sweep again with both hands pressing at once.
 pub fn run(
     scene: &HapticScene,
     motion: &PressMotion,
     repeats: usize,
     realtime_seconds: f64,
+    hands: usize,
 ) -> Result<HapticBenchReport, FemError> {
     let targets = press_targets(scene);
     let mut sweeps = vec![sweep(scene, "all", &targets, motion, repeats)];
@@ -74,6 +107,15 @@ pub fn run(
         let pressed = std::slice::from_ref(target);
         sweeps.push(sweep(scene, name, pressed, motion, repeats));
     }
+    let (one_hand, two_hands) = match hands {
+        2 => {
+            let both = sweep(&with_left_hand(scene), "all", &targets, motion, repeats);
+            let one = HandsTick::from(&sweeps[0]);
+            sweeps.push(both);
+            (Some(one), sweeps.last().map(HandsTick::from))
+        }
+        _ => (None, None),
+    };
     let fem_contact = fem_contact(&targets[0], repeats, sweeps[0].compute_p50_us)?;
     let render_cpu_ms = render_cpu(scene, &targets, repeats);
     let realtime = [
@@ -96,12 +138,35 @@ pub fn run(
         render_cpu_ms,
         realtime,
         realtime_seconds,
+        one_hand,
+        two_hands,
     })
+}
+
+/// `scene` with a left hand holding the right's instruments.
+fn with_left_hand(scene: &HapticScene) -> HapticScene {
+    let mut both = scene.clone();
+    both.hands.push(scene.hands[0].clone());
+    both
 }
 
 fn device(targets: &[PressTarget], motion: &PressMotion) -> Box<dyn HapticDevice> {
     let trajectory = press_and_slide(targets, motion);
     Box::new(Scripted::new("benchmark sweep", trajectory))
+}
+
+/// A device per hand of `scene`: the right sweeps `targets` in order, the left in the
+/// opposite order, so that the hands press different organs at once.
+fn devices(
+    scene: &HapticScene,
+    targets: &[PressTarget],
+    motion: &PressMotion,
+) -> Vec<Box<dyn HapticDevice>> {
+    let reversed: Vec<PressTarget> = targets.iter().rev().copied().collect();
+    let orders = [targets, &reversed[..]];
+    (orders.iter().take(scene.hands.len()))
+        .map(|order| device(order, motion))
+        .collect()
 }
 
 fn sweep(
@@ -114,8 +179,8 @@ fn sweep(
     let ticks = (press_and_slide(targets, motion).duration_s() / TICK_S) as u64;
     let runs: Vec<_> = (0..repeats.max(1))
         .map(|_| {
-            let device = device(targets, motion);
-            let mut haptic = HapticLoop::new(scene, device).expect("scene was built");
+            let devices = devices(scene, targets, motion);
+            let mut haptic = HapticLoop::with_devices(scene, devices).expect("scene was built");
             haptic.run_simulated(ticks)
         })
         .collect();
@@ -126,6 +191,7 @@ fn sweep(
     };
     SweepFigures {
         pressed: pressed.to_owned(),
+        hands: scene.hands.len(),
         ticks,
         contact_ticks: runs[0].force.contact_ticks,
         beyond_range_ticks: runs[0].range.beyond_ticks,
@@ -235,20 +301,30 @@ impl fmt::Display for HapticBenchReport {
         )?;
         writeln!(
             f,
-            "{:<14} {:>7} {:>8} {:>8} {:>9} {:>9} {:>9}",
-            "pressed", "ticks", "contact", "beyond", "p50 µs", "p99 µs", "max µs"
+            "{:<14} {:>5} {:>7} {:>8} {:>8} {:>9} {:>9} {:>9}",
+            "pressed", "hands", "ticks", "contact", "beyond", "p50 µs", "p99 µs", "max µs"
         )?;
         for s in &self.sweeps {
             writeln!(
                 f,
-                "{:<14} {:>7} {:>8} {:>8} {:>9.1} {:>9.1} {:>9.1}",
+                "{:<14} {:>5} {:>7} {:>8} {:>8} {:>9.1} {:>9.1} {:>9.1}",
                 s.pressed,
+                s.hands,
                 s.ticks,
                 s.contact_ticks,
                 s.beyond_range_ticks,
                 s.compute_p50_us,
                 s.compute_p99_us,
                 s.compute_max_us
+            )?;
+        }
+        if let (Some(one), Some(two)) = (&self.one_hand, &self.two_hands) {
+            writeln!(
+                f,
+                "two hands at once: tick p99 {:.1} µs against one hand's {:.1} µs ({:.2}x)",
+                two.tick_p99_us,
+                one.tick_p99_us,
+                two.tick_p99_us / one.tick_p99_us.max(f64::MIN_POSITIVE)
             )?;
         }
         writeln!(

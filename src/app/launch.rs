@@ -15,13 +15,13 @@ use super::haptic::ExerciseRun;
 use super::haptic::{
     HapticLoop, HapticScene, HapticThread, HeadlessReport, RealTimeReport, Scheduling,
 };
-use super::scene::{Detail, default_scene, mouse_device, press_targets};
+use super::scene::{Detail, HandDevices, default_scene, press_targets};
 use super::window::{
     FrameReport, Lesson, Lessons, MenuPlan, Opening, SceneSource, ScreenshotPlan, WindowScene,
 };
 use crate::devices::{
     DeviceSpec, ForceDimension, HapticDevice, OpenHaptics, PressMotion, Recorder, Scripted, TICK_S,
-    TimerMode, Trajectory, VirtualHandle, press_and_slide, stop_requested,
+    TimerMode, Trajectory, press_and_slide, stop_requested,
 };
 use crate::scenario::Scenario;
 use crate::store::OnStale;
@@ -32,6 +32,8 @@ pub struct Options {
     pub detail: Detail,
     pub on_stale: OnStale,
     pub device: Option<DeviceSpec>,
+    /// A bimanual scenario's left-hand device (the right's is `device`).
+    pub left_device: Option<DeviceSpec>,
     pub record: Option<PathBuf>,
     pub ticks: Option<u64>,
     /// Headless: tick on the real clock with this timer instead of a simulated one. The
@@ -177,19 +179,19 @@ pub fn open_window(
     screenshot: Option<ScreenshotPlan>,
     lesson: Option<WindowLesson>,
 ) -> Result<(Report, Attempts), String> {
-    // `--device` first, else the device the opening scenario is meant for.
-    let spec = options.device.clone().or_else(|| {
-        let lesson = lesson.as_ref()?;
-        lesson.scenario.device.spec()
-    });
+    // `--device` and `--left-device` first, else the devices the opening scenario is meant for.
+    let scenario = lesson.as_ref().map(|lesson| &lesson.scenario.device);
+    let spec = (options.device.clone()).or_else(|| scenario?.spec());
+    let left_spec = (options.left_device.clone()).or_else(|| scenario?.left_spec());
     let scene = match &lesson {
         Some(lesson) => scenario_scene_capped(options, &lesson.scenario)?,
         None => scene(options)?,
     };
-    let WindowDevice { device, mouse } = window_device(&spec, &scene)?;
-    let device = recorded(device, &options.record);
-    let device_name = device.name().to_owned();
-    let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
+    let HandDevices { devices, mice } = window_devices([&spec, &left_spec], &scene)?;
+    let devices = recorded_hands(devices, &options.record);
+    let names: Vec<&str> = devices.iter().map(|d| d.name()).collect();
+    let device_name = names.join(" + ");
+    let mut haptic = HapticLoop::with_devices(&scene, devices).map_err(|e| e.to_string())?;
     let (lesson, folder) = match lesson {
         Some(WindowLesson {
             scenario,
@@ -220,7 +222,7 @@ pub fn open_window(
     let (exit, frames) = super::window::run(WindowScene {
         scene,
         snapshots,
-        virtual_device: mouse,
+        mice,
         device_name,
         exit_after_s,
         screenshot,
@@ -249,34 +251,42 @@ pub fn open_window(
     }
 }
 
-/// The window's device, and the mouse's handle when the mouse drives it.
-struct WindowDevice {
-    device: Box<dyn HapticDevice>,
-    mouse: Option<Arc<VirtualHandle>>,
-}
-
-/// The hardware or scripted device `spec` asks for, else the mouse.
-fn window_device(spec: &Option<DeviceSpec>, scene: &HapticScene) -> Result<WindowDevice, String> {
-    Ok(match (open_hardware(spec), spec) {
-        (Some(device), _) => WindowDevice {
-            device: device?,
-            mouse: None,
-        },
-        (None, Some(DeviceSpec::Scripted(path))) => {
-            let trajectory = Trajectory::load(path).map_err(|e| e.to_string())?;
-            WindowDevice {
-                device: scripted(spec, trajectory),
-                mouse: None,
+/// Each hand's device in the window: a bimanual script serves both hands; otherwise the
+/// hardware or scripted device `specs` asks for the hand (the right's first), else the mouse.
+fn window_devices(
+    specs: [&Option<DeviceSpec>; 2],
+    scene: &HapticScene,
+) -> Result<HandDevices, String> {
+    let hands = scene.hands.len();
+    if let Some(DeviceSpec::Scripted(path)) = specs[0] {
+        let scripts = Trajectory::load_hands(path).map_err(|e| e.to_string())?;
+        if scripts.len() > 1 || hands == 1 {
+            if scripts.len() != hands {
+                return Err(format!(
+                    "{}: {} hand(s) in the file, and the scene has {hands}",
+                    path.display(),
+                    scripts.len()
+                ));
             }
+            return Ok(HandDevices {
+                devices: scripts.into_iter().map(|t| scripted(specs[0], t)).collect(),
+                mice: vec![None; hands],
+            });
         }
-        (None, _) => {
-            let (device, handle) = mouse_device(scene);
-            WindowDevice {
-                device,
-                mouse: Some(handle),
+    }
+    let mut devices = HandDevices::mouse(scene);
+    for (hand, spec) in specs.into_iter().enumerate().take(hands) {
+        let device = match (open_hardware(spec), spec) {
+            (Some(device), _) => device?,
+            (None, Some(DeviceSpec::Scripted(path))) => {
+                scripted(spec, Trajectory::load(path).map_err(|e| e.to_string())?)
             }
-        }
-    })
+            (None, _) => continue,
+        };
+        devices.devices[hand] = device;
+        devices.mice[hand] = None;
+    }
+    Ok(devices)
 }
 
 /// How the window's menu builds the scene of the scenario chosen.
@@ -314,19 +324,33 @@ fn attempts(lessons: &Lessons, haptic: &mut HapticLoop) -> Attempts {
 
 /// Runs a scenario's exercise on the scripted device `options` names, on a simulated clock,
 /// until its tasks have ended or the script has (plus 100 ms).
+/// A bimanual scenario's script carries both hands (a bimanual trajectory file).
 pub fn run_scenario_headless(options: &Options, scenario: Scenario) -> Result<Outcome, String> {
     let scene = scenario_scene_capped(options, &scenario)?;
-    let trajectory = match &options.device {
-        Some(DeviceSpec::Scripted(path)) => Trajectory::load(path).map_err(|e| e.to_string())?,
-        _ => {
-            return Err(
-                "a headless exercise needs a scripted device: --device scripted:FILE".into(),
-            );
-        }
+    let Some(DeviceSpec::Scripted(path)) = &options.device else {
+        return Err("a headless exercise needs a scripted device: --device scripted:FILE".into());
     };
-    let ticks = ticks_for(options, &trajectory);
-    let device = recorded(scripted(&options.device, trajectory), &options.record);
-    run_simulated(scenario, &scene, device, ticks)
+    let hands = Trajectory::load_hands(path).map_err(|e| e.to_string())?;
+    if hands.len() != scene.hands.len() {
+        return Err(format!(
+            "{}: {} hand(s) in the file, and the scenario is for {} (a bimanual file has the \
+             left hand's columns, `left_x_m`…: docs/devices.md)",
+            path.display(),
+            hands.len(),
+            scene.hands.len()
+        ));
+    }
+    let ticks = ticks_for(options, &hands[0]);
+    let devices = hands
+        .into_iter()
+        .map(|t| scripted(&options.device, t))
+        .collect();
+    run_simulated(
+        scenario,
+        &scene,
+        recorded_hands(devices, &options.record),
+        ticks,
+    )
 }
 
 /// The ticks `--ticks` asks for, or the script's length plus 100 ms.
@@ -388,9 +412,19 @@ fn open_hardware(spec: &Option<DeviceSpec>) -> Option<Result<Box<dyn HapticDevic
 }
 
 fn recorded(device: Box<dyn HapticDevice>, record: &Option<PathBuf>) -> Box<dyn HapticDevice> {
+    recorded_hands(vec![device], record).remove(0)
+}
+
+/// The hands' devices, recorded to one file if `record` names one.
+fn recorded_hands(
+    devices: Vec<Box<dyn HapticDevice>>,
+    record: &Option<PathBuf>,
+) -> Vec<Box<dyn HapticDevice>> {
     match record {
-        Some(path) => Box::new(Recorder::new(device, path)),
-        None => device,
+        Some(path) => (Recorder::hands(devices, path).into_iter())
+            .map(|r| Box::new(r) as Box<dyn HapticDevice>)
+            .collect(),
+        None => devices,
     }
 }
 

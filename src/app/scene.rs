@@ -502,15 +502,47 @@ fn attachments_of(organ: &str, vademecum: &Vademecum, mesh: &TetMesh) -> Vec<Att
         .collect()
 }
 
-/// The mouse's device for `scene`, its tool starting 3 cm in front of the first organ's press
-/// target, and the handle the window moves it by.
-pub fn mouse_device(scene: &HapticScene) -> (Box<dyn HapticDevice>, Arc<VirtualHandle>) {
+/// The mouse's device for `scene`'s hand `hand`, its tool starting 3 cm in front of the first
+/// organ's press target (the left hand's 4 cm to the left of the right's), and the handle the
+/// window moves it by.
+pub fn mouse_device(
+    scene: &HapticScene,
+    hand: usize,
+) -> (Box<dyn HapticDevice>, Arc<VirtualHandle>) {
     let start = press_targets(scene)
         .first()
         .map_or_else(Vector3::zeros, |t| t.point_m + t.normal * 0.03);
-    let workspace = scene.hands[0].workspace;
+    let start = start - Vector3::x() * (LEFT_HAND_APART_M * hand as f64);
+    let workspace = scene.hands[hand].workspace;
     let (device, handle) = VirtualDevice::new(&workspace.to_device(&start));
     (Box::new(device), handle)
+}
+
+/// How far to the left of the right hand's tool the mouse's left hand starts (m).
+const LEFT_HAND_APART_M: f64 = 0.04;
+
+/// Each hand's device: the mouse's wherever no other is named.
+pub struct HandDevices {
+    /// One a hand, the right hand's first.
+    pub devices: Vec<Box<dyn HapticDevice>>,
+    /// The mouse's handle of each hand it drives, by hand.
+    pub mice: Vec<Option<Arc<VirtualHandle>>>,
+}
+
+impl HandDevices {
+    /// Every hand of `scene` on the mouse.
+    pub fn mouse(scene: &HapticScene) -> Self {
+        let mut devices = Self {
+            devices: Vec::new(),
+            mice: Vec::new(),
+        };
+        for hand in 0..scene.hands.len() {
+            let (device, handle) = mouse_device(scene, hand);
+            devices.devices.push(device);
+            devices.mice.push(Some(handle));
+        }
+        devices
+    }
 }
 
 /// Per organ, the accessible point that faces the surgeon most (the largest anterior

@@ -34,9 +34,16 @@ struct Cli {
     /// The haptic device: `scripted:FILE` replays a trajectory CSV (time_s,x_m,y_m,z_m,buttons);
     /// `virtual` is the mouse; `openhaptics[:NAME]` a Geomagic Touch, `forcedimension` an omega,
     /// sigma or delta (their vendor libraries loaded at run time; `trainer devices` says what
-    /// is found). Headless default: a built-in press-and-slide on every organ.
+    /// is found). Headless default: a built-in press-and-slide on every organ. In a bimanual
+    /// scenario this is the right hand's, and a `scripted:FILE` with the left hand's columns
+    /// (`left_x_m`…) drives both hands.
     #[arg(long, global = true)]
     device: Option<DeviceSpec>,
+    /// A bimanual scenario's left-hand device, named as --device names it (two Geomagic
+    /// devices by their configuration names, `openhaptics:LEFT`, or one of each backend).
+    /// Default: the scenario's `left_backend`, else the mouse (H hands it between the hands).
+    #[arg(long, global = true)]
+    left_device: Option<DeviceSpec>,
     /// Record what the device reports to this trajectory file (replayable with scripted:FILE).
     #[arg(long, global = true)]
     record: Option<PathBuf>,
@@ -314,6 +321,7 @@ fn launch_options(cli: &Cli) -> launch::Options {
         detail: detail_of(cli),
         on_stale,
         device: cli.device.clone(),
+        left_device: cli.left_device.clone(),
         record: cli.record.clone(),
         ticks: cli.ticks,
         realtime,

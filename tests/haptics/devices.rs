@@ -51,7 +51,10 @@ fn a_bimanual_trajectory_carries_both_hands() {
     assert_eq!((right.buttons, left.buttons), (0, 1));
     assert_eq!(hands[1].sample(1.0).buttons, 0);
     let message = Trajectory::load(&path).unwrap_err().to_string();
-    assert!(message.contains("2 hand(s)") && message.contains("has 1"), "{message}");
+    assert!(
+        message.contains("2 hand(s)") && message.contains("has 1"),
+        "{message}"
+    );
     let again = write("hands-again.csv", "");
     Trajectory::save_hands(&again, &hands).unwrap();
     assert_eq!(Trajectory::load_hands(&again).unwrap(), hands);
@@ -60,7 +63,10 @@ fn a_bimanual_trajectory_carries_both_hands() {
         "time_s,x_m,y_m,z_m,left_x_m,left_y_m,left_z_m\n0,0,0,0,0,0,0\n0.5,0,0,0,0,nan,0\n",
     );
     let message = Trajectory::load_hands(&bad).unwrap_err().to_string();
-    assert!(message.contains("line 3") && message.contains("not finite"), "{message}");
+    assert!(
+        message.contains("line 3") && message.contains("not finite"),
+        "{message}"
+    );
 }
 
 #[test]

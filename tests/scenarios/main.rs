@@ -84,7 +84,7 @@ fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     let trajectory = Trajectory::load(&path).unwrap();
     let ticks = ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64;
     let device = Box::new(Scripted::new("test", trajectory));
-    run_simulated(scenario, &scene, device, ticks).unwrap()
+    run_simulated(scenario, &scene, vec![device], ticks).unwrap()
 }
 
 const SHIPPED: [&str; 12] = [
@@ -930,7 +930,7 @@ fn two_instruments_changed_and_changed_back_press_as_one() {
             scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Refuse).unwrap();
         let ticks = ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64;
         let device = Box::new(Scripted::new("test", trajectory));
-        run_simulated(scenario.clone(), &scene, device, ticks).unwrap()
+        run_simulated(scenario.clone(), &scene, vec![device], ticks).unwrap()
     };
     let plain = run(held_still(&[])).card;
     let changed = run(held_still(&[0.2, 0.6])).card;

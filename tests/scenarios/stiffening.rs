@@ -163,7 +163,9 @@ fn a_scored_press_beyond_the_range_says_so_in_its_feedback() {
         let (script, ..) = press_script(&scene);
         let ticks = (script.duration_s() / TICK_S).ceil() as u64;
         let device = Box::new(Scripted::new("30 mm press", script));
-        run_simulated(scenario, &scene, device, ticks).unwrap().card
+        run_simulated(scenario, &scene, vec![device], ticks)
+            .unwrap()
+            .card
     };
     let (exponential, linear) = (attempt("Exponential"), attempt("Linear"));
     let beyond = |card: &Scorecard| {

@@ -68,7 +68,12 @@ impl Scope {
                 }
             }
         }
-        let sees = |point: &Vector3<f64>| self.rig.scope.sees(&self.pose, point);
+        let sees = |point: &Vector3<f64>| self.sees(point);
         (tip_m.map(sees), self.rig.keep_in_view_m.as_ref().map(sees))
+    }
+
+    /// Whether `point` is in the view where the camera was last read.
+    pub fn sees(&self, point: &Vector3<f64>) -> bool {
+        self.rig.scope.sees(&self.pose, point)
     }
 }

@@ -15,10 +15,10 @@ use bevy::prelude::*;
 
 use super::components::{HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion};
 use super::cutting::OrganCut;
-use super::hand::{DeviceForce, HandIndex, Tool};
+use super::hand::{DeviceForce, HandIndex, MAX_HANDS, Tool};
 use super::resources::{Scope, TickClock};
 use super::snapshot::SnapshotPublisher;
-use crate::scenario::{BladeSample, Exercise, Progress, RegionSite, Sample};
+use crate::scenario::{BladeSample, Exercise, HandSample, Progress, RegionSite, Sample};
 
 /// What scoring reads of an organ entity.
 #[derive(QueryData)]
@@ -186,7 +186,7 @@ pub fn score_tick(
     hands: Query<(&HandIndex, &Tool, &DeviceForce)>,
     organs: Query<ScoredOrgan>,
     mut run: ResMut<ExerciseRun>,
-    scope: Option<ResMut<Scope>>,
+    mut scope: Option<ResMut<Scope>>,
 ) {
     if !run.link.started() {
         return;
@@ -197,16 +197,13 @@ pub fn score_tick(
     let Some(exercise) = run.exercise.as_mut() else {
         return;
     };
-    let Some((_, tool, force)) = hands.iter().find(|(hand, ..)| hand.0 == 0) else {
+    let mut samples = [None; MAX_HANDS];
+    for (hand, tool, force) in &hands {
+        samples[hand.0] = Some(hand_sample(hand.0, tool, force, &organs));
+    }
+    let Some(right) = samples[0] else {
         return;
     };
-    let bits = |of: &dyn Fn(&ScoredOrganItem) -> bool| {
-        (organs.iter())
-            .filter(|o| o.index.0 < 64 && of(o))
-            .fold(0, |bits, o| bits | 1 << o.index.0)
-    };
-    let touching = bits(&|o| o.touch.0[0].contact.is_some());
-    let grasping = bits(&|o| o.motion.is_some_and(|m| m.organ.holding()));
     let tore = organs.iter().any(|o| o.motion.is_some_and(|m| m.tore));
     let blade = organs.iter().find_map(|o| blade_sample(o.index, o.cut?));
     let (region_moved_m, surrounding_force_n) = exercise
@@ -215,31 +212,63 @@ pub fn score_tick(
     let beyond_range_m = (organs.iter().flat_map(|o| &o.touch.0))
         .filter_map(|touch| touch.contact.map(|c| c.beyond_range_m))
         .fold(0.0, f64::max);
-    let tip_m = tool.sample.map(|s| s.tip_m);
     let elapsed_s = exercise.elapsed_s(clock.time_s);
-    let (tip_in_view, target_in_view) = scope.map_or((None, None), |mut scope| {
-        scope.in_view(tip_m.as_ref(), elapsed_s)
+    let (tip_in_view, target_in_view) = scope.as_mut().map_or((None, None), |scope| {
+        scope.in_view(right.tip_m.as_ref(), elapsed_s)
+    });
+    let left = samples[1].map(|mut left| {
+        left.tip_in_view = scope.as_ref().zip(left.tip_m).map(|(s, tip)| s.sees(&tip));
+        left
     });
     exercise.step(&Sample {
         time_s: clock.time_s,
-        tip_m,
-        force_n: force.sent_n.norm(),
-        touching,
-        button: tool.sample.is_some_and(|s| s.buttons & 1 != 0),
-        instrument: tool.rack.in_hand().0,
+        tip_m: right.tip_m,
+        force_n: right.force_n,
+        touching: right.touching,
+        button: right.button,
+        instrument: right.instrument,
         region_moved_m,
         surrounding_force_n,
-        grasping,
+        grasping: right.grasping,
         tore,
         blade,
         tip_in_view,
         target_in_view,
         beyond_range_m,
+        left,
     });
     if exercise.finished() {
         let run = &mut *run;
         run.link.hand_over(&mut run.exercise);
         run.ended = run.exercise.is_none();
+    }
+}
+
+/// Hand `slot`'s tool, force, and the organs it touches and holds (bit `k` for organ `k`);
+/// whether its tip is in view is the scope's to say.
+fn hand_sample(
+    slot: usize,
+    tool: &Tool,
+    force: &DeviceForce,
+    organs: &Query<ScoredOrgan>,
+) -> HandSample {
+    let bits = |of: &dyn Fn(&ScoredOrganItem) -> bool| {
+        (organs.iter())
+            .filter(|o| o.index.0 < 64 && of(o))
+            .fold(0, |bits, o| bits | 1 << o.index.0)
+    };
+    let holds = |o: &ScoredOrganItem| {
+        o.motion
+            .is_some_and(|m| m.organ.holding() && m.hand == slot)
+    };
+    HandSample {
+        tip_m: tool.sample.map(|s| s.tip_m),
+        force_n: force.sent_n.norm(),
+        touching: bits(&|o| o.touch.0[slot].contact.is_some()),
+        grasping: bits(&holds),
+        button: tool.sample.is_some_and(|s| s.buttons & 1 != 0),
+        instrument: tool.rack.in_hand().0,
+        tip_in_view: None,
     }
 }
 

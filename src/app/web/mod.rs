@@ -12,10 +12,10 @@ use std::sync::Arc;
 
 use super::attempt::{scenario_files, scenario_scene};
 use super::haptic::{FramePaced, HapticLoop, HapticScene, SceneSwap};
-use super::scene::{Detail, mouse_device};
+use super::scene::{Detail, HandDevices};
 use super::window::{self, Lesson, Lessons, MenuPlan, Opening, WindowScene};
 use super::{DEFAULT_SCENARIO, SHIPPED_SCENARIOS};
-use crate::devices::{HapticDevice, Scripted, Trajectory, VirtualHandle};
+use crate::devices::{HapticDevice, Scripted, Trajectory};
 use crate::pgd::{container, web_form};
 use crate::scenario::{self, Scenario};
 use crate::store::OnStale;
@@ -35,22 +35,15 @@ pub fn start() {
 async fn run(query: page::Query) -> Result<(), String> {
     let (file, scenario) = opening_scenario(query.scenario.as_deref())?;
     let scene = fetched_scene(scenario.clone(), query.detail).await?;
-    let (device, virtual_device) = match &query.script {
-        Some(url) => (scripted(url).await?, None),
-        None => {
-            let (device, handle) = mouse_device(&scene);
-            (device, Some(handle))
-        }
+    let devices = match &query.script {
+        Some(url) => HandDevices {
+            devices: vec![scripted(url).await?],
+            mice: vec![None],
+        },
+        None => HandDevices::mouse(&scene),
     };
     page::status("ready");
-    window::run(window_scene(
-        scene,
-        scenario,
-        file,
-        device,
-        virtual_device,
-        query.detail,
-    )?);
+    window::run(window_scene(scene, scenario, file, devices, query.detail)?);
     Ok(())
 }
 
@@ -115,14 +108,14 @@ fn window_scene(
     scene: HapticScene,
     scenario: Scenario,
     file: PathBuf,
-    device: Box<dyn HapticDevice>,
-    virtual_device: Option<Arc<VirtualHandle>>,
+    HandDevices { devices, mice }: HandDevices,
     detail: Detail,
 ) -> Result<WindowScene, String> {
-    let device_name = device.name().to_owned();
-    let mut haptic = HapticLoop::new(&scene, device).map_err(|e| e.to_string())?;
+    let names: Vec<&str> = devices.iter().map(|d| d.name()).collect();
+    let device_name = names.join(" + ");
+    let mut haptic = HapticLoop::with_devices(&scene, devices).map_err(|e| e.to_string())?;
     let lesson = Lesson::prepare(&mut haptic, scenario, file, scene.clone());
-    if virtual_device.is_none() {
+    if mice.iter().all(Option::is_none) {
         lesson.link.start();
     }
     let snapshots = haptic.publish();
@@ -139,7 +132,7 @@ fn window_scene(
     Ok(WindowScene {
         scene,
         snapshots,
-        virtual_device,
+        mice,
         device_name,
         exit_after_s: None,
         screenshot: None,

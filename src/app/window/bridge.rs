@@ -15,7 +15,8 @@ use crate::mesh::organs::Organ;
 #[derive(Resource)]
 pub struct HapticLink {
     pub scene: HapticScene,
-    pub virtual_device: Option<Arc<VirtualHandle>>,
+    /// By hand, the virtual device's handle where the mouse drives the hand's tool.
+    pub mice: Vec<Option<Arc<VirtualHandle>>>,
     pub device_name: String,
     snapshots: Mutex<triple_buffer::Output<HapticSnapshot>>,
     exit_after: Option<Duration>,
@@ -31,6 +32,11 @@ impl HapticLink {
     ) {
         self.scene = scene;
         self.snapshots = Mutex::new(snapshots);
+    }
+
+    /// Whether the mouse drives any hand.
+    pub(super) fn mouse_drives(&self) -> bool {
+        self.mice.iter().any(Option::is_some)
     }
 
     /// The centre of the scene's organs (m).
@@ -77,7 +83,7 @@ impl HapticLink {
     ) -> Self {
         Self {
             scene,
-            virtual_device: None,
+            mice: Vec::new(),
             device_name: String::new(),
             snapshots: Mutex::new(snapshots),
             exit_after: None,
@@ -104,7 +110,7 @@ impl BridgePlugin {
     pub fn new(window: WindowScene) -> Self {
         Self(Mutex::new(Some(HapticLink {
             scene: window.scene,
-            virtual_device: window.virtual_device,
+            mice: window.mice,
             device_name: window.device_name,
             snapshots: Mutex::new(window.snapshots),
             exit_after: window.exit_after_s.map(Duration::from_secs_f64),

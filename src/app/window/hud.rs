@@ -116,7 +116,7 @@ fn update_hud(
     let filled = ((force_n / limit_n).clamp(0.0, 1.0) * 20.0).round() as usize;
     let gauge = format!("[{}{}]", "#".repeat(filled), "-".repeat(20 - filled));
     let status = status_line(&link, &snapshot.0);
-    let help = if link.virtual_device.is_some() {
+    let help = if link.mouse_drives() {
         "\nmouse: move the tool | wheel or W/S: push in / pull out | Q/E: turn the handle\n\
          right-drag: orbit | middle-drag: pan | Ctrl+wheel or +/-: zoom"
     } else {

@@ -4,14 +4,19 @@
 //! pan, during which the tool stays where it is. Q and E turn the handle (a scalpel's edge)
 //! about the axis facing the surgeon. Through a port the cursor still leads the tip: the
 //! handle goes where the shaft to it must be. Tab is the device's second button: it changes
-//! the instrument in hand, where a scenario gives several.
+//! the instrument in hand, where a scenario gives several. With two hands on the mouse, it
+//! drives one at a time ([`MouseHand`]): H hands it to the other, and the hand let go holds
+//! its place, its buttons as they were (a closed grasper keeps its hold).
 
+use std::sync::Arc;
+
+use bevy::ecs::system::SystemParam;
 use bevy::input::mouse::{MouseScrollUnit, MouseWheel};
 use bevy::prelude::*;
 
 use super::bridge::{HapticLink, HapticView};
 use super::{FrameSet, from_bevy, to_bevy};
-use crate::devices::CHANGE_BUTTON;
+use crate::devices::{CHANGE_BUTTON, VirtualHandle};
 
 /// How far one wheel notch moves the tip along the view (m).
 const WHEEL_STEP_M: f32 = 0.002;
@@ -27,36 +32,75 @@ pub(super) struct InputPlugin;
 
 impl Plugin for InputPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(
+        app.init_resource::<MouseHand>().add_systems(
             Update,
-            (drive_virtual_device, turn_and_press).in_set(FrameSet::Input),
+            (change_hand, drive_virtual_device, turn_and_press)
+                .chain()
+                .in_set(FrameSet::Input),
         );
     }
 }
 
+/// The hand the mouse drives (0 the right, 1 the left).
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MouseHand(pub usize);
+
+/// H hands the mouse to the next hand it can drive; one the scene lacks goes back to the first.
+fn change_hand(
+    link: Res<HapticLink>,
+    keys: Res<ButtonInput<KeyCode>>,
+    mut hand: ResMut<MouseHand>,
+) {
+    let driven = |h: &usize| link.mice.get(*h).is_some_and(Option::is_some);
+    if !driven(&hand.0) {
+        hand.0 = (0..link.mice.len()).find(driven).unwrap_or(0);
+    }
+    if keys.just_pressed(KeyCode::KeyH) {
+        let hands = link.mice.len();
+        let next = (1..hands).map(|k| (hand.0 + k) % hands).find(driven);
+        hand.0 = next.unwrap_or(hand.0);
+    }
+}
+
+/// The mouse's handle of the hand it drives, if it drives one.
+fn driven(link: &HapticLink, hand: MouseHand) -> Option<&Arc<VirtualHandle>> {
+    link.mice.get(hand.0)?.as_ref()
+}
+
+/// The window and the camera the cursor is cast from.
+#[derive(SystemParam)]
+struct CursorView<'w, 's> {
+    windows: Query<'w, 's, &'static Window>,
+    cameras: Query<'w, 's, (&'static Camera, &'static GlobalTransform)>,
+}
+
 fn drive_virtual_device(
     haptic: HapticView,
-    windows: Query<&Window>,
-    cameras: Query<(&Camera, &GlobalTransform)>,
+    view: CursorView,
     mut wheel: MessageReader<MouseWheel>,
     keys: Res<ButtonInput<KeyCode>>,
     buttons: Res<ButtonInput<MouseButton>>,
     time: Res<Time>,
+    mouse: Res<MouseHand>,
 ) {
     let (link, snapshot) = (&haptic.link, &haptic.snapshot);
-    let Some(handle) = &link.virtual_device else {
+    let (Some(handle), Some(hand), Some(published)) = (
+        driven(link, *mouse),
+        link.scene.hands.get(mouse.0),
+        snapshot.0.hands.get(mouse.0),
+    ) else {
         return;
     };
-    let (Ok(window), Ok((camera, eye))) = (windows.single(), cameras.single()) else {
+    let (Ok(window), Ok((camera, eye))) = (view.windows.single(), view.cameras.single()) else {
         return;
     };
     let forward = eye.forward();
     // The cursor places the tip of the instrument in hand in the scene; the device's handle
     // is in its own workspace, offset by the instrument's indexing and, through its port,
     // where the shaft to that tip puts it.
-    let workspace = link.scene.hands[0].workspace;
-    let instruments = &snapshot.0.first_hand().instruments;
-    let port = (link.scene.hands[0].instruments.get(instruments.in_hand)).and_then(|i| i.port);
+    let workspace = hand.workspace;
+    let instruments = &published.instruments;
+    let port = (hand.instruments.get(instruments.in_hand)).and_then(|i| i.port);
     let offset_m = instruments.offset_m;
     let handle_m = workspace.to_scene_m(&handle.tip_m()) + offset_m;
     let tip_m = port
@@ -102,11 +146,12 @@ fn drive_virtual_device(
 /// hardware), Tab its second.
 fn turn_and_press(
     link: Res<HapticLink>,
+    mouse: Res<MouseHand>,
     keys: Res<ButtonInput<KeyCode>>,
     buttons: Res<ButtonInput<MouseButton>>,
     time: Res<Time>,
 ) {
-    let Some(handle) = &link.virtual_device else {
+    let Some(handle) = driven(&link, *mouse) else {
         return;
     };
     let turning = match (keys.pressed(KeyCode::KeyQ), keys.pressed(KeyCode::KeyE)) {

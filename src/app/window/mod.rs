@@ -46,8 +46,8 @@ use crate::devices::VirtualHandle;
 pub struct WindowScene {
     pub scene: HapticScene,
     pub snapshots: triple_buffer::Output<HapticSnapshot>,
-    /// The virtual device's handle when the mouse drives the tool.
-    pub virtual_device: Option<Arc<VirtualHandle>>,
+    /// By hand, the virtual device's handle where the mouse drives the hand's tool.
+    pub mice: Vec<Option<Arc<VirtualHandle>>>,
     pub device_name: String,
     /// Close the window after this many seconds (for measurements under Xvfb).
     pub exit_after_s: Option<f64>,

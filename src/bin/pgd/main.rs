@@ -371,6 +371,7 @@ fn bench_haptics(options: HapticsBenchArgs) -> ExitCode {
         law,
         coarse,
         depth_mm,
+        hands,
         json,
     } = options;
     let motion = match args::millimetres("depth-mm", Some(depth_mm), 0.0) {
@@ -392,7 +393,13 @@ fn bench_haptics(options: HapticsBenchArgs) -> ExitCode {
     };
     print_report(
         "pgd bench haptics",
-        app::bench::run(&scene, &motion, repeats, realtime_seconds),
+        app::bench::run(
+            &scene,
+            &motion,
+            repeats,
+            realtime_seconds,
+            usize::from(hands),
+        ),
         json,
     )
 }

@@ -1,12 +1,13 @@
 //! A scenario's tasks as they run: fed one [`Sample`] per haptic tick, each task measures what
 //! its kind is scored on and ends when done or out of time; then the next starts.
 
+use super::bimanual::BimanualTracker;
 use super::format::Scenario;
 use super::keratotomy::Keratometer;
 use super::motion::MotionTracker;
 use super::sample::{NoduleSite, RegionSite, Sample};
 use super::task::{
-    AnyRun, LimitWatch, Mistake, Mistakes, RunSetup, Task, TaskMetrics, TaskProgress, Tick,
+    AnyRun, Hand, LimitWatch, Mistake, Mistakes, RunSetup, Task, TaskMetrics, TaskProgress, Tick,
 };
 
 /// Where the scenario's points lie on the scene's organs, found when the exercise is set up.
@@ -50,6 +51,10 @@ struct Running {
     force_sum: f64,
     over_limit: LimitWatch,
     motion: MotionTracker,
+    /// Both hands, in a bimanual exercise.
+    hands: Option<BimanualTracker>,
+    /// The hand that does the task.
+    hand: Hand,
     run: Box<dyn AnyRun>,
 }
 
@@ -80,7 +85,10 @@ impl Exercise {
         let total_s: f64 = scenario.tasks.iter().map(Task::time_limit_s).sum();
         let samples = (total_s / (PLOT_EVERY as f64 * crate::devices::TICK_S)).ceil() as usize;
         let prepared = (scenario.tasks.iter().enumerate())
-            .map(|(k, task)| Some(Running::prepare(task, setup(&scenario, &sites, k))))
+            .map(|(k, task)| {
+                let setup = setup(&scenario, &sites, k);
+                Some(Running::prepare(task, setup, scenario.bimanual()))
+            })
             .collect();
         Self {
             prepared,
@@ -198,7 +206,7 @@ fn setup(scenario: &Scenario, sites: &Sites, k: usize) -> RunSetup {
 
 impl Running {
     /// The run of `task`, before it starts.
-    fn prepare(task: &Task, setup: RunSetup) -> Self {
+    fn prepare(task: &Task, setup: RunSetup, bimanual: bool) -> Self {
         Self {
             metrics: TaskMetrics {
                 kind: task.label(),
@@ -211,6 +219,8 @@ impl Running {
             force_sum: 0.0,
             over_limit: LimitWatch::default(),
             motion: MotionTracker::default(),
+            hands: bimanual.then(BimanualTracker::default),
+            hand: task.hand(),
             run: task.run(setup),
         }
     }
@@ -219,6 +229,7 @@ impl Running {
     fn into_metrics(self, task: &Task) -> TaskMetrics {
         let mut m = self.metrics;
         m.motion = self.motion.metrics();
+        m.hands = self.hands.as_ref().map(BimanualTracker::metrics);
         m.mean_force_n = match m.contact_s > 0.0 {
             true => self.force_sum / m.contact_s,
             false => 0.0,
@@ -232,6 +243,17 @@ impl Running {
 
     /// What every task measures of a tick, then what its type measures.
     fn step(&mut self, sample: &Sample, dt: f64) {
+        if let (Some(hands), Some(left)) = (&mut self.hands, &sample.left) {
+            hands.step(sample, left, dt);
+        }
+        let own;
+        let sample = match self.hand {
+            Hand::Right => sample,
+            Hand::Left => {
+                own = sample.of_left_hand();
+                &own
+            }
+        };
         self.motion.in_hand(sample.instrument);
         self.motion.step(sample.tip_m, dt);
         if let Some(in_view) = sample.tip_in_view {

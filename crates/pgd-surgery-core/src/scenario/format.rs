@@ -37,6 +37,11 @@ pub struct Scenario {
     /// device drives one at a time, and its second button changes to the next (docs).
     #[serde(default)]
     pub instruments: Vec<Instrument>,
+    /// A bimanual exercise: the instruments in the trainee's left hand, each through its own
+    /// port, on a device of its own (`device.left_backend`, or `--left-device`); the hand
+    /// above (`tool` and `port`, or `instruments`) is the right. Empty: one hand.
+    #[serde(default)]
+    pub left_hand: Vec<Instrument>,
     /// The camera through its own port (laparoscopy); none: the desktop view of the open
     /// abdomen.
     #[serde(default)]
@@ -275,6 +280,10 @@ pub struct Device {
     /// it. None: the mouse in the window.
     #[serde(default)]
     pub backend: Option<String>,
+    /// A bimanual exercise's left-hand device, named as `--left-device` names it; it
+    /// overrides this. None: the mouse.
+    #[serde(default)]
+    pub left_backend: Option<String>,
 }
 
 fn default_workspace_scale() -> Scale {
@@ -290,6 +299,11 @@ impl Device {
     pub fn spec(&self) -> Option<DeviceSpec> {
         self.backend.as_ref()?.parse().ok()
     }
+
+    /// The left hand's device the scenario names, if it names one that reads.
+    pub fn left_spec(&self) -> Option<DeviceSpec> {
+        self.left_backend.as_ref()?.parse().ok()
+    }
 }
 
 impl Default for Device {
@@ -298,6 +312,7 @@ impl Default for Device {
             max_force_n: default_device_force(),
             workspace_scale: default_workspace_scale(),
             backend: None,
+            left_backend: None,
         }
     }
 }
@@ -349,23 +364,40 @@ impl Scenario {
             .collect()
     }
 
+    /// Each hand's instruments, the right hand's first: one hand, or two in a bimanual
+    /// exercise.
+    pub fn hands(&self) -> Vec<Vec<(Tool, Option<Port>)>> {
+        let mut hands = vec![self.instruments_in_hand()];
+        if !self.left_hand.is_empty() {
+            let left = self.left_hand.iter();
+            hands.push(
+                left.map(|i| (i.tool.clone(), Some(i.port.clone())))
+                    .collect(),
+            );
+        }
+        hands
+    }
+
+    /// Whether the exercise is for both hands.
+    pub fn bimanual(&self) -> bool {
+        !self.left_hand.is_empty()
+    }
+
     /// The tip (m) every instrument presses with: the first's (a loaded scenario's
     /// instruments all have its radius).
     pub fn tip_radius_m(&self) -> f64 {
         self.instruments_in_hand()[0].0.tip_radius_m()
     }
 
-    /// The blade of the first instrument that cuts, if one does.
+    /// The blade of the first instrument that cuts, in either hand, if one does.
     pub fn blade(&self) -> Option<crate::cutting::Blade> {
-        let instruments = self.instruments_in_hand();
-        instruments.iter().find_map(|(tool, _)| tool.blade())
+        let hands = self.hands();
+        hands.iter().flatten().find_map(|(tool, _)| tool.blade())
     }
 
-    /// Whether an instrument grasps (and so the organs move by default).
+    /// Whether an instrument in either hand grasps (and so the organs move by default).
     pub fn grasps(&self) -> bool {
-        self.instruments_in_hand()
-            .iter()
-            .any(|(tool, _)| tool.grasps())
+        self.hands().iter().flatten().any(|(tool, _)| tool.grasps())
     }
 
     /// Whether `organ` moves: as it says, else when an instrument grasps.
@@ -448,6 +480,10 @@ pub struct Rubric {
     /// default.
     #[serde(default)]
     pub view: f64,
+    /// Weight of working with both hands (bimanual exercises): the share of the task's time
+    /// with tissue in hand during which both hands are on it. None by default.
+    #[serde(default)]
+    pub both_hands: f64,
     /// Points lost per error (a forbidden zone entered, a press over the limit).
     #[serde(default = "default_error_penalty")]
     pub error_penalty: f64,
@@ -490,6 +526,7 @@ impl Default for Rubric {
             accuracy: default_accuracy(),
             motion: 0.0,
             view: 0.0,
+            both_hands: 0.0,
             error_penalty: default_error_penalty(),
             pass_mark: default_pass_mark(),
             all_tasks_required: true,

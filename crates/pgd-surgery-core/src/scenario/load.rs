@@ -9,7 +9,7 @@ use std::path::Path;
 use super::format::{LaparoscopeEntry, Scenario};
 use super::problem::{Problem, REFERENCE, ScenarioError};
 use super::scene::{OrganEntry, metres};
-use super::task::{SceneFacts, Task, TaskCheck};
+use super::task::{Hand, SceneFacts, Task, TaskCheck};
 use super::tasks::registered_names;
 use crate::contact::PointshellDensity;
 use crate::devices::{DeviceSpec, MAX_INSTRUMENTS};
@@ -155,6 +155,7 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
     check_laparoscope(scenario, &mut problems);
     check_instruments(scenario, &mut problems);
     check_backend(scenario, &mut problems);
+    check_left_hand(scenario, &mut problems);
     problems
 }
 
@@ -271,16 +272,64 @@ fn check_instruments(scenario: &Scenario, problems: &mut Vec<Problem>) {
 
 /// A device the scenario names must be one the trainer knows.
 fn check_backend(scenario: &Scenario, problems: &mut Vec<Problem>) {
-    let Some(backend) = &scenario.device.backend else {
-        return;
-    };
-    if let Err(message) = backend.parse::<DeviceSpec>() {
+    let device = &scenario.device;
+    for (name, backend) in [
+        ("backend", &device.backend),
+        ("left_backend", &device.left_backend),
+    ] {
+        let Some(Err(message)) = backend.as_ref().map(|b| b.parse::<DeviceSpec>()) else {
+            continue;
+        };
         problems.push(Problem {
-            field: "device.backend".into(),
-            anchors: vec!["device".into(), "backend".into()],
+            field: format!("device.{name}"),
+            anchors: vec!["device".into(), format!("{name}:")],
             message,
             hint: "`trainer devices` lists the devices and which this machine has".into(),
         });
+    }
+    if device.left_backend.is_some() && !scenario.bimanual() {
+        problems.push(Problem {
+            field: "device.left_backend".into(),
+            anchors: vec!["device".into(), "left_backend:".into()],
+            message: "a left-hand device, and no instrument in the left hand".into(),
+            hint: "give the left hand its instruments with `left_hand: [Instrument(…)]`, or drop `left_backend`".into(),
+        });
+    }
+}
+
+/// The left hand holds at most [`MAX_INSTRUMENTS`], each with the right hand's first tip (the
+/// organs' vademecums are built for one tool radius).
+fn check_left_hand(scenario: &Scenario, problems: &mut Vec<Problem>) {
+    let hand = &scenario.left_hand;
+    if hand.len() > MAX_INSTRUMENTS {
+        problems.push(Problem {
+            field: "left_hand".into(),
+            anchors: vec!["left_hand".into()],
+            message: format!(
+                "{} instruments in the left hand: a hand changes between {MAX_INSTRUMENTS} at most",
+                hand.len()
+            ),
+            hint: "keep the instruments the exercise needs".into(),
+        });
+    }
+    let tip_m = scenario.tip_radius_m();
+    for (k, instrument) in hand.iter().enumerate() {
+        let other_m = instrument.tool.tip_radius_m();
+        if (other_m - tip_m).abs() > 1e-9 {
+            let mut anchors = vec!["left_hand".to_owned()];
+            anchors.extend(std::iter::repeat_n("Instrument(".to_owned(), k + 1));
+            anchors.push("tip_radius_mm".into());
+            problems.push(Problem {
+                field: format!("left_hand[{k}].tool.tip_radius_mm"),
+                anchors,
+                message: format!(
+                    "its tip is {} mm, the right hand's {} mm: the organs are built for one tip",
+                    other_m * 1e3,
+                    tip_m * 1e3
+                ),
+                hint: "give every instrument the right hand's first tip_radius_mm".into(),
+            });
+        }
     }
 }
 
@@ -302,6 +351,13 @@ fn check_task(
         ));
     }
     let mut check = TaskCheck::new(scene, &task.shared, k, task.name());
+    if task.hand() == Hand::Left && !scenario.bimanual() {
+        check.problem(
+            "hand",
+            "a task for the left hand, and no instrument in the left hand",
+            "give the left hand its instruments with `left_hand: [Instrument(…)]`, or drop `hand`",
+        );
+    }
     task.check(&mut check);
     problems.extend(check.problems);
 }

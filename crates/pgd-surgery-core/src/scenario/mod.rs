@@ -7,6 +7,7 @@
 //! measured; and the rubric's score (`score`). No Bevy here: the app layer runs an
 //! [`Exercise`] inside the haptic schedule.
 
+mod bimanual;
 mod exercise;
 mod format;
 mod incision;
@@ -21,6 +22,7 @@ pub mod task;
 pub mod tasks;
 mod units;
 
+pub use bimanual::{BimanualMetrics, BimanualTracker};
 pub use exercise::{Exercise, Progress, Sites};
 pub use format::{
     Contact, Device, Difficulty, Instrument, LaparoscopeEntry, Port, Rubric, Scenario, ScopeKey,
@@ -34,10 +36,10 @@ pub use keratotomy::{
 pub use load::{load, parse};
 pub use motion::{IDLE_M_PER_S, MOVING_M_PER_S, MotionMetrics, MotionTracker, STRIDE};
 pub use problem::ScenarioError;
-pub use sample::{NoduleSite, RegionSite, Sample};
+pub use sample::{HandSample, NoduleSite, RegionSite, Sample};
 pub use scene::{Nodule, OrganEntry, Spot, metres};
 pub use score::{CutMade, Scorecard, TaskScore, score};
-pub use task::{MISTAKES_LISTED, Mistake, Mistakes, Task, TaskMetrics, TaskShared, TaskType};
+pub use task::{Hand, MISTAKES_LISTED, Mistake, Mistakes, Task, TaskMetrics, TaskShared, TaskType};
 pub use tasks::{COVERED_TO_FINISH, register, registered_names};
 pub use units::{
     DepthFraction, Dioptres, EdgeLength, FieldOfView, IncisionCount, Millimetres, ModeCount,

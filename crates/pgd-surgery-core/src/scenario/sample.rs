@@ -40,9 +40,65 @@ pub struct Sample {
     /// load step of the organ's nonlinear vademecum), on the organ it presses deepest so;
     /// zero within range.
     pub beyond_range_m: f64,
+    /// In a bimanual exercise, the left hand's (the fields above that name the tool, the
+    /// force, what it touches and holds are the right hand's).
+    pub left: Option<HandSample>,
+}
+
+/// One hand's part of a tick's sample: its tool and force, what it touches and holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HandSample {
+    pub tip_m: Option<Vector3<f64>>,
+    /// The force sent to the hand's device (N).
+    pub force_n: f64,
+    /// Bit `k` for the scenario's `organs[k]`, as in [`Sample::touching`].
+    pub touching: u64,
+    pub grasping: u64,
+    pub button: bool,
+    pub instrument: usize,
+    pub tip_in_view: Option<bool>,
+}
+
+impl HandSample {
+    /// Whether the hand's tool is on tissue: touching or holding it.
+    pub fn working(&self) -> bool {
+        self.touching != 0 || self.grasping != 0
+    }
 }
 
 impl Sample {
+    /// The right hand's part of the sample (the only hand of a one-hand exercise).
+    pub fn right(&self) -> HandSample {
+        HandSample {
+            tip_m: self.tip_m,
+            force_n: self.force_n,
+            touching: self.touching,
+            grasping: self.grasping,
+            button: self.button,
+            instrument: self.instrument,
+            tip_in_view: self.tip_in_view,
+        }
+    }
+
+    /// The sample as the left hand's task sees it: the left hand's tool, force, touch and
+    /// hold in place of the right's (the right hand's, if there is no left).
+    pub fn of_left_hand(&self) -> Sample {
+        let Some(left) = self.left else {
+            return *self;
+        };
+        Sample {
+            tip_m: left.tip_m,
+            force_n: left.force_n,
+            touching: left.touching,
+            grasping: left.grasping,
+            button: left.button,
+            instrument: left.instrument,
+            tip_in_view: left.tip_in_view,
+            left: Some(self.right()),
+            ..*self
+        }
+    }
+
     pub fn touches(&self, organ: usize) -> bool {
         organ < 64 && self.touching & (1 << organ) != 0
     }

@@ -94,6 +94,10 @@ fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
         ),
         (rubric.motion, economy(m)),
         (rubric.view, in_view(m)),
+        (
+            rubric.both_hands,
+            m.hands.as_ref().map_or(1.0, |h| h.together()),
+        ),
     ];
     let weights: f64 = terms.iter().map(|(w, _)| w).sum();
     let weighted = terms.iter().map(|(w, v)| w * v).sum::<f64>() / weights.max(f64::MIN_POSITIVE);
@@ -106,11 +110,17 @@ fn economy(m: &TaskMetrics) -> f64 {
     m.motion.economy.map_or(1.0, |e| (1.0 / e).clamp(0.0, 1.0))
 }
 
-/// The share of the task's time in the camera's view: the mean over the tip and the point to
-/// keep in view (those measured; 1 with neither).
+/// The share of the task's time in the camera's view: the mean over the tip (each hand's, in
+/// a bimanual exercise) and the point to keep in view (those measured; 1 with none).
 fn in_view(m: &TaskMetrics) -> f64 {
-    let shares: Vec<f64> = [m.motion.out_of_view_s, m.target_out_of_view_s]
+    // Both hands' tips, in a bimanual exercise.
+    let tips = match &m.hands {
+        Some(h) => [h.right.out_of_view_s, h.left.out_of_view_s],
+        None => [m.motion.out_of_view_s, None],
+    };
+    let shares: Vec<f64> = tips
         .into_iter()
+        .chain([m.target_out_of_view_s])
         .flatten()
         .map(|out_s| 1.0 - out_s / m.time_s.max(f64::MIN_POSITIVE))
         .collect();

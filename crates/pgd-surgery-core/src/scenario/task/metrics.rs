@@ -28,8 +28,13 @@ pub struct TaskMetrics {
     /// ...and how many more were made, counted but not listed.
     #[serde(skip_serializing_if = "is_zero")]
     pub more_errors: usize,
-    /// The tool tip's motion over the task: path, economy, movements, idle time, jerk.
+    /// The tool tip's motion over the task (the task's hand's): path, economy, movements,
+    /// idle time, jerk.
     pub motion: MotionMetrics,
+    /// In a bimanual exercise, both hands: each one's motion, their work together, the idle
+    /// hand's drift.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hands: Option<crate::scenario::BimanualMetrics>,
     /// Laparoscopy: the time the point to keep in view was out of the camera's view (s).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub target_out_of_view_s: Option<f64>,

@@ -14,8 +14,8 @@ mod watch;
 use std::any::Any;
 use std::fmt::{self, Debug};
 
-use serde::Serialize;
 use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
 
 pub use check::{SceneFacts, TaskCheck};
 pub use metrics::TaskMetrics;
@@ -36,6 +36,17 @@ pub struct TaskShared {
     /// The force above which pressing or pulling is an error (the band's top in force control).
     pub max_force_n: Newtons,
     pub time_limit_s: Seconds,
+    /// The hand that does the task in a bimanual exercise (the right by default): what every
+    /// task measures (force, contact, motion) is that hand's.
+    pub hand: Hand,
+}
+
+/// A trainee's hand, as a bimanual exercise's tasks name it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+pub enum Hand {
+    #[default]
+    Right,
+    Left,
 }
 
 /// The region a task watches move (retraction, grasp): its organ, the point nearest which it
@@ -250,6 +261,11 @@ impl Task {
 
     pub fn time_limit_s(&self) -> f64 {
         self.shared.time_limit_s.0
+    }
+
+    /// The hand that does the task.
+    pub fn hand(&self) -> Hand {
+        self.shared.hand
     }
 
     /// What the task asks, in words, for the trainee.

@@ -16,7 +16,7 @@ use serde::de::{
 use serde::{Deserialize, forward_to_deserialize_any};
 
 use super::registry::{self, Entry};
-use crate::scenario::task::{Task, TaskShared};
+use crate::scenario::task::{Hand, Task, TaskShared};
 use crate::scenario::units::{Newtons, Seconds};
 
 impl<'de> Deserialize<'de> for Task {
@@ -102,6 +102,7 @@ struct SharedFields {
     organ: Option<String>,
     max_force_n: Option<Newtons>,
     time_limit_s: Option<Seconds>,
+    hand: Option<Hand>,
 }
 
 impl SharedFields {
@@ -119,6 +120,7 @@ impl SharedFields {
             organ: self.organ,
             max_force_n: self.max_force_n.ok_or(E::missing_field("max_force_n"))?,
             time_limit_s: self.time_limit_s.ok_or(E::missing_field("time_limit_s"))?,
+            hand: self.hand.unwrap_or_default(),
         })
     }
 }
@@ -187,7 +189,7 @@ fn with_shared(own: &'static [&'static str], on_an_organ: bool) -> &'static [&'s
     if let Some(&(.., list)) = (lists.iter()).find(|(k, o, _)| *k == key && *o == on_an_organ) {
         return list;
     }
-    let shared = (["organ", "max_force_n", "time_limit_s"].into_iter())
+    let shared = (["organ", "max_force_n", "time_limit_s", "hand"].into_iter())
         .filter(|field| on_an_organ || *field != "organ");
     let list: &'static [&'static str] = Vec::leak(own.iter().copied().chain(shared).collect());
     lists.push((key, on_an_organ, list));
@@ -246,6 +248,7 @@ impl<'de, A: MapAccess<'de>> MapAccess<'de> for Split<'_, A, A::Error> {
                 "organ" => self.shared_value("organ", |s| &mut s.organ)?,
                 "max_force_n" => self.shared_value("max_force_n", |s| &mut s.max_force_n)?,
                 "time_limit_s" => self.shared_value("time_limit_s", |s| &mut s.time_limit_s)?,
+                "hand" => self.shared_value("hand", |s| &mut s.hand)?,
                 own if !self.fields.is_empty() && !self.fields.contains(&own) => {
                     let expected = with_shared(self.fields, self.on_an_organ);
                     return self.keep(Err(de::Error::unknown_field(own, expected)));
