@@ -403,8 +403,8 @@ fn open_hardware(spec: &Option<DeviceSpec>) -> Option<Result<Box<dyn HapticDevic
         Some(DeviceSpec::OpenHaptics(name)) => {
             OpenHaptics::open(None, name.as_deref()).map(|d| Box::new(d) as Box<dyn HapticDevice>)
         }
-        Some(DeviceSpec::ForceDimension) => {
-            ForceDimension::open(None).map(|d| Box::new(d) as Box<dyn HapticDevice>)
+        Some(DeviceSpec::ForceDimension(index)) => {
+            ForceDimension::open(None, *index).map(|d| Box::new(d) as Box<dyn HapticDevice>)
         }
         _ => return None,
     };

@@ -32,15 +32,15 @@ struct Cli {
     #[arg(long, global = true)]
     headless: bool,
     /// The haptic device: `scripted:FILE` replays a trajectory CSV (time_s,x_m,y_m,z_m,buttons);
-    /// `virtual` is the mouse; `openhaptics[:NAME]` a Geomagic Touch, `forcedimension` an omega,
-    /// sigma or delta (their vendor libraries loaded at run time; `trainer devices` says what
+    /// `virtual` is the mouse; `openhaptics[:NAME]` a Geomagic Touch, `forcedimension[:INDEX]`
+    /// an omega, sigma or delta (INDEX in the SDK's list, 0 first) (their vendor libraries loaded at run time; `trainer devices` says what
     /// is found). Headless default: a built-in press-and-slide on every organ. In a bimanual
     /// scenario this is the right hand's, and a `scripted:FILE` with the left hand's columns
     /// (`left_x_m`…) drives both hands.
     #[arg(long, global = true)]
     device: Option<DeviceSpec>,
-    /// A bimanual scenario's left-hand device, named as --device names it (two Geomagic
-    /// devices by their configuration names, `openhaptics:LEFT`, or one of each backend).
+    /// A bimanual scenario's left-hand device, named as --device names it (two Force
+    /// Dimension devices by index, `forcedimension:1`, or one of each backend).
     /// Default: the scenario's `left_backend`, else the mouse (H hands it between the hands).
     #[arg(long, global = true)]
     left_device: Option<DeviceSpec>,

@@ -61,7 +61,7 @@ fn touch_pressing(test: &str) -> (VendorFake, OpenHaptics) {
 /// The fake Force Dimension library's copy for `test`, a device open on it commanding 1 N.
 fn omega_pressing(test: &str) -> (VendorFake, ForceDimension) {
     let fake = VendorFake::new("fake_dhd", test);
-    let mut device = ForceDimension::open(Some(&fake.path)).unwrap();
+    let mut device = ForceDimension::open(Some(&fake.path), None).unwrap();
     device.write_force(&Vector3::new(0.0, 0.0, 1.0)).unwrap();
     fake.wait("fake_dhd_frames", 3);
     assert_ne!(fake.vector("fake_dhd_last_force"), Vector3::zeros());

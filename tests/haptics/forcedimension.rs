@@ -5,12 +5,16 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
-use pgd_surgery::devices::{ForceDimension, HapticDevice};
+use pgd_surgery::app::haptic::{DeviceForce, FaultLog, HapticLoop, TickClock};
+use pgd_surgery::devices::{ForceDimension, HapticDevice, SafetySettings, TICK_S};
+
+use crate::common::{TIP_RADIUS_M, target};
 
 use crate::fakes::{
     assert_edge_guarded, assert_faded, assert_held_to_ceiling, assert_watchdog_held,
     press_then_fault, pressing_tip_m,
 };
+use crate::two_hands::{APART_M, left_target, two_hands};
 use crate::vendor_fake::VendorFake;
 
 /// This test's own copy of the fake dhd library, and its controls.
@@ -30,12 +34,37 @@ impl Fake {
         unsafe { f(m[0], m[1], m[2], buttons) };
     }
 
+    /// Places device `id`'s end effector so that the tool's tip is at `tip_m` in the scene.
+    fn place_tip(&self, id: i32, tip_m: &Vector3<f64>) {
+        let f = self
+            .0
+            .call::<unsafe extern "C" fn(i32, f64, f64, f64, u32)>("fake_dhd_set_effector_of");
+        // SAFETY: plain values. The scene's (x, y, z) is the device's (−y, x, z).
+        unsafe { f(id, -tip_m.y, tip_m.x, tip_m.z, 0) };
+    }
+
     fn last_force(&self) -> Vector3<f64> {
         self.0.vector("fake_dhd_last_force")
     }
 
+    /// The force last sent to device `id`, in the device's frame.
+    fn last_force_of(&self, id: i32) -> Vector3<f64> {
+        let f = self
+            .0
+            .call::<unsafe extern "C" fn(i32, *mut f64)>("fake_dhd_last_force_of");
+        let mut out = [0.0; 3];
+        // SAFETY: room for three doubles.
+        unsafe { f(id, out.as_mut_ptr()) };
+        Vector3::from(out)
+    }
+
     fn open(&self) -> Result<ForceDimension, String> {
-        ForceDimension::open(Some(&self.0.path)).map_err(|e| e.to_string())
+        self.open_index(None)
+    }
+
+    /// Opens the device at `index` in the SDK's list (the first available without).
+    fn open_index(&self, index: Option<u8>) -> Result<ForceDimension, String> {
+        ForceDimension::open(Some(&self.0.path), index).map_err(|e| e.to_string())
     }
 
     fn wait_frames(&self, frames: i64) {
@@ -47,12 +76,18 @@ impl Fake {
         // SAFETY: a plain value.
         unsafe { self.0.call::<unsafe extern "C" fn(i32)>(name)(value) };
     }
+
+    /// A control taking a device's ID and one int.
+    fn control_of(&self, name: &str, id: i32, value: i32) {
+        // SAFETY: plain values.
+        unsafe { self.0.call::<unsafe extern "C" fn(i32, i32)>(name)(id, value) };
+    }
 }
 
 /// No library, or no device: one message each, naming what is missing.
 #[test]
 fn a_missing_library_or_device_is_named() {
-    let error = ForceDimension::open(Some(Path::new("/nowhere/libdhd.so")))
+    let error = ForceDimension::open(Some(Path::new("/nowhere/libdhd.so")), None)
         .err()
         .unwrap()
         .to_string();
@@ -175,4 +210,74 @@ fn a_driver_reporting_100_n_is_held_to_the_ceiling() {
     };
     let mut device = fake.open().unwrap();
     assert_held_to_ceiling(&mut device, &fake.0, "fake_dhd");
+}
+
+/// Two devices by index, one a hand, both pressing the liver 35 mm apart: each device is sent
+/// its own hand's force (the scene's force in the device's axes, to 1e-12 N), both push back;
+/// an SDK error on device 1 fades the left hand to zero within the filter's ticks and names
+/// it, while device 0 goes on being sent the right hand's force. An index past the devices
+/// connected is refused, saying how many there are.
+#[test]
+fn two_devices_by_index_each_serve_their_own_hand() {
+    let fake = Fake::new("two-devices");
+    fake.control("fake_dhd_set_connected", 2);
+    let missing = fake.open_index(Some(2)).err().unwrap();
+    assert!(
+        missing.contains("no device 2: the SDK finds 2"),
+        "{missing}"
+    );
+    let targets = [target(), left_target(APART_M)];
+    for (id, t) in targets.iter().enumerate() {
+        fake.place_tip(id as i32, &(t.point_m + t.normal * (TIP_RADIUS_M - 0.004)));
+    }
+    let devices: Vec<Box<dyn HapticDevice>> = [0, 1]
+        .map(|index| Box::new(fake.open_index(Some(index)).unwrap()) as Box<dyn HapticDevice>)
+        .into();
+    assert!(devices[1].name().ends_with("(1)"), "{}", devices[1].name());
+    let mut haptic = HapticLoop::with_devices(&two_hands(), devices).unwrap();
+    let tick = |haptic: &mut HapticLoop, n: u64| {
+        haptic.tick(TickClock {
+            tick: n,
+            time_s: n as f64 * TICK_S,
+            overruns_in_a_row: 0,
+        });
+        fake.wait_frames(2);
+        [0, 1].map(|hand| haptic.hand::<DeviceForce>(hand).unwrap().sent_n)
+    };
+    let mut sent = [Vector3::zeros(); 2];
+    for n in 0..400 {
+        sent = tick(&mut haptic, n);
+    }
+    for (hand, t) in targets.iter().enumerate() {
+        assert!(
+            sent[hand].dot(&t.normal) > 0.05,
+            "hand {hand}: {:?}",
+            sent[hand]
+        );
+        let device = fake.last_force_of(hand as i32);
+        let in_device = Vector3::new(-sent[hand].y, sent[hand].x, sent[hand].z);
+        assert!(
+            (device - in_device).norm() < 1e-12,
+            "{device:?} {in_device:?}"
+        );
+    }
+    assert!((sent[0] - sent[1]).norm() > 1e-3, "the hands feel apart");
+    fake.control_of("fake_dhd_inject_error_of", 1, 7);
+    let fade = SafetySettings::default().fade_ticks as u64;
+    for n in 400..405 + fade {
+        sent = tick(&mut haptic, n);
+    }
+    assert_eq!(sent[1], Vector3::zeros());
+    assert!(sent[0].dot(&targets[0].normal) > 0.05, "{:?}", sent[0]);
+    let right = Vector3::new(-sent[0].y, sent[0].x, sent[0].z);
+    assert!((fake.last_force_of(0) - right).norm() < 1e-12);
+    let faults = |hand| haptic.hand::<FaultLog>(hand).unwrap().log.len();
+    assert_eq!(faults(0), 0);
+    let left_log = &haptic.hand::<FaultLog>(1).unwrap().log;
+    assert!(
+        left_log
+            .iter()
+            .any(|(_, f)| f.to_string().contains("communication error")),
+        "{left_log:?}"
+    );
 }

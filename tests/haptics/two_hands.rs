@@ -21,7 +21,7 @@ use crate::faults::{Faulty, Kind};
 
 /// Where the left hand presses: the liver's surface `apart_m` across from the right hand's
 /// target.
-fn left_target(apart_m: f64) -> PressTarget {
+pub fn left_target(apart_m: f64) -> PressTarget {
     let right = target();
     let across = right.normal.cross(&Vector3::x()).normalize();
     let surface = ContactSurface::new(&liver().vademecum).unwrap();
@@ -45,7 +45,7 @@ fn presses(apart_m: f64) -> [Box<dyn HapticDevice>; 2] {
 }
 
 /// The liver with two hands, each a probe in open surgery.
-fn two_hands() -> HapticScene {
+pub fn two_hands() -> HapticScene {
     let mut scene = scene(SafetySettings::default());
     scene.hands.push(SceneHand::default());
     scene
@@ -74,7 +74,7 @@ fn contacts(haptic: &mut HapticLoop) -> [ToolContact; 2] {
 }
 
 /// How far apart the hands press in the runs that are not about the distance (m).
-const APART_M: f64 = 0.035;
+pub const APART_M: f64 = 0.035;
 
 /// Two presses `apart_m` apart hold their tips still; full FEM is given the same two tips: the
 /// forces whose patch loads move the surface under each tip to where the tip holds it (its

@@ -442,6 +442,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "RadialKeratotomy.depth_fraction",
             "not a depth fraction",
         ),
+        (
+            "countertraction-one-hand",
+            8,
+            "tasks[0].countertraction",
+            "no instrument in the left hand",
+        ),
     ];
     for (name, line, field, message) in cases {
         let file = root().join(format!("tests/scenarios/broken/{name}.scenario.ron"));

@@ -36,6 +36,8 @@ pub const LIBRARY: VendorLibrary = VendorLibrary {
 /// The dhd functions the backend calls, resolved once; the library stays open with them.
 struct Dhd {
     open: unsafe extern "C" fn() -> c_int,
+    open_id: unsafe extern "C" fn(c_char) -> c_int,
+    get_device_count: unsafe extern "C" fn() -> c_int,
     close: unsafe extern "C" fn(c_char) -> c_int,
     enable_force: unsafe extern "C" fn(u8, c_char) -> c_int,
     get_position: unsafe extern "C" fn(*mut f64, *mut f64, *mut f64, c_char) -> c_int,
@@ -61,6 +63,8 @@ impl Dhd {
         }
         Ok(Self {
             open: resolve!("dhdOpen"),
+            open_id: resolve!("dhdOpenID"),
+            get_device_count: resolve!("dhdGetDeviceCount"),
             close: resolve!("dhdClose"),
             enable_force: resolve!("dhdEnableForce"),
             get_position: resolve!("dhdGetPosition"),
@@ -210,34 +214,31 @@ pub struct ForceDimension {
 }
 
 impl ForceDimension {
-    /// Opens the first device through the dhd library at `library` (or the one `LIBRARY`
-    /// finds) and starts its servo thread. On any error after the device was opened, it is
-    /// closed before the error is returned.
-    pub fn open(library: Option<&Path>) -> Result<Self, DeviceError> {
+    /// Opens a device through the dhd library at `library` (or the one `LIBRARY` finds): the
+    /// one at `index` in the SDK's list of connected devices (two hands, two devices), or the
+    /// first available; and starts its servo thread. On any error after the device was
+    /// opened, it is closed before the error is returned.
+    pub fn open(library: Option<&Path>, index: Option<u8>) -> Result<Self, DeviceError> {
         let path = library.map_or_else(|| LIBRARY.path(), Path::to_path_buf);
         let dhd = Arc::new(Dhd::load(&path)?);
         let failed = |what: &str, (code, text): (u32, String)| DeviceError::Failed {
-            device: "Force Dimension".into(),
+            device: match index {
+                Some(index) => format!("Force Dimension device {index}"),
+                None => "Force Dimension".into(),
+            },
             message: format!("{what}: {text} (dhd error {code})"),
         };
-        // SAFETY: takes nothing; returns the device's ID, or −1.
-        let id = unsafe { (dhd.open)() };
-        if id < 0 {
-            return Err(failed(
-                "no device could be opened (is it plugged in, powered and calibrated?)",
-                dhd.last_error(),
-            ));
-        }
+        let id = open_device(&dhd, index).map_err(|(what, error)| failed(&what, error))?;
         let session = Arc::new(Session {
             dhd: dhd.clone(),
-            id: id as c_char,
+            id,
             link: Arc::new(ServoLink::default()),
             running: Arc::new(AtomicBool::new(true)),
             servo: Mutex::new(None),
             released: AtomicBool::new(false),
         });
         super::register(&(session.clone() as Arc<dyn Release>));
-        // SAFETY: the ID was just returned by `dhdOpen`.
+        // SAFETY: the ID was just returned by `dhdOpen` or `dhdOpenID`.
         let (model, max_force) = unsafe {
             (
                 c_text((dhd.get_system_name)(session.id)),
@@ -253,10 +254,11 @@ impl ForceDimension {
         let servo = spawn_servo(&session)
             .map_err(|e| failed("cannot start the servo thread", (0, e.to_string())))?;
         *session.servo.lock().unwrap_or_else(|p| p.into_inner()) = Some(servo);
-        let name = format!(
-            "Force Dimension {}",
-            model.unwrap_or_else(|| "device".into())
-        );
+        let model = model.unwrap_or_else(|| "device".into());
+        let name = match index {
+            Some(index) => format!("Force Dimension {model} ({index})"),
+            None => format!("Force Dimension {model}"),
+        };
         if !session.link.await_first_sample() {
             let (code, text) = dhd.last_error();
             return Err(DeviceError::Failed {
@@ -282,6 +284,32 @@ impl ForceDimension {
     /// What the haptic loop and the servo share.
     pub fn link(&self) -> &Arc<ServoLink> {
         &self.session.link
+    }
+}
+
+/// Opens the device at `index` in the SDK's list, or the first available; its ID, or what
+/// failed and the SDK's error.
+fn open_device(dhd: &Dhd, index: Option<u8>) -> Result<c_char, (String, (u32, String))> {
+    let unopened = || "no device could be opened (is it plugged in, powered and calibrated?)";
+    let Some(index) = index else {
+        // SAFETY: takes nothing; returns the device's ID, or −1.
+        let id = unsafe { (dhd.open)() };
+        return match id < 0 {
+            true => Err((unopened().into(), dhd.last_error())),
+            false => Ok(id as c_char),
+        };
+    };
+    // SAFETY: takes nothing; returns how many devices are connected, or −1.
+    let count = unsafe { (dhd.get_device_count)() };
+    if count >= 0 && i32::from(index) >= count {
+        let what = format!("there is no device {index}: the SDK finds {count} (0 is the first)");
+        return Err((what, dhd.last_error()));
+    }
+    // SAFETY: a plain value; returns the device's ID, or −1.
+    let id = unsafe { (dhd.open_id)(index as c_char) };
+    match id < 0 {
+        true => Err((unopened().into(), dhd.last_error())),
+        false => Ok(id as c_char),
     }
 }
 

@@ -2,6 +2,7 @@
 //! its kind is scored on and ends when done or out of time; then the next starts.
 
 use super::bimanual::BimanualTracker;
+use super::countertraction::CountertractionWatch;
 use super::format::Scenario;
 use super::keratotomy::Keratometer;
 use super::motion::MotionTracker;
@@ -55,6 +56,8 @@ struct Running {
     hands: Option<BimanualTracker>,
     /// The hand that does the task.
     hand: Hand,
+    /// The other hand's hold, when the task asks for counter-traction.
+    countertraction: Option<CountertractionWatch>,
     run: Box<dyn AnyRun>,
 }
 
@@ -87,7 +90,9 @@ impl Exercise {
         let prepared = (scenario.tasks.iter().enumerate())
             .map(|(k, task)| {
                 let setup = setup(&scenario, &sites, k);
-                Some(Running::prepare(task, setup, scenario.bimanual()))
+                let mut running = Running::prepare(task, setup, scenario.bimanual());
+                running.countertraction = countertraction(&scenario, task);
+                Some(running)
             })
             .collect();
         Self {
@@ -204,6 +209,14 @@ fn setup(scenario: &Scenario, sites: &Sites, k: usize) -> RunSetup {
     }
 }
 
+/// The watch of `task`'s counter-traction, if it asks for one (on an organ of the scenario's:
+/// the scenario's check makes sure).
+fn countertraction(scenario: &Scenario, task: &Task) -> Option<CountertractionWatch> {
+    let countertraction = task.shared.countertraction.as_ref()?;
+    let organ = (scenario.organs.iter()).position(|o| o.name == countertraction.organ)?;
+    Some(CountertractionWatch::new(countertraction, organ))
+}
+
 impl Running {
     /// The run of `task`, before it starts.
     fn prepare(task: &Task, setup: RunSetup, bimanual: bool) -> Self {
@@ -221,6 +234,7 @@ impl Running {
             motion: MotionTracker::default(),
             hands: bimanual.then(BimanualTracker::default),
             hand: task.hand(),
+            countertraction: None,
             run: task.run(setup),
         }
     }
@@ -230,6 +244,7 @@ impl Running {
         let mut m = self.metrics;
         m.motion = self.motion.metrics();
         m.hands = self.hands.as_ref().map(BimanualTracker::metrics);
+        m.countertraction = (self.countertraction.as_ref()).map(CountertractionWatch::metrics);
         m.mean_force_n = match m.contact_s > 0.0 {
             true => self.force_sum / m.contact_s,
             false => 0.0,
@@ -246,6 +261,7 @@ impl Running {
         if let (Some(hands), Some(left)) = (&mut self.hands, &sample.left) {
             hands.step(sample, left, dt);
         }
+        self.step_countertraction(sample, dt);
         let own;
         let sample = match self.hand {
             Hand::Right => sample,
@@ -290,6 +306,23 @@ impl Running {
             motion: &self.motion,
         };
         self.run.step(&mut tick);
+    }
+
+    /// Watches the other hand's hold, if the task asks for one.
+    fn step_countertraction(&mut self, sample: &Sample, dt: f64) {
+        let (Some(watch), Some(left)) = (&mut self.countertraction, sample.left) else {
+            return;
+        };
+        let other = match self.hand {
+            Hand::Right => left,
+            Hand::Left => sample.right(),
+        };
+        if let Some(lapse) = watch.step(&other, dt) {
+            (self.mistakes).note(Mistake::Countertraction {
+                time_s: sample.time_s,
+                lapse,
+            });
+        }
     }
 
     /// Whether the task is over before its time: done, or ended as its type says.

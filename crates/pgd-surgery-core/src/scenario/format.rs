@@ -480,8 +480,10 @@ pub struct Rubric {
     /// default.
     #[serde(default)]
     pub view: f64,
-    /// Weight of working with both hands (bimanual exercises): the share of the task's time
-    /// with tissue in hand during which both hands are on it. None by default.
+    /// Weight of working with both hands (bimanual exercises): for a task with
+    /// counter-traction, the share of its time the other hand held its organ within the band;
+    /// otherwise the share of the time with tissue in hand during which both hands are on it.
+    /// None by default.
     #[serde(default)]
     pub both_hands: f64,
     /// Points lost per error (a forbidden zone entered, a press over the limit).

@@ -6,6 +6,7 @@
 
 use std::path::Path;
 
+use super::countertraction::Countertraction;
 use super::format::{LaparoscopeEntry, Scenario};
 use super::problem::{Problem, REFERENCE, ScenarioError};
 use super::scene::{OrganEntry, metres};
@@ -358,8 +359,55 @@ fn check_task(
             "give the left hand its instruments with `left_hand: [Instrument(…)]`, or drop `hand`",
         );
     }
+    if let Some(countertraction) = &task.shared.countertraction {
+        check_countertraction(scenario, countertraction, &mut check);
+    }
     task.check(&mut check);
     problems.extend(check.problems);
+}
+
+/// A task's counter-traction: in a bimanual exercise, on one of its organs, with a band the
+/// device can send.
+fn check_countertraction(
+    scenario: &Scenario,
+    countertraction: &Countertraction,
+    check: &mut TaskCheck<'_>,
+) {
+    let field = "countertraction";
+    if !scenario.bimanual() {
+        check.problem(
+            field,
+            "counter-traction by the other hand, and no instrument in the left hand",
+            "give the left hand its instruments with `left_hand: [Instrument(…)]`, or drop `countertraction`",
+        );
+    }
+    let organ = &countertraction.organ;
+    if !scenario.organs.iter().any(|o| &o.name == organ) {
+        check.problem_at(
+            "countertraction.organ",
+            &["tasks", field, organ],
+            format!("`{organ}` is not among the scenario's organs"),
+            "name one of `organs`",
+        );
+    }
+    let (min_n, max_n) = (countertraction.min_force_n.0, countertraction.max_force_n.0);
+    if min_n >= max_n {
+        check.problem_at(
+            "countertraction.min_force_n",
+            &["tasks", field, "min_force_n"],
+            format!("the band's bottom {min_n} N is not below its top {max_n} N"),
+            "make min_force_n smaller than max_force_n",
+        );
+    }
+    let device_n = check.scene.device_max_force_n;
+    if max_n > device_n {
+        check.problem_at(
+            "countertraction.max_force_n",
+            &["tasks", field, "max_force_n"],
+            format!("{max_n} N is above the device's limit of {device_n} N"),
+            "lower it, or raise device.max_force_n",
+        );
+    }
 }
 
 fn generated_organs() -> String {

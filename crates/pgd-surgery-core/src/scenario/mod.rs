@@ -8,6 +8,7 @@
 //! [`Exercise`] inside the haptic schedule.
 
 mod bimanual;
+mod countertraction;
 mod exercise;
 mod format;
 mod incision;
@@ -23,6 +24,7 @@ pub mod tasks;
 mod units;
 
 pub use bimanual::{BimanualMetrics, BimanualTracker};
+pub use countertraction::{Countertraction, CountertractionMetrics, CountertractionWatch, Lapse};
 pub use exercise::{Exercise, Progress, Sites};
 pub use format::{
     Contact, Device, Difficulty, Instrument, LaparoscopeEntry, Port, Rubric, Scenario, ScopeKey,

@@ -94,14 +94,22 @@ fn task_score(rubric: &Rubric, m: &TaskMetrics) -> f64 {
         ),
         (rubric.motion, economy(m)),
         (rubric.view, in_view(m)),
-        (
-            rubric.both_hands,
-            m.hands.as_ref().map_or(1.0, |h| h.together()),
-        ),
+        (rubric.both_hands, both_hands(m)),
     ];
     let weights: f64 = terms.iter().map(|(w, _)| w).sum();
     let weighted = terms.iter().map(|(w, v)| w * v).sum::<f64>() / weights.max(f64::MIN_POSITIVE);
     (100.0 * weighted - rubric.error_penalty * m.error_count() as f64).clamp(0.0, 100.0)
+}
+
+/// How the hands worked together, as a share: with counter-traction, the share of the task's
+/// time the other hand held its organ within its band; otherwise the share of the time on
+/// tissue both hands worked at once (1 with one hand).
+fn both_hands(m: &TaskMetrics) -> f64 {
+    match (&m.countertraction, &m.hands) {
+        (Some(countertraction), _) => countertraction.in_band_share(),
+        (None, Some(hands)) => hands.together(),
+        (None, None) => 1.0,
+    }
 }
 
 /// Economy of motion as a share: the shortest path needed over the path taken (1 when the tip
@@ -146,6 +154,9 @@ fn force_control(m: &TaskMetrics) -> f64 {
 /// Time out of the camera's view the debrief mentions (s): a glance aside is not worth a line.
 const NOTED_OUT_OF_VIEW_S: f64 = 0.5;
 
+/// Counter-traction held in its band less than this share of a task's time gets a line.
+const NOTED_IN_BAND: f64 = 0.95;
+
 fn task_feedback(task: &TaskScore) -> Vec<String> {
     let m = &task.metrics;
     let outcome = m.outcome.as_ref();
@@ -183,6 +194,16 @@ fn task_feedback(task: &TaskScore) -> Vec<String> {
         ));
     }
     lines.extend(outcome.map(|o| o.feedback()).unwrap_or_default());
+    if let Some(c) = (m.countertraction.as_ref()).filter(|c| c.in_band_share() < NOTED_IN_BAND) {
+        lines.push(format!(
+            "the counter-traction was within its band {:.0} % of the time (slack {:.1} s, \
+             too hard {:.1} s, not held {:.1} s)",
+            100.0 * c.in_band_share(),
+            c.slack_s,
+            c.over_s,
+            c.not_held_s
+        ));
+    }
     if let Some(complication) = &m.complication {
         lines.push(format!("complication: {complication}; the attempt fails"));
     }

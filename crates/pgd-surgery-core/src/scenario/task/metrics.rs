@@ -35,6 +35,9 @@ pub struct TaskMetrics {
     /// hand's drift.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hands: Option<crate::scenario::BimanualMetrics>,
+    /// The other hand's counter-traction, when the task asks for one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub countertraction: Option<crate::scenario::CountertractionMetrics>,
     /// Laparoscopy: the time the point to keep in view was out of the camera's view (s).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub target_out_of_view_s: Option<f64>,

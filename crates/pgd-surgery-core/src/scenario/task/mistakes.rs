@@ -3,6 +3,7 @@
 //! zone names) only when the attempt is scored, away from it.
 
 use super::Task;
+use crate::scenario::countertraction::Lapse;
 use crate::scenario::units::Newtons;
 
 /// How many mistakes a task keeps in detail; past that they are counted, not listed.
@@ -16,6 +17,8 @@ pub enum Mistake {
     /// A mistake of the task's type's own, numbered `code` by it, with an amount to say (a
     /// limit, a zone's number); its type puts it into words.
     Own { time_s: f64, code: u16, amount: f64 },
+    /// The other hand's counter-traction lapsed (the task's `countertraction`).
+    Countertraction { time_s: f64, lapse: Lapse },
 }
 
 impl Mistake {
@@ -32,6 +35,11 @@ impl Mistake {
                 code,
                 amount,
             } => format!("{time_s:.2} s: {}", task.describe_mistake(code, amount)),
+            Mistake::Countertraction { time_s, lapse } => {
+                let countertraction = task.shared.countertraction.as_ref();
+                let words = countertraction.map(|c| c.describe(task.hand(), lapse));
+                format!("{time_s:.2} s: {}", words.unwrap_or_default())
+            }
         }
     }
 }

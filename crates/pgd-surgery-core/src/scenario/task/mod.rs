@@ -22,6 +22,7 @@ pub use metrics::TaskMetrics;
 pub use mistakes::{MISTAKES_LISTED, Mistake, Mistakes};
 pub use watch::{HYSTERESIS, Hold, LimitWatch};
 
+use super::countertraction::Countertraction;
 use super::keratotomy::Keratometer;
 use super::motion::MotionTracker;
 use super::sample::{NoduleSite, Sample};
@@ -39,6 +40,9 @@ pub struct TaskShared {
     /// The hand that does the task in a bimanual exercise (the right by default): what every
     /// task measures (force, contact, motion) is that hand's.
     pub hand: Hand,
+    /// In a bimanual exercise, an organ the other hand keeps held within a force band
+    /// throughout the task (traction and counter-traction).
+    pub countertraction: Option<Countertraction>,
 }
 
 /// A trainee's hand, as a bimanual exercise's tasks name it.
@@ -47,6 +51,24 @@ pub enum Hand {
     #[default]
     Right,
     Left,
+}
+
+impl Hand {
+    /// The other hand.
+    pub fn other(self) -> Hand {
+        match self {
+            Hand::Right => Hand::Left,
+            Hand::Left => Hand::Right,
+        }
+    }
+
+    /// The hand in words ("right", "left").
+    pub fn name(self) -> &'static str {
+        match self {
+            Hand::Right => "right",
+            Hand::Left => "left",
+        }
+    }
 }
 
 /// The region a task watches move (retraction, grasp): its organ, the point nearest which it

@@ -16,6 +16,7 @@ use serde::de::{
 use serde::{Deserialize, forward_to_deserialize_any};
 
 use super::registry::{self, Entry};
+use crate::scenario::countertraction::Countertraction;
 use crate::scenario::task::{Hand, Task, TaskShared};
 use crate::scenario::units::{Newtons, Seconds};
 
@@ -103,6 +104,7 @@ struct SharedFields {
     max_force_n: Option<Newtons>,
     time_limit_s: Option<Seconds>,
     hand: Option<Hand>,
+    countertraction: Option<Countertraction>,
 }
 
 impl SharedFields {
@@ -121,6 +123,7 @@ impl SharedFields {
             max_force_n: self.max_force_n.ok_or(E::missing_field("max_force_n"))?,
             time_limit_s: self.time_limit_s.ok_or(E::missing_field("time_limit_s"))?,
             hand: self.hand.unwrap_or_default(),
+            countertraction: self.countertraction,
         })
     }
 }
@@ -189,8 +192,15 @@ fn with_shared(own: &'static [&'static str], on_an_organ: bool) -> &'static [&'s
     if let Some(&(.., list)) = (lists.iter()).find(|(k, o, _)| *k == key && *o == on_an_organ) {
         return list;
     }
-    let shared = (["organ", "max_force_n", "time_limit_s", "hand"].into_iter())
-        .filter(|field| on_an_organ || *field != "organ");
+    let shared = ([
+        "organ",
+        "max_force_n",
+        "time_limit_s",
+        "hand",
+        "countertraction",
+    ]
+    .into_iter())
+    .filter(|field| on_an_organ || *field != "organ");
     let list: &'static [&'static str] = Vec::leak(own.iter().copied().chain(shared).collect());
     lists.push((key, on_an_organ, list));
     list
@@ -249,6 +259,9 @@ impl<'de, A: MapAccess<'de>> MapAccess<'de> for Split<'_, A, A::Error> {
                 "max_force_n" => self.shared_value("max_force_n", |s| &mut s.max_force_n)?,
                 "time_limit_s" => self.shared_value("time_limit_s", |s| &mut s.time_limit_s)?,
                 "hand" => self.shared_value("hand", |s| &mut s.hand)?,
+                "countertraction" => {
+                    self.shared_value("countertraction", |s| &mut s.countertraction)?
+                }
                 own if !self.fields.is_empty() && !self.fields.contains(&own) => {
                     let expected = with_shared(self.fields, self.on_an_organ);
                     return self.keep(Err(de::Error::unknown_field(own, expected)));
