@@ -19,6 +19,8 @@ macro_rules! with_shipped_stems {
         $then!(
             "liver-steady-press",
             "abdomen-tour",
+            "bimanual-liver-lift",
+            "bimanual-traction-countertraction",
             "cornea-radial-keratotomy",
             "duodenum-navigation",
             "gallbladder-gentle-press",

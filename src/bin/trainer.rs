@@ -145,7 +145,7 @@ enum Command {
     /// List the haptic device backends, which of them can be used on this machine, and why
     /// the others cannot.
     Devices,
-    /// An hour of use on the simulated clock: every shipped scenario in turn, attempted
+    /// An hour of use on the simulated clock: every shipped one-hand scenario in turn, attempted
     /// carelessly then competently by its scripted runs, each attempt scored and kept; reports
     /// the resident memory (every simulated minute, and its growth per attempt), the tick
     /// times at the start and the end, the forces' NaNs, largest steps and faults (with --json

@@ -14,7 +14,7 @@ use pgd_surgery::app::attempt::{Outcome, end, prepare, scenario_scene, sites_on}
 use pgd_surgery::app::haptic::{ExerciseRun, HapticLoop, SettleCuts, TickClock};
 use pgd_surgery::app::scene::Detail;
 use pgd_surgery::app::shipped::SHIPPED_RUNS;
-use pgd_surgery::devices::{Scripted, TICK_S, Trajectory};
+use pgd_surgery::devices::{HapticDevice, Scripted, TICK_S, Trajectory};
 use pgd_surgery::scenario::{Exercise, parse};
 use pgd_surgery::store::OnStale;
 
@@ -75,10 +75,12 @@ const WARM_UP_TICKS: u64 = 200;
 fn counted_run(file: &str, text: &str, script: &str) -> (Outcome, u64, u64) {
     let scenario = parse(Path::new(file), text).unwrap();
     let scene = scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Refuse).unwrap();
-    let trajectory = Trajectory::read(Path::new(file), script.as_bytes()).unwrap();
-    let ticks = ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64;
-    let device = Box::new(Scripted::new("counted", trajectory));
-    let mut haptic = HapticLoop::new(&scene, device).unwrap();
+    let hands = Trajectory::read_hands(Path::new(file), script.as_bytes()).unwrap();
+    let ticks = ((hands[0].duration_s() + 0.1) / TICK_S).ceil() as u64;
+    let devices = (hands.into_iter())
+        .map(|hand| Box::new(Scripted::new("counted", hand)) as Box<dyn HapticDevice>)
+        .collect();
+    let mut haptic = HapticLoop::with_devices(&scene, devices).unwrap();
     haptic.world_mut().insert_resource(SettleCuts);
     let sites = sites_on(&scene, &scenario);
     prepare(&mut haptic, Exercise::new(scenario, sites)).start();

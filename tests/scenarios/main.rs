@@ -27,7 +27,7 @@ use pgd_surgery::app::attempt::{Outcome, run_simulated, scenario_scene, scenario
 use pgd_surgery::app::scene::{Detail, default_scene};
 use pgd_surgery::cutting::Front;
 use pgd_surgery::cutting::keratotomy::Cornea;
-use pgd_surgery::devices::{Scripted, TICK_S, Trajectory};
+use pgd_surgery::devices::{HapticDevice, Scripted, TICK_S, Trajectory};
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::io::write_vtu;
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate};
@@ -81,13 +81,15 @@ fn run_without_nodules(name: &str, script: &str) -> Outcome {
 fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     let scene = scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Refuse).unwrap();
     let path = root().join(format!("scenarios/runs/{name}.{script}.csv"));
-    let trajectory = Trajectory::load(&path).unwrap();
-    let ticks = ((trajectory.duration_s() + 0.1) / TICK_S).ceil() as u64;
-    let device = Box::new(Scripted::new("test", trajectory));
-    run_simulated(scenario, &scene, vec![device], ticks).unwrap()
+    let hands = Trajectory::load_hands(&path).unwrap();
+    let ticks = ((hands[0].duration_s() + 0.1) / TICK_S).ceil() as u64;
+    let devices = (hands.into_iter())
+        .map(|hand| Box::new(Scripted::new("test", hand)) as Box<dyn HapticDevice>)
+        .collect();
+    run_simulated(scenario, &scene, devices, ticks).unwrap()
 }
 
-const SHIPPED: [&str; 12] = [
+const SHIPPED: [&str; 14] = [
     "liver-steady-press",
     "pancreas-palpation",
     "gallbladder-gentle-press",
@@ -100,6 +102,8 @@ const SHIPPED: [&str; 12] = [
     "liver-laparoscopic-press",
     "gallbladder-liver-two-ports",
     "cornea-radial-keratotomy",
+    "bimanual-traction-countertraction",
+    "bimanual-liver-lift",
 ];
 
 #[test]
@@ -113,6 +117,45 @@ fn every_shipped_scenario_validates() {
         }
     }
     assert!(found >= SHIPPED.len(), "{found} scenarios");
+}
+
+/// The bimanual runs are scored on both hands. Competent: the left hand keeps its hold within
+/// the band through the right hand's whole task, never letting go, and holds still while the
+/// right hand works (under 1 mm of drift), both hands on tissue together at least as long as
+/// the right hand's hold (2 s and 3 s).
+/// Careless: the left hand lets go during the right hand's task (one error, saying which
+/// hand and organ), the hold out of its band most of the time, and the right hand presses
+/// over its limit.
+#[test]
+fn bimanual_runs_are_scored_on_both_hands() {
+    for (name, organ) in [
+        ("bimanual-traction-countertraction", "gallbladder"),
+        ("bimanual-liver-lift", "liver"),
+    ] {
+        let competent = &run(name, "competent").card.tasks[1].metrics;
+        let hold = competent.countertraction.as_ref().unwrap();
+        assert!(competent.completed, "{name}: {competent:?}");
+        assert!(
+            hold.in_band_share() > 0.95 && hold.let_go == 0,
+            "{name}: {hold:?}"
+        );
+        let hands = competent.hands.as_ref().unwrap();
+        assert!(hands.left.path_length_mm < 1.0, "{name}: {hands:?}");
+        assert!(hands.right.path_length_mm > 10.0, "{name}: {hands:?}");
+        assert!(hands.both_working_s > 2.0, "{name}: {hands:?}");
+        let careless = &run(name, "careless").card.tasks[1].metrics;
+        let hold = careless.countertraction.as_ref().unwrap();
+        assert_eq!(hold.let_go, 1, "{name}: {hold:?}");
+        assert!(hold.in_band_share() < 0.5, "{name}: {hold:?}");
+        let let_go = format!("the left hand let go of the {organ}");
+        let errors = &careless.errors;
+        assert_eq!(
+            errors.iter().filter(|e| e.contains(&let_go)).count(),
+            1,
+            "{errors:?}"
+        );
+        assert!(careless.time_over_limit_s > 1.0, "{name}: {careless:?}");
+    }
 }
 
 /// The careless liver press is scored on what it did: pressed too hard, more than once, and

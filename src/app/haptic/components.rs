@@ -56,9 +56,10 @@ impl ToolTouch {
 pub struct HandTouches(pub Vec<ToolTouch>);
 
 impl HandTouches {
-    /// `hands` hands' touches, none touching, each with room for the largest patch.
+    /// `hands` hands' touches, none touching, each with room for the largest patch (each
+    /// reserved anew: a clone would keep the lengths and lose the room).
     pub fn reserved(vademecum: &Vademecum, hands: usize) -> Self {
-        Self(vec![ToolTouch::reserved(vademecum); hands])
+        Self((0..hands).map(|_| ToolTouch::reserved(vademecum)).collect())
     }
 
     /// Whether any hand's tool touches the organ.

@@ -260,8 +260,8 @@ fn attempt_once(
     Ok((outcome, haptic))
 }
 
-/// Every shipped scenario with a shipped run, its scene built once (its vademecums built
-/// where missing).
+/// Every shipped one-hand scenario with a shipped run, its scene built once (its
+/// vademecums built where missing).
 fn soak_scenarios(plan: &SoakPlan) -> Result<Vec<SoakScenario>, String> {
     let runs: Vec<_> = (SHIPPED_RUNS.iter())
         .filter(|run| plan.only.as_deref().is_none_or(|only| run.file == only))
@@ -274,23 +274,30 @@ fn soak_scenarios(plan: &SoakPlan) -> Result<Vec<SoakScenario>, String> {
             shipped.join(", ")
         ));
     }
-    runs.into_iter()
-        .map(|run| {
-            let scenario =
-                scenario::parse(Path::new(run.file), run.scenario).map_err(|e| e.to_string())?;
-            let scene = scenario_scene(&scenario, &plan.vademecums, plan.detail, OnStale::Rebuild)?;
-            let script = |name: &str, text: &str| {
-                Trajectory::read(Path::new(name), text.as_bytes()).map_err(|e| e.to_string())
-            };
-            Ok(SoakScenario {
-                file: run.file,
-                careless: script(run.careless_file, run.careless)?,
-                competent: script(run.competent_file, run.competent)?,
-                scenario,
-                scene,
-            })
-        })
-        .collect()
+    let script = |name: &str, text: &str| {
+        Trajectory::read(Path::new(name), text.as_bytes()).map_err(|e| e.to_string())
+    };
+    let mut soaked = Vec::with_capacity(runs.len());
+    for run in runs {
+        let scenario =
+            scenario::parse(Path::new(run.file), run.scenario).map_err(|e| e.to_string())?;
+        // The soak's one device is one hand: the bimanual exercises are left out.
+        if scenario.bimanual() {
+            continue;
+        }
+        let scene = scenario_scene(&scenario, &plan.vademecums, plan.detail, OnStale::Rebuild)?;
+        soaked.push(SoakScenario {
+            file: run.file,
+            careless: script(run.careless_file, run.careless)?,
+            competent: script(run.competent_file, run.competent)?,
+            scenario,
+            scene,
+        });
+    }
+    match soaked.is_empty() {
+        true => Err("the soak plays one-hand scenarios, and this one is bimanual".into()),
+        false => Ok(soaked),
+    }
 }
 
 /// How many attempts the history holds for `trainee`.

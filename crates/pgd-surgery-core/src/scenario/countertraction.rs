@@ -35,10 +35,14 @@ impl Countertraction {
     }
 }
 
+/// A break in the hold this long is letting go (s): a touch that flickers off for a few
+/// ticks as the tool slides on the tissue is not.
+pub const LET_GO_S: f64 = 0.1;
+
 /// A break in the counter-traction, noted as a mistake.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Lapse {
-    /// The other hand held the organ, then no longer did.
+    /// The other hand held the organ, then no longer did for [`LET_GO_S`].
     LetGo,
     /// Its force went above the band (once per excursion, as a force limit is watched).
     TooHard,
@@ -77,7 +81,10 @@ pub struct CountertractionWatch {
     organ: usize,
     min_force_n: f64,
     max_force_n: f64,
+    /// Whether the hand has held the organ and not let go since...
     holding: bool,
+    /// ...and for how long its hold has been broken (s).
+    broken_s: f64,
     over: LimitWatch,
     metrics: CountertractionMetrics,
 }
@@ -90,6 +97,7 @@ impl CountertractionWatch {
             min_force_n: countertraction.min_force_n.0,
             max_force_n: countertraction.max_force_n.0,
             holding: false,
+            broken_s: 0.0,
             over: LimitWatch::default(),
             metrics: CountertractionMetrics::default(),
         }
@@ -99,15 +107,20 @@ impl CountertractionWatch {
     pub fn step(&mut self, other: &HandSample, dt: f64) -> Option<Lapse> {
         let bit = 1u64.checked_shl(self.organ as u32).unwrap_or(0);
         let held = (other.grasping | other.touching) & bit != 0;
-        let let_go = self.holding && !held;
-        self.holding = held;
         let m = &mut self.metrics;
         if !held {
             m.not_held_s += dt;
-            m.let_go += u32::from(let_go);
             self.over = LimitWatch::default();
+            self.broken_s += dt;
+            let let_go = self.holding && self.broken_s >= LET_GO_S;
+            if let_go {
+                self.holding = false;
+                m.let_go += 1;
+            }
             return let_go.then_some(Lapse::LetGo);
         }
+        self.holding = true;
+        self.broken_s = 0.0;
         let force = other.force_n;
         let too_hard = self
             .over
@@ -140,7 +153,8 @@ mod tests {
 
     /// Four seconds at 1 kHz of a left hand on the scenario's second organ: a second in the
     /// band, half a second slack, half a second too hard (one mistake), a second in the band
-    /// again, then let go for a second (one mistake). Each time to a tick; a hold on another
+    /// again but for a 20 ms flicker off the organ (no mistake), then let go for a second
+    /// (one mistake, once the break has lasted 0.1 s). Each time to a tick; a hold on another
     /// organ does not count.
     #[test]
     fn the_other_hands_hold_is_timed_in_and_out_of_its_band() {
@@ -154,8 +168,9 @@ mod tests {
                 t if t < 2.0 => 1.4,
                 _ => 0.6,
             };
+            let flicker = (2.5..2.52).contains(&t);
             let hand = HandSample {
-                grasping: if t < 3.0 { 0b10 } else { 0b01 },
+                grasping: if t < 3.0 && !flicker { 0b10 } else { 0b01 },
                 force_n,
                 ..HandSample::default()
             };
@@ -163,12 +178,12 @@ mod tests {
         }
         let m = watch.metrics();
         let close = |a: f64, b: f64| (a - b).abs() < 1.5e-3;
-        assert!(close(m.in_band_s, 2.0), "{m:?}");
+        assert!(close(m.in_band_s, 1.98), "{m:?}");
         assert!(close(m.slack_s, 0.5), "{m:?}");
         assert!(close(m.over_s, 0.5), "{m:?}");
-        assert!(close(m.not_held_s, 1.0), "{m:?}");
+        assert!(close(m.not_held_s, 1.02), "{m:?}");
         assert_eq!(m.let_go, 1);
-        assert_eq!(lapses, [(1500, Lapse::TooHard), (3000, Lapse::LetGo)]);
-        assert!((m.in_band_share() - 0.5).abs() < 1e-3);
+        assert_eq!(lapses, [(1500, Lapse::TooHard), (3099, Lapse::LetGo)]);
+        assert!((m.in_band_share() - 0.495).abs() < 1e-3);
     }
 }
