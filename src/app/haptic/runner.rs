@@ -219,14 +219,29 @@ impl HapticLoop {
         }
         let mut haptic = Self::parked(scene)?;
         haptic.world.remove_resource::<Parked>();
-        for (&entity, device) in haptic.hands.iter().zip(devices) {
-            let safety = Safety(SafetyFilter::new(scene.safety, device.limits()));
-            haptic
-                .world
-                .entity_mut(entity)
-                .insert((Device(device), safety));
+        for (hand, device) in devices.into_iter().enumerate() {
+            haptic.hold(hand, device, scene.safety);
         }
         Ok(haptic)
+    }
+
+    /// Gives hand `hand` `device`, behind a safety filter of `settings`.
+    fn hold(&mut self, hand: usize, device: Box<dyn HapticDevice>, settings: SafetySettings) {
+        let safety = Safety(SafetyFilter::new(settings, device.limits()));
+        (self.world.entity_mut(self.hands[hand])).insert((Device(device), safety));
+    }
+
+    /// Gives a parked loop's hand `hand` a device of its own, for a hand the running loop it
+    /// will take over has none for (a bimanual scene taking over a one-hand one: its left
+    /// hand on the mouse); one the running loop has replaces it then. Nothing for a loop not
+    /// parked, or a hand the scene lacks.
+    pub fn give_device(&mut self, hand: usize, device: Box<dyn HapticDevice>) {
+        let Some(Parked(settings)) = self.world.get_resource::<Parked>().copied() else {
+            return;
+        };
+        if hand < self.hands.len() {
+            self.hold(hand, device, settings);
+        }
     }
 
     /// A world for `scene` without a device, to be built away from the haptic thread (its
@@ -290,8 +305,9 @@ impl HapticLoop {
     /// Takes `running`'s devices and their safety filters (retuned to this scene's settings),
     /// hand by hand, so that the force each hand feels carries over the change of scene at
     /// the allowed rate. Does nothing if this loop has its devices already; a hand `running`
-    /// has no device for stays without one (and a device of a hand this scene lacks stays
-    /// with `running`, which closes it when dropped).
+    /// has no device for keeps the one [`HapticLoop::give_device`] gave it, or stays without
+    /// one (and a device of a hand this scene lacks stays with `running`, which closes it
+    /// when dropped).
     pub fn take_devices(&mut self, running: &mut HapticLoop) {
         let Some(Parked(settings)) = self.world.get_resource::<Parked>().copied() else {
             return;

@@ -61,6 +61,10 @@ pub struct HandSnapshot {
     pub blade_edge: Option<Vector3<f64>>,
     /// Whether the force is faded or held after a fault.
     pub faulted: bool,
+    /// The organs the hand's tool touches (bit `k` for the scene's `k`th)...
+    pub touching: u64,
+    /// ...and the one its grasper's jaws hold, if any.
+    pub holding: Option<usize>,
 }
 
 /// The instruments as the window draws and drives them (fixed-size: the loop allocates nothing).

@@ -78,4 +78,26 @@ mod tests {
         let retired = swap.0.lock().unwrap().retired.take().unwrap();
         assert!(retired.hand::<Device>(0).is_none());
     }
+
+    /// A two-hand scene taking over a one-hand loop: its right hand takes the running loop's
+    /// device, its left keeps the one given it while parked.
+    #[test]
+    fn a_hand_new_to_the_running_loop_keeps_the_device_given_it() {
+        let scripted = |name: &str| {
+            let rows = vec![TrajectoryRow::new(0.0, &DeviceSample::at(Vector3::zeros()))];
+            Box::new(Scripted::new(name, Trajectory { rows }))
+        };
+        let mut running = HapticLoop::new(&scene(3.3), scripted("the right hand")).unwrap();
+        let mut two_hands = scene(3.3);
+        two_hands.hands.push(two_hands.hands[0].clone());
+        let mut parked = HapticLoop::parked(&two_hands).unwrap();
+        parked.give_device(1, scripted("the left hand"));
+        let swap = SceneSwap::default();
+        swap.offer(parked);
+        swap.take(&mut running);
+        let name = |hand| running.hand::<Device>(hand).map(|d| d.0.name().to_owned());
+        assert_eq!(name(0).as_deref(), Some("the right hand"));
+        assert_eq!(name(1).as_deref(), Some("the left hand"));
+        assert!(running.hand::<Safety>(1).is_some());
+    }
 }

@@ -441,13 +441,26 @@ pub fn publish_snapshot(
         }
     }
     for published in &organs {
-        let organ = &mut snapshot.organs[published.index.0];
+        let k = published.index.0;
+        let organ = &mut snapshot.organs[k];
         let touching = published.touch.pressing();
         organ.contact = touching.and_then(|slot| published.touch.0[slot].contact);
         organ.deformation.clone_from(&published.deformation.0);
         if let Some(motion) = published.motion {
             organ.motion.clone_from(&motion.correction);
             organ.grasped = motion.organ.holding();
+        }
+        for (hand, touch) in snapshot.hands.iter_mut().zip(&published.touch.0) {
+            let bit = 1u64.checked_shl(k as u32).unwrap_or(0);
+            hand.touching = match touch.contact.is_some() {
+                true => hand.touching | bit,
+                false => hand.touching & !bit,
+            };
+        }
+        if let Some(motion) = published.motion.filter(|m| m.organ.holding())
+            && let Some(hand) = snapshot.hands.get_mut(motion.hand)
+        {
+            hand.holding = Some(k);
         }
         if let Some(cut) = published.cut {
             organ.strokes.clear();
@@ -468,6 +481,8 @@ fn publish_hand(hand: &PublishedHandItem, cut_organs: bool, published: &mut Hand
     published.instruments = InstrumentsView::of(&tool.rack);
     published.force_n = hand.force.sent_n;
     published.faulted = hand.safety.is_some_and(|s| s.0.is_faulted());
+    // Found again with the organs.
+    published.holding = None;
     let cuts = cut_organs && tool.action() == Action::Cut;
     published.blade_edge = tool
         .sample

@@ -1,5 +1,6 @@
 //! What the trainee reads: the task and its clock, the force the device renders against its
-//! limit, what the tool touches, faults, how to drive the virtual tool and steer the
+//! limit, what the tool touches, faults (in a bimanual exercise a line a hand: its
+//! instrument, what it holds or touches, its force, and which hand the mouse drives), how to drive the virtual tool and steer the
 //! laparoscope, and a warning while the instrument is out of the laparoscope's view. The
 //! device's name, the loop's timing and the tissue's laws are behind F3: a trainee has no use
 //! for them, a developer does.
@@ -9,9 +10,10 @@ use bevy::prelude::*;
 
 use super::FrameSet;
 use super::bridge::{HapticLink, Snapshot};
+use super::input::MouseHand;
 use super::laparoscope::CameraMode;
 use super::lesson::{Lesson, Stage};
-use crate::app::haptic::{HapticSnapshot, organ_with_law};
+use crate::app::haptic::{HandIndex, HapticSnapshot, organ_with_law};
 use crate::devices::Action;
 use crate::scenario::{Progress, Scenario};
 
@@ -84,11 +86,13 @@ struct Rate {
     hz: f64,
 }
 
-/// How the trainee has set the view: the camera, and whether the details show.
+/// How the trainee has set the view and the controls: the camera, whether the details show,
+/// and which hand the mouse drives.
 #[derive(SystemParam)]
 struct ViewChoices<'w> {
     mode: Res<'w, CameraMode>,
     details: Res<'w, Details>,
+    mouse: Option<Res<'w, MouseHand>>,
 }
 
 fn update_hud(
@@ -113,9 +117,17 @@ fn update_hud(
     }
     let limit_n = link.scene.safety.max_force_n;
     let force_n = snapshot.0.first_hand().force_n.norm();
-    let filled = ((force_n / limit_n).clamp(0.0, 1.0) * 20.0).round() as usize;
-    let gauge = format!("[{}{}]", "#".repeat(filled), "-".repeat(20 - filled));
-    let status = status_line(&link, &snapshot.0);
+    let mouse = (view.mouse.as_deref()).filter(|_| link.mouse_drives());
+    let (force, status) = match snapshot.0.hands.len() {
+        1 => (
+            format!(
+                "force {force_n:.3} N {} limit {limit_n:.1} N",
+                gauge(force_n, limit_n)
+            ),
+            status_line(&link, &snapshot.0),
+        ),
+        _ => two_hands_lines(&link, &snapshot.0, mouse.map(|m| m.0)),
+    };
     let help = if link.mouse_drives() {
         "\nmouse: move the tool | wheel or W/S: push in / pull out | Q/E: turn the handle\n\
          right-drag: orbit | middle-drag: pan | Ctrl+wheel or +/-: zoom"
@@ -127,7 +139,7 @@ fn update_hud(
         task: lesson.map_or_else(String::new, |lesson| {
             task_line(&lesson.scenario, snapshot.0.exercise)
         }),
-        force: format!("force {force_n:.3} N {gauge} limit {limit_n:.1} N"),
+        force,
         status,
         guidance: format!(
             "{}{help}{}{}",
@@ -148,6 +160,77 @@ fn update_hud(
         ),
     };
     text.0 = lines.compose(view.details.0);
+}
+
+/// A force against the limit as a bar of 20.
+fn gauge(force_n: f64, limit_n: f64) -> String {
+    let filled = ((force_n / limit_n).clamp(0.0, 1.0) * 20.0).round() as usize;
+    format!("[{}{}]", "#".repeat(filled), "-".repeat(20 - filled))
+}
+
+/// Two hands: a line each (its instrument, what it holds or touches, its force against the
+/// limit, and whether the mouse drives it), then the faults, or how to hand the mouse over.
+fn two_hands_lines(
+    link: &HapticLink,
+    snapshot: &HapticSnapshot,
+    mouse: Option<usize>,
+) -> (String, String) {
+    let limit_n = link.scene.safety.max_force_n;
+    let name = |k: usize| {
+        link.scene
+            .organs
+            .get(k)
+            .map_or("?", |(name, _)| name.as_str())
+    };
+    let lines: Vec<String> = (snapshot.hands.iter().zip(&link.scene.hands).enumerate())
+        .map(|(index, (hand, scene))| {
+            let instrument = scene.instruments.get(hand.instruments.in_hand);
+            let tool = instrument.map_or("tool", |i| action_name(i.action));
+            let touching: Vec<&str> = (0..link.scene.organs.len())
+                .filter(|&k| hand.touching & (1 << k) != 0)
+                .map(name)
+                .collect();
+            let doing = match (hand.holding, touching.is_empty()) {
+                (Some(k), _) => format!("holding the {}", name(k)),
+                (None, false) => format!("touching {}", touching.join(", ")),
+                (None, true) => "free".to_owned(),
+            };
+            let driven = match mouse == Some(index) {
+                true => " (mouse)",
+                false => "",
+            };
+            let force_n = hand.force_n.norm();
+            format!(
+                "{}{driven}: {tool}, {doing} | {force_n:.3} N {}",
+                HandIndex(index).name(),
+                gauge(force_n, limit_n)
+            )
+        })
+        .collect();
+    let faulted: Vec<&str> = (snapshot.hands.iter().enumerate())
+        .filter(|(_, hand)| hand.faulted)
+        .map(|(index, _)| HandIndex(index).name())
+        .collect();
+    let status = match (faulted.is_empty(), mouse) {
+        (false, _) => format!(
+            "FAULT: the {}'s force faded to zero (see the log)",
+            faulted.join(" and the ")
+        ),
+        (true, Some(_)) => {
+            format!("limit {limit_n:.1} N a hand | H: the mouse takes the other hand")
+        }
+        (true, None) => format!("limit {limit_n:.1} N a hand"),
+    };
+    (lines.join("\n"), status)
+}
+
+/// What an instrument is called on the HUD.
+fn action_name(action: Action) -> &'static str {
+    match action {
+        Action::Press => "probe",
+        Action::Grasp => "grasper",
+        Action::Cut => "scalpel",
+    }
 }
 
 /// What the tool is doing: a fault, a grasp, the organs it touches, or nothing.
@@ -255,11 +338,7 @@ fn instrument_line(link: &HapticLink, snapshot: &HapticSnapshot) -> String {
         return String::new();
     }
     let in_hand = snapshot.first_hand().instruments.in_hand;
-    let name = match instruments[in_hand].action {
-        Action::Press => "probe",
-        Action::Grasp => "grasper",
-        Action::Cut => "scalpel",
-    };
+    let name = action_name(instruments[in_hand].action);
     format!(
         "\nin hand: {name}, instrument {} of {} | Tab (the device's second button): change it, off the tissue",
         in_hand + 1,

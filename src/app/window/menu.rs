@@ -17,6 +17,7 @@ use super::lesson::{Lesson, Lessons, Stage, spawn_panel};
 use super::offscreen::Offscreen;
 use super::{FrameSet, SceneChanged};
 use crate::app::haptic::{HapticLoop, HapticScene, HapticSnapshot, SceneSwap};
+use crate::app::scene::mouse_device;
 use crate::scenario::{self, Scenario};
 
 /// Builds a scenario's scene: its organs' vademecums read (in a web page, fetched first), or
@@ -393,7 +394,8 @@ fn finish_loading(
     };
     commands.remove_resource::<Loading>();
     match result {
-        Ok(prepared) => {
+        Ok(mut prepared) => {
+            mouse_for_new_hands(&mut link, &mut prepared);
             plan.swap.offer(prepared.haptic);
             // This frame's snapshot is read from the new scene's end, after this stage.
             link.change_scene(prepared.lesson.scene.clone(), prepared.snapshots);
@@ -407,6 +409,22 @@ fn finish_loading(
             menu.problem = Some(problem);
             next.set(Stage::Menu);
         }
+    }
+}
+
+/// The hands the chosen scene has and the running one lacks (a bimanual exercise after a
+/// one-hand one: its left hand) go on the mouse, which H hands them; the mouse no longer
+/// drives a hand the chosen scene lacks.
+fn mouse_for_new_hands(link: &mut HapticLink, prepared: &mut Prepared) {
+    let scene = &prepared.lesson.scene;
+    link.mice.truncate(scene.hands.len());
+    for hand in link.scene.hands.len()..scene.hands.len() {
+        let (device, handle) = mouse_device(scene, hand);
+        prepared.haptic.give_device(hand, device);
+        if link.mice.len() <= hand {
+            link.mice.resize(hand + 1, None);
+        }
+        link.mice[hand] = Some(handle);
     }
 }
 

@@ -82,7 +82,7 @@ struct Frame<'w, 's> {
     camera: Query<'w, 's, (&'static Camera, &'static GlobalTransform)>,
     window: Query<'w, 's, &'static Window, With<PrimaryWindow>>,
     organs: Query<'w, 's, (&'static Name, &'static OrganView, &'static Mesh3d)>,
-    tip: Query<'w, 's, (&'static Transform, &'static Visibility), With<ToolTip>>,
+    tips: Query<'w, 's, (&'static ToolTip, &'static Transform, &'static Visibility)>,
     meshes: Res<'w, Assets<Mesh>>,
     link: Res<'w, HapticLink>,
     snapshot: Res<'w, Snapshot>,
@@ -278,12 +278,10 @@ fn frame_legend(frame: &Frame) -> Result<Legend, String> {
             triangles,
         })
         .collect();
-    let tool = frame
-        .tip
-        .single()
-        .ok()
-        .filter(|(_, visibility)| **visibility != Visibility::Hidden)
-        .map(|(transform, _)| {
+    // The right hand's tool (the only one of a one-hand exercise).
+    let tool = (frame.tips.iter())
+        .find(|(tip, _, visibility)| tip.0 == 0 && **visibility != Visibility::Hidden)
+        .map(|(_, transform, _)| {
             (
                 transform.translation,
                 frame.link.scene.probe.tip_radius_m as f32,

@@ -1,20 +1,24 @@
-//! The tool as the trainee sees it: a sphere at the tip the device reports, the steel shaft
-//! of each instrument through a port (the one in hand, and those put down where they were
-//! left), and an arrow of the force the device renders.
+//! The tools as the trainee sees them, one a hand: a sphere at the tip each device reports,
+//! the steel shaft of each instrument through a port (the one in hand, and those put down
+//! where they were left), and an arrow of the force each device renders.
 
 use bevy::prelude::*;
 
 use super::bridge::{HapticLink, Snapshot};
 use super::{FrameSet, SceneView, to_bevy};
 
-/// The sphere drawn at the tool tip.
+/// The sphere drawn at a hand's tool tip (the hand's index: 0 the right).
 #[derive(Component)]
-pub(super) struct ToolTip;
+pub(super) struct ToolTip(pub(super) usize);
 
-/// An instrument's shaft through its port (the scenario's instrument this is): a steel rod
-/// from its handle to its tip.
+/// An instrument's shaft through its port: a steel rod from its handle to its tip.
 #[derive(Component)]
-pub(super) struct Shaft(usize);
+pub(super) struct Shaft {
+    /// The hand holding it...
+    hand: usize,
+    /// ...and its place among that hand's instruments.
+    index: usize,
+}
 
 /// A laparoscopic instrument's shaft radius (m): 5 mm instruments.
 const SHAFT_RADIUS_M: f32 = 0.0025;
@@ -41,19 +45,23 @@ fn spawn_tool(
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
 ) {
-    commands.spawn((
-        SceneView,
-        ToolTip,
-        Mesh3d(meshes.add(Sphere::new(link.scene.probe.tip_radius_m as f32))),
-        MeshMaterial3d(materials.add(StandardMaterial {
-            base_color: Color::srgb(0.75, 0.77, 0.80),
-            metallic: 0.9,
-            perceptual_roughness: 0.25,
-            ..default()
-        })),
-        Transform::default(),
-        Visibility::Hidden,
-    ));
+    let sphere = meshes.add(Sphere::new(link.scene.probe.tip_radius_m as f32));
+    let polished = materials.add(StandardMaterial {
+        base_color: Color::srgb(0.75, 0.77, 0.80),
+        metallic: 0.9,
+        perceptual_roughness: 0.25,
+        ..default()
+    });
+    for hand in 0..link.scene.hands.len() {
+        commands.spawn((
+            SceneView,
+            ToolTip(hand),
+            Mesh3d(sphere.clone()),
+            MeshMaterial3d(polished.clone()),
+            Transform::default(),
+            Visibility::Hidden,
+        ));
+    }
     let shaft = meshes.add(Cylinder::new(SHAFT_RADIUS_M, 1.0));
     let steel = materials.add(StandardMaterial {
         base_color: Color::srgb(0.55, 0.57, 0.60),
@@ -61,11 +69,17 @@ fn spawn_tool(
         perceptual_roughness: 0.3,
         ..default()
     });
-    for (index, instrument) in link.scene.hands[0].instruments.iter().enumerate() {
+    let instruments = (link.scene.hands.iter().enumerate()).flat_map(|(hand, h)| {
+        h.instruments
+            .iter()
+            .enumerate()
+            .map(move |(k, i)| (hand, k, i))
+    });
+    for (hand, index, instrument) in instruments {
         if instrument.port.is_some() {
             commands.spawn((
                 SceneView,
-                Shaft(index),
+                Shaft { hand, index },
                 Mesh3d(shaft.clone()),
                 MeshMaterial3d(steel.clone()),
                 Transform::default(),
@@ -77,17 +91,16 @@ fn spawn_tool(
 
 fn follow_device(
     snapshot: Res<Snapshot>,
-    mut tip: Query<(&mut Transform, &mut Visibility), With<ToolTip>>,
+    mut tips: Query<(&ToolTip, &mut Transform, &mut Visibility)>,
 ) {
-    let Ok((mut transform, mut visibility)) = tip.single_mut() else {
-        return;
-    };
-    match snapshot.0.first_hand().tip_m {
-        Some(p) => {
-            transform.translation = to_bevy(&p);
-            *visibility = Visibility::Visible;
+    for (tip, mut transform, mut visibility) in &mut tips {
+        match snapshot.0.hands.get(tip.0).and_then(|hand| hand.tip_m) {
+            Some(p) => {
+                transform.translation = to_bevy(&p);
+                *visibility = Visibility::Visible;
+            }
+            None => *visibility = Visibility::Hidden,
         }
-        None => *visibility = Visibility::Hidden,
     }
 }
 
@@ -99,17 +112,15 @@ fn draw_shaft(
     snapshot: Res<Snapshot>,
     mut shafts: Query<(&Shaft, &mut Transform, &mut Visibility)>,
 ) {
-    let instruments = &snapshot.0.first_hand().instruments;
     for (shaft, mut transform, mut visibility) in &mut shafts {
-        let ends = if shaft.0 == instruments.in_hand {
-            snapshot
-                .0
-                .first_hand()
-                .handle_m
-                .zip(snapshot.0.first_hand().tip_m)
+        let Some(hand) = snapshot.0.hands.get(shaft.hand) else {
+            continue;
+        };
+        let ends = if shaft.index == hand.instruments.in_hand {
+            hand.handle_m.zip(hand.tip_m)
         } else {
-            let port = link.scene.hands[0].instruments[shaft.0].port;
-            (instruments.put_down[shaft.0].zip(port))
+            let port = link.scene.hands[shaft.hand].instruments[shaft.index].port;
+            (hand.instruments.put_down[shaft.index].zip(port))
                 .and_then(|(handle, port)| Some((handle, port.pose(&handle)?.tip_m)))
         };
         let Some((handle, tip)) = ends else {
@@ -128,22 +139,22 @@ fn draw_shaft(
     }
 }
 
+/// Each hand's force as an arrow from its tip, red while the hand's force is faded after a
+/// fault.
 fn draw_force(snapshot: Res<Snapshot>, mut gizmos: Gizmos) {
-    let (Some(tip), force) = (
-        snapshot.0.first_hand().tip_m,
-        snapshot.0.first_hand().force_n,
-    ) else {
-        return;
-    };
-    if force.norm() < 1e-4 {
-        return;
+    for hand in &snapshot.0.hands {
+        let Some(tip) = hand.tip_m else {
+            continue;
+        };
+        if hand.force_n.norm() < 1e-4 {
+            continue;
+        }
+        let start = to_bevy(&tip);
+        let arrow = to_bevy(&hand.force_n) * ARROW_M_PER_N;
+        let colour = match hand.faulted {
+            true => Color::srgb(1.0, 0.2, 0.2),
+            false => Color::srgb(1.0, 0.85, 0.2),
+        };
+        gizmos.arrow(start, start + arrow, colour);
     }
-    let start = to_bevy(&tip);
-    let arrow = to_bevy(&force) * ARROW_M_PER_N;
-    let colour = if snapshot.0.first_hand().faulted {
-        Color::srgb(1.0, 0.2, 0.2)
-    } else {
-        Color::srgb(1.0, 0.85, 0.2)
-    };
-    gizmos.arrow(start, start + arrow, colour);
 }
