@@ -39,8 +39,9 @@ struct Cli {
     /// (`left_x_m`…) drives both hands.
     #[arg(long, global = true)]
     device: Option<DeviceSpec>,
-    /// A bimanual scenario's left-hand device, named as --device names it (two Force
-    /// Dimension devices by index, `forcedimension:1`, or one of each backend).
+    /// A bimanual scenario's left-hand device, named as --device names it (two Geomagic
+    /// devices by their configuration names, `openhaptics:LEFT`, two Force Dimension devices
+    /// by index, `forcedimension:1`, or one of each backend).
     /// Default: the scenario's `left_backend`, else the mouse (H hands it between the hands).
     #[arg(long, global = true)]
     left_device: Option<DeviceSpec>,

@@ -4,15 +4,19 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+use bevy::ecs::entity::Entity;
 use nalgebra::Vector3;
-use pgd_surgery::app::haptic::{FaultLog, HapticLoop, HapticThread, Scheduling};
-use pgd_surgery::devices::{HapticDevice, OpenHaptics, SafetySettings, TimerMode};
+use pgd_surgery::app::haptic::{
+    Device, DeviceForce, FaultLog, HandIndex, HapticLoop, HapticThread, Scheduling, TickClock,
+};
+use pgd_surgery::devices::{HapticDevice, OpenHaptics, SafetySettings, TICK_S, TimerMode};
 
 use crate::common::{TIP_RADIUS_M, scene, target};
 use crate::fakes::{
     assert_edge_guarded, assert_faded, assert_held_to_ceiling, assert_watchdog_held,
     press_then_fault, pressing_tip_m,
 };
+use crate::two_hands::{APART_M, left_target, two_hands};
 use crate::vendor_fake::VendorFake;
 
 /// This test's own copy of the fake HD library, and its controls.
@@ -53,6 +57,32 @@ impl Fake {
 
     fn open(&self) -> OpenHaptics {
         OpenHaptics::open(Some(self.path()), None).unwrap()
+    }
+
+    /// Places device `handle`'s stylus so that the tool's tip is at `tip_m` in the scene.
+    fn place_tip(&self, handle: u32, tip_m: &Vector3<f64>) {
+        let f = self
+            .0
+            .call::<unsafe extern "C" fn(u32, f64, f64, f64, i32)>("fake_hd_set_stylus_of");
+        // SAFETY: plain values. The scene's (x, y, z) m is the device's (x, z, −y) mm.
+        unsafe { f(handle, tip_m.x * 1e3, tip_m.z * 1e3, -tip_m.y * 1e3, 0) };
+    }
+
+    /// The force device `handle` last rendered, in its own frame.
+    fn last_force_of(&self, handle: u32) -> Vector3<f64> {
+        let f = self
+            .0
+            .call::<unsafe extern "C" fn(u32, *mut f64)>("fake_hd_last_force_of");
+        let mut out = [0.0; 3];
+        // SAFETY: room for three doubles.
+        unsafe { f(handle, out.as_mut_ptr()) };
+        Vector3::from(out)
+    }
+
+    /// A control taking a device's handle and returning an int.
+    fn flag_of(&self, name: &str, handle: u32) -> i32 {
+        // SAFETY: a plain value.
+        unsafe { self.0.call::<unsafe extern "C" fn(u32) -> i32>(name)(handle) }
     }
 
     /// Waits until the fake's scheduler has run `frames` more frames.
@@ -313,4 +343,91 @@ fn the_force_answers_the_stylus_through_the_real_schedule() {
         latencies_ms.iter().all(|&l| l < 200.0),
         "{latencies_ms:?}\nfaults: {faults:?}\n{report:?}"
     );
+}
+
+/// Takes hand `hand`'s device out of the loop.
+fn take_device(haptic: &mut HapticLoop, hand: usize) -> Box<dyn HapticDevice> {
+    let world = haptic.world_mut();
+    let mut hands = world.query::<(Entity, &HandIndex)>();
+    let (entity, _) = (hands.iter(world))
+        .find(|(_, index)| index.0 == hand)
+        .unwrap();
+    world.entity_mut(entity).take::<Device>().unwrap().0
+}
+
+/// Two Geomagic devices by their configuration names, one a hand, both pressing the liver
+/// 35 mm apart through one HD scheduler: each renders its own hand's force (the scene's force
+/// in the device's axes, to 1e-12 N); an HD error on the left device fades the left hand
+/// alone. Closing the left device ends its servo at zero force and disables it while the
+/// scheduler runs on for the right, which goes on rendering; closing the right stops it.
+#[test]
+fn two_devices_by_name_each_serve_their_own_hand() {
+    let fake = Fake::new("two-devices");
+    let targets = [target(), left_target(APART_M)];
+    let open = |name: &str| OpenHaptics::open(Some(fake.path()), Some(name)).unwrap();
+    let (right, left) = (open("RIGHT"), open("LEFT"));
+    assert!(left.name().ends_with("(LEFT)"), "{}", left.name());
+    for (handle, t) in [1, 2].into_iter().zip(&targets) {
+        fake.place_tip(handle, &(t.point_m + t.normal * (TIP_RADIUS_M - 0.004)));
+    }
+    fake.wait_frames(3);
+    let devices: Vec<Box<dyn HapticDevice>> = vec![Box::new(right), Box::new(left)];
+    let mut haptic = HapticLoop::with_devices(&two_hands(), devices).unwrap();
+    let tick = |haptic: &mut HapticLoop, n: u64| {
+        haptic.tick(TickClock {
+            tick: n,
+            time_s: n as f64 * TICK_S,
+            overruns_in_a_row: 0,
+        });
+        fake.wait_frames(2);
+        [0, 1].map(|hand| haptic.hand::<DeviceForce>(hand).unwrap().sent_n)
+    };
+    let in_device = |f: Vector3<f64>| Vector3::new(f.x, f.z, -f.y);
+    let mut sent = [Vector3::zeros(); 2];
+    for n in 0..400 {
+        sent = tick(&mut haptic, n);
+    }
+    for (hand, t) in targets.iter().enumerate() {
+        assert!(
+            sent[hand].dot(&t.normal) > 0.05,
+            "hand {hand}: {:?}",
+            sent[hand]
+        );
+        let rendered = fake.last_force_of(hand as u32 + 1);
+        assert!(
+            (rendered - in_device(sent[hand])).norm() < 1e-12,
+            "{rendered:?}"
+        );
+    }
+    let inject = fake
+        .0
+        .call::<unsafe extern "C" fn(u32, u32)>("fake_hd_inject_error_of");
+    // SAFETY: plain values.
+    unsafe { inject(2, 0x0201) };
+    fake.wait_frames(2);
+    let fade = SafetySettings::default().fade_ticks as u64;
+    for n in 400..405 + fade {
+        sent = tick(&mut haptic, n);
+    }
+    assert_eq!(sent[1], Vector3::zeros());
+    assert!(sent[0].dot(&targets[0].normal) > 0.05, "{:?}", sent[0]);
+    assert_eq!(haptic.hand::<FaultLog>(0).unwrap().log.len(), 0);
+    let left_log = &haptic.hand::<FaultLog>(1).unwrap().log;
+    assert!(
+        (left_log.iter()).any(|(_, f)| f.to_string().contains("HD_EXCEEDED_MAX_FORCE")),
+        "{left_log:?}"
+    );
+    let mut right = take_device(&mut haptic, 0);
+    drop(take_device(&mut haptic, 1));
+    assert_eq!(fake.last_force_of(2), Vector3::zeros());
+    assert_eq!(fake.flag_of("fake_hd_disabled_of", 2), 1);
+    assert_eq!(fake.flag("fake_hd_running"), 1);
+    assert_eq!(fake.flag("fake_hd_scheduled"), 1);
+    right.write_force(&Vector3::new(0.0, 0.0, 0.5)).unwrap();
+    fake.wait_frames(3);
+    assert_eq!(fake.last_force_of(1), Vector3::new(0.0, 0.5, 0.0));
+    drop(right);
+    assert_eq!(fake.flag("fake_hd_running"), 0);
+    assert_eq!(fake.flag_of("fake_hd_disabled_of", 1), 1);
+    assert_eq!(fake.last_force_of(1), Vector3::zeros());
 }

@@ -10,8 +10,9 @@
 
 use std::ffi::{CString, c_char, c_int, c_uint, c_ulong, c_ushort, c_void};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
 
 use libloading::Library;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
@@ -40,6 +41,7 @@ const HD_NOMINAL_MAX_CONTINUOUS_FORCE: c_uint = 0x2604;
 const HD_CURRENT_FORCE: c_uint = 0x2700;
 const HD_FORCE_OUTPUT: c_uint = 0x4000;
 const HD_INVALID_HANDLE: c_uint = 0xFFFF_FFFF;
+const HD_CALLBACK_DONE: c_uint = 0;
 const HD_CALLBACK_CONTINUE: c_uint = 1;
 const HD_DEFAULT_SCHEDULER_PRIORITY: c_ushort = u16::MAX / 2;
 
@@ -167,11 +169,39 @@ fn frame() -> Matrix3<f64> {
     Matrix3::new(1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0)
 }
 
+/// How many devices' servos the HD scheduler runs, by HD library (the tests load copies of
+/// a fake, each with a scheduler of its own). The scheduler is one for the library: it
+/// starts with the first device's servo and stops with the last one's, so that closing one
+/// hand's device leaves the other's running.
+static SCHEDULER_USERS: Mutex<Vec<(PathBuf, usize)>> = Mutex::new(Vec::new());
+
+/// Runs `change` on the count of devices `library`'s scheduler serves, under its lock.
+fn with_scheduler_users<T>(library: &Path, change: impl FnOnce(&mut usize) -> T) -> T {
+    let mut all = SCHEDULER_USERS.lock().unwrap_or_else(|p| p.into_inner());
+    let k = match all.iter().position(|(path, _)| path == library) {
+        Some(k) => k,
+        None => {
+            all.push((library.to_owned(), 0));
+            all.len() - 1
+        }
+    };
+    change(&mut all[k].1)
+}
+
+/// How long a device closing while another's servo runs waits for its own servo's last frame,
+/// at zero force, before unscheduling it without one.
+const LAST_FRAME_WAIT: Duration = Duration::from_millis(100);
+
 /// What the scheduler callback reaches: the functions, the device and the link.
 struct Servo {
     hd: Arc<Hd>,
     handle: c_uint,
     link: Arc<ServoLink>,
+    /// Set when the device closes while the scheduler runs on for another: the next frame
+    /// renders zero and is the callback's last...
+    leaving: AtomicBool,
+    /// ...which it says here.
+    left: AtomicBool,
 }
 
 /// One servo frame: read, publish, render, report.
@@ -195,7 +225,11 @@ extern "C" fn servo_frame(data: *mut c_void) -> c_uint {
         orientation,
         buttons: buttons as u32,
     });
-    let force = to_device_force(&servo.link.force_to_render());
+    let leaving = servo.leaving.load(Ordering::Acquire);
+    let force = match leaving {
+        true => Vector3::zeros(),
+        false => to_device_force(&servo.link.force_to_render()),
+    };
     // SAFETY: the force is three doubles.
     unsafe {
         (hd.set_doublev)(HD_CURRENT_FORCE, force.as_ptr());
@@ -204,6 +238,10 @@ extern "C" fn servo_frame(data: *mut c_void) -> c_uint {
     if let Some((code, internal)) = hd.error() {
         servo.link.report_error(code, internal);
     }
+    if leaving {
+        servo.left.store(true, Ordering::Release);
+        return HD_CALLBACK_DONE;
+    }
     HD_CALLBACK_CONTINUE
 }
 
@@ -211,6 +249,8 @@ extern "C" fn servo_frame(data: *mut c_void) -> c_uint {
 /// the program leaves (see [`super::release`]).
 struct Session {
     hd: Arc<Hd>,
+    /// The HD library's file: whose scheduler serves the device.
+    library: PathBuf,
     handle: c_uint,
     /// The servo callback's handle once scheduled (with the scheduler started).
     scheduled: Option<c_ulong>,
@@ -219,25 +259,61 @@ struct Session {
 }
 
 impl Release for Session {
-    /// Zero force at once (the link halted), the scheduler stopped (no callback runs after it
-    /// returns) and the callback unscheduled, zero written in a last frame, the device disabled.
+    /// Zero force at once (the link halted). The last device the scheduler serves: the
+    /// scheduler stopped (no callback runs after it returns) and the callback unscheduled,
+    /// zero written in a last frame. Another device still served: this one's servo renders
+    /// zero in a last frame of its own and ends, the scheduler running on. Then the device is
+    /// disabled.
     fn release(&self) {
         if self.released.swap(true, Ordering::AcqRel) {
             return;
         }
         self.servo.link.halt();
-        // SAFETY: the handle is the one initialized; the callback's data (`servo`) lives as long
-        // as the session, past the scheduler's stop.
-        unsafe {
-            if let Some(scheduled) = self.scheduled {
-                (self.hd.stop_scheduler)();
-                (self.hd.unschedule)(scheduled);
+        let Some(scheduled) = self.scheduled else {
+            // SAFETY: the handle is the one initialized; no callback of it was scheduled.
+            unsafe { (self.hd.disable_device)(self.handle) };
+            return;
+        };
+        with_scheduler_users(&self.library, |users| {
+            *users = users.saturating_sub(1);
+            match *users {
+                0 => self.stop_last(scheduled),
+                _ => self.leave_running(scheduled),
             }
-            let zero = [0.0f64; 3];
+        });
+        // SAFETY: the handle is the one initialized; its callback no longer runs.
+        unsafe { (self.hd.disable_device)(self.handle) };
+    }
+}
+
+impl Session {
+    /// The scheduler's last device: the scheduler stopped, the callback unscheduled, zero
+    /// written in a frame of this thread's.
+    fn stop_last(&self, scheduled: c_ulong) {
+        let zero = [0.0f64; 3];
+        // SAFETY: the handle is the one initialized; the callback's data (`servo`) lives as
+        // long as the session, past the scheduler's stop.
+        unsafe {
+            (self.hd.stop_scheduler)();
+            (self.hd.unschedule)(scheduled);
             (self.hd.begin_frame)(self.handle);
             (self.hd.set_doublev)(HD_CURRENT_FORCE, zero.as_ptr());
             (self.hd.end_frame)(self.handle);
-            (self.hd.disable_device)(self.handle);
+        }
+    }
+
+    /// Another device's servo runs on: this one's renders zero in its last frame and ends
+    /// itself; if the scheduler runs no frame of it in time, it is unscheduled.
+    fn leave_running(&self, scheduled: c_ulong) {
+        self.servo.leaving.store(true, Ordering::Release);
+        let asked = Instant::now();
+        while !self.servo.left.load(Ordering::Acquire) {
+            if asked.elapsed() > LAST_FRAME_WAIT {
+                // SAFETY: the callback's handle, scheduled and not ended.
+                unsafe { (self.hd.unschedule)(scheduled) };
+                return;
+            }
+            std::thread::sleep(Duration::from_micros(200));
         }
     }
 }
@@ -287,12 +363,15 @@ impl OpenHaptics {
         }
         let mut session = Session {
             hd: hd.clone(),
+            library: path.clone(),
             handle,
             scheduled: None,
             servo: Box::new(Servo {
                 hd: hd.clone(),
                 handle,
                 link: Arc::new(ServoLink::default()),
+                leaving: AtomicBool::new(false),
+                left: AtomicBool::new(false),
             }),
             released: AtomicBool::new(false),
         };
@@ -321,7 +400,13 @@ impl OpenHaptics {
                 data,
                 HD_DEFAULT_SCHEDULER_PRIORITY,
             ));
-            (hd.start_scheduler)();
+            // One scheduler for every device: started with the first one's servo.
+            with_scheduler_users(&path, |users| {
+                if *users == 0 {
+                    (hd.start_scheduler)();
+                }
+                *users += 1;
+            });
         }
         let session = Arc::new(session);
         super::register(&(session.clone() as Arc<dyn Release>));
