@@ -14,7 +14,9 @@ use pgd_surgery::devices::{
 use pgd_surgery::fem::{FemModel, Law, Loads, NewtonSettings, PatchKernel};
 use pgd_surgery::mesh::Surface;
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate, region};
-use pgd_surgery::pgd::{BuildSettings, OrganModel, Silent, Vademecum, build, organ};
+use pgd_surgery::pgd::{
+    BuildSettings, OrganModel, Silent, Vademecum, build, default_load_steps_m, organ,
+};
 
 pub const TIP_RADIUS_M: f64 = 0.012;
 
@@ -25,32 +27,42 @@ pub struct Liver {
 
 pub fn liver() -> &'static Liver {
     static LIVER: OnceLock<Liver> = OnceLock::new();
-    LIVER.get_or_init(|| {
-        let settings = OrganSettings {
-            resolution: 0.25,
-            seed: 1,
-            ..OrganSettings::default()
-        };
-        let mesh = generate(Organ::Liver, &settings).unwrap();
-        let material = organ::material(Organ::Liver, Law::Linear);
-        let model = organ::clamped_model(mesh, material).unwrap();
-        let source = OrganModel {
-            source: "liver".into(),
-            model: &model,
-            clamped_region: region::CLAMPED.into(),
-            accessible_region: region::ACCESSIBLE.into(),
-        };
-        let settings = BuildSettings {
-            tool_tip_radius_m: TIP_RADIUS_M,
-            local_radius_m: 0.025,
-            ..BuildSettings::default()
-        };
-        let vademecum = build(&source, &settings, &Silent).unwrap().0;
-        Liver {
-            vademecum: Arc::new(vademecum),
-            model,
-        }
-    })
+    LIVER.get_or_init(|| coarse_liver(Law::Linear))
+}
+
+/// The coarse liver under the trainer's exponential law, its vademecum with the law's default
+/// load steps for the 12 mm tool.
+pub fn exponential_liver() -> &'static Liver {
+    static LIVER: OnceLock<Liver> = OnceLock::new();
+    LIVER.get_or_init(|| coarse_liver(Law::Exponential))
+}
+
+fn coarse_liver(law: Law) -> Liver {
+    let settings = OrganSettings {
+        resolution: 0.25,
+        seed: 1,
+        ..OrganSettings::default()
+    };
+    let mesh = generate(Organ::Liver, &settings).unwrap();
+    let material = organ::material(Organ::Liver, law);
+    let model = organ::clamped_model(mesh, material).unwrap();
+    let source = OrganModel {
+        source: "liver".into(),
+        model: &model,
+        clamped_region: region::CLAMPED.into(),
+        accessible_region: region::ACCESSIBLE.into(),
+    };
+    let settings = BuildSettings {
+        tool_tip_radius_m: TIP_RADIUS_M,
+        local_radius_m: 0.025,
+        load_steps_m: default_load_steps_m(Some(Organ::Liver), TIP_RADIUS_M, law),
+        ..BuildSettings::default()
+    };
+    let vademecum = build(&source, &settings, &Silent).unwrap().0;
+    Liver {
+        vademecum: Arc::new(vademecum),
+        model,
+    }
 }
 
 pub fn scene(safety: SafetySettings) -> HapticScene {
@@ -112,23 +124,35 @@ pub fn fem_patch(point: Point3<f64>, facing: &Vector3<f64>) -> Vec<(usize, f64)>
 /// Full FEM's 3 × 3 compliance (m/N) from the patch load `loaded` to the patch `read`: the
 /// displacement averaged over `read` under unit forces along each axis spread over `loaded`.
 pub fn fem_response(loaded: &[(usize, f64)], read: &[(usize, f64)]) -> Matrix3<f64> {
-    let model = &liver().model;
     let mut c = Matrix3::zeros();
     for d in 0..3 {
-        let mut loads = Loads::new(model.mesh().node_count());
-        for &(node, share) in loaded {
-            let mut f = [0.0; 3];
-            f[d] = share;
-            loads.add_nodal_force(node, f).unwrap();
-        }
-        let u = model
-            .solve_static(&loads, &NewtonSettings::default())
-            .unwrap()
-            .displacement_m;
-        let under = read.iter().fold(Vector3::zeros(), |acc, &(n, s)| {
-            acc + Vector3::new(u[3 * n], u[3 * n + 1], u[3 * n + 2]) * s
-        });
-        c.set_column(d, &under);
+        let u = fem_displacement(&liver().model, &[(loaded, Vector3::ith(d, 1.0))]);
+        c.set_column(d, &patch_average(&u, read));
     }
     c
+}
+
+/// A patch on the FEM mesh (its nodes and their shares of the load) and the force (N) spread
+/// over it.
+pub type PatchForce<'a> = (&'a [(usize, f64)], Vector3<f64>);
+
+/// Full FEM's displacement (m, three per node) of `model` under forces each spread over a
+/// patch by its shares.
+pub fn fem_displacement(model: &FemModel, forces: &[PatchForce<'_>]) -> Vec<f64> {
+    let mut loads = Loads::new(model.mesh().node_count());
+    for (patch, force) in forces {
+        for &(node, share) in *patch {
+            let f = force * share;
+            loads.add_nodal_force(node, [f.x, f.y, f.z]).unwrap();
+        }
+    }
+    let solved = model.solve_static(&loads, &NewtonSettings::default());
+    solved.unwrap().displacement_m
+}
+
+/// The displacement `u` averaged over a patch by its shares.
+pub fn patch_average(u: &[f64], patch: &[(usize, f64)]) -> Vector3<f64> {
+    patch.iter().fold(Vector3::zeros(), |acc, &(n, s)| {
+        acc + Vector3::new(u[3 * n], u[3 * n + 1], u[3 * n + 2]) * s
+    })
 }

@@ -1,10 +1,12 @@
 //! What the backends' tests against the vendor fakes share: the run every backend's fault test
 //! makes, and the checks of the watchdog and the edge guard.
 
+use std::ops::Range;
+
 use nalgebra::Vector3;
 use pgd_surgery::app::haptic::{DeviceForce, FaultLog, HapticLoop, TickClock};
 use pgd_surgery::devices::{
-    HapticDevice, MAX_FORCE_LIMIT_N, SafetySettings, ServoLink, TICK_S, WATCHDOG_S,
+    HapticDevice, MAX_FORCE_LIMIT_N, PressTarget, SafetySettings, ServoLink, TICK_S, WATCHDOG_S,
 };
 
 use crate::common::{TIP_RADIUS_M, scene, target};
@@ -50,8 +52,71 @@ pub fn press_then_fault(
 
 /// The tool at 4 mm into the liver where the tests press (the scene's frame).
 pub fn pressing_tip_m() -> Vector3<f64> {
-    let target = target();
+    pressing_at(&target())
+}
+
+/// The tool at 4 mm into the liver at `target` (the scene's frame).
+pub fn pressing_at(target: &PressTarget) -> Vector3<f64> {
     target.point_m + target.normal * (TIP_RADIUS_M - 0.004)
+}
+
+/// Ticks `haptic`'s two hands over `ticks`, `frame` waiting for the servos after each; each
+/// hand's force sent at the last.
+pub fn tick_hands(
+    haptic: &mut HapticLoop,
+    ticks: Range<u64>,
+    frame: impl Fn(),
+) -> [Vector3<f64>; 2] {
+    let mut sent = [Vector3::zeros(); 2];
+    for n in ticks {
+        haptic.tick(TickClock {
+            tick: n,
+            time_s: n as f64 * TICK_S,
+            overruns_in_a_row: 0,
+        });
+        frame();
+        sent = [0, 1].map(|hand| haptic.hand::<DeviceForce>(hand).unwrap().sent_n);
+    }
+    sent
+}
+
+/// Both hands push back along their `targets`' normals, and each device renders its own
+/// hand's force: `rendered(hand)` (the scene's axes) is what the hand sent, to 1e-12 N.
+pub fn assert_each_device_renders_its_hand(
+    sent: &[Vector3<f64>; 2],
+    targets: &[PressTarget; 2],
+    rendered: impl Fn(usize) -> Vector3<f64>,
+) {
+    for (hand, t) in targets.iter().enumerate() {
+        assert!(
+            sent[hand].dot(&t.normal) > 0.05,
+            "hand {hand}: {:?}",
+            sent[hand]
+        );
+        let device = rendered(hand);
+        assert!(
+            (device - sent[hand]).norm() < 1e-12,
+            "hand {hand}: {device:?}"
+        );
+    }
+}
+
+/// After a fault of the left hand's device: the left hand's force is zero and its log says
+/// so in words that contain `says`; the right hand still pushes back, with no fault.
+pub fn assert_left_alone_faded(
+    haptic: &HapticLoop,
+    sent: &[Vector3<f64>; 2],
+    right_target: &PressTarget,
+    says: &str,
+) {
+    assert_eq!(sent[1], Vector3::zeros());
+    assert!(sent[0].dot(&right_target.normal) > 0.05, "{:?}", sent[0]);
+    assert!(haptic.hand::<FaultLog>(0).unwrap().log.is_empty());
+    let left = &haptic.hand::<FaultLog>(1).unwrap().log;
+    assert!(
+        left.iter().any(|(_, f)| f.to_string().contains(says)),
+        "{left:?}"
+    );
 }
 
 /// The run pushed the trainee back with no fault, then faded the force to zero within the

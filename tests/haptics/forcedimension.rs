@@ -5,14 +5,15 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
-use pgd_surgery::app::haptic::{DeviceForce, FaultLog, HapticLoop, TickClock};
-use pgd_surgery::devices::{ForceDimension, HapticDevice, SafetySettings, TICK_S};
+use pgd_surgery::app::haptic::HapticLoop;
+use pgd_surgery::devices::{ForceDimension, HapticDevice, SafetySettings};
 
-use crate::common::{TIP_RADIUS_M, target};
+use crate::common::target;
 
 use crate::fakes::{
-    assert_edge_guarded, assert_faded, assert_held_to_ceiling, assert_watchdog_held,
-    press_then_fault, pressing_tip_m,
+    assert_each_device_renders_its_hand, assert_edge_guarded, assert_faded, assert_held_to_ceiling,
+    assert_left_alone_faded, assert_watchdog_held, press_then_fault, pressing_at, pressing_tip_m,
+    tick_hands,
 };
 use crate::two_hands::{APART_M, left_target, two_hands};
 use crate::vendor_fake::VendorFake;
@@ -228,56 +229,25 @@ fn two_devices_by_index_each_serve_their_own_hand() {
     );
     let targets = [target(), left_target(APART_M)];
     for (id, t) in targets.iter().enumerate() {
-        fake.place_tip(id as i32, &(t.point_m + t.normal * (TIP_RADIUS_M - 0.004)));
+        fake.place_tip(id as i32, &pressing_at(t));
     }
     let devices: Vec<Box<dyn HapticDevice>> = [0, 1]
         .map(|index| Box::new(fake.open_index(Some(index)).unwrap()) as Box<dyn HapticDevice>)
         .into();
     assert!(devices[1].name().ends_with("(1)"), "{}", devices[1].name());
     let mut haptic = HapticLoop::with_devices(&two_hands(), devices).unwrap();
-    let tick = |haptic: &mut HapticLoop, n: u64| {
-        haptic.tick(TickClock {
-            tick: n,
-            time_s: n as f64 * TICK_S,
-            overruns_in_a_row: 0,
-        });
-        fake.wait_frames(2);
-        [0, 1].map(|hand| haptic.hand::<DeviceForce>(hand).unwrap().sent_n)
+    let frame = || fake.wait_frames(2);
+    // The device's (x, y, z) is the scene's (−y, x, z), forces as positions.
+    let in_scene = |hand: usize| {
+        let f = fake.last_force_of(hand as i32);
+        Vector3::new(f.y, -f.x, f.z)
     };
-    let mut sent = [Vector3::zeros(); 2];
-    for n in 0..400 {
-        sent = tick(&mut haptic, n);
-    }
-    for (hand, t) in targets.iter().enumerate() {
-        assert!(
-            sent[hand].dot(&t.normal) > 0.05,
-            "hand {hand}: {:?}",
-            sent[hand]
-        );
-        let device = fake.last_force_of(hand as i32);
-        let in_device = Vector3::new(-sent[hand].y, sent[hand].x, sent[hand].z);
-        assert!(
-            (device - in_device).norm() < 1e-12,
-            "{device:?} {in_device:?}"
-        );
-    }
+    let sent = tick_hands(&mut haptic, 0..400, frame);
+    assert_each_device_renders_its_hand(&sent, &targets, in_scene);
     assert!((sent[0] - sent[1]).norm() > 1e-3, "the hands feel apart");
     fake.control_of("fake_dhd_inject_error_of", 1, 7);
     let fade = SafetySettings::default().fade_ticks as u64;
-    for n in 400..405 + fade {
-        sent = tick(&mut haptic, n);
-    }
-    assert_eq!(sent[1], Vector3::zeros());
-    assert!(sent[0].dot(&targets[0].normal) > 0.05, "{:?}", sent[0]);
-    let right = Vector3::new(-sent[0].y, sent[0].x, sent[0].z);
-    assert!((fake.last_force_of(0) - right).norm() < 1e-12);
-    let faults = |hand| haptic.hand::<FaultLog>(hand).unwrap().log.len();
-    assert_eq!(faults(0), 0);
-    let left_log = &haptic.hand::<FaultLog>(1).unwrap().log;
-    assert!(
-        left_log
-            .iter()
-            .any(|(_, f)| f.to_string().contains("communication error")),
-        "{left_log:?}"
-    );
+    let sent = tick_hands(&mut haptic, 400..405 + fade, frame);
+    assert_left_alone_faded(&haptic, &sent, &targets[0], "communication error");
+    assert!((in_scene(0) - sent[0]).norm() < 1e-12);
 }

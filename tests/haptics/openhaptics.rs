@@ -6,15 +6,14 @@ use std::time::{Duration, Instant};
 
 use bevy::ecs::entity::Entity;
 use nalgebra::Vector3;
-use pgd_surgery::app::haptic::{
-    Device, DeviceForce, FaultLog, HandIndex, HapticLoop, HapticThread, Scheduling, TickClock,
-};
-use pgd_surgery::devices::{HapticDevice, OpenHaptics, SafetySettings, TICK_S, TimerMode};
+use pgd_surgery::app::haptic::{Device, FaultLog, HandIndex, HapticLoop, HapticThread, Scheduling};
+use pgd_surgery::devices::{HapticDevice, OpenHaptics, SafetySettings, TimerMode};
 
 use crate::common::{TIP_RADIUS_M, scene, target};
 use crate::fakes::{
-    assert_edge_guarded, assert_faded, assert_held_to_ceiling, assert_watchdog_held,
-    press_then_fault, pressing_tip_m,
+    assert_each_device_renders_its_hand, assert_edge_guarded, assert_faded, assert_held_to_ceiling,
+    assert_left_alone_faded, assert_watchdog_held, press_then_fault, pressing_at, pressing_tip_m,
+    tick_hands,
 };
 use crate::two_hands::{APART_M, left_target, two_hands};
 use crate::vendor_fake::VendorFake;
@@ -368,37 +367,19 @@ fn two_devices_by_name_each_serve_their_own_hand() {
     let (right, left) = (open("RIGHT"), open("LEFT"));
     assert!(left.name().ends_with("(LEFT)"), "{}", left.name());
     for (handle, t) in [1, 2].into_iter().zip(&targets) {
-        fake.place_tip(handle, &(t.point_m + t.normal * (TIP_RADIUS_M - 0.004)));
+        fake.place_tip(handle, &pressing_at(t));
     }
     fake.wait_frames(3);
     let devices: Vec<Box<dyn HapticDevice>> = vec![Box::new(right), Box::new(left)];
     let mut haptic = HapticLoop::with_devices(&two_hands(), devices).unwrap();
-    let tick = |haptic: &mut HapticLoop, n: u64| {
-        haptic.tick(TickClock {
-            tick: n,
-            time_s: n as f64 * TICK_S,
-            overruns_in_a_row: 0,
-        });
-        fake.wait_frames(2);
-        [0, 1].map(|hand| haptic.hand::<DeviceForce>(hand).unwrap().sent_n)
+    let frame = || fake.wait_frames(2);
+    // The device's (x, y, z) is the scene's (x, z, −y), forces as positions.
+    let in_scene = |hand: usize| {
+        let f = fake.last_force_of(hand as u32 + 1);
+        Vector3::new(f.x, -f.z, f.y)
     };
-    let in_device = |f: Vector3<f64>| Vector3::new(f.x, f.z, -f.y);
-    let mut sent = [Vector3::zeros(); 2];
-    for n in 0..400 {
-        sent = tick(&mut haptic, n);
-    }
-    for (hand, t) in targets.iter().enumerate() {
-        assert!(
-            sent[hand].dot(&t.normal) > 0.05,
-            "hand {hand}: {:?}",
-            sent[hand]
-        );
-        let rendered = fake.last_force_of(hand as u32 + 1);
-        assert!(
-            (rendered - in_device(sent[hand])).norm() < 1e-12,
-            "{rendered:?}"
-        );
-    }
+    let sent = tick_hands(&mut haptic, 0..400, frame);
+    assert_each_device_renders_its_hand(&sent, &targets, in_scene);
     let inject = fake
         .0
         .call::<unsafe extern "C" fn(u32, u32)>("fake_hd_inject_error_of");
@@ -406,17 +387,8 @@ fn two_devices_by_name_each_serve_their_own_hand() {
     unsafe { inject(2, 0x0201) };
     fake.wait_frames(2);
     let fade = SafetySettings::default().fade_ticks as u64;
-    for n in 400..405 + fade {
-        sent = tick(&mut haptic, n);
-    }
-    assert_eq!(sent[1], Vector3::zeros());
-    assert!(sent[0].dot(&targets[0].normal) > 0.05, "{:?}", sent[0]);
-    assert_eq!(haptic.hand::<FaultLog>(0).unwrap().log.len(), 0);
-    let left_log = &haptic.hand::<FaultLog>(1).unwrap().log;
-    assert!(
-        (left_log.iter()).any(|(_, f)| f.to_string().contains("HD_EXCEEDED_MAX_FORCE")),
-        "{left_log:?}"
-    );
+    let sent = tick_hands(&mut haptic, 400..405 + fade, frame);
+    assert_left_alone_faded(&haptic, &sent, &targets[0], "HD_EXCEEDED_MAX_FORCE");
     let mut right = take_device(&mut haptic, 0);
     drop(take_device(&mut haptic, 1));
     assert_eq!(fake.last_force_of(2), Vector3::zeros());

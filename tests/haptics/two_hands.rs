@@ -4,18 +4,19 @@
 
 use std::sync::{Arc, Mutex};
 
-use nalgebra::{Matrix3, Matrix6, Point3, Vector3, Vector6};
+use nalgebra::{Matrix6, Point3, Vector3, Vector6};
 use pgd_surgery::app::haptic::{
     DeviceForce, ForceTrace, HandTouches, HapticLoop, HapticScene, SceneHand, Tool,
 };
-use pgd_surgery::contact::{ContactSurface, ToolContact};
+use pgd_surgery::contact::{ContactSurface, Probe, ToolContact};
 use pgd_surgery::devices::{
     DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice, PressMotion, PressTarget,
     SafetySettings, press_and_slide,
 };
 
 use crate::common::{
-    TIP_RADIUS_M, fem_patch, fem_response, liver, scene, scripted, target, tick_at,
+    Liver, TIP_RADIUS_M, exponential_liver, fem_displacement, fem_patch, fem_response, liver,
+    patch_average, scripted, target, tick_at,
 };
 use crate::faults::{Faulty, Kind};
 
@@ -46,7 +47,16 @@ fn presses(apart_m: f64) -> [Box<dyn HapticDevice>; 2] {
 
 /// The liver with two hands, each a probe in open surgery.
 pub fn two_hands() -> HapticScene {
-    let mut scene = scene(SafetySettings::default());
+    two_hands_on(liver())
+}
+
+/// `liver` with two hands, each a probe in open surgery.
+fn two_hands_on(liver: &Liver) -> HapticScene {
+    let organs = vec![("liver".into(), liver.vademecum.clone())];
+    let probe = Probe {
+        tip_radius_m: TIP_RADIUS_M,
+    };
+    let mut scene = HapticScene::pressing(organs, probe);
     scene.hands.push(SceneHand::default());
     scene
 }
@@ -76,47 +86,120 @@ fn contacts(haptic: &mut HapticLoop) -> [ToolContact; 2] {
 /// How far apart the hands press in the runs that are not about the distance (m).
 pub const APART_M: f64 = 0.035;
 
-/// Two presses `apart_m` apart hold their tips still; full FEM is given the same two tips: the
-/// forces whose patch loads move the surface under each tip to where the tip holds it (its
-/// depth below the rest surface, along the normal), the 6 × 6 system of the two patches'
-/// compliances solved. Returns each hand's felt-force error against it, and how far off each
-/// hand's press alone would be (what the other hand's load changes).
-fn felt_against_full_fem(apart_m: f64) -> [(f64, f64); 2] {
-    let mut haptic = HapticLoop::with_devices(&two_hands(), presses(apart_m).into()).unwrap();
-    haptic.run_simulated(holding_tick());
-    let contacts = contacts(&mut haptic);
-    let patches = contacts.map(|c| {
-        let facing = liver().vademecum.triangle_facing(c.hit.at.triangle);
-        fem_patch(Point3::from(c.hit.point_m), &facing)
-    });
-    let block = |read: usize, loaded: usize| fem_response(&patches[loaded], &patches[read]);
-    let mut compliance = Matrix6::zeros();
-    for (read, loaded) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
-        let c: Matrix3<f64> = block(read, loaded);
-        (compliance.fixed_view_mut::<3, 3>(3 * read, 3 * loaded)).copy_from(&c);
+/// Two presses held still on a liver, as full FEM is given them: each hand's contact, its
+/// patch on the FEM mesh, the surface displacement under each tip where the tip holds it
+/// (its depth below the rest surface, along the normal), and the two patches' 6 × 6 linear
+/// compliance (m/N).
+struct TwoPresses {
+    contacts: [ToolContact; 2],
+    patches: [Vec<(usize, f64)>; 2],
+    held: Vector6<f64>,
+    compliance: Matrix6<f64>,
+}
+
+impl TwoPresses {
+    /// Both hands press `scene`'s liver `apart_m` apart and hold; the forces sent are checked
+    /// to be the felt ones, reversed.
+    fn hold(scene: &HapticScene, apart_m: f64) -> Self {
+        let mut haptic = HapticLoop::with_devices(scene, presses(apart_m).into()).unwrap();
+        haptic.run_simulated(holding_tick());
+        let contacts = contacts(&mut haptic);
+        for (hand, contact) in contacts.iter().enumerate() {
+            let sent = haptic.hand::<DeviceForce>(hand).unwrap().sent_n;
+            assert!(
+                (sent + contact.force_n).norm() < 1e-12,
+                "hand {hand} sent {sent:?}"
+            );
+        }
+        let patches = contacts.map(|c| {
+            let facing = liver().vademecum.triangle_facing(c.hit.at.triangle);
+            fem_patch(Point3::from(c.hit.point_m), &facing)
+        });
+        let mut compliance = Matrix6::zeros();
+        for (read, loaded) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+            let c = fem_response(&patches[loaded], &patches[read]);
+            (compliance.fixed_view_mut::<3, 3>(3 * read, 3 * loaded)).copy_from(&c);
+        }
+        let tips = [0, 1].map(|hand| haptic.hand::<Tool>(hand).unwrap().sample.unwrap().tip_m);
+        let held = [0, 1].map(|hand| {
+            let (hit, tip) = (&contacts[hand].hit, tips[hand]);
+            -hit.normal * (TIP_RADIUS_M - (tip - hit.point_m).dot(&hit.normal))
+        });
+        Self {
+            contacts,
+            patches,
+            held: Vector6::from_iterator(held.iter().flat_map(|h| h.iter().copied())),
+            compliance,
+        }
     }
-    let tips = [0, 1].map(|hand| haptic.hand::<Tool>(hand).unwrap().sample.unwrap().tip_m);
-    let held = [0, 1].map(|hand| {
-        let (hit, tip) = (&contacts[hand].hit, tips[hand]);
-        -hit.normal * (TIP_RADIUS_M - (tip - hit.point_m).dot(&hit.normal))
-    });
-    let targets = Vector6::from_iterator(held.iter().flat_map(|h| h.iter().copied()));
-    let reference = compliance.lu().solve(&targets).unwrap();
-    [0, 1].map(|hand| {
+
+    /// Hand `hand`'s felt force against `reference` (both hands' forces, N): the relative
+    /// error.
+    fn error(&self, hand: usize, reference: &Vector6<f64>, apart_m: f64) -> f64 {
         let full = reference.fixed_rows::<3>(3 * hand).into_owned();
-        let alone = block(hand, hand).try_inverse().unwrap() * held[hand];
-        let felt = contacts[hand].force_n;
+        let felt = self.contacts[hand].force_n;
         let error = (felt - full).norm() / full.norm();
-        let coupling = (alone - full).norm() / full.norm();
         eprintln!(
-            "{:.0} mm apart, hand {hand}: force {felt:?} N, full FEM {full:?} N, error {error:.2e}; \
-             alone {coupling:.2e} off",
+            "{:.0} mm apart, hand {hand}: force {felt:?} N, full FEM {full:?} N, error {error:.2e}",
             apart_m * 1e3
         );
-        let sent = haptic.hand::<DeviceForce>(hand).unwrap().sent_n;
-        assert!((sent + felt).norm() < 1e-12, "hand {hand} sent {sent:?}");
-        (error, coupling)
+        error
+    }
+}
+
+/// Two presses `apart_m` apart on the linear liver; full FEM is given the same two tips: the
+/// forces whose patch loads move the surface under each tip to where the tip holds it, the
+/// 6 × 6 system of the two patches' compliances solved. Returns each hand's felt-force error
+/// against it, and how far off each hand's press alone would be (what the other hand's load
+/// changes).
+fn felt_against_full_fem(apart_m: f64) -> [(f64, f64); 2] {
+    let presses = TwoPresses::hold(&two_hands(), apart_m);
+    let reference = presses.compliance.lu().solve(&presses.held).unwrap();
+    [0, 1].map(|hand| {
+        let error = presses.error(hand, &reference, apart_m);
+        let block = presses.compliance.fixed_view::<3, 3>(3 * hand, 3 * hand);
+        let held = presses.held.fixed_rows::<3>(3 * hand);
+        let alone = block.try_inverse().unwrap() * held;
+        let full = reference.fixed_rows::<3>(3 * hand);
+        (error, (alone - full).norm() / full.norm())
     })
+}
+
+/// Two presses `apart_m` apart on the exponential liver; full nonlinear FEM is given the same
+/// two tips: the forces whose patch loads move the surface under each tip to where the tip
+/// holds it, found from the felt forces by Newton solves of the nonlinear model, each
+/// correction through the linear 6 × 6 compliance, until the surface is within 1e-4 of where
+/// the tips hold it. Returns each hand's felt-force error against it.
+fn felt_against_nonlinear_fem(apart_m: f64) -> [f64; 2] {
+    let presses = TwoPresses::hold(&two_hands_on(exponential_liver()), apart_m);
+    let lu = presses.compliance.lu();
+    let model = &exponential_liver().model;
+    let mut forces = Vector6::from_iterator(
+        presses
+            .contacts
+            .iter()
+            .flat_map(|c| c.force_n.iter().copied()),
+    );
+    let mut converged = false;
+    for _ in 0..30 {
+        let force = |hand: usize| forces.fixed_rows::<3>(3 * hand).into_owned();
+        let loads = [0, 1].map(|hand| (&presses.patches[hand][..], force(hand)));
+        let u = fem_displacement(model, &loads);
+        let moved = [0, 1].map(|hand| patch_average(&u, &presses.patches[hand]));
+        let moved = Vector6::from_iterator(moved.iter().flat_map(|m| m.iter().copied()));
+        let residual = presses.held - moved;
+        if residual.norm() < 1e-4 * presses.held.norm() {
+            converged = true;
+            break;
+        }
+        forces += lu.solve(&residual).unwrap();
+    }
+    assert!(
+        converged,
+        "{:.0} mm apart: the reference did not converge",
+        apart_m * 1e3
+    );
+    [0, 1].map(|hand| presses.error(hand, &forces, apart_m))
 }
 
 /// 30 and 45 mm apart (the 12 mm tips clear of each other), each hand moves the surface under
@@ -135,6 +218,30 @@ fn two_hands_feel_full_fem_under_both_loads_within_the_felt_force_target() {
             assert!(
                 coupling > 2.0 * error,
                 "hand {hand}: a press alone is {coupling} off, the two {error}"
+            );
+        }
+    }
+}
+
+/// The exponential liver (the trainer's default tissue), the two presses 30, 45 and 60 mm
+/// apart, each 8 mm deep: each hand's felt force against full nonlinear FEM under both loads,
+/// within the product's felt-force target (7 %). Each hand's press blends the vademecum's
+/// load steps by its own load, the other hand's load among the organ's loads it answers.
+/// Measured (docs/pgd.md, "Two tools at once"): 8.2–10.1 %, over the target. Slow tier: the
+/// exponential liver's vademecum and about thirty Newton solves of the nonlinear liver take
+/// four minutes on two cores.
+#[test]
+#[ignore = "slow tier: the exponential liver built and solved by Newton, about four minutes"]
+fn two_nonlinear_presses_feel_full_nonlinear_fem_within_the_felt_force_target() {
+    let errors =
+        [0.030, 0.045, 0.060].map(|apart_m| (apart_m, felt_against_nonlinear_fem(apart_m)));
+    for (apart_m, hands) in errors {
+        for (hand, error) in hands.into_iter().enumerate() {
+            assert!(
+                error < 0.07,
+                "{:.0} mm apart: hand {hand}'s felt force off full nonlinear FEM by {error} \
+                 (all: {errors:?})",
+                apart_m * 1e3
             );
         }
     }

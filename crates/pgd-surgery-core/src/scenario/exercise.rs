@@ -2,13 +2,13 @@
 //! its kind is scored on and ends when done or out of time; then the next starts.
 
 use super::bimanual::BimanualTracker;
-use super::countertraction::CountertractionWatch;
 use super::format::Scenario;
 use super::keratotomy::Keratometer;
 use super::motion::MotionTracker;
 use super::sample::{NoduleSite, RegionSite, Sample};
 use super::task::{
-    AnyRun, Hand, LimitWatch, Mistake, Mistakes, RunSetup, Task, TaskMetrics, TaskProgress, Tick,
+    AnyRun, CountertractionWatch, Hand, LimitWatch, Mistake, Mistakes, RunSetup, Task, TaskMetrics,
+    TaskProgress, Tick,
 };
 
 /// Where the scenario's points lie on the scene's organs, found when the exercise is set up.

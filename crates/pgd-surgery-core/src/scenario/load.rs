@@ -6,11 +6,10 @@
 
 use std::path::Path;
 
-use super::countertraction::Countertraction;
 use super::format::{LaparoscopeEntry, Scenario};
 use super::problem::{Problem, REFERENCE, ScenarioError};
 use super::scene::{OrganEntry, metres};
-use super::task::{Hand, SceneFacts, Task, TaskCheck};
+use super::task::{BandEnd, Countertraction, Hand, SceneFacts, Task, TaskCheck};
 use super::tasks::registered_names;
 use crate::contact::PointshellDensity;
 use crate::devices::{DeviceSpec, MAX_INSTRUMENTS};
@@ -390,24 +389,17 @@ fn check_countertraction(
             "name one of `organs`",
         );
     }
-    let (min_n, max_n) = (countertraction.min_force_n.0, countertraction.max_force_n.0);
-    if min_n >= max_n {
-        check.problem_at(
-            "countertraction.min_force_n",
-            &["tasks", field, "min_force_n"],
-            format!("the band's bottom {min_n} N is not below its top {max_n} N"),
-            "make min_force_n smaller than max_force_n",
-        );
-    }
-    let device_n = check.scene.device_max_force_n;
-    if max_n > device_n {
-        check.problem_at(
-            "countertraction.max_force_n",
-            &["tasks", field, "max_force_n"],
-            format!("{max_n} N is above the device's limit of {device_n} N"),
-            "lower it, or raise device.max_force_n",
-        );
-    }
+    let min = BandEnd {
+        field: "countertraction.min_force_n",
+        anchors: &["tasks", field, "min_force_n"],
+        value_n: countertraction.min_force_n.0,
+    };
+    let max = BandEnd {
+        field: "countertraction.max_force_n",
+        anchors: &["tasks", field, "max_force_n"],
+        value_n: countertraction.max_force_n.0,
+    };
+    check.force_band(min, max);
 }
 
 fn generated_organs() -> String {

@@ -8,7 +8,6 @@
 //! [`Exercise`] inside the haptic schedule.
 
 mod bimanual;
-mod countertraction;
 mod exercise;
 mod format;
 mod incision;
@@ -24,7 +23,6 @@ pub mod tasks;
 mod units;
 
 pub use bimanual::{BimanualMetrics, BimanualTracker};
-pub use countertraction::{Countertraction, CountertractionMetrics, CountertractionWatch, Lapse};
 pub use exercise::{Exercise, Progress, Sites};
 pub use format::{
     Contact, Device, Difficulty, Instrument, LaparoscopeEntry, Port, Rubric, Scenario, ScopeKey,
@@ -41,7 +39,10 @@ pub use problem::ScenarioError;
 pub use sample::{HandSample, NoduleSite, RegionSite, Sample};
 pub use scene::{Nodule, OrganEntry, Spot, metres};
 pub use score::{CutMade, Scorecard, TaskScore, score};
-pub use task::{Hand, MISTAKES_LISTED, Mistake, Mistakes, Task, TaskMetrics, TaskShared, TaskType};
+pub use task::{
+    Countertraction, CountertractionMetrics, CountertractionWatch, Hand, Lapse, MISTAKES_LISTED,
+    Mistake, Mistakes, Task, TaskMetrics, TaskShared, TaskType,
+};
 pub use tasks::{COVERED_TO_FINISH, register, registered_names};
 pub use units::{
     DepthFraction, Dioptres, EdgeLength, FieldOfView, IncisionCount, Millimetres, ModeCount,

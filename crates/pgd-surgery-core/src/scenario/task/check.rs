@@ -19,6 +19,14 @@ pub struct SceneFacts<'a> {
     pub device_max_force_n: f64,
 }
 
+/// One end of a force band as [`TaskCheck::force_band`] checks it: its field's path (after
+/// `tasks[k].`), the words that find it in the file, and its value (N).
+pub struct BandEnd<'a> {
+    pub field: &'a str,
+    pub anchors: &'a [&'a str],
+    pub value_n: f64,
+}
+
 /// The scene as a task's check sees it, and the problems noted so far.
 pub struct TaskCheck<'a> {
     pub scene: SceneFacts<'a>,
@@ -94,6 +102,31 @@ impl<'a> TaskCheck<'a> {
             self.problem(
                 "max_force_n",
                 format!("{max_force_n} N is above the device's limit of {device_n} N"),
+                "lower it, or raise device.max_force_n",
+            );
+        }
+    }
+
+    /// A force band, `min` to `max` (each its field's path and the anchors that find it, and
+    /// its value in N), must not be empty, and its top must be a force the device can send.
+    pub fn force_band(&mut self, min: BandEnd<'_>, max: BandEnd<'_>) {
+        let (min_n, max_n) = (min.value_n, max.value_n);
+        if min_n >= max_n {
+            self.problem_at(
+                min.field,
+                min.anchors,
+                format!("the band is empty: {min_n} N is not below {max_n} N"),
+                "make min_force_n smaller than max_force_n",
+            );
+        }
+        let device_n = self.scene.device_max_force_n;
+        if max_n > device_n {
+            self.problem_at(
+                max.field,
+                max.anchors,
+                format!(
+                    "{max_n} N is above the device's limit of {device_n} N: the band cannot be reached"
+                ),
                 "lower it, or raise device.max_force_n",
             );
         }

@@ -3,7 +3,7 @@
 //! zone names) only when the attempt is scored, away from it.
 
 use super::Task;
-use crate::scenario::countertraction::Lapse;
+use super::countertraction::Lapse;
 use crate::scenario::units::Newtons;
 
 /// How many mistakes a task keeps in detail; past that they are counted, not listed.

@@ -7,6 +7,7 @@
 //! module each, with the registry and the reader.
 
 mod check;
+mod countertraction;
 mod metrics;
 mod mistakes;
 mod watch;
@@ -17,12 +18,14 @@ use std::fmt::{self, Debug};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-pub use check::{SceneFacts, TaskCheck};
+pub use check::{BandEnd, SceneFacts, TaskCheck};
+pub use countertraction::{
+    Countertraction, CountertractionMetrics, CountertractionWatch, LET_GO_S, Lapse,
+};
 pub use metrics::TaskMetrics;
 pub use mistakes::{MISTAKES_LISTED, Mistake, Mistakes};
 pub use watch::{HYSTERESIS, Hold, LimitWatch};
 
-use super::countertraction::Countertraction;
 use super::keratotomy::Keratometer;
 use super::motion::MotionTracker;
 use super::sample::{NoduleSite, Sample};

@@ -3,7 +3,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::scenario::task::{
-    Hold, RunSetup, TaskCheck, TaskProgress, TaskResult, TaskRun, TaskShared, TaskType, Tick,
+    BandEnd, Hold, RunSetup, TaskCheck, TaskProgress, TaskResult, TaskRun, TaskShared, TaskType,
+    Tick,
 };
 use crate::scenario::units::{Newtons, Seconds};
 
@@ -32,24 +33,17 @@ impl TaskType for ForceControl {
     }
 
     fn check(&self, check: &mut TaskCheck<'_>) {
-        let (min_n, max_n) = (self.min_force_n.0, check.shared.max_force_n.0);
-        if min_n >= max_n {
-            check.problem(
-                "min_force_n",
-                format!("the band is empty: {min_n} N is not below max_force_n {max_n} N"),
-                "min_force_n must be below max_force_n",
-            );
-        }
-        let device_n = check.scene.device_max_force_n;
-        if max_n > device_n {
-            check.problem(
-                "max_force_n",
-                format!(
-                    "{max_n} N is above the device's limit of {device_n} N: the band cannot be reached"
-                ),
-                "lower it, or raise device.max_force_n",
-            );
-        }
+        let min = BandEnd {
+            field: "min_force_n",
+            anchors: &["tasks", "min_force_n"],
+            value_n: self.min_force_n.0,
+        };
+        let max = BandEnd {
+            field: "max_force_n",
+            anchors: &["tasks", "max_force_n"],
+            value_n: check.shared.max_force_n.0,
+        };
+        check.force_band(min, max);
         check.hold_fits(self.hold_s.0);
     }
 

@@ -16,8 +16,7 @@ use serde::de::{
 use serde::{Deserialize, forward_to_deserialize_any};
 
 use super::registry::{self, Entry};
-use crate::scenario::countertraction::Countertraction;
-use crate::scenario::task::{Hand, Task, TaskShared};
+use crate::scenario::task::{Countertraction, Hand, Task, TaskShared};
 use crate::scenario::units::{Newtons, Seconds};
 
 impl<'de> Deserialize<'de> for Task {

@@ -6,9 +6,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::sample::HandSample;
-use super::task::{Hand, LimitWatch};
-use super::units::Newtons;
+use super::{Hand, LimitWatch};
+use crate::scenario::sample::HandSample;
+use crate::scenario::units::Newtons;
 
 /// `Countertraction(organ, min_force_n, max_force_n)`: the other hand keeps `organ` held —
 /// in a grasper's jaws or under its tool — with the force it feels between the two, the whole
