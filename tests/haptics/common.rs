@@ -126,23 +126,29 @@ pub fn fem_patch(point: Point3<f64>, facing: &Vector3<f64>) -> Vec<(usize, f64)>
 pub fn fem_response(loaded: &[(usize, f64)], read: &[(usize, f64)]) -> Matrix3<f64> {
     let mut c = Matrix3::zeros();
     for d in 0..3 {
-        let u = fem_displacement(&liver().model, &[(loaded, Vector3::ith(d, 1.0))]);
+        let unit = PatchForce {
+            patch: loaded,
+            force_n: Vector3::ith(d, 1.0),
+        };
+        let u = fem_displacement(&liver().model, &[unit]);
         c.set_column(d, &patch_average(&u, read));
     }
     c
 }
 
-/// A patch on the FEM mesh (its nodes and their shares of the load) and the force (N) spread
-/// over it.
-pub type PatchForce<'a> = (&'a [(usize, f64)], Vector3<f64>);
+/// A force spread over a patch of the FEM mesh by the patch's shares.
+pub struct PatchForce<'a> {
+    pub patch: &'a [(usize, f64)],
+    pub force_n: Vector3<f64>,
+}
 
 /// Full FEM's displacement (m, three per node) of `model` under forces each spread over a
-/// patch by its shares.
+/// patch.
 pub fn fem_displacement(model: &FemModel, forces: &[PatchForce<'_>]) -> Vec<f64> {
     let mut loads = Loads::new(model.mesh().node_count());
-    for (patch, force) in forces {
+    for PatchForce { patch, force_n } in forces {
         for &(node, share) in *patch {
-            let f = force * share;
+            let f = force_n * share;
             loads.add_nodal_force(node, [f.x, f.y, f.z]).unwrap();
         }
     }

@@ -15,8 +15,8 @@ use pgd_surgery::devices::{
 };
 
 use crate::common::{
-    Liver, TIP_RADIUS_M, exponential_liver, fem_displacement, fem_patch, fem_response, liver,
-    patch_average, scripted, target, tick_at,
+    Liver, PatchForce, TIP_RADIUS_M, exponential_liver, fem_displacement, fem_patch, fem_response,
+    liver, patch_average, scripted, target, tick_at,
 };
 use crate::faults::{Faulty, Kind};
 
@@ -183,7 +183,10 @@ fn felt_against_nonlinear_fem(apart_m: f64) -> [f64; 2] {
     let mut converged = false;
     for _ in 0..30 {
         let force = |hand: usize| forces.fixed_rows::<3>(3 * hand).into_owned();
-        let loads = [0, 1].map(|hand| (&presses.patches[hand][..], force(hand)));
+        let loads = [0, 1].map(|hand| PatchForce {
+            patch: &presses.patches[hand],
+            force_n: force(hand),
+        });
         let u = fem_displacement(model, &loads);
         let moved = [0, 1].map(|hand| patch_average(&u, &presses.patches[hand]));
         let moved = Vector6::from_iterator(moved.iter().flat_map(|m| m.iter().copied()));

@@ -88,20 +88,24 @@ impl SplitSurface {
         rest.iter().copied().chain(copies).collect()
     }
 
-    /// Moves `positions` (the uncut organ deformed under `load`, one per surface vertex) as
-    /// the cut organ deforms on each vertex's own side, and appends the copies, opened.
+    /// Moves `positions` (the uncut organ deformed under `loads`, every hand's, one per
+    /// surface vertex) as the cut organ deforms on each vertex's own side, and appends the
+    /// copies, opened: the cut answers the loads together (one hand's traction opens the cut
+    /// the other hand's blade made).
     pub(super) fn displace(
         &self,
         vademecum: &Vademecum,
-        load: &PatchLoad,
+        loads: &[PatchLoad],
         positions: &mut Vec<[f32; 3]>,
     ) {
         let view = &self.view;
         let node = |m: usize| vademecum.positions[m] as usize;
-        let nodal: Vec<(usize, f64)> = load
-            .shares
-            .iter()
-            .flat_map(|&(m, share)| (0..3).map(move |c| (3 * node(m) + c, share * load.force_n[c])))
+        let nodal: Vec<(usize, f64)> = (loads.iter())
+            .flat_map(|load| {
+                (load.shares.iter()).flat_map(move |&(m, share)| {
+                    (0..3).map(move |c| (3 * node(m) + c, share * load.force_n[c]))
+                })
+            })
             .collect();
         let answer = view.answer(&nodal);
         for (k, position) in positions.iter_mut().enumerate() {

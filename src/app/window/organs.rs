@@ -15,7 +15,7 @@ use super::cut_surface::{SplitSurface, walls_mesh};
 use super::{FrameSet, SceneView, tissue};
 use crate::dynamics::DynamicModel;
 use crate::mesh::vertex_normals;
-use crate::pgd::{SurfaceModes, Vademecum};
+use crate::pgd::{PatchLoad, SurfaceModes, Vademecum};
 
 /// An organ's visual model, mapped to its vademecum through the load positions (surface
 /// vertex `k` is volume node `positions[k]`).
@@ -190,7 +190,7 @@ fn deform(
         if let Some(motion) = &view.motion {
             motion.add_to_surface(&view.vademecum.positions, &organ.motion, &mut positions);
         }
-        let tool = &organ.deformation.loads[0];
+        let loads = &organ.deformation.loads;
         if let Some(rebuilt) = refresh_split(view, &link) {
             if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
                 *mesh = rebuilt;
@@ -203,7 +203,7 @@ fn deform(
             }
         }
         if let Some(split) = &view.split {
-            split.displace(&view.vademecum, tool, &mut positions);
+            split.displace(&view.vademecum, loads, &mut positions);
             let drawn = walls.iter().find(|(cut, _)| cut.index == view.index);
             if let Some(mut mesh) = drawn.and_then(|(_, m)| meshes.get_mut(&m.0)) {
                 let (points, indices) = split.walls(&positions);
@@ -211,7 +211,7 @@ fn deform(
             }
         }
         let triangles = view.drawn_triangles();
-        let colours = contact_tint(positions.len(), &tool.shares);
+        let colours = contact_tint(positions.len(), loads);
         if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
             mesh.insert_attribute(
                 Mesh::ATTRIBUTE_NORMAL,
@@ -248,11 +248,14 @@ fn refresh_split(view: &mut OrganView, link: &HapticLink) -> Option<Mesh> {
 
 /// Vertex colours that light up the tool's contact patch (by each position's share of the
 /// load) and leave the rest of the organ its tissue's colour.
-fn contact_tint(vertices: usize, shares: &[(usize, f64)]) -> Vec<[f32; 4]> {
+fn contact_tint(vertices: usize, loads: &[PatchLoad]) -> Vec<[f32; 4]> {
     let mut colours = vec![[1.0; 4]; vertices];
-    let largest = shares.iter().map(|s| s.1).fold(0.0, f64::max);
-    if largest > 0.0 {
-        for &(m, share) in shares {
+    for load in loads {
+        let largest = load.shares.iter().map(|s| s.1).fold(0.0, f64::max);
+        if largest <= 0.0 {
+            continue;
+        }
+        for &(m, share) in &load.shares {
             let t = (0.7 * share / largest) as f32;
             colours[m] = [1.0 + t, 1.0 + 0.8 * t, 1.0 + 0.3 * t, 1.0];
         }
