@@ -187,7 +187,7 @@ fn two_hands_lines(
             let instrument = scene.instruments.get(hand.instruments.in_hand);
             let tool = instrument.map_or("tool", |i| action_name(i.action));
             let touching: Vec<&str> = (0..link.scene.organs.len())
-                .filter(|&k| hand.touching & (1 << k) != 0)
+                .filter(|&k| k < 64 && hand.touching & (1 << k) != 0)
                 .map(name)
                 .collect();
             let doing = match (hand.holding, touching.is_empty()) {

@@ -90,9 +90,7 @@ impl Exercise {
         let prepared = (scenario.tasks.iter().enumerate())
             .map(|(k, task)| {
                 let setup = setup(&scenario, &sites, k);
-                let mut running = Running::prepare(task, setup, scenario.bimanual());
-                running.countertraction = countertraction(&scenario, task);
-                Some(running)
+                Some(Running::prepare(task, setup, &scenario))
             })
             .collect();
         Self {
@@ -218,8 +216,8 @@ fn countertraction(scenario: &Scenario, task: &Task) -> Option<CountertractionWa
 }
 
 impl Running {
-    /// The run of `task`, before it starts.
-    fn prepare(task: &Task, setup: RunSetup, bimanual: bool) -> Self {
+    /// The run of `task`, one of `scenario`'s, before it starts.
+    fn prepare(task: &Task, setup: RunSetup, scenario: &Scenario) -> Self {
         Self {
             metrics: TaskMetrics {
                 kind: task.label(),
@@ -232,9 +230,9 @@ impl Running {
             force_sum: 0.0,
             over_limit: LimitWatch::default(),
             motion: MotionTracker::default(),
-            hands: bimanual.then(BimanualTracker::default),
+            hands: scenario.bimanual().then(BimanualTracker::default),
             hand: task.hand(),
-            countertraction: None,
+            countertraction: countertraction(scenario, task),
             run: task.run(setup),
         }
     }

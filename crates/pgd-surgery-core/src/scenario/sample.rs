@@ -64,6 +64,11 @@ impl HandSample {
     pub fn working(&self) -> bool {
         self.touching != 0 || self.grasping != 0
     }
+
+    /// Whether the hand holds the scenario's `organ`-th organ: in its jaws or under its tool.
+    pub fn holds(&self, organ: usize) -> bool {
+        organ < 64 && (self.touching | self.grasping) & (1 << organ) != 0
+    }
 }
 
 impl Sample {

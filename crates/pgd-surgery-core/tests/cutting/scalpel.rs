@@ -237,15 +237,7 @@ fn the_view_opens_the_lips_as_full_xfem_does() {
     let view = worker.settle().clone();
     assert!(!view.functions.is_empty(), "the stroke enriched nothing");
     // The tool pressing down and across the cut beside it, 1 N.
-    let press = top_patch(
-        &model,
-        Point3::new(22.0 * MM, 21.0 * MM, 10.0 * MM),
-        4.0 * MM,
-    );
-    let pressed = PatchForce {
-        patch: press,
-        force_n: Vector3::new(0.0, 0.5, -1.0),
-    };
+    let pressed = top_force(&model, 21.0, [0.0, 0.5, -1.0]);
     let widest = view_against_xfem(&model, &view, &[pressed]);
     eprintln!("the lips open by up to {:.3} mm", widest / MM);
     assert!(widest > 1e-3 * MM, "the lips did not open");
@@ -259,24 +251,8 @@ fn the_view_opens_the_lips_as_full_xfem_does() {
 fn the_view_answers_two_hands_at_once_as_full_xfem_does() {
     let (model, mut worker) = stroke_on_block(&[30.0]);
     let view = worker.settle().clone();
-    let press = top_patch(
-        &model,
-        Point3::new(22.0 * MM, 21.0 * MM, 10.0 * MM),
-        4.0 * MM,
-    );
-    let pull = top_patch(
-        &model,
-        Point3::new(22.0 * MM, 9.0 * MM, 10.0 * MM),
-        4.0 * MM,
-    );
-    let pressed = PatchForce {
-        patch: press,
-        force_n: Vector3::new(0.0, 0.5, -1.0),
-    };
-    let pulled = PatchForce {
-        patch: pull,
-        force_n: Vector3::new(0.0, -0.5, 0.5),
-    };
+    let pressed = top_force(&model, 21.0, [0.0, 0.5, -1.0]);
+    let pulled = top_force(&model, 9.0, [0.0, -0.5, 0.5]);
     let alone = view_against_xfem(&model, &view, std::slice::from_ref(&pressed));
     let both = view_against_xfem(&model, &view, &[pressed, pulled]);
     eprintln!(
@@ -291,6 +267,16 @@ fn the_view_answers_two_hands_at_once_as_full_xfem_does() {
 struct PatchForce {
     patch: Vec<(usize, f64)>,
     force_n: Vector3<f64>,
+}
+
+/// `force_n` (N) on the 4 mm patch of the block's top at `y_mm` across the stroke (which runs
+/// along y = 20 mm), 22 mm along it: beside the cut, or across it on the other side.
+fn top_force(model: &FemModel, y_mm: f64, force_n: [f64; 3]) -> PatchForce {
+    let at = Point3::new(22.0 * MM, y_mm * MM, 10.0 * MM);
+    PatchForce {
+        patch: top_patch(model, at, 4.0 * MM),
+        force_n: Vector3::from(force_n),
+    }
 }
 
 /// The view's answer to `patches` against the full X-FEM solve of the same cut under the same

@@ -105,8 +105,7 @@ impl CountertractionWatch {
 
     /// Takes one tick of the other hand; returns the lapse it made, if any.
     pub fn step(&mut self, other: &HandSample, dt: f64) -> Option<Lapse> {
-        let bit = 1u64.checked_shl(self.organ as u32).unwrap_or(0);
-        let held = (other.grasping | other.touching) & bit != 0;
+        let held = other.holds(self.organ);
         let m = &mut self.metrics;
         if !held {
             m.not_held_s += dt;
