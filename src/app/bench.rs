@@ -9,11 +9,14 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use super::haptic::{HapticLoop, HapticScene, HapticThread, RealTimeReport, Scheduling, TickTimes};
+use super::haptic::{
+    HapticLoop, HapticScene, HapticThread, RealTimeReport, SceneHand, Scheduling, TickTimes,
+};
 use super::scene::press_targets;
 use crate::bench::fem::median_ms;
 use crate::devices::{
-    HapticDevice, PressMotion, PressTarget, Scripted, TICK_S, TimerMode, press_and_slide,
+    Action, HapticDevice, Instrument, PressMotion, PressTarget, Scripted, TICK_S, TimerMode,
+    grasp_and_hold, press_and_slide,
 };
 use crate::fem::{FemError, Law, Loads, NewtonSettings};
 use crate::mesh::Surface;
@@ -28,6 +31,8 @@ pub struct SweepFigures {
     pub hands: usize,
     pub ticks: u64,
     pub contact_ticks: u64,
+    /// Ticks the left hand's grasper held an organ (first run; none with one hand).
+    pub left_holding_ticks: u64,
     /// Ticks whose press went beyond a nonlinear vademecum's range (first run).
     pub beyond_range_ticks: u64,
     /// Medians over the repeats of each run's quantiles (µs).
@@ -63,7 +68,8 @@ pub struct HapticBenchReport {
     /// With `--hands 2`: the four-organ sweep with one hand...
     #[serde(skip_serializing_if = "Option::is_none")]
     pub one_hand: Option<HandsTick>,
-    /// ...and with two, the left hand sweeping the organs in the opposite order at once.
+    /// ...and with two at once: the left hand a grasper holding the gallbladder drawn out
+    /// (where it moves) while the right sweeps.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub two_hands: Option<HandsTick>,
 }
@@ -74,6 +80,8 @@ pub struct HapticBenchReport {
 pub struct HandsTick {
     pub hands: usize,
     pub contact_ticks: u64,
+    /// Ticks the left hand's grasper held an organ.
+    pub left_holding_ticks: u64,
     pub tick_p50_us: f64,
     pub tick_p99_us: f64,
     pub tick_max_us: f64,
@@ -84,6 +92,7 @@ impl From<&SweepFigures> for HandsTick {
         Self {
             hands: sweep.hands,
             contact_ticks: sweep.contact_ticks,
+            left_holding_ticks: sweep.left_holding_ticks,
             tick_p50_us: sweep.compute_p50_us,
             tick_p99_us: sweep.compute_p99_us,
             tick_max_us: sweep.compute_max_us,
@@ -143,10 +152,16 @@ pub fn run(
     })
 }
 
-/// `scene` with a left hand holding the right's instruments.
+/// `scene` with a left hand holding a grasper in the open.
 fn with_left_hand(scene: &HapticScene) -> HapticScene {
     let mut both = scene.clone();
-    both.hands.push(scene.hands[0].clone());
+    both.hands.push(SceneHand {
+        instruments: vec![Instrument {
+            action: Action::Grasp,
+            port: None,
+        }],
+        ..SceneHand::default()
+    });
     both
 }
 
@@ -155,18 +170,23 @@ fn device(targets: &[PressTarget], motion: &PressMotion) -> Box<dyn HapticDevice
     Box::new(Scripted::new("benchmark sweep", trajectory))
 }
 
-/// A device per hand of `scene`: the right sweeps `targets` in order, the left in the
-/// opposite order, so that the hands press different organs at once.
+/// A device per hand of `scene`: the right sweeps `targets` in order; the left grasps the
+/// gallbladder (else the first organ) and holds it drawn out while the right sweeps.
 fn devices(
     scene: &HapticScene,
     targets: &[PressTarget],
     motion: &PressMotion,
 ) -> Vec<Box<dyn HapticDevice>> {
-    let reversed: Vec<PressTarget> = targets.iter().rev().copied().collect();
-    let orders = [targets, &reversed[..]];
-    (orders.iter().take(scene.hands.len()))
-        .map(|order| device(order, motion))
-        .collect()
+    let mut devices = vec![device(targets, motion)];
+    if scene.hands.len() > 1 {
+        let mut organs = scene.organs.iter();
+        let held = organs.position(|(name, _)| name == "gallbladder");
+        let target = &targets[held.unwrap_or(0)];
+        let sweep_s = press_and_slide(targets, motion).duration_s();
+        let trajectory = grasp_and_hold(target, motion, sweep_s);
+        devices.push(Box::new(Scripted::new("benchmark grasp", trajectory)));
+    }
+    devices
 }
 
 fn sweep(
@@ -194,6 +214,7 @@ fn sweep(
         hands: scene.hands.len(),
         ticks,
         contact_ticks: runs[0].force.contact_ticks,
+        left_holding_ticks: runs[0].left_force.as_ref().map_or(0, |f| f.holding_ticks),
         beyond_range_ticks: runs[0].range.beyond_ticks,
         compute_p50_us: median(&|t| t.p50_us),
         compute_p99_us: median(&|t| t.p99_us),
@@ -321,10 +342,12 @@ impl fmt::Display for HapticBenchReport {
         if let (Some(one), Some(two)) = (&self.one_hand, &self.two_hands) {
             writeln!(
                 f,
-                "two hands at once: tick p99 {:.1} µs against one hand's {:.1} µs ({:.2}x)",
+                "two hands at once: tick p99 {:.1} µs against one hand's {:.1} µs ({:.2}x); \
+                 the left grasper held for {} ticks",
                 two.tick_p99_us,
                 one.tick_p99_us,
-                two.tick_p99_us / one.tick_p99_us.max(f64::MIN_POSITIVE)
+                two.tick_p99_us / one.tick_p99_us.max(f64::MIN_POSITIVE),
+                two.left_holding_ticks
             )?;
         }
         writeln!(

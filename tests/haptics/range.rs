@@ -141,7 +141,7 @@ fn beyond_the_range_the_felt_force_follows_a_move_of_the_surface() {
     let target = Target {
         vademecum: &vademecum,
         surface: &surface,
-        moved_by_others: |_| Vector3::zeros(),
+        moved_by_others: |_: &_| Vector3::zeros(),
         moved_by_all: |_: &SurfacePoint| Vector3::zeros(),
     };
     let probe = Probe {

@@ -73,11 +73,11 @@ impl HandTouches {
     }
 }
 
-/// `patch`'s shares by mesh node rather than by load position, into `nodes` (emptied first;
-/// its room kept, so that a buffer made for every position never grows).
-pub fn patch_nodes(patch: &Patch, vademecum: &Vademecum, nodes: &mut Vec<(usize, f64)>) {
+/// A patch's `shares` by mesh node rather than by load position, into `nodes` (emptied
+/// first; its room kept, so that a buffer made for every position never grows).
+pub fn patch_nodes(shares: &[(usize, f64)], vademecum: &Vademecum, nodes: &mut Vec<(usize, f64)>) {
     nodes.clear();
-    let shares = patch.shares.iter();
+    let shares = shares.iter();
     nodes.extend(shares.map(|&(position, share)| (vademecum.positions[position] as usize, share)));
 }
 

@@ -10,9 +10,10 @@ use nalgebra::{Matrix3, Point3, Unit, Vector3};
 
 use super::components::{HandTouches, OrganBody, OrganDeformation, patch_nodes};
 use super::hand::{HandIndex, Tool};
-use crate::contact::ToolContact;
+use crate::contact::{ToolContact, follow};
 use crate::cutting::{BladeContact, CutWorker, Scalpel};
 use crate::devices::Action;
+use crate::pgd::{PatchLoad, Vademecum};
 
 /// An organ a scalpel cuts: the blade on it, and its cut state on a worker thread (whose
 /// latest view the tick reads; the worker frees the views it replaces, so that the tick never
@@ -24,17 +25,22 @@ pub struct OrganCut {
     /// Scratch kept from tick to tick: the patch's nodes and shares, room for every load
     /// position.
     nodes: Vec<(usize, f64)>,
+    /// Each hand's load on the organ as the cut stage settled it last tick, what the other
+    /// hands' presses answer through the cut this tick.
+    settled: Vec<PatchLoad>,
     /// The exercise's attempt the tissue was cut in (0 before the first).
     pub(super) attempt: u32,
 }
 
 impl OrganCut {
-    /// `positions`: the organ's load positions, the most a patch holds.
-    pub fn new(scalpel: Scalpel, worker: CutWorker, positions: usize) -> Self {
+    /// `positions`: the organ's load positions, the most a patch holds; `hands`: how many
+    /// hands load it.
+    pub fn new(scalpel: Scalpel, worker: CutWorker, positions: usize, hands: usize) -> Self {
         Self {
             scalpel,
             worker,
             nodes: Vec::with_capacity(positions),
+            settled: (0..hands).map(|_| PatchLoad::reserved(positions)).collect(),
             attempt: 0,
         }
     }
@@ -44,10 +50,11 @@ impl OrganCut {
 #[derive(Resource, Clone, Copy, Debug, Default)]
 pub struct SettleCuts;
 
-/// Reads each cut organ's latest cut, softens every hand's press on it, and hands the blade's
-/// step, if any, to the organ's cut state: the blade is the first hand's whose instrument
-/// cuts, its press on tissue the other hand may hold taut (that hand's load is among the
-/// organ's loads the press answers).
+/// Reads each cut organ's latest cut, softens every hand's press on it, moves each press by
+/// what the cut lets the organ's other loads move its patch, and hands the blade's step, if
+/// any, to the organ's cut state: the blade is the first hand's whose instrument cuts, its
+/// press on tissue the other hand may hold taut (that hand's load, a grasp's or a press's, is
+/// among the organ's loads the press answers).
 pub fn cut(
     tools: Query<(&HandIndex, &Tool)>,
     settle: Option<Res<SettleCuts>>,
@@ -60,6 +67,7 @@ pub fn cut(
             scalpel,
             worker,
             nodes,
+            settled,
             ..
         } = organ.cut.into_inner();
         match settle {
@@ -70,7 +78,7 @@ pub fn cut(
             let Some(contact) = touch.contact.as_mut() else {
                 continue;
             };
-            patch_nodes(&touch.patch, &body.vademecum, nodes);
+            patch_nodes(&touch.patch.shares, &body.vademecum, nodes);
             soften(contact, worker.added_compliance(nodes));
             let cuts = blade.is_some_and(|(hand, _)| hand.0 == slot);
             if let Some(parted_m) = scalpel.parted_depth_m().filter(|_| cuts) {
@@ -78,6 +86,11 @@ pub fn cut(
             }
             contact.force_n = contact.stiffness_n_per_m * contact.indentation_m;
             deformation.0.loads[slot].force_n = contact.force_n;
+        }
+        let loads = &mut deformation.0.loads;
+        answer_other_loads(&body.vademecum, worker, nodes, settled, &mut touches, loads);
+        for (settled, load) in settled.iter_mut().zip(loads.iter()) {
+            settled.clone_from(load);
         }
         // The cut organ answers any instrument softer, but only a blade parts it.
         let pressed = blade.and_then(|(hand, tool)| {
@@ -90,6 +103,42 @@ pub fn cut(
         if let Some(step) = scalpel.tick(pressed.as_ref()) {
             worker.submit(step);
         }
+    }
+}
+
+/// Where two or more hands load a cut organ, each press follows what the cut adds to its
+/// patch's displacement under the others' loads (`Y_aᵀ Y_b f_b`; the vademecum moved the
+/// surface by the uncut part already): the grasp that pulls the tissue across the cut, or
+/// the press on its other lip, moves the tissue under the blade further than the uncut organ
+/// would. The others' loads are taken as this stage `settled` them last tick, as the press
+/// took their uncut part, so that hands held still settle on the full cut organ's answer.
+fn answer_other_loads(
+    vademecum: &Vademecum,
+    worker: &mut CutWorker,
+    nodes: &mut Vec<(usize, f64)>,
+    settled: &[PatchLoad],
+    touches: &mut HandTouches,
+    loads: &mut [PatchLoad],
+) {
+    if worker.view().unknowns == 0 {
+        return;
+    }
+    for (slot, touch) in touches.0.iter_mut().enumerate() {
+        let others = || {
+            let others = settled.iter().enumerate();
+            others.filter(move |&(b, load)| b != slot && load.is_active())
+        };
+        if touch.contact.is_none() || others().next().is_none() {
+            continue;
+        }
+        worker.clear_loads();
+        for (_, load) in others() {
+            patch_nodes(&load.shares, vademecum, nodes);
+            worker.add_load(nodes, &load.force_n);
+        }
+        patch_nodes(&loads[slot].shares, vademecum, nodes);
+        let by_others = worker.patch_response(nodes).moved_m;
+        follow(&mut touch.contact, &mut loads[slot], &by_others);
     }
 }
 

@@ -33,6 +33,8 @@ impl TickTimes {
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct ForceSummary {
     pub contact_ticks: u64,
+    /// Ticks the hand's jaws held an organ.
+    pub holding_ticks: u64,
     pub max_desired_n: f64,
     pub max_sent_n: f64,
     /// Mean magnitude of the sent force over the ticks in contact.
@@ -43,7 +45,8 @@ pub struct ForceSummary {
 }
 
 impl ForceSummary {
-    pub(super) fn record(&mut self, force: &DeviceForce, touching: bool) {
+    pub(super) fn record(&mut self, force: &DeviceForce, touching: bool, holding: bool) {
+        self.holding_ticks += u64::from(holding);
         let sent = force.sent_n.norm();
         let change = (force.sent_n - nalgebra::Vector3::from(self.final_n)).norm();
         self.max_change_n_per_tick = self.max_change_n_per_tick.max(change);

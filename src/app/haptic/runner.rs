@@ -276,7 +276,8 @@ impl HapticLoop {
             {
                 let scalpel = Scalpel::new(cutting.blade, cut.toughness_j_per_m2);
                 let worker = CutWorker::spawn(cut.model.clone(), name, cut.drawn.clone())?;
-                organ.insert(OrganCut::new(scalpel, worker, vademecum.positions.len()));
+                let positions = vademecum.positions.len();
+                organ.insert(OrganCut::new(scalpel, worker, positions, hands));
             }
         }
         let hands = (scene.hands.iter().enumerate())
@@ -423,11 +424,13 @@ impl HapticLoop {
         HeadlessReport::new(device, organs, faults, ran, forces, range, &compute)
     }
 
-    /// Records the tick's force of each hand, and how far each tool pressed beyond its
-    /// organ's range.
+    /// Records the tick's force of each hand, whether it holds an organ, and how far each
+    /// tool pressed beyond its organ's range.
     fn record_tick(&mut self, forces: &mut [ForceSummary], range: &mut RangeSummary) {
         let mut organs = self.world.query::<(&OrganBody, &HandTouches)>();
+        let mut moving = self.world.query::<&OrganMotion>();
         for (slot, summary) in forces.iter_mut().enumerate() {
+            let holding = (moving.iter(&self.world)).any(|m| m.organ.holding() && m.hand == slot);
             let mut touching = false;
             for (body, touches) in organs.iter(&self.world) {
                 let Some(contact) = &touches.0[slot].contact else {
@@ -438,7 +441,7 @@ impl HapticLoop {
                 range.record(&body.name, contact.beyond_range_m, valid_m);
             }
             let force = self.world.get::<DeviceForce>(self.hands[slot]);
-            summary.record(force.expect("every hand has its force"), touching);
+            summary.record(force.expect("every hand has its force"), touching, holding);
         }
     }
 

@@ -426,7 +426,7 @@ mod tests {
         stroke().into_iter().for_each(|step| worker.submit(step));
         assert!(worker.settle().unknowns > 0, "the stroke cut nothing");
         let scalpel = Scalpel::new(Blade::default(), LIVER_TOUGHNESS_J_PER_M2);
-        OrganCut::new(scalpel, worker, 0)
+        OrganCut::new(scalpel, worker, 0, 1)
     }
 
     /// The first attempt keeps the tissue as it is; once a retry is started, the cut organs

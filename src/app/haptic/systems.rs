@@ -15,7 +15,7 @@ use super::resources::{OrganCoupling, TickClock};
 use super::snapshot::{HandSnapshot, InstrumentsView, LoopTiming, SnapshotPublisher};
 use crate::contact::{Target, follow, press};
 use crate::devices::{Action, Fault, Fulcrum};
-use crate::pgd::{Deformation, SurfacePoint};
+use crate::pgd::{Deformation, Patch, SurfacePoint};
 
 /// Reads each hand's device into its [`Tool::hand`], mapped onto the scene. A non-finite
 /// sample or a device error is a fault of that hand, whose tool keeps its last good position;
@@ -94,41 +94,44 @@ fn place(tool: &mut Tool) {
 
 /// Presses each hand's tool into every organ it touches, on the surface as the organ's other
 /// loads (the other hand's among them) have moved it, and sets the hand's load on the organ.
+/// Every hand reads the others' loads as the last tick left them, and the new loads are set
+/// once all have pressed: a hand's press on a cut organ is settled by the cut stage, after
+/// this one, and a second hand must not read the first's unsettled press.
 pub fn tool_contact(
     tools: Query<(&HandIndex, &Tool)>,
     mut organs: Query<(&OrganBody, &mut HandTouches, &mut OrganDeformation)>,
 ) {
     for (hand, tool) in &tools {
-        for (body, mut touches, mut deformation) in &mut organs {
-            press_organ(
-                hand.0,
-                tool,
-                body,
-                &mut touches.0[hand.0],
-                &mut deformation.0,
-            );
+        for (body, mut touches, deformation) in &mut organs {
+            press_organ(hand.0, tool, body, &mut touches.0[hand.0], &deformation.0);
+        }
+    }
+    for (_, mut touches, mut deformation) in &mut organs {
+        let loads = deformation.0.loads.iter_mut();
+        for (load, touch) in loads.zip(touches.0.iter_mut()) {
+            std::mem::swap(load, &mut touch.next_load);
         }
     }
 }
 
-/// Hand `slot`'s tool pressed into one organ.
+/// Hand `slot`'s tool pressed into one organ: its contact, and its load next.
 fn press_organ(
     slot: usize,
     tool: &Tool,
     body: &OrganBody,
     touch: &mut ToolTouch,
-    deformation: &mut Deformation,
+    deformation: &Deformation,
 ) {
     let Some(sample) = &tool.sample else {
-        deformation.loads[slot].release();
+        touch.next_load.release();
         touch.contact = None;
         return;
     };
     let target = Target {
         vademecum: &body.vademecum,
         surface: &body.surface,
-        moved_by_others: |position: usize| {
-            deformation.position_displacement_without(&body.vademecum, position, slot)
+        moved_by_others: |patch: &Patch| {
+            deformation.patch_displacement_without(&body.vademecum, patch, slot)
         },
         moved_by_all: |at: &SurfacePoint| deformation.displacement(&body.vademecum, at),
     };
@@ -141,7 +144,6 @@ fn press_organ(
         &mut touch.patch,
         &mut touch.next_load,
     );
-    std::mem::swap(&mut deformation.loads[slot], &mut touch.next_load);
 }
 
 /// One hand's grasper jaws this tick.
@@ -259,7 +261,7 @@ pub struct MovingOrgan {
 /// compliance there), starting from the press's force.
 fn take_hold(body: &OrganBody, touch: &ToolTouch, motion: &mut OrganMotion, hand_m: &Vector3<f64>) {
     let vademecum = &body.vademecum;
-    patch_nodes(&touch.patch, vademecum, &mut motion.patch_nodes);
+    patch_nodes(&touch.patch.shares, vademecum, &mut motion.patch_nodes);
     let compliance = vademecum.compliance(&touch.patch, &Vector3::zeros());
     let centre = touch.contact.map_or(Vector3::zeros(), |c| c.hit.point_m);
     let basis = &motion.model.basis;

@@ -610,8 +610,9 @@ pub struct HapticsBenchArgs {
     /// vademecum's range to time the presses beyond it).
     #[arg(long, default_value_t = PressMotion::default().depth_m * 1e3)]
     pub depth_mm: f64,
-    /// Hands pressing: 2 times the four-organ sweep again with a left hand sweeping the
-    /// organs in the opposite order at once (`one_hand` and `two_hands` in the report).
+    /// Hands: 2 times the four-organ sweep again with a left hand grasping the gallbladder
+    /// (which then moves, in both sweeps) and holding it drawn out while the right hand
+    /// sweeps (`one_hand` and `two_hands` in the report).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
     pub hands: u8,
     /// Print the report as JSON instead of a table.

@@ -381,9 +381,11 @@ fn bench_haptics(options: HapticsBenchArgs) -> ExitCode {
         },
         Err(e) => return fail("pgd bench haptics", &e),
     };
+    // Two hands: the left grasps the gallbladder, which moves for it.
+    let moves = |organ: Organ| dynamic || (hands == 2 && organ == Organ::Gallbladder);
     let organs = SCENE_ORGANS.map(|organ| SceneOrgan {
-        dynamic,
-        law: law.map_or(default_law(Some(organ), false, dynamic), |l| l.law()),
+        dynamic: moves(organ),
+        law: law.map_or(default_law(Some(organ), false, moves(organ)), |l| l.law()),
         ..SceneOrgan::from(organ)
     });
     let detail = if coarse { Detail::Coarse } else { Detail::Full };

@@ -71,12 +71,12 @@ impl ToolContact {
     }
 }
 
-/// What the tool presses: an organ's vademecum, its contact surface, how far each load
-/// position has moved under the organ's other loads, and how far each surface point has moved
-/// under all its loads (the tool's of the last tick included) (m).
+/// What the tool presses: an organ's vademecum, its contact surface, how far a patch has
+/// moved under the organ's other loads (averaged by its shares), and how far each surface
+/// point has moved under all its loads (the tool's of the last tick included) (m).
 pub struct Target<'a, F, G>
 where
-    F: Fn(usize) -> Vector3<f64>,
+    F: Fn(&Patch) -> Vector3<f64>,
     G: Fn(&SurfacePoint) -> Vector3<f64>,
 {
     pub vademecum: &'a Vademecum,
@@ -99,7 +99,7 @@ pub fn press<F, G>(
     load: &mut PatchLoad,
 ) -> Option<ToolContact>
 where
-    F: Fn(usize) -> Vector3<f64>,
+    F: Fn(&Patch) -> Vector3<f64>,
     G: Fn(&SurfacePoint) -> Vector3<f64>,
 {
     let vademecum = target.vademecum;
@@ -145,7 +145,7 @@ fn touch<F, G>(
     patch: &mut Patch,
 ) -> Option<ToolContact>
 where
-    F: Fn(usize) -> Vector3<f64>,
+    F: Fn(&Patch) -> Vector3<f64>,
     G: Fn(&SurfacePoint) -> Vector3<f64>,
 {
     let (vademecum, surface) = (target.vademecum, target.surface);
@@ -160,11 +160,7 @@ where
         )?;
     }
     vademecum.patch_into(&hit.at, patch);
-    let moved_m: Vector3<f64> = patch
-        .shares
-        .iter()
-        .map(|&(position, share)| (target.moved_by_others)(position) * share)
-        .sum();
+    let moved_m = (target.moved_by_others)(patch);
     let depth_m = probe.tip_radius_m - (tip_m - hit.point_m - moved_m).dot(&hit.normal);
     if depth_m <= 0.0 {
         return None;

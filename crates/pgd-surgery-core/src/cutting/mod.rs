@@ -34,7 +34,7 @@ pub use validation::{
     CutCase, CutPattern, CutValidationReport, CutValidationSettings, tool_patch,
     validate_incisions, validate_keratotomy,
 };
-pub use view::{CutAnswer, CutView};
+pub use view::{CutAnswer, CutScratch, CutView, PatchCut};
 pub use worker::{CutWorker, LatestCut};
 pub use xfem::CutSolution;
 

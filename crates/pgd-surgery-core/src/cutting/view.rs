@@ -71,13 +71,72 @@ impl CutView {
     }
 
     /// What the cut adds to the uncut compliance (m/N) of the patch `patch` (nodes and their
-    /// shares of the tool's load): `Yᵀ Y`, zero with nothing cut. `y` is scratch space, kept
-    /// from tick to tick so that nothing is allocated once it has grown.
-    pub fn added_compliance(&self, patch: &[(usize, f64)], y: &mut [Vec<f64>; 3]) -> Matrix3<f64> {
+    /// shares of the tool's load): `Yᵀ Y`, zero with nothing cut. `scratch` is kept from tick
+    /// to tick so that nothing is allocated once it has grown.
+    pub fn added_compliance(
+        &self,
+        patch: &[(usize, f64)],
+        scratch: &mut CutScratch,
+    ) -> Matrix3<f64> {
         if self.unknowns == 0 {
             return Matrix3::zeros();
         }
-        for (axis, y) in y.iter_mut().enumerate() {
+        self.patch_rows(patch, &mut scratch.rows);
+        gram(scratch.rows.as_slice())
+    }
+
+    /// Starts summing the cut's part of the organ's loads in `scratch`: none yet.
+    pub fn clear_loads(&self, scratch: &mut CutScratch) {
+        scratch.loads.clear();
+        scratch.loads.resize(self.unknowns, 0.0);
+    }
+
+    /// Adds the cut's part of `force_n` (N) spread over the patch `patch` to the loads summed
+    /// in `scratch`: `w += Ẑᵀ P f`.
+    pub fn add_load(
+        &self,
+        patch: &[(usize, f64)],
+        force_n: &Vector3<f64>,
+        scratch: &mut CutScratch,
+    ) {
+        for &(node, share) in patch {
+            for axis in 0..3 {
+                let load = [(3 * node + axis, share * force_n[axis])];
+                add_surface_part(
+                    &self.surface_index_of,
+                    &self.z_hat_surface,
+                    &load,
+                    &mut scratch.loads,
+                );
+            }
+        }
+    }
+
+    /// What the cut adds at the patch `patch`: to its compliance (`Yᵀ Y`), and to its
+    /// displacement under the loads summed in `scratch` (`Yᵀ w`, its own load's part among
+    /// them if it was added). Both zero with nothing cut.
+    pub fn patch_response(&self, patch: &[(usize, f64)], scratch: &mut CutScratch) -> PatchCut {
+        if self.unknowns == 0 {
+            return PatchCut::default();
+        }
+        self.patch_rows(patch, &mut scratch.rows);
+        let rows = &scratch.rows;
+        let moved = |axis: usize| {
+            rows[axis]
+                .iter()
+                .zip(&scratch.loads)
+                .map(|(y, w)| y * w)
+                .sum()
+        };
+        PatchCut {
+            added_m_per_n: gram(rows.as_slice()),
+            moved_m: Vector3::from_fn(|axis, _| moved(axis)),
+        }
+    }
+
+    /// `Y = Ẑᵀ P` for the patch `patch`, a row per axis, into `rows`.
+    fn patch_rows(&self, patch: &[(usize, f64)], rows: &mut [Vec<f64>; 3]) {
+        for (axis, y) in rows.iter_mut().enumerate() {
             y.clear();
             y.resize(self.unknowns, 0.0);
             for &(node, share) in patch {
@@ -85,7 +144,34 @@ impl CutView {
                 add_surface_part(&self.surface_index_of, &self.z_hat_surface, &load, y);
             }
         }
-        gram(y.as_slice())
+    }
+}
+
+/// What a cut adds at a tool's patch ([`CutView::patch_response`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PatchCut {
+    /// To the patch's compliance (m/N).
+    pub added_m_per_n: Matrix3<f64>,
+    /// To the patch's displacement under the organ's loads (m).
+    pub moved_m: Vector3<f64>,
+}
+
+/// Scratch space for a view's answers at a patch: `Y`'s three rows, and the cut's part of the
+/// organ's loads, `w`. Made with room for every unknown of a view, the haptic tick never grows
+/// it.
+#[derive(Clone, Debug, Default)]
+pub struct CutScratch {
+    rows: [Vec<f64>; 3],
+    loads: Vec<f64>,
+}
+
+impl CutScratch {
+    /// Room for `unknowns` enriched unknowns.
+    pub fn with_room(unknowns: usize) -> Self {
+        Self {
+            rows: std::array::from_fn(|_| Vec::with_capacity(unknowns)),
+            loads: Vec::with_capacity(unknowns),
+        }
     }
 }
 

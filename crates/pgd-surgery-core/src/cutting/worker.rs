@@ -17,7 +17,7 @@ mod threaded;
 use std::borrow::Borrow;
 use std::sync::{Arc, Mutex, PoisonError};
 
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 
 #[cfg(target_arch = "wasm32")]
 use inline::Backend;
@@ -29,12 +29,8 @@ use super::enrichment::Front;
 use super::response::ExactResponse;
 use super::scalpel::CutStep;
 use super::state::CutState;
-use super::view::CutView;
+use super::view::{CutScratch, CutView, PatchCut};
 use crate::fem::FemModel;
-
-/// The scratch of `Yᵀ Y` over a view's unknowns ([`CutView::added_compliance`]): made by the
-/// worker with each view, with room for all its unknowns, so that the tick never grows it.
-type Rows = [Vec<f64>; 3];
 
 /// What the haptic side hands the worker: a step to apply, or a view it no longer reads with
 /// its scratch, to be freed by the worker rather than on the haptic thread (a view holds
@@ -43,13 +39,13 @@ enum Job {
     Step(CutStep),
     /// Undo every incision (a new attempt at the exercise starts on uncut tissue).
     Heal,
-    Retire(Arc<CutView>, Rows),
+    Retire(Arc<CutView>, CutScratch),
 }
 
 /// What the worker answers a step or a heal with.
 enum Outcome {
     /// The cut grew, or was healed: the state as it now stands, and its scratch.
-    Changed(Arc<CutView>, Rows),
+    Changed(Arc<CutView>, CutScratch),
     /// Nothing to publish (an incision set on the surface has cut nothing yet).
     Unchanged,
     /// The cut state refused the step and stands as it was.
@@ -109,8 +105,8 @@ impl<M: Borrow<FemModel>> Cutter<M> {
                 };
                 Ok(true)
             }
-            Job::Retire(view, rows) => {
-                drop((view, rows));
+            Job::Retire(view, scratch) => {
+                drop((view, scratch));
                 return (cutter, None);
             }
         };
@@ -118,8 +114,8 @@ impl<M: Borrow<FemModel>> Cutter<M> {
             Ok(true) => {
                 let view = Arc::new(cutter.state.view());
                 latest.set(view.clone());
-                let rows = std::array::from_fn(|_| Vec::with_capacity(view.unknowns));
-                Outcome::Changed(view, rows)
+                let scratch = CutScratch::with_room(view.unknowns);
+                Outcome::Changed(view, scratch)
             }
             Ok(false) => Outcome::Unchanged,
             Err(error) => Outcome::Refused(error),
@@ -149,7 +145,8 @@ const REFUSALS_KEPT: usize = 32;
 pub struct CutWorker {
     backend: Backend,
     view: Arc<CutView>,
-    rows: Rows,
+    /// Scratch for the latest view's answers, made with it by the worker.
+    scratch: CutScratch,
     /// The first [`REFUSALS_KEPT`] refusals (later ones are not kept: the list never grows
     /// on the haptic thread).
     refused: Vec<CutError>,
@@ -169,7 +166,7 @@ impl CutWorker {
         Ok(Self {
             backend: Backend::start(model, response, name, latest)?,
             view: Arc::new(empty),
-            rows: Rows::default(),
+            scratch: CutScratch::default(),
             refused: Vec::with_capacity(REFUSALS_KEPT),
         })
     }
@@ -209,7 +206,25 @@ impl CutWorker {
     /// What the cut adds to the uncut compliance (m/N) of the patch `patch` (mesh nodes and
     /// their shares) in the latest view taken: allocates nothing.
     pub fn added_compliance(&mut self, patch: &[(usize, f64)]) -> Matrix3<f64> {
-        self.view.added_compliance(patch, &mut self.rows)
+        self.view.added_compliance(patch, &mut self.scratch)
+    }
+
+    /// Starts summing the organ's loads for [`Self::patch_response`]: none yet.
+    pub fn clear_loads(&mut self) {
+        self.view.clear_loads(&mut self.scratch);
+    }
+
+    /// Adds `force_n` (N) on the patch `patch` (mesh nodes and their shares) to the organ's
+    /// loads.
+    pub fn add_load(&mut self, patch: &[(usize, f64)], force_n: &Vector3<f64>) {
+        self.view.add_load(patch, force_n, &mut self.scratch);
+    }
+
+    /// What the cut adds at the patch `patch` in the latest view taken: to its compliance, and
+    /// to its displacement under the loads added since [`Self::clear_loads`]. Allocates
+    /// nothing.
+    pub fn patch_response(&mut self, patch: &[(usize, f64)]) -> PatchCut {
+        self.view.patch_response(patch, &mut self.scratch)
     }
 
     /// Steps handed over and not yet answered.
@@ -230,10 +245,10 @@ impl CutWorker {
 
     fn take(&mut self, outcome: Outcome) {
         match outcome {
-            Outcome::Changed(view, rows) => {
+            Outcome::Changed(view, scratch) => {
                 let old = std::mem::replace(&mut self.view, view);
-                let old_rows = std::mem::replace(&mut self.rows, rows);
-                self.backend.send(Job::Retire(old, old_rows));
+                let old_scratch = std::mem::replace(&mut self.scratch, scratch);
+                self.backend.send(Job::Retire(old, old_scratch));
             }
             Outcome::Unchanged => {}
             Outcome::Refused(error) if self.refused.len() < REFUSALS_KEPT => {

@@ -83,8 +83,9 @@ pub fn felt_force(
     Ok(compliance.try_inverse().map(|k| k * indentation_m))
 }
 
-/// One factorization, a solve per load vector (full dofs).
-fn solve_each(
+/// Solves the cut organ under each of `loads` (nodal forces over every dof), with one
+/// factorization.
+pub fn solve_each(
     model: &FemModel,
     enrichment: &Enrichment,
     loads: &[&[f64]],

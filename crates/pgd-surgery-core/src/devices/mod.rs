@@ -50,7 +50,7 @@ pub use safety::{Fault, SafetyFilter, SafetySettings, check_force_limit};
 pub use scripted::Scripted;
 pub use servo::{ServoLink, WATCHDOG_S, WatchdogRecord, halt_every_link};
 pub use spec::DeviceSpec;
-pub use sweep::{PressMotion, PressTarget, press_and_slide};
+pub use sweep::{GRASP_PULL_M, PressMotion, PressTarget, grasp_and_hold, press_and_slide};
 pub use timing::{Histogram, Metronome, TimerMode};
 pub use trajectory::{Trajectory, TrajectoryError, TrajectoryRow};
 #[cfg(not(target_arch = "wasm32"))]

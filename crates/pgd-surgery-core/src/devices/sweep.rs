@@ -1,5 +1,5 @@
-//! Built-in scripts: a press-and-slide at each of a list of surface points, for the headless
-//! demo, tests and the timing benchmark.
+//! Built-in scripts: a press-and-slide at each of a list of surface points, and a grasp held
+//! at one, for the headless demo, tests and the timing benchmark.
 
 use nalgebra::Vector3;
 
@@ -51,11 +51,7 @@ pub fn press_and_slide(targets: &[PressTarget], motion: &PressMotion) -> Traject
     let mut rows = Vec::new();
     let mut time_s = 0.0;
     for target in targets {
-        let n = target.normal;
-        let tangent = n.cross(&helper_axis(&n)).normalize();
-        let centre = |depth: f64, slide: f64| {
-            target.point_m + n * (motion.tip_radius_m - depth) + tangent * slide
-        };
+        let centre = |depth: f64, slide: f64| target.tip_at(motion, depth, slide);
         let keyframes = [
             (0.0, centre(-CLEARANCE_M, 0.0)),
             (motion.approach_s, centre(0.0, 0.0)),
@@ -75,6 +71,50 @@ pub fn press_and_slide(targets: &[PressTarget], motion: &PressMotion) -> Traject
         }
     }
     Trajectory { rows }
+}
+
+/// How far a held grasp draws the tissue back out along the normal (m): traction.
+pub const GRASP_PULL_M: f64 = 0.01;
+
+/// A grasp at `target` held for `hold_s`: down and in as a press, the jaws (button 0) closed
+/// at depth, the tissue drawn back out by [`GRASP_PULL_M`] over the slide's time and held
+/// there, then let go and lifted.
+pub fn grasp_and_hold(target: &PressTarget, motion: &PressMotion, hold_s: f64) -> Trajectory {
+    const JAWS_S: f64 = 0.05;
+    let centre = |depth: f64| target.tip_at(motion, depth, 0.0);
+    let pulled = motion.depth_m - GRASP_PULL_M;
+    let keyframes = [
+        (0.0, centre(-CLEARANCE_M), false),
+        (motion.approach_s, centre(0.0), false),
+        (motion.press_s, centre(motion.depth_m), false),
+        (JAWS_S, centre(motion.depth_m), true),
+        (motion.slide_s, centre(pulled), true),
+        (hold_s, centre(pulled), true),
+        (JAWS_S, centre(pulled), false),
+        (motion.lift_s, centre(-CLEARANCE_M), false),
+    ];
+    let mut time_s = 0.0;
+    let rows = keyframes.map(|(dt, tip, closed)| {
+        time_s += dt;
+        let sample = DeviceSample {
+            buttons: u32::from(closed),
+            ..DeviceSample::at(tip)
+        };
+        TrajectoryRow::new(time_s, &sample)
+    });
+    Trajectory {
+        rows: rows.to_vec(),
+    }
+}
+
+impl PressTarget {
+    /// Where `motion`'s tip is centred with its lowest point `depth_m` below this point of the
+    /// surface (negative: above), slid `slide_m` along the surface.
+    fn tip_at(&self, motion: &PressMotion, depth_m: f64, slide_m: f64) -> Vector3<f64> {
+        let n = self.normal;
+        let tangent = n.cross(&helper_axis(&n)).normalize();
+        self.point_m + n * (motion.tip_radius_m - depth_m) + tangent * slide_m
+    }
 }
 
 fn helper_axis(n: &Vector3<f64>) -> Vector3<f64> {

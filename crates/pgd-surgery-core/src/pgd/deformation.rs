@@ -4,7 +4,7 @@
 
 use nalgebra::Vector3;
 
-use super::{SurfaceModes, SurfacePoint, Vademecum};
+use super::{Patch, SurfaceModes, SurfacePoint, Vademecum};
 
 /// A force on a tool-sized patch of the accessible surface.
 #[derive(Debug, Default, PartialEq)]
@@ -253,16 +253,19 @@ impl Deformation {
         self.nodes_displacement_without(vademecum, &vademecum.point(at), &nodes, skip)
     }
 
-    /// [`Self::displacement_without`] at load position `position`.
-    pub fn position_displacement_without(
+    /// [`Self::displacement_without`] averaged over `patch` by its shares, read at its blend
+    /// of nodes at once: each other load's modal coefficients are computed once for the
+    /// patch, not once for each of its positions.
+    pub fn patch_displacement_without(
         &self,
         vademecum: &Vademecum,
-        position: usize,
+        patch: &Patch,
         skip: usize,
     ) -> Vector3<f64> {
-        let rest = Vector3::from(vademecum.position_coords_m[position].map(f64::from));
-        let node = vademecum.positions[position] as usize;
-        self.nodes_displacement_without(vademecum, &rest, &[(node, 1.0)], skip)
+        let rest = (patch.shares.iter())
+            .map(|&(m, share)| Vector3::from(vademecum.position_coords_m[m].map(f64::from)) * share)
+            .sum();
+        self.nodes_displacement_without(vademecum, &rest, &patch.blend, skip)
     }
 
     /// [`Self::displacement_without`] at the point at rest `rest` that blends volume nodes

@@ -90,6 +90,9 @@ pub struct SurfacePoint {
 #[derive(Clone, Debug, Default)]
 pub struct Patch {
     pub shares: Vec<(usize, f64)>,
+    /// The same shares by volume node: a blend, where a field is read over the whole patch
+    /// at once ([`super::Deformation::patch_displacement_without`]).
+    pub blend: Vec<(usize, f64)>,
     slot_of: Vec<u32>,
     columns: StepColumns,
 }
@@ -101,6 +104,7 @@ impl Patch {
         let positions = vademecum.positions.len();
         Self {
             shares: Vec::with_capacity(positions),
+            blend: Vec::with_capacity(positions),
             slot_of: Vec::with_capacity(positions),
             columns: StepColumns {
                 columns: Vec::with_capacity(positions * vademecum.steps.len()),
@@ -328,6 +332,9 @@ impl Vademecum {
             let corners = (0..3).map(|k| (corners[k] as usize, at.barycentric[k]));
             patch.set(self.positions.len(), corners);
         }
+        patch.blend.clear();
+        let shares = patch.shares.iter();
+        (patch.blend).extend(shares.map(|&(m, share)| (self.positions[m] as usize, share)));
     }
 
     /// The load positions as the tool's patch sees them.

@@ -440,21 +440,32 @@ fn top_patch(model: &FemModel, tool: Point3<f64>, radius_m: f64) -> Vec<(usize, 
 /// from three full X-FEM solves.
 fn full_compliance(
     model: &FemModel,
-    (faces, front): (&[CutFace], Front),
+    cut: (&[CutFace], Front),
     patch: &[(usize, f64)],
+) -> Matrix3<f64> {
+    full_cross_compliance(model, cut, patch, patch)
+}
+
+/// How the patch `read` moves (m) under a load (N) on the patch `loaded` of `model` cut by
+/// `faces` (their front placed as `front` says), from three full X-FEM solves.
+fn full_cross_compliance(
+    model: &FemModel,
+    (faces, front): (&[CutFace], Front),
+    loaded: &[(usize, f64)],
+    read: &[(usize, f64)],
 ) -> Matrix3<f64> {
     let mesh = model.mesh();
     let enrichment = Enrichment::with_front(mesh, faces, front);
     let mut compliance = Matrix3::zeros();
     for axis in 0..3 {
         let mut loads = Loads::new(mesh.node_count());
-        for &(n, share) in patch {
+        for &(n, share) in loaded {
             let mut force = [0.0; 3];
             force[axis] = share;
             loads.add_nodal_force(n, force).unwrap();
         }
         let u = xfem::solve(model, &enrichment, &loads).unwrap();
-        for &(n, share) in patch {
+        for &(n, share) in read {
             let un = Vector3::from_column_slice(&u.nodes_m[3 * n..3 * n + 3]);
             compliance.set_column(axis, &(compliance.column(axis) + un * share));
         }

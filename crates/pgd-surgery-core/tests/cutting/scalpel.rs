@@ -11,7 +11,7 @@ use pgd_surgery_core::cutting::{
 };
 use pgd_surgery_core::fem::{FemModel, Loads};
 
-use super::{MM, block_to_cut, full_compliance, top_patch};
+use super::{MM, block_to_cut, full_compliance, full_cross_compliance, top_patch};
 
 /// The blade on the block's top at `x` mm along a line at `y = 20 mm`, wobbling 0.4 mm across
 /// it, pressing `pressing_n` at `depth_mm`, its edge along `edge`.
@@ -225,6 +225,44 @@ fn the_worker_serves_the_felt_compliance_of_full_xfem() {
     let after = worker.settle().clone();
     assert!(matches!(worker.refused(), [CutError::Degenerate(_)]));
     assert_eq!(after.unknowns, view.unknowns);
+}
+
+/// Two hands on the cut block, a patch each side of the stroke: what the worker adds to the
+/// displacement of the pressed patch under both loads, its own answered by its own added
+/// compliance and the other's by the cross term, equals the difference full X-FEM solves make
+/// between the cut and the uncut block, to round-off; and the cut does change how one lip
+/// moves the other.
+#[test]
+fn the_worker_serves_one_patch_s_move_under_the_other_s_load_as_full_xfem_does() {
+    let (model, mut worker) = stroke_on_block(&[30.0]);
+    let view = worker.settle().clone();
+    let pressed = top_force(&model, 21.0, [0.0, 0.5, -1.0]);
+    let pulled = top_force(&model, 17.0, [0.0, -0.5, 0.5]);
+    worker.clear_loads();
+    for load in [&pressed, &pulled] {
+        worker.add_load(&load.patch, &load.force_n);
+    }
+    let served = worker.patch_response(&pressed.patch);
+    let added = |loaded: &[(usize, f64)]| {
+        let full =
+            |faces| full_cross_compliance(&model, (faces, Front::Nearest), loaded, &pressed.patch);
+        full(&view.faces) - full(&[])
+    };
+    let own = added(&pressed.patch);
+    let across = added(&pulled.patch);
+    let full = own * pressed.force_n + across * pulled.force_n;
+    let error = (served.moved_m - full).norm() / full.norm();
+    eprintln!(
+        "the cut adds {:.4} mm under both loads ({:.4} mm of it the pull's); served off by {error:.1e}",
+        full.norm() / MM,
+        (across * pulled.force_n).norm() / MM
+    );
+    assert!(error < 1e-9);
+    assert!((served.added_m_per_n - own).norm() < 1e-9 * own.norm());
+    assert!(
+        (across * pulled.force_n).norm() > 1e-3 * MM,
+        "the cut does not change how the pull moves the other lip"
+    );
 }
 
 /// What the window draws of a cut organ under the tool's load, from the worker's view alone:
