@@ -10,8 +10,8 @@
 //! - [`cli`], what the binaries' commands do and print; the binaries in `src/bin` stay thin.
 
 pub use pgd_surgery_core::{
-    bench, contact, cutting, dense_sums, devices, dynamics, fem, mesh, parry_interop, pgd, report,
-    scenario, store,
+    bench, contact, cutting, dense_sums, devices, dissection, dynamics, fem, mesh, parry_interop,
+    pgd, report, scenario, store,
 };
 
 pub mod app;

@@ -2,7 +2,8 @@
 //! layers, each using only those below it:
 //!
 //! - the numerics: [`mesh`], [`fem`] (the reference every vademecum is checked against),
-//!   [`pgd`] (the vademecums), [`contact`], [`cutting`], [`dynamics`] (organs that move),
+//!   [`pgd`] (the vademecums), [`contact`], [`cutting`], [`dissection`] (organs freed from
+//!   one another), [`dynamics`] (organs that move),
 //!   [`devices`] (the device layer), [`scenario`] (exercises), [`dense_sums`],
 //!   [`parry_interop`], and [`bench`](mod@bench), which times them;
 //! - services: [`store`] (organs and vademecums on disk) and [`report`] (files for people).
@@ -16,6 +17,7 @@ pub mod contact;
 pub mod cutting;
 pub mod dense_sums;
 pub mod devices;
+pub mod dissection;
 pub mod dynamics;
 pub mod fem;
 pub mod mesh;

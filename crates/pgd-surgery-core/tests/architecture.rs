@@ -16,6 +16,7 @@ const LAYERS: [&[&str]; 4] = [
         "pgd",
         "contact",
         "cutting",
+        "dissection",
         "dynamics",
         "devices",
         "scenario",
