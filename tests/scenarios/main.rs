@@ -5,6 +5,7 @@
 //! `trainer` binary validates, runs and reports.
 
 mod allocations;
+mod bed;
 #[path = "../../crates/pgd-surgery-core/tests/support/cache.rs"]
 mod cache;
 #[path = "../../crates/pgd-surgery-core/tests/support/counting.rs"]

@@ -1,6 +1,9 @@
 //! Freeing one organ from another: the connective tissue between them as cohesive ties that
-//! hold, give and tear ([`cohesive`]). `docs/dissection.md` has the model and its sources.
+//! hold, give and tear ([`cohesive`]), placed where the two organs' surfaces face each other
+//! ([`bed`]). `docs/dissection.md` has the model and its sources.
 
+pub mod bed;
 pub mod cohesive;
 
+pub use bed::{Bed, BedError, FreedSurface, Tie, TieLoad};
 pub use cohesive::{CohesiveError, CohesiveLaw, CohesiveTie};
