@@ -11,7 +11,7 @@
 
 pub use pgd_surgery_core::{
     bench, contact, cutting, dense_sums, devices, dissection, dynamics, fem, mesh, parry_interop,
-    pgd, report, scenario, store,
+    pgd, report, rods, scenario, store,
 };
 
 pub mod app;

@@ -3,7 +3,7 @@
 //!
 //! - the numerics: [`mesh`], [`fem`] (the reference every vademecum is checked against),
 //!   [`pgd`] (the vademecums), [`contact`], [`cutting`], [`dissection`] (organs freed from
-//!   one another), [`dynamics`] (organs that move),
+//!   one another), [`rods`] (ducts and vessels), [`dynamics`] (organs that move),
 //!   [`devices`] (the device layer), [`scenario`] (exercises), [`dense_sums`],
 //!   [`parry_interop`], and [`bench`](mod@bench), which times them;
 //! - services: [`store`] (organs and vademecums on disk) and [`report`] (files for people).
@@ -24,5 +24,6 @@ pub mod mesh;
 pub mod parry_interop;
 pub mod pgd;
 pub mod report;
+pub mod rods;
 pub mod scenario;
 pub mod store;

@@ -17,6 +17,7 @@ const LAYERS: [&[&str]; 4] = [
         "contact",
         "cutting",
         "dissection",
+        "rods",
         "dynamics",
         "devices",
         "scenario",

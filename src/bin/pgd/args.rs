@@ -554,6 +554,16 @@ pub enum BenchTarget {
         #[arg(long)]
         json: bool,
     },
+    /// A duct as a rod, clamped at one end and its tip pulled, settled once a tick: the
+    /// solve's time per tick and its Newton steps, for 20, 30 and 60 segments.
+    Rods {
+        /// Ticks timed per rod.
+        #[arg(long, default_value_t = 10_000)]
+        ticks: usize,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Assembly, factorization and solve on a liver-sized mesh (~4,300 nodes, ~21,000 tets).
     Fem {
         /// Print the report as JSON instead of a table.

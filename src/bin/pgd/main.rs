@@ -327,6 +327,9 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             vademecums,
             json,
         } => bench_scalpel(repeats, coarse, &vademecums, json),
+        BenchTarget::Rods { ticks, json } => {
+            print_report("pgd bench rods", bench::rods::run(ticks), json)
+        }
         BenchTarget::Cutting { cells, json } => print_report(
             "pgd bench cutting",
             bench::cutting::run([cells[0], cells[1], cells[2]]),

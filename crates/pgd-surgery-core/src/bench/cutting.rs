@@ -12,7 +12,7 @@ use std::time::Instant;
 use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
-use super::fem::median;
+use super::fem::{median, quantile};
 use crate::cutting::{CutState, Enrichment, ExactResponse, UncutResponse, tool_patch, xfem};
 use crate::fem::{Dirichlet, FemModel, Law, Loads, Material, TISSUE_DENSITY_KG_M3};
 use crate::mesh::box_mesh;
@@ -170,13 +170,6 @@ fn beside_the_incisions(model: &FemModel, top: &[usize]) -> Vec<(usize, f64)> {
     let positions: Vec<Point3<f64>> = top.iter().map(|&n| model.mesh().nodes()[n]).collect();
     let tool = Point3::new(24.0 * MM, 21.5 * MM, 10.0 * MM);
     tool_patch(top, &positions, tool, 4.0 * MM)
-}
-
-/// The `q`-quantile of `samples`.
-fn quantile(samples: &[f64], q: f64) -> f64 {
-    let mut sorted = samples.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    sorted[((q * (sorted.len() - 1) as f64).round() as usize).min(sorted.len() - 1)]
 }
 
 /// Four radial incisions from 4 to 13 mm around the block's top centre, four segments each;

@@ -165,6 +165,13 @@ pub fn median_ms(repeats: usize, f: &mut dyn FnMut()) -> f64 {
 }
 
 /// The middle sample (the upper of the two middle ones for an even count).
+/// The `q`-quantile of `samples`.
+pub(crate) fn quantile(samples: &[f64], q: f64) -> f64 {
+    let mut sorted = samples.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    sorted[((q * (sorted.len() - 1) as f64).round() as usize).min(sorted.len() - 1)]
+}
+
 pub(crate) fn median(mut samples: Vec<f64>) -> f64 {
     samples.sort_by(f64::total_cmp);
     samples[samples.len() / 2]

@@ -7,4 +7,5 @@ pub mod cutting;
 pub mod dynamics;
 pub mod fem;
 pub mod frame;
+pub mod rods;
 pub mod vademecum;

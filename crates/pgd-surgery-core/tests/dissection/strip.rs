@@ -9,6 +9,7 @@
 
 use nalgebra::{Matrix2, Vector2, Vector3};
 use pgd_surgery_core::dissection::{CohesiveLaw, CohesiveTie};
+use pgd_surgery_core::rods::Banded;
 
 /// The strip and its bond.
 #[derive(Clone, Copy, Debug)]
@@ -133,7 +134,9 @@ impl Peel {
                 break;
             }
             let mut step: Vec<f64> = gradient.iter().map(|g| -g).collect();
-            tangent.solve(&mut step);
+            tangent
+                .solve(&mut step)
+                .expect("the strip's tangent is positive definite");
             self.x.iter_mut().zip(&step).for_each(|(x, s)| *x += s);
         }
         assert!(
@@ -296,7 +299,7 @@ impl Peel {
 
     fn gradient_and_tangent(&self) -> (Vec<f64>, Banded) {
         let unknowns = self.x.len();
-        let mut tangent = Banded::zeros(unknowns);
+        let mut tangent = Banded::zeros(unknowns, BAND);
         let mut forces = vec![Vector2::zeros(); self.nodes()];
         {
             let mut add = |a: usize, b: usize, block: Matrix2<f64>| {
@@ -318,64 +321,5 @@ impl Peel {
             }
         }
         (gradient, tangent)
-    }
-}
-
-/// A banded square matrix of half bandwidth [`BAND`], solved by elimination without pivoting
-/// (the strip's tangent is symmetric and, with the ties' secants, positive definite).
-struct Banded {
-    n: usize,
-    values: Vec<f64>,
-}
-
-impl Banded {
-    fn zeros(n: usize) -> Self {
-        Self {
-            n,
-            values: vec![0.0; n * (2 * BAND + 1)],
-        }
-    }
-
-    fn index(&self, row: usize, column: usize) -> usize {
-        row * (2 * BAND + 1) + column + BAND - row
-    }
-
-    fn add(&mut self, row: usize, column: usize, value: f64) {
-        assert!(
-            row.abs_diff(column) <= BAND,
-            "({row}, {column}) outside the band"
-        );
-        let k = self.index(row, column);
-        self.values[k] += value;
-    }
-
-    fn get(&self, row: usize, column: usize) -> f64 {
-        self.values[self.index(row, column)]
-    }
-
-    /// Solves in place: `b` becomes `A⁻¹ b` (the matrix is consumed by the elimination).
-    fn solve(&mut self, b: &mut [f64]) {
-        let n = self.n;
-        for k in 0..n {
-            let pivot = self.get(k, k);
-            assert!(pivot.abs() > 0.0, "a zero pivot at {k}");
-            for row in k + 1..(k + BAND + 1).min(n) {
-                let factor = self.get(row, k) / pivot;
-                if factor == 0.0 {
-                    continue;
-                }
-                for column in k..(k + BAND + 1).min(n) {
-                    let v = self.get(k, column);
-                    let i = self.index(row, column);
-                    self.values[i] -= factor * v;
-                }
-                b[row] -= factor * b[k];
-            }
-        }
-        for k in (0..n).rev() {
-            let end = (k + BAND + 1).min(n);
-            let known: f64 = (k + 1..end).map(|c| self.get(k, c) * b[c]).sum();
-            b[k] = (b[k] - known) / self.get(k, k);
-        }
     }
 }

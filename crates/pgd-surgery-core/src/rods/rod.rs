@@ -1,0 +1,406 @@
+//! A thin tube — a duct, an artery — as a reduced beam: a chain of nodes along its axis, each
+//! segment stretching at the tube's axial stiffness `EA`, each node bending at its flexural
+//! stiffness `EI` by the turn between its two segments' unit tangents,
+//! `E = (EI / 2Δ) |tᵢ − tᵢ₋₁|²` (`2 (1 − cos φ)`, the turn's angle squared when small).
+//! Large displacements and rotations are exact in both: the stretching reads the segments'
+//! lengths, the bending only their directions, so that neither leaks into the other. Twist is
+//! left out: an isotropic tube whose ends are free to turn about its axis carries none, and
+//! the biliary tree's are. A static solve is a Newton iteration on the chain's energy with a
+//! banded tangent (the bending's by Gauss–Newton), `O(nodes)` a step.
+
+use std::fmt;
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::banded::Banded;
+
+/// A tube's cross-section: its outer radius and wall (a solid rod when the wall reaches the
+/// axis).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TubeSection {
+    pub outer_radius_m: f64,
+    pub wall_m: f64,
+}
+
+impl TubeSection {
+    fn inner_radius_m(&self) -> f64 {
+        (self.outer_radius_m - self.wall_m).max(0.0)
+    }
+
+    /// The wall's area (m²).
+    pub fn area_m2(&self) -> f64 {
+        std::f64::consts::PI * (self.outer_radius_m.powi(2) - self.inner_radius_m().powi(2))
+    }
+
+    /// The second moment of area about a diameter (m⁴).
+    pub fn second_moment_m4(&self) -> f64 {
+        std::f64::consts::FRAC_PI_4 * (self.outer_radius_m.powi(4) - self.inner_radius_m().powi(4))
+    }
+}
+
+/// Why a rod was refused or a solve failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RodError {
+    /// A dimension or a modulus that must be finite and positive is not.
+    NotPositive { name: &'static str, value: f64 },
+    /// Fewer than two segments, or more than the solve is meant for.
+    Segments(usize),
+    /// A node number beyond the rod's.
+    NoNode { node: usize, nodes: usize },
+    /// Newton's method did not settle (a load too large for one solve: ramp it).
+    Unsettled { iterations: usize, residual_n: f64 },
+    /// No node is held: the rod would fly off.
+    Unheld,
+}
+
+impl fmt::Display for RodError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NotPositive { name, value } => {
+                write!(f, "{name} must be finite and above zero, not {value}")
+            }
+            Self::Segments(n) => write!(f, "{n} segments: from 2 to {MAX_SEGMENTS}"),
+            Self::NoNode { node, nodes } => write!(f, "node {node} of a rod of {nodes} nodes"),
+            Self::Unsettled {
+                iterations,
+                residual_n,
+            } => write!(
+                f,
+                "the rod did not settle in {iterations} Newton steps ({residual_n:.3e} N left); \
+                 apply the load in smaller steps"
+            ),
+            Self::Unheld => write!(f, "no node of the rod is held"),
+        }
+    }
+}
+
+impl std::error::Error for RodError {}
+
+/// The most segments a rod takes.
+pub const MAX_SEGMENTS: usize = 10_000;
+
+/// The tangent's half bandwidth: bending couples a node with the next two, three unknowns
+/// each.
+const BAND: usize = 8;
+
+/// How many Newton steps a solve may take.
+const MAX_STEPS: usize = 100;
+
+/// A rod: its rest chain, its stiffnesses, where it is now and which nodes are held.
+#[derive(Clone, Debug)]
+pub struct Rod {
+    rest: Vec<Vector3<f64>>,
+    segment_m: f64,
+    axial_n: f64,
+    bending_n_m2: f64,
+    /// Where each node is (m).
+    pub positions: Vec<Vector3<f64>>,
+    held: Vec<bool>,
+    /// The clamped first end's direction: the first segment bends against it as against a
+    /// segment before the end held in the clamp.
+    clamp: Option<Vector3<f64>>,
+    /// Kept from solve to solve, so that a solve allocates nothing once they have grown.
+    scratch: Scratch,
+}
+
+/// A solve's work space.
+#[derive(Clone, Debug, Default)]
+struct Scratch {
+    dof: Vec<Option<usize>>,
+    tangent: Option<Banded>,
+    residual: Vec<f64>,
+    forces: Vec<Vector3<f64>>,
+}
+
+/// What a solve took.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settled {
+    pub newton_steps: usize,
+    pub residual_n: f64,
+}
+
+impl Rod {
+    /// A straight rod from `from_m` to `to_m` in `segments` equal segments, of `section` and
+    /// Young's modulus `young_pa`; no node held.
+    pub fn straight(
+        from_m: Vector3<f64>,
+        to_m: Vector3<f64>,
+        segments: usize,
+        section: TubeSection,
+        young_pa: f64,
+    ) -> Result<Self, RodError> {
+        let length_m = (to_m - from_m).norm();
+        let named = [
+            ("length_m", length_m),
+            ("outer_radius_m", section.outer_radius_m),
+            ("wall_m", section.wall_m),
+            ("young_pa", young_pa),
+        ];
+        if let Some(&(name, value)) = named.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
+            return Err(RodError::NotPositive { name, value });
+        }
+        if !(2..=MAX_SEGMENTS).contains(&segments) {
+            return Err(RodError::Segments(segments));
+        }
+        let rest: Vec<Vector3<f64>> = (0..=segments)
+            .map(|k| from_m + (to_m - from_m) * (k as f64 / segments as f64))
+            .collect();
+        Ok(Self {
+            positions: rest.clone(),
+            held: vec![false; rest.len()],
+            clamp: None,
+            scratch: Scratch::default(),
+            rest,
+            segment_m: length_m / segments as f64,
+            axial_n: young_pa * section.area_m2(),
+            bending_n_m2: young_pa * section.second_moment_m4(),
+        })
+    }
+
+    /// How many nodes it has.
+    pub fn nodes(&self) -> usize {
+        self.rest.len()
+    }
+
+    /// Holds node `node` where it is.
+    pub fn hold(&mut self, node: usize) -> Result<(), RodError> {
+        let nodes = self.nodes();
+        let held = self
+            .held
+            .get_mut(node)
+            .ok_or(RodError::NoNode { node, nodes })?;
+        *held = true;
+        Ok(())
+    }
+
+    /// Clamps the first end: its node held, and its tangent, as it is now: the first
+    /// segment turns against the clamp's direction as against one more segment held in it.
+    pub fn clamp_start(&mut self) {
+        self.held[0] = true;
+        self.clamp = Some((self.positions[1] - self.positions[0]).normalize());
+    }
+
+    /// The rod's elastic energy (J).
+    pub fn energy_j(&self) -> f64 {
+        let (k, kb) = self.stiffnesses();
+        let stretch: f64 = (self.positions.windows(2))
+            .map(|w| 0.5 * k * ((w[1] - w[0]).norm() - self.segment_m).powi(2))
+            .sum();
+        let bend: f64 = (self.turning()).map(|i| self.turn(i).energy_j(kb)).sum();
+        stretch + bend
+    }
+
+    /// A segment's stiffness (N/m) and a node's against its turn (N·m): `EA / Δ`, `EI / Δ`.
+    fn stiffnesses(&self) -> (f64, f64) {
+        (
+            self.axial_n / self.segment_m,
+            self.bending_n_m2 / self.segment_m,
+        )
+    }
+
+    /// Settles the free nodes under `loads` (node, force in N) by Newton's method from where
+    /// they are, until the forces left are below `tolerance_n` (N). Allocates nothing once a
+    /// first solve has made its work space.
+    pub fn solve(
+        &mut self,
+        loads: &[(usize, Vector3<f64>)],
+        tolerance_n: f64,
+    ) -> Result<Settled, RodError> {
+        let nodes = self.nodes();
+        if let Some(&(node, _)) = loads.iter().find(|(n, _)| *n >= nodes) {
+            return Err(RodError::NoNode { node, nodes });
+        }
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let settled = self.settle(loads, tolerance_n, &mut scratch);
+        self.scratch = scratch;
+        settled
+    }
+
+    fn settle(
+        &mut self,
+        loads: &[(usize, Vector3<f64>)],
+        tolerance_n: f64,
+        scratch: &mut Scratch,
+    ) -> Result<Settled, RodError> {
+        self.dof_numbers(&mut scratch.dof);
+        let unknowns = 3 * scratch.dof.iter().flatten().count();
+        if unknowns == 3 * self.nodes() {
+            return Err(RodError::Unheld);
+        }
+        if scratch.tangent.as_ref().is_none_or(|t| t.len() != unknowns) {
+            scratch.tangent = Some(Banded::zeros(unknowns, BAND));
+        }
+        let Scratch {
+            dof,
+            tangent,
+            residual,
+            forces,
+        } = scratch;
+        let tangent = tangent.as_mut().expect("made above");
+        residual.resize(unknowns, 0.0);
+        forces.resize(self.nodes(), Vector3::zeros());
+        for step in 0..=MAX_STEPS {
+            self.internal_forces(forces);
+            for &(node, force) in loads {
+                forces[node] -= force;
+            }
+            for (node, f) in forces.iter().enumerate() {
+                if let Some(d) = dof[node] {
+                    residual[d..d + 3].copy_from_slice(f.as_slice());
+                }
+            }
+            let residual_n = residual.iter().map(|r| r * r).sum::<f64>().sqrt();
+            if residual_n < tolerance_n {
+                return Ok(Settled {
+                    newton_steps: step,
+                    residual_n,
+                });
+            }
+            let unsettled = RodError::Unsettled {
+                iterations: step,
+                residual_n,
+            };
+            if step == MAX_STEPS {
+                return Err(unsettled);
+            }
+            tangent.clear();
+            self.add_tangent(dof, tangent);
+            residual.iter_mut().for_each(|r| *r = -*r);
+            tangent.solve(residual).ok_or(unsettled)?;
+            for (node, d) in dof.iter().enumerate() {
+                if let Some(d) = d {
+                    self.positions[node] += Vector3::from_column_slice(&residual[*d..*d + 3]);
+                }
+            }
+        }
+        unreachable!("the loop returns at its last step")
+    }
+
+    /// Each free node's first unknown, in order along the rod, into `dof`.
+    fn dof_numbers(&self, dof: &mut Vec<Option<usize>>) {
+        let mut next = 0;
+        dof.clear();
+        dof.extend(self.held.iter().map(|&held| {
+            (!held).then(|| {
+                next += 3;
+                next - 3
+            })
+        }));
+    }
+
+    /// The energy's gradient at each node (N): what holds the node back.
+    pub fn internal_forces(&self, forces: &mut [Vector3<f64>]) {
+        forces.fill(Vector3::zeros());
+        let (k, kb) = self.stiffnesses();
+        for i in 0..self.nodes() - 1 {
+            let q = self.positions[i + 1] - self.positions[i];
+            let l = q.norm();
+            let f = q * (k * (l - self.segment_m) / l);
+            forces[i + 1] += f;
+            forces[i] -= f;
+        }
+        for i in self.turning() {
+            let turn = self.turn(i);
+            let pull = turn.gradient(kb);
+            for (node, f) in turn.nodes.into_iter().zip(pull) {
+                forces[node] += f;
+            }
+        }
+    }
+
+    /// The turn at node `i` between its two segments; at a clamped first node, between the
+    /// clamp's direction and the first segment (the clamp's part of the Jacobian zero: it is
+    /// held).
+    fn turn(&self, i: usize) -> Turn {
+        let across = |t: Vector3<f64>, l: f64| (Matrix3::identity() - t * t.transpose()) / l;
+        let after = self.positions[i + 1] - self.positions[i];
+        let la = after.norm();
+        let ta = after / la;
+        let pa = across(ta, la);
+        let Some(i_before) = i.checked_sub(1) else {
+            let clamp = self.clamp.expect("only a clamped first node turns");
+            return Turn {
+                nodes: [0, 0, 1],
+                residual: ta - clamp,
+                jacobian: [Matrix3::zeros(), -pa, pa],
+                weight: 2.0,
+            };
+        };
+        let before = self.positions[i] - self.positions[i_before];
+        let lb = before.norm();
+        let tb = before / lb;
+        let pb = across(tb, lb);
+        Turn {
+            nodes: [i_before, i, i + 1],
+            residual: ta - tb,
+            jacobian: [pb, -pa - pb, pa],
+            weight: 1.0,
+        }
+    }
+
+    /// The nodes that turn: every inner one, and the first where it is clamped.
+    fn turning(&self) -> std::ops::Range<usize> {
+        let first = if self.clamp.is_some() { 0 } else { 1 };
+        first..self.nodes() - 1
+    }
+    /// Adds the energy's Hessian over the free nodes to `tangent`: the stretching's, its part
+    /// across a segment kept from going negative under compression, and the bending's
+    /// Gauss–Newton part `c Jᵀ J` (a modified Newton's method, whose solution is the same).
+    fn add_tangent(&self, dof: &[Option<usize>], tangent: &mut Banded) {
+        let (k, kb) = self.stiffnesses();
+        let mut add = |a: usize, b: usize, block: &Matrix3<f64>| {
+            if let (Some(ra), Some(rb)) = (dof[a], dof[b]) {
+                for (r, c) in (0..3).flat_map(|r| (0..3).map(move |c| (r, c))) {
+                    tangent.add(ra + r, rb + c, block[(r, c)]);
+                }
+            }
+        };
+        for i in 0..self.nodes() - 1 {
+            let q = self.positions[i + 1] - self.positions[i];
+            let l = q.norm();
+            let u = q / l;
+            let uu = u * u.transpose();
+            let transverse = (1.0 - self.segment_m / l).max(0.0);
+            let block = (uu + (Matrix3::identity() - uu) * transverse) * k;
+            add(i, i, &block);
+            add(i + 1, i + 1, &block);
+            add(i, i + 1, &-block);
+            add(i + 1, i, &-block);
+        }
+        for i in self.turning() {
+            let turn = self.turn(i);
+            for (a, b) in (0..3).flat_map(|a| (0..3).map(move |b| (a, b))) {
+                add(turn.nodes[a], turn.nodes[b], &turn.tangent(a, b, kb));
+            }
+        }
+    }
+}
+
+/// The turn at a node: `r = tᵢ − tᵢ₋₁`, its Jacobian with respect to the three nodes it
+/// reads, and its weight: 1 for an inner node, whose turn spans a segment's length of the
+/// rod, 2 at a clamp, whose turn spans only the half segment inside the rod (so its
+/// curvature is twice the turn over the segment).
+struct Turn {
+    nodes: [usize; 3],
+    residual: Vector3<f64>,
+    jacobian: [Matrix3<f64>; 3],
+    weight: f64,
+}
+
+impl Turn {
+    /// Its bending energy (J) for `c = EI / Δ`: `c w |r|² / 2`.
+    fn energy_j(&self, c: f64) -> f64 {
+        0.5 * c * self.weight * self.residual.norm_squared()
+    }
+
+    /// The bending energy's gradient at the three nodes, `c w Jᵀ r`.
+    fn gradient(&self, c: f64) -> [Vector3<f64>; 3] {
+        self.jacobian
+            .map(|j| j.transpose() * self.residual * (c * self.weight))
+    }
+
+    /// Its Gauss–Newton tangent between two of its nodes, `c w Jₐᵀ J_b`.
+    fn tangent(&self, a: usize, b: usize, c: f64) -> Matrix3<f64> {
+        self.jacobian[a].transpose() * self.jacobian[b] * (c * self.weight)
+    }
+}

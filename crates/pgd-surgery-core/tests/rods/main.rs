@@ -1,0 +1,156 @@
+//! A rod against the analytic solutions of a cantilever (Euler–Bernoulli for a small tip load,
+//! the elastica for a large one) and of a tube under tension.
+
+use nalgebra::Vector3;
+use pgd_surgery_core::rods::{Rod, RodError, TubeSection};
+
+/// A duct 50 mm long, 5 mm across with a 0.5 mm wall, of a 4.7 MPa wall (the pancreatic
+/// duct's measured modulus, the nearest duct measured), along x.
+const LENGTH_M: f64 = 0.05;
+const YOUNG_PA: f64 = 4.7e6;
+const SECTION: TubeSection = TubeSection {
+    outer_radius_m: 2.5e-3,
+    wall_m: 0.5e-3,
+};
+
+/// Forces left in a settled rod: a nanonewton.
+const TOLERANCE_N: f64 = 1e-9;
+
+fn flexural() -> f64 {
+    YOUNG_PA * SECTION.second_moment_m4()
+}
+
+/// The duct in `segments`, clamped at x = 0.
+fn cantilever(segments: usize) -> Rod {
+    let mut rod = Rod::straight(
+        Vector3::zeros(),
+        Vector3::x() * LENGTH_M,
+        segments,
+        SECTION,
+        YOUNG_PA,
+    )
+    .unwrap();
+    rod.clamp_start();
+    rod
+}
+
+/// The tip's displacement under `load_n` at the tip, applied in `ramp` equal steps.
+fn tip_under(rod: &mut Rod, load_n: Vector3<f64>, ramp: usize) -> Vector3<f64> {
+    let tip = rod.nodes() - 1;
+    for k in 1..=ramp {
+        rod.solve(&[(tip, load_n * (k as f64 / ramp as f64))], TOLERANCE_N)
+            .unwrap();
+    }
+    rod.positions[tip] - Vector3::x() * LENGTH_M
+}
+
+/// A tip load that bends the duct by 1 % of its length: the tip moves `P L³ / 3 E I`
+/// (Euler–Bernoulli) to 0.5 % with 40 segments.
+#[test]
+fn a_cantilever_under_a_small_tip_load_bends_as_euler_bernoulli_says() {
+    let deflection_m = 0.01 * LENGTH_M;
+    let load_n = 3.0 * flexural() * deflection_m / LENGTH_M.powi(3);
+    let moved = tip_under(&mut cantilever(40), -Vector3::z() * load_n, 1);
+    let error = (-moved.z - deflection_m).abs() / deflection_m;
+    eprintln!(
+        "{load_n:.3e} N: tip {:.4} mm down, Euler–Bernoulli {:.4} mm ({error:.2e})",
+        -moved.z * 1e3,
+        deflection_m * 1e3
+    );
+    assert!(error < 5e-3, "off by {error}");
+}
+
+/// The elastica of a cantilever under a tip load `α = P L² / E I` (its end force staying
+/// vertical), inextensible: `θ'' = −α cos θ`, `θ(0) = 0`, `θ'(1) = 0` over `s ∈ [0, 1]`,
+/// solved by shooting on `θ'(0)` with a fourth-order Runge–Kutta march of 4,000 steps.
+/// Returns the tip's (x, y) over the length, y along the load.
+fn elastica_tip(alpha: f64) -> (f64, f64) {
+    let march = |kappa0: f64| {
+        let steps = 4000;
+        let h = 1.0 / steps as f64;
+        // (θ, θ', x, y)
+        let derivative = |s: [f64; 4]| [s[1], -alpha * s[0].cos(), s[0].cos(), s[0].sin()];
+        let mut s = [0.0, kappa0, 0.0, 0.0];
+        for _ in 0..steps {
+            let add = |a: [f64; 4], b: [f64; 4], t: f64| std::array::from_fn(|i| a[i] + t * b[i]);
+            let k1 = derivative(s);
+            let k2 = derivative(add(s, k1, h / 2.0));
+            let k3 = derivative(add(s, k2, h / 2.0));
+            let k4 = derivative(add(s, k3, h));
+            s = std::array::from_fn(|i| {
+                s[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            });
+        }
+        s
+    };
+    let (mut low, mut high) = (0.0, alpha);
+    for _ in 0..80 {
+        let mid = 0.5 * (low + high);
+        if march(mid)[1] < 0.0 {
+            low = mid;
+        } else {
+            high = mid;
+        }
+    }
+    let end = march(0.5 * (low + high));
+    (end[2], end[3])
+}
+
+/// Tip loads of `α = P L² / E I` = 1 and 3 bend the duct through large rotations: its tip
+/// lies where the elastica puts it, to 1 % of the length (the duct stretches by 0.3 % under
+/// the larger load, the elastica not at all), closer with 40 segments than with 10.
+#[test]
+fn a_cantilever_under_a_large_tip_load_bends_as_the_elastica() {
+    for alpha in [1.0, 3.0] {
+        let load_n = alpha * flexural() / LENGTH_M.powi(2);
+        let (x, y) = elastica_tip(alpha);
+        let errors = [10, 40].map(|segments| {
+            let moved = tip_under(&mut cantilever(segments), -Vector3::z() * load_n, 20);
+            let tip = (LENGTH_M + moved.x, -moved.z);
+            let error = ((tip.0 / LENGTH_M - x).powi(2) + (tip.1 / LENGTH_M - y).powi(2)).sqrt();
+            eprintln!(
+                "α = {alpha}, {segments} segments: tip at ({:.4}, {:.4}) L, elastica ({x:.4}, {y:.4}) L, off by {error:.2e} L",
+                tip.0 / LENGTH_M,
+                tip.1 / LENGTH_M
+            );
+            error
+        });
+        assert!(errors[1] < 0.01, "α = {alpha}: off by {} L", errors[1]);
+        assert!(errors[1] < errors[0], "α = {alpha}: {errors:?}");
+    }
+}
+
+/// Pulled along its axis by 1 N at the free end, the tube lengthens by `F L / E A` to 1e-9,
+/// and stays straight.
+#[test]
+fn a_tube_under_tension_lengthens_as_f_l_over_e_a() {
+    let mut rod = cantilever(20);
+    let moved = tip_under(&mut rod, Vector3::x(), 1);
+    let expected = LENGTH_M / (YOUNG_PA * SECTION.area_m2());
+    let error = (moved.x - expected).abs() / expected;
+    eprintln!(
+        "1 N: {:.4} mm longer, F L / E A {:.4} mm",
+        moved.x * 1e3,
+        expected * 1e3
+    );
+    assert!(error < 1e-9, "off by {error}");
+    assert!(rod.positions.iter().all(|p| p.y == 0.0 && p.z == 0.0));
+}
+
+/// A rod held nowhere, a load on a node it lacks and a section of no wall are refused.
+#[test]
+fn bad_rods_and_loads_are_refused() {
+    let mut free = Rod::straight(Vector3::zeros(), Vector3::x(), 4, SECTION, YOUNG_PA).unwrap();
+    assert_eq!(free.solve(&[], TOLERANCE_N), Err(RodError::Unheld));
+    let mut held = cantilever(4);
+    assert!(matches!(
+        held.solve(&[(9, Vector3::x())], TOLERANCE_N),
+        Err(RodError::NoNode { node: 9, .. })
+    ));
+    let hollow = TubeSection {
+        wall_m: 0.0,
+        ..SECTION
+    };
+    let refused = Rod::straight(Vector3::zeros(), Vector3::x(), 4, hollow, YOUNG_PA).unwrap_err();
+    assert!(refused.to_string().contains("wall_m"), "{refused}");
+}
