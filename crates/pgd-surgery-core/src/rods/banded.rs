@@ -56,6 +56,24 @@ impl Banded {
         self.values[self.index(row, column)]
     }
 
+    /// Adds the 3 × 3 `block` with its first entry at (`row`, `column`), which must lie within
+    /// the band.
+    pub fn add_block(&mut self, row: usize, column: usize, block: &nalgebra::Matrix3<f64>) {
+        assert!(
+            row.abs_diff(column) + 2 <= self.band,
+            "a block at ({row}, {column}) outside a band of {}",
+            self.band
+        );
+        for r in 0..3 {
+            let start = self.index(row + r, column);
+            let entries = &mut self.values[start..start + 3];
+            entries
+                .iter_mut()
+                .enumerate()
+                .for_each(|(c, v)| *v += block[(r, c)]);
+        }
+    }
+
     /// Solves `A x = b` in place (`b` becomes `x`), eliminating within the band; the matrix
     /// is consumed by the elimination. `None` at a pivot that is not positive and finite
     /// (the matrix was singular or not positive definite).
@@ -67,22 +85,27 @@ impl Banded {
                 return None;
             }
             let end = (k + band + 1).min(n);
+            // Row k from its diagonal to the band's edge, contiguous in the storage.
+            let (pivot_start, span) = (self.index(k, k), end - k);
             for row in k + 1..end {
                 let factor = self.get(row, k) / pivot;
                 if factor == 0.0 {
                     continue;
                 }
-                for column in k..end {
-                    let v = self.get(k, column);
-                    let i = self.index(row, column);
-                    self.values[i] -= factor * v;
+                let start = self.index(row, k);
+                let (above, below) = self.values.split_at_mut(start);
+                let pivot_row = &above[pivot_start..pivot_start + span];
+                for (v, p) in below[..span].iter_mut().zip(pivot_row) {
+                    *v -= factor * p;
                 }
                 b[row] -= factor * b[k];
             }
         }
         for k in (0..n).rev() {
             let end = (k + band + 1).min(n);
-            let known: f64 = (k + 1..end).map(|c| self.get(k, c) * b[c]).sum();
+            let start = self.index(k, k + 1);
+            let row = &self.values[start..start + (end - k - 1)];
+            let known: f64 = row.iter().zip(&b[k + 1..end]).map(|(a, x)| a * x).sum();
             b[k] = (b[k] - known) / self.get(k, k);
         }
         Some(())

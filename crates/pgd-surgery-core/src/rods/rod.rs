@@ -110,6 +110,8 @@ struct Scratch {
     tangent: Option<Banded>,
     residual: Vec<f64>,
     forces: Vec<Vector3<f64>>,
+    /// Each turning node's turn, made once a Newton step for the forces and the tangent.
+    turns: Vec<Turn>,
 }
 
 /// What a solve took.
@@ -235,12 +237,15 @@ impl Rod {
             tangent,
             residual,
             forces,
+            turns,
         } = scratch;
         let tangent = tangent.as_mut().expect("made above");
         residual.resize(unknowns, 0.0);
         forces.resize(self.nodes(), Vector3::zeros());
         for step in 0..=MAX_STEPS {
-            self.internal_forces(forces);
+            turns.clear();
+            turns.extend(self.turning().map(|i| self.turn(i)));
+            self.internal_forces(turns, forces);
             for &(node, force) in loads {
                 forces[node] -= force;
             }
@@ -264,7 +269,7 @@ impl Rod {
                 return Err(unsettled);
             }
             tangent.clear();
-            self.add_tangent(dof, tangent);
+            self.add_tangent(dof, turns, tangent);
             residual.iter_mut().for_each(|r| *r = -*r);
             tangent.solve(residual).ok_or(unsettled)?;
             for (node, d) in dof.iter().enumerate() {
@@ -288,8 +293,9 @@ impl Rod {
         }));
     }
 
-    /// The energy's gradient at each node (N): what holds the node back.
-    pub fn internal_forces(&self, forces: &mut [Vector3<f64>]) {
+    /// The energy's gradient at each node (N), what holds the node back, its nodes' `turns`
+    /// made.
+    fn internal_forces(&self, turns: &[Turn], forces: &mut [Vector3<f64>]) {
         forces.fill(Vector3::zeros());
         let (k, kb) = self.stiffnesses();
         for i in 0..self.nodes() - 1 {
@@ -299,8 +305,7 @@ impl Rod {
             forces[i + 1] += f;
             forces[i] -= f;
         }
-        for i in self.turning() {
-            let turn = self.turn(i);
+        for turn in turns {
             let pull = turn.gradient(kb);
             for (node, f) in turn.nodes.into_iter().zip(pull) {
                 forces[node] += f;
@@ -346,13 +351,11 @@ impl Rod {
     /// Adds the energy's Hessian over the free nodes to `tangent`: the stretching's, its part
     /// across a segment kept from going negative under compression, and the bending's
     /// Gauss–Newton part `c Jᵀ J` (a modified Newton's method, whose solution is the same).
-    fn add_tangent(&self, dof: &[Option<usize>], tangent: &mut Banded) {
+    fn add_tangent(&self, dof: &[Option<usize>], turns: &[Turn], tangent: &mut Banded) {
         let (k, kb) = self.stiffnesses();
         let mut add = |a: usize, b: usize, block: &Matrix3<f64>| {
             if let (Some(ra), Some(rb)) = (dof[a], dof[b]) {
-                for (r, c) in (0..3).flat_map(|r| (0..3).map(move |c| (r, c))) {
-                    tangent.add(ra + r, rb + c, block[(r, c)]);
-                }
+                tangent.add_block(ra, rb, block);
             }
         };
         for i in 0..self.nodes() - 1 {
@@ -367,8 +370,7 @@ impl Rod {
             add(i, i + 1, &-block);
             add(i + 1, i, &-block);
         }
-        for i in self.turning() {
-            let turn = self.turn(i);
+        for turn in turns {
             for (a, b) in (0..3).flat_map(|a| (0..3).map(move |b| (a, b))) {
                 add(turn.nodes[a], turn.nodes[b], &turn.tangent(a, b, kb));
             }
@@ -380,6 +382,7 @@ impl Rod {
 /// reads, and its weight: 1 for an inner node, whose turn spans a segment's length of the
 /// rod, 2 at a clamp, whose turn spans only the half segment inside the rod (so its
 /// curvature is twice the turn over the segment).
+#[derive(Clone, Copy, Debug)]
 struct Turn {
     nodes: [usize; 3],
     residual: Vector3<f64>,
