@@ -1,9 +1,12 @@
 //! Freeing one organ from another: the connective tissue between them as cohesive ties that
 //! hold, give and tear ([`cohesive`]), placed where the two organs' surfaces face each other
-//! ([`bed`]). `docs/dissection.md` has the model and its sources.
+//! ([`bed`]), their forces each tick answered with the organs' own give ([`solve`]).
+//! `docs/dissection.md` has the model and its sources.
 
 pub mod bed;
 pub mod cohesive;
+pub mod solve;
 
 pub use bed::{Bed, BedError, FreedSurface, Tie, TieLoad};
 pub use cohesive::{CohesiveError, CohesiveLaw, CohesiveTie};
+pub use solve::{TieCompliance, TieConvergence, TieSolve};
