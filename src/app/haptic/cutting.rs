@@ -50,8 +50,9 @@ impl OrganCut {
 #[derive(Resource, Clone, Copy, Debug, Default)]
 pub struct SettleCuts;
 
-/// Reads each cut organ's latest cut, softens every hand's press on it, moves each press by
-/// what the cut lets the organ's other loads move its patch, and hands the blade's step, if
+/// Reads each cut organ's latest cut, softens every hand's press on it and moves it by what
+/// the cut lets the organ's other loads move its patch (one answer of the cut for both), and
+/// hands the blade's step, if
 /// any, to the organ's cut state: the blade is the first hand's whose instrument cuts, its
 /// press on tissue the other hand may hold taut (that hand's load, a grasp's or a press's, is
 /// among the organ's loads the press answers).
@@ -74,21 +75,22 @@ pub fn cut(
             Some(_) => worker.settle(),
             None => worker.poll(),
         };
+        let loads = &mut deformation.0.loads;
         for (slot, touch) in touches.0.iter_mut().enumerate() {
             let Some(contact) = touch.contact.as_mut() else {
                 continue;
             };
-            patch_nodes(&touch.patch.shares, &body.vademecum, nodes);
-            soften(contact, worker.added_compliance(nodes));
+            add_other_loads(&body.vademecum, worker, nodes, settled, slot);
+            let cut = worker.patch_response(&touch.patch.blend);
+            soften(contact, cut.added_m_per_n);
             let cuts = blade.is_some_and(|(hand, _)| hand.0 == slot);
             if let Some(parted_m) = scalpel.parted_depth_m().filter(|_| cuts) {
                 give(contact, parted_m);
             }
             contact.force_n = contact.stiffness_n_per_m * contact.indentation_m;
-            deformation.0.loads[slot].force_n = contact.force_n;
+            loads[slot].force_n = contact.force_n;
+            follow(&mut touch.contact, &mut loads[slot], &cut.moved_m);
         }
-        let loads = &mut deformation.0.loads;
-        answer_other_loads(&body.vademecum, worker, nodes, settled, &mut touches, loads);
         for (settled, load) in settled.iter_mut().zip(loads.iter()) {
             settled.clone_from(load);
         }
@@ -106,39 +108,25 @@ pub fn cut(
     }
 }
 
-/// Where two or more hands load a cut organ, each press follows what the cut adds to its
-/// patch's displacement under the others' loads (`Y_aᵀ Y_b f_b`; the vademecum moved the
-/// surface by the uncut part already): the grasp that pulls the tissue across the cut, or
-/// the press on its other lip, moves the tissue under the blade further than the uncut organ
-/// would. The others' loads are taken as this stage `settled` them last tick, as the press
-/// took their uncut part, so that hands held still settle on the full cut organ's answer.
-fn answer_other_loads(
+/// Has the cut organ's worker sum the loads of the hands other than `slot` as this stage
+/// `settled` them last tick, for the press of `slot` to follow what the cut adds to its
+/// patch's displacement under them (`Y_aᵀ Y_b f_b`; the vademecum moved the surface by the
+/// uncut part already): the grasp that pulls the tissue across the cut, or the press on its
+/// other lip, moves the tissue under the blade further than the uncut organ would. Taken as
+/// settled last tick, as the press took their uncut part, so that hands held still settle on
+/// the full cut organ's answer.
+fn add_other_loads(
     vademecum: &Vademecum,
     worker: &mut CutWorker,
     nodes: &mut Vec<(usize, f64)>,
     settled: &[PatchLoad],
-    touches: &mut HandTouches,
-    loads: &mut [PatchLoad],
+    slot: usize,
 ) {
-    if worker.view().unknowns == 0 {
-        return;
-    }
-    for (slot, touch) in touches.0.iter_mut().enumerate() {
-        let others = || {
-            let others = settled.iter().enumerate();
-            others.filter(move |&(b, load)| b != slot && load.is_active())
-        };
-        if touch.contact.is_none() || others().next().is_none() {
-            continue;
-        }
-        worker.clear_loads();
-        for (_, load) in others() {
-            patch_nodes(&load.shares, vademecum, nodes);
-            worker.add_load(nodes, &load.force_n);
-        }
-        patch_nodes(&loads[slot].shares, vademecum, nodes);
-        let by_others = worker.patch_response(nodes).moved_m;
-        follow(&mut touch.contact, &mut loads[slot], &by_others);
+    worker.clear_loads();
+    let others = settled.iter().enumerate();
+    for (_, load) in others.filter(|&(b, load)| b != slot && load.is_active()) {
+        patch_nodes(&load.shares, vademecum, nodes);
+        worker.add_load(nodes, &load.force_n);
     }
 }
 
@@ -153,7 +141,7 @@ pub struct CutOrgan {
 }
 
 /// The press's stiffness as the cut organ answers it: the patch compliance the cut `added`
-/// ([`CutWorker::added_compliance`]) on top of the vademecum's, inverted.
+/// ([`CutWorker::patch_response`]) on top of the vademecum's, inverted.
 fn soften(contact: &mut ToolContact, added: Matrix3<f64>) {
     if added == Matrix3::zeros() {
         return;

@@ -5,7 +5,7 @@ use bevy::prelude::*;
 use nalgebra::Vector3;
 
 use super::components::{
-    HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, patch_nodes,
+    HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch,
 };
 use super::cutting::OrganCut;
 use super::hand::{
@@ -261,7 +261,7 @@ pub struct MovingOrgan {
 /// compliance there), starting from the press's force.
 fn take_hold(body: &OrganBody, touch: &ToolTouch, motion: &mut OrganMotion, hand_m: &Vector3<f64>) {
     let vademecum = &body.vademecum;
-    patch_nodes(&touch.patch.shares, vademecum, &mut motion.patch_nodes);
+    motion.patch_nodes.clone_from(&touch.patch.blend);
     let compliance = vademecum.compliance(&touch.patch, &Vector3::zeros());
     let centre = touch.contact.map_or(Vector3::zeros(), |c| c.hit.point_m);
     let basis = &motion.model.basis;

@@ -92,13 +92,16 @@ impl CutView {
     }
 
     /// Adds the cut's part of `force_n` (N) spread over the patch `patch` to the loads summed
-    /// in `scratch`: `w += Ẑᵀ P f`.
+    /// in `scratch`: `w += Ẑᵀ P f` (nothing with nothing cut).
     pub fn add_load(
         &self,
         patch: &[(usize, f64)],
         force_n: &Vector3<f64>,
         scratch: &mut CutScratch,
     ) {
+        if self.unknowns == 0 {
+            return;
+        }
         for &(node, share) in patch {
             for axis in 0..3 {
                 let load = [(3 * node + axis, share * force_n[axis])];

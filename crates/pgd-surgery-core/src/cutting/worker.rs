@@ -17,7 +17,7 @@ mod threaded;
 use std::borrow::Borrow;
 use std::sync::{Arc, Mutex, PoisonError};
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 #[cfg(target_arch = "wasm32")]
 use inline::Backend;
@@ -201,12 +201,6 @@ impl CutWorker {
     /// The latest view taken (by [`Self::poll`] or [`Self::settle`]).
     pub fn view(&self) -> &Arc<CutView> {
         &self.view
-    }
-
-    /// What the cut adds to the uncut compliance (m/N) of the patch `patch` (mesh nodes and
-    /// their shares) in the latest view taken: allocates nothing.
-    pub fn added_compliance(&mut self, patch: &[(usize, f64)]) -> Matrix3<f64> {
-        self.view.added_compliance(patch, &mut self.scratch)
     }
 
     /// Starts summing the organ's loads for [`Self::patch_response`]: none yet.
