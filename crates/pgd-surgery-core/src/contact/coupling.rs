@@ -247,6 +247,35 @@ impl Coupling {
         }
     }
 
+    /// Organ `index`'s pose this tick: its coefficients as [`Self::read`] took them and, once
+    /// [`Self::tick`] has run, the carry of the organ it hangs from.
+    pub fn pose(&self, index: usize) -> OrganPose<'_> {
+        let organ = &self.organs[index];
+        OrganPose {
+            alpha: &organ.alpha,
+            carry: &organ.carry,
+        }
+    }
+
+    /// Adds to organ `index`'s coupling of this tick (after [`Self::tick`]) a force another
+    /// organ puts on it beyond contact, spread over an area (a bed's tie): `force_n` on the
+    /// surface point `blend` of its load positions, as modal coefficients of every load step
+    /// and its share of the total. It has no point load: a traction spread over the area
+    /// has no dimple of its own for the near field to draw.
+    pub fn add_spread_force(
+        &mut self,
+        index: usize,
+        vademecum: &Vademecum,
+        blend: &[(usize, f64)],
+        force_n: &Vector3<f64>,
+    ) {
+        let organ = &mut self.organs[index];
+        for (step, range) in organ.steps.iter().enumerate() {
+            vademecum.add_coefficients(step, blend, force_n, &mut organ.coupling[range.clone()]);
+        }
+        organ.coupling_force_n += force_n;
+    }
+
     /// How far (m) this tick's contact forces move the surface under the tool holding organ
     /// `index`: the tool's load follows it in the same tick (`super::hold`).
     pub fn tool_moved_m(&self, index: usize) -> Vector3<f64> {

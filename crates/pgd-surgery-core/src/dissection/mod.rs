@@ -1,12 +1,15 @@
 //! Freeing one organ from another: the connective tissue between them as cohesive ties that
 //! hold, give and tear ([`cohesive`]), placed where the two organs' surfaces face each other
-//! ([`bed`]), their forces each tick answered with the organs' own give ([`solve`]).
+//! ([`bed`]), their forces each tick answered with the organs' own give ([`solve`]), between
+//! two organs of a scene's contact stage ([`tied`]).
 //! `docs/dissection.md` has the model and its sources.
 
 pub mod bed;
 pub mod cohesive;
 pub mod solve;
+pub mod tied;
 
 pub use bed::{Bed, BedError, FreedSurface, Tie, TieLoad};
 pub use cohesive::{CohesiveError, CohesiveLaw, CohesiveTie};
 pub use solve::{TieCompliance, TieConvergence, TieSolve};
+pub use tied::{TiedOrgans, TiedReport};
