@@ -11,7 +11,7 @@ use super::haptic::{
     ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SceneHand, SceneScope,
     SettleCuts, TickClock,
 };
-use super::scene::{Detail, SceneOrgan, scene_files, scene_of, scene_vademecums};
+use super::scene::{Detail, SceneOrgan, scene_files, scene_of, scene_vademecums, tie_organs};
 use crate::contact::{ContactSurface, CouplingSettings};
 use crate::devices::{HapticDevice, Instrument, ScopeHandle, TICK_S, Workspace, stop_requested};
 use crate::mesh::organs::Organ;
@@ -52,6 +52,9 @@ pub fn scenario_scene(
     scene.scope = scenario.laparoscope.as_ref().and_then(scene_scope);
     if let (Some(cutting), Some(blade)) = (&mut scene.cutting, scenario.blade()) {
         cutting.blade = blade;
+    }
+    for attachment in &scenario.attachments {
+        tie_organs(&mut scene, attachment)?;
     }
     Ok(scene)
 }

@@ -12,7 +12,7 @@ use serde::Serialize;
 use super::haptic::{
     HapticLoop, HapticScene, HapticThread, RealTimeReport, SceneHand, Scheduling, TickTimes,
 };
-use super::scene::press_targets;
+use super::scene::{press_targets, tie_organs};
 use crate::bench::fem::median_ms;
 use crate::devices::{
     Action, HapticDevice, Instrument, PressMotion, PressTarget, Scripted, TICK_S, TimerMode,
@@ -22,6 +22,7 @@ use crate::fem::{FemError, Law, Loads, NewtonSettings};
 use crate::mesh::Surface;
 use crate::mesh::organs::{self, Organ, OrganSettings};
 use crate::pgd::{self, SurfaceModes};
+use crate::scenario::AttachmentEntry;
 
 #[derive(Clone, Debug, Serialize)]
 pub struct SweepFigures {
@@ -72,6 +73,18 @@ pub struct HapticBenchReport {
     /// (where it moves) while the right sweeps.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub two_hands: Option<HandsTick>,
+    /// Where the scene has a gallbladder and a liver: the four-organ sweep (with every hand)
+    /// with the gallbladder tied to the liver by its bed and without, in the same run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bed: Option<BedTick>,
+}
+
+/// The tick's compute with the gallbladder's bed and without (µs, as [`HandsTick`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct BedTick {
+    pub ties: usize,
+    pub with_bed: HandsTick,
+    pub without_bed: HandsTick,
 }
 
 /// The tick's compute with so many hands (µs; medians over the repeats of each run's
@@ -125,6 +138,7 @@ pub fn run(
         }
         _ => (None, None),
     };
+    let bed = bed_tick(scene, &targets, motion, repeats, hands);
     let fem_contact = fem_contact(&targets[0], repeats, sweeps[0].compute_p50_us)?;
     let render_cpu_ms = render_cpu(scene, &targets, repeats);
     let realtime = [
@@ -149,6 +163,32 @@ pub fn run(
         realtime_seconds,
         one_hand,
         two_hands,
+        bed,
+    })
+}
+
+/// The four-organ sweep with `hands` hands, with the gallbladder tied to the liver by its
+/// bed and without; none where the scene lacks either.
+fn bed_tick(
+    scene: &HapticScene,
+    targets: &[PressTarget],
+    motion: &PressMotion,
+    repeats: usize,
+    hands: usize,
+) -> Option<BedTick> {
+    let mut without = match hands {
+        2 => with_left_hand(scene),
+        _ => scene.clone(),
+    };
+    without.beds.clear();
+    let mut with = without.clone();
+    tie_organs(&mut with, &AttachmentEntry::gallbladder_bed()).ok()?;
+    let ties = with.beds[0].bed.ties.len();
+    let run = |scene: &HapticScene| HandsTick::from(&sweep(scene, "all", targets, motion, repeats));
+    Some(BedTick {
+        ties,
+        without_bed: run(&without),
+        with_bed: run(&with),
     })
 }
 
@@ -348,6 +388,17 @@ impl fmt::Display for HapticBenchReport {
                 one.tick_p99_us,
                 two.tick_p99_us / one.tick_p99_us.max(f64::MIN_POSITIVE),
                 two.left_holding_ticks
+            )?;
+        }
+        if let Some(bed) = &self.bed {
+            writeln!(
+                f,
+                "the gallbladder tied to the liver ({} ties): tick p99 {:.1} µs against {:.1} µs \
+                 untied ({:.2}x)",
+                bed.ties,
+                bed.with_bed.tick_p99_us,
+                bed.without_bed.tick_p99_us,
+                bed.with_bed.tick_p99_us / bed.without_bed.tick_p99_us.max(f64::MIN_POSITIVE),
             )?;
         }
         writeln!(

@@ -8,19 +8,22 @@ use std::sync::{Arc, OnceLock};
 use nalgebra::Vector3;
 
 use super::haptic::{CutOrgan, HapticScene, SceneCutting, SceneDynamics, SceneHand};
-use crate::contact::{AttachmentSpec, Coupling, CouplingSettings, FieldOrigin, Probe};
+use crate::contact::{
+    AttachmentSpec, ContactSurface, Coupling, CouplingSettings, FieldOrigin, Probe,
+};
 use crate::cutting::keratotomy::{Cornea, REFERENCE_MESH};
 use crate::cutting::{Blade, CutError};
 use crate::devices::{
     Action, HapticDevice, Instrument, PressTarget, SafetySettings, VirtualDevice, VirtualHandle,
     Workspace,
 };
+use crate::dissection::{Bed, TiedOrgans};
 use crate::dynamics::{DynamicModel, GraspSettings, TRAINER_MODES};
 use crate::fem::{FemModel, Inclusion, Law};
 use crate::mesh::TetMesh;
 use crate::mesh::organs::{Organ, OrganSettings, region};
 use crate::pgd::{BuildSettings, Vademecum};
-use crate::scenario::{Keratometer, default_law};
+use crate::scenario::{AttachmentEntry, Keratometer, default_law};
 #[cfg(not(target_arch = "wasm32"))]
 use crate::store::build_in_background;
 use crate::store::{OnStale, OrganSource, VademecumSpec, ensure_vademecum, vademecum_file_name};
@@ -126,7 +129,37 @@ impl Detail {
 pub fn default_scene(dir: &Path, detail: Detail, on_stale: OnStale) -> Result<HapticScene, String> {
     let organs = SCENE_ORGANS.map(SceneOrgan::from);
     let coupling = CouplingSettings::default();
-    scene_of(&organs, None, &coupling, dir, detail, on_stale)
+    let mut scene = scene_of(&organs, None, &coupling, dir, detail, on_stale)?;
+    tie_organs(&mut scene, &AttachmentEntry::gallbladder_bed())?;
+    Ok(scene)
+}
+
+/// Binds `attachment.organ` to the organ it lies on in `scene` by a bed of cohesive ties
+/// where their surfaces face each other within its gap (setting up an organ coupling if the
+/// scene has none). Refused, naming both organs, where the surfaces do not face each other.
+pub fn tie_organs(scene: &mut HapticScene, attachment: &AttachmentEntry) -> Result<(), String> {
+    let place = format!("attachment of {} to {}", attachment.organ, attachment.to);
+    let find = |name: &str| {
+        (scene.organs.iter().position(|(n, _)| n == name))
+            .map(|index| (index, scene.organs[index].1.clone()))
+            .ok_or_else(|| format!("{place}: `{name}` is not in the scene"))
+    };
+    let (freed, base) = (find(&attachment.organ)?, find(&attachment.to)?);
+    let law = attachment.law().map_err(|e| format!("{place}: {e}"))?;
+    let surface = ContactSurface::new(&base.1).map_err(|e| format!("{place}: {e}"))?;
+    let bed = Bed::on(law, &freed.1, &surface, attachment.gap_m())
+        .map_err(|e| format!("{place}: {e}"))?;
+    if scene.coupling.is_none() {
+        let apart = CouplingSettings {
+            master: String::new(),
+            ..CouplingSettings::default()
+        };
+        let (coupling, _) =
+            Coupling::new(&scene.organs, &[], &apart, None).map_err(|e| e.to_string())?;
+        scene.coupling = Some(Arc::new(coupling));
+    }
+    scene.beds.push(TiedOrgans::new(bed, freed, base));
+    Ok(())
 }
 
 /// An organ of a scene: its mesh, its tissue (with any stiffer or softer regions in it) and
@@ -329,6 +362,7 @@ pub fn scene_of(
         }],
         safety: SafetySettings::default(),
         coupling: (!coupling.is_empty()).then(|| Arc::new(coupling)),
+        beds: Vec::new(),
         dynamics,
         cutting,
         scope: None,

@@ -302,6 +302,30 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "in millimetres",
         ),
         ("missing-tasks", 5, "", "missing field named `tasks`"),
+        (
+            "attachment-gap-out-of-range",
+            6,
+            "attachments[0].gap_mm",
+            "not a gap that connective tissue bridges",
+        ),
+        (
+            "attachment-fracture-energy-out-of-range",
+            9,
+            "attachments[0].fracture_energy_j_per_m2",
+            "not the fracture energy of connective tissue",
+        ),
+        (
+            "attachment-brittle",
+            12,
+            "attachments[1].fracture_energy_j_per_m2",
+            "fails before the peak traction",
+        ),
+        (
+            "attachment-organ-not-in-scene",
+            6,
+            "attachments[0].organ",
+            "`pancreas` is not in this scenario",
+        ),
         ("unknown-organ", 4, "organs[1]", "no organ `spleen`"),
         (
             "organ-not-in-scene",

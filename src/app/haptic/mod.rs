@@ -30,7 +30,7 @@ pub use hand::{
     Device, DeviceForce, FaultLog, ForceTrace, GraspForce, HandIndex, MAX_HANDS, Safety, Tool,
 };
 pub use report::{FaultSummary, ForceSummary, HeadlessReport, RangeSummary, TickTimes};
-pub use resources::{OrganCoupling, SceneScope, Scope, TickClock};
+pub use resources::{OrganBeds, OrganCoupling, SceneScope, Scope, TickClock};
 pub use runner::{
     CutOrgan, HapticLoop, HapticScene, SceneCutting, SceneDynamics, SceneError, SceneHand,
 };

@@ -8,6 +8,7 @@ use nalgebra::Vector3;
 
 use crate::contact::Coupling;
 use crate::devices::{Laparoscope, ScopeHandle, ScopePose, ScopeScript};
+use crate::dissection::TiedOrgans;
 
 /// The tick being run, set by the runner before each run of the schedule.
 #[derive(Resource, Clone, Copy, Debug, Default)]
@@ -21,6 +22,11 @@ pub struct TickClock {
 /// The organs' contact and attachments, with their state from tick to tick.
 #[derive(Resource, Clone)]
 pub struct OrganCoupling(pub Coupling);
+
+/// The beds binding organs to others, with their ties' state from tick to tick; run by the
+/// contact stage with the coupling.
+#[derive(Resource, Clone)]
+pub struct OrganBeds(pub Vec<TiedOrgans>);
 
 /// A scene's laparoscope: its optic, its pose (shared with the window, which steers it), and
 /// the point the trainee is to keep in view, if any.

@@ -18,7 +18,7 @@ use super::hand::{
     Device, DeviceForce, FaultLog, ForceTrace, GraspForce, HandIndex, MAX_HANDS, Safety, Tool,
 };
 use super::report::{FaultSummary, ForceSummary, HeadlessReport, RangeSummary};
-use super::resources::{OrganCoupling, SceneScope, Scope, TickClock};
+use super::resources::{OrganBeds, OrganCoupling, SceneScope, Scope, TickClock};
 use super::snapshot::{HandSnapshot, HapticSnapshot, OrganSnapshot, SnapshotPublisher};
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
 use crate::cutting::{Blade, CutError, CutWorker, LatestCut, Scalpel};
@@ -26,6 +26,7 @@ use crate::devices::{
     Fulcrum, HapticDevice, Histogram, Instrument, Rack, SafetyFilter, SafetySettings, TICK_S,
     Workspace, stop_requested,
 };
+use crate::dissection::TiedOrgans;
 use crate::dynamics::{DynamicModel, GraspSettings};
 use crate::fem::FemModel;
 use crate::pgd::{Deformation, Vademecum};
@@ -43,6 +44,9 @@ pub struct HapticScene {
     pub safety: SafetySettings,
     /// Organ/organ contact and attachments (set up, at rest); `None` leaves the organs apart.
     pub coupling: Option<Arc<Coupling>>,
+    /// Organs bound to others by connective tissue (the gallbladder in its bed), at rest;
+    /// each needs the coupling.
+    pub beds: Vec<TiedOrgans>,
     /// Organs that move, and the grasper that pulls them; `None`: every organ quasi-static and
     /// the tool a probe.
     pub dynamics: Option<SceneDynamics>,
@@ -65,6 +69,7 @@ impl HapticScene {
             hands: vec![SceneHand::default()],
             safety: SafetySettings::default(),
             coupling: None,
+            beds: Vec::new(),
             dynamics: None,
             cutting: None,
             scope: None,
@@ -292,6 +297,9 @@ impl HapticLoop {
                 coupling.reserve_output(&mut deformation.0);
             }
             world.insert_resource(OrganCoupling(coupling));
+            if !scene.beds.is_empty() {
+                world.insert_resource(OrganBeds(scene.beds.clone()));
+            }
         }
         if let Some(scope) = &scene.scope {
             world.insert_resource(Scope::new(scope.clone()));

@@ -11,7 +11,7 @@ use super::cutting::OrganCut;
 use super::hand::{
     DeviceForce, FaultLog, ForceTrace, GraspForce, HandIndex, HandState, MAX_HANDS, Safety, Tool,
 };
-use super::resources::{OrganCoupling, TickClock};
+use super::resources::{OrganBeds, OrganCoupling, TickClock};
 use super::snapshot::{HandSnapshot, InstrumentsView, LoopTiming, SnapshotPublisher};
 use crate::contact::{Target, follow, press};
 use crate::devices::{Action, Fault, Fulcrum};
@@ -280,10 +280,15 @@ pub fn evaluate_modes(mut organs: Query<(&OrganBody, &mut OrganDeformation)>) {
 
 /// Organ against organ: hands every organ's coefficients (a moving organ's motion included,
 /// every hand's load in them) and the hold of the first hand that presses it to the coupling,
-/// ticks its pairs and attachments, and gives each organ its coupling loads and carry. The
-/// holding hand's load follows the contact's push in the same tick, so the trainee feels the
-/// organ behind at once; another hand's press on the same organ answers it next tick.
-pub fn organ_contact(mut coupling: ResMut<OrganCoupling>, mut organs: Query<CoupledOrgan>) {
+/// ticks its pairs and attachments, then the beds' ties, and gives each organ its coupling
+/// loads and carry. The holding hand's load
+/// follows the contact's push in the same tick, so the trainee feels the organ behind at
+/// once; another hand's press on the same organ answers it next tick.
+pub fn organ_contact(
+    mut coupling: ResMut<OrganCoupling>,
+    mut beds: Option<ResMut<OrganBeds>>,
+    mut organs: Query<CoupledOrgan>,
+) {
     let coupling = &mut coupling.0;
     for organ in &organs {
         let deformation = &organ.deformation.0;
@@ -294,6 +299,9 @@ pub fn organ_contact(mut coupling: ResMut<OrganCoupling>, mut organs: Query<Coup
         coupling.hold(organ.index.0, contact, &deformation.loads[slot]);
     }
     coupling.tick();
+    for bed in beds.iter_mut().flat_map(|b| b.0.iter_mut()) {
+        bed.tick(coupling);
+    }
     for mut organ in &mut organs {
         let index = organ.index.0;
         let deformation = &mut organ.deformation.0;

@@ -6,8 +6,8 @@
 //! The organs' coefficients already hold the ties' forces of the last tick (the coupling is
 //! part of them), so the separation measured at the ties is that of the other loads plus
 //! what the last forces made; the solve takes the latter out through the same compliance
-//! it answers the forces with. That compliance is the two organs' modes between the ties
-//! (the symmetric part of `D Lᵀ`, as organ contact's, in three directions): the near field
+//! it answers the forces with. That compliance is the two organs' linear modes between the
+//! ties (the symmetric part of `X Yᵀ`, as organ contact's, in three directions): the near field
 //! the modes miss is not in it, so the ties see the organs a little stiffer than the field
 //! they draw, and the next tick's measurement takes up the difference. The ties' forces load
 //! both organs through their modes alone: together they are a traction spread over the bed,
@@ -32,11 +32,9 @@ struct TiedSide {
     /// Each tie's point as a blend of the organ's load positions.
     blends: Vec<Vec<(usize, f64)>>,
     rest_m: Vec<Vector3<f64>>,
+    /// Every load step's modes at the ties: where the organ's coefficients move them.
     displacement: ModalRows,
-    load: ModalRows,
-    /// `Σ_j Lⱼ fⱼ` and `Σ_j Dⱼ fⱼ` for the forces being applied (one per mode).
-    by_load: Vec<f32>,
-    by_displacement: Vec<f32>,
+    linear: LinearRows,
 }
 
 impl TiedSide {
@@ -48,18 +46,13 @@ impl TiedSide {
                     .sum()
             })
             .collect();
-        let displacement = ModalRows::displacements(&vademecum, blends.iter());
-        let load = ModalRows::loads(&vademecum, blends.iter());
-        let modes = vademecum.total_modes();
         Self {
             index,
+            displacement: ModalRows::displacements(&vademecum, blends.iter()),
+            linear: LinearRows::new(&vademecum, &blends),
             vademecum,
             blends,
             rest_m,
-            displacement,
-            load,
-            by_load: vec![0.0; modes],
-            by_displacement: vec![0.0; modes],
         }
     }
 
@@ -68,34 +61,79 @@ impl TiedSide {
         let modal = self.displacement.apply(i, pose.alpha).map(f64::from);
         modal + pose.carry.at(&self.rest_m[i])
     }
+}
+
+/// One organ's linear load step at the ties, the compliance the solve answers with: per tie
+/// and mode, the spatial mode `X` there and the parametric mode `Y` (coefficient per
+/// newton). The nonlinear steps are left out: the ties' forces are far below the levels that
+/// reach them, and their corrections, taken at full weight, make the compliance's symmetric
+/// part indefinite (a stiffening tissue's correction takes compliance away), which conjugate
+/// gradients cannot take.
+#[derive(Clone, Debug)]
+struct LinearRows {
+    modes: usize,
+    /// `[tie * modes + mode]`.
+    spatial: Vec<Vector3<f64>>,
+    parametric: Vec<Vector3<f64>>,
+    /// `Σ_j Yⱼ fⱼ` and `Σ_j Xⱼ fⱼ` for the forces being applied (one per mode).
+    by_parametric: Vec<f64>,
+    by_spatial: Vec<f64>,
+}
+
+impl LinearRows {
+    fn new(vademecum: &Vademecum, blends: &[Vec<(usize, f64)>]) -> Self {
+        let modes = vademecum.modes(0);
+        let gather = |value: &dyn Fn(usize, usize) -> Vector3<f64>| -> Vec<Vector3<f64>> {
+            (blends.iter())
+                .flat_map(|blend| {
+                    (0..modes).map(move |k| blend.iter().map(|&(m, w)| value(k, m) * w).sum())
+                })
+                .collect()
+        };
+        let node = |m: usize| vademecum.positions[m] as usize;
+        Self {
+            modes,
+            spatial: gather(&|k, m| vademecum.mode_at_node(0, k, node(m))),
+            parametric: gather(&|k, m| vademecum.load_mode_at(0, k, m)),
+            by_parametric: vec![0.0; modes],
+            by_spatial: vec![0.0; modes],
+        }
+    }
+
+    fn rows(&self, i: usize) -> (&[Vector3<f64>], &[Vector3<f64>]) {
+        let range = i * self.modes..(i + 1) * self.modes;
+        (&self.spatial[range.clone()], &self.parametric[range])
+    }
 
     /// Sums the forces' modal sums for [`Self::add_answer`].
     fn gather(&mut self, forces_n: &[Vector3<f64>]) {
-        self.by_load.fill(0.0);
-        self.by_displacement.fill(0.0);
+        self.by_parametric.fill(0.0);
+        self.by_spatial.fill(0.0);
         for (j, force) in forces_n.iter().enumerate() {
             if *force == Vector3::zeros() {
                 continue;
             }
-            let f = force.map(|c| c as f32);
+            let range = j * self.modes..(j + 1) * self.modes;
             let sums = [
-                (&self.load, &mut self.by_load),
-                (&self.displacement, &mut self.by_displacement),
+                (&self.parametric[range.clone()], &mut self.by_parametric),
+                (&self.spatial[range], &mut self.by_spatial),
             ];
             for (rows, sum) in sums {
                 sum.iter_mut()
-                    .zip(rows.along(j, f))
-                    .for_each(|(s, v)| *s += v);
+                    .zip(rows)
+                    .for_each(|(s, r)| *s += r.dot(force));
             }
         }
     }
 
     /// Adds how far the gathered forces move tie `i`'s point (m): the symmetric part of
-    /// `D Lᵀ`.
+    /// `X Yᵀ`.
     fn add_answer(&self, i: usize, out: &mut Vector3<f64>) {
-        let free =
-            self.displacement.apply(i, &self.by_load) + self.load.apply(i, &self.by_displacement);
-        *out += free.map(f64::from) * 0.5;
+        let (spatial, parametric) = self.rows(i);
+        let sum = |rows: &[Vector3<f64>], by: &[f64]| -> Vector3<f64> {
+            rows.iter().zip(by).map(|(r, b)| r * *b).sum()
+        };
+        *out += (sum(spatial, &self.by_parametric) + sum(parametric, &self.by_spatial)) * 0.5;
     }
 }
 
@@ -108,12 +146,12 @@ struct BothSides<'a> {
 impl TieCompliance for BothSides<'_> {
     /// A force `f` on the freed organ and `−f` on the base both open the tie along `f`.
     fn separation(&mut self, forces_n: &[Vector3<f64>], out_m: &mut [Vector3<f64>]) {
-        self.freed.gather(forces_n);
-        self.base.gather(forces_n);
+        self.freed.linear.gather(forces_n);
+        self.base.linear.gather(forces_n);
         for (i, out) in out_m.iter_mut().enumerate() {
             *out = Vector3::zeros();
-            self.freed.add_answer(i, out);
-            self.base.add_answer(i, out);
+            self.freed.linear.add_answer(i, out);
+            self.base.linear.add_answer(i, out);
         }
     }
 }

@@ -10,6 +10,7 @@ use crate::devices::DeviceSpec;
 use crate::fem::Law;
 use crate::mesh::organs::Organ;
 
+use super::attachment::AttachmentEntry;
 use super::scene::{Nodule, OrganEntry, metres, organ_list};
 use super::task::Task;
 use super::units::{EdgeLength, FieldOfView, Millimetres, Newtons, Scale, ScopeAngle};
@@ -55,6 +56,10 @@ pub struct Scenario {
     /// How the organs touch each other.
     #[serde(default)]
     pub contact: Contact,
+    /// Organs bound to others by connective tissue where their surfaces face each other
+    /// (`Attachment(organ: "gallbladder", to: "liver")`), which the trainee frees.
+    #[serde(default)]
+    pub attachments: Vec<AttachmentEntry>,
     /// Done in order: each task starts when the one before is done or out of time.
     pub tasks: Vec<Task>,
     #[serde(default)]

@@ -6,6 +6,7 @@
 
 use std::path::Path;
 
+use super::attachment::AttachmentEntry;
 use super::format::{LaparoscopeEntry, Scenario};
 use super::problem::{Problem, REFERENCE, ScenarioError};
 use super::scene::{OrganEntry, metres};
@@ -103,6 +104,9 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
     for (k, nodule) in scenario.nodules.iter().enumerate() {
         let field = format!("nodules[{k}].organ");
         problems.extend(not_in_scene(scenario, &nodule.organ, field, "nodules"));
+    }
+    for (k, attachment) in scenario.attachments.iter().enumerate() {
+        check_attachment(scenario, k, attachment, &mut problems);
     }
     if let Some(master) = &scenario.contact.master {
         problems.extend(not_in_scene(
@@ -465,6 +469,52 @@ fn check_stiffening(k: usize, organ: &OrganEntry, law: Law) -> Option<Problem> {
         message: format!("the {} law has no stiffening", law.name()),
         hint: "set `law: Exponential` with it, or leave it out".into(),
     })
+}
+
+/// An attachment binds two different organs of the scene, by a tissue whose fracture energy
+/// reaches its peak traction.
+fn check_attachment(
+    scenario: &Scenario,
+    k: usize,
+    attachment: &AttachmentEntry,
+    problems: &mut Vec<Problem>,
+) {
+    let field = |name: &str| format!("attachments[{k}].{name}");
+    // The k-th `Attachment(` after `attachments:`, then the named field in it.
+    let anchors = |name: &str| {
+        let mut anchors = vec!["attachments".to_owned()];
+        anchors.extend((0..=k).map(|_| "Attachment".to_owned()));
+        anchors.push(name.to_owned());
+        anchors
+    };
+    problems.extend(not_in_scene(
+        scenario,
+        &attachment.organ,
+        field("organ"),
+        "attachments",
+    ));
+    problems.extend(not_in_scene(
+        scenario,
+        &attachment.to,
+        field("to"),
+        "attachments",
+    ));
+    if attachment.organ == attachment.to {
+        problems.push(Problem {
+            field: field("to"),
+            anchors: anchors("to"),
+            message: format!("`{}` is attached to itself", attachment.organ),
+            hint: "attach it to the organ it lies on".into(),
+        });
+    }
+    if let Err(e) = attachment.law() {
+        problems.push(Problem {
+            field: field("fracture_energy_j_per_m2"),
+            anchors: anchors("fracture_energy_j_per_m2"),
+            message: e.to_string(),
+            hint: "the law must reach its peak before it fails: 2 G / T above T / K".into(),
+        });
+    }
 }
 
 /// A problem if `organ`, named at `field` in the `section` of the file, is not in the scene.

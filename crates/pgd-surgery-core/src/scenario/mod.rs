@@ -7,6 +7,7 @@
 //! measured; and the rubric's score (`score`). No Bevy here: the app layer runs an
 //! [`Exercise`] inside the haptic schedule.
 
+mod attachment;
 mod bimanual;
 mod exercise;
 mod format;
@@ -22,6 +23,7 @@ pub mod task;
 pub mod tasks;
 mod units;
 
+pub use attachment::{AttachmentEntry, DEFAULT_TIE_GAP_MM};
 pub use bimanual::{BimanualMetrics, BimanualTracker};
 pub use exercise::{Exercise, Progress, Sites};
 pub use format::{

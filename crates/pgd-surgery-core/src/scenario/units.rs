@@ -343,3 +343,77 @@ mod tests {
         assert_eq!(Newtons(0.0304).to_string(), "0.03");
     }
 }
+
+/// The widest gap between two organs' surfaces that connective tissue ties, in
+/// millimetres: from 0.5 to 10.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct TieGap(pub f64);
+
+impl TryFrom<f64> for TieGap {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (0.5..=10.0).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v} mm is not a gap that connective tissue bridges (0.5 to 10 mm; the \
+                 gallbladder's bed is 3)"
+            )),
+        }
+    }
+}
+
+/// The energy that frees a square metre of attachment, in J/m²: from 1 to 1000.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct FractureEnergy(pub f64);
+
+impl TryFrom<f64> for FractureEnergy {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (1.0..=1000.0).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v} J/m² is not the fracture energy of connective tissue (1 to 1000; the \
+                 gallbladder's bed is taken as 50, liver parenchyma is 76 to 225)"
+            )),
+        }
+    }
+}
+
+/// The largest traction connective tissue carries, in pascals: from 100 Pa to 100 kPa.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct PeakTraction(pub f64);
+
+impl TryFrom<f64> for PeakTraction {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (100.0..=1e5).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v} Pa is not the peak traction of connective tissue (100 to 100000 Pa; the \
+                 gallbladder's bed is taken as 5000)"
+            )),
+        }
+    }
+}
+
+/// Connective tissue's traction per metre of opening before damage, in Pa/m: from 1e5 to
+/// 1e9.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct TieStiffness(pub f64);
+
+impl TryFrom<f64> for TieStiffness {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (1e5..=1e9).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v} Pa/m is not a stiffness of connective tissue (1e5 to 1e9 Pa/m; the \
+                 gallbladder's bed is taken as 5e6, its peak reached at 1 mm)"
+            )),
+        }
+    }
+}
