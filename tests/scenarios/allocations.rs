@@ -173,3 +173,23 @@ fn report(run: &str, ticks: u64, count: u64) -> Vec<String> {
     }
     misplaced
 }
+
+/// The gentle press on the gallbladder with the gallbladder tied to the liver by its bed: the
+/// bed's ties, solved every tick, allocate nothing.
+#[test]
+fn a_tick_with_the_gallbladder_tied_to_its_bed_allocates_only_what_is_named() {
+    let run = (SHIPPED_RUNS.iter())
+        .find(|run| run.file.ends_with("gallbladder-gentle-press.scenario.ron"))
+        .unwrap();
+    let organs = r#"organs: ["liver", "gallbladder"],"#;
+    let tied = run.scenario.replace(
+        organs,
+        &format!(r#"{organs} attachments: [Attachment(organ: "gallbladder", to: "liver")],"#),
+    );
+    assert_ne!(tied, run.scenario);
+    counting::on_allocation(Some(trace));
+    let (_, ticks, count) = counted_run(run.file, &tied, run.competent);
+    let misplaced = report("gallbladder tied to its bed (competent)", ticks, count);
+    counting::on_allocation(None);
+    assert!(misplaced.is_empty(), "{misplaced:#?}");
+}
