@@ -158,6 +158,12 @@ impl CohesiveTie {
         law.damage(self.reached_m)
     }
 
+    /// Divides the tie for good (burned through): it fails as if opened to its failure
+    /// separation.
+    pub fn sever(&mut self, law: &CohesiveLaw) {
+        self.reached_m = self.reached_m.max(law.failure_separation_m());
+    }
+
     /// Whether the tie has failed: it carries nothing in tension or shear any more.
     pub fn failed(&self, law: &CohesiveLaw) -> bool {
         self.damage(law) >= 1.0

@@ -1,15 +1,18 @@
 //! Freeing one organ from another: the connective tissue between them as cohesive ties that
 //! hold, give and tear ([`cohesive`]), placed where the two organs' surfaces face each other
 //! ([`bed`]), their forces each tick answered with the organs' own give ([`solve`]), between
-//! two organs of a scene's contact stage ([`tied`]).
+//! two organs of a scene's contact stage ([`tied`]); the hook's energy and the ties and walls
+//! it burns ([`cautery`]).
 //! `docs/dissection.md` has the model and its sources.
 
 pub mod bed;
+pub mod cautery;
 pub mod cohesive;
 pub mod solve;
 pub mod tied;
 
 pub use bed::{Bed, BedError, FreedSurface, Tie, TieLoad};
+pub use cautery::{Cautery, CauteryMode, POWER_RANGE_W, PowerOutOfRange, TieBurns, TissueHeat};
 pub use cohesive::{CohesiveError, CohesiveLaw, CohesiveTie};
 pub use solve::{TieCompliance, TieConvergence, TieSolve};
 pub use tied::{TiedOrgans, TiedReport};
