@@ -10,7 +10,9 @@ use pgd_surgery::app::haptic::{
 use pgd_surgery::app::scene::{Detail, SceneOrgan, press_targets, scene_of, tie_organs};
 use pgd_surgery::contact::{ContactSurface, Coupling, CouplingSettings};
 use pgd_surgery::devices::{DeviceSample, Scripted, TICK_S, Trajectory, TrajectoryRow};
-use pgd_surgery::dissection::{Bed, BedError, CohesiveLaw, TiedOrgans};
+use pgd_surgery::dissection::{
+    Bed, BedError, Cautery, CauteryMode, CohesiveLaw, Tie, TiedOrgans, TissueHeat,
+};
 use pgd_surgery::mesh::organs::Organ;
 use pgd_surgery::pgd::{Deformation, Vademecum, load};
 use pgd_surgery::scenario::AttachmentEntry;
@@ -298,4 +300,65 @@ fn the_bed_holds_the_gallbladder_against_a_press_through_the_loop() {
     assert!(drift < 0.01);
     assert_eq!(with_bed.released, 0.0);
     assert!(largest_change <= 0.02, "{largest_change} N in a tick");
+}
+
+/// The hook held, at 30 W in cut, at the middle of the bed's centre tie, reaching 4 mm: the
+/// live ties whose middles are within reach (counted here from the organs' rest surfaces)
+/// share its energy, none is divided before the first could have taken its channel's energy
+/// (`TissueHeat::tie_burn_j`) at its share, all are divided by the time they could all have
+/// taken theirs, and the bed's released share is then their share of its area; 20 mm clear
+/// of the bed the hook heats no tie.
+#[test]
+fn the_hook_divides_the_ties_within_its_reach() {
+    let mut tied = Tied::new();
+    tied.tick();
+    let (gallbladder, liver) = (&tied.organs[0], &tied.organs[1]);
+    let middle = |t: &Tie| {
+        let freed = Vector3::from(gallbladder.position_coords_m[t.position].map(f64::from));
+        (freed + liver.point(&t.facing)) * 0.5
+    };
+    let centre = tied.tied.bed.ties[tied.tied.bed.ties.len() / 2];
+    let tip = middle(&centre);
+    let reach_m = 4e-3;
+    let within: Vec<Tie> = (tied.tied.bed.ties.iter())
+        .filter(|t| (middle(t) - tip).norm() <= reach_m)
+        .copied()
+        .collect();
+    let hook = Cautery::new(CauteryMode::Cut, 30.0).unwrap();
+    let tissue = TissueHeat::SOFT_TISSUE;
+    let needed_j: Vec<f64> = (within.iter())
+        .map(|t| tissue.tie_burn_j(t.area_m2, 2e-3, CauteryMode::Cut))
+        .collect();
+    let earliest_s =
+        needed_j.iter().copied().fold(f64::INFINITY, f64::min) * within.len() as f64 / hook.power_w;
+    let latest_s = needed_j.iter().sum::<f64>() / hook.power_w;
+    let tick_s = 1e-3;
+    let (mut divided, mut first_s, mut heated_first) = (0, None, None);
+    for tick in 1..=((latest_s / tick_s) as usize + 2) {
+        let outcome = tied
+            .tied
+            .burn_near(&tip, reach_m, hook.energy_j(tick_s), CauteryMode::Cut);
+        heated_first.get_or_insert(outcome.heated);
+        if outcome.divided > 0 && first_s.is_none() {
+            first_s = Some(tick as f64 * tick_s);
+        }
+        divided += outcome.divided;
+    }
+    let released: f64 = within.iter().map(|t| t.area_m2).sum::<f64>() / tied.tied.bed.area_m2();
+    eprintln!(
+        "{} ties within {} mm; first divided at {:.3} s (earliest {earliest_s:.3} s), all by \
+         {latest_s:.3} s; released {:.1} %",
+        within.len(),
+        reach_m * 1e3,
+        first_s.unwrap_or(f64::NAN),
+        100.0 * tied.tied.bed.released_share()
+    );
+    assert!(!within.is_empty());
+    assert_eq!(heated_first, Some(within.len()));
+    assert!(first_s.unwrap() >= earliest_s - tick_s);
+    assert_eq!(divided, within.len());
+    assert!((tied.tied.bed.released_share() - released).abs() < 1e-12);
+    let clear = tip + centre.normal.into_inner() * 0.02;
+    let outcome = tied.tied.burn_near(&clear, reach_m, 1.0, CauteryMode::Cut);
+    assert_eq!(outcome.heated, 0);
 }

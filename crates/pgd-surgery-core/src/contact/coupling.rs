@@ -257,22 +257,17 @@ impl Coupling {
         }
     }
 
-    /// Adds to organ `index`'s coupling of this tick (after [`Self::tick`]) a force another
-    /// organ puts on it beyond contact, spread over an area (a bed's tie): `force_n` on the
-    /// surface point `blend` of its load positions, as modal coefficients of every load step
-    /// and its share of the total. It has no point load: a traction spread over the area
-    /// has no dimple of its own for the near field to draw.
-    pub fn add_spread_force(
-        &mut self,
-        index: usize,
-        vademecum: &Vademecum,
-        blend: &[(usize, f64)],
-        force_n: &Vector3<f64>,
-    ) {
+    /// Adds to organ `index`'s coupling of this tick (after [`Self::tick`]) loads another
+    /// organ puts on it beyond contact, spread over an area (a bed's ties): the coefficients
+    /// of its linear load step, `linear` (one per mode of step 0), and their sum `force_n`.
+    /// They have no point load: a traction spread over an area has no dimple of its own for
+    /// the near field to draw.
+    pub fn add_linear_load(&mut self, index: usize, linear: &[f64], force_n: &Vector3<f64>) {
         let organ = &mut self.organs[index];
-        for (step, range) in organ.steps.iter().enumerate() {
-            vademecum.add_coefficients(step, blend, force_n, &mut organ.coupling[range.clone()]);
-        }
+        let step = organ.steps[0].clone();
+        (organ.coupling[step].iter_mut())
+            .zip(linear)
+            .for_each(|(c, l)| *c += l);
         organ.coupling_force_n += force_n;
     }
 

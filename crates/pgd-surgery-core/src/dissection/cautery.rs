@@ -141,12 +141,12 @@ pub struct TieBurns {
 }
 
 impl TieBurns {
-    /// Nothing burned yet, for the ties of `bed`.
-    pub fn new(bed: &Bed, tissue: TissueHeat, thickness_m: f64) -> Self {
+    /// Nothing burned yet, for a bed of `ties` ties.
+    pub fn new(ties: usize, tissue: TissueHeat, thickness_m: f64) -> Self {
         Self {
             tissue,
             thickness_m,
-            absorbed_j: vec![0.0; bed.ties.len()],
+            absorbed_j: vec![0.0; ties],
         }
     }
 
@@ -214,7 +214,7 @@ mod tests {
             for (tie, side_m) in [(0, 1e-2), (1, 0.5e-2)] {
                 let hook = Cautery::new(mode, 30.0).unwrap();
                 let mut bed = bed();
-                let mut burns = TieBurns::new(&bed, tissue, 2e-3);
+                let mut burns = TieBurns::new(bed.ties.len(), tissue, 2e-3);
                 let expected_s = per_m3 * width_m * side_m * 2e-3 / 30.0;
                 let mut divided_at = None;
                 for tick in 1..=20_000 {

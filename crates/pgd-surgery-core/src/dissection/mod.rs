@@ -15,4 +15,4 @@ pub use bed::{Bed, BedError, FreedSurface, Tie, TieLoad};
 pub use cautery::{Cautery, CauteryMode, POWER_RANGE_W, PowerOutOfRange, TieBurns, TissueHeat};
 pub use cohesive::{CohesiveError, CohesiveLaw, CohesiveTie};
 pub use solve::{TieCompliance, TieConvergence, TieSolve};
-pub use tied::{TiedOrgans, TiedReport};
+pub use tied::{HookOnTies, TiedOrgans, TiedReport};

@@ -5,54 +5,63 @@
 //!
 //! The organs' coefficients already hold the ties' forces of the last tick (the coupling is
 //! part of them), so the separation measured at the ties is that of the other loads plus
-//! what the last forces made; the solve takes the latter out through the same compliance
-//! it answers the forces with. That compliance is the two organs' linear modes between the
-//! ties (the symmetric part of `X Yᵀ`, as organ contact's, in three directions): the near field
-//! the modes miss is not in it, so the ties see the organs a little stiffer than the field
-//! they draw, and the next tick's measurement takes up the difference. The ties' forces load
-//! both organs through their modes alone: together they are a traction spread over the bed,
-//! which has no dimple under each tie for the near field to draw. The near field of other
-//! loads (the dimple under a tool) is not read at the ties either.
+//! what the last forces made; the solve takes the latter out through the same compliance it
+//! answers the forces with, and adds back the share of the forces it finds.
+//!
+//! That compliance is both organs' **linear load step** between the ties (the symmetric part
+//! of spatial times parametric modes, in three directions). Made of separated modes, it is
+//! only nearly positive: it is set up once as `W Wᵀ`, its negative part dropped, so that
+//! conjugate gradients always descend. The nonlinear load steps are left out: the ties' forces stay far
+//! below the levels that reach them, and a stiffening tissue's corrections, taken at full
+//! weight, make the compliance far from positive.
+//!
+//! The ties load both organs through their linear modes alone: together they are a traction
+//! spread over the bed, which has no dimple under each tie for the near field to draw. The
+//! near field of other loads (the dimple under a tool) is not read at the ties either.
 
 use std::sync::Arc;
 
-use nalgebra::Vector3;
+use nalgebra::{DMatrix, SymmetricEigen, Vector3};
 
 use super::bed::Bed;
+use super::cautery::{CauteryMode, TieBurns, TissueHeat};
 use super::solve::{TieCompliance, TieConvergence, TieSolve};
 use crate::contact::{Coupling, ModalRows, OrganPose};
 use crate::pgd::Vademecum;
 
-/// One organ's side of the ties: its modes at them, its vademecum and where the ties sit
-/// on it at rest.
+/// The connective tissue layer's thickness the hook burns through (m): the bed's ties span
+/// up to its 3 mm gap; the areolar layer is taken as 2 mm.
+const LAYER_THICKNESS_M: f64 = 2e-3;
+
+/// One organ's side of the ties.
 #[derive(Clone, Debug)]
 struct TiedSide {
     index: usize,
-    vademecum: Arc<Vademecum>,
-    /// Each tie's point as a blend of the organ's load positions.
-    blends: Vec<Vec<(usize, f64)>>,
+    /// Where each tie sits on the organ at rest (m).
     rest_m: Vec<Vector3<f64>>,
     /// Every load step's modes at the ties: where the organ's coefficients move them.
     displacement: ModalRows,
-    linear: LinearRows,
+    /// The linear step's parametric modes at the ties, `[tie][mode]` (coefficient per
+    /// newton): the coefficients the ties' forces give the organ.
+    parametric: Vec<Vector3<f64>>,
+    /// The coefficients of this tick's forces on this side (one per linear mode).
+    linear: Vec<f64>,
 }
 
 impl TiedSide {
-    fn new(index: usize, vademecum: Arc<Vademecum>, blends: Vec<Vec<(usize, f64)>>) -> Self {
-        let rest_m = (blends.iter())
-            .map(|blend| {
-                (blend.iter())
-                    .map(|&(m, w)| Vector3::from(vademecum.position_coords_m[m].map(f64::from)) * w)
-                    .sum()
-            })
-            .collect();
+    fn new(index: usize, vademecum: &Vademecum, blends: &[Vec<(usize, f64)>]) -> Self {
+        let point = |blend: &Vec<(usize, f64)>| -> Vector3<f64> {
+            (blend.iter())
+                .map(|&(m, w)| Vector3::from(vademecum.position_coords_m[m].map(f64::from)) * w)
+                .sum()
+        };
+        let modes = vademecum.modes(0);
         Self {
             index,
-            displacement: ModalRows::displacements(&vademecum, blends.iter()),
-            linear: LinearRows::new(&vademecum, &blends),
-            vademecum,
-            blends,
-            rest_m,
+            rest_m: blends.iter().map(point).collect(),
+            displacement: ModalRows::displacements(vademecum, blends.iter()),
+            parametric: linear_rows(blends, modes, |k, m| vademecum.load_mode_at(0, k, m)),
+            linear: vec![0.0; modes],
         }
     }
 
@@ -61,98 +70,90 @@ impl TiedSide {
         let modal = self.displacement.apply(i, pose.alpha).map(f64::from);
         modal + pose.carry.at(&self.rest_m[i])
     }
+
+    /// The linear coefficients of the forces `sign × forces_n` on the ties.
+    fn gather(&mut self, forces_n: &[Vector3<f64>], sign: f64) {
+        gather(&self.parametric, forces_n, sign, &mut self.linear);
+    }
 }
 
-/// One organ's linear load step at the ties, the compliance the solve answers with: per tie
-/// and mode, the spatial mode `X` there and the parametric mode `Y` (coefficient per
-/// newton). The nonlinear steps are left out: the ties' forces are far below the levels that
-/// reach them, and their corrections, taken at full weight, make the compliance's symmetric
-/// part indefinite (a stiffening tissue's correction takes compliance away), which conjugate
-/// gradients cannot take.
-#[derive(Clone, Debug)]
-struct LinearRows {
+/// Per tie (a blend of load positions) and per mode of the linear step, `value(mode,
+/// position)` blended: `[tie * modes + mode]`.
+fn linear_rows(
+    blends: &[Vec<(usize, f64)>],
     modes: usize,
-    /// `[tie * modes + mode]`.
-    spatial: Vec<Vector3<f64>>,
-    parametric: Vec<Vector3<f64>>,
-    /// `Σ_j Yⱼ fⱼ` and `Σ_j Xⱼ fⱼ` for the forces being applied (one per mode).
-    by_parametric: Vec<f64>,
-    by_spatial: Vec<f64>,
+    value: impl Fn(usize, usize) -> Vector3<f64>,
+) -> Vec<Vector3<f64>> {
+    let value = &value;
+    (blends.iter())
+        .flat_map(|blend| {
+            (0..modes).map(move |k| blend.iter().map(|&(m, w)| value(k, m) * w).sum())
+        })
+        .collect()
 }
 
-impl LinearRows {
-    fn new(vademecum: &Vademecum, blends: &[Vec<(usize, f64)>]) -> Self {
-        let modes = vademecum.modes(0);
-        let gather = |value: &dyn Fn(usize, usize) -> Vector3<f64>| -> Vec<Vector3<f64>> {
-            (blends.iter())
-                .flat_map(|blend| {
-                    (0..modes).map(move |k| blend.iter().map(|&(m, w)| value(k, m) * w).sum())
-                })
-                .collect()
-        };
-        let node = |m: usize| vademecum.positions[m] as usize;
+/// `out_k = sign × Σ_j rows[j][k] · f_j`.
+fn gather(rows: &[Vector3<f64>], forces_n: &[Vector3<f64>], sign: f64, out: &mut [f64]) {
+    out.fill(0.0);
+    let modes = out.len();
+    for (j, force) in forces_n.iter().enumerate() {
+        if *force == Vector3::zeros() {
+            continue;
+        }
+        let f = force * sign;
+        let row = &rows[j * modes..(j + 1) * modes];
+        out.iter_mut().zip(row).for_each(|(o, r)| *o += r.dot(&f));
+    }
+}
+
+/// The ties' compliance within a tick as `W Wᵀ` (`W`: a column per retained direction, each
+/// a vector per tie).
+#[derive(Clone, Debug)]
+struct LowRank {
+    ties: usize,
+    columns: Vec<Vector3<f64>>,
+    /// `Wᵀ f` for the forces being applied.
+    projected: Vec<f64>,
+}
+
+impl LowRank {
+    /// The positive part of the symmetric `c` (over the ties' `3 n` components): its
+    /// eigenvectors scaled by the roots of its eigenvalues above a 1e-12 share of the largest.
+    fn positive_part(c: DMatrix<f64>) -> Self {
+        let ties = c.nrows() / 3;
+        let eigen = SymmetricEigen::new(c);
+        let largest = eigen.eigenvalues.iter().copied().fold(0.0, f64::max);
+        let mut columns = Vec::new();
+        for (k, &lambda) in eigen.eigenvalues.iter().enumerate() {
+            if lambda > 1e-12 * largest {
+                let v = eigen.eigenvectors.column(k) * lambda.sqrt();
+                columns
+                    .extend((0..ties).map(|i| Vector3::new(v[3 * i], v[3 * i + 1], v[3 * i + 2])));
+            }
+        }
+        let rank = columns.len() / ties.max(1);
         Self {
-            modes,
-            spatial: gather(&|k, m| vademecum.mode_at_node(0, k, node(m))),
-            parametric: gather(&|k, m| vademecum.load_mode_at(0, k, m)),
-            by_parametric: vec![0.0; modes],
-            by_spatial: vec![0.0; modes],
+            ties,
+            columns,
+            projected: vec![0.0; rank],
         }
     }
 
-    fn rows(&self, i: usize) -> (&[Vector3<f64>], &[Vector3<f64>]) {
-        let range = i * self.modes..(i + 1) * self.modes;
-        (&self.spatial[range.clone()], &self.parametric[range])
-    }
-
-    /// Sums the forces' modal sums for [`Self::add_answer`].
-    fn gather(&mut self, forces_n: &[Vector3<f64>]) {
-        self.by_parametric.fill(0.0);
-        self.by_spatial.fill(0.0);
-        for (j, force) in forces_n.iter().enumerate() {
-            if *force == Vector3::zeros() {
-                continue;
-            }
-            let range = j * self.modes..(j + 1) * self.modes;
-            let sums = [
-                (&self.parametric[range.clone()], &mut self.by_parametric),
-                (&self.spatial[range], &mut self.by_spatial),
-            ];
-            for (rows, sum) in sums {
-                sum.iter_mut()
-                    .zip(rows)
-                    .for_each(|(s, r)| *s += r.dot(force));
-            }
+    fn apply(&mut self, forces_n: &[Vector3<f64>], out_m: &mut [Vector3<f64>]) {
+        let columns = self.columns.chunks_exact(self.ties.max(1));
+        for (p, w) in self.projected.iter_mut().zip(columns.clone()) {
+            *p = w.iter().zip(forces_n).map(|(w, f)| w.dot(f)).sum();
+        }
+        out_m.iter_mut().for_each(|o| *o = Vector3::zeros());
+        for (p, w) in self.projected.iter().zip(columns) {
+            out_m.iter_mut().zip(w).for_each(|(o, w)| *o += w * *p);
         }
     }
-
-    /// Adds how far the gathered forces move tie `i`'s point (m): the symmetric part of
-    /// `X Yᵀ`.
-    fn add_answer(&self, i: usize, out: &mut Vector3<f64>) {
-        let (spatial, parametric) = self.rows(i);
-        let sum = |rows: &[Vector3<f64>], by: &[f64]| -> Vector3<f64> {
-            rows.iter().zip(by).map(|(r, b)| r * *b).sum()
-        };
-        *out += (sum(spatial, &self.by_parametric) + sum(parametric, &self.by_spatial)) * 0.5;
-    }
 }
 
-/// The two organs' compliance between the ties.
-struct BothSides<'a> {
-    freed: &'a mut TiedSide,
-    base: &'a mut TiedSide,
-}
-
-impl TieCompliance for BothSides<'_> {
-    /// A force `f` on the freed organ and `−f` on the base both open the tie along `f`.
+impl TieCompliance for LowRank {
     fn separation(&mut self, forces_n: &[Vector3<f64>], out_m: &mut [Vector3<f64>]) {
-        self.freed.linear.gather(forces_n);
-        self.base.linear.gather(forces_n);
-        for (i, out) in out_m.iter_mut().enumerate() {
-            *out = Vector3::zeros();
-            self.freed.linear.add_answer(i, out);
-            self.base.linear.add_answer(i, out);
-        }
+        self.apply(forces_n, out_m);
     }
 }
 
@@ -174,20 +175,34 @@ pub struct TiedOrgans {
     pub bed: Bed,
     freed: TiedSide,
     base: TiedSide,
+    compliance: LowRank,
     solve: TieSolve,
     convergence: TieConvergence,
     forces_n: Vec<Vector3<f64>>,
     measured_m: Vec<Vector3<f64>>,
     by_others_m: Vec<Vector3<f64>>,
+    /// Where each tie's middle is this tick (m): what the hook reaches.
+    middle_m: Vec<Vector3<f64>>,
+    burns: TieBurns,
     report: TiedReport,
+}
+
+/// What the hook did to the ties in one tick.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HookOnTies {
+    /// Live ties within the hook's reach, which shared its energy.
+    pub heated: usize,
+    /// Of those, the ties divided in this tick.
+    pub divided: usize,
 }
 
 impl TiedOrgans {
     /// The bed between organ `freed` and organ `base` (the coupling's indices) with their
     /// vademecums.
     pub fn new(bed: Bed, freed: (usize, Arc<Vademecum>), base: (usize, Arc<Vademecum>)) -> Self {
-        let freed_blends = (bed.ties.iter()).map(|t| vec![(t.position, 1.0)]).collect();
-        let base_blends = (bed.ties.iter())
+        let freed_blends: Vec<Vec<(usize, f64)>> =
+            bed.ties.iter().map(|t| vec![(t.position, 1.0)]).collect();
+        let base_blends: Vec<Vec<(usize, f64)>> = (bed.ties.iter())
             .map(|t| {
                 let corners = base.1.triangles[t.facing.triangle];
                 (0..3)
@@ -196,15 +211,22 @@ impl TiedOrgans {
             })
             .collect();
         let n = bed.ties.len();
+        let mut within_tick = DMatrix::zeros(3 * n, 3 * n);
+        for (vademecum, blends) in [(&freed.1, &freed_blends), (&base.1, &base_blends)] {
+            add_linear_compliance(vademecum, blends, &mut within_tick);
+        }
         Self {
-            freed: TiedSide::new(freed.0, freed.1, freed_blends),
-            base: TiedSide::new(base.0, base.1, base_blends),
+            freed: TiedSide::new(freed.0, &freed.1, &freed_blends),
+            base: TiedSide::new(base.0, &base.1, &base_blends),
+            compliance: LowRank::positive_part(within_tick),
             bed,
             solve: TieSolve::default(),
             convergence: TieConvergence::default(),
             forces_n: vec![Vector3::zeros(); n],
             measured_m: vec![Vector3::zeros(); n],
             by_others_m: vec![Vector3::zeros(); n],
+            middle_m: vec![Vector3::zeros(); n],
+            burns: TieBurns::new(n, TissueHeat::SOFT_TISSUE, LAYER_THICKNESS_M),
             report: TiedReport::default(),
         }
     }
@@ -219,6 +241,37 @@ impl TiedOrgans {
         &self.forces_n
     }
 
+    /// The hook's energy of one tick, `energy_j` in `mode`, shared equally among the live
+    /// ties whose middle (as the last tick left it) lies within `reach_m` of its tip; each
+    /// divided once it has taken what divides it ([`TieBurns::heat`]).
+    pub fn burn_near(
+        &mut self,
+        tip_m: &Vector3<f64>,
+        reach_m: f64,
+        energy_j: f64,
+        mode: CauteryMode,
+    ) -> HookOnTies {
+        let law = self.bed.law;
+        let reaches = |tie: &super::Tie, middle: &Vector3<f64>| {
+            (middle - tip_m).norm() <= reach_m && !tie.state.failed(&law)
+        };
+        let ties = self.bed.ties.iter().zip(&self.middle_m);
+        let heated = ties.filter(|(t, m)| reaches(t, m)).count();
+        let mut outcome = HookOnTies { heated, divided: 0 };
+        if heated == 0 {
+            return outcome;
+        }
+        let share_j = energy_j / heated as f64;
+        for (i, middle) in self.middle_m.iter().enumerate() {
+            if reaches(&self.bed.ties[i], middle)
+                && self.burns.heat(&mut self.bed, i, share_j, mode)
+            {
+                outcome.divided += 1;
+            }
+        }
+        outcome
+    }
+
     pub fn report(&self) -> &TiedReport {
         &self.report
     }
@@ -231,40 +284,62 @@ impl TiedOrgans {
             coupling.pose(self.freed.index),
             coupling.pose(self.base.index),
         );
-        for (i, measured) in self.measured_m.iter_mut().enumerate() {
-            *measured = self.freed.moved_m(i, &freed_pose) - self.base.moved_m(i, &base_pose);
+        for (i, (measured, middle)) in (self.measured_m.iter_mut())
+            .zip(self.middle_m.iter_mut())
+            .enumerate()
+        {
+            let (freed, base) = (
+                self.freed.moved_m(i, &freed_pose),
+                self.base.moved_m(i, &base_pose),
+            );
+            *measured = freed - base;
+            *middle = (self.freed.rest_m[i] + freed + self.base.rest_m[i] + base) * 0.5;
         }
-        let mut sides = BothSides {
-            freed: &mut self.freed,
-            base: &mut self.base,
-        };
         // What the last tick's forces add to the measurement comes out: the solve adds it
         // back for the forces it finds.
-        sides.separation(&self.forces_n, &mut self.by_others_m);
+        self.compliance.apply(&self.forces_n, &mut self.by_others_m);
         for (others, measured) in self.by_others_m.iter_mut().zip(&self.measured_m) {
             *others = measured - *others;
         }
         let products = self.solve.solve(
             &mut self.bed,
             &self.by_others_m,
-            &mut sides,
+            &mut self.compliance,
             &mut self.forces_n,
             self.convergence,
         );
+        let force_on_freed_n: Vector3<f64> = self.forces_n.iter().sum();
         self.report = TiedReport {
-            force_on_freed_n: self.forces_n.iter().sum(),
+            force_on_freed_n,
             live_ties: (self.bed.ties.iter())
                 .filter(|t| !t.state.failed(&self.bed.law))
                 .count(),
             products: products + 1,
         };
-        for (i, force) in self.forces_n.iter().enumerate() {
-            if *force == Vector3::zeros() {
-                continue;
-            }
-            let (freed, base) = (&self.freed, &self.base);
-            coupling.add_spread_force(freed.index, &freed.vademecum, &freed.blends[i], force);
-            coupling.add_spread_force(base.index, &base.vademecum, &base.blends[i], &-force);
-        }
+        self.freed.gather(&self.forces_n, 1.0);
+        self.base.gather(&self.forces_n, -1.0);
+        coupling.add_linear_load(self.freed.index, &self.freed.linear, &force_on_freed_n);
+        coupling.add_linear_load(self.base.index, &self.base.linear, &-force_on_freed_n);
     }
+}
+
+/// Adds one organ's linear-step compliance between the ties (the symmetric part of `X Yᵀ`)
+/// to `c`.
+fn add_linear_compliance(
+    vademecum: &Vademecum,
+    blends: &[Vec<(usize, f64)>],
+    c: &mut DMatrix<f64>,
+) {
+    let modes = vademecum.modes(0);
+    let node = |m: usize| vademecum.positions[m] as usize;
+    let spatial = linear_rows(blends, modes, |k, m| vademecum.mode_at_node(0, k, node(m)));
+    let parametric = linear_rows(blends, modes, |k, m| vademecum.load_mode_at(0, k, m));
+    let as_matrix = |rows: &[Vector3<f64>]| {
+        DMatrix::from_fn(3 * blends.len(), modes, |r, k| {
+            rows[(r / 3) * modes + k][r % 3]
+        })
+    };
+    let (x, y) = (as_matrix(&spatial), as_matrix(&parametric));
+    let product = &x * y.transpose();
+    *c += (&product + product.transpose()) * 0.5;
 }
