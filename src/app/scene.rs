@@ -129,9 +129,7 @@ impl Detail {
 pub fn default_scene(dir: &Path, detail: Detail, on_stale: OnStale) -> Result<HapticScene, String> {
     let organs = SCENE_ORGANS.map(SceneOrgan::from);
     let coupling = CouplingSettings::default();
-    let mut scene = scene_of(&organs, None, &coupling, dir, detail, on_stale)?;
-    tie_organs(&mut scene, &AttachmentEntry::gallbladder_bed())?;
-    Ok(scene)
+    scene_of(&organs, None, &coupling, dir, detail, on_stale)
 }
 
 /// Binds `attachment.organ` to the organ it lies on in `scene` by a bed of cohesive ties
