@@ -68,15 +68,6 @@ impl fmt::Display for BedError {
 
 impl std::error::Error for BedError {}
 
-/// What a tie puts on the organs this tick: on the freed organ's `position`, `force_n`; on
-/// the base at `facing`, its opposite.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TieLoad {
-    pub position: usize,
-    pub facing: SurfacePoint,
-    pub force_n: Vector3<f64>,
-}
-
 /// The ties between two organs, and their law.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Bed {
@@ -153,29 +144,6 @@ impl Bed {
             .sum();
         released / self.area_m2()
     }
-
-    /// One tick: each tie not yet failed is separated by the freed organ's displacement at
-    /// its position (`freed_moved`, m) less the base's at its facing point (`base_moved`),
-    /// its damage grows with that, and its load is put in `loads` (emptied first; its room
-    /// kept, so that a buffer made for every tie never grows).
-    pub fn tick(
-        &mut self,
-        freed_moved: impl Fn(usize) -> Vector3<f64>,
-        base_moved: impl Fn(&SurfacePoint) -> Vector3<f64>,
-        loads: &mut Vec<TieLoad>,
-    ) {
-        loads.clear();
-        let law = &self.law;
-        for tie in self.ties.iter_mut().filter(|t| !t.state.failed(law)) {
-            let separation = freed_moved(tie.position) - base_moved(&tie.facing);
-            let traction = tie.state.traction(law, &separation, &tie.normal);
-            loads.push(TieLoad {
-                position: tie.position,
-                facing: tie.facing,
-                force_n: traction * tie.area_m2,
-            });
-        }
-    }
 }
 
 #[cfg(test)]
@@ -245,47 +213,5 @@ mod tests {
             }
         );
         assert!(refused.to_string().contains("0.5 mm apart"), "{refused}");
-    }
-
-    /// The freed organ lifted evenly by `lift_m`: every tie pulls it back by the law's
-    /// traction over its area and the base up by as much (the loads sum to zero between the
-    /// two organs); lifted past the failure separation, the whole bed is released and loads
-    /// nothing any more.
-    #[test]
-    fn ties_load_both_organs_equal_and_opposite_until_they_fail() {
-        let mut bed = bed_on_plane(&freed(), 1e-3).unwrap();
-        let law = bed.law;
-        let mut loads = Vec::with_capacity(bed.ties.len());
-        let lift_m = 0.5 * law.peak_separation_m();
-        bed.tick(|_| Vector3::z() * lift_m, |_| Vector3::zeros(), &mut loads);
-        let on_freed: Vector3<f64> = loads.iter().map(|l| l.force_n).sum();
-        let expected = -law.stiffness_pa_per_m * lift_m * bed.area_m2();
-        assert!(
-            (on_freed - Vector3::z() * expected).norm() < 1e-12,
-            "{on_freed:?}"
-        );
-        assert_eq!(bed.released_share(), 0.0);
-        let beyond = 1.01 * law.failure_separation_m();
-        bed.tick(|_| Vector3::z() * beyond, |_| Vector3::zeros(), &mut loads);
-        assert_eq!(bed.released_share(), 1.0);
-        bed.tick(|_| Vector3::zeros(), |_| Vector3::zeros(), &mut loads);
-        assert!(loads.is_empty());
-    }
-
-    /// Only the separation counts: both organs moved alike load nothing, and the base moved
-    /// away from the freed organ opens the ties as the freed organ lifted would.
-    #[test]
-    fn the_separation_is_the_difference_of_the_two_displacements() {
-        let mut bed = bed_on_plane(&freed(), 1e-3).unwrap();
-        let mut loads = Vec::new();
-        let carried = Vector3::new(0.003, -0.002, 0.004);
-        bed.tick(|_| carried, |_| carried, &mut loads);
-        assert!(loads.iter().all(|l| l.force_n == Vector3::zeros()));
-        let mut lifted = bed.clone();
-        let mut lifted_loads = Vec::new();
-        let opening = Vector3::z() * 2e-4;
-        bed.tick(|_| Vector3::zeros(), |_| -opening, &mut loads);
-        lifted.tick(|_| opening, |_| Vector3::zeros(), &mut lifted_loads);
-        assert_eq!(loads, lifted_loads);
     }
 }

@@ -166,13 +166,6 @@ impl TieBurns {
         target.state.sever(&law);
         true
     }
-
-    /// How much of what divides tie `tie` it has taken in `mode` (1 once divided).
-    pub fn share(&self, bed: &Bed, tie: usize, mode: CauteryMode) -> f64 {
-        let tie_area = bed.ties[tie].area_m2;
-        let needed = self.tissue.tie_burn_j(tie_area, self.thickness_m, mode);
-        (self.absorbed_j[tie] / needed).min(1.0)
-    }
 }
 
 #[cfg(test)]
@@ -230,7 +223,6 @@ mod tests {
                 );
                 assert!(bed.ties[tie].state.failed(&bed.law));
                 assert!(!burns.heat(&mut bed, tie, 1e3, mode));
-                assert_eq!(burns.share(&bed, tie, mode), 1.0);
                 assert!(!bed.ties[1 - tie].state.failed(&bed.law));
             }
         }

@@ -11,7 +11,7 @@ pub mod cohesive;
 pub mod solve;
 pub mod tied;
 
-pub use bed::{Bed, BedError, FreedSurface, Tie, TieLoad};
+pub use bed::{Bed, BedError, FreedSurface, Tie};
 pub use cautery::{Cautery, CauteryMode, POWER_RANGE_W, PowerOutOfRange, TieBurns, TissueHeat};
 pub use cohesive::{CohesiveError, CohesiveLaw, CohesiveTie};
 pub use solve::{TieCompliance, TieConvergence, TieSolve};

@@ -231,11 +231,6 @@ impl TiedOrgans {
         }
     }
 
-    /// The freed organ's and the base's indices in the coupling.
-    pub fn organs(&self) -> (usize, usize) {
-        (self.freed.index, self.base.index)
-    }
-
     /// Each tie's force on the freed organ in the last tick (N), in the bed's order.
     pub fn forces_n(&self) -> &[Vector3<f64>] {
         &self.forces_n
