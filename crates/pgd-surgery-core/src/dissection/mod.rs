@@ -1,8 +1,8 @@
 //! Freeing one organ from another: the connective tissue between them as cohesive ties that
 //! hold, give and tear ([`cohesive`]), placed where the two organs' surfaces face each other
 //! ([`bed`]), their forces each tick answered with the organs' own give ([`solve`]), between
-//! two organs of a scene's contact stage ([`tied`]); the hook's energy and the ties and walls
-//! it burns ([`cautery`]).
+//! two organs of a scene's contact stage ([`tied`]); the hook's energy and the ties it burns
+//! ([`cautery`]), and the burns it leaves on the organs' walls instead ([`wall`]).
 //! `docs/dissection.md` has the model and its sources.
 
 pub mod bed;
@@ -10,9 +10,11 @@ pub mod cautery;
 pub mod cohesive;
 pub mod solve;
 pub mod tied;
+pub mod wall;
 
 pub use bed::{Bed, BedError, FreedSurface, Tie};
 pub use cautery::{Cautery, CauteryMode, POWER_RANGE_W, PowerOutOfRange, TieBurns, TissueHeat};
 pub use cohesive::{CohesiveError, CohesiveLaw, CohesiveTie};
 pub use solve::{TieCompliance, TieConvergence, TieSolve};
 pub use tied::{HookOnTies, TiedOrgans, TiedReport};
+pub use wall::{BurnMark, BurnSite, MAX_BURN_MARKS, Wall, WallBurn, WallBurns};
