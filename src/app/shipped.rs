@@ -25,6 +25,7 @@ macro_rules! with_shipped_stems {
             "duodenum-navigation",
             "gallbladder-gentle-press",
             "gallbladder-grasp-retract",
+            "gallbladder-liver-bed-dissection",
             "gallbladder-liver-two-ports",
             "gallbladder-retraction",
             "liver-capsule-incision",

@@ -90,7 +90,7 @@ fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     run_simulated(scenario, &scene, devices, ticks).unwrap()
 }
 
-const SHIPPED: [&str; 14] = [
+const SHIPPED: [&str; 15] = [
     "liver-steady-press",
     "pancreas-palpation",
     "gallbladder-gentle-press",
@@ -105,6 +105,7 @@ const SHIPPED: [&str; 14] = [
     "cornea-radial-keratotomy",
     "bimanual-traction-countertraction",
     "bimanual-liver-lift",
+    "gallbladder-liver-bed-dissection",
 ];
 
 #[test]
@@ -319,6 +320,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             12,
             "attachments[1].fracture_energy_j_per_m2",
             "fails before the peak traction",
+        ),
+        (
+            "hook-power-out-of-range",
+            5,
+            "tool.Hook.power_w",
+            "not a power the hook delivers",
         ),
         (
             "attachment-organ-not-in-scene",
@@ -1023,4 +1030,50 @@ fn two_instruments_changed_and_changed_back_press_as_one() {
     assert!((cm.path_length_mm - pm.path_length_mm).abs() < 1e-6);
     assert!((cm.economy.unwrap() - pm.economy.unwrap()).abs() < 1e-6);
     assert!(summary(&changed).contains("instruments changed 2 times"));
+}
+
+/// The gallbladder off its bed. Competent: the left hand holds the infundibulum drawn
+/// laterally while the hook's energy goes to the connective tissue alone, until a third of
+/// the bed is released: no burn, no energy on no tissue, passed. Careless: energy with the
+/// hook on nothing, then held on the gallbladder's wall until it is burned through, a
+/// perforation that spills bile and fails the attempt; the debrief says where.
+#[test]
+fn dissection_frees_the_bed_and_a_burn_through_the_wall_fails_it() {
+    use pgd_surgery::scenario::tasks::DissectionResult;
+    let name = "gallbladder-liver-bed-dissection";
+    let competent = run(name, "competent").card;
+    let metrics = &competent.tasks[1].metrics;
+    let done = metrics.result::<DissectionResult>().unwrap();
+    assert!(metrics.completed && competent.passed, "{competent:#?}");
+    assert!(done.released_share >= 0.33, "{done:?}");
+    assert!(done.ties_divided > 10, "{done:?}");
+    assert!(
+        done.burns.is_empty() && done.perforation.is_none(),
+        "{done:?}"
+    );
+    assert_eq!(done.energy.in_air_j, 0.0);
+    assert!((done.energy.on_ties_j - done.energy.total_j).abs() < 1e-9);
+    let hold = metrics.countertraction.as_ref().unwrap();
+    assert!(hold.in_band_share() > 0.95, "{hold:?}");
+
+    let careless = run(name, "careless").card;
+    let metrics = &careless.tasks[1].metrics;
+    let done = metrics.result::<DissectionResult>().unwrap();
+    assert!(!careless.passed && careless.score < competent.score);
+    // 0.3 s at 30 W with the hook on nothing.
+    assert!((done.energy.in_air_j - 9.0).abs() < 0.1, "{done:?}");
+    let perforation = done.perforation.as_ref().expect("perforated");
+    assert_eq!(perforation.organ, "gallbladder");
+    assert_eq!(done.burns.len(), 1);
+    // Through the 2 mm wall under the 1 mm cut zone: 2 mm × π (0.5 mm)² × 2.03 GJ/m³ ≈ 3.2 J.
+    assert!((done.energy.on_walls_j - 3.19).abs() < 0.05, "{done:?}");
+    assert!((perforation.time_s - done.burns[0].time_s - 0.106).abs() < 0.002);
+    let debrief = careless.feedback.join("\n");
+    for words in [
+        "perforation, bile spilled",
+        "burned the gallbladder at (",
+        "on no tissue",
+    ] {
+        assert!(debrief.contains(words), "{debrief}");
+    }
 }

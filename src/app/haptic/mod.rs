@@ -3,6 +3,7 @@
 //! a simulated clock ([`HapticLoop::run_simulated`], for `--headless`, tests and benchmarks).
 //! The render side only ever reads the latest [`HapticSnapshot`].
 
+mod cautery;
 mod components;
 mod cutting;
 mod frame_paced;
@@ -21,6 +22,7 @@ use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
 use snapshot::SnapshotPublisher;
 
+pub use cautery::{HookWork, OrganBurns};
 pub use components::{
     HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, organ_with_law,
 };
@@ -50,7 +52,7 @@ pub enum HapticSet {
     ReadDevice,
     ToolContact,
     EvaluateModes,
-    /// Organ against organ, and attachments.
+    /// Organ against organ, attachments, and the hook's energy.
     OrganContact,
     ComputeForce,
     Safety,
@@ -93,13 +95,20 @@ pub fn haptic_schedule() -> Schedule {
             .chain()
             .in_set(HapticSet::ToolContact),
         systems::evaluate_modes.in_set(HapticSet::EvaluateModes),
-        systems::organ_contact
-            .run_if(resource_exists::<OrganCoupling>)
+        (
+            systems::organ_contact.run_if(resource_exists::<OrganCoupling>),
+            cautery::cauterize.run_if(resource_exists::<cautery::OrganBurns>),
+        )
+            .chain()
             .in_set(HapticSet::OrganContact),
         systems::compute_force.in_set(HapticSet::ComputeForce),
         systems::apply_safety.in_set(HapticSet::Safety),
         systems::write_device.in_set(HapticSet::WriteDevice),
-        (scoring::score_tick, scoring::heal_on_retry)
+        (
+            scoring::score_tick,
+            scoring::heal_on_retry,
+            scoring::heal_beds_on_retry,
+        )
             .chain()
             .run_if(resource_exists::<ExerciseRun>)
             .in_set(HapticSet::Score),

@@ -10,6 +10,7 @@ use bevy::platform::time::Instant;
 use bevy::ecs::component::Mutable;
 use bevy::prelude::*;
 
+use super::cautery::{HookWork, OrganBurns, walls_of};
 use super::components::{
     HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, organ_with_law,
 };
@@ -23,10 +24,10 @@ use super::snapshot::{HandSnapshot, HapticSnapshot, OrganSnapshot, SnapshotPubli
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
 use crate::cutting::{Blade, CutError, CutWorker, LatestCut, Scalpel};
 use crate::devices::{
-    Fulcrum, HapticDevice, Histogram, Instrument, Rack, SafetyFilter, SafetySettings, TICK_S,
-    Workspace, stop_requested,
+    Action, Fulcrum, HapticDevice, Histogram, Instrument, Rack, SafetyFilter, SafetySettings,
+    TICK_S, Workspace, stop_requested,
 };
-use crate::dissection::TiedOrgans;
+use crate::dissection::{TiedOrgans, TissueHeat, WallBurns};
 use crate::dynamics::{DynamicModel, GraspSettings};
 use crate::fem::FemModel;
 use crate::pgd::{Deformation, Vademecum};
@@ -89,6 +90,14 @@ impl HapticScene {
     pub fn ports(&self) -> impl Iterator<Item = Fulcrum> + '_ {
         let instruments = self.hands.iter().flat_map(|h| &h.instruments);
         instruments.filter_map(|i| i.port)
+    }
+
+    /// Whether an instrument of either hand is an electrocautery hook.
+    pub fn has_hook(&self) -> bool {
+        let instruments = self.hands.iter().flat_map(|h| &h.instruments);
+        instruments
+            .into_iter()
+            .any(|i| matches!(i.action, Action::Cauterize(_)))
     }
 
     /// The right hand (the only one of a one-hand scene).
@@ -191,7 +200,12 @@ fn spawn_hand(world: &mut World, probe: Probe, index: usize, hand: &SceneHand) -
     };
     let parts = (HandIndex(index), tool, DeviceForce::default());
     world
-        .spawn((parts, GraspForce::default(), FaultLog::default()))
+        .spawn((
+            parts,
+            GraspForce::default(),
+            FaultLog::default(),
+            HookWork::default(),
+        ))
         .id()
 }
 
@@ -303,6 +317,10 @@ impl HapticLoop {
         }
         if let Some(scope) = &scene.scope {
             world.insert_resource(Scope::new(scope.clone()));
+        }
+        if scene.has_hook() {
+            let walls = walls_of(scene.organs.iter().map(|(name, _)| name.as_str()));
+            world.insert_resource(OrganBurns(WallBurns::new(walls, TissueHeat::SOFT_TISSUE)));
         }
         Ok(Self {
             world,

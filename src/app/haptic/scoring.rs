@@ -13,12 +13,15 @@ use std::sync::{Arc, Mutex};
 use bevy::ecs::query::QueryData;
 use bevy::prelude::*;
 
+use super::cautery::{HookWork, OrganBurns, released_share};
 use super::components::{HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion};
 use super::cutting::OrganCut;
 use super::hand::{DeviceForce, HandIndex, MAX_HANDS, Tool};
-use super::resources::{Scope, TickClock};
+use super::resources::{OrganBeds, Scope, TickClock};
 use super::snapshot::SnapshotPublisher;
-use crate::scenario::{BladeSample, Exercise, HandSample, Progress, RegionSite, Sample};
+use crate::scenario::{
+    BladeSample, Exercise, HandSample, HookTarget, Progress, RegionSite, Sample,
+};
 
 /// What scoring reads of an organ entity.
 #[derive(QueryData)]
@@ -183,8 +186,9 @@ impl ExerciseRun {
 
 pub fn score_tick(
     clock: Res<TickClock>,
-    hands: Query<(&HandIndex, &Tool, &DeviceForce)>,
+    hands: Query<(&HandIndex, &Tool, &DeviceForce, &HookWork)>,
     organs: Query<ScoredOrgan>,
+    beds: Option<Res<OrganBeds>>,
     mut run: ResMut<ExerciseRun>,
     mut scope: Option<ResMut<Scope>>,
 ) {
@@ -198,9 +202,13 @@ pub fn score_tick(
         return;
     };
     let mut samples = [None; MAX_HANDS];
-    for (hand, tool, force) in &hands {
+    for (hand, tool, force, _) in &hands {
         samples[hand.0] = Some(hand_sample(hand.0, tool, force, &organs));
     }
+    let hook = (hands.iter())
+        .map(|(_, _, _, work)| work.0)
+        .find(|work| work.on != HookTarget::Off)
+        .unwrap_or_default();
     let Some(right) = samples[0] else {
         return;
     };
@@ -236,6 +244,8 @@ pub fn score_tick(
         target_in_view,
         beyond_range_m,
         left,
+        hook,
+        released_share: released_share(beds.as_deref()),
     });
     if exercise.finished() {
         let run = &mut *run;
@@ -328,6 +338,29 @@ pub fn heal_on_retry(run: Res<ExerciseRun>, mut organs: Query<&mut OrganCut>) {
     }
 }
 
+/// A new attempt starts on whole tissue: once the run has taken its next attempt, the beds
+/// are healed and the burns gone.
+pub fn heal_beds_on_retry(
+    run: Res<ExerciseRun>,
+    mut healed_for: Local<u32>,
+    mut beds: Option<ResMut<OrganBeds>>,
+    mut burns: Option<ResMut<OrganBurns>>,
+) {
+    let attempts = run.attempts();
+    if *healed_for == attempts {
+        return;
+    }
+    if *healed_for > 0 {
+        beds.iter_mut()
+            .flat_map(|b| b.0.iter_mut())
+            .for_each(|bed| bed.heal());
+        if let Some(burns) = burns.as_mut() {
+            burns.0.clear();
+        }
+    }
+    *healed_for = attempts;
+}
+
 #[cfg(test)]
 mod tests {
     use std::path::Path;
@@ -350,7 +383,12 @@ mod tests {
     fn world(link: &Arc<ExerciseLink>) -> World {
         let mut world = World::new();
         world.insert_resource(TickClock::default());
-        world.spawn((HandIndex(0), Tool::default(), DeviceForce::default()));
+        world.spawn((
+            HandIndex(0),
+            Tool::default(),
+            DeviceForce::default(),
+            HookWork::default(),
+        ));
         world.insert_resource(ExerciseRun::new(link.clone()));
         world
     }

@@ -230,6 +230,7 @@ fn action_name(action: Action) -> &'static str {
         Action::Press => "probe",
         Action::Grasp => "grasper",
         Action::Cut => "scalpel",
+        Action::Cauterize(_) => "hook",
     }
 }
 

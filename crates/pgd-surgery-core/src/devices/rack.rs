@@ -20,7 +20,7 @@ pub const MAX_INSTRUMENTS: usize = 4;
 const FIRST_REACH_M: f64 = 0.03;
 
 /// What an instrument does besides pressing.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum Action {
     #[default]
     Press,
@@ -28,6 +28,8 @@ pub enum Action {
     Grasp,
     /// Its blade parts the tissue it presses.
     Cut,
+    /// An electrocautery hook: the device's first button applies its energy.
+    Cauterize(crate::dissection::Cautery),
 }
 
 /// An instrument: what it does, and the port it goes through (none: open surgery, the device

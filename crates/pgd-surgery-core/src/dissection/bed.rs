@@ -138,10 +138,9 @@ impl Bed {
 
     /// The share of the bed's area whose ties have failed.
     pub fn released_share(&self) -> f64 {
-        let released: f64 = (self.ties.iter())
+        let released = (self.ties.iter())
             .filter(|t| t.state.failed(&self.law))
-            .map(|t| t.area_m2)
-            .sum();
+            .fold(0.0, |sum, t| sum + t.area_m2);
         released / self.area_m2()
     }
 }

@@ -28,7 +28,7 @@ const BOILING_C: f64 = 100.0;
 const WATER_LATENT_J_PER_KG: f64 = 2.257e6;
 
 /// How the hook's energy is delivered.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
 pub enum CauteryMode {
     Cut,
     Coagulate,
@@ -152,6 +152,11 @@ impl TieBurns {
 
     /// Tie `tie` of `bed` takes `energy_j` in `mode`; once it has taken what divides it, it
     /// fails for good. Returns whether it was divided now.
+    /// Every tie as if never heated.
+    pub fn cool(&mut self) {
+        self.absorbed_j.fill(0.0);
+    }
+
     pub fn heat(&mut self, bed: &mut Bed, tie: usize, energy_j: f64, mode: CauteryMode) -> bool {
         let law = bed.law;
         let target = &mut bed.ties[tie];

@@ -215,9 +215,16 @@ impl TiedOrgans {
         for (vademecum, blends) in [(&freed.1, &freed_blends), (&base.1, &base_blends)] {
             add_linear_compliance(vademecum, blends, &mut within_tick);
         }
+        let (freed, base) = (
+            TiedSide::new(freed.0, &freed.1, &freed_blends),
+            TiedSide::new(base.0, &base.1, &base_blends),
+        );
+        let middle_m = (freed.rest_m.iter().zip(&base.rest_m))
+            .map(|(f, b)| (f + b) * 0.5)
+            .collect();
         Self {
-            freed: TiedSide::new(freed.0, &freed.1, &freed_blends),
-            base: TiedSide::new(base.0, &base.1, &base_blends),
+            freed,
+            base,
             compliance: LowRank::positive_part(within_tick),
             bed,
             solve: TieSolve::default(),
@@ -225,10 +232,15 @@ impl TiedOrgans {
             forces_n: vec![Vector3::zeros(); n],
             measured_m: vec![Vector3::zeros(); n],
             by_others_m: vec![Vector3::zeros(); n],
-            middle_m: vec![Vector3::zeros(); n],
+            middle_m,
             burns: TieBurns::new(n, TissueHeat::SOFT_TISSUE, LAYER_THICKNESS_M),
             report: TiedReport::default(),
         }
+    }
+
+    /// Where each tie's middle is (m), as the last tick left it (at rest before the first).
+    pub fn middles_m(&self) -> &[Vector3<f64>] {
+        &self.middle_m
     }
 
     /// Each tie's force on the freed organ in the last tick (N), in the bed's order.
@@ -265,6 +277,17 @@ impl TiedOrgans {
             }
         }
         outcome
+    }
+
+    /// The bed whole again for another attempt: every tie undamaged and unheated, carrying
+    /// nothing until the next tick solves it.
+    pub fn heal(&mut self) {
+        for tie in &mut self.bed.ties {
+            tie.state = super::CohesiveTie::default();
+        }
+        self.burns.cool();
+        self.forces_n.fill(Vector3::zeros());
+        self.report = TiedReport::default();
     }
 
     pub fn report(&self) -> &TiedReport {

@@ -102,6 +102,11 @@ impl WallBurns {
         }
     }
 
+    /// No burns, for another attempt (the list keeps its room).
+    pub fn clear(&mut self) {
+        self.marks.clear();
+    }
+
     pub fn marks(&self) -> &[BurnMark] {
         &self.marks
     }

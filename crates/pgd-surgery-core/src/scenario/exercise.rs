@@ -204,6 +204,7 @@ fn setup(scenario: &Scenario, sites: &Sites, k: usize) -> RunSetup {
             .map(|(_, site)| *site)
             .collect(),
         keratometer: sites.keratometers.get(k).cloned().flatten(),
+        organ_names: scenario.organs.iter().map(|o| o.name.clone()).collect(),
     }
 }
 

@@ -7,13 +7,14 @@ use serde::Deserialize;
 
 use crate::contact::PointshellDensity;
 use crate::devices::DeviceSpec;
+use crate::dissection::{Cautery, CauteryMode};
 use crate::fem::Law;
 use crate::mesh::organs::Organ;
 
 use super::attachment::AttachmentEntry;
 use super::scene::{Nodule, OrganEntry, metres, organ_list};
 use super::task::Task;
-use super::units::{EdgeLength, FieldOfView, Millimetres, Newtons, Scale, ScopeAngle};
+use super::units::{EdgeLength, FieldOfView, Millimetres, Newtons, Scale, ScopeAngle, Watts};
 
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -101,6 +102,20 @@ pub enum Tool {
         #[serde(default)]
         edge_mm: Option<EdgeLength>,
     },
+    /// An L-hook on electrocautery: it presses like a probe of this radius, and while the
+    /// device's first button is held it delivers `power_w` in `mode` (`Cut`: a 1 mm zone,
+    /// `Coagulate`: 3 mm), dividing the connective tissue it reaches or burning the wall it
+    /// touches (`docs/dissection.md`).
+    Hook {
+        tip_radius_mm: Millimetres,
+        power_w: Watts,
+        #[serde(default = "default_cautery_mode")]
+        mode: CauteryMode,
+    },
+}
+
+fn default_cautery_mode() -> CauteryMode {
+    CauteryMode::Cut
 }
 
 impl Default for Tool {
@@ -116,7 +131,8 @@ impl Tool {
         match self {
             Tool::Probe { tip_radius_mm }
             | Tool::Grasper { tip_radius_mm }
-            | Tool::Scalpel { tip_radius_mm, .. } => tip_radius_mm.metres(),
+            | Tool::Scalpel { tip_radius_mm, .. }
+            | Tool::Hook { tip_radius_mm, .. } => tip_radius_mm.metres(),
         }
     }
 
@@ -149,6 +165,10 @@ impl Tool {
             Tool::Probe { .. } => crate::devices::Action::Press,
             Tool::Grasper { .. } => crate::devices::Action::Grasp,
             Tool::Scalpel { .. } => crate::devices::Action::Cut,
+            Tool::Hook { power_w, mode, .. } => crate::devices::Action::Cauterize(Cautery {
+                mode: *mode,
+                power_w: power_w.0,
+            }),
         }
     }
 }
@@ -403,6 +423,11 @@ impl Scenario {
     /// Whether an instrument in either hand grasps (and so the organs move by default).
     pub fn grasps(&self) -> bool {
         self.hands().iter().flatten().any(|(tool, _)| tool.grasps())
+    }
+
+    /// Whether an instrument in either hand is an electrocautery hook.
+    pub fn hook(&self) -> bool {
+        (self.hands().iter().flatten()).any(|(tool, _)| matches!(tool, Tool::Hook { .. }))
     }
 
     /// Whether `organ` moves: as it says, else when an instrument grasps.

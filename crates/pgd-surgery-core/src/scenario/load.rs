@@ -150,6 +150,8 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
         nodules: &scenario.nodules,
         blade: scenario.blade().is_some(),
         grasps: scenario.grasps(),
+        hook: scenario.hook(),
+        attachments: &scenario.attachments,
         device_max_force_n: scenario.device.max_force_n.0,
     };
     for (k, task) in scenario.tasks.iter().enumerate() {

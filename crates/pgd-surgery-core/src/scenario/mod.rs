@@ -38,7 +38,7 @@ pub use keratotomy::{
 pub use load::{load, parse};
 pub use motion::{IDLE_M_PER_S, MOVING_M_PER_S, MotionMetrics, MotionTracker, STRIDE};
 pub use problem::ScenarioError;
-pub use sample::{HandSample, NoduleSite, RegionSite, Sample};
+pub use sample::{HandSample, HookSample, HookTarget, NoduleSite, RegionSite, Sample, WallSample};
 pub use scene::{Nodule, OrganEntry, Spot, metres};
 pub use score::{CutMade, Scorecard, TaskScore, score};
 pub use task::{

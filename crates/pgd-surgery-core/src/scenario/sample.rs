@@ -43,6 +43,46 @@ pub struct Sample {
     /// In a bimanual exercise, the left hand's (the fields above that name the tool, the
     /// force, what it touches and holds are the right hand's).
     pub left: Option<HandSample>,
+    /// The hook's energy in this tick and where it went (either hand's).
+    pub hook: HookSample,
+    /// The share (0–1, by area) of the scene's attachments released so far.
+    pub released_share: f64,
+}
+
+/// The energy an electrocautery hook delivered in one tick, and what took it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HookSample {
+    pub energy_j: f64,
+    pub on: HookTarget,
+}
+
+/// What took the hook's energy in a tick.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum HookTarget {
+    /// No energy: the button is up, or the instrument is not a hook.
+    #[default]
+    Off,
+    /// The connective tissue within the hook's reach: `heated` ties shared it, `divided` of
+    /// them were divided.
+    Ties { heated: u32, divided: u32 },
+    /// An organ's wall (no ties within reach): a non-target burn.
+    Wall(WallSample),
+    /// Nothing: the hook touched no tissue.
+    Air,
+}
+
+/// A burn on an organ's wall in one tick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WallSample {
+    /// The organ, bit `k`'s organ of [`Sample::touching`].
+    pub organ: usize,
+    /// A mark of its own (not one deepened), and its area (m²).
+    pub new_mark: bool,
+    pub area_m2: f64,
+    /// The wall gave way in this tick: a hollow organ perforated (`hollow`), a solid one's
+    /// capsule burned through.
+    pub through_now: bool,
+    pub hollow: bool,
 }
 
 /// One hand's part of a tick's sample: its tool and force, what it touches and holds.

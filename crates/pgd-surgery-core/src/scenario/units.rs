@@ -417,3 +417,35 @@ impl TryFrom<f64> for TieStiffness {
         }
     }
 }
+
+/// The hook's power on its generator, in watts: what the generator delivers (1 to 120 W).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct Watts(pub f64);
+
+impl TryFrom<f64> for Watts {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        crate::dissection::Cautery::new(crate::dissection::CauteryMode::Cut, value)
+            .map(|hook| Self(hook.power_w))
+            .map_err(|refused| refused.to_string())
+    }
+}
+
+/// The share of an attachment to release, from more than 0 to 1 (all of it).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct ReleaseShare(pub f64);
+
+impl TryFrom<f64> for ReleaseShare {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && v > 0.0 && v <= 1.0 => Ok(Self(v)),
+            v => Err(format!(
+                "{v} is not a share of the attachment: more than 0 and at most 1 (0.9 frees \
+                 nine tenths of it)"
+            )),
+        }
+    }
+}

@@ -1,6 +1,7 @@
 //! What a task type checks of its fields once the whole scenario is read, and how it says
 //! what is wrong: the field, the problem and a hint, located in the text by the field's name.
 
+use crate::scenario::attachment::AttachmentEntry;
 use crate::scenario::problem::Problem;
 use crate::scenario::scene::{Nodule, OrganEntry};
 
@@ -13,8 +14,12 @@ pub struct SceneFacts<'a> {
     pub nodules: &'a [Nodule],
     /// Whether an instrument in the trainee's hand is a scalpel...
     pub blade: bool,
-    /// ...or a grasper.
+    /// ...or a grasper...
     pub grasps: bool,
+    /// ...or an electrocautery hook.
+    pub hook: bool,
+    /// The organs bound to others by connective tissue.
+    pub attachments: &'a [AttachmentEntry],
     /// The most the scenario's device may push (N).
     pub device_max_force_n: f64,
 }

@@ -91,6 +91,8 @@ pub struct RunSetup {
     pub nodules: Vec<NoduleSite>,
     /// The cut organ's model, for a task that predicts what its cut does (keratotomy).
     pub keratometer: Option<Keratometer>,
+    /// The scene's organs' names, in order (the sample's organ bits'), for the report.
+    pub organ_names: Vec<String>,
 }
 
 /// One tick as a task's run sees it: the sample, the time since the last, the metrics every

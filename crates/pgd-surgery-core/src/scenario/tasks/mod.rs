@@ -1,6 +1,7 @@
 //! The built-in task types, one module each, and their registration: adding a type is its
 //! module and a line in [`built_in`].
 
+mod dissection;
 mod force_control;
 mod grasp;
 mod incision;
@@ -12,6 +13,7 @@ mod registry;
 mod retraction;
 mod safe_navigation;
 
+pub use dissection::{BurnMade, Dissection, DissectionResult, EnergySpent};
 pub use force_control::{ForceControl, ForceControlResult};
 pub use grasp::{Grasp, GraspResult};
 pub use incision::{COVERED_TO_FINISH, Incision, IncisionResult};
@@ -35,5 +37,6 @@ fn built_in() -> Vec<Entry> {
         Entry::of::<Grasp>(),
         Entry::of::<Incision>(),
         Entry::of::<RadialKeratotomy>(),
+        Entry::of::<Dissection>(),
     ]
 }
