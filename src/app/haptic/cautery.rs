@@ -95,11 +95,3 @@ pub fn released_share(beds: Option<&OrganBeds>) -> f64 {
         false => 0.0,
     }
 }
-
-/// The walls of a scene's organs, by their names (a generated organ's own, a solid organ's
-/// capsule otherwise).
-pub fn walls_of<'a>(names: impl Iterator<Item = &'a str>) -> Vec<Wall> {
-    names
-        .map(|name| Wall::of(crate::mesh::organs::Organ::from_name(name)))
-        .collect()
-}

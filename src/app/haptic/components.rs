@@ -9,7 +9,9 @@ use bevy::prelude::*;
 use crate::contact::{ContactSurface, ToolContact};
 use crate::devices::TICK_S;
 use crate::dynamics::{DynamicModel, GraspSettings, GraspedOrgan};
-use crate::pgd::{Deformation, Patch, PatchLoad, Vademecum};
+use nalgebra::Vector3;
+
+use crate::pgd::{Deformation, Patch, PatchLoad, SurfacePoint, Vademecum};
 
 /// An organ's mechanical model (the vademecum, which carries the regions it was built with in
 /// its header) and collision model (its accessible surface).
@@ -122,5 +124,33 @@ impl OrganMotion {
             tore: false,
             hand: 0,
         }
+    }
+
+    /// What the organ's motion adds to its static field (m) at the blend of volume nodes
+    /// `nodes` (`(node, weight)`): the kept modes times the correction, as the window draws
+    /// it.
+    pub fn moved_at(&self, nodes: &[(usize, f64)]) -> Vector3<f64> {
+        let mut moved = Vector3::zeros();
+        for (k, &c) in self.correction.iter().enumerate() {
+            if c == 0.0 {
+                continue;
+            }
+            let mode = self.model.basis.mode(k);
+            for &(node, weight) in nodes {
+                let at = 3 * node;
+                moved += Vector3::new(mode[at], mode[at + 1], mode[at + 2]) * (c * weight);
+            }
+        }
+        moved
+    }
+
+    /// [`Self::moved_at`] a surface point of the organ's `vademecum`.
+    pub fn moved_at_point(&self, vademecum: &Vademecum, at: &SurfacePoint) -> Vector3<f64> {
+        let corners = vademecum.triangles[at.triangle];
+        let nodes: [(usize, f64); 3] = std::array::from_fn(|k| {
+            let node = vademecum.positions[corners[k] as usize] as usize;
+            (node, at.barycentric[k])
+        });
+        self.moved_at(&nodes)
     }
 }

@@ -37,7 +37,9 @@ pub use runner::{
     CutOrgan, HapticLoop, HapticScene, SceneCutting, SceneDynamics, SceneError, SceneHand,
 };
 pub use scoring::{ExerciseLink, ExerciseRun};
-pub use snapshot::{HandSnapshot, HapticSnapshot, LoopTiming, OrganSnapshot};
+pub use snapshot::{
+    BedView, BurnsView, HandSnapshot, HapticSnapshot, LoopTiming, OrganSnapshot, TieView,
+};
 pub use swap::SceneSwap;
 #[cfg(not(target_arch = "wasm32"))]
 pub use thread::{HapticThread, RealTimeReport, Scheduling};

@@ -10,7 +10,7 @@ use bevy::platform::time::Instant;
 use bevy::ecs::component::Mutable;
 use bevy::prelude::*;
 
-use super::cautery::{HookWork, OrganBurns, walls_of};
+use super::cautery::{HookWork, OrganBurns};
 use super::components::{
     HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, organ_with_law,
 };
@@ -20,14 +20,16 @@ use super::hand::{
 };
 use super::report::{FaultSummary, ForceSummary, HeadlessReport, RangeSummary};
 use super::resources::{OrganBeds, OrganCoupling, SceneScope, Scope, TickClock};
-use super::snapshot::{HandSnapshot, HapticSnapshot, OrganSnapshot, SnapshotPublisher};
+use super::snapshot::{
+    BedView, BurnsView, HandSnapshot, HapticSnapshot, OrganSnapshot, SnapshotPublisher,
+};
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
 use crate::cutting::{Blade, CutError, CutWorker, LatestCut, Scalpel};
 use crate::devices::{
     Action, Fulcrum, HapticDevice, Histogram, Instrument, Rack, SafetyFilter, SafetySettings,
     TICK_S, Workspace, stop_requested,
 };
-use crate::dissection::{TiedOrgans, TissueHeat, WallBurns};
+use crate::dissection::{TiedOrgans, TissueHeat, Wall, WallBurns};
 use crate::dynamics::{DynamicModel, GraspSettings};
 use crate::fem::FemModel;
 use crate::pgd::{Deformation, Vademecum};
@@ -319,8 +321,9 @@ impl HapticLoop {
             world.insert_resource(Scope::new(scope.clone()));
         }
         if scene.has_hook() {
-            let walls = walls_of(scene.organs.iter().map(|(name, _)| name.as_str()));
-            world.insert_resource(OrganBurns(WallBurns::new(walls, TissueHeat::SOFT_TISSUE)));
+            let walls = (scene.organs.iter()).map(|(name, _)| Wall::of_name(name));
+            let burns = WallBurns::new(walls.collect(), TissueHeat::SOFT_TISSUE);
+            world.insert_resource(OrganBurns(burns));
         }
         Ok(Self {
             world,
@@ -397,9 +400,15 @@ impl HapticLoop {
             })
             .collect();
         organs.sort_by_key(|(index, _)| *index);
+        let beds = self
+            .world
+            .get_resource::<OrganBeds>()
+            .map_or(&[][..], |b| &b.0[..]);
         let template = HapticSnapshot {
             hands: vec![HandSnapshot::default(); self.hands.len()],
             organs: organs.into_iter().map(|(_, organ)| organ).collect(),
+            beds: beds.iter().map(BedView::at_rest).collect(),
+            burns: BurnsView::with_room(),
             ..HapticSnapshot::default()
         };
         let (input, output) = triple_buffer::triple_buffer(&template);

@@ -8,7 +8,8 @@ use nalgebra::Vector3;
 use crate::contact::ToolContact;
 use crate::cutting::Stroke;
 use crate::devices::{MAX_INSTRUMENTS, Rack};
-use crate::pgd::Deformation;
+use crate::dissection::{BurnMark, MAX_BURN_MARKS, TieEnds, TiedOrgans};
+use crate::pgd::{Deformation, SurfacePoint};
 use crate::scenario::Progress;
 
 #[derive(Clone, Debug, Default)]
@@ -36,6 +37,89 @@ pub struct HapticSnapshot {
     pub timing: LoopTiming,
     /// Where the scenario's exercise stands, once started.
     pub exercise: Option<Progress>,
+    /// Each bed's ties, in the scene's order of beds.
+    pub beds: Vec<BedView>,
+    /// The burns the hook left on the organs' walls.
+    pub burns: BurnsView,
+}
+
+/// A bed's ties as the window draws them, in the bed's order.
+#[derive(Clone, Debug, Default)]
+pub struct BedView {
+    pub ties: Vec<TieView>,
+}
+
+impl BedView {
+    /// The bed's ties where it stands (at rest before the first tick).
+    pub fn at_rest(bed: &TiedOrgans) -> Self {
+        let mut view = Self {
+            ties: vec![TieView::default(); bed.bed.ties.len()],
+        };
+        view.update(bed);
+        view
+    }
+
+    /// The ties as `bed` stands this tick.
+    pub fn update(&mut self, bed: &TiedOrgans) {
+        let law = &bed.bed.law;
+        let ties = bed.bed.ties.iter().zip(bed.ends_m());
+        for (view, (tie, ends)) in self.ties.iter_mut().zip(ties) {
+            *view = TieView {
+                ends: *ends,
+                damage: tie.state.damage(law),
+                failed: tie.state.failed(law),
+            };
+        }
+    }
+}
+
+/// A tie as the window draws it.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TieView {
+    pub ends: TieEnds,
+    /// Its damage, 0 whole to 1.
+    pub damage: f64,
+    /// Divided by the hook or torn.
+    pub failed: bool,
+}
+
+/// The burn marks, in room for every mark the scene keeps (so the loop allocates nothing).
+#[derive(Clone, Debug, Default)]
+pub struct BurnsView {
+    room: Vec<BurnMark>,
+    count: usize,
+}
+
+impl BurnsView {
+    /// No marks, with room for [`MAX_BURN_MARKS`].
+    pub fn with_room() -> Self {
+        let unburned = BurnMark {
+            organ: 0,
+            at: SurfacePoint {
+                triangle: 0,
+                barycentric: [1.0, 0.0, 0.0],
+            },
+            at_rest_m: Vector3::zeros(),
+            area_m2: 0.0,
+            energy_j: 0.0,
+            depth_m: 0.0,
+            through: false,
+        };
+        Self {
+            room: vec![unburned; MAX_BURN_MARKS],
+            count: 0,
+        }
+    }
+
+    pub fn marks(&self) -> &[BurnMark] {
+        &self.room[..self.count]
+    }
+
+    /// The marks `marks` (as many as there is room for).
+    pub fn set(&mut self, marks: &[BurnMark]) {
+        self.count = marks.len().min(self.room.len());
+        self.room[..self.count].copy_from_slice(&marks[..self.count]);
+    }
 }
 
 impl HapticSnapshot {
@@ -59,6 +143,8 @@ pub struct HandSnapshot {
     pub force_n: Vector3<f64>,
     /// The scalpel's edge (unit, the scene's frame) when the tool is a scalpel.
     pub blade_edge: Option<Vector3<f64>>,
+    /// With a hook in hand: whether its energy is on (the button held).
+    pub cautery: Option<bool>,
     /// Whether the force is faded or held after a fault.
     pub faulted: bool,
     /// The organs the hand's tool touches (bit `k` for the scene's `k`th)...

@@ -4,6 +4,7 @@ use bevy::ecs::query::QueryData;
 use bevy::prelude::*;
 use nalgebra::Vector3;
 
+use super::cautery::OrganBurns;
 use super::components::{
     HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch,
 };
@@ -99,14 +100,24 @@ fn place(tool: &mut Tool) {
 /// this one, and a second hand must not read the first's unsettled press.
 pub fn tool_contact(
     tools: Query<(&HandIndex, &Tool)>,
-    mut organs: Query<(&OrganBody, &mut HandTouches, &mut OrganDeformation)>,
+    mut organs: Query<(
+        &OrganBody,
+        &mut HandTouches,
+        &mut OrganDeformation,
+        Option<&OrganMotion>,
+    )>,
 ) {
     for (hand, tool) in &tools {
-        for (body, mut touches, deformation) in &mut organs {
-            press_organ(hand.0, tool, body, &mut touches.0[hand.0], &deformation.0);
+        for (body, mut touches, deformation, motion) in &mut organs {
+            let organ = PressedOrgan {
+                body,
+                deformation: &deformation.0,
+                motion,
+            };
+            press_organ(hand.0, tool, &organ, &mut touches.0[hand.0]);
         }
     }
-    for (_, mut touches, mut deformation) in &mut organs {
+    for (_, mut touches, mut deformation, _) in &mut organs {
         let loads = deformation.0.loads.iter_mut();
         for (load, touch) in loads.zip(touches.0.iter_mut()) {
             std::mem::swap(load, &mut touch.next_load);
@@ -114,26 +125,36 @@ pub fn tool_contact(
     }
 }
 
+/// An organ as a tool presses it: its surface, its static field and, if it moves, its
+/// motion (the surface the tool meets is where the window draws it).
+struct PressedOrgan<'a> {
+    body: &'a OrganBody,
+    deformation: &'a Deformation,
+    motion: Option<&'a OrganMotion>,
+}
+
 /// Hand `slot`'s tool pressed into one organ: its contact, and its load next.
-fn press_organ(
-    slot: usize,
-    tool: &Tool,
-    body: &OrganBody,
-    touch: &mut ToolTouch,
-    deformation: &Deformation,
-) {
+fn press_organ(slot: usize, tool: &Tool, organ: &PressedOrgan, touch: &mut ToolTouch) {
     let Some(sample) = &tool.sample else {
         touch.next_load.release();
         touch.contact = None;
         return;
     };
+    let (vademecum, deformation) = (&organ.body.vademecum, organ.deformation);
     let target = Target {
-        vademecum: &body.vademecum,
-        surface: &body.surface,
+        vademecum,
+        surface: &organ.body.surface,
         moved_by_others: |patch: &Patch| {
-            deformation.patch_displacement_without(&body.vademecum, patch, slot)
+            let moved = organ
+                .motion
+                .map_or(Vector3::zeros(), |m| m.moved_at(&patch.blend));
+            deformation.patch_displacement_without(vademecum, patch, slot) + moved
         },
-        moved_by_all: |at: &SurfacePoint| deformation.displacement(&body.vademecum, at),
+        moved_by_all: |at: &SurfacePoint| {
+            let moved =
+                (organ.motion).map_or(Vector3::zeros(), |m| m.moved_at_point(vademecum, at));
+            deformation.displacement(vademecum, at) + moved
+        },
     };
     let previous = touch.contact.map(|contact| contact.hit.at);
     touch.contact = press(
@@ -438,9 +459,18 @@ pub fn publish_snapshot(
     hands: Query<PublishedHand>,
     organs: Query<PublishedOrgan>,
     timing: Option<Res<LoopTiming>>,
+    beds: Option<Res<OrganBeds>>,
+    burns: Option<Res<OrganBurns>>,
     mut publisher: ResMut<SnapshotPublisher>,
 ) {
     let snapshot = publisher.0.input_buffer_mut();
+    let beds = beds.as_ref().map_or(&[][..], |b| &b.0[..]);
+    for (view, bed) in snapshot.beds.iter_mut().zip(beds) {
+        view.update(bed);
+    }
+    if let Some(burns) = burns {
+        snapshot.burns.set(burns.0.marks());
+    }
     snapshot.tick = clock.tick;
     snapshot.time_s = clock.time_s;
     snapshot.timing = timing.map_or_else(LoopTiming::default, |t| *t);
@@ -493,6 +523,10 @@ fn publish_hand(hand: &PublishedHandItem, cut_organs: bool, published: &mut Hand
     published.faulted = hand.safety.is_some_and(|s| s.0.is_faulted());
     // Found again with the organs.
     published.holding = None;
+    published.cautery = match tool.action() {
+        Action::Cauterize(_) => Some(tool.sample.is_some_and(|s| s.buttons & 1 != 0)),
+        _ => None,
+    };
     let cuts = cut_organs && tool.action() == Action::Cut;
     published.blade_edge = tool
         .sample

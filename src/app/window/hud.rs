@@ -15,6 +15,7 @@ use super::laparoscope::CameraMode;
 use super::lesson::{Lesson, Stage};
 use crate::app::haptic::{HandIndex, HapticSnapshot, organ_with_law};
 use crate::devices::Action;
+use crate::dissection::CauteryMode;
 use crate::scenario::{Progress, Scenario};
 
 #[derive(Component)]
@@ -185,7 +186,11 @@ fn two_hands_lines(
     let lines: Vec<String> = (snapshot.hands.iter().zip(&link.scene.hands).enumerate())
         .map(|(index, (hand, scene))| {
             let instrument = scene.instruments.get(hand.instruments.in_hand);
-            let tool = instrument.map_or("tool", |i| action_name(i.action));
+            let tool = instrument.map_or("tool".to_owned(), |i| action_name(i.action));
+            let energy = match hand.cautery {
+                Some(true) => " ENERGY ON",
+                _ => "",
+            };
             let touching: Vec<&str> = (0..link.scene.organs.len())
                 .filter(|&k| k < 64 && hand.touching & (1 << k) != 0)
                 .map(name)
@@ -201,7 +206,7 @@ fn two_hands_lines(
             };
             let force_n = hand.force_n.norm();
             format!(
-                "{}{driven}: {tool}, {doing} | {force_n:.3} N {}",
+                "{}{driven}: {tool}{energy}, {doing} | {force_n:.3} N {}",
                 HandIndex(index).name(),
                 gauge(force_n, limit_n)
             )
@@ -224,13 +229,19 @@ fn two_hands_lines(
     (lines.join("\n"), status)
 }
 
-/// What an instrument is called on the HUD.
-fn action_name(action: Action) -> &'static str {
+/// What an instrument is called on the HUD (a hook with its power and mode).
+fn action_name(action: Action) -> String {
     match action {
-        Action::Press => "probe",
-        Action::Grasp => "grasper",
-        Action::Cut => "scalpel",
-        Action::Cauterize(_) => "hook",
+        Action::Press => "probe".to_owned(),
+        Action::Grasp => "grasper".to_owned(),
+        Action::Cut => "scalpel".to_owned(),
+        Action::Cauterize(hook) => {
+            let mode = match hook.mode {
+                CauteryMode::Cut => "cut",
+                CauteryMode::Coagulate => "coagulation",
+            };
+            format!("hook ({:.0} W, {mode})", hook.power_w)
+        }
     }
 }
 

@@ -6,6 +6,7 @@ mod abdomen;
 mod bridge;
 mod camera;
 mod cut_surface;
+mod dissection;
 mod frames;
 mod hud;
 mod incision;
@@ -179,6 +180,7 @@ impl PluginGroup for TrainerWindowPlugins {
             .add(camera::CameraPlugin)
             .add(tool::ToolPlugin)
             .add(incision::IncisionPlugin)
+            .add(dissection::DissectionPlugin)
             .add(input::InputPlugin)
             .add(hud::HudPlugin)
             .add(frames::FramesPlugin(self.log));

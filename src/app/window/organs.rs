@@ -12,7 +12,9 @@ use bevy::prelude::*;
 
 use super::bridge::{HapticLink, Snapshot};
 use super::cut_surface::{SplitSurface, walls_mesh};
+use super::dissection::tint_burns;
 use super::{FrameSet, SceneView, tissue};
+use crate::dissection::Wall;
 use crate::dynamics::DynamicModel;
 use crate::mesh::vertex_normals;
 use crate::pgd::{PatchLoad, SurfaceModes, Vademecum};
@@ -211,7 +213,17 @@ fn deform(
             }
         }
         let triangles = view.drawn_triangles();
-        let colours = contact_tint(positions.len(), loads);
+        let mut colours = contact_tint(positions.len(), loads);
+        if let Some((name, _)) = link.scene.organs.get(view.index) {
+            let burns = &snapshot.0.burns;
+            tint_burns(
+                &mut colours,
+                view.index,
+                Wall::of_name(name),
+                burns,
+                &view.vademecum,
+            );
+        }
         if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
             mesh.insert_attribute(
                 Mesh::ATTRIBUTE_NORMAL,

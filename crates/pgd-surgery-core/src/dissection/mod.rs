@@ -16,5 +16,5 @@ pub use bed::{Bed, BedError, FreedSurface, Tie};
 pub use cautery::{Cautery, CauteryMode, POWER_RANGE_W, PowerOutOfRange, TieBurns, TissueHeat};
 pub use cohesive::{CohesiveError, CohesiveLaw, CohesiveTie};
 pub use solve::{TieCompliance, TieConvergence, TieSolve};
-pub use tied::{HookOnTies, TiedOrgans, TiedReport};
+pub use tied::{HookOnTies, TieEnds, TiedOrgans, TiedReport};
 pub use wall::{BurnMark, BurnSite, MAX_BURN_MARKS, Wall, WallBurn, WallBurns};

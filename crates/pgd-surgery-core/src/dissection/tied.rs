@@ -181,10 +181,23 @@ pub struct TiedOrgans {
     forces_n: Vec<Vector3<f64>>,
     measured_m: Vec<Vector3<f64>>,
     by_others_m: Vec<Vector3<f64>>,
-    /// Where each tie's middle is this tick (m): what the hook reaches.
-    middle_m: Vec<Vector3<f64>>,
+    /// Where each tie's ends are this tick: what the hook reaches and the window draws.
+    ends_m: Vec<TieEnds>,
     burns: TieBurns,
     report: TiedReport,
+}
+
+/// Where a tie's two ends are (m, the scene's frame): on the freed organ and on its base.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TieEnds {
+    pub freed_m: Vector3<f64>,
+    pub base_m: Vector3<f64>,
+}
+
+impl TieEnds {
+    pub fn middle_m(&self) -> Vector3<f64> {
+        (self.freed_m + self.base_m) * 0.5
+    }
 }
 
 /// What the hook did to the ties in one tick.
@@ -219,8 +232,8 @@ impl TiedOrgans {
             TiedSide::new(freed.0, &freed.1, &freed_blends),
             TiedSide::new(base.0, &base.1, &base_blends),
         );
-        let middle_m = (freed.rest_m.iter().zip(&base.rest_m))
-            .map(|(f, b)| (f + b) * 0.5)
+        let ends_m = (freed.rest_m.iter().zip(&base.rest_m))
+            .map(|(&freed_m, &base_m)| TieEnds { freed_m, base_m })
             .collect();
         Self {
             freed,
@@ -232,15 +245,15 @@ impl TiedOrgans {
             forces_n: vec![Vector3::zeros(); n],
             measured_m: vec![Vector3::zeros(); n],
             by_others_m: vec![Vector3::zeros(); n],
-            middle_m,
+            ends_m,
             burns: TieBurns::new(n, TissueHeat::SOFT_TISSUE, LAYER_THICKNESS_M),
             report: TiedReport::default(),
         }
     }
 
-    /// Where each tie's middle is (m), as the last tick left it (at rest before the first).
-    pub fn middles_m(&self) -> &[Vector3<f64>] {
-        &self.middle_m
+    /// Where each tie's ends are, as the last tick left them (at rest before the first).
+    pub fn ends_m(&self) -> &[TieEnds] {
+        &self.ends_m
     }
 
     /// Each tie's force on the freed organ in the last tick (N), in the bed's order.
@@ -249,7 +262,7 @@ impl TiedOrgans {
     }
 
     /// The hook's energy of one tick, `energy_j` in `mode`, shared equally among the live
-    /// ties whose middle (as the last tick left it) lies within `reach_m` of its tip; each
+    /// ties whose middle (as the last tick left it, [`TieEnds::middle_m`]) lies within `reach_m` of its tip; each
     /// divided once it has taken what divides it ([`TieBurns::heat`]).
     pub fn burn_near(
         &mut self,
@@ -259,19 +272,18 @@ impl TiedOrgans {
         mode: CauteryMode,
     ) -> HookOnTies {
         let law = self.bed.law;
-        let reaches = |tie: &super::Tie, middle: &Vector3<f64>| {
-            (middle - tip_m).norm() <= reach_m && !tie.state.failed(&law)
+        let reaches = |tie: &super::Tie, ends: &TieEnds| {
+            (ends.middle_m() - tip_m).norm() <= reach_m && !tie.state.failed(&law)
         };
-        let ties = self.bed.ties.iter().zip(&self.middle_m);
+        let ties = self.bed.ties.iter().zip(&self.ends_m);
         let heated = ties.filter(|(t, m)| reaches(t, m)).count();
         let mut outcome = HookOnTies { heated, divided: 0 };
         if heated == 0 {
             return outcome;
         }
         let share_j = energy_j / heated as f64;
-        for (i, middle) in self.middle_m.iter().enumerate() {
-            if reaches(&self.bed.ties[i], middle)
-                && self.burns.heat(&mut self.bed, i, share_j, mode)
+        for (i, ends) in self.ends_m.iter().enumerate() {
+            if reaches(&self.bed.ties[i], ends) && self.burns.heat(&mut self.bed, i, share_j, mode)
             {
                 outcome.divided += 1;
             }
@@ -302,8 +314,8 @@ impl TiedOrgans {
             coupling.pose(self.freed.index),
             coupling.pose(self.base.index),
         );
-        for (i, (measured, middle)) in (self.measured_m.iter_mut())
-            .zip(self.middle_m.iter_mut())
+        for (i, (measured, ends)) in (self.measured_m.iter_mut())
+            .zip(self.ends_m.iter_mut())
             .enumerate()
         {
             let (freed, base) = (
@@ -311,7 +323,10 @@ impl TiedOrgans {
                 self.base.moved_m(i, &base_pose),
             );
             *measured = freed - base;
-            *middle = (self.freed.rest_m[i] + freed + self.base.rest_m[i] + base) * 0.5;
+            *ends = TieEnds {
+                freed_m: self.freed.rest_m[i] + freed,
+                base_m: self.base.rest_m[i] + base,
+            };
         }
         // What the last tick's forces add to the measurement comes out: the solve adds it
         // back for the forces it finds.

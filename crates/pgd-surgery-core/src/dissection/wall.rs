@@ -41,6 +41,11 @@ impl Wall {
         }
     }
 
+    /// The wall of a scene's organ by its name (a generated organ's own).
+    pub fn of_name(name: &str) -> Wall {
+        Wall::of(Organ::from_name(name))
+    }
+
     pub fn thickness_m(self) -> f64 {
         match self {
             Wall::Hollow { thickness_m } | Wall::Capsule { thickness_m } => thickness_m,
