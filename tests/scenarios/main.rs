@@ -322,6 +322,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "fails before the peak traction",
         ),
         (
+            "attachment-not-facing",
+            6,
+            "attachments[0].to",
+            "do not face each other within 3.0 mm",
+        ),
+        (
             "hook-power-out-of-range",
             5,
             "tool.Hook.power_w",

@@ -43,20 +43,28 @@ impl ContactSurface {
         if vademecum.triangles.is_empty() {
             return Err(ContactError::NoSurface { source_name });
         }
-        let normals = vademecum.rest_normals();
-        let vertices = vademecum
-            .position_coords_m
+        let (coords, triangles) = (&vademecum.position_coords_m, vademecum.triangles.clone());
+        Self::of_triangles(coords, triangles, vademecum.rest_normals()).map_err(|reason| {
+            ContactError::Degenerate {
+                source_name,
+                reason,
+            }
+        })
+    }
+
+    /// A surface of vertices `coords_m` and `triangles` over them, with each vertex's outward
+    /// unit normal; why not, if the triangles are degenerate.
+    pub fn of_triangles(
+        coords_m: &[[f32; 3]],
+        triangles: Vec<[u32; 3]>,
+        normals: Vec<Vector3<f64>>,
+    ) -> Result<Self, String> {
+        let vertices = coords_m
             .iter()
             .map(|p| to_parry(&Point3::from(p.map(f64::from))))
             .collect();
-        let mesh = TriMesh::new(vertices, vademecum.triangles.clone()).map_err(|e| {
-            ContactError::Degenerate {
-                source_name,
-                reason: e.to_string(),
-            }
-        })?;
-        let (offsets, vertex_triangles) =
-            triangles_around(&vademecum.triangles, vademecum.position_coords_m.len());
+        let (offsets, vertex_triangles) = triangles_around(&triangles, coords_m.len());
+        let mesh = TriMesh::new(vertices, triangles).map_err(|e| e.to_string())?;
         Ok(Self {
             mesh,
             normals,

@@ -4,8 +4,11 @@
 
 use serde::Deserialize;
 
+use super::scene::OrganEntry;
 use super::units::{FractureEnergy, PeakTraction, TieGap, TieStiffness};
-use crate::dissection::{CohesiveError, CohesiveLaw};
+use crate::contact::ContactSurface;
+use crate::dissection::{Bed, BedError, CohesiveError, CohesiveLaw, FreedSurface};
+use crate::mesh::{Surface, TetMesh};
 
 /// The gap the default scene's gallbladder bed ties within (mm).
 pub const DEFAULT_TIE_GAP_MM: f64 = 3.0;
@@ -60,4 +63,44 @@ impl AttachmentEntry {
             (self.fracture_energy_j_per_m2).map_or(bed.fracture_energy_j_per_m2, |g| g.0),
         )
     }
+}
+
+/// Whether `freed`'s surface faces `base`'s within `gap_m` anywhere, on their outline meshes
+/// ([`OrganEntry::outline_mesh`]); `None` when a mesh cannot be had.
+pub(super) fn facing(
+    freed: &OrganEntry,
+    base: &OrganEntry,
+    gap_m: f64,
+) -> Option<Result<(), BedError>> {
+    let (freed_mesh, base_mesh) = (freed.outline_mesh()?, base.outline_mesh()?);
+    let freed_surface = Surface::extract(&freed_mesh);
+    let coords = surface_coords(&freed_surface, &freed_mesh);
+    let normals = freed_surface.vertex_normals(&freed_mesh);
+    let areas: Vec<f32> = (freed_surface.vertex_areas(&freed_mesh).iter())
+        .map(|&a| a as f32)
+        .collect();
+    let freed = FreedSurface {
+        coords_m: &coords,
+        normals: &normals,
+        areas_m2: &areas,
+    };
+    let base_surface = Surface::extract(&base_mesh);
+    let triangles = (base_surface.local_triangles().iter())
+        .map(|t| t.map(|v| v as u32))
+        .collect();
+    let base = ContactSurface::of_triangles(
+        &surface_coords(&base_surface, &base_mesh),
+        triangles,
+        base_surface.vertex_normals(&base_mesh),
+    )
+    .ok()?;
+    let law = CohesiveLaw::gallbladder_bed();
+    Some(Bed::between(law, &freed, |at| base.closest(at), gap_m).map(|_| ()))
+}
+
+/// The surface's vertices (m).
+fn surface_coords(surface: &Surface, mesh: &TetMesh) -> Vec<[f32; 3]> {
+    (surface.nodes.iter())
+        .map(|&n| mesh.nodes()[n].cast::<f32>().into())
+        .collect()
 }

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use super::attachment::AttachmentEntry;
+use super::attachment::{AttachmentEntry, facing};
 use super::format::{LaparoscopeEntry, Scenario};
 use super::problem::{Problem, REFERENCE, ScenarioError};
 use super::scene::{OrganEntry, metres};
@@ -507,6 +507,20 @@ fn check_attachment(
             anchors: anchors("to"),
             message: format!("`{}` is attached to itself", attachment.organ),
             hint: "attach it to the organ it lies on".into(),
+        });
+    }
+    let (freed, base) = (
+        scenario.organ(&attachment.organ),
+        scenario.organ(&attachment.to),
+    );
+    if let Some((freed, base)) = freed.zip(base).filter(|(f, b)| f.name != b.name)
+        && let Some(Err(e)) = facing(freed, base, attachment.gap_m())
+    {
+        problems.push(Problem {
+            field: field("to"),
+            anchors: anchors("to"),
+            message: format!("the {} and the {}: {e}", attachment.organ, attachment.to),
+            hint: "attach organs that lie against each other, or widen gap_mm (up to 10)".into(),
         });
     }
     if let Err(e) = attachment.law() {

@@ -4,7 +4,6 @@ use parry3d::query::PointQuery;
 use serde::{Deserialize, Serialize};
 
 use crate::mesh::Surface;
-use crate::mesh::organs::{Organ, OrganSettings};
 use crate::scenario::incision::{IncisionMetrics, IncisionTracker};
 use crate::scenario::scene::{OrganEntry, metres};
 use crate::scenario::task::{
@@ -148,17 +147,7 @@ fn farthest_off_surface(
     entry: &OrganEntry,
     points_mm: [(f64, f64, f64); 2],
 ) -> Option<(usize, f64)> {
-    let mesh = match (&entry.mesh, Organ::from_name(&entry.name)) {
-        (Some(path), _) => crate::mesh::io::load(path, &Default::default()).ok()?,
-        (None, Some(organ)) => {
-            let coarse = OrganSettings {
-                resolution: 0.25,
-                ..OrganSettings::default()
-            };
-            crate::mesh::organs::generate(organ, &coarse).ok()?
-        }
-        (None, None) => return None,
-    };
+    let mesh = entry.outline_mesh()?;
     let surface = Surface::extract(&mesh);
     let positions: Vec<[f32; 3]> = mesh
         .nodes()
