@@ -4,6 +4,7 @@
 use std::sync::Arc;
 
 use nalgebra::Vector3;
+use pgd_surgery::app::attempt::scenario_scene;
 use pgd_surgery::app::haptic::{
     FaultLog, ForceTrace, HapticLoop, HapticScene, OrganBeds, TickClock,
 };
@@ -361,4 +362,179 @@ fn the_hook_divides_the_ties_within_its_reach() {
     let clear = tip + centre.normal.into_inner() * 0.02;
     let outcome = tied.tied.burn_near(&clear, reach_m, 1.0, CauteryMode::Cut);
     assert_eq!(outcome.heated, 0);
+}
+
+/// The dissection scenario's scene with a right hand that stays clear and a left hand whose
+/// grasper closes at 1 s on the gallbladder's anterior face below the bed (at rest), then
+/// draws it down and forward, away from the liver, `pull_mm` by `pull_until_s`, where it
+/// opens the jaws.
+fn pulled_off_the_bed(pull_mm: f64, pull_until_s: f64) -> HapticLoop {
+    use pgd_surgery::devices::HapticDevice;
+    let scenario = pgd_surgery::scenario::load(
+        &super::root().join("scenarios/gallbladder-liver-bed-dissection.scenario.ron"),
+    )
+    .unwrap();
+    let scene = scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Refuse).unwrap();
+    let port = scene.hands[1].instruments[0].port.unwrap();
+    let row = |time_s: f64, tip_m: Vector3<f64>, buttons: u32| TrajectoryRow {
+        buttons,
+        ..TrajectoryRow::new(time_s, &DeviceSample::at(port.handle_for(&tip_m).unwrap()))
+    };
+    let clear = Vector3::new(0.074892, 0.344516, -0.209355);
+    let right = Trajectory {
+        rows: vec![TrajectoryRow::new(0.0, &DeviceSample::at(clear))],
+    };
+    let gallbladder = ContactSurface::new(&scene.organs[1].1).unwrap();
+    let edge = gallbladder
+        .closest(&Vector3::new(0.045, 0.045, -0.062))
+        .unwrap();
+    let on = edge.point_m + edge.normal * (scene.probe.tip_radius_m - 0.001);
+    let away = on + Vector3::new(0.0, 0.4, -1.0).normalize() * pull_mm * 1e-3;
+    let left = Trajectory {
+        rows: vec![
+            row(0.0, on + edge.normal * 0.01, 0),
+            row(0.9, on, 0),
+            row(1.0, on, 1),
+            row(pull_until_s, away, 1),
+            row(pull_until_s + 0.001, away, 0),
+        ],
+    };
+    let devices: Vec<Box<dyn HapticDevice>> = vec![
+        Box::new(Scripted::new("right", right)),
+        Box::new(Scripted::new("left", left)),
+    ];
+    HapticLoop::with_devices(&scene, devices).unwrap()
+}
+
+fn tick_at(haptic: &mut HapticLoop, tick: u64) {
+    haptic.tick(TickClock {
+        tick,
+        time_s: tick as f64 * TICK_S,
+        overruns_in_a_row: 0,
+    });
+}
+
+/// The dissection's competent run replayed through the haptic loop: as the hook divides the
+/// ties the released share only grows, every tie force and both hands' forces stay finite, and
+/// in the ten ticks after a tie is divided the force the physics asks of each hand changes by
+/// at most 20 mN a tick (the hook held still while it burns; its own motion in and out of contact steps the
+/// force by the tissue's stiffness times its speed, which is the script's, not the bed's).
+#[test]
+fn the_plane_opens_under_the_hook_without_a_force_step() {
+    use pgd_surgery::app::haptic::DeviceForce;
+    use pgd_surgery::devices::HapticDevice;
+    let root = super::root();
+    let scenario = pgd_surgery::scenario::load(
+        &root.join("scenarios/gallbladder-liver-bed-dissection.scenario.ron"),
+    )
+    .unwrap();
+    let scene = scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Refuse).unwrap();
+    let run = root.join("scenarios/runs/gallbladder-liver-bed-dissection.competent.csv");
+    let hands = Trajectory::load_hands(&run).unwrap();
+    let ticks = (hands[0].duration_s() / TICK_S) as u64;
+    let devices: Vec<Box<dyn HapticDevice>> = (hands.into_iter())
+        .map(|hand| Box::new(Scripted::new("run", hand)) as Box<dyn HapticDevice>)
+        .collect();
+    let mut haptic = HapticLoop::with_devices(&scene, devices).unwrap();
+    let mut released = 0.0_f64;
+    let mut last_n: [Option<Vector3<f64>>; 2] = [None; 2];
+    let mut largest_step_n = [0.0_f64; 2];
+    // The last tick a tie was divided in: its force leaves the organs in the ticks after.
+    let mut after_division: Option<u64> = None;
+    for tick in 0..ticks {
+        tick_at(&mut haptic, tick);
+        let bed = &haptic.world().resource::<OrganBeds>().0[0];
+        let share = bed.bed.released_share();
+        assert!(
+            share >= released,
+            "tick {tick}: healed from {released} to {share}"
+        );
+        if share > released {
+            after_division = Some(tick);
+        }
+        released = share;
+        assert!(
+            bed.forces_n()
+                .iter()
+                .all(|f| f.iter().all(|c| c.is_finite()))
+        );
+        for hand in 0..2 {
+            let desired_n = haptic.hand::<DeviceForce>(hand).unwrap().desired_n;
+            assert!(desired_n.iter().all(|c| c.is_finite()), "tick {tick}");
+            if let Some(last) = last_n[hand]
+                && after_division.is_some_and(|d| tick < d + 10)
+            {
+                largest_step_n[hand] = largest_step_n[hand].max((desired_n - last).norm());
+            }
+            last_n[hand] = Some(desired_n);
+        }
+    }
+    eprintln!(
+        "{:.1} % released; as ties are divided the hands' forces step {:.2} and {:.2} mN a tick at most",
+        100.0 * released,
+        largest_step_n[0] * 1e3,
+        largest_step_n[1] * 1e3
+    );
+    assert!(released > 0.33, "{released}");
+    assert!(
+        largest_step_n.iter().all(|&s| s <= 0.02),
+        "{largest_step_n:?} N in a tick"
+    );
+}
+
+/// Every tie of the bed divided, the grasper draws the gallbladder 30 mm down and forward
+/// and opens its jaws: freed, the gallbladder hangs from its duodenal end alone and swings, a
+/// point of its hepatic face moving back and forth by millimetres (the motion turning at
+/// least twice), the swing dying down from the first second to the fourth, all finite.
+#[test]
+fn a_freed_gallbladder_hangs_from_what_is_left_and_swings() {
+    use pgd_surgery::app::haptic::{OrganBody, OrganMotion};
+    let pull_until_s = 4.0;
+    let mut haptic = pulled_off_the_bed(30.0, pull_until_s);
+    {
+        let mut beds = haptic.world_mut().resource_mut::<OrganBeds>();
+        let bed = &mut beds.0[0].bed;
+        let law = bed.law;
+        bed.ties.iter_mut().for_each(|t| t.state.sever(&law));
+    }
+    for tick in 0..(pull_until_s / TICK_S) as u64 {
+        tick_at(&mut haptic, tick);
+    }
+    // A point of the gallbladder's hepatic face, the first tie's.
+    let node = {
+        let tie = haptic.world().resource::<OrganBeds>().0[0].bed.ties[0];
+        let mut bodies = haptic.world_mut().query::<(&OrganBody, &OrganMotion)>();
+        let (body, _) = (bodies.iter(haptic.world()))
+            .find(|(b, _)| b.name == "gallbladder")
+            .unwrap();
+        body.vademecum.positions[tie.position] as usize
+    };
+    let first = (pull_until_s / TICK_S) as u64;
+    let mut swing_m = Vec::new();
+    // The jaws open on the second tick.
+    tick_at(&mut haptic, first);
+    tick_at(&mut haptic, first + 1);
+    for tick in first + 2..first + 4002 {
+        tick_at(&mut haptic, tick);
+        let mut motions = haptic.world_mut().query::<(&OrganBody, &OrganMotion)>();
+        let (_, motion) = (motions.iter(haptic.world()))
+            .find(|(b, _)| b.name == "gallbladder")
+            .unwrap();
+        assert!(!motion.organ.holding());
+        swing_m.push(motion.moved_at(&[(node, 1.0)]));
+    }
+    let second = |k: usize| &swing_m[k * 1000..(k + 1) * 1000];
+    let range_m = |part: &[Vector3<f64>]| {
+        let mean = part.iter().sum::<Vector3<f64>>() / part.len() as f64;
+        part.iter().map(|p| (p - mean).norm()).fold(0.0, f64::max)
+    };
+    let ranges: Vec<f64> = (0..4).map(|k| range_m(second(k))).collect();
+    let turns = (swing_m.windows(3))
+        .filter(|w| (w[1].x - w[0].x) * (w[2].x - w[1].x) < 0.0)
+        .count();
+    eprintln!("freed: swing each second {ranges:?} m, the x motion turning {turns} times");
+    assert!(swing_m.iter().all(|p| p.iter().all(|c| c.is_finite())));
+    assert!(ranges[0] > 1e-3, "{ranges:?}");
+    assert!(turns >= 2, "{turns} turns");
+    assert!(ranges[3] < ranges[0], "{ranges:?}");
 }
