@@ -12,7 +12,7 @@ use pgd_surgery::app::{self, DEFAULT_SCENARIO, launch};
 use pgd_surgery::cli::{
     HistoryRequest, HistoryTarget, debrief, list_devices, numbered, parse_force_limit_n,
     parse_positive_seconds, parse_seconds, prepare_scenarios, run_soak, show_history,
-    validate_scenarios,
+    show_standing, validate_scenarios,
 };
 use pgd_surgery::devices::{DeviceSpec, TimerMode};
 use pgd_surgery::history::HistoryFilter;
@@ -127,8 +127,16 @@ enum Command {
         #[arg(long, default_value = "reports")]
         report_dir: PathBuf,
     },
-    /// Check scenario files without running them; every problem is printed with its file,
-    /// line, column and field.
+    /// Where a trainee (--trainee, default the login name) stands in a curriculum: each
+    /// module done, open or locked, each exercise's attempts and best score against its
+    /// proficiency rule, from the history (--history).
+    Curriculum {
+        /// The curriculum, e.g. curricula/cholecystectomy.curriculum.ron.
+        file: PathBuf,
+    },
+    /// Check scenario files (and curricula, `….curriculum.ron`, with every scenario they
+    /// name) without running them; every problem is printed with its file, line, column and
+    /// field.
     Validate {
         #[arg(required = true)]
         files: Vec<PathBuf>,
@@ -265,6 +273,10 @@ fn main() -> ExitCode {
 fn run_command(cli: &Cli) -> Option<ExitCode> {
     Some(match cli.command.as_ref()? {
         Command::Validate { files } => validate_scenarios(files),
+        Command::Curriculum { file } => {
+            let trainee = cli.trainee.clone().unwrap_or_else(login_name);
+            show_standing(file, &cli.history, &trainee)
+        }
         Command::Prepare { files, web } => {
             prepare_scenarios(files, &cli.vademecums, detail_of(cli), web.as_deref())
         }

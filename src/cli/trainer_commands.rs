@@ -30,10 +30,15 @@ pub fn numbered(attempts: launch::Attempts) -> Vec<(PathBuf, Option<usize>, Outc
         .collect()
 }
 
-/// `trainer validate`: every file checked, every problem printed; fails if any file has one.
+/// `trainer validate`: every file checked (scenarios, and curricula by their name), every
+/// problem printed; fails if any file has one.
 pub fn validate_scenarios(files: &[PathBuf]) -> ExitCode {
     let mut failed = false;
     for file in files {
+        if super::is_curriculum(file) {
+            failed |= !super::validate_curriculum(file);
+            continue;
+        }
         match scenario::load(file) {
             Ok(s) => {
                 println!(

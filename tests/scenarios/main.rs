@@ -10,6 +10,7 @@ mod bed;
 mod cache;
 #[path = "../../crates/pgd-surgery-core/tests/support/counting.rs"]
 mod counting;
+mod curriculum;
 mod cutting;
 #[path = "../../crates/pgd-surgery-core/tests/support/fuzz.rs"]
 mod fuzz;

@@ -25,6 +25,25 @@ pub fn load(file: &Path) -> Result<Scenario, ScenarioError> {
 
 /// Parses and checks scenario text; `file` names it in errors.
 pub fn parse(file: &Path, text: &str) -> Result<Scenario, ScenarioError> {
+    let mut scenario: Scenario = read_ron(file, text)?;
+    // Mesh files are written relative to the scenario's folder.
+    let folder = file.parent().unwrap_or(Path::new(""));
+    for mesh in scenario.organs.iter_mut().filter_map(|o| o.mesh.as_mut()) {
+        *mesh = folder.join(&*mesh);
+    }
+    let problems = check(&scenario);
+    match problems.into_iter().next() {
+        None => Ok(scenario),
+        Some(problem) => Err(problem.locate(file, text)),
+    }
+}
+
+/// RON text as a `T`, an error naming the line, the column and the field path where it is
+/// not one; `file` names it in errors.
+pub(super) fn read_ron<T: serde::de::DeserializeOwned>(
+    file: &Path,
+    text: &str,
+) -> Result<T, ScenarioError> {
     let syntax = |e: ron::error::SpannedError, field: String| {
         let hint = hint_for(&e.code);
         ScenarioError {
@@ -41,7 +60,7 @@ pub fn parse(file: &Path, text: &str) -> Result<Scenario, ScenarioError> {
         ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
     let mut de = ron::Deserializer::from_str_with_options(text, &options)
         .map_err(|e| syntax(e, String::new()))?;
-    let mut scenario: Scenario = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+    let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         // serde_path_to_error writes `?` for a step it cannot name and `.` for the root.
         let field = e.path().to_string().replace('?', "");
         let field = field.trim_matches('.').to_owned();
@@ -49,16 +68,7 @@ pub fn parse(file: &Path, text: &str) -> Result<Scenario, ScenarioError> {
     })?;
     de.end()
         .map_err(|e| syntax(de.span_error(e), String::new()))?;
-    // Mesh files are written relative to the scenario's folder.
-    let folder = file.parent().unwrap_or(Path::new(""));
-    for mesh in scenario.organs.iter_mut().filter_map(|o| o.mesh.as_mut()) {
-        *mesh = folder.join(&*mesh);
-    }
-    let problems = check(&scenario);
-    match problems.into_iter().next() {
-        None => Ok(scenario),
-        Some(problem) => Err(problem.locate(file, text)),
-    }
+    Ok(value)
 }
 
 fn hint_for(code: &ron::Error) -> String {

@@ -4,11 +4,13 @@
 //! and their reader in `tasks`), run one after another fed by the haptic loop one tick at a
 //! time (`exercise`, `sample`), with the tool's motion (`motion`), the cut against an
 //! incision's line (`incision`) and the incisions of a radial keratotomy (`keratotomy`)
-//! measured; and the rubric's score (`score`). No Bevy here: the app layer runs an
+//! measured; and the rubric's score (`score`). A programme's curriculum of scenarios, read
+//! the same way, and where a trainee stands in it (`curriculum`). No Bevy here: the app layer runs an
 //! [`Exercise`] inside the haptic schedule.
 
 mod attachment;
 mod bimanual;
+pub mod curriculum;
 mod exercise;
 mod format;
 mod incision;

@@ -449,3 +449,36 @@ impl TryFrom<f64> for ReleaseShare {
         }
     }
 }
+
+/// A score, 0 to 100.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct Score(pub f64);
+
+impl TryFrom<f64> for Score {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (0.0..=100.0).contains(&v) => Ok(Self(v)),
+            v => Err(format!("{v} is not a score: scores run from 0 to 100")),
+        }
+    }
+}
+
+/// A number of attempts, 1 to 100.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "usize")]
+pub struct AttemptCount(pub usize);
+
+impl TryFrom<usize> for AttemptCount {
+    type Error = String;
+    fn try_from(value: usize) -> Result<Self, String> {
+        match value {
+            1..=100 => Ok(Self(value)),
+            v => Err(format!(
+                "{v} is not a number of attempts to ask for: 1 to 100 (learning curves flatten \
+                 after 10 to 15)"
+            )),
+        }
+    }
+}

@@ -1,0 +1,117 @@
+//! `trainer curriculum`: where a trainee stands in a programme's curriculum, from the attempts
+//! kept in the history; and `trainer validate`'s verdict on a curriculum file.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use crate::history::{History, HistoryFilter};
+use crate::scenario::curriculum::{
+    CountedAttempt, Curriculum, ExerciseStanding, ModuleStanding, ModuleState, load_curriculum,
+    standing,
+};
+
+/// Whether `file` is a curriculum (by its name, `….curriculum.ron`) rather than a scenario.
+pub fn is_curriculum(file: &Path) -> bool {
+    file.to_string_lossy().ends_with(".curriculum.ron")
+}
+
+/// Checks a curriculum file and every scenario it names; prints the verdict, `true` if good.
+pub fn validate_curriculum(file: &Path) -> bool {
+    match load_curriculum(file) {
+        Ok(curriculum) => {
+            let exercises: usize = curriculum.modules.iter().map(|m| m.exercises.len()).sum();
+            println!(
+                "{}: ok ({}, {} modules, {exercises} exercises)",
+                file.display(),
+                curriculum.title,
+                curriculum.modules.len()
+            );
+            true
+        }
+        Err(e) => {
+            eprintln!("{e}");
+            false
+        }
+    }
+}
+
+/// Prints where `trainee` stands in the curriculum `file`, from the history at `database`.
+pub fn show_standing(file: &Path, database: &Path, trainee: &str) -> ExitCode {
+    let curriculum = match load_curriculum(file) {
+        Ok(curriculum) => curriculum,
+        Err(e) => {
+            eprintln!("{e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let filter = HistoryFilter {
+        trainee: Some(trainee.to_owned()),
+        scenario: None,
+    };
+    let attempts = match History::open(database).and_then(|h| h.attempts(&filter)) {
+        Ok(attempts) => attempts,
+        Err(e) => return super::fail("trainer curriculum", &e.to_string()),
+    };
+    let counted: Vec<CountedAttempt> = (attempts.iter())
+        .map(|a| CountedAttempt {
+            scenario: &a.scenario,
+            score: a.score,
+            passed: a.passed,
+        })
+        .collect();
+    print!(
+        "{}",
+        standing_text(
+            &curriculum,
+            &standing(&curriculum, &counted),
+            trainee,
+            database
+        )
+    );
+    ExitCode::SUCCESS
+}
+
+/// The standing as `trainer curriculum` prints it.
+fn standing_text(
+    curriculum: &Curriculum,
+    modules: &[ModuleStanding],
+    trainee: &str,
+    database: &Path,
+) -> String {
+    let mut text = format!(
+        "{}: where {trainee} stands ({})\n",
+        curriculum.title,
+        database.display()
+    );
+    for (k, (module, entry)) in modules.iter().zip(&curriculum.modules).enumerate() {
+        let state = match module.state {
+            ModuleState::Done => "done".to_owned(),
+            ModuleState::Open => "open".to_owned(),
+            ModuleState::Locked => format!("locked (opens after {})", entry.opens_after.join(", ")),
+        };
+        text += &format!("{}. {}: {state}\n", k + 1, module.name);
+        for exercise in &module.exercises {
+            text += &format!("     {}\n", exercise_line(exercise));
+        }
+    }
+    text
+}
+
+/// One exercise: had or how far, the rule, the attempts and the best score.
+fn exercise_line(exercise: &ExerciseStanding) -> String {
+    let (done, of) = exercise.progress;
+    let status = match exercise.had() {
+        true => "had".to_owned(),
+        false => format!("{done} of {of}"),
+    };
+    let attempts = match (exercise.attempts, exercise.best_score) {
+        (0, _) | (_, None) => "no attempt yet".to_owned(),
+        (1, Some(best)) => format!("1 attempt, best {best:.0}"),
+        (n, Some(best)) => format!("{n} attempts, best {best:.0}"),
+    };
+    format!(
+        "{}: {status} ({}; {attempts})",
+        exercise.name,
+        exercise.rule.describe()
+    )
+}
