@@ -10,9 +10,9 @@ use pgd_surgery::app::soak::SoakPlan;
 use pgd_surgery::app::window::{Opening, ScreenshotPlan};
 use pgd_surgery::app::{self, DEFAULT_SCENARIO, launch};
 use pgd_surgery::cli::{
-    HistoryRequest, HistoryTarget, debrief, list_devices, numbered, parse_force_limit_n,
-    parse_positive_seconds, parse_seconds, prepare_scenarios, run_soak, show_history,
-    show_standing, validate_scenarios,
+    CohortRequest, HistoryRequest, HistoryTarget, debrief, list_devices, numbered,
+    parse_force_limit_n, parse_positive_seconds, parse_seconds, prepare_scenarios, run_soak,
+    show_cohort, show_history, show_standing, validate_scenarios,
 };
 use pgd_surgery::devices::{DeviceSpec, TimerMode};
 use pgd_surgery::history::HistoryFilter;
@@ -186,6 +186,13 @@ enum Command {
         /// Where the learning-curve plot goes.
         #[arg(long, default_value = "reports/learning-curve.png")]
         plot: PathBuf,
+        /// The programme's view: every trainee's standing in the curriculum (--curriculum) as
+        /// a table, and their learning curves (--plot, and its numbers beside it as CSV).
+        #[arg(long, requires = "curriculum", conflicts_with_all = ["csv", "scenario"])]
+        cohort: bool,
+        /// The curriculum the cohort's standing is read against.
+        #[arg(long)]
+        curriculum: Option<PathBuf>,
     },
 }
 
@@ -300,9 +307,20 @@ fn run_command(cli: &Cli) -> Option<ExitCode> {
             plot.as_deref(),
         ),
         Command::History {
+            cohort: true,
+            curriculum: Some(curriculum),
+            plot,
+            ..
+        } => show_cohort(&CohortRequest {
+            database: &cli.history,
+            curriculum,
+            plot,
+        }),
+        Command::History {
             scenario,
             csv,
             plot,
+            ..
         } => show_history(&HistoryRequest {
             database: &cli.history,
             filter: HistoryFilter {

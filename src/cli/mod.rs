@@ -11,6 +11,7 @@ mod pgd_fit;
 mod pgd_indent;
 mod pgd_mesh;
 mod pgd_validate;
+mod trainer_cohort;
 mod trainer_commands;
 mod trainer_curriculum;
 mod trainer_devices;
@@ -18,6 +19,7 @@ mod trainer_history;
 mod trainer_soak;
 
 pub use output::{fail, print_json, print_report};
+pub use trainer_cohort::{CohortRequest, show_cohort};
 pub use trainer_curriculum::{is_curriculum, show_standing, validate_curriculum};
 
 /// A mesh read for a command, and the generated organ it is, if it is one.

@@ -44,7 +44,8 @@ fn standing(db: &Path, trainee: &str) -> String {
 /// Ada passes every basic skill at 85 twice in a row but the palpation, where a failed
 /// attempt at 90 (a complication) breaks her run: the basics stay open, the tasks locked.
 /// One more passed palpation and the basics are done, the tasks open; Bob, with no attempt,
-/// has the basics open and the tasks locked.
+/// has the basics open and the tasks locked. The cohort's view has a row each, the exercises
+/// each has had, and their learning curves as a plot and CSV.
 #[test]
 fn the_curriculum_opens_its_modules_as_the_benchmarks_are_met() {
     let curriculum = load_curriculum(&root().join(SHIPPED)).unwrap();
@@ -101,6 +102,41 @@ fn the_curriculum_opens_its_modules_as_the_benchmarks_are_met() {
         text.contains("liver-steady-press: 0 of 2 (80 on 2 attempts in a row; no attempt yet)"),
         "{text}"
     );
+    // The programme's view: both trainees, a row each, and their curves as PNG and CSV.
+    history
+        .record(&attempt("bob", "liver-steady-press", 55.0, false, at + 60))
+        .unwrap();
+    let plot = dir.join("cohort.png");
+    let output = Command::new(TRAINER)
+        .current_dir(root())
+        .args(["history", "--cohort", "--curriculum", SHIPPED, "--history"])
+        .arg(&db)
+        .arg("--plot")
+        .arg(&plot)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{output:?}");
+    let table = String::from_utf8(output.stdout).unwrap();
+    let row = |name: &str| {
+        table
+            .lines()
+            .find(|l| l.starts_with(name))
+            .unwrap_or_default()
+            .to_owned()
+    };
+    let (ada, bob) = (row("ada"), row("bob"));
+    let made = 2 * basics.len() + 2;
+    assert!(
+        ada.contains("done") && ada.contains("open") && ada.contains(&format!("6/9  {made:>8}")),
+        "{table}"
+    );
+    assert!(
+        bob.contains("open") && bob.contains("locked") && bob.contains("0/9"),
+        "{table}"
+    );
+    assert!(std::fs::metadata(&plot).unwrap().len() > 1000);
+    let csv = std::fs::read_to_string(dir.join("cohort.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + made + 1, "{csv}");
 }
 
 /// Broken curricula: a module opening after one not listed before it, a scenario that is not
