@@ -44,6 +44,8 @@ pub struct Options {
     pub free_camera: bool,
     /// Render into an image of this size (pixels) instead of a window.
     pub offscreen: Option<(u32, u32)>,
+    /// The menu offers this curriculum's exercises in its order, the locked ones refused.
+    pub curriculum: Option<super::window::MenuCurriculum>,
 }
 
 /// What a headless run reports.
@@ -217,6 +219,7 @@ pub fn open_window(
         scenes: scene_source(options),
         swap: haptic.swap(),
         built: Arc::new(|| crate::store::background_status().built),
+        curriculum: options.curriculum.clone(),
     });
     let lessons = Lessons::default();
     let (exit, frames) = super::window::run(WindowScene {

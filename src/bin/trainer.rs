@@ -10,7 +10,7 @@ use pgd_surgery::app::soak::SoakPlan;
 use pgd_surgery::app::window::{Opening, ScreenshotPlan};
 use pgd_surgery::app::{self, DEFAULT_SCENARIO, launch};
 use pgd_surgery::cli::{
-    CohortRequest, HistoryRequest, HistoryTarget, debrief, list_devices, numbered,
+    CohortRequest, HistoryRequest, HistoryTarget, debrief, list_devices, menu_curriculum, numbered,
     parse_force_limit_n, parse_positive_seconds, parse_seconds, prepare_scenarios, run_soak,
     show_cohort, show_history, show_standing, validate_scenarios,
 };
@@ -96,6 +96,10 @@ struct Cli {
     /// The history database every scored attempt is kept in (SQLite).
     #[arg(long, global = true, default_value = "reports/history.sqlite")]
     history: PathBuf,
+    /// The window's menu offers this curriculum's exercises in its order, module by module,
+    /// each marked had or locked for --trainee (from --history); a locked one is refused.
+    #[arg(long)]
+    curriculum: Option<PathBuf>,
     /// The window without an exercise: the organs and the tool only (by default the window
     /// opens the menu of scenarios/, the built-in scenarios/liver-steady-press.scenario.ron
     /// chosen).
@@ -251,7 +255,16 @@ fn main() -> ExitCode {
         );
         return ExitCode::from(2);
     }
-    let options = launch_options(&cli);
+    let mut options = launch_options(&cli);
+    if let Some(file) = &cli.curriculum {
+        match menu_curriculum(file, &history.database, &history.trainee) {
+            Ok(curriculum) => options.curriculum = Some(curriculum),
+            Err(e) => {
+                eprintln!("{e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    }
     let exercise = match chosen_exercise(&cli) {
         Ok(exercise) => exercise,
         Err(code) => return code,
@@ -359,6 +372,7 @@ fn launch_options(cli: &Cli) -> launch::Options {
         max_force_n: cli.max_force_n,
         free_camera: cli.free_camera,
         offscreen: cli.offscreen.then_some(cli.size),
+        curriculum: None,
     }
 }
 

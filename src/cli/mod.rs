@@ -20,7 +20,7 @@ mod trainer_soak;
 
 pub use output::{fail, print_json, print_report};
 pub use trainer_cohort::{CohortRequest, show_cohort};
-pub use trainer_curriculum::{is_curriculum, show_standing, validate_curriculum};
+pub use trainer_curriculum::{is_curriculum, menu_curriculum, show_standing, validate_curriculum};
 
 /// A mesh read for a command, and the generated organ it is, if it is one.
 pub struct LoadedMesh {

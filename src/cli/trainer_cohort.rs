@@ -4,11 +4,10 @@
 use std::path::Path;
 use std::process::ExitCode;
 
+use super::trainer_curriculum::counted;
 use crate::history::{AttemptRecord, History, HistoryFilter};
 use crate::report::{CurvePoint, learning_curve};
-use crate::scenario::curriculum::{
-    CountedAttempt, Curriculum, ModuleState, load_curriculum, standing,
-};
+use crate::scenario::curriculum::{Curriculum, ModuleState, load_curriculum, standing};
 
 /// What `trainer history --cohort` is asked.
 pub struct CohortRequest<'a> {
@@ -74,14 +73,7 @@ fn cohort_table(curriculum: &Curriculum, attempts: &[AttemptRecord]) -> String {
     for trainee in trainees(attempts) {
         let theirs: Vec<&AttemptRecord> =
             attempts.iter().filter(|a| a.trainee == trainee).collect();
-        let counted: Vec<CountedAttempt> = (theirs.iter())
-            .map(|a| CountedAttempt {
-                scenario: &a.scenario,
-                score: a.score,
-                passed: a.passed,
-            })
-            .collect();
-        let stands = standing(curriculum, &counted);
+        let stands = standing(curriculum, &counted(theirs.iter().copied()));
         let states: String = (stands.iter())
             .map(|m| match m.state {
                 ModuleState::Done => "done",

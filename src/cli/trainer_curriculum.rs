@@ -1,10 +1,12 @@
 //! `trainer curriculum`: where a trainee stands in a programme's curriculum, from the attempts
 //! kept in the history; and `trainer validate`'s verdict on a curriculum file.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 
-use crate::history::{History, HistoryFilter};
+use crate::app::window::MenuCurriculum;
+use crate::history::{AttemptRecord, History, HistoryFilter};
 use crate::scenario::curriculum::{
     CountedAttempt, Curriculum, ExerciseStanding, ModuleStanding, ModuleState, load_curriculum,
     standing,
@@ -44,31 +46,55 @@ pub fn show_standing(file: &Path, database: &Path, trainee: &str) -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
+    let attempts = match attempts_of(database, trainee) {
+        Ok(attempts) => attempts,
+        Err(e) => return super::fail("trainer curriculum", &e),
+    };
+    let stands = standing(&curriculum, &counted(&attempts));
+    print!("{}", standing_text(&curriculum, &stands, trainee, database));
+    ExitCode::SUCCESS
+}
+
+/// The curriculum `file` for the window's menu, where `trainee` stands read afresh from the
+/// history at `database` each time the menu opens (a history that cannot be read counts no
+/// attempt).
+pub fn menu_curriculum(
+    file: &Path,
+    database: &Path,
+    trainee: &str,
+) -> Result<MenuCurriculum, String> {
+    let curriculum = load_curriculum(file).map_err(|e| e.to_string())?;
+    let (database, trainee): (PathBuf, String) = (database.to_owned(), trainee.to_owned());
+    let read = curriculum.clone();
+    Ok(MenuCurriculum {
+        curriculum,
+        standing: Arc::new(move || {
+            let attempts = attempts_of(&database, &trainee).unwrap_or_default();
+            standing(&read, &counted(&attempts))
+        }),
+    })
+}
+
+/// `trainee`'s attempts kept in the history at `database`, in the order made.
+fn attempts_of(database: &Path, trainee: &str) -> Result<Vec<AttemptRecord>, String> {
     let filter = HistoryFilter {
         trainee: Some(trainee.to_owned()),
         scenario: None,
     };
-    let attempts = match History::open(database).and_then(|h| h.attempts(&filter)) {
-        Ok(attempts) => attempts,
-        Err(e) => return super::fail("trainer curriculum", &e.to_string()),
-    };
-    let counted: Vec<CountedAttempt> = (attempts.iter())
+    (History::open(database).and_then(|h| h.attempts(&filter))).map_err(|e| e.to_string())
+}
+
+/// The attempts as the curriculum counts them.
+pub(super) fn counted<'a>(
+    attempts: impl IntoIterator<Item = &'a AttemptRecord>,
+) -> Vec<CountedAttempt<'a>> {
+    (attempts.into_iter())
         .map(|a| CountedAttempt {
             scenario: &a.scenario,
             score: a.score,
             passed: a.passed,
         })
-        .collect();
-    print!(
-        "{}",
-        standing_text(
-            &curriculum,
-            &standing(&curriculum, &counted),
-            trainee,
-            database
-        )
-    );
-    ExitCode::SUCCESS
+        .collect()
 }
 
 /// The standing as `trainer curriculum` prints it.

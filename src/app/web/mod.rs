@@ -128,6 +128,7 @@ fn window_scene(
         }),
         swap: swap.clone(),
         built: Arc::new(Vec::new),
+        curriculum: None,
     };
     Ok(WindowScene {
         scene,

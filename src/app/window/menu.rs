@@ -18,6 +18,7 @@ use super::offscreen::Offscreen;
 use super::{FrameSet, SceneChanged};
 use crate::app::haptic::{HapticLoop, HapticScene, HapticSnapshot, SceneSwap};
 use crate::app::scene::mouse_device;
+use crate::scenario::curriculum::{Curriculum, ModuleStanding, ModuleState};
 use crate::scenario::{self, Scenario};
 
 /// Builds a scenario's scene: its organs' vademecums read (in a web page, fetched first), or
@@ -39,6 +40,27 @@ pub struct MenuPlan {
     pub swap: SceneSwap,
     /// The vademecum files built in the background so far ([`HapticScene::meanwhile`]).
     pub built: BuiltFiles,
+    /// A programme's curriculum: the menu then offers its exercises in its order, module by
+    /// module, the locked ones refused.
+    pub curriculum: Option<MenuCurriculum>,
+}
+
+/// A curriculum as the menu offers it, and where the trainee stands in it (read afresh each
+/// time the menu opens: an attempt just made may have opened a module).
+#[derive(Clone)]
+pub struct MenuCurriculum {
+    pub curriculum: Curriculum,
+    pub standing: Arc<dyn Fn() -> Vec<ModuleStanding> + Send + Sync>,
+}
+
+/// Where an entry stands in the curriculum: its module, the module's state, whether the
+/// exercise is had, and (locked) what the module waits on.
+#[derive(Clone, Debug, PartialEq)]
+struct Place {
+    module: String,
+    state: ModuleState,
+    had: bool,
+    waits_on: String,
 }
 
 /// The files the background builder has built (none in a web page, which builds nothing).
@@ -48,6 +70,8 @@ pub type BuiltFiles = Arc<dyn Fn() -> Vec<PathBuf> + Send + Sync>;
 struct Entry {
     file: PathBuf,
     scenario: Result<Scenario, String>,
+    /// In a curriculum, where it stands.
+    place: Option<Place>,
 }
 
 /// The menu on screen: its entries, the one highlighted, and why the last choice failed.
@@ -92,7 +116,7 @@ impl Plugin for MenuPlugin {
             .add_systems(
                 Update,
                 (
-                    (move_selection, choose_on_enter)
+                    (move_selection, refuse_locked, choose_on_enter)
                         .chain()
                         .run_if(in_state(Stage::Menu)),
                     finish_loading.run_if(in_state(Stage::Loading)),
@@ -103,8 +127,37 @@ impl Plugin for MenuPlugin {
     }
 }
 
-/// The scenarios on offer, read afresh (an educator may have edited or added one).
+/// The scenarios on offer, read afresh (an educator may have edited or added one): the
+/// curriculum's in its order, or the folder's and the built-in ones.
 fn entries(plan: &MenuPlan) -> Vec<Entry> {
+    match &plan.curriculum {
+        Some(curriculum) => curriculum_entries(&curriculum.curriculum, &(curriculum.standing)()),
+        None => folder_entries(plan),
+    }
+}
+
+/// The curriculum's exercises, module by module, each with where it stands.
+fn curriculum_entries(curriculum: &Curriculum, standing: &[ModuleStanding]) -> Vec<Entry> {
+    let modules = curriculum.modules.iter().zip(standing);
+    modules
+        .flat_map(|(module, stands)| {
+            let exercises = module.exercises.iter().zip(&stands.exercises);
+            exercises.map(move |(exercise, had)| Entry {
+                scenario: scenario::load(&exercise.scenario).map_err(|e| e.to_string()),
+                file: exercise.scenario.clone(),
+                place: Some(Place {
+                    module: module.name.clone(),
+                    state: stands.state,
+                    had: had.had(),
+                    waits_on: module.opens_after.join(", "),
+                }),
+            })
+        })
+        .collect()
+}
+
+/// The folder's scenarios, and the built-in ones it lacks first.
+fn folder_entries(plan: &MenuPlan) -> Vec<Entry> {
     let mut files: Vec<PathBuf> = plan
         .folder
         .as_deref()
@@ -120,6 +173,7 @@ fn entries(plan: &MenuPlan) -> Vec<Entry> {
         .map(|file| Entry {
             scenario: scenario::load(&file).map_err(|e| e.to_string()),
             file,
+            place: None,
         })
         .collect();
     let missing: Vec<Entry> = plan
@@ -133,6 +187,7 @@ fn entries(plan: &MenuPlan) -> Vec<Entry> {
         .map(|&(file, text)| Entry {
             scenario: scenario::parse(Path::new(file), text).map_err(|e| e.to_string()),
             file: PathBuf::from(file),
+            place: None,
         })
         .collect();
     entries.splice(0..0, missing);
@@ -201,6 +256,17 @@ fn menu_text(menu: &Menu, rows: usize) -> String {
         lines.push(format!("  ↑ {first} more"));
     }
     for (k, entry) in menu.entries.iter().enumerate().skip(first).take(rows) {
+        let module = entry.place.as_ref().map(|p| &p.module);
+        let before = k
+            .checked_sub(1)
+            .and_then(|j| menu.entries[j].place.as_ref());
+        if let Some(place) = entry
+            .place
+            .as_ref()
+            .filter(|_| module != before.map(|p| &p.module))
+        {
+            lines.push(module_header(place));
+        }
         lines.push(entry_text(entry, k == menu.selected));
     }
     let below = count.saturating_sub(first + rows);
@@ -223,10 +289,25 @@ fn menu_text(menu: &Menu, rows: usize) -> String {
     )
 }
 
+/// A curriculum module's line above its exercises: its name and state.
+fn module_header(place: &Place) -> String {
+    let state = match place.state {
+        ModuleState::Done => "done".to_owned(),
+        ModuleState::Open => "open".to_owned(),
+        ModuleState::Locked => format!("locked: opens after {}", place.waits_on),
+    };
+    format!("{} ({state})", place.module)
+}
+
 /// One entry: its title, difficulty and organs (or why it cannot be run); the selected one
-/// marked, with its file below.
+/// marked, with its file below; in a curriculum, whether it is had or locked.
 fn entry_text(entry: &Entry, selected: bool) -> String {
     let name = file_name(&entry.file);
+    let mark = match &entry.place {
+        Some(place) if place.state == ModuleState::Locked => "[locked] ",
+        Some(place) if place.had => "[had] ",
+        _ => "",
+    };
     let line = match &entry.scenario {
         Ok(s) => format!(
             "{}  ({}; {})",
@@ -240,8 +321,8 @@ fn entry_text(entry: &Entry, selected: bool) -> String {
         ),
     };
     match selected {
-        true => format!("> {line}\n      {name}"),
-        false => format!("  {line}"),
+        true => format!("> {mark}{line}\n      {name}"),
+        false => format!("  {mark}{line}"),
     }
 }
 
@@ -282,9 +363,14 @@ fn choose_on_enter(
     if !keys.just_pressed(KeyCode::Enter) {
         return;
     }
+    let chosen = menu.entries.get(menu.selected);
+    if chosen.and_then(locked_problem).is_some() {
+        return;
+    }
     let Some(Entry {
         file,
         scenario: Ok(scenario),
+        ..
     }) = menu.entries.get(menu.selected)
     else {
         return;
@@ -302,6 +388,35 @@ fn choose_on_enter(
         scene,
         &mut next,
     );
+}
+
+/// Enter on a locked curriculum exercise: the menu says why it cannot be chosen.
+fn refuse_locked(
+    keys: Res<ButtonInput<KeyCode>>,
+    screen: ScreenHeight,
+    mut menu: ResMut<Menu>,
+    mut text: Single<&mut Text, With<MenuText>>,
+) {
+    if !keys.just_pressed(KeyCode::Enter) {
+        return;
+    }
+    if let Some(locked) = menu.entries.get(menu.selected).and_then(locked_problem) {
+        menu.problem = Some(locked);
+        text.0 = menu_text(&menu, screen.entry_rows());
+    }
+}
+
+/// Why a locked curriculum exercise cannot be chosen; none for another entry.
+fn locked_problem(entry: &Entry) -> Option<String> {
+    let place = entry.place.as_ref()?;
+    (place.state == ModuleState::Locked).then(|| {
+        format!(
+            "{} is locked: the module {} opens once {} done",
+            file_name(&entry.file),
+            place.module,
+            place.waits_on
+        )
+    })
 }
 
 /// On the briefing, once a nonlinear vademecum that the lesson's scene runs linear tissue for
@@ -450,6 +565,64 @@ mod tests {
         )
     }
 
+    /// A curriculum in the menu: its exercises in its order under their modules' headers,
+    /// the had one marked, the locked module's refused with what it waits on.
+    #[test]
+    fn a_curriculum_orders_the_menu_and_locks_its_modules() {
+        use crate::scenario::curriculum::{
+            CountedAttempt, ExerciseEntry, Module, Proficiency, standing,
+        };
+        use crate::scenario::{AttemptCount, Score};
+        let exercise = |name: &str| ExerciseEntry {
+            scenario: PathBuf::from(format!("scenarios/{name}.scenario.ron")),
+            proficiency: Proficiency::Attempts {
+                count: AttemptCount(1),
+                min_score: Score(80.0),
+            },
+        };
+        let curriculum = Curriculum {
+            title: "t".into(),
+            modules: vec![
+                Module {
+                    name: "Basics".into(),
+                    opens_after: Vec::new(),
+                    exercises: vec![exercise("liver-steady-press"), exercise("pancreas-tour")],
+                },
+                Module {
+                    name: "Tasks".into(),
+                    opens_after: vec!["Basics".into()],
+                    exercises: vec![exercise("gallbladder-grasp-retract")],
+                },
+            ],
+        };
+        let made = [CountedAttempt {
+            scenario: "scenarios/liver-steady-press.scenario.ron",
+            score: 90.0,
+            passed: true,
+        }];
+        let menu = Menu {
+            entries: curriculum_entries(&curriculum, &standing(&curriculum, &made)),
+            selected: 2,
+            problem: None,
+        };
+        let text = menu_text(&menu, 10);
+        let lines: Vec<&str> = text.lines().skip(2).collect();
+        assert_eq!(lines[0], "Basics (open)", "{text}");
+        assert!(
+            lines[1].starts_with("  [had] Steady press on the liver"),
+            "{text}"
+        );
+        assert!(lines[2].starts_with("  Pancreas: head to tail"), "{text}");
+        assert_eq!(lines[3], "Tasks (locked: opens after Basics)", "{text}");
+        assert!(lines[4].starts_with("> [locked] "), "{text}");
+        let refused = locked_problem(&menu.entries[2]).expect("locked");
+        assert!(
+            refused.contains("gallbladder-grasp-retract.scenario.ron is locked"),
+            "{refused}"
+        );
+        assert!(locked_problem(&menu.entries[0]).is_none());
+    }
+
     /// Thirty scenarios in eight rows: the menu shows eight entries around the selected one,
     /// says how many are above and below, and scrolls as the selection moves; at the ends it
     /// shows the first or the last eight.
@@ -459,6 +632,7 @@ mod tests {
             .map(|k| Entry {
                 file: PathBuf::from(format!("s{k:02}.scenario.ron")),
                 scenario: Err("not read".into()),
+                place: None,
             })
             .collect();
         let mut menu = Menu {
@@ -538,6 +712,7 @@ mod tests {
             }),
             swap: swap.clone(),
             built: Arc::new(move || done.lock().unwrap().clone()),
+            curriculum: None,
         };
         let lessons = Lessons::default();
         let mut app = App::new();

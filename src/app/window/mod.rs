@@ -35,7 +35,7 @@ pub use bridge::{HapticLink, Snapshot};
 pub use frames::FrameReport;
 pub use legend::{Legend, LipLegend, OrganLegend, TextLegend, ToolLegend};
 pub use lesson::{Lesson, Lessons, Opening};
-pub use menu::{MenuPlan, SceneSource};
+pub use menu::{MenuCurriculum, MenuPlan, SceneSource};
 pub use screenshot::ScreenshotPlan;
 #[cfg(target_arch = "wasm32")]
 pub use web_page::publish;

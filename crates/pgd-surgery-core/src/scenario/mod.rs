@@ -49,6 +49,7 @@ pub use task::{
 };
 pub use tasks::{COVERED_TO_FINISH, register, registered_names};
 pub use units::{
-    DepthFraction, Dioptres, EdgeLength, FieldOfView, IncisionCount, Millimetres, ModeCount,
-    Newtons, Pascals, PoissonRatio, Ratio, Scale, ScopeAngle, Seconds, Stiffening, Toughness,
+    AttemptCount, DepthFraction, Dioptres, EdgeLength, FieldOfView, IncisionCount, Millimetres,
+    ModeCount, Newtons, Pascals, PoissonRatio, Ratio, Scale, ScopeAngle, Score, Seconds,
+    Stiffening, Toughness,
 };
