@@ -246,7 +246,14 @@ impl ScreenHeight<'_, '_> {
 /// one in sight (with its file on a second line); marks say how many are above and below.
 fn menu_text(menu: &Menu, rows: usize) -> String {
     let count = menu.entries.len();
-    let rows = rows.max(1).min(count.max(1));
+    // A curriculum's module names take rows of their own.
+    let headers = (menu.entries.windows(2))
+        .filter(|pair| {
+            pair[0].place.as_ref().map(|p| &p.module) != pair[1].place.as_ref().map(|p| &p.module)
+        })
+        .count()
+        + usize::from(menu.entries.first().is_some_and(|e| e.place.is_some()));
+    let rows = rows.saturating_sub(headers).max(1).min(count.max(1));
     let first = menu
         .selected
         .saturating_sub(rows / 2)
