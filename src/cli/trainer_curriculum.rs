@@ -75,8 +75,12 @@ pub fn menu_curriculum(
     })
 }
 
-/// `trainee`'s attempts kept in the history at `database`, in the order made.
+/// `trainee`'s attempts kept in the history at `database`, in the order made (none, and no
+/// database made, where there is none yet).
 fn attempts_of(database: &Path, trainee: &str) -> Result<Vec<AttemptRecord>, String> {
+    if !database.exists() {
+        return Ok(Vec::new());
+    }
     let filter = HistoryFilter {
         trainee: Some(trainee.to_owned()),
         scenario: None,
