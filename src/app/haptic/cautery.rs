@@ -76,6 +76,7 @@ fn burn_wall(
     let mark = &burns.marks()[burn.mark];
     HookTarget::Wall(WallSample {
         organ,
+        mark: burn.mark,
         new_mark: burn.new,
         area_m2: mark.area_m2,
         through_now: burn.through_now,

@@ -76,7 +76,9 @@ pub enum HookTarget {
 pub struct WallSample {
     /// The organ, bit `k`'s organ of [`Sample::touching`].
     pub organ: usize,
-    /// A mark of its own (not one deepened), and its area (m²).
+    /// The mark burned, in the scene's list of marks...
+    pub mark: usize,
+    /// ...a mark of its own (not one deepened), and its area (m²).
     pub new_mark: bool,
     pub area_m2: f64,
     /// The wall gave way in this tick: a hollow organ perforated (`hollow`), a solid one's

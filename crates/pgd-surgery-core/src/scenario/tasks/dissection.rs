@@ -97,6 +97,8 @@ pub struct EnergySpent {
 /// A burn mark the hook left on an organ, where it was first made.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Burn {
+    /// The mark in the scene's list of marks.
+    mark: usize,
     time_s: f64,
     organ: usize,
     at_mm: [f64; 3],
@@ -127,6 +129,7 @@ impl DissectionRun {
         let sample = tick.sample;
         let at_mm = sample.tip_m.map_or([0.0; 3], |tip| (tip * 1e3).into());
         let burn = Burn {
+            mark: wall.mark,
             time_s: sample.time_s,
             organ: wall.organ,
             at_mm,
@@ -148,8 +151,8 @@ impl DissectionRun {
             }
             false => {
                 tick.mistake(CAPSULE, 0.0);
-                let nearest = (self.burns.iter_mut().rev()).find(|b| b.organ == wall.organ);
-                if let Some(mark) = nearest {
+                let burned = self.burns.iter_mut().find(|b| b.mark == wall.mark);
+                if let Some(mark) = burned {
                     mark.capsule = true;
                 }
             }
@@ -325,5 +328,128 @@ impl TaskResult for DissectionResult {
                 p.time_s, p.organ
             )
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use crate::scenario::sample::{HookSample, HookTarget, Sample, WallSample};
+    use crate::scenario::{Exercise, Sites, parse, score};
+
+    use super::DissectionResult;
+
+    const SCENARIO: &str = r#"Scenario(title: "t", briefing: "b", organs: ["liver", "gallbladder"],
+        tool: Hook(tip_radius_mm: 6.0, power_w: 30.0),
+        attachments: [Attachment(organ: "gallbladder", to: "liver")],
+        tasks: [Dissection(organ: "gallbladder", release_share: 0.5, max_force_n: 2.0,
+                           time_limit_s: 10.0)])"#;
+
+    /// A tick at `time_s` whose hook delivered 30 mJ to `on`, with `released` of the bed.
+    fn tick(time_s: f64, on: HookTarget, released: f64) -> Sample {
+        let energy_j = if on == HookTarget::Off { 0.0 } else { 0.03 };
+        Sample {
+            time_s,
+            hook: HookSample { energy_j, on },
+            released_share: released,
+            ..Sample::default()
+        }
+    }
+
+    fn wall(organ: usize, mark: usize, new_mark: bool, through_now: bool) -> HookTarget {
+        HookTarget::Wall(WallSample {
+            organ,
+            mark,
+            new_mark,
+            area_m2: 0.785e-6,
+            through_now,
+            hollow: organ == 1,
+        })
+    }
+
+    /// Energy on no tissue for 0.1 s (one error, its energy), a burn of the liver whose second
+    /// tick goes through its capsule (a burn and a capsule injury, on that mark), ties
+    /// divided to half the bed: done, the energy apportioned, the burn listed with its organ.
+    #[test]
+    fn a_dissection_counts_its_burns_and_its_energy() {
+        let scenario = parse(Path::new("t.scenario.ron"), SCENARIO).unwrap();
+        let mut exercise = Exercise::new(scenario, Sites::default());
+        let mut samples = Vec::new();
+        samples.extend((0..100).map(|k| tick(k as f64 * 1e-3, HookTarget::Air, 0.0)));
+        samples.push(tick(0.1, HookTarget::Off, 0.0));
+        samples.push(tick(0.2, wall(0, 0, true, false), 0.0));
+        samples.push(tick(0.201, wall(0, 0, false, true), 0.0));
+        samples.push(tick(
+            0.3,
+            HookTarget::Ties {
+                heated: 2,
+                divided: 1,
+            },
+            0.3,
+        ));
+        samples.push(tick(
+            0.4,
+            HookTarget::Ties {
+                heated: 1,
+                divided: 1,
+            },
+            0.5,
+        ));
+        for sample in &samples {
+            exercise.step(sample);
+        }
+        assert!(exercise.finished());
+        let (scenario, metrics, _) = exercise.finish();
+        let m = &metrics[0];
+        let done = m.result::<DissectionResult>().unwrap();
+        assert!(m.completed, "{m:#?}");
+        assert_eq!(done.ties_divided, 2);
+        assert_eq!(done.burns.len(), 1);
+        assert_eq!(
+            (done.burns[0].organ.as_str(), done.capsule_injuries),
+            ("liver", 1)
+        );
+        assert!(done.perforation.is_none());
+        assert!(
+            (done.energy.in_air_j - 3.0).abs() < 1e-9,
+            "{:?}",
+            done.energy
+        );
+        assert!((done.energy.on_walls_j - 0.06).abs() < 1e-9);
+        assert!((done.energy.on_ties_j - 0.06).abs() < 1e-9);
+        assert_eq!(m.errors.len(), 3, "{:?}", m.errors);
+        let card = score(&scenario, metrics);
+        assert!(card.feedback.iter().any(|l| l.contains("burned the liver")));
+    }
+
+    /// Burned through the gallbladder's wall: the task ends there, not done, and the attempt
+    /// fails whatever its score, saying where and that bile spilled.
+    #[test]
+    fn a_perforation_ends_the_task_and_fails_the_attempt() {
+        let scenario = parse(Path::new("t.scenario.ron"), SCENARIO).unwrap();
+        let mut exercise = Exercise::new(scenario, Sites::default());
+        exercise.step(&tick(
+            0.0,
+            HookTarget::Ties {
+                heated: 1,
+                divided: 1,
+            },
+            0.4,
+        ));
+        exercise.step(&Sample {
+            tip_m: Some(nalgebra::Vector3::new(0.04, 0.03, -0.06)),
+            ..tick(0.1, wall(1, 0, true, true), 0.4)
+        });
+        assert!(exercise.finished());
+        let (scenario, metrics, _) = exercise.finish();
+        assert!(!metrics[0].completed);
+        let card = score(&scenario, metrics);
+        assert!(!card.passed);
+        let complication = card.feedback.join("\n");
+        assert!(
+            complication.contains("burned through the gallbladder's wall at (40, 30, -60) mm: a perforation, bile spilled"),
+            "{complication}"
+        );
     }
 }
