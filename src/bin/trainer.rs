@@ -197,6 +197,9 @@ enum Command {
         /// The curriculum the cohort's standing is read against.
         #[arg(long)]
         curriculum: Option<PathBuf>,
+        /// With --cohort: only these trainees (a group: names separated by commas).
+        #[arg(long, value_delimiter = ',', requires = "cohort")]
+        group: Vec<String>,
     },
 }
 
@@ -323,11 +326,13 @@ fn run_command(cli: &Cli) -> Option<ExitCode> {
             cohort: true,
             curriculum: Some(curriculum),
             plot,
+            group,
             ..
         } => show_cohort(&CohortRequest {
             database: &cli.history,
             curriculum,
             plot,
+            group,
         }),
         Command::History {
             scenario,

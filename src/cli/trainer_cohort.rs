@@ -1,5 +1,6 @@
-//! `trainer history --cohort`: a programme's view of its trainees, each one's standing in a
-//! curriculum as a table, and the cohort's learning curves (one PNG, one CSV).
+//! `trainer history --cohort`: a programme's view of its trainees (all, or a group), each
+//! one's standing in a curriculum as a table, and the cohort's learning curves (one PNG, one
+//! CSV).
 
 use std::path::Path;
 use std::process::ExitCode;
@@ -15,6 +16,8 @@ pub struct CohortRequest<'a> {
     pub curriculum: &'a Path,
     /// Where the cohort's learning curves go (the CSV beside it, `.csv`).
     pub plot: &'a Path,
+    /// Only these trainees; all when empty.
+    pub group: &'a [String],
 }
 
 /// Prints each trainee's standing and writes the cohort's learning curves.
@@ -27,10 +30,13 @@ pub fn show_cohort(request: &CohortRequest) -> ExitCode {
         }
     };
     let all = HistoryFilter::default();
-    let attempts = match History::open(request.database).and_then(|h| h.attempts(&all)) {
+    let mut attempts = match History::open(request.database).and_then(|h| h.attempts(&all)) {
         Ok(attempts) => attempts,
         Err(e) => return super::fail("trainer history", &e.to_string()),
     };
+    if !request.group.is_empty() {
+        attempts.retain(|a| request.group.contains(&a.trainee));
+    }
     print!("{}", cohort_table(&curriculum, &attempts));
     match write_curves(&attempts, request.plot) {
         Ok(()) => ExitCode::SUCCESS,
@@ -52,11 +58,9 @@ fn trainees(attempts: &[AttemptRecord]) -> Vec<&str> {
 /// One row a trainee: each module's state, the exercises had, the attempts, the last report.
 fn cohort_table(curriculum: &Curriculum, attempts: &[AttemptRecord]) -> String {
     let exercises: usize = curriculum.modules.iter().map(|m| m.exercises.len()).sum();
-    let mut text = format!(
-        "{}: {} trainees\n",
-        curriculum.title,
-        trainees(attempts).len()
-    );
+    let count = trainees(attempts).len();
+    let plural = if count == 1 { "" } else { "s" };
+    let mut text = format!("{}: {count} trainee{plural}\n", curriculum.title);
     let modules: Vec<String> = (1..=curriculum.modules.len())
         .map(|k| format!("module {k}"))
         .collect();

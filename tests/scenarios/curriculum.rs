@@ -137,6 +137,28 @@ fn the_curriculum_opens_its_modules_as_the_benchmarks_are_met() {
     assert!(std::fs::metadata(&plot).unwrap().len() > 1000);
     let csv = std::fs::read_to_string(dir.join("cohort.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + made + 1, "{csv}");
+    // A group of one.
+    let output = Command::new(TRAINER)
+        .current_dir(root())
+        .args([
+            "history",
+            "--cohort",
+            "--curriculum",
+            SHIPPED,
+            "--group",
+            "bob",
+            "--history",
+        ])
+        .arg(&db)
+        .arg("--plot")
+        .arg(dir.join("bob.png"))
+        .output()
+        .unwrap();
+    let table = String::from_utf8(output.stdout).unwrap();
+    assert!(
+        table.contains(": 1 trainee\n") && table.contains("\nbob ") && !table.contains("\nada "),
+        "{table}"
+    );
 }
 
 /// Broken curricula: a module opening after one not listed before it, a scenario that is not
