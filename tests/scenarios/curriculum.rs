@@ -8,7 +8,7 @@ use std::process::Command;
 use pgd_surgery::history::{AttemptRecord, History};
 use pgd_surgery::scenario::curriculum::load_curriculum;
 
-use crate::{TRAINER, root};
+use crate::{TRAINER, assert_refused, root};
 
 const SHIPPED: &str = "curricula/cholecystectomy.curriculum.ron";
 
@@ -188,16 +188,11 @@ fn bad_curricula_are_refused_with_file_line_field_and_hint() {
     ];
     for (name, line, field, message) in cases {
         let file = root().join(format!("tests/scenarios/broken/{name}.curriculum.ron"));
-        let error = load_curriculum(&file).unwrap_err();
-        let shown = error.to_string();
-        assert_eq!(error.line, line, "{shown}");
-        assert!(
-            error.field.contains(field),
-            "{name}: field `{}`",
-            error.field
+        assert_refused(
+            &file,
+            &load_curriculum(&file).unwrap_err(),
+            (line, field, message),
         );
-        assert!(error.message.contains(message), "{shown}");
-        assert!(!error.hint.is_empty(), "{shown}");
         let output = Command::new(TRAINER)
             .current_dir(root())
             .arg("validate")

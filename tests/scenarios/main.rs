@@ -38,7 +38,7 @@ use pgd_surgery::report::write_report;
 use pgd_surgery::scenario::tasks::{
     Incision, IncisionResult, PalpationResult, RadialKeratotomyResult, RetractionResult,
 };
-use pgd_surgery::scenario::{Scenario, Scorecard, TaskMetrics, load, parse};
+use pgd_surgery::scenario::{Scenario, ScenarioError, Scorecard, TaskMetrics, load, parse};
 use pgd_surgery::store::{OnStale, VademecumSpec, ensure_vademecum};
 
 const TRAINER: &str = env!("CARGO_BIN_EXE_trainer");
@@ -533,21 +533,27 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
     ];
     for (name, line, field, message) in cases {
         let file = root().join(format!("tests/scenarios/broken/{name}.scenario.ron"));
-        let error = load(&file).unwrap_err();
-        let shown = error.to_string();
-        assert_eq!(error.line, line, "{shown}");
-        assert!(
-            error.field.contains(field),
-            "{name}: field `{}`",
-            error.field
-        );
-        assert!(error.message.contains(message), "{shown}");
-        assert!(!error.hint.is_empty(), "{shown}");
-        assert!(
-            shown.starts_with(&format!("{}:{line}:", file.display())),
-            "{shown}"
-        );
+        assert_refused(&file, &load(&file).unwrap_err(), (line, field, message));
     }
+}
+
+/// `error`, refusing `file`, is at `line`, names `field` and says `message`, with a hint,
+/// and reads `file:line:…`.
+fn assert_refused(file: &Path, error: &ScenarioError, (line, field, message): (usize, &str, &str)) {
+    let shown = error.to_string();
+    assert_eq!(error.line, line, "{shown}");
+    assert!(
+        error.field.contains(field),
+        "{}: field `{}`",
+        file.display(),
+        error.field
+    );
+    assert!(error.message.contains(message), "{shown}");
+    assert!(!error.hint.is_empty(), "{shown}");
+    assert!(
+        shown.starts_with(&format!("{}:{line}:", file.display())),
+        "{shown}"
+    );
 }
 
 #[test]

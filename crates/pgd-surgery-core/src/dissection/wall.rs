@@ -162,11 +162,6 @@ impl WallBurns {
             .map(|(i, m)| (i, (m.at_rest_m - site.at_rest_m).norm()))
             .min_by(|a, b| a.1.total_cmp(&b.1))
     }
-
-    /// The marks on `organ` that went through its wall or capsule.
-    pub fn through_on(&self, organ: usize) -> impl Iterator<Item = &BurnMark> {
-        (self.marks.iter()).filter(move |m| m.organ == organ && m.through)
-    }
 }
 
 #[cfg(test)]
@@ -217,8 +212,14 @@ mod tests {
                 "organ {organ}: {through_at} s against {expected_s} s"
             );
             assert_eq!(burns.marks().len(), 1);
-            assert_eq!(burns.through_on(organ).count(), 1);
-            assert_eq!(burns.through_on(1 - organ).count(), 0);
+            let through = |o: usize| {
+                burns
+                    .marks()
+                    .iter()
+                    .filter(move |m| m.organ == o && m.through)
+            };
+            assert_eq!(through(organ).count(), 1);
+            assert_eq!(through(1 - organ).count(), 0);
         }
     }
 
