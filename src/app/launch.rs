@@ -20,8 +20,8 @@ use super::window::{
     FrameReport, Lesson, Lessons, MenuPlan, Opening, SceneSource, ScreenshotPlan, WindowScene,
 };
 use crate::devices::{
-    DeviceSpec, ForceDimension, HapticDevice, OpenHaptics, PressMotion, Recorder, Scripted, TICK_S,
-    TimerMode, Trajectory, press_and_slide, stop_requested,
+    DeviceSpec, ForceDimension, Haply, HapticDevice, OpenHaptics, PressMotion, Recorder, Scripted,
+    TICK_S, TimerMode, Trajectory, press_and_slide, stop_requested,
 };
 use crate::scenario::Scenario;
 use crate::store::OnStale;
@@ -400,7 +400,8 @@ pub fn install_exit_guards() -> Result<(), String> {
 }
 
 /// The hardware device `spec` names, opened (`None` when it names none): a Geomagic device
-/// through OpenHaptics, or a Force Dimension one through its SDK.
+/// through OpenHaptics, a Force Dimension one through its SDK, or a Haply Inverse3 through its
+/// service.
 fn open_hardware(spec: &Option<DeviceSpec>) -> Option<Result<Box<dyn HapticDevice>, String>> {
     let opened = match spec {
         Some(DeviceSpec::OpenHaptics(name)) => {
@@ -408,6 +409,10 @@ fn open_hardware(spec: &Option<DeviceSpec>) -> Option<Result<Box<dyn HapticDevic
         }
         Some(DeviceSpec::ForceDimension(index)) => {
             ForceDimension::open(None, *index).map(|d| Box::new(d) as Box<dyn HapticDevice>)
+        }
+        Some(DeviceSpec::Haply { url, device_id }) => {
+            Haply::open(url.as_deref(), device_id.as_deref())
+                .map(|d| Box::new(d) as Box<dyn HapticDevice>)
         }
         _ => return None,
     };

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use crate::app::missing_display;
-use crate::devices::{DeviceError, ForceDimension, OpenHaptics};
+use crate::devices::{DeviceError, ForceDimension, Haply, OpenHaptics};
 
 /// One backend: how the command line names it, whether it is usable here, and what to know.
 struct Backend {
@@ -26,6 +26,26 @@ fn vendor(spec: &'static str, devices: &str, found: Result<PathBuf, DeviceError>
         },
         Err(e) => Backend {
             spec,
+            usable: false,
+            note: e.to_string(),
+        },
+    }
+}
+
+/// The Haply backend: usable when a Haply Inverse Service answers at its address (the
+/// variable `PGD_HAPLY_URL`'s, else the default), else why not.
+fn haply() -> Backend {
+    match Haply::probe(None) {
+        Ok((url, version)) => Backend {
+            spec: "haply[:URL][@ID]",
+            usable: true,
+            note: format!(
+                "Haply Inverse3: the Haply Inverse Service {version} answers at {url} (the \
+                 device is opened when the trainer starts)"
+            ),
+        },
+        Err(e) => Backend {
+            spec: "haply[:URL][@ID]",
             usable: false,
             note: e.to_string(),
         },
@@ -63,11 +83,7 @@ pub fn list_devices() -> ExitCode {
             "Force Dimension omega, sigma, delta",
             ForceDimension::find_library(),
         ),
-        Backend {
-            spec: "haply[:PORT]",
-            usable: false,
-            note: "Haply Inverse3: not supported yet".into(),
-        },
+        haply(),
     ];
     println!("{:<20} {:<8} notes", "device", "usable");
     for b in &backends {

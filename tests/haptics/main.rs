@@ -10,6 +10,8 @@ mod faults;
 mod forcedimension;
 mod fulcrum;
 mod grasp;
+mod haply;
+mod haply_fake;
 mod instruments;
 mod laparoscope;
 mod openhaptics;

@@ -1,5 +1,5 @@
 //! The device layer, free of Bevy: the device trait and its backends (scripted, recorder,
-//! virtual, and the OpenHaptics and Force Dimension hardware over the servo link and its
+//! virtual, and the OpenHaptics, Force Dimension and Haply hardware over the servo link and its
 //! watchdog), the trajectory files they replay and record, the map from the device's workspace
 //! to the scene, the instruments through ports (one in hand at a time) and the laparoscope,
 //! the safety filter between the physics and the motors, and the clock that paces the 1 kHz
@@ -9,6 +9,8 @@ mod device;
 #[cfg(not(target_arch = "wasm32"))]
 mod forcedimension;
 mod fulcrum;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod haply;
 mod laparoscope;
 #[cfg(not(target_arch = "wasm32"))]
 mod openhaptics;
@@ -36,6 +38,8 @@ pub use device::{
 #[cfg(not(target_arch = "wasm32"))]
 pub use forcedimension::ForceDimension;
 pub use fulcrum::{Fulcrum, HANDLE_AXIS, MIN_OUTSIDE_M, Pose};
+#[cfg(not(target_arch = "wasm32"))]
+pub use haply::Haply;
 pub use laparoscope::{
     Laparoscope, MIN_INSIDE_M, ScopeHandle, ScopePose, ScopeScript, Steer, View,
 };

@@ -1,5 +1,5 @@
 //! Which device to serve, as the command line names it: `scripted:FILE`, `virtual`,
-//! `openhaptics[:NAME]` or `forcedimension[:INDEX]`.
+//! `openhaptics[:NAME]`, `forcedimension[:INDEX]` or `haply[:URL][@ID]`.
 
 use std::path::PathBuf;
 use std::str::FromStr;
@@ -19,12 +19,50 @@ pub enum DeviceSpec {
     /// A Force Dimension device (omega, sigma, delta) through its dhd SDK: the one at an
     /// index of the SDK's list (0 first), or the first available.
     ForceDimension(Option<u8>),
+    /// A Haply Inverse3 through the Haply Inverse Service: the service at a `ws://` URL (or
+    /// its default address), the Inverse3 of a device id (or the first listed).
+    Haply {
+        url: Option<String>,
+        device_id: Option<String>,
+    },
+}
+
+/// `haply[:URL][@ID]` without its `haply`: the URL and the device id, each if given.
+fn haply(s: &str, rest: &str) -> Result<DeviceSpec, String> {
+    let (url, device_id) = match rest.rsplit_once('@') {
+        Some((url, id)) if !id.is_empty() && !id.contains('/') => (url, Some(id.to_owned())),
+        Some(_) => {
+            return Err(format!(
+                "`{s}`: `@` is followed by the Inverse3's device id"
+            ));
+        }
+        None => (rest, None),
+    };
+    let url = match url.strip_prefix(':') {
+        Some(url) if url.starts_with("ws://") => Some(url.to_owned()),
+        Some(url) => {
+            return Err(format!(
+                "`{s}`: `{url}` is not the service's address, ws://HOST:PORT (by default \
+                 ws://localhost:10001)"
+            ));
+        }
+        None if url.is_empty() => None,
+        None => {
+            return Err(format!(
+                "`{s}`: expected haply[:ws://HOST:PORT][@DEVICE_ID]"
+            ));
+        }
+    };
+    Ok(DeviceSpec::Haply { url, device_id })
 }
 
 impl FromStr for DeviceSpec {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if let Some(rest) = s.strip_prefix("haply") {
+            return haply(s, rest);
+        }
         match s.split_once(':') {
             Some(("scripted", path)) if !path.is_empty() => Ok(Self::Scripted(path.into())),
             None if s == "virtual" => Ok(Self::Virtual),
@@ -46,8 +84,40 @@ impl FromStr for DeviceSpec {
             _ => Err(format!(
                 "unknown device `{s}`: expected `scripted:FILE` (a trajectory CSV), `virtual` \
                  (the mouse), `openhaptics[:NAME]` (a Geomagic Touch, Touch X or Phantom) or \
-                 `forcedimension[:INDEX]` (omega, sigma, delta)"
+                 `forcedimension[:INDEX]` (omega, sigma, delta) or `haply[:URL][@ID]` (a Haply \
+                 Inverse3 through its service)"
             )),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_haply_device_is_named_by_its_service_and_id() {
+        let spec = |s: &str| s.parse::<DeviceSpec>();
+        let haply = |url: Option<&str>, id: Option<&str>| DeviceSpec::Haply {
+            url: url.map(str::to_owned),
+            device_id: id.map(str::to_owned),
+        };
+        assert_eq!(spec("haply"), Ok(haply(None, None)));
+        assert_eq!(spec("haply@049D"), Ok(haply(None, Some("049D"))));
+        let url = "ws://127.0.0.1:4000";
+        assert_eq!(spec(&format!("haply:{url}")), Ok(haply(Some(url), None)));
+        assert_eq!(
+            spec(&format!("haply:{url}@A1")),
+            Ok(haply(Some(url), Some("A1")))
+        );
+        for bad in [
+            "haply:localhost:10001",
+            "haply@",
+            "haplyx",
+            "haply:ws://h/x@a/b",
+        ] {
+            let error = spec(bad).unwrap_err();
+            assert!(error.contains(bad), "{error}");
         }
     }
 }
