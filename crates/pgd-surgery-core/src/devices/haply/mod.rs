@@ -231,7 +231,7 @@ impl HapticDevice for Haply {
 
     fn read(&mut self, _time_s: f64) -> Result<DeviceSample, DeviceError> {
         let shared = &self.session.shared;
-        match shared.condition() {
+        match shared.take_condition() {
             Condition::Fine => shared.link.latest().ok_or_else(|| DeviceError::Failed {
                 device: self.name.clone(),
                 message: "the servo has read no position yet".into(),

@@ -101,6 +101,10 @@ impl Condition {
 pub struct Shared {
     pub link: Arc<ServoLink>,
     condition: AtomicU32,
+    /// The last condition other than [`Condition::Fine`] since the loop last read: one that
+    /// came and went between two ticks (a connection dropped and made again at once) is
+    /// still reported.
+    latched: AtomicU32,
     pub running: AtomicBool,
     exchanges: AtomicU64,
     malformed: AtomicU64,
@@ -112,6 +116,7 @@ impl Shared {
         Self {
             link,
             condition: AtomicU32::new(Condition::Fine as u32),
+            latched: AtomicU32::new(Condition::Fine as u32),
             running: AtomicBool::new(true),
             exchanges: AtomicU64::new(0),
             malformed: AtomicU64::new(0),
@@ -123,8 +128,21 @@ impl Shared {
         Condition::from_code(self.condition.load(Ordering::Acquire))
     }
 
+    /// What the loop reports at its read: the condition now, else the last other than fine
+    /// since its previous read (cleared by this one).
+    pub fn take_condition(&self) -> Condition {
+        let latched = Condition::from_code(self.latched.swap(0, Ordering::AcqRel));
+        match self.condition() {
+            Condition::Fine => latched,
+            now => now,
+        }
+    }
+
     fn set_condition(&self, condition: Condition) {
         self.condition.store(condition as u32, Ordering::Release);
+        if condition != Condition::Fine {
+            self.latched.store(condition as u32, Ordering::Release);
+        }
     }
 
     /// Exchanges completed so far (a message sent and its reply merged).
@@ -298,6 +316,38 @@ impl Servo {
         let _ = self.send_and_receive(zero);
         if let Some(channel) = self.channel.take() {
             channel.close();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::devices::haply::wire::Inverse3Status;
+
+    /// Calibration first, then readiness, then a position to render from.
+    #[test]
+    fn a_device_renders_only_calibrated_ready_and_placed() {
+        let status = |calibrated, ready| Inverse3Status {
+            calibrated,
+            ready,
+            ..Inverse3Status::default()
+        };
+        let device = |status, placed: bool| Inverse3View {
+            status,
+            cursor_position_m: placed.then(Vector3::zeros),
+            ..Inverse3View::default()
+        };
+        let cases = [
+            (device(status(false, true), true), Condition::NotCalibrated),
+            (device(status(false, false), true), Condition::NotCalibrated),
+            (device(status(true, false), true), Condition::NotReady),
+            (device(status(true, true), false), Condition::NotReady),
+            (device(status(true, true), true), Condition::Fine),
+        ];
+        for (device, condition) in cases {
+            assert_eq!(Condition::of(&device), condition, "{:?}", device.status);
+            assert_eq!(Condition::from_code(condition as u32), condition);
         }
     }
 }
