@@ -15,7 +15,7 @@ use pgd_surgery::cli::{
     show_cohort, show_history, show_standing, validate_scenarios,
 };
 use pgd_surgery::devices::{DeviceSpec, TimerMode};
-use pgd_surgery::history::HistoryFilter;
+use pgd_surgery::history::{HistoryFilter, Store, TrainerConfig, machine_name};
 use pgd_surgery::scenario::{self, Scenario};
 use pgd_surgery::store::OnStale;
 
@@ -93,9 +93,15 @@ struct Cli {
     /// name); with `history`, only this trainee's attempts are listed.
     #[arg(long, global = true)]
     trainee: Option<String>,
-    /// The history database every scored attempt is kept in (SQLite).
-    #[arg(long, global = true, default_value = "reports/history.sqlite")]
-    history: PathBuf,
+    /// Where every scored attempt is kept: a SQLite file, or a programme's PostgreSQL
+    /// database, postgres://USER@HOST/DATABASE (docs/programme.md). Default: the configuration
+    /// file's `history`, else reports/history.sqlite.
+    #[arg(long, global = true)]
+    history: Option<String>,
+    /// The configuration file (default: the one PGD_TRAINER_CONFIG names, else
+    /// ~/.config/pgd-surgery/trainer.ron or /etc/pgd-surgery/trainer.ron if there is one).
+    #[arg(long, global = true)]
+    config: Option<PathBuf>,
     /// The window's menu offers this curriculum's exercises in its order, module by module,
     /// each marked had or locked for --trainee (from --history); a locked one is refused.
     #[arg(long)]
@@ -240,13 +246,16 @@ fn main() -> ExitCode {
     if let Err(e) = launch::install_exit_guards() {
         eprintln!("trainer: {e}; a device is still zeroed by its watchdog if the trainer dies");
     }
-    if let Some(code) = run_command(&cli) {
+    let history = match history_target(&cli) {
+        Ok(history) => history,
+        Err(e) => {
+            eprintln!("trainer: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    if let Some(code) = run_command(&cli, &history) {
         return code;
     }
-    let history = HistoryTarget {
-        database: cli.history.clone(),
-        trainee: cli.trainee.clone().unwrap_or_else(login_name),
-    };
     if !cli.headless
         && !cli.offscreen
         && let Some(why) = app::missing_display()
@@ -260,7 +269,7 @@ fn main() -> ExitCode {
     }
     let mut options = launch_options(&cli);
     if let Some(file) = &cli.curriculum {
-        match menu_curriculum(file, &history.database, &history.trainee) {
+        match menu_curriculum(file, &history.store, &history.trainee) {
             Ok(curriculum) => options.curriculum = Some(curriculum),
             Err(e) => {
                 eprintln!("{e}");
@@ -291,15 +300,33 @@ fn main() -> ExitCode {
     run_window(&cli, &options, exercise, &history)
 }
 
+/// Where attempts are kept (the command line's `--history`, else the configuration file's,
+/// else reports/history.sqlite), whose they are and the station's name.
+fn history_target(cli: &Cli) -> Result<HistoryTarget, String> {
+    let config = match &cli.config {
+        Some(file) => TrainerConfig::load(file)?,
+        None => TrainerConfig::find()?.0,
+    };
+    let local = (config.local_history.clone()).unwrap_or_else(|| DEFAULT_HISTORY.into());
+    let history = (cli.history.clone())
+        .or(config.history)
+        .unwrap_or_else(|| local.display().to_string());
+    Ok(HistoryTarget {
+        store: Store::of(&history, &local),
+        trainee: cli.trainee.clone().unwrap_or_else(login_name),
+        station: config.station.unwrap_or_else(machine_name),
+    })
+}
+
+/// The station's own history when nothing names another.
+const DEFAULT_HISTORY: &str = "reports/history.sqlite";
+
 /// The commands that are not a run of the trainer (validate, prepare, devices, soak,
 /// history): their exit code, or `None` for a run.
-fn run_command(cli: &Cli) -> Option<ExitCode> {
+fn run_command(cli: &Cli, history: &HistoryTarget) -> Option<ExitCode> {
     Some(match cli.command.as_ref()? {
         Command::Validate { files } => validate_scenarios(files),
-        Command::Curriculum { file } => {
-            let trainee = cli.trainee.clone().unwrap_or_else(login_name);
-            show_standing(file, &cli.history, &trainee)
-        }
+        Command::Curriculum { file } => show_standing(file, &history.store, &history.trainee),
         Command::Prepare { files, web } => {
             prepare_scenarios(files, &cli.vademecums, detail_of(cli), web.as_deref())
         }
@@ -329,7 +356,7 @@ fn run_command(cli: &Cli) -> Option<ExitCode> {
             group,
             ..
         } => show_cohort(&CohortRequest {
-            database: &cli.history,
+            store: &history.store,
             curriculum,
             plot,
             group,
@@ -340,7 +367,7 @@ fn run_command(cli: &Cli) -> Option<ExitCode> {
             plot,
             ..
         } => show_history(&HistoryRequest {
-            database: &cli.history,
+            store: &history.store,
             filter: HistoryFilter {
                 trainee: cli.trainee.clone(),
                 scenario: scenario.as_ref().map(|s| s.display().to_string()),

@@ -6,13 +6,13 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use super::trainer_curriculum::counted;
-use crate::history::{AttemptRecord, History, HistoryFilter};
+use crate::history::{AttemptRecord, HistoryFilter, Store, read_attempts};
 use crate::report::{CurvePoint, learning_curve};
 use crate::scenario::curriculum::{Curriculum, ModuleState, load_curriculum, standing};
 
 /// What `trainer history --cohort` is asked.
 pub struct CohortRequest<'a> {
-    pub database: &'a Path,
+    pub store: &'a Store,
     pub curriculum: &'a Path,
     /// Where the cohort's learning curves go (the CSV beside it, `.csv`).
     pub plot: &'a Path,
@@ -30,8 +30,13 @@ pub fn show_cohort(request: &CohortRequest) -> ExitCode {
         }
     };
     let all = HistoryFilter::default();
-    let mut attempts = match History::open(request.database).and_then(|h| h.attempts(&all)) {
-        Ok(attempts) => attempts,
+    let mut attempts = match read_attempts(request.store, &all) {
+        Ok((attempts, warning)) => {
+            if let Some(warning) = warning {
+                eprintln!("trainer history: warning: {warning}");
+            }
+            attempts
+        }
         Err(e) => return super::fail("trainer history", &e.to_string()),
     };
     if !request.group.is_empty() {

@@ -1,12 +1,12 @@
 //! `trainer curriculum`: where a trainee stands in a programme's curriculum, from the attempts
 //! kept in the history; and `trainer validate`'s verdict on a curriculum file.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 use std::sync::Arc;
 
 use crate::app::window::MenuCurriculum;
-use crate::history::{AttemptRecord, History, HistoryFilter};
+use crate::history::{AttemptRecord, HistoryFilter, Store, read_attempts};
 use crate::scenario::curriculum::{
     CountedAttempt, Curriculum, ExerciseStanding, ModuleStanding, ModuleState, load_curriculum,
     standing,
@@ -37,8 +37,8 @@ pub fn validate_curriculum(file: &Path) -> bool {
     }
 }
 
-/// Prints where `trainee` stands in the curriculum `file`, from the history at `database`.
-pub fn show_standing(file: &Path, database: &Path, trainee: &str) -> ExitCode {
+/// Prints where `trainee` stands in the curriculum `file`, from the history in `store`.
+pub fn show_standing(file: &Path, store: &Store, trainee: &str) -> ExitCode {
     let curriculum = match load_curriculum(file) {
         Ok(curriculum) => curriculum,
         Err(e) => {
@@ -46,46 +46,55 @@ pub fn show_standing(file: &Path, database: &Path, trainee: &str) -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    let attempts = match attempts_of(database, trainee) {
+    let attempts = match attempts_of(store, trainee) {
         Ok(attempts) => attempts,
         Err(e) => return super::fail("trainer curriculum", &e),
     };
     let stands = standing(&curriculum, &counted(&attempts));
-    print!("{}", standing_text(&curriculum, &stands, trainee, database));
+    print!(
+        "{}",
+        standing_text(&curriculum, &stands, trainee, &store.shown())
+    );
     ExitCode::SUCCESS
 }
 
 /// The curriculum `file` for the window's menu, where `trainee` stands read afresh from the
-/// history at `database` each time the menu opens (a history that cannot be read counts no
+/// history in `store` each time the menu opens (a history that cannot be read counts no
 /// attempt).
 pub fn menu_curriculum(
     file: &Path,
-    database: &Path,
+    store: &Store,
     trainee: &str,
 ) -> Result<MenuCurriculum, String> {
     let curriculum = load_curriculum(file).map_err(|e| e.to_string())?;
-    let (database, trainee): (PathBuf, String) = (database.to_owned(), trainee.to_owned());
+    let (store, trainee): (Store, String) = (store.clone(), trainee.to_owned());
     let read = curriculum.clone();
     Ok(MenuCurriculum {
         curriculum,
         standing: Arc::new(move || {
-            let attempts = attempts_of(&database, &trainee).unwrap_or_default();
+            let attempts = attempts_of(&store, &trainee).unwrap_or_default();
             standing(&read, &counted(&attempts))
         }),
     })
 }
 
-/// `trainee`'s attempts kept in the history at `database`, in the order made (none, and no
-/// database made, where there is none yet).
-fn attempts_of(database: &Path, trainee: &str) -> Result<Vec<AttemptRecord>, String> {
-    if !database.exists() {
+/// `trainee`'s attempts kept in the history in `store`, in the order made (none, and no
+/// database made, where a local one does not exist yet).
+fn attempts_of(store: &Store, trainee: &str) -> Result<Vec<AttemptRecord>, String> {
+    if let Store::Local(database) = store
+        && !database.exists()
+    {
         return Ok(Vec::new());
     }
     let filter = HistoryFilter {
         trainee: Some(trainee.to_owned()),
         scenario: None,
     };
-    (History::open(database).and_then(|h| h.attempts(&filter))).map_err(|e| e.to_string())
+    let (attempts, warning) = read_attempts(store, &filter).map_err(|e| e.to_string())?;
+    if let Some(warning) = warning {
+        eprintln!("trainer: warning: {warning}");
+    }
+    Ok(attempts)
 }
 
 /// The attempts as the curriculum counts them.
@@ -106,13 +115,9 @@ fn standing_text(
     curriculum: &Curriculum,
     modules: &[ModuleStanding],
     trainee: &str,
-    database: &Path,
+    store: &str,
 ) -> String {
-    let mut text = format!(
-        "{}: where {trainee} stands ({})\n",
-        curriculum.title,
-        database.display()
-    );
+    let mut text = format!("{}: where {trainee} stands ({store})\n", curriculum.title);
     for (k, (module, entry)) in modules.iter().zip(&curriculum.modules).enumerate() {
         let state = match module.state {
             ModuleState::Done => "done".to_owned(),

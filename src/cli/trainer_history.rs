@@ -1,20 +1,22 @@
 //! `trainer history`: the attempts kept so far, as a table and a learning-curve plot, or as
 //! CSV for an educator; and keeping each new attempt at the end of its debrief.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 
 use crate::history::{
-    AttemptRecord, History, HistoryError, HistoryFilter, keep_attempt, now_unix_s,
+    AttemptRecord, HistoryError, HistoryFilter, Kept, Store, keep_attempt, now_unix_s,
+    read_attempts,
 };
 use crate::report::{CurvePoint, learning_curve};
 use crate::scenario::Scorecard;
 
-/// Where attempts are kept, and whose they are.
+/// Where attempts are kept, whose they are, and the station they are made on.
 #[derive(Clone, Debug)]
 pub struct HistoryTarget {
-    pub database: PathBuf,
+    pub store: Store,
     pub trainee: String,
+    pub station: String,
 }
 
 /// Keeps a scored attempt in the history; says where it went. Fails only when the attempt
@@ -25,13 +27,27 @@ pub fn keep_scored(
     scenario: &Path,
     report: Option<&Path>,
 ) -> ExitCode {
-    let record = AttemptRecord::of(card, scenario, &target.trainee, report, now_unix_s());
-    match keep_attempt(&target.database, &record) {
-        Ok(id) => {
+    let record = AttemptRecord::of(card, scenario, &target.trainee, report, now_unix_s())
+        .at_station(&target.station);
+    let (trainee, store) = (&target.trainee, target.store.shown());
+    match keep_attempt(&target.store, &record) {
+        Ok(Kept::Local { id }) => {
+            eprintln!("history: attempt {id} of {trainee} kept in {store}");
+            ExitCode::SUCCESS
+        }
+        Ok(Kept::Shared { sent }) => {
+            let queued = match sent {
+                1 => String::new(),
+                n => format!(", with {} attempts queued before", n - 1),
+            };
+            eprintln!("history: the attempt of {trainee} kept in {store}{queued}");
+            ExitCode::SUCCESS
+        }
+        Ok(Kept::Queued { reason, pending }) => {
             eprintln!(
-                "history: attempt {id} of {} kept in {}",
-                target.trainee,
-                target.database.display()
+                "history: {store} cannot be reached ({reason}); the attempt of {trainee} is kept \
+                 in {} and will be sent with the next one ({pending} waiting)",
+                target.store.local().display()
             );
             ExitCode::SUCCESS
         }
@@ -48,7 +64,7 @@ pub fn keep_scored(
 
 /// What `trainer history` is asked.
 pub struct HistoryRequest<'a> {
-    pub database: &'a Path,
+    pub store: &'a Store,
     pub filter: HistoryFilter,
     /// CSV on standard output instead of the table and the plot.
     pub csv: bool,
@@ -57,15 +73,22 @@ pub struct HistoryRequest<'a> {
 
 /// Lists the attempts the request selects.
 pub fn show_history(request: &HistoryRequest) -> ExitCode {
-    if !request.database.exists() {
+    if let Store::Local(database) = request.store
+        && !database.exists()
+    {
         eprintln!(
             "trainer: no history at {} yet: attempts are kept there as they are scored",
-            request.database.display()
+            database.display()
         );
         return ExitCode::FAILURE;
     }
-    let attempts = match History::open(request.database).and_then(|h| h.attempts(&request.filter)) {
-        Ok(attempts) => attempts,
+    let attempts = match read_attempts(request.store, &request.filter) {
+        Ok((attempts, warning)) => {
+            if let Some(warning) = warning {
+                eprintln!("trainer: warning: {warning}");
+            }
+            attempts
+        }
         Err(e) => {
             eprintln!("trainer: {e}");
             return ExitCode::FAILURE;

@@ -15,6 +15,8 @@ const SHIPPED: &str = "curricula/cholecystectomy.curriculum.ron";
 fn attempt(trainee: &str, name: &str, score: f64, passed: bool, at_unix_s: i64) -> AttemptRecord {
     AttemptRecord {
         id: 0,
+        uid: String::new(),
+        station: String::new(),
         trainee: trainee.into(),
         scenario: format!("scenarios/{name}.scenario.ron"),
         title: name.into(),

@@ -5,7 +5,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use pgd_surgery::history::{AttemptRecord, History, HistoryError, HistoryFilter, keep_attempt};
+use pgd_surgery::history::{
+    AttemptRecord, History, HistoryError, HistoryFilter, Store, keep_attempt,
+};
 
 use crate::{TRAINER, run_steady_press};
 
@@ -20,6 +22,8 @@ fn folder(test: &str) -> PathBuf {
 fn record(trainee: &str, scenario: &str, score: f64, at_unix_s: i64) -> AttemptRecord {
     AttemptRecord {
         id: 0,
+        uid: String::new(),
+        station: String::new(),
         trainee: trainee.into(),
         scenario: scenario.into(),
         title: format!("{scenario} title"),
@@ -77,6 +81,51 @@ fn attempts_read_back_as_written_and_filter() {
     assert_eq!(all[0].when(), "1970-01-01T00:01:40Z");
 }
 
+/// A history an older trainer wrote (schema 1: no attempt ids) is brought to the current
+/// schema when opened, its attempts kept; a new attempt with an id is kept once however often
+/// it is recorded, and those without ids each time.
+#[test]
+fn an_older_history_is_migrated_and_an_attempt_kept_once() {
+    let db = folder("migrated").join("history.sqlite");
+    let old = rusqlite::Connection::open(&db).unwrap();
+    old.execute_batch(
+        "CREATE TABLE attempts (id INTEGER PRIMARY KEY, trainee TEXT NOT NULL, \
+         scenario TEXT NOT NULL, title TEXT NOT NULL, at_unix_s INTEGER NOT NULL, \
+         score REAL NOT NULL, passed INTEGER NOT NULL, time_s REAL NOT NULL, \
+         path_mm REAL NOT NULL, peak_force_n REAL NOT NULL, errors INTEGER NOT NULL, \
+         report TEXT NOT NULL);
+         INSERT INTO attempts VALUES (1, 'ann', 'a.ron', 'A', 100, 81.5, 1, 30.0, 120.0, \
+         0.4, 0, '');
+         PRAGMA user_version = 1;",
+    )
+    .unwrap();
+    drop(old);
+    let history = History::open(&db).unwrap();
+    let all = HistoryFilter::default();
+    let kept = history.attempts(&all).unwrap();
+    assert_eq!(
+        (kept.len(), kept[0].score, kept[0].uid.as_str()),
+        (1, 81.5, "")
+    );
+    let with_id = AttemptRecord {
+        uid: "64-0123".into(),
+        ..record("bob", "b.ron", 60.0, 200)
+    };
+    let first = history.record(&with_id).unwrap();
+    assert_eq!(history.record(&with_id).unwrap(), first);
+    let without = record("cy", "c.ron", 50.0, 300);
+    assert_ne!(
+        history.record(&without).unwrap(),
+        history.record(&without).unwrap()
+    );
+    assert_eq!(history.attempts(&all).unwrap().len(), 4);
+    let version: i64 = rusqlite::Connection::open(&db)
+        .unwrap()
+        .query_row("PRAGMA user_version", [], |r| r.get(0))
+        .unwrap();
+    assert_eq!(version, 2);
+}
+
 /// A file that is not a history database: refused with its path, left as it was, and the
 /// attempt written beside it, where the error says, reading back as the attempt.
 #[test]
@@ -85,7 +134,7 @@ fn a_corrupt_database_is_refused_and_the_attempt_kept_aside() {
     let junk = b"this is not a database, and it must not be overwritten".repeat(100);
     std::fs::write(&db, &junk).unwrap();
     let attempt = record("ann", "a.ron", 75.0, 1234);
-    let error = keep_attempt(&db, &attempt).unwrap_err();
+    let error = keep_attempt(&Store::Local(db.clone()), &attempt).unwrap_err();
     eprintln!("{error}");
     let HistoryError::SetAside { path, aside, .. } = &error else {
         panic!("{error}");
