@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs the system packages the trainer needs on Debian/Ubuntu: the X11 and Vulkan runtime
 # libraries its window loads, Mesa's Vulkan drivers (software rendering where there is no GPU
-# driver), and Xvfb, the virtual X server the window tests draw into. Building needs nothing
-# beyond the Rust toolchain and a C compiler.
+# driver), Xvfb, the virtual X server the window tests draw into, and the PostgreSQL server
+# the shared-history tests start clusters of their own with. Building needs nothing beyond the
+# Rust toolchain and a C compiler.
 #   scripts/setup-debian.sh --web   also what the browser test needs: Chromium, and Node.js
 #                                   where the machine has none
 set -euo pipefail
@@ -11,6 +12,7 @@ packages=(
   libx11-6 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0
   libvulkan1 mesa-vulkan-drivers
   xvfb
+  postgresql
 )
 case "${1:-}" in
   "") ;;

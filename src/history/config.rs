@@ -40,8 +40,7 @@ impl TrainerConfig {
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
         options.from_str(&text).map_err(|e| {
             format!(
-                "{}:{}:{}: {} (the fields are history, local_history and station; \
-                 docs/programme.md)",
+                "{}:{}:{}: {} (the trainer's configuration file: docs/programme.md)",
                 path.display(),
                 e.span.start.line,
                 e.span.start.col,

@@ -218,11 +218,13 @@ impl SharedHistory {
     }
 }
 
-/// A PostgreSQL error with the server's own words, when it gave some.
+/// A PostgreSQL error with the server's own words when it gave some, else with its cause
+/// (the connection refused, the name not found).
 fn describe(e: &postgres::Error) -> String {
-    match e.as_db_error() {
-        Some(db) => format!("{}: {}", db.severity(), db.message()),
-        None => e.to_string(),
+    match (e.as_db_error(), std::error::Error::source(e)) {
+        (Some(db), _) => format!("{}: {}", db.severity(), db.message()),
+        (None, Some(cause)) => format!("{e}: {cause}"),
+        (None, None) => e.to_string(),
     }
 }
 

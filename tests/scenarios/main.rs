@@ -18,6 +18,8 @@ mod fuzz_files;
 mod glyphs;
 mod history;
 mod motion;
+mod postgres_server;
+mod shared_history;
 mod soak;
 mod stiffening;
 
@@ -587,11 +589,21 @@ fn run_steady_press(script: &str, dir: &Path, extra: &[&str]) -> std::process::O
         .arg(vademecums())
         .arg("--report-dir")
         .arg(dir)
-        .arg("--history")
-        .arg(dir.join("history.sqlite"))
+        .args(history_unless_named(dir, extra))
         .current_dir(root())
         .output()
         .unwrap()
+}
+
+/// `--history DIR/history.sqlite`, unless `extra` names a history or a configuration.
+fn history_unless_named(dir: &Path, extra: &[&str]) -> Vec<String> {
+    match extra.iter().any(|a| *a == "--history" || *a == "--config") {
+        true => Vec::new(),
+        false => vec![
+            "--history".into(),
+            dir.join("history.sqlite").display().to_string(),
+        ],
+    }
 }
 
 #[test]
