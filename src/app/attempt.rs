@@ -133,8 +133,8 @@ fn coupling_of(scenario: &Scenario) -> CouplingSettings {
 /// The scene's organ a scenario's entry describes, with its nodules in its tissue.
 fn scene_organ(scenario: &Scenario, entry: &OrganEntry) -> Result<SceneOrgan, String> {
     let name = &entry.name;
-    let source = match &entry.mesh {
-        Some(path) => OrganSource::File(path.clone()),
+    let source = match entry.mesh_file() {
+        Some(file) => OrganSource::File(file),
         None => OrganSource::Generated(
             Organ::from_name(name).ok_or_else(|| format!("there is no organ `{name}`"))?,
         ),

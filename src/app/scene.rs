@@ -207,8 +207,8 @@ impl SceneOrgan {
     fn vademecum(&self, dir: &Path, detail: Detail, tip_m: f64) -> VademecumSpec {
         let stem = match &self.source {
             OrganSource::Generated(_) => self.name.clone(),
-            OrganSource::File(path) => {
-                let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+            OrganSource::File(file) => {
+                let stem = file.path.file_stem().unwrap_or_default().to_string_lossy();
                 format!("{}.mesh-{stem}", self.name)
             }
         };

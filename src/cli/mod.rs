@@ -26,6 +26,8 @@ pub use trainer_curriculum::{is_curriculum, menu_curriculum, show_standing, vali
 pub struct LoadedMesh {
     pub organ: Option<crate::mesh::organs::Organ>,
     pub mesh: crate::mesh::TetMesh,
+    /// What the region selectors picked, when any were given.
+    pub selection: Option<crate::mesh::SelectionReport>,
 }
 pub use parse::{
     parse_cut_pattern, parse_force_limit_n, parse_inclusion, parse_point_mm,
@@ -38,7 +40,7 @@ pub use pgd_fit::{FitReport, fit_uniaxial_test, plot_fit};
 pub use pgd_indent::{
     IndentReport, IndentRequest, LawCurve, indent_organ, plot_indentation, print_indentation,
 };
-pub use pgd_mesh::report_mesh;
+pub use pgd_mesh::{MeshReport, report_mesh};
 pub use pgd_validate::{
     plot_force_depth, print_cut_validation, print_force_depth, print_validation, validate_cuts,
     validate_vademecum,

@@ -55,7 +55,7 @@ pub struct LawCurve {
 /// Presses the organ `mesh` (with `clamped` and `accessible` regions) with its tool, once per
 /// material, from rest to the requested depth in `request.steps` equal steps.
 pub fn indent_organ(
-    LoadedMesh { organ, mesh }: LoadedMesh,
+    LoadedMesh { organ, mesh, .. }: LoadedMesh,
     materials: &[Material],
     request: &IndentRequest,
     progress: &dyn Progress,

@@ -21,7 +21,7 @@ use crate::store::Bar;
 /// curves beside it first.
 pub fn validate_vademecum(
     source: &str,
-    LoadedMesh { organ, mesh }: LoadedMesh,
+    LoadedMesh { organ, mesh, .. }: LoadedMesh,
     file: &Path,
     settings: impl Fn(Option<Organ>) -> ValidationSettings,
 ) -> Result<ValidationReport, String> {
@@ -159,7 +159,7 @@ pub fn plot_force_depth(
 /// path).
 pub fn validate_cuts(
     source: &str,
-    LoadedMesh { organ, mesh }: LoadedMesh,
+    LoadedMesh { organ, mesh, .. }: LoadedMesh,
     file: &Path,
     settings: &CutValidationSettings,
     exact: bool,

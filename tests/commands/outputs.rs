@@ -32,6 +32,7 @@ fn pgd_indent_gives_a_force_depth_curve_per_law() {
         LoadedMesh {
             organ: None,
             mesh: mesh.clone(),
+            selection: None,
         },
         &materials,
         &request,
@@ -60,7 +61,11 @@ fn pgd_indent_gives_a_force_depth_curve_per_law() {
         ..request
     };
     let refused = indent_organ(
-        LoadedMesh { organ: None, mesh },
+        LoadedMesh {
+            organ: None,
+            mesh,
+            selection: None,
+        },
         &materials,
         &no_steps,
         &silent,
@@ -88,4 +93,60 @@ fn the_force_depth_plot_is_drawn_only_when_there_are_curves() {
     assert_eq!(plot_force_depth(&checked(0), &file), Ok(None));
     let png = plot_force_depth(&checked(1), &file).unwrap().unwrap();
     assert!(std::fs::read(png).unwrap().starts_with(b"\x89PNG"));
+}
+
+/// `pgd mesh FILE --clamp … --accessible … --preview`: what each selector picked, counted, the
+/// regions set, the picture drawn; a selector that picks nothing refused with the organ's
+/// extent, and exit status 1.
+#[test]
+fn pgd_mesh_picks_regions_by_selectors_and_draws_them() {
+    let folder = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("pgd-mesh-selectors");
+    std::fs::create_dir_all(&folder).unwrap();
+    let block = pgd_surgery::mesh::box_mesh([0.040, 0.020, 0.010], [4, 2, 1]).unwrap();
+    let file = folder.join("block.vtu");
+    pgd_surgery::mesh::io::write_vtu(&file, &block, &[]).unwrap();
+    let preview = folder.join("regions.png");
+    let _ = std::fs::remove_file(&preview);
+    let pgd = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_pgd"))
+            .arg("mesh")
+            .arg(&file)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let out = pgd(&[
+        "--clamp",
+        "region:x0",
+        "--clamp",
+        "not:facing:0,0,1,1",
+        "--accessible",
+        "facing:0,0,1,1",
+        "--preview",
+        preview.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for line in [
+        "region:x0: 6 nodes",
+        "not:facing:0,0,1,1: 15 nodes",
+        "clamped: 3 nodes",
+        "facing:0,0,1,1: 16 faces",
+        "node set clamped: 3 nodes",
+        "face set accessible: 16 faces",
+    ] {
+        assert!(stdout.contains(line), "`{line}` in:\n{stdout}");
+    }
+    assert!(std::fs::metadata(&preview).unwrap().len() > 1000);
+    let out = pgd(&["--clamp", "sphere:100,100,100,5"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("picks nothing") && stderr.contains("spans x 0.0 to 40.0"),
+        "{stderr}"
+    );
 }

@@ -35,6 +35,7 @@ use pgd_surgery::devices::{HapticDevice, Scripted, TICK_S, Trajectory};
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::io::write_vtu;
 use pgd_surgery::mesh::organs::{Organ, OrganSettings, generate};
+use pgd_surgery::mesh::{Regions, TetMesh};
 use pgd_surgery::pgd::BuildSettings;
 use pgd_surgery::report::write_report;
 use pgd_surgery::scenario::tasks::{
@@ -783,6 +784,70 @@ fn an_organ_from_a_mesh_file_feels_as_the_organ_it_was_written_from() {
         ((file_n - generated_n) / generated_n).abs() < 1e-6,
         "{file_n} N against {generated_n} N"
     );
+}
+
+/// A mesh file whose regions have other names (as a segmentation tool's would): the
+/// scenario picks them with `clamp: [Region(…)]` and `accessible: [Region(…)]`, and the organ
+/// pushes back as the generated liver whose regions they are, to 1e-6 relative. A selector
+/// that picks nothing is refused where it is written, with the organ's extent.
+#[test]
+fn a_scenario_picks_a_mesh_files_regions_with_selectors() {
+    let folder = Path::new(env!("CARGO_TARGET_TMPDIR")).join("mesh-selectors");
+    std::fs::create_dir_all(folder.join("meshes")).unwrap();
+    let settings = OrganSettings {
+        resolution: 0.25,
+        ..OrganSettings::default()
+    };
+    let liver = generate(Organ::Liver, &settings).unwrap();
+    let regions = Regions {
+        node_sets: [(
+            "vena_cava".to_owned(),
+            liver.node_set("clamped").unwrap().to_vec(),
+        )]
+        .into(),
+        face_sets: [(
+            "front".to_owned(),
+            liver.face_set("accessible").unwrap().to_vec(),
+        )]
+        .into(),
+    };
+    let renamed = TetMesh::new(
+        "segmented",
+        liver.nodes().to_vec(),
+        liver.tets().to_vec(),
+        regions,
+    )
+    .unwrap();
+    write_vtu(&folder.join("meshes/segmented.vtu"), &renamed, &[]).unwrap();
+    let file = folder.join("segmented.scenario.ron");
+    let entry = |clamp: &str| {
+        format!(
+            r#"Organ(name: "segmented", mesh: "meshes/segmented.vtu", law: Linear,
+                clamp: [{clamp}], accessible: [Region("front")])"#
+        )
+    };
+    std::fs::write(
+        &file,
+        one_organ_press(&entry(r#"Region("vena_cava")"#), "segmented"),
+    )
+    .unwrap();
+    let picked = load(&file).unwrap();
+    let generated = parse(&file, &one_organ_press(LINEAR_LIVER, "liver")).unwrap();
+    let (picked_n, generated_n) = (held_force_n(picked), held_force_n(generated));
+    eprintln!("held {picked_n:.6} N on the picked regions, {generated_n:.6} N on the liver's");
+    assert!(generated_n > 0.1, "{generated_n} N");
+    assert!(
+        ((picked_n - generated_n) / generated_n).abs() < 1e-6,
+        "{picked_n} N"
+    );
+    let nowhere = one_organ_press(&entry("Box(500, 500, 500, 600, 600, 600)"), "segmented");
+    std::fs::write(&file, &nowhere).unwrap();
+    let error = load(&file).unwrap_err();
+    assert!(
+        error.message.contains("picks nothing") && error.message.contains("spans x"),
+        "{error}"
+    );
+    assert_eq!(error.field, "organs[0].mesh", "{error}");
 }
 
 /// A scenario's contact master carries the distance field the other organs are tested

@@ -12,6 +12,7 @@ use pgd_surgery::devices::PressMotion;
 use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
 use pgd_surgery::mesh::io::ImportOptions;
 use pgd_surgery::mesh::organs::{CORNEA_LAYERS, Organ, OrganSettings};
+use pgd_surgery::mesh::{RegionSelectors, Selector};
 use pgd_surgery::pgd::{
     self, BuildSettings, PgdSettings, RegionSettings, SecantSettings, ValidationSettings,
 };
@@ -40,6 +41,9 @@ pub enum Command {
         /// Also write the mesh (with its regions) as .vtu for ParaView.
         #[arg(long, value_name = "FILE.vtu")]
         out: Option<PathBuf>,
+        /// Also draw the organ with its clamped (red) and accessible (green) regions as PNG.
+        #[arg(long, value_name = "FILE.png")]
+        preview: Option<PathBuf>,
         /// Print the report as JSON.
         #[arg(long)]
         json: bool,
@@ -226,11 +230,22 @@ pub struct MeshArgs {
     /// Surfaces (.obj, .stl): target node count of the tetrahedralization.
     #[arg(long, default_value_t = 4000)]
     pub nodes: usize,
+    /// Files: the nodes held fixed, picked by where they are (millimetres, after --scale):
+    /// box:X0,Y0,Z0,X1,Y1,Z1, sphere:X,Y,Z,R, plane:X,Y,Z,NX,NY,NZ (the side the normal
+    /// points to), facing:NX,NY,NZ,DEG, region:NAME; given again, they add up; not:… takes
+    /// its part away. Without it, the file's own `clamped` region.
+    #[arg(long, value_name = "SELECTOR")]
+    pub clamp: Vec<Selector>,
+    /// Files: the surface the tool may touch, picked as --clamp picks (default with --clamp:
+    /// the surface no clamped node touches; without either, the file's own `accessible`).
+    #[arg(long, value_name = "SELECTOR")]
+    pub accessible: Vec<Selector>,
 }
 
 impl MeshArgs {
+    /// The mesh, its regions picked by the selectors given (with what each picked).
     pub fn load(&self) -> Result<LoadedMesh, String> {
-        let (organ, mesh) = store::load_source(&store::MeshSource {
+        let (organ, mut mesh) = store::load_source(&store::MeshSource {
             name: &self.source,
             organ: OrganSettings {
                 resolution: self.resolution,
@@ -240,9 +255,24 @@ impl MeshArgs {
             import: ImportOptions {
                 scale: self.scale,
                 surface_nodes: self.nodes,
+                regions: RegionSelectors::default(),
             },
         })?;
-        Ok(LoadedMesh { organ, mesh })
+        let selectors = RegionSelectors {
+            clamp: self.clamp.clone(),
+            accessible: self.accessible.clone(),
+        };
+        let selection = match selectors.is_empty() {
+            true => None,
+            false => {
+                Some((selectors.apply(&mut mesh)).map_err(|e| format!("{}: {e}", self.source))?)
+            }
+        };
+        Ok(LoadedMesh {
+            organ,
+            mesh,
+            selection,
+        })
     }
 
     /// The file name a vademecum of this source gets by default.

@@ -53,8 +53,19 @@ fn indent_command(
 
 fn main() -> ExitCode {
     match Cli::parse().command {
-        Command::Mesh { mesh, out, json } => match mesh.load() {
-            Ok(loaded) => cli::report_mesh(&mesh.source, &loaded.mesh, out.as_deref(), json),
+        Command::Mesh {
+            mesh,
+            out,
+            preview,
+            json,
+        } => match mesh.load() {
+            Ok(loaded) => cli::report_mesh(&cli::MeshReport {
+                source: &mesh.source,
+                loaded: &loaded,
+                out: out.as_deref(),
+                preview: preview.as_deref(),
+                json,
+            }),
             Err(e) => fail("pgd mesh", &e),
         },
         Command::Build {
@@ -254,6 +265,7 @@ fn job<'a>(
     let LoadedMesh {
         organ,
         mesh: tet_mesh,
+        ..
     } = mesh.load()?;
     Ok(BuildJob {
         source: &mesh.source,

@@ -67,6 +67,12 @@ impl TetMesh {
         Ok(())
     }
 
+    /// Removes the node set and the face set `name`, if there are any.
+    pub fn remove_region(&mut self, name: &str) {
+        self.regions.node_sets.remove(name);
+        self.regions.face_sets.remove(name);
+    }
+
     /// Adds or replaces a face set, checking its indices.
     pub fn set_face_set(&mut self, name: &str, faces: Vec<[usize; 3]>) -> Result<(), MeshError> {
         self.check_region(name, faces.iter().flatten())?;

@@ -5,6 +5,7 @@
 mod convergence;
 mod learning_curve;
 mod plot;
+mod regions;
 mod scorecard;
 
 pub use convergence::{
@@ -12,4 +13,5 @@ pub use convergence::{
 };
 pub use learning_curve::{CurvePoint, learning_curve};
 pub use plot::{FONT_DATA, LineChart, Series, line_chart, save_png, without_glyph};
+pub use regions::draw_regions;
 pub use scorecard::{summary, write_report};

@@ -444,8 +444,12 @@ fn check_organ(k: usize, organ: &OrganEntry) -> Option<Problem> {
         message,
         hint: hint.into(),
     };
-    let regions_hint = "name the fixed nodes `clamped` and the surface the tool may touch `accessible` (Gmsh physical groups, VTK point data); `pgd mesh FILE` lists a mesh's regions";
-    match crate::mesh::io::load(mesh, &Default::default()) {
+    let regions_hint = "name the fixed nodes `clamped` and the surface the tool may touch `accessible` (Gmsh physical groups, VTK point data), or pick them: clamp: [Box(…)], accessible: [Facing(…)]; `pgd mesh FILE` lists a mesh's regions";
+    match crate::mesh::io::load(mesh, &organ.import()) {
+        Err(e @ crate::mesh::io::ImportError::Selection { .. }) => Some(problem(
+            e.to_string(),
+            "selectors are in millimetres in the mesh's frame; `pgd mesh FILE --clamp … --accessible … --preview regions.png` shows what they pick",
+        )),
         Err(e) => Some(problem(
             e.to_string(),
             "a tetrahedral mesh in metres (.msh, .vtk or .vtu), its path relative to the scenario's folder",

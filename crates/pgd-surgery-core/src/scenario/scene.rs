@@ -8,8 +8,10 @@ use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 
 use crate::fem::Law;
-use crate::mesh::TetMesh;
+use crate::mesh::io::ImportOptions;
 use crate::mesh::organs::{Organ, OrganSettings};
+use crate::mesh::{RegionSelectors, Selector, TetMesh};
+use crate::store::MeshFile;
 
 use super::units::{Millimetres, ModeCount, Pascals, PoissonRatio, Ratio, Stiffening, Toughness};
 
@@ -49,11 +51,20 @@ impl Spot {
 pub struct OrganEntry {
     /// What tasks and nodules call it; a generated organ's name unless `mesh` is given.
     pub name: String,
-    /// A tetrahedral mesh file (.msh, .vtk, .vtu, in metres) with a node set `clamped` (held
-    /// fixed) and a surface `accessible` (where the tool may touch), written relative to the
-    /// scenario's folder (read as such: the path here is resolved).
+    /// A mesh file (.msh, .vtk, .vtu, in metres, or a closed .obj/.stl surface), written
+    /// relative to the scenario's folder (read as such: the path here is resolved). Its
+    /// clamped nodes and accessible surface are its own regions `clamped` and `accessible`,
+    /// or those `clamp` and `accessible` pick.
     #[serde(default)]
     pub mesh: Option<PathBuf>,
+    /// A mesh file's nodes held fixed, picked by where they are (`Box`, `Sphere`, `Plane`,
+    /// `Facing`, `Region`, `Not`; millimetres).
+    #[serde(default)]
+    pub clamp: Vec<Selector>,
+    /// A mesh file's surface the tool may touch, picked as `clamp` is; without it, the
+    /// surface that no clamped node touches.
+    #[serde(default)]
+    pub accessible: Vec<Selector>,
     /// Its tissue's Young's modulus, when not the organ's own (for a mesh file: the liver's).
     #[serde(default)]
     pub young_pa: Option<Pascals>,
@@ -96,8 +107,8 @@ impl OrganEntry {
     /// organ's at a quarter of its resolution; `None` when it cannot be had (its own check
     /// says why).
     pub fn outline_mesh(&self) -> Option<TetMesh> {
-        match (&self.mesh, Organ::from_name(&self.name)) {
-            (Some(path), _) => crate::mesh::io::load(path, &Default::default()).ok(),
+        match (self.mesh_file(), Organ::from_name(&self.name)) {
+            (Some(file), _) => crate::mesh::io::load(&file.path, &self.import()).ok(),
             (None, Some(organ)) => {
                 let coarse = OrganSettings {
                     resolution: 0.25,
@@ -109,11 +120,37 @@ impl OrganEntry {
         }
     }
 
+    /// Its mesh file and how its regions are found, if it is read from one.
+    pub fn mesh_file(&self) -> Option<MeshFile> {
+        self.mesh.as_ref().map(|path| MeshFile {
+            path: path.clone(),
+            regions: self.regions(),
+        })
+    }
+
+    /// The selectors of its regions.
+    fn regions(&self) -> RegionSelectors {
+        RegionSelectors {
+            clamp: self.clamp.clone(),
+            accessible: self.accessible.clone(),
+        }
+    }
+
+    /// How its mesh file is read.
+    pub fn import(&self) -> ImportOptions {
+        ImportOptions {
+            regions: self.regions(),
+            ..ImportOptions::default()
+        }
+    }
+
     /// A generated organ with its own tissue and default vademecum.
     pub fn named(name: &str) -> Self {
         Self {
             name: name.to_owned(),
             mesh: None,
+            clamp: Vec::new(),
+            accessible: Vec::new(),
             young_pa: None,
             poisson_ratio: None,
             max_modes: None,

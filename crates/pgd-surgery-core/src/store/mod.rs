@@ -12,7 +12,7 @@ mod vademecums;
 #[cfg(not(target_arch = "wasm32"))]
 pub use background::{BackgroundStatus, Building, background_status, build_in_background};
 pub use progress::Bar;
-pub use source::{MeshSource, OrganSource, load_source};
+pub use source::{MeshFile, MeshSource, OrganSource, load_source};
 pub use vademecums::{
     BuildJob, OnStale, VademecumSpec, build_and_save, ensure_vademecum, vademecum_file_name,
 };

@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
-use crate::mesh::TetMesh;
 use crate::mesh::io::{ImportOptions, load};
 use crate::mesh::organs::{self, Organ, OrganSettings};
+use crate::mesh::{RegionSelectors, TetMesh};
 
 /// How to get the mesh, with the knobs of both kinds of source.
 pub struct MeshSource<'a> {
@@ -18,7 +18,10 @@ pub struct MeshSource<'a> {
 pub fn load_source(source: &MeshSource) -> Result<(Option<Organ>, TetMesh), String> {
     let origin = match Organ::from_name(source.name) {
         Some(organ) => OrganSource::Generated(organ),
-        None => OrganSource::File(PathBuf::from(source.name)),
+        None => OrganSource::File(MeshFile {
+            path: PathBuf::from(source.name),
+            regions: source.import.regions.clone(),
+        }),
     };
     let mesh = origin.load(&source.organ, &source.import)?;
     Ok((origin.organ(), mesh))
@@ -29,9 +32,27 @@ pub fn load_source(source: &MeshSource) -> Result<(Option<Organ>, TetMesh), Stri
 pub enum OrganSource {
     /// Generated (at the given settings).
     Generated(Organ),
-    /// Read from a tetrahedral mesh file with a `clamped` node set and an `accessible`
-    /// surface; its tissue is the liver's unless given.
-    File(PathBuf),
+    /// Read from a mesh file; its tissue is the liver's unless given.
+    File(MeshFile),
+}
+
+/// A mesh file and how its regions are found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshFile {
+    pub path: PathBuf,
+    /// The clamped nodes and the accessible surface picked by where they are; none: the
+    /// file's own `clamped` node set and `accessible` surface.
+    pub regions: RegionSelectors,
+}
+
+impl MeshFile {
+    /// A file that names its own regions.
+    pub fn with_regions(path: PathBuf) -> Self {
+        Self {
+            path,
+            regions: RegionSelectors::default(),
+        }
+    }
 }
 
 impl OrganSource {
@@ -59,7 +80,13 @@ impl OrganSource {
             OrganSource::Generated(organ) => {
                 organs::generate(*organ, settings).map_err(|e| format!("{}: {e}", organ.name()))
             }
-            OrganSource::File(path) => load(path, import).map_err(|e| e.to_string()),
+            OrganSource::File(file) => {
+                let import = ImportOptions {
+                    regions: file.regions.clone(),
+                    ..import.clone()
+                };
+                load(&file.path, &import).map_err(|e| e.to_string())
+            }
         }
     }
 }

@@ -87,7 +87,16 @@ impl VademecumSpec {
         let law = self.law.name();
         let source = match &self.source {
             OrganSource::Generated(organ) => organ.name().to_owned(),
-            OrganSource::File(path) => path.display().to_string(),
+            OrganSource::File(file) => {
+                let regions = &file.regions;
+                let selectors = (regions.clamp.iter().map(|s| format!(" --clamp {s}"))).chain(
+                    regions
+                        .accessible
+                        .iter()
+                        .map(|s| format!(" --accessible {s}")),
+                );
+                file.path.display().to_string() + &selectors.collect::<String>()
+            }
         };
         let mut command = format!("cargo run --release --bin pgd -- build {source} --law {law}");
         let mesh = OrganSettings::default();

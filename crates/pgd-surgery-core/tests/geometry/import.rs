@@ -165,6 +165,7 @@ fn a_closed_obj_surface_becomes_a_valid_tet_mesh() {
     let options = ImportOptions {
         scale: 1e-3,
         surface_nodes: 1500,
+        ..ImportOptions::default()
     };
     let mesh = load(&file("cube.obj", CUBE_OBJ.as_bytes()), &options).unwrap();
     let q = QualityReport::measure(mesh.nodes(), mesh.tets());
@@ -230,6 +231,7 @@ fn ascii_and_binary_stl_read_the_same_solid() {
     let options = ImportOptions {
         scale: 1.0,
         surface_nodes: 800,
+        ..ImportOptions::default()
     };
     let a = load(&file("t.stl", ascii.as_bytes()), &options).unwrap();
     let b = load(&file("tb.stl", &binary), &options).unwrap();
@@ -307,6 +309,7 @@ fn unusable_meshes_are_refused_with_the_reason() {
         &ImportOptions {
             scale: 1e-3,
             surface_nodes: 500,
+            ..ImportOptions::default()
         },
     )
     .unwrap_err();
@@ -349,6 +352,7 @@ fn an_organ_surface_in_stl_becomes_a_valid_tet_mesh() {
     let options = ImportOptions {
         scale: 1e-3,
         surface_nodes: 3000,
+        ..ImportOptions::default()
     };
     let mesh = load(&file("liver.stl", &stl), &options).unwrap();
     let q = QualityReport::measure(mesh.nodes(), mesh.tets());

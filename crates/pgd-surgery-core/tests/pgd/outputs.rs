@@ -71,7 +71,7 @@ fn a_vademecum_queued_for_the_background_is_built_there_once() {
     let path = dir.join("block.vtu");
     write_vtu(&path, &mesh, &[]).unwrap();
     let file = dir.join("block-neo-hookean.vdm");
-    let source = store::OrganSource::File(path);
+    let source = store::OrganSource::File(store::MeshFile::with_regions(path));
     let mut spec = VademecumSpec::new("block", source, Law::NeoHookean, file.clone());
     spec.build.tool_tip_radius_m = 0.012;
     spec.build.local_radius_m = 0.015;

@@ -17,7 +17,7 @@ use std::path::Path;
 use nalgebra::Point3;
 use thiserror::Error;
 
-use super::{MeshError, QualityReport, Regions, Surface, TetMesh};
+use super::{MeshError, QualityReport, RegionSelectors, Regions, Surface, TetMesh};
 pub use surface::{SurfaceMesh, read_obj, read_stl, tetrahedralize};
 pub use vtu::write_vtu;
 
@@ -39,6 +39,8 @@ pub enum ImportError {
     Unsupported { file: String, message: String },
     #[error("{file}: the mesh cannot be simulated: {reason}")]
     Unusable { file: String, reason: String },
+    #[error("{file}: {message}")]
+    Selection { file: String, message: String },
     #[error(transparent)]
     Mesh(#[from] MeshError),
 }
@@ -134,13 +136,16 @@ fn add_surface_faces_of_node_sets(mesh: &mut TetMesh) -> Result<(), MeshError> {
     Ok(())
 }
 
-/// Options for reading surfaces, which must be tetrahedralized.
-#[derive(Clone, Copy, Debug)]
+/// Options for reading a mesh file.
+#[derive(Clone, Debug)]
 pub struct ImportOptions {
     /// Multiplies coordinates: 0.001 for files in millimetres.
     pub scale: f64,
     /// Target node count when tetrahedralizing a surface.
     pub surface_nodes: usize,
+    /// The clamped nodes and the accessible surface, picked by where they are (after
+    /// `scale`); none: the file's own `clamped` and `accessible` regions.
+    pub regions: RegionSelectors,
 }
 
 impl Default for ImportOptions {
@@ -148,6 +153,7 @@ impl Default for ImportOptions {
         Self {
             scale: 1.0,
             surface_nodes: 4_000,
+            regions: RegionSelectors::default(),
         }
     }
 }
@@ -162,8 +168,23 @@ pub fn load(path: &Path, options: &ImportOptions) -> Result<TetMesh, ImportError
 }
 
 /// Reads the `bytes` of the mesh file `path` (which names it in errors and gives the format
-/// by its extension).
+/// by its extension), its regions picked by `options.regions` when it gives any.
 pub fn parse(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<TetMesh, ImportError> {
+    let mut mesh = read_mesh(path, bytes, options)?;
+    if !options.regions.is_empty() {
+        options
+            .regions
+            .apply(&mut mesh)
+            .map_err(|message| ImportError::Selection {
+                file: path.display().to_string(),
+                message,
+            })?;
+    }
+    Ok(mesh)
+}
+
+/// The mesh in the `bytes` of `path`, scaled, with the regions it names.
+fn read_mesh(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<TetMesh, ImportError> {
     let file = path.display().to_string();
     let text = |bytes: Vec<u8>| {
         String::from_utf8(bytes).map_err(|e| ImportError::Unsupported {
