@@ -10,7 +10,7 @@ use pgd_surgery::cutting::CutPattern;
 use pgd_surgery::cutting::keratotomy::REFERENCE_MESH;
 use pgd_surgery::devices::PressMotion;
 use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
-use pgd_surgery::mesh::io::ImportOptions;
+use pgd_surgery::mesh::io::{Frame, ImportOptions};
 use pgd_surgery::mesh::organs::{CORNEA_LAYERS, Organ, OrganSettings};
 use pgd_surgery::mesh::{RegionSelectors, Selector};
 use pgd_surgery::pgd::{
@@ -33,8 +33,9 @@ pub struct Cli {
 #[derive(Subcommand)]
 pub enum Command {
     /// Generate an organ (liver, gallbladder, pancreas, duodenum, cornea) or read a mesh file
-    /// (.msh, .vtk, .vtu, or a closed .obj/.stl surface, which is tetrahedralized), and print
-    /// its statistics and quality report. Exits with status 1 if the mesh cannot be simulated.
+    /// (.msh, .vtk, .vtu, or an .obj/.stl/.ply/VTK polydata surface, which is mended and
+    /// tetrahedralized), pick its regions if asked, and print its statistics, regions and
+    /// quality report. Exits with status 1 if the mesh cannot be simulated.
     Mesh {
         #[command(flatten)]
         mesh: MeshArgs,
@@ -230,6 +231,11 @@ pub struct MeshArgs {
     /// Surfaces (.obj, .stl): target node count of the tetrahedralization.
     #[arg(long, default_value_t = 4000)]
     pub nodes: usize,
+    /// Files: the patient frame their coordinates are in, ras or lps (default: the one the
+    /// file states, as 3D Slicer writes SPACE=RAS or SPACE=LPS in its header, else ras); lps
+    /// is turned into the trainer's ras.
+    #[arg(long)]
+    pub frame: Option<Frame>,
     /// Files: the nodes held fixed, picked by where they are (millimetres, after --scale):
     /// box:X0,Y0,Z0,X1,Y1,Z1, sphere:X,Y,Z,R, plane:X,Y,Z,NX,NY,NZ (the side the normal
     /// points to), facing:NX,NY,NZ,DEG, region:NAME; given again, they add up; not:… takes
@@ -256,6 +262,7 @@ impl MeshArgs {
                 scale: self.scale,
                 surface_nodes: self.nodes,
                 regions: RegionSelectors::default(),
+                frame: self.frame,
             },
         })?;
         let selectors = RegionSelectors {

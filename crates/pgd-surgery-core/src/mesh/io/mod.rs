@@ -1,11 +1,14 @@
-//! Reading real meshes (Gmsh `.msh` v2/v4 ASCII, VTK legacy `.vtk`, `.vtu`, closed OBJ/STL
-//! surfaces, which are tetrahedralized) and writing `.vtu` for ParaView.
+//! Reading real meshes (Gmsh `.msh` v2/v4 ASCII, VTK legacy `.vtk` grids, `.vtu`, and surfaces
+//! as segmentation tools write them, OBJ, STL, PLY and VTK polydata, which are mended and
+//! tetrahedralized) and writing `.vtu` for ParaView.
 //!
 //! Every error names the file, and for text formats the line. A mesh that parses but cannot be
 //! simulated (inverted or flat elements, a surface with holes) is refused with its quality
 //! report's reason.
 
+mod mend;
 mod msh;
+mod ply;
 mod surface;
 mod tokens;
 mod vtk;
@@ -18,6 +21,8 @@ use nalgebra::Point3;
 use thiserror::Error;
 
 use super::{MeshError, QualityReport, RegionSelectors, Regions, Surface, TetMesh};
+pub use mend::{MAX_HOLE_EDGES, Mended, mend};
+pub use ply::read_ply;
 pub use surface::{SurfaceMesh, read_obj, read_stl, tetrahedralize};
 pub use vtu::write_vtu;
 
@@ -146,6 +151,45 @@ pub struct ImportOptions {
     /// The clamped nodes and the accessible surface, picked by where they are (after
     /// `scale`); none: the file's own `clamped` and `accessible` regions.
     pub regions: RegionSelectors,
+    /// The patient frame the file's coordinates are in; `None`: the one the file states
+    /// (3D Slicer writes `SPACE=RAS` or `SPACE=LPS` in its header), else RAS.
+    pub frame: Option<Frame>,
+}
+
+/// The patient frames 3D Slicer writes surfaces in. The trainer keeps meshes in RAS (x to the
+/// patient's right, y anterior, z superior); LPS files are turned half a turn about z.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Frame {
+    Ras,
+    Lps,
+}
+
+impl std::str::FromStr for Frame {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "ras" => Ok(Self::Ras),
+            "lps" => Ok(Self::Lps),
+            _ => Err(format!(
+                "`{s}` is no patient frame: ras (3D Slicer's own) or lps (DICOM's, and Slicer's \
+                 files since 4.11)"
+            )),
+        }
+    }
+}
+
+impl Frame {
+    /// The frame a file states in its first kilobyte (`SPACE=RAS` or `SPACE=LPS`), if it
+    /// states one.
+    pub fn stated(bytes: &[u8]) -> Option<Self> {
+        let head = String::from_utf8_lossy(&bytes[..bytes.len().min(1024)]).to_ascii_uppercase();
+        match (head.contains("SPACE=LPS"), head.contains("SPACE=RAS")) {
+            (true, false) => Some(Self::Lps),
+            (false, true) => Some(Self::Ras),
+            _ => None,
+        }
+    }
 }
 
 impl Default for ImportOptions {
@@ -154,6 +198,7 @@ impl Default for ImportOptions {
             scale: 1.0,
             surface_nodes: 4_000,
             regions: RegionSelectors::default(),
+            frame: None,
         }
     }
 }
@@ -183,9 +228,18 @@ pub fn parse(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<Tet
     Ok(mesh)
 }
 
-/// The mesh in the `bytes` of `path`, scaled, with the regions it names.
+/// The mesh in the `bytes` of `path`, scaled and turned into RAS, with the regions it names.
 fn read_mesh(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<TetMesh, ImportError> {
     let file = path.display().to_string();
+    let frame = (options.frame)
+        .or_else(|| Frame::stated(&bytes))
+        .unwrap_or(Frame::Ras);
+    // Scaled, and from LPS half a turn about z (x and y reversed): a rotation, so the
+    // surface keeps its orientation.
+    let placed = |surface: SurfaceMesh| match frame {
+        Frame::Ras => surface.scaled(options.scale),
+        Frame::Lps => surface.scaled(options.scale).turned_about_z(),
+    };
     let text = |bytes: Vec<u8>| {
         String::from_utf8(bytes).map_err(|e| ImportError::Unsupported {
             file: file.clone(),
@@ -202,27 +256,41 @@ fn read_mesh(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<Tet
         .unwrap_or_default();
     let mut raw = match extension.as_str() {
         "msh" => msh::read(&file, &text(bytes)?)?,
-        "vtk" => vtk::read(&file, &text(bytes)?)?,
+        "vtk" => match vtk::read(&file, &text(bytes)?)? {
+            vtk::Dataset::Grid(raw) => raw,
+            vtk::Dataset::Surface(surface) => {
+                return tetrahedralize(&file, placed(surface), options.surface_nodes);
+            }
+        },
         "vtu" => vtu::read(&file, &text(bytes)?)?,
         "obj" => {
             let surface = read_obj(&file, &text(bytes)?)?;
-            return tetrahedralize(&file, surface.scaled(options.scale), options.surface_nodes);
+            return tetrahedralize(&file, placed(surface), options.surface_nodes);
         }
         "stl" => {
             let surface = read_stl(&file, &bytes)?;
-            return tetrahedralize(&file, surface.scaled(options.scale), options.surface_nodes);
+            return tetrahedralize(&file, placed(surface), options.surface_nodes);
+        }
+        "ply" => {
+            let surface = read_ply(&file, &bytes)?;
+            return tetrahedralize(&file, placed(surface), options.surface_nodes);
         }
         _ => {
             return Err(ImportError::Unsupported {
                 file,
                 message: format!(
-                    "unknown mesh format '.{extension}'; expected .msh, .vtk, .vtu, .obj or .stl"
+                    "unknown mesh format '.{extension}'; expected .msh, .vtk, .vtu, .obj, .stl or .ply"
                 ),
             });
         }
     };
+    let turn = match frame {
+        Frame::Ras => 1.0,
+        Frame::Lps => -1.0,
+    };
     for p in &mut raw.nodes {
-        *p = Point3::from(p.coords * options.scale);
+        let c = p.coords * options.scale;
+        *p = Point3::new(turn * c.x, turn * c.y, c.z);
     }
     raw.into_mesh(&file)
 }

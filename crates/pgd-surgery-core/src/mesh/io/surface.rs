@@ -8,6 +8,7 @@ use parry3d::query::PointQuery;
 use parry3d::shape::{TriMesh, TriMeshFlags};
 
 use super::ImportError;
+use super::mend::mend;
 use super::tokens::Tokens;
 use crate::mesh::{Implicit, TetMesh, stuff_to_node_count};
 use crate::parry_interop::to_parry;
@@ -27,6 +28,14 @@ impl SurfaceMesh {
     pub fn scaled(mut self, scale: f64) -> Self {
         for p in &mut self.vertices {
             *p = Point3::from(p.coords * scale);
+        }
+        self
+    }
+
+    /// Turned half a turn about z (x and y reversed): LPS to RAS, or back.
+    pub fn turned_about_z(mut self) -> Self {
+        for p in &mut self.vertices {
+            *p = Point3::new(-p.x, -p.y, p.z);
         }
         self
     }
@@ -181,17 +190,22 @@ fn merge_vertices(triangles: Vec<[Point3<f64>; 3]>) -> SurfaceMesh {
     surface
 }
 
-/// Tetrahedralizes the inside of a closed, manifold, consistently oriented surface, with about
-/// `target_nodes` nodes.
+/// Tetrahedralizes the inside of a surface, with about `target_nodes` nodes, once it is
+/// mended ([`mend`]: what was mended is said on the error stream) and found closed, manifold
+/// and consistently oriented.
 pub fn tetrahedralize(
     file: &str,
-    mut surface: SurfaceMesh,
+    surface: SurfaceMesh,
     target_nodes: usize,
 ) -> Result<TetMesh, ImportError> {
     let refuse = |reason: String| ImportError::Unusable {
         file: file.to_owned(),
         reason,
     };
+    let (mut surface, mended) = mend(surface).map_err(refuse)?;
+    if !mended.is_nothing() {
+        eprintln!("{file}: mended: {mended}");
+    }
     check_closed(&surface).map_err(refuse)?;
     let (min, max) = bounds(&surface.vertices);
     let size = (max - min).norm();

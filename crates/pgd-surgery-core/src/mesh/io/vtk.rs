@@ -1,15 +1,23 @@
-//! VTK legacy `.vtk`, ASCII unstructured grids: the classic `CELLS n size` layout and the
-//! `OFFSETS`/`CONNECTIVITY` layout of format 5. Tetrahedra (cell type 10) make the mesh; other
-//! cells are skipped.
+//! VTK legacy `.vtk`, ASCII: unstructured grids, whose tetrahedra (cell type 10) make the
+//! mesh (other cells skipped), and polydata surfaces, whose polygons and triangle strips make
+//! a surface to tetrahedralize; cells in the classic `CELLS n size` layout or the
+//! `OFFSETS`/`CONNECTIVITY` layout of format 5.
 
 use nalgebra::Point3;
 
+use super::surface::SurfaceMesh;
 use super::tokens::Tokens;
 use super::{ImportError, RawMesh};
 
+/// What a legacy file holds.
+pub(super) enum Dataset {
+    Grid(RawMesh),
+    Surface(SurfaceMesh),
+}
+
 const VTK_TETRA: usize = 10;
 
-pub(super) fn read(file: &str, text: &str) -> Result<RawMesh, ImportError> {
+pub(super) fn read(file: &str, text: &str) -> Result<Dataset, ImportError> {
     let header = text.lines().next().unwrap_or_default();
     if !header.starts_with("# vtk DataFile") {
         return Err(ImportError::Syntax {
@@ -32,26 +40,87 @@ pub(super) fn read(file: &str, text: &str) -> Result<RawMesh, ImportError> {
         )));
     }
     t.expect("DATASET")?;
-    let dataset = t.next("a dataset type")?;
-    if dataset != "UNSTRUCTURED_GRID" {
-        return Err(t.error(format!("expected an UNSTRUCTURED_GRID, found '{dataset}'")));
+    match t.next("a dataset type")? {
+        "UNSTRUCTURED_GRID" => grid(t).map(Dataset::Grid),
+        "POLYDATA" => polydata(t).map(Dataset::Surface),
+        other => Err(t.error(format!(
+            "expected an UNSTRUCTURED_GRID or a POLYDATA surface, found '{other}'"
+        ))),
     }
+}
+
+/// The points of a `POINTS n type` section.
+fn points(t: &mut Tokens) -> Result<Vec<Point3<f64>>, ImportError> {
+    let count: usize = t.parse("the number of points")?;
+    let _kind = t.next("a data type")?;
+    (0..count)
+        .map(|_| {
+            let p: [f64; 3] = [t.parse("x")?, t.parse("y")?, t.parse("z")?];
+            match p.iter().all(|c| c.is_finite()) {
+                true => Ok(Point3::from(p)),
+                false => Err(t.error("a point has a non-finite coordinate")),
+            }
+        })
+        .collect()
+}
+
+/// A polydata surface: its polygons fanned and its strips split into triangles; vertices and
+/// lines are skipped.
+fn polydata(mut t: Tokens) -> Result<SurfaceMesh, ImportError> {
+    let mut surface = SurfaceMesh::default();
+    while let Ok(keyword) = t.next("a section") {
+        match keyword {
+            "POINTS" => surface.vertices = points(&mut t)?,
+            "POLYGONS" => {
+                for polygon in read_cells(&mut t)? {
+                    if polygon.len() < 3 {
+                        return Err(t.error(format!("a polygon of {} points", polygon.len())));
+                    }
+                    for k in 1..polygon.len() - 1 {
+                        surface
+                            .triangles
+                            .push([polygon[0], polygon[k], polygon[k + 1]]);
+                    }
+                }
+            }
+            "TRIANGLE_STRIPS" => {
+                for strip in read_cells(&mut t)? {
+                    for k in 0..strip.len().saturating_sub(2) {
+                        let (a, b, c) = (strip[k], strip[k + 1], strip[k + 2]);
+                        // Every other triangle of a strip runs the other way.
+                        surface.triangles.push(match k % 2 {
+                            0 => [a, b, c],
+                            _ => [b, a, c],
+                        });
+                    }
+                }
+            }
+            "VERTICES" | "LINES" => {
+                read_cells(&mut t)?;
+            }
+            "POINT_DATA" | "CELL_DATA" | "FIELD" | "METADATA" => break,
+            other => return Err(t.error(format!("unexpected '{other}'"))),
+        }
+    }
+    let count = surface.vertices.len();
+    if let Some(f) = surface
+        .triangles
+        .iter()
+        .find(|f| f.iter().any(|&v| v >= count))
+    {
+        return Err(t.error(format!("a polygon {f:?} names a point past the {count}")));
+    }
+    Ok(surface)
+}
+
+/// An unstructured grid's tetrahedra.
+fn grid(mut t: Tokens) -> Result<RawMesh, ImportError> {
     let mut mesh = RawMesh::default();
     let mut cells: Vec<Vec<usize>> = Vec::new();
     let mut types: Vec<usize> = Vec::new();
     while let Ok(keyword) = t.next("a section") {
         match keyword {
-            "POINTS" => {
-                let count: usize = t.parse("the number of points")?;
-                let _kind = t.next("a data type")?;
-                for _ in 0..count {
-                    let p: [f64; 3] = [t.parse("x")?, t.parse("y")?, t.parse("z")?];
-                    if !p.iter().all(|c| c.is_finite()) {
-                        return Err(t.error("a point has a non-finite coordinate"));
-                    }
-                    mesh.nodes.push(Point3::from(p));
-                }
-            }
+            "POINTS" => mesh.nodes = points(&mut t)?,
             "CELLS" => cells = read_cells(&mut t)?,
             "CELL_TYPES" => {
                 let count: usize = t.parse("the number of cell types")?;
