@@ -90,6 +90,24 @@ fn check_two_tets(mesh: &pgd_surgery_core::mesh::TetMesh) {
     assert!((mesh.volume() - (1.0 / 6.0 + 2.0 / 6.0)).abs() < 1e-12);
 }
 
+/// The two tetrahedra in Gmsh's version 1, which names no physical group: the triangle of
+/// group 7 is the face set `physical_7`, which a selector (`region:physical_7`) can name.
+pub const MSH1: &str = "$NOD\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n$ENDNOD\n\
+    $ELM\n3\n1 2 7 1 3 1 3 2\n2 4 0 1 4 1 2 3 4\n3 4 0 1 4 2 3 4 5\n$ENDELM\n";
+
+#[test]
+fn gmsh_v1_reads_with_numbered_physical_surfaces() {
+    let mesh = import("one.msh", MSH1).unwrap();
+    check_two_tets(&mesh);
+    assert_eq!(mesh.face_set("physical_7").unwrap().len(), 1);
+    let wrong = MSH1.replace("1 2 7 1 3 1 3 2", "1 2 7 1 4 1 3 2 4");
+    let error = import("wrong.msh", &wrong).unwrap_err().to_string();
+    assert!(
+        error.contains("wrong.msh:") && error.contains("type 2 with 4 nodes"),
+        "{error}"
+    );
+}
+
 #[test]
 fn gmsh_v2_and_v4_read_with_physical_surfaces() {
     for (name, text) in [("two.msh", MSH2), ("two4.msh", MSH4)] {

@@ -1,5 +1,6 @@
-//! Gmsh `.msh`, ASCII versions 2.2 and 4.1. Tetrahedra (type 4) make the mesh; triangles (type
-//! 2) in physical groups become face sets named after the group.
+//! Gmsh `.msh`, ASCII versions 1, 2.2 and 4.1. Tetrahedra (type 4) make the mesh; triangles
+//! (type 2) in physical groups become face sets named after the group (version 1 names none:
+//! `physical_<number>`).
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -13,6 +14,9 @@ const TETRAHEDRON: usize = 4;
 
 pub(super) fn read(file: &str, text: &str) -> Result<RawMesh, ImportError> {
     let mut t = Tokens::new(file, text);
+    if text.trim_start().starts_with("$NOD") {
+        return read_v1(t);
+    }
     t.expect("$MeshFormat")?;
     let version: f64 = t.parse("a format version")?;
     let binary: u8 = t.parse("the file type (0 = ASCII)")?;
@@ -49,6 +53,40 @@ pub(super) fn read(file: &str, text: &str) -> Result<RawMesh, ImportError> {
             }
         }
     }
+    Ok(reader.finish())
+}
+
+/// Version 1: `$NOD` (count, then `tag x y z`) and `$ELM` (count, then `tag type physical
+/// elementary node-count nodes…`).
+fn read_v1(mut t: Tokens) -> Result<RawMesh, ImportError> {
+    let mut reader = Reader::default();
+    t.expect("$NOD")?;
+    let count: usize = t.parse("the number of nodes")?;
+    for _ in 0..count {
+        let tag: usize = t.parse("a node tag")?;
+        let p = Reader::point(&mut t)?;
+        reader.add_node(&t, tag, p)?;
+    }
+    t.expect("$ENDNOD")?;
+    t.expect("$ELM")?;
+    let count: usize = t.parse("the number of elements")?;
+    for _ in 0..count {
+        let _tag: usize = t.parse("an element tag")?;
+        let kind: usize = t.parse("an element type")?;
+        let physical: usize = t.parse("a physical group")?;
+        let _elementary: usize = t.parse("an elementary entity")?;
+        let nodes: usize = t.parse("the number of nodes")?;
+        let expected = match kind {
+            TRIANGLE => Some(3),
+            TETRAHEDRON => Some(4),
+            _ => None,
+        };
+        if expected.is_some_and(|n| n != nodes) {
+            return Err(t.error(format!("an element of type {kind} with {nodes} nodes")));
+        }
+        reader.element(&mut t, kind, (physical != 0).then_some(physical))?;
+    }
+    t.expect("$ENDELM")?;
     Ok(reader.finish())
 }
 
