@@ -8,10 +8,9 @@ use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 
 use crate::fem::Law;
-use crate::mesh::io::ImportOptions;
+use crate::mesh::io::{ImportOptions, MeshFile};
 use crate::mesh::organs::{Organ, OrganSettings};
 use crate::mesh::{RegionSelectors, Selector, TetMesh};
-use crate::store::MeshFile;
 
 use super::units::{Millimetres, ModeCount, Pascals, PoissonRatio, Ratio, Stiffening, Toughness};
 

@@ -9,10 +9,11 @@ mod progress;
 mod source;
 mod vademecums;
 
+pub use crate::mesh::io::MeshFile;
 #[cfg(not(target_arch = "wasm32"))]
 pub use background::{BackgroundStatus, Building, background_status, build_in_background};
 pub use progress::Bar;
-pub use source::{MeshFile, MeshSource, OrganSource, load_source};
+pub use source::{MeshSource, OrganSource, load_source};
 pub use vademecums::{
     BuildJob, OnStale, VademecumSpec, build_and_save, ensure_vademecum, vademecum_file_name,
 };

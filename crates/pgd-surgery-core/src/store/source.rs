@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
-use crate::mesh::io::{ImportOptions, load};
+use crate::mesh::TetMesh;
+use crate::mesh::io::{ImportOptions, MeshFile, load};
 use crate::mesh::organs::{self, Organ, OrganSettings};
-use crate::mesh::{RegionSelectors, TetMesh};
 
 /// How to get the mesh, with the knobs of both kinds of source.
 pub struct MeshSource<'a> {
@@ -34,25 +34,6 @@ pub enum OrganSource {
     Generated(Organ),
     /// Read from a mesh file; its tissue is the liver's unless given.
     File(MeshFile),
-}
-
-/// A mesh file and how its regions are found.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MeshFile {
-    pub path: PathBuf,
-    /// The clamped nodes and the accessible surface picked by where they are; none: the
-    /// file's own `clamped` node set and `accessible` surface.
-    pub regions: RegionSelectors,
-}
-
-impl MeshFile {
-    /// A file that names its own regions.
-    pub fn with_regions(path: PathBuf) -> Self {
-        Self {
-            path,
-            regions: RegionSelectors::default(),
-        }
-    }
 }
 
 impl OrganSource {

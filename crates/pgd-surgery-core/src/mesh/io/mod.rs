@@ -15,7 +15,7 @@ mod vtk;
 mod vtu;
 
 use std::collections::{BTreeMap, HashSet};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use nalgebra::Point3;
 use thiserror::Error;
@@ -141,6 +141,25 @@ fn add_surface_faces_of_node_sets(mesh: &mut TetMesh) -> Result<(), MeshError> {
     Ok(())
 }
 
+/// A mesh file and how its regions are found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshFile {
+    pub path: PathBuf,
+    /// The clamped nodes and the accessible surface picked by where they are; none: the
+    /// file's own `clamped` node set and `accessible` surface.
+    pub regions: RegionSelectors,
+}
+
+impl MeshFile {
+    /// A file that names its own regions.
+    pub fn with_regions(path: PathBuf) -> Self {
+        Self {
+            path,
+            regions: RegionSelectors::default(),
+        }
+    }
+}
+
 /// Options for reading a mesh file.
 #[derive(Clone, Debug)]
 pub struct ImportOptions {
@@ -228,6 +247,23 @@ pub fn parse(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<Tet
     Ok(mesh)
 }
 
+/// `surface` mended ([`mend`]: what was mended is said on the error stream) and
+/// tetrahedralized.
+fn mended_and_meshed(
+    file: &str,
+    surface: SurfaceMesh,
+    options: &ImportOptions,
+) -> Result<TetMesh, ImportError> {
+    let (surface, mended) = mend(surface).map_err(|reason| ImportError::Unusable {
+        file: file.to_owned(),
+        reason,
+    })?;
+    if !mended.is_nothing() {
+        eprintln!("{file}: mended: {mended}");
+    }
+    tetrahedralize(file, surface, options.surface_nodes)
+}
+
 /// The mesh in the `bytes` of `path`, scaled and turned into RAS, with the regions it names.
 fn read_mesh(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<TetMesh, ImportError> {
     let file = path.display().to_string();
@@ -240,6 +276,7 @@ fn read_mesh(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<Tet
         Frame::Ras => surface.scaled(options.scale),
         Frame::Lps => surface.scaled(options.scale).turned_about_z(),
     };
+    let meshed = |surface: SurfaceMesh| mended_and_meshed(&file, placed(surface), options);
     let text = |bytes: Vec<u8>| {
         String::from_utf8(bytes).map_err(|e| ImportError::Unsupported {
             file: file.clone(),
@@ -259,21 +296,21 @@ fn read_mesh(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<Tet
         "vtk" => match vtk::read(&file, &text(bytes)?)? {
             vtk::Dataset::Grid(raw) => raw,
             vtk::Dataset::Surface(surface) => {
-                return tetrahedralize(&file, placed(surface), options.surface_nodes);
+                return meshed(surface);
             }
         },
         "vtu" => vtu::read(&file, &text(bytes)?)?,
         "obj" => {
             let surface = read_obj(&file, &text(bytes)?)?;
-            return tetrahedralize(&file, placed(surface), options.surface_nodes);
+            return meshed(surface);
         }
         "stl" => {
             let surface = read_stl(&file, &bytes)?;
-            return tetrahedralize(&file, placed(surface), options.surface_nodes);
+            return meshed(surface);
         }
         "ply" => {
             let surface = read_ply(&file, &bytes)?;
-            return tetrahedralize(&file, placed(surface), options.surface_nodes);
+            return meshed(surface);
         }
         _ => {
             return Err(ImportError::Unsupported {

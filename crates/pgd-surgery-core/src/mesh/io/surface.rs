@@ -8,7 +8,6 @@ use parry3d::query::PointQuery;
 use parry3d::shape::{TriMesh, TriMeshFlags};
 
 use super::ImportError;
-use super::mend::mend;
 use super::tokens::Tokens;
 use crate::mesh::{Implicit, TetMesh, stuff_to_node_count};
 use crate::parry_interop::to_parry;
@@ -190,22 +189,17 @@ fn merge_vertices(triangles: Vec<[Point3<f64>; 3]>) -> SurfaceMesh {
     surface
 }
 
-/// Tetrahedralizes the inside of a surface, with about `target_nodes` nodes, once it is
-/// mended ([`mend`]: what was mended is said on the error stream) and found closed, manifold
-/// and consistently oriented.
+/// Tetrahedralizes the inside of a closed, manifold, consistently oriented surface, with about
+/// `target_nodes` nodes.
 pub fn tetrahedralize(
     file: &str,
-    surface: SurfaceMesh,
+    mut surface: SurfaceMesh,
     target_nodes: usize,
 ) -> Result<TetMesh, ImportError> {
     let refuse = |reason: String| ImportError::Unusable {
         file: file.to_owned(),
         reason,
     };
-    let (mut surface, mended) = mend(surface).map_err(refuse)?;
-    if !mended.is_nothing() {
-        eprintln!("{file}: mended: {mended}");
-    }
     check_closed(&surface).map_err(refuse)?;
     let (min, max) = bounds(&surface.vertices);
     let size = (max - min).norm();
