@@ -156,7 +156,12 @@ pub fn tie_organs(scene: &mut HapticScene, attachment: &AttachmentEntry) -> Resu
             Coupling::new(&scene.organs, &[], &apart, None).map_err(|e| e.to_string())?;
         scene.coupling = Some(Arc::new(coupling));
     }
-    scene.beds.push(TiedOrgans::new(bed, freed, base));
+    let freed_index = freed.0;
+    let mut tied = TiedOrgans::new(bed, freed.clone(), base);
+    if let Some(model) = (scene.dynamics.as_ref()).and_then(|d| d.model(freed_index)) {
+        tied.restrain_kept_modes(&model.basis, &freed.1);
+    }
+    scene.beds.push(tied);
     Ok(())
 }
 

@@ -538,3 +538,59 @@ fn a_freed_gallbladder_hangs_from_what_is_left_and_swings() {
     assert!(turns >= 2, "{turns} turns");
     assert!(ranges[3] < ranges[0], "{ranges:?}");
 }
+
+/// What the left hand felt over a pull (each tick while its jaws held), and the ties' sum on
+/// the gallbladder at the end of it.
+struct Pull {
+    force_n: Vec<Vector3<f64>>,
+    ties_n: Vector3<f64>,
+}
+
+/// The grasper draws the gallbladder 30 mm away from the liver from 1 s to 4 s, its bed whole
+/// or every tie divided; what the hand felt until the jaws open.
+fn pull_off(severed: bool) -> Pull {
+    use pgd_surgery::app::haptic::DeviceForce;
+    let pull_until_s = 4.0;
+    let mut haptic = pulled_off_the_bed(30.0, pull_until_s);
+    if severed {
+        let mut beds = haptic.world_mut().resource_mut::<OrganBeds>();
+        let bed = &mut beds.0[0].bed;
+        let law = bed.law;
+        bed.ties.iter_mut().for_each(|t| t.state.sever(&law));
+    }
+    let mut force_n = Vec::new();
+    for tick in 0..(pull_until_s / TICK_S) as u64 {
+        tick_at(&mut haptic, tick);
+        force_n.push(haptic.hand::<DeviceForce>(1).unwrap().desired_n);
+    }
+    let ties_n = haptic.world().resource::<OrganBeds>().0[0]
+        .report()
+        .force_on_freed_n;
+    Pull { force_n, ties_n }
+}
+
+/// A grasped gallbladder feels its bed: drawn 30 mm away from the liver, it pulls back on the
+/// hand at least twice as hard as the same gallbladder with every tie divided (the ties hold
+/// its kept modes as well as its static field), the ties' sum on it points back against the
+/// pull, and the hand's force stays finite and changes by at most 20 mN a tick while the jaws
+/// hold.
+#[test]
+fn a_grasped_gallbladder_feels_its_bed() {
+    let (tied, freed) = (pull_off(false), pull_off(true));
+    let last = |p: &Pull| p.force_n[p.force_n.len() - 1].norm();
+    let largest_change = (tied.force_n.windows(2))
+        .map(|w| (w[1] - w[0]).norm())
+        .fold(0.0, f64::max);
+    let away = Vector3::new(0.0, 0.4, -1.0).normalize();
+    eprintln!(
+        "drawn 30 mm: {:.3} N tied, {:.3} N freed; the ties pull back {:.3} N; largest change {:.2} mN a tick",
+        last(&tied),
+        last(&freed),
+        -tied.ties_n.dot(&away),
+        largest_change * 1e3
+    );
+    assert!((tied.force_n.iter().chain(&freed.force_n)).all(|f| f.iter().all(|c| c.is_finite())));
+    assert!(last(&tied) >= 2.0 * last(&freed));
+    assert!(tied.ties_n.dot(&away) < 0.0);
+    assert!(largest_change <= 0.02, "{largest_change} N in a tick");
+}

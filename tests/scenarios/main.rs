@@ -1145,6 +1145,14 @@ fn dissection_frees_the_bed_and_a_burn_through_the_wall_fails_it() {
     assert!((done.energy.on_ties_j - done.energy.total_j).abs() < 1e-9);
     let hold = metrics.countertraction.as_ref().unwrap();
     assert!(hold.in_band_share() > 0.95, "{hold:?}");
+    eprintln!(
+        "competent: {:.1} % released, {} ties divided, {:.0} J on the ties, {:.1} s, score {:.0}",
+        100.0 * done.released_share,
+        done.ties_divided,
+        done.energy.on_ties_j,
+        metrics.time_s,
+        competent.score
+    );
 
     let careless = run(name, "careless").card;
     let metrics = &careless.tasks[1].metrics;

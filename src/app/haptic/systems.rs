@@ -16,6 +16,7 @@ use super::resources::{OrganBeds, OrganCoupling, TickClock};
 use super::snapshot::{HandSnapshot, InstrumentsView, LoopTiming, SnapshotPublisher};
 use crate::contact::{Target, follow, press};
 use crate::devices::{Action, Fault, Fulcrum};
+use crate::dissection::TiedOrgans;
 use crate::pgd::{Deformation, Patch, SurfacePoint};
 
 /// Reads each hand's device into its [`Tool::hand`], mapped onto the scene. A non-finite
@@ -313,7 +314,7 @@ pub fn organ_contact(
     let coupling = &mut coupling.0;
     for organ in &organs {
         let deformation = &organ.deformation.0;
-        let moved = organ.motion.map_or(&[][..], |m| &m.in_vademecum_modes);
+        let moved = (organ.motion.as_ref()).map_or(&[][..], |m| &m.in_vademecum_modes[..]);
         coupling.read(organ.index.0, deformation, moved);
         let slot = organ.touch.pressing().unwrap_or(0);
         let contact = organ.touch.0[slot].contact.as_ref();
@@ -322,6 +323,7 @@ pub fn organ_contact(
     coupling.tick();
     for bed in beds.iter_mut().flat_map(|b| b.0.iter_mut()) {
         bed.tick(coupling);
+        restrain(bed, &mut organs);
     }
     for mut organ in &mut organs {
         let index = organ.index.0;
@@ -338,6 +340,18 @@ pub fn organ_contact(
     }
 }
 
+/// Hands a bed's hold on its freed organ's kept modes to that organ's motion, if it moves.
+fn restrain(bed: &TiedOrgans, organs: &mut Query<CoupledOrgan>) {
+    let Some((freed, stiffness)) = bed.restraint() else {
+        return;
+    };
+    let moving = organs.iter_mut().find(|o| o.index.0 == freed);
+    if let Some(mut motion) = moving.and_then(|o| o.motion) {
+        let motion = &mut *motion;
+        (motion.organ).set_restraint(&motion.model.basis.omega2, stiffness);
+    }
+}
+
 /// An organ as the organ/organ contact stage reads and loads it.
 #[derive(QueryData)]
 #[query_data(mutable)]
@@ -345,7 +359,7 @@ pub struct CoupledOrgan {
     index: &'static OrganIndex,
     touch: &'static mut HandTouches,
     deformation: &'static mut OrganDeformation,
-    motion: Option<&'static OrganMotion>,
+    motion: Option<&'static mut OrganMotion>,
 }
 
 /// The force on each hand's tool: the opposite of what it applies to the organs; through a

@@ -15,6 +15,13 @@
 //! below the levels that reach them, and a stiffening tissue's corrections, taken at full
 //! weight, make the compliance far from positive.
 //!
+//! A freed organ that moves (reduced dynamics, which a grasper drives) is also held by the
+//! ties in its kept modes: each tick they give it their stiffness over those modes,
+//! `K_r = Σ kᵢ Φᵢᵀ Φᵢ` (each live tie's secant stiffness times its area, `Φᵢ` the kept modes
+//! at its end on the organ), so that a pull on it is resisted as the bed resists it and lets
+//! go as the ties fail. The springs are taken to the liver as fixed: its give under the ties
+//! is far below theirs.
+//!
 //! The ties load both organs through their linear modes alone: together they are a traction
 //! spread over the bed, which has no dimple under each tie for the near field to draw. The
 //! near field of other loads (the dimple under a tool) is not read at the ties either.
@@ -27,6 +34,7 @@ use super::bed::Bed;
 use super::cautery::{CauteryMode, TieBurns, TissueHeat};
 use super::solve::{TieCompliance, TieConvergence, TieSolve};
 use crate::contact::{Coupling, ModalRows, OrganPose};
+use crate::dynamics::ModalBasis;
 use crate::pgd::Vademecum;
 
 /// The connective tissue layer's thickness the hook burns through (m): the bed's ties span
@@ -185,6 +193,37 @@ pub struct TiedOrgans {
     ends_m: Vec<TieEnds>,
     burns: TieBurns,
     report: TiedReport,
+    kept: Option<KeptAtTies>,
+}
+
+/// The freed organ's kept vibration modes at the ties, and the ties' stiffness over them.
+#[derive(Clone, Debug)]
+struct KeptAtTies {
+    modes: usize,
+    /// `[tie * modes + mode]`: the mode's displacement at the tie's end on the organ.
+    at_ties: Vec<Vector3<f64>>,
+    /// `modes × modes`, row-major (s⁻² in the mass-orthonormal modes).
+    stiffness: Vec<f64>,
+}
+
+impl KeptAtTies {
+    /// `K_r = Σ kᵢ Φᵢᵀ Φᵢ` over the live ties of `bed`.
+    fn restrain(&mut self, bed: &Bed) {
+        let (law, r) = (&bed.law, self.modes);
+        self.stiffness.fill(0.0);
+        for (tie, phi) in bed.ties.iter().zip(self.at_ties.chunks_exact(r)) {
+            let k = law.stiffness_pa_per_m * (1.0 - tie.state.damage(law)) * tie.area_m2;
+            if tie.state.failed(law) || k <= 0.0 {
+                continue;
+            }
+            for (a, row) in self.stiffness.chunks_exact_mut(r).enumerate() {
+                let phi_a = phi[a] * k;
+                row.iter_mut()
+                    .zip(phi)
+                    .for_each(|(s, phi_b)| *s += phi_a.dot(phi_b));
+            }
+        }
+    }
 }
 
 /// Where a tie's two ends are (m, the scene's frame): on the freed organ and on its base.
@@ -248,7 +287,35 @@ impl TiedOrgans {
             ends_m,
             burns: TieBurns::new(n, TissueHeat::SOFT_TISSUE, LAYER_THICKNESS_M),
             report: TiedReport::default(),
+            kept: None,
         }
+    }
+
+    /// Holds the freed organ's kept modes (`basis`, of the organ whose vademecum is `freed`)
+    /// by the ties too: from the next tick, [`Self::restraint`] gives their stiffness over
+    /// them.
+    pub fn restrain_kept_modes(&mut self, basis: &ModalBasis, freed: &Vademecum) {
+        let modes = basis.len();
+        let at_ties = (self.bed.ties.iter())
+            .flat_map(|tie| {
+                let node = freed.positions[tie.position] as usize;
+                (0..modes).map(move |k| {
+                    Vector3::from_column_slice(&basis.mode(k)[3 * node..3 * node + 3])
+                })
+            })
+            .collect();
+        self.kept = Some(KeptAtTies {
+            modes,
+            at_ties,
+            stiffness: vec![0.0; modes * modes],
+        });
+    }
+
+    /// The freed organ's index in the coupling and the live ties' stiffness over its kept
+    /// modes as the last tick left them (`modes × modes`, row-major, s⁻²), if the ties hold
+    /// its kept modes ([`Self::restrain_kept_modes`]).
+    pub fn restraint(&self) -> Option<(usize, &[f64])> {
+        (self.kept.as_ref()).map(|kept| (self.freed.index, &kept.stiffness[..]))
     }
 
     /// Where each tie's ends are, as the last tick left them (at rest before the first).
@@ -349,6 +416,9 @@ impl TiedOrgans {
                 .count(),
             products: products + 1,
         };
+        if let Some(kept) = &mut self.kept {
+            kept.restrain(&self.bed);
+        }
         self.freed.gather(&self.forces_n, 1.0);
         self.base.gather(&self.forces_n, -1.0);
         coupling.add_linear_load(self.freed.index, &self.freed.linear, &force_on_freed_n);

@@ -15,12 +15,18 @@
 //!   slip the tissue leaves the jaws.
 //! - **Release**: when the jaws open (or the tissue escapes), the organ is let go at once and
 //!   swings back; the force at the hand fades to zero over `release_s`, so it never jumps.
+//! - **A restraint** (a bed's ties holding the organ where it lies, as a stiffness over the
+//!   kept modes, [`GraspedOrgan::set_restraint`]) is stepped with the organ, and the kept
+//!   modes' static share of the jaws' pull is the restrained organ's, `(Λ + K_r)⁻¹ Φₛᵀ F`:
+//!   the hand feels the organ held by its bed, and the vademecum's static field (in which the
+//!   ties hold the organ too) is what the motion corrects.
 //! - **Damage**: a pull above `damage_force_n`, or the grasped point drawn further than
 //!   `damage_stretch_m` from where it was grasped, marks the tissue damaged (reported once per
 //!   grasp).
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::small_spd::SmallSpd;
 use super::{DynamicsError, EnergyMomentum, ModalBasis, ReducedKsv, ReducedState};
 
 /// The grasper's settings. The defaults are chosen for a hand-held device of about 3 N peak,
@@ -183,6 +189,8 @@ pub struct GraspedOrgan {
     load: Vec<f64>,
     /// The force the jaws put on the organ this tick (N).
     applied_n: Vector3<f64>,
+    /// `Λ + K_r` factored, while a restraint holds the organ.
+    restrained_stiffness: Option<SmallSpd>,
 }
 
 impl GraspedOrgan {
@@ -204,7 +212,30 @@ impl GraspedOrgan {
             previous_hand_m: None,
             load: vec![0.0; r],
             applied_n: Vector3::zeros(),
+            restrained_stiffness: None,
         }
+    }
+
+    /// Springs that hold the organ where it lies (a bed's ties), as a stiffness over the kept
+    /// modes (`r × r`, row-major, symmetric positive semi-definite, s⁻²), the modes' squared
+    /// frequencies being `omega2`: they act from the next tick on. All zeros lets the organ
+    /// go. Allocates only the first time.
+    pub fn set_restraint(&mut self, omega2: &[f64], stiffness: &[f64]) {
+        self.step.set_restraint(stiffness);
+        if self.step.restraint().is_none() {
+            self.restrained_stiffness = None;
+            return;
+        }
+        let r = omega2.len();
+        let factor = self
+            .restrained_stiffness
+            .get_or_insert_with(|| SmallSpd::identity(r));
+        factor.refactor(|m| {
+            for (i, j) in (0..r).flat_map(|i| (0..r).map(move |j| (i, j))) {
+                let diagonal = if i == j { omega2[i] } else { 0.0 };
+                m[(i, j)] = diagonal + stiffness[i * r + j];
+            }
+        });
     }
 
     /// One tick with the hand at `hand_m`, the jaws kept `closed` or opened: the coupling
@@ -301,17 +332,18 @@ impl GraspedOrgan {
     }
 
     /// The kept modes' dynamic correction to the static answer of the jaws' load,
-    /// `q − Λ⁻¹ Φₛᵀ F` (mode acceleration), into `out`: the organ's displacement is the
-    /// vademecum's static field for `F` at the point plus `Φ` times this.
+    /// `q − Λ⁻¹ Φₛᵀ F` (mode acceleration; `q − (Λ + K_r)⁻¹ Φₛᵀ F` under a restraint), into
+    /// `out`: the organ's displacement is the vademecum's static field for `F` at the point
+    /// plus `Φ` times this.
     pub fn correction(&self, omega2: &[f64], out: &mut [f64]) {
-        for (((o, q), phi), w2) in out
-            .iter_mut()
-            .zip(&self.state.q)
-            .zip(&self.point.modes)
-            .zip(omega2)
-        {
-            *o = q - phi.dot(&self.applied_n) / w2;
+        self.point.generalized(&self.applied_n, out);
+        match &self.restrained_stiffness {
+            Some(factor) => factor.solve(out),
+            None => out.iter_mut().zip(omega2).for_each(|(o, w2)| *o /= w2),
         }
+        out.iter_mut()
+            .zip(&self.state.q)
+            .for_each(|(o, q)| *o = q - *o);
     }
 
     /// How far the kept modes have moved the grasp point from rest (m).

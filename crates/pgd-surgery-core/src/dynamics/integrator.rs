@@ -16,10 +16,17 @@
 //! so 3.6–5.5 iterations reach the default tolerance (or, asked, round-off) with no
 //! factorization. Where they do not (a body far turned from rest), the exact Jacobian takes
 //! over.
+//!
+//! A **restraint** (springs that hold the body where it lies, such as a bed's ties, as a
+//! symmetric positive stiffness `K_r` over the modes) adds `K_r (q₀ + q₁)/2` to the
+//! algorithmic force: the midpoint rule conserves a linear spring's energy exactly, so the
+//! step stays unconditionally stable however stiff the springs. Half of it joins the rest
+//! Jacobian, which is then factored once as the restraint is set.
 
 use nalgebra::{DMatrix, DVector};
 
 use super::polynomial::Scratch;
+use super::small_spd::SmallSpd;
 use super::{DynamicsError, ReducedKsv};
 
 /// Iterations with the rest Jacobian before Newton's method takes the exact one: enough
@@ -103,6 +110,12 @@ pub struct EnergyMomentum {
     /// Per mode: `cᵢ` (1/s) and the Newton Jacobian's diagonal.
     damping: Vec<f64>,
     jacobian: Vec<f64>,
+    /// The restraint's stiffness over the modes (s⁻², mass-orthonormal modes), row-major;
+    /// all zero unless set.
+    restraint: Vec<f64>,
+    restrained: bool,
+    /// With a restraint, the rest Jacobian with half its stiffness, factored.
+    restrained_jacobian: SmallSpd,
     /// The step is solved when an update of `Δ` is below this (relative).
     pub tolerance: f64,
     /// Iterate past the tolerance to round-off: energy and momentum then stay to round-off
@@ -128,10 +141,14 @@ impl EnergyMomentum {
             .zip(&damping)
             .map(|(w2, c)| 2.0 / (step_s * step_s) + c / step_s + 0.5 * w2.max(0.0))
             .collect();
+        let r = model.len();
         Self {
             step_s,
             damping,
             jacobian,
+            restraint: vec![0.0; r * r],
+            restrained: false,
+            restrained_jacobian: SmallSpd::identity(r),
             tolerance: 1e-9,
             to_round_off: false,
             max_iterations: 50,
@@ -145,6 +162,28 @@ impl EnergyMomentum {
 
     pub fn step_s(&self) -> f64 {
         self.step_s
+    }
+
+    /// Sets the restraint's stiffness over the modes (`r × r`, row-major, symmetric and
+    /// positive semi-definite; s⁻² in the mass-orthonormal modes): it holds from the next step
+    /// on. All zeros lets the body go.
+    pub fn set_restraint(&mut self, stiffness: &[f64]) {
+        self.restraint.copy_from_slice(stiffness);
+        self.restrained = stiffness.iter().any(|&k| k != 0.0);
+        if self.restrained {
+            let (diagonal, r) = (&self.jacobian, self.jacobian.len());
+            self.restrained_jacobian.refactor(|m| {
+                for (i, j) in (0..r).flat_map(|i| (0..r).map(move |j| (i, j))) {
+                    let on_diagonal = if i == j { diagonal[i] } else { 0.0 };
+                    m[(i, j)] = on_diagonal + 0.5 * stiffness[i * r + j];
+                }
+            });
+        }
+    }
+
+    /// The restraint's stiffness as last set (row-major; zeros when none).
+    pub fn restraint(&self) -> Option<&[f64]> {
+        self.restrained.then_some(&self.restraint[..])
     }
 
     /// Advances `state` by one step under the generalized force `external` (held over the
@@ -165,6 +204,8 @@ impl EnergyMomentum {
             self.residual(model, state, external);
             if iteration > REST_ITERATIONS && model.is_nonlinear() {
                 self.exact_newton_update(model, state)?;
+            } else if self.restrained {
+                self.restrained_jacobian.solve(&mut self.residual);
             } else {
                 for (r, j) in self.residual.iter_mut().zip(&self.jacobian) {
                     *r /= j;
@@ -211,6 +252,13 @@ impl EnergyMomentum {
             *q1 = q0 + d;
         }
         model.algorithmic_force((&state.q, &self.q1), &mut self.force, &mut self.scratch);
+        if self.restrained {
+            let r = self.force.len();
+            for (f, row) in self.force.iter_mut().zip(self.restraint.chunks_exact(r)) {
+                let mid = row.iter().zip(state.q.iter().zip(&self.q1));
+                *f += mid.map(|(k, (q0, q1))| k * 0.5 * (q0 + q1)).sum::<f64>();
+            }
+        }
         let terms = self.delta.iter().zip(&state.v).zip(&self.damping);
         let forces = self.force.iter().zip(external);
         for ((residual, ((d, v), c)), (f, e)) in self.residual.iter_mut().zip(terms).zip(forces) {
@@ -230,6 +278,9 @@ impl EnergyMomentum {
         let mut matrix = DMatrix::from_row_slice(r, r, &jacobian);
         for i in 0..r {
             matrix[(i, i)] += 2.0 / (h * h) + self.damping[i] / h;
+            for j in 0..r {
+                matrix[(i, j)] += 0.5 * self.restraint[i * r + j];
+            }
         }
         let update = matrix
             .lu()

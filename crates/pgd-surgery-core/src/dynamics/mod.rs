@@ -21,6 +21,7 @@ mod integrator;
 mod mode_fit;
 mod organ;
 mod polynomial;
+mod small_spd;
 
 pub use basis::ModalBasis;
 pub use error::DynamicsError;

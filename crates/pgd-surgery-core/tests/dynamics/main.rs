@@ -8,3 +8,4 @@ mod grasp;
 mod modal;
 mod mode_fit;
 mod polynomial;
+mod restraint;
