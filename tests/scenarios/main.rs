@@ -786,6 +786,111 @@ fn an_organ_from_a_mesh_file_feels_as_the_organ_it_was_written_from() {
     );
 }
 
+/// `mesh`'s boundary as an ASCII STL in millimetres, each triangle facing out of its
+/// tetrahedron: a surface as a segmentation tool exports it.
+fn write_stl_mm(path: &Path, mesh: &TetMesh) {
+    use std::collections::HashMap;
+    let nodes = mesh.nodes();
+    let mut faces: HashMap<[usize; 3], ([usize; 3], usize)> = HashMap::new();
+    for tet in mesh.tets() {
+        for skip in 0..4 {
+            let face: Vec<usize> = (0..4).filter(|&c| c != skip).map(|c| tet[c]).collect();
+            let mut key = [face[0], face[1], face[2]];
+            key.sort_unstable();
+            let entry = ([face[0], face[1], face[2]], tet[skip]);
+            if faces.remove(&key).is_none() {
+                faces.insert(key, entry);
+            }
+        }
+    }
+    let mut stl = String::from("solid liver\n");
+    for ([a, b, c], opposite) in faces.into_values() {
+        let (pa, pb, pc) = (nodes[a], nodes[b], nodes[c]);
+        let normal = (pb - pa).cross(&(pc - pa));
+        let outward = normal.dot(&(pa - nodes[opposite])) > 0.0;
+        let corners = if outward { [pa, pb, pc] } else { [pa, pc, pb] };
+        stl.push_str("facet normal 0 0 0\nouter loop\n");
+        for p in corners {
+            stl.push_str(&format!(
+                "vertex {} {} {}\n",
+                p.x * 1e3,
+                p.y * 1e3,
+                p.z * 1e3
+            ));
+        }
+        stl.push_str("endloop\nendfacet\n");
+    }
+    stl.push_str("endsolid liver\n");
+    std::fs::write(path, stl).unwrap();
+}
+
+/// From a segmentation to a rehearsal, as the README's three commands and the shipped example
+/// scenario go: the coarse liver's surface written as an STL in millimetres (what a
+/// segmentation exports), imported by `pgd mesh --scale 0.001 --clamp facing:0,-1,0,35` into
+/// the example's mesh (as many nodes as the coarse liver has), and
+/// `scenarios/examples/patient-liver.scenario.ron` run on it (its vademecum built) with the
+/// steady press's competent script: the task is passed, and the press holds within 25 % of
+/// what it holds on the coarse liver itself clamped by the same selector. That is the
+/// remeshing tolerance: the surface is meshed anew by the tetrahedralizer, and on meshes this
+/// coarse the new mesh is 23 % stiffer under the probe (measured; docs/geometry.md).
+#[test]
+fn the_patient_example_runs_from_a_segmentation_surface() {
+    let folder = Path::new(env!("CARGO_TARGET_TMPDIR")).join("patient-example");
+    std::fs::create_dir_all(folder.join("meshes")).unwrap();
+    let settings = OrganSettings {
+        resolution: 0.25,
+        ..OrganSettings::default()
+    };
+    let liver = generate(Organ::Liver, &settings).unwrap();
+    let surface = folder.join("liver.stl");
+    write_stl_mm(&surface, &liver);
+    let mesh = folder.join("meshes/patient-liver.vtu");
+    let _ = std::fs::remove_file(&mesh);
+    let imported = Command::new(env!("CARGO_BIN_EXE_pgd"))
+        .arg("mesh")
+        .arg(&surface)
+        .args(["--scale", "0.001", "--clamp", "facing:0,-1,0,35"])
+        .args(["--nodes", &liver.nodes().len().to_string(), "--out"])
+        .arg(&mesh)
+        .output()
+        .unwrap();
+    assert!(
+        imported.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&imported.stdout),
+        String::from_utf8_lossy(&imported.stderr)
+    );
+    let shipped = root().join("scenarios/examples/patient-liver.scenario.ron");
+    let file = folder.join("patient-liver.scenario.ron");
+    std::fs::copy(&shipped, &file).unwrap();
+    let scenario = load(&file).unwrap();
+    scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Rebuild).unwrap();
+    let outcome = run_scenario(scenario, "liver-steady-press", "competent");
+    let held = |trace: &[(f64, f64)]| {
+        let held: Vec<f64> = (trace.iter())
+            .filter(|(t, _)| (2.0..4.0).contains(t))
+            .map(|(_, f)| *f)
+            .collect();
+        held.iter().sum::<f64>() / held.len() as f64
+    };
+    let patient_n = held(&outcome.force_trace);
+    write_vtu(&folder.join("meshes/coarse-liver.vtu"), &liver, &[]).unwrap();
+    let same_clamp = r#"Organ(name: "coarse-liver", mesh: "meshes/coarse-liver.vtu", law: Linear,
+                               clamp: [Facing(0, -1, 0, 35)])"#;
+    let generated = parse(&file, &one_organ_press(same_clamp, "coarse-liver")).unwrap();
+    let generated_n = held_force_n(generated);
+    eprintln!(
+        "held {patient_n:.4} N on the patient's liver, {generated_n:.4} N on the coarse one; \
+         score {:.0}",
+        outcome.card.score
+    );
+    assert!(outcome.card.passed, "{:#?}", outcome.card);
+    assert!(
+        ((patient_n - generated_n) / generated_n).abs() < 0.25,
+        "{patient_n} N against {generated_n} N"
+    );
+}
+
 /// A mesh file whose regions have other names (as a segmentation tool's would): the
 /// scenario picks them with `clamp: [Region(…)]` and `accessible: [Region(…)]`, and the organ
 /// pushes back as the generated liver whose regions they are, to 1e-6 relative. A selector
