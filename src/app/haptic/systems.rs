@@ -134,9 +134,14 @@ struct PressedOrgan<'a> {
     motion: Option<&'a OrganMotion>,
 }
 
-/// Hand `slot`'s tool pressed into one organ: its contact, and its load next.
+/// Hand `slot`'s tool pressed into one organ: its contact, and its load next. Jaws that hold
+/// the organ, or are letting it go (the hand's force fading), press none of it: held, the
+/// grasp stage sets their load; opening, they leave the tissue they held, which is where they
+/// are.
 fn press_organ(slot: usize, tool: &Tool, organ: &PressedOrgan, touch: &mut ToolTouch) {
-    let Some(sample) = &tool.sample else {
+    let jaws_on_it = (organ.motion)
+        .is_some_and(|m| m.hand == slot && (m.organ.holding() || m.organ.releasing()));
+    let Some(sample) = tool.sample.as_ref().filter(|_| !jaws_on_it) else {
         touch.next_load.release();
         touch.contact = None;
         return;

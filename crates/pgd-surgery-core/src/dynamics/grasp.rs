@@ -331,6 +331,11 @@ impl GraspedOrgan {
         matches!(self.jaws, Jaws::Holding { .. })
     }
 
+    /// Whether the jaws have let the tissue go and the hand's force is still fading.
+    pub fn releasing(&self) -> bool {
+        matches!(self.jaws, Jaws::Releasing { .. })
+    }
+
     /// The kept modes' dynamic correction to the static answer of the jaws' load,
     /// `q − Λ⁻¹ Φₛᵀ F` (mode acceleration; `q − (Λ + K_r)⁻¹ Φₛᵀ F` under a restraint), into
     /// `out`: the organ's displacement is the vademecum's static field for `F` at the point
