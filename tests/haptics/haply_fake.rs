@@ -24,7 +24,7 @@ use tungstenite::{Message, WebSocket};
 pub const DEVICE_ID: &str = "049D";
 pub const GRIP_ID: &str = "0A1B";
 
-/// The handle's mass (kg), the hand's spring (N/m) and damping (N s/m, critical).
+/// The handle's mass (kg), the hand's spring (N/m) and damping (N s/m): critical, `2 √(k m)`.
 const MASS_KG: f64 = 0.1;
 const SPRING_N_PER_M: f64 = 200.0;
 const DAMPING_N_S_PER_M: f64 = 8.944;

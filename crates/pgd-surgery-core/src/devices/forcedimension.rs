@@ -9,8 +9,8 @@
 
 use std::ffi::{CStr, c_char, c_int, c_uint};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
@@ -18,7 +18,7 @@ use libloading::Library;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 
 use super::release::Release;
-use super::servo::ServoLink;
+use super::servo::{ServoLink, ServoThread};
 use super::vendor::VendorLibrary;
 use super::{
     DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice, Metronome, TICK_S, TimerMode,
@@ -169,7 +169,7 @@ struct Session {
     id: c_char,
     link: Arc<ServoLink>,
     running: Arc<AtomicBool>,
-    servo: Mutex<Option<JoinHandle<()>>>,
+    servo: ServoThread,
     released: AtomicBool,
 }
 
@@ -182,16 +182,7 @@ impl Release for Session {
         }
         self.link.halt();
         self.running.store(false, Ordering::Relaxed);
-        let servo = self
-            .servo
-            .lock()
-            .unwrap_or_else(|poisoned| poisoned.into_inner())
-            .take();
-        if let Some(servo) = servo
-            && servo.thread().id() != std::thread::current().id()
-        {
-            let _ = servo.join();
-        }
+        self.servo.join();
         // SAFETY: the servo has stopped; the ID is the one opened.
         unsafe {
             (self.dhd.set_force)(0.0, 0.0, 0.0, self.id);
@@ -234,7 +225,7 @@ impl ForceDimension {
             id,
             link: Arc::new(ServoLink::default()),
             running: Arc::new(AtomicBool::new(true)),
-            servo: Mutex::new(None),
+            servo: ServoThread::default(),
             released: AtomicBool::new(false),
         });
         super::register(&(session.clone() as Arc<dyn Release>));
@@ -253,7 +244,7 @@ impl ForceDimension {
         }
         let servo = spawn_servo(&session)
             .map_err(|e| failed("cannot start the servo thread", (0, e.to_string())))?;
-        *session.servo.lock().unwrap_or_else(|p| p.into_inner()) = Some(servo);
+        session.servo.set(servo);
         let model = model.unwrap_or_else(|| "device".into());
         let name = match index {
             Some(index) => format!("Force Dimension {model} ({index})"),

@@ -16,7 +16,9 @@
 //! A panic or a signal halts every link at once through [`halt_every_link`], which takes no
 //! lock: whatever thread holds the release registry, no servo renders force after it.
 
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -286,6 +288,29 @@ impl ServoLink {
     /// Samples the servo has published so far.
     pub fn samples(&self) -> u64 {
         self.samples.load(Ordering::Acquire)
+    }
+}
+
+/// A servo thread of ours (for an SDK without a scheduler of its own), stopped once when its
+/// device is released: joined, unless the release runs on the servo thread itself, which
+/// cannot wait for itself. A poisoned lock is taken as it is: release must not fail.
+#[derive(Debug, Default)]
+pub struct ServoThread(Mutex<Option<JoinHandle<()>>>);
+
+impl ServoThread {
+    /// The thread started for the device.
+    pub fn set(&self, thread: JoinHandle<()>) {
+        *self.0.lock().unwrap_or_else(|p| p.into_inner()) = Some(thread);
+    }
+
+    /// Waits for the thread to end (its `running` flag cleared by the caller), once.
+    pub fn join(&self) {
+        let thread = self.0.lock().unwrap_or_else(|p| p.into_inner()).take();
+        if let Some(thread) = thread
+            && thread.thread().id() != std::thread::current().id()
+        {
+            let _ = thread.join();
+        }
     }
 }
 

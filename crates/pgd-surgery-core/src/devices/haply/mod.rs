@@ -10,9 +10,8 @@ mod channel;
 mod servo;
 mod wire;
 
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
-use std::thread::JoinHandle;
 
 pub use channel::{DEFAULT_URL, ServiceUrl};
 pub use servo::{
@@ -24,7 +23,7 @@ pub use wire::{
 };
 
 use super::release::Release;
-use super::servo::ServoLink;
+use super::servo::{ServoLink, ServoThread};
 use super::{DeviceError, DeviceLimits, DeviceSample, EdgeForce, HapticDevice};
 use channel::{Channel, format_for};
 use servo::{SNAPSHOT_WITHIN, Servo, Shared};
@@ -33,7 +32,7 @@ use servo::{SNAPSHOT_WITHIN, Servo, Shared};
 /// leaves (see [`super::release`]).
 struct Session {
     shared: Arc<Shared>,
-    servo: Mutex<Option<JoinHandle<()>>>,
+    servo: ServoThread,
     released: AtomicBool,
 }
 
@@ -46,14 +45,7 @@ impl Release for Session {
         }
         self.shared.link.halt();
         self.shared.running.store(false, Ordering::Relaxed);
-        let servo = (self.servo.lock())
-            .unwrap_or_else(|poisoned| poisoned.into_inner())
-            .take();
-        if let Some(servo) = servo
-            && servo.thread().id() != std::thread::current().id()
-        {
-            let _ = servo.join();
-        }
+        self.servo.join();
     }
 }
 
@@ -138,7 +130,7 @@ impl Haply {
         };
         let session = Arc::new(Session {
             shared: shared.clone(),
-            servo: Mutex::new(None),
+            servo: ServoThread::default(),
             released: AtomicBool::new(false),
         });
         super::register(&(session.clone() as Arc<dyn Release>));
@@ -146,7 +138,7 @@ impl Haply {
             .name("haply servo".into())
             .spawn(move || servo.run())
             .map_err(|e| failed(&ws, format!("cannot start the servo thread: {e}")))?;
-        *session.servo.lock().unwrap_or_else(|p| p.into_inner()) = Some(thread);
+        session.servo.set(thread);
         if condition != Condition::Fine {
             eprintln!("warning: {}", condition.describe(&device_id, &ws));
         }
