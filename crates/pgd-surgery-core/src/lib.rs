@@ -3,7 +3,8 @@
 //!
 //! - the numerics: [`mesh`], [`fem`] (the reference every vademecum is checked against),
 //!   [`pgd`] (the vademecums), [`contact`], [`cutting`], [`dissection`] (organs freed from
-//!   one another), [`rods`] (ducts and vessels), [`dynamics`] (organs that move),
+//!   one another), [`rods`] (ducts and vessels), [`biliary`] (the ducts and the artery of a
+//!   cholecystectomy, their clips and division, the critical view of safety), [`dynamics`] (organs that move),
 //!   [`devices`] (the device layer), [`scenario`] (exercises), [`dense_sums`],
 //!   [`parry_interop`], and [`bench`](mod@bench), which times them;
 //! - services: [`store`] (organs and vademecums on disk) and [`report`] (files for people).
@@ -13,6 +14,7 @@
 //! (`pgd_surgery`) re-exports every module under the same name.
 
 pub mod bench;
+pub mod biliary;
 pub mod contact;
 pub mod cutting;
 pub mod dense_sums;

@@ -18,6 +18,7 @@ const LAYERS: [&[&str]; 4] = [
         "cutting",
         "dissection",
         "rods",
+        "biliary",
         "dynamics",
         "devices",
         "scenario",

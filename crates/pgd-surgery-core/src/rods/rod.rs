@@ -159,6 +159,11 @@ impl Rod {
         })
     }
 
+    /// The length of each segment at rest (m).
+    pub fn segment_m(&self) -> f64 {
+        self.segment_m
+    }
+
     /// How many nodes it has.
     pub fn nodes(&self) -> usize {
         self.rest.len()

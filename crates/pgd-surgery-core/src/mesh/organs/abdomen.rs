@@ -80,6 +80,18 @@ impl Abdomen {
         }
     }
 
+    /// The gallbladder's axis: its fundus and its neck (m).
+    pub fn gallbladder_axis_m(&self) -> (Point3<f64>, Point3<f64>) {
+        (self.fundus, self.neck)
+    }
+
+    /// The point of the duodenum's axis above its centre at `x_m` (m), on its arc.
+    pub fn duodenum_axis_above_m(&self, x_m: f64) -> Point3<f64> {
+        let arc = &self.duodenum;
+        let cos = ((x_m - arc.centre.x) / arc.arc_radius).clamp(-1.0, 1.0);
+        arc.point_at(libm::acos(cos).clamp(arc.from, arc.to))
+    }
+
     /// Length of the gallbladder from fundus to neck (m).
     pub fn gallbladder_length_m(&self) -> f64 {
         (self.neck - self.fundus).norm()

@@ -1,0 +1,166 @@
+//! The critical view of safety (Strasberg), judged from the scene: (1) the hepatocystic
+//! triangle cleared of fat, as the share of its fat's volume cleared; (2) the lower third of
+//! the gallbladder separated from its bed, as the share of the bed's area there whose ties
+//! have failed; (3) two structures, and only two, seen entering the gallbladder: each tube
+//! that enters it seen from the optic along its last centimetre, unhidden by fat, by the other
+//! tubes and by the organs.
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use super::anatomy::{BiliaryTree, Structure, Tube};
+use super::geometry::Segment;
+use crate::dissection::Bed;
+
+/// How much of each criterion is enough; a scenario may ask for more or less.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CriticalViewRule {
+    /// The share of the triangle's fat cleared.
+    pub triangle_cleared: f64,
+    /// The share of the gallbladder's lower third released from its bed.
+    pub lower_third_released: f64,
+    /// The share of a tube's last centimetre in sight for it to count as seen.
+    pub seen_share: f64,
+}
+
+impl Default for CriticalViewRule {
+    fn default() -> Self {
+        Self {
+            triangle_cleared: 0.9,
+            lower_third_released: 0.9,
+            seen_share: 0.5,
+        }
+    }
+}
+
+/// How far back from the gallbladder a tube is looked at (m), and at how many points.
+pub const ENTRY_M: f64 = 0.01;
+const ENTRY_SAMPLES: usize = 6;
+
+/// The gallbladder's lower third: its third nearest the neck along its axis.
+const LOWER_THIRD_FROM: f64 = 2.0 / 3.0;
+
+/// A tube entering the gallbladder and how much of its entry is in sight.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Entering {
+    pub structure: Structure,
+    pub seen_share: f64,
+}
+
+/// The three criteria as measured, and the rule they were judged by.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CriticalView {
+    pub triangle_cleared: f64,
+    pub lower_third_released: f64,
+    pub entering: Vec<Entering>,
+    pub rule: CriticalViewRule,
+}
+
+impl CriticalView {
+    /// Judges `tree` from the optic at `optic_m`, the gallbladder's lower third
+    /// `lower_third_released` off its bed; `organs_hide` says whether an organ stands on a
+    /// sight line.
+    pub fn judge(
+        tree: &BiliaryTree,
+        lower_third_released: f64,
+        optic_m: Vector3<f64>,
+        organs_hide: impl Fn(&Segment) -> bool,
+        rule: CriticalViewRule,
+    ) -> Self {
+        let entering = (tree.tubes.iter().filter(|t| t.enters_gallbladder))
+            .map(|tube| Entering {
+                structure: tube.structure,
+                seen_share: seen_share(tree, tube, optic_m, &organs_hide),
+            })
+            .collect();
+        Self {
+            triangle_cleared: tree.fat.cleared_share(),
+            lower_third_released,
+            entering,
+            rule,
+        }
+    }
+
+    pub fn triangle_met(&self) -> bool {
+        self.triangle_cleared >= self.rule.triangle_cleared
+    }
+
+    pub fn lower_third_met(&self) -> bool {
+        self.lower_third_released >= self.rule.lower_third_released
+    }
+
+    /// The tubes seen entering the gallbladder.
+    pub fn seen(&self) -> usize {
+        (self.entering.iter())
+            .filter(|e| e.seen_share >= self.rule.seen_share)
+            .count()
+    }
+
+    /// Two tubes enter the gallbladder, and both are seen.
+    pub fn two_structures_met(&self) -> bool {
+        self.entering.len() == 2 && self.seen() == 2
+    }
+
+    /// All three criteria met.
+    pub fn reached(&self) -> bool {
+        self.triangle_met() && self.lower_third_met() && self.two_structures_met()
+    }
+}
+
+/// The share of `tube`'s last [`ENTRY_M`] whose near side is in sight from `optic_m`.
+fn seen_share(
+    tree: &BiliaryTree,
+    tube: &Tube,
+    optic_m: Vector3<f64>,
+    organs_hide: &impl Fn(&Segment) -> bool,
+) -> f64 {
+    let length_m = tube.length_m();
+    let seen = (0..ENTRY_SAMPLES)
+        .filter(|&k| {
+            let from_end_m = ENTRY_M * (k as f64 + 0.5) / ENTRY_SAMPLES as f64;
+            let centre = tube.point_at(length_m - from_end_m);
+            let towards = (optic_m - centre).normalize();
+            let sight = Segment::new(centre + towards * tube.section.outer_radius_m, optic_m);
+            !(tree.fat.blocks(&sight)
+                || other_tubes_hide(tree, tube, &sight)
+                || organs_hide(&sight))
+        })
+        .count();
+    seen as f64 / ENTRY_SAMPLES as f64
+}
+
+fn other_tubes_hide(tree: &BiliaryTree, looked_at: &Tube, sight: &Segment) -> bool {
+    (tree
+        .tubes
+        .iter()
+        .filter(|t| t.structure != looked_at.structure))
+    .any(|tube| {
+        (tube.segments())
+            .any(|(_, axis)| axis.closest(sight).distance_m < tube.section.outer_radius_m)
+    })
+}
+
+/// The share of the area of `bed` within the freed organ's lower third (its third nearest
+/// `neck_m` along the axis from `fundus_m`) whose ties have failed; `coords_m` are the freed
+/// organ's load positions at rest. 1 where the bed has no tie there.
+pub fn lower_third_released(
+    bed: &Bed,
+    coords_m: &[[f32; 3]],
+    fundus_m: Vector3<f64>,
+    neck_m: Vector3<f64>,
+) -> f64 {
+    let axis = neck_m - fundus_m;
+    let in_lower_third = |position: usize| {
+        let at = Vector3::from(coords_m[position].map(f64::from));
+        (at - fundus_m).dot(&axis) / axis.norm_squared() >= LOWER_THIRD_FROM
+    };
+    let (mut area, mut released) = (0.0, 0.0);
+    for tie in bed.ties.iter().filter(|t| in_lower_third(t.position)) {
+        area += tie.area_m2;
+        if tie.state.failed(&bed.law) {
+            released += tie.area_m2;
+        }
+    }
+    if area > 0.0 { released / area } else { 1.0 }
+}
