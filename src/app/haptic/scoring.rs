@@ -20,7 +20,7 @@ use super::hand::{DeviceForce, HandIndex, MAX_HANDS, Tool};
 use super::resources::{OrganBeds, Scope, TickClock};
 use super::snapshot::SnapshotPublisher;
 use crate::scenario::{
-    BladeSample, Exercise, HandSample, HookTarget, Progress, RegionSite, Sample,
+    BiliarySample, BladeSample, Exercise, HandSample, HookTarget, Progress, RegionSite, Sample,
 };
 
 /// What scoring reads of an organ entity.
@@ -246,6 +246,7 @@ pub fn score_tick(
         left,
         hook,
         released_share: released_share(beds.as_deref()),
+        biliary: BiliarySample::default(),
     });
     if exercise.finished() {
         let run = &mut *run;

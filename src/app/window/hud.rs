@@ -242,6 +242,8 @@ fn action_name(action: Action) -> String {
             };
             format!("hook ({:.0} W, {mode})", hook.power_w)
         }
+        Action::Clip { .. } => "clip applier".to_owned(),
+        Action::Divide { .. } => "scissors".to_owned(),
     }
 }
 

@@ -14,7 +14,7 @@ use crate::dissection::Bed;
 
 /// How much of each criterion is enough; a scenario may ask for more or less.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[serde(rename = "CriticalView", default, deny_unknown_fields)]
 pub struct CriticalViewRule {
     /// The share of the triangle's fat cleared.
     pub triangle_cleared: f64,

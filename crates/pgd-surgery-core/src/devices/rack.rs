@@ -30,6 +30,12 @@ pub enum Action {
     Cut,
     /// An electrocautery hook: the device's first button applies its energy.
     Cauterize(crate::dissection::Cautery),
+    /// A clip applier whose jaws, this long (m), close on the device's first button and
+    /// leave a clip across the tube between them.
+    Clip { jaw_m: f64 },
+    /// Scissors whose blades, this long (m), close on the device's first button and divide
+    /// the tube between them.
+    Divide { blade_m: f64 },
 }
 
 /// An instrument: what it does, and the port it goes through (none: open surgery, the device

@@ -12,9 +12,12 @@ use crate::fem::Law;
 use crate::mesh::organs::Organ;
 
 use super::attachment::AttachmentEntry;
+use super::biliary::BiliaryEntry;
 use super::scene::{Nodule, OrganEntry, metres, organ_list};
 use super::task::Task;
-use super::units::{EdgeLength, FieldOfView, Millimetres, Newtons, Scale, ScopeAngle, Watts};
+use super::units::{
+    EdgeLength, FieldOfView, JawLength, Millimetres, Newtons, Scale, ScopeAngle, Watts,
+};
 
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -61,6 +64,11 @@ pub struct Scenario {
     /// (`Attachment(organ: "gallbladder", to: "liver")`), which the trainee frees.
     #[serde(default)]
     pub attachments: Vec<AttachmentEntry>,
+    /// The cystic duct, the common duct and the cystic artery between the gallbladder, the
+    /// liver and the duodenum, in the fat of the hepatocystic triangle (`Biliary(…)`; none
+    /// when left out).
+    #[serde(default)]
+    pub biliary: Option<BiliaryEntry>,
     /// Done in order: each task starts when the one before is done or out of time.
     pub tasks: Vec<Task>,
     #[serde(default)]
@@ -112,7 +120,27 @@ pub enum Tool {
         #[serde(default = "default_cautery_mode")]
         mode: CauteryMode,
     },
+    /// A clip applier: its closed jaws press like a probe of this radius; the device's first
+    /// button closes them, leaving a clip across the duct or artery between them, `jaw_mm`
+    /// long (9 when left out: a medium-large clip) (`docs/biliary.md`).
+    ClipApplier {
+        tip_radius_mm: Millimetres,
+        #[serde(default)]
+        jaw_mm: Option<JawLength>,
+    },
+    /// Laparoscopic scissors: they press like a probe of this radius; the device's first
+    /// button closes the blades, `blade_mm` long (15 when left out), dividing the duct or
+    /// artery between them (`docs/biliary.md`).
+    Scissors {
+        tip_radius_mm: Millimetres,
+        #[serde(default)]
+        blade_mm: Option<JawLength>,
+    },
 }
+
+/// A clip applier's jaws and scissors' blades when the scenario does not say (mm).
+pub const DEFAULT_JAW_MM: f64 = 9.0;
+pub const DEFAULT_BLADE_MM: f64 = 15.0;
 
 fn default_cautery_mode() -> CauteryMode {
     CauteryMode::Cut
@@ -132,7 +160,9 @@ impl Tool {
             Tool::Probe { tip_radius_mm }
             | Tool::Grasper { tip_radius_mm }
             | Tool::Scalpel { tip_radius_mm, .. }
-            | Tool::Hook { tip_radius_mm, .. } => tip_radius_mm.metres(),
+            | Tool::Hook { tip_radius_mm, .. }
+            | Tool::ClipApplier { tip_radius_mm, .. }
+            | Tool::Scissors { tip_radius_mm, .. } => tip_radius_mm.metres(),
         }
     }
 
@@ -169,6 +199,12 @@ impl Tool {
                 mode: *mode,
                 power_w: power_w.0,
             }),
+            Tool::ClipApplier { jaw_mm, .. } => crate::devices::Action::Clip {
+                jaw_m: jaw_mm.map_or(DEFAULT_JAW_MM, |j| j.0) * 1e-3,
+            },
+            Tool::Scissors { blade_mm, .. } => crate::devices::Action::Divide {
+                blade_m: blade_mm.map_or(DEFAULT_BLADE_MM, |b| b.0) * 1e-3,
+            },
         }
     }
 }
@@ -427,7 +463,12 @@ impl Scenario {
 
     /// Whether an instrument in either hand is an electrocautery hook.
     pub fn hook(&self) -> bool {
-        (self.hands().iter().flatten()).any(|(tool, _)| matches!(tool, Tool::Hook { .. }))
+        self.holds(|tool| matches!(tool, Tool::Hook { .. }))
+    }
+
+    /// Whether either hand has an instrument `is`.
+    pub fn holds(&self, is: impl Fn(&Tool) -> bool) -> bool {
+        (self.hands().iter().flatten()).any(|(tool, _)| is(tool))
     }
 
     /// Whether `organ` moves: as it says, else when an instrument grasps.

@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use super::attachment::{AttachmentEntry, facing};
-use super::format::{LaparoscopeEntry, Scenario};
+use super::format::{LaparoscopeEntry, Scenario, Tool};
 use super::problem::{Problem, REFERENCE, ScenarioError};
 use super::scene::{OrganEntry, metres};
 use super::task::{BandEnd, Countertraction, Hand, SceneFacts, Task, TaskCheck};
@@ -161,12 +161,16 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
         blade: scenario.blade().is_some(),
         grasps: scenario.grasps(),
         hook: scenario.hook(),
+        clips: scenario.holds(|t| matches!(t, Tool::ClipApplier { .. })),
+        divides: scenario.holds(|t| matches!(t, Tool::Scissors { .. })),
+        biliary: scenario.biliary.is_some(),
         attachments: &scenario.attachments,
         device_max_force_n: scenario.device.max_force_n.0,
     };
     for (k, task) in scenario.tasks.iter().enumerate() {
         check_task(scenario, scene, k, task, &mut problems);
     }
+    super::biliary::check(scenario.biliary.as_ref(), &scene, &mut problems);
     check_rubric(scenario, &mut problems);
     check_laparoscope(scenario, &mut problems);
     check_instruments(scenario, &mut problems);

@@ -9,6 +9,7 @@
 //! [`Exercise`] inside the haptic schedule.
 
 mod attachment;
+mod biliary;
 mod bimanual;
 pub mod curriculum;
 mod exercise;
@@ -26,6 +27,7 @@ pub mod tasks;
 mod units;
 
 pub use attachment::{AttachmentEntry, DEFAULT_TIE_GAP_MM};
+pub use biliary::BiliaryEntry;
 pub use bimanual::{BimanualMetrics, BimanualTracker};
 pub use exercise::{Exercise, Progress, Sites};
 pub use format::{
@@ -40,7 +42,10 @@ pub use keratotomy::{
 pub use load::{load, parse};
 pub use motion::{IDLE_M_PER_S, MOVING_M_PER_S, MotionMetrics, MotionTracker, STRIDE};
 pub use problem::ScenarioError;
-pub use sample::{HandSample, HookSample, HookTarget, NoduleSite, RegionSite, Sample, WallSample};
+pub use sample::{
+    BiliarySample, HandSample, HookSample, HookTarget, NoduleSite, RegionSite, Sample, ViewSample,
+    WallSample,
+};
 pub use scene::{Nodule, OrganEntry, Spot, metres};
 pub use score::{CutMade, Scorecard, TaskScore, score};
 pub use task::{

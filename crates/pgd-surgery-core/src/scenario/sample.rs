@@ -4,6 +4,7 @@
 use nalgebra::Vector3;
 
 use super::incision::BladeSample;
+use crate::biliary::{Clip, Division};
 use crate::pgd::SurfacePoint;
 
 /// What the haptic loop knows of one tick, for scoring.
@@ -47,6 +48,42 @@ pub struct Sample {
     pub hook: HookSample,
     /// The share (0–1, by area) of the scene's attachments released so far.
     pub released_share: f64,
+    /// What happened to the biliary tree in this tick (nothing without one).
+    pub biliary: BiliarySample,
+}
+
+/// The biliary tree in one tick: a clip placed or a tube divided in it, what the open stumps
+/// have let out so far and the critical view of safety as it stands.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BiliarySample {
+    pub clip: Option<Clip>,
+    pub division: Option<Division>,
+    pub blood_lost_m3: f64,
+    pub bile_spilled_m3: f64,
+    pub view: ViewSample,
+}
+
+/// The critical view of safety's criteria, as [`crate::biliary::CriticalView`] measures them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ViewSample {
+    pub triangle_cleared: f64,
+    pub lower_third_released: f64,
+    /// The tubes entering the gallbladder, and how many of them are seen.
+    pub entering: u8,
+    pub seen: u8,
+    pub reached: bool,
+}
+
+impl ViewSample {
+    pub fn of(view: &crate::biliary::CriticalView) -> Self {
+        Self {
+            triangle_cleared: view.triangle_cleared,
+            lower_third_released: view.lower_third_released,
+            entering: view.entering.len() as u8,
+            seen: view.seen() as u8,
+            reached: view.reached(),
+        }
+    }
 }
 
 /// The energy an electrocautery hook delivered in one tick, and what took it.

@@ -450,6 +450,31 @@ impl TryFrom<f64> for ReleaseShare {
     }
 }
 
+/// The length of a clip applier's jaws or of scissors' blades, in millimetres: from 3 to 30
+/// (a medium-large ligating clip is about 9 mm long).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "f64")]
+pub struct JawLength(pub f64);
+
+impl JawLength {
+    pub fn metres(self) -> f64 {
+        self.0 * 1e-3
+    }
+}
+
+impl TryFrom<f64> for JawLength {
+    type Error = String;
+    fn try_from(value: f64) -> Result<Self, String> {
+        match value {
+            v if v.is_finite() && (3.0..=30.0).contains(&v) => Ok(Self(v)),
+            v => Err(format!(
+                "{v} mm is not the length of a laparoscopic instrument's jaws: from 3 to 30 mm \
+                 (a medium-large clip is 9 mm, scissors' blades about 15)"
+            )),
+        }
+    }
+}
+
 /// A score, 0 to 100.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(try_from = "f64")]

@@ -4,6 +4,8 @@
 //! the common bile duct; a bleed's volume against Poiseuille's law; and each criterion of the
 //! critical view of safety met and not met on constructed scenes.
 
+mod task;
+
 use nalgebra::{Unit, Vector3};
 use pgd_surgery_core::biliary::anatomy::RANGES;
 use pgd_surgery_core::biliary::critical_view::lower_third_released;

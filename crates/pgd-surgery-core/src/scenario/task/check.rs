@@ -16,8 +16,14 @@ pub struct SceneFacts<'a> {
     pub blade: bool,
     /// ...or a grasper...
     pub grasps: bool,
-    /// ...or an electrocautery hook.
+    /// ...or an electrocautery hook...
     pub hook: bool,
+    /// ...or a clip applier...
+    pub clips: bool,
+    /// ...or scissors.
+    pub divides: bool,
+    /// Whether the scene has a biliary tree (`Biliary(…)`).
+    pub biliary: bool,
     /// The organs bound to others by connective tissue.
     pub attachments: &'a [AttachmentEntry],
     /// The most the scenario's device may push (N).

@@ -1,6 +1,7 @@
 //! The built-in task types, one module each, and their registration: adding a type is its
 //! module and a line in [`built_in`].
 
+mod clip_and_cut;
 mod dissection;
 mod force_control;
 mod grasp;
@@ -13,6 +14,7 @@ mod registry;
 mod retraction;
 mod safe_navigation;
 
+pub use clip_and_cut::{ClipAndCut, ClipAndCutResult, ClipPlaced, DivisionMade};
 pub use dissection::{BurnMade, Dissection, DissectionResult, EnergySpent};
 pub use force_control::{ForceControl, ForceControlResult};
 pub use grasp::{Grasp, GraspResult};
@@ -38,5 +40,6 @@ fn built_in() -> Vec<Entry> {
         Entry::of::<Incision>(),
         Entry::of::<RadialKeratotomy>(),
         Entry::of::<Dissection>(),
+        Entry::of::<ClipAndCut>(),
     ]
 }
