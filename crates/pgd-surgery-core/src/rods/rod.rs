@@ -96,6 +96,8 @@ pub struct Rod {
     /// Where each node is (m).
     pub positions: Vec<Vector3<f64>>,
     held: Vec<bool>,
+    /// Segments divided: neither stretched nor bent across.
+    cut: Vec<bool>,
     /// The clamped first end's direction: the first segment bends against it as against a
     /// segment before the end held in the clamp.
     clamp: Option<Vector3<f64>>,
@@ -150,6 +152,7 @@ impl Rod {
         Ok(Self {
             positions: rest.clone(),
             held: vec![false; rest.len()],
+            cut: vec![false; segments],
             clamp: None,
             scratch: Scratch::default(),
             rest,
@@ -180,6 +183,45 @@ impl Rod {
         Ok(())
     }
 
+    /// Lets node `node` go, if it was held.
+    pub fn release(&mut self, node: usize) {
+        if let Some(held) = self.held.get_mut(node) {
+            *held = false;
+        }
+    }
+
+    /// Whether node `node` is held.
+    pub fn is_held(&self, node: usize) -> bool {
+        self.held.get(node).copied().unwrap_or(false)
+    }
+
+    /// Divides segment `segment`: from now on it neither stretches nor bends, and its two
+    /// nodes are held where they are (the stumps stay where they were cut, and each piece
+    /// stays held at both its ends).
+    pub fn divide(&mut self, segment: usize) -> Result<(), RodError> {
+        let nodes = self.nodes();
+        let cut = self.cut.get_mut(segment).ok_or(RodError::NoNode {
+            node: segment + 1,
+            nodes,
+        })?;
+        *cut = true;
+        self.held[segment] = true;
+        self.held[segment + 1] = true;
+        Ok(())
+    }
+
+    /// Whether segment `segment` has been divided.
+    pub fn is_divided(&self, segment: usize) -> bool {
+        self.cut.get(segment).copied().unwrap_or(false)
+    }
+
+    /// The energy's gradient at each node at the end of the last solve (N): at a held node,
+    /// the force its holder pushes the rod with, so that the rod pushes the holder with its
+    /// opposite. Empty before a first solve.
+    pub fn node_forces_n(&self) -> &[Vector3<f64>] {
+        &self.scratch.forces
+    }
+
     /// Clamps the first end: its node held, and its tangent, as it is now: the first
     /// segment turns against the clamp's direction as against one more segment held in it.
     pub fn clamp_start(&mut self) {
@@ -190,8 +232,9 @@ impl Rod {
     /// The rod's elastic energy (J).
     pub fn energy_j(&self) -> f64 {
         let (k, kb) = self.stiffnesses();
-        let stretch: f64 = (self.positions.windows(2))
-            .map(|w| 0.5 * k * ((w[1] - w[0]).norm() - self.segment_m).powi(2))
+        let stretch: f64 = (self.positions.windows(2).zip(&self.cut))
+            .filter(|(_, cut)| !**cut)
+            .map(|(w, _)| 0.5 * k * ((w[1] - w[0]).norm() - self.segment_m).powi(2))
             .sum();
         let bend: f64 = (self.turning()).map(|i| self.turn(i).energy_j(kb)).sum();
         stretch + bend
@@ -303,7 +346,7 @@ impl Rod {
     fn internal_forces(&self, turns: &[Turn], forces: &mut [Vector3<f64>]) {
         forces.fill(Vector3::zeros());
         let (k, kb) = self.stiffnesses();
-        for i in 0..self.nodes() - 1 {
+        for i in self.stretching() {
             let q = self.positions[i + 1] - self.positions[i];
             let l = q.norm();
             let f = q * (k * (l - self.segment_m) / l);
@@ -348,10 +391,17 @@ impl Rod {
         }
     }
 
-    /// The nodes that turn: every inner one, and the first where it is clamped.
-    fn turning(&self) -> std::ops::Range<usize> {
+    /// The nodes that turn: every inner one, and the first where it is clamped; none beside
+    /// a divided segment.
+    fn turning(&self) -> impl Iterator<Item = usize> + '_ {
         let first = if self.clamp.is_some() { 0 } else { 1 };
-        first..self.nodes() - 1
+        (first..self.nodes() - 1)
+            .filter(|&i| !(self.cut[i] || i.checked_sub(1).is_some_and(|b| self.cut[b])))
+    }
+
+    /// The segments that stretch: every one not divided, by its first node.
+    fn stretching(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.nodes() - 1).filter(|&i| !self.cut[i])
     }
     /// Adds the energy's Hessian over the free nodes to `tangent`: the stretching's, its part
     /// across a segment kept from going negative under compression, and the bending's
@@ -363,7 +413,7 @@ impl Rod {
                 tangent.add_block(ra, rb, block);
             }
         };
-        for i in 0..self.nodes() - 1 {
+        for i in self.stretching() {
             let q = self.positions[i + 1] - self.positions[i];
             let l = q.norm();
             let u = q / l;

@@ -154,3 +154,55 @@ fn bad_rods_and_loads_are_refused() {
     let refused = Rod::straight(Vector3::zeros(), Vector3::x(), 4, hollow, YOUNG_PA).unwrap_err();
     assert!(refused.to_string().contains("wall_m"), "{refused}");
 }
+
+/// A tube held at both ends and stretched by `δ` carries `E A δ / L` at each end. Divided at
+/// segment 10 of 20, each piece is held at the cut and stretched on its own: stretching the
+/// far piece further changes nothing at the near end, and the far end carries its own
+/// piece's tension, `E A (9 δ / 20 + d) / (9 Δ)`, to 1e-9.
+#[test]
+fn a_divided_tube_carries_nothing_across_its_cut() {
+    let segments = 20;
+    let mut rod = Rod::straight(
+        Vector3::zeros(),
+        Vector3::x() * LENGTH_M,
+        segments,
+        SECTION,
+        YOUNG_PA,
+    )
+    .unwrap();
+    let (first, last) = (0, segments);
+    rod.hold(first).unwrap();
+    rod.hold(last).unwrap();
+    let axial = YOUNG_PA * SECTION.area_m2();
+    let stretch_m = 1e-3;
+    rod.positions[last].x += stretch_m;
+    rod.solve(&[], TOLERANCE_N).unwrap();
+    let tension = axial * stretch_m / LENGTH_M;
+    let near = -rod.node_forces_n()[first].x;
+    assert!(
+        (near - tension).abs() < 1e-9 * tension,
+        "{near} for {tension}"
+    );
+
+    rod.divide(10).unwrap();
+    assert!(rod.is_divided(10) && rod.is_held(10) && rod.is_held(11));
+    let further_m = 2e-3;
+    rod.positions[last].x += further_m;
+    rod.solve(&[], TOLERANCE_N).unwrap();
+    let near_after = -rod.node_forces_n()[first].x;
+    assert!(
+        (near_after - tension).abs() < 1e-9 * tension,
+        "{near_after} for {tension}"
+    );
+    let segment_m = LENGTH_M / segments as f64;
+    let far_piece = axial * (9.0 * stretch_m / 20.0 + further_m) / (9.0 * segment_m);
+    let far = rod.node_forces_n()[last].x;
+    assert!(
+        (far - far_piece).abs() < 1e-9 * far_piece,
+        "{far} for {far_piece}"
+    );
+    assert!(
+        rod.divide(segments).is_err(),
+        "a rod of 20 segments has no segment 20"
+    );
+}
