@@ -8,8 +8,8 @@ use std::time::Duration;
 use nalgebra::Vector3;
 
 use super::haptic::{
-    ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SceneHand, SceneScope,
-    SettleCuts, TickClock,
+    ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SceneBiliary,
+    SceneHand, SceneScope, SettleCuts, TickClock,
 };
 use super::scene::{Detail, SceneOrgan, scene_files, scene_of, scene_vademecums, tie_organs};
 use crate::contact::{ContactSurface, CouplingSettings};
@@ -55,6 +55,12 @@ pub fn scenario_scene(
     }
     for attachment in &scenario.attachments {
         tie_organs(&mut scene, attachment)?;
+    }
+    if let Some(entry) = &scenario.biliary {
+        scene.biliary = Some(SceneBiliary {
+            tree: entry.tree().map_err(|e| format!("biliary tree: {e}"))?,
+            rule: entry.critical_view,
+        });
     }
     Ok(scene)
 }

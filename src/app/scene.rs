@@ -369,6 +369,7 @@ pub fn scene_of(
         dynamics,
         cutting,
         scope: None,
+        biliary: None,
         meanwhile,
     })
 }

@@ -28,6 +28,7 @@ macro_rules! with_shipped_stems {
             "gallbladder-liver-bed-dissection",
             "gallbladder-liver-two-ports",
             "gallbladder-retraction",
+            "lap-chole-clip-and-cut",
             "liver-capsule-incision",
             "liver-laparoscopic-press",
             "pancreas-palpation",

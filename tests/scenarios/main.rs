@@ -8,6 +8,7 @@ mod allocations;
 mod bed;
 #[path = "../../crates/pgd-surgery-core/tests/support/cache.rs"]
 mod cache;
+mod clip_and_cut;
 #[path = "../../crates/pgd-surgery-core/tests/support/counting.rs"]
 mod counting;
 mod curriculum;
@@ -94,7 +95,7 @@ fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     run_simulated(scenario, &scene, devices, ticks).unwrap()
 }
 
-const SHIPPED: [&str; 15] = [
+const SHIPPED: [&str; 16] = [
     "liver-steady-press",
     "pancreas-palpation",
     "gallbladder-gentle-press",
@@ -110,6 +111,7 @@ const SHIPPED: [&str; 15] = [
     "bimanual-traction-countertraction",
     "bimanual-liver-lift",
     "gallbladder-liver-bed-dissection",
+    "lap-chole-clip-and-cut",
 ];
 
 #[test]

@@ -3,6 +3,7 @@
 //! a simulated clock ([`HapticLoop::run_simulated`], for `--headless`, tests and benchmarks).
 //! The render side only ever reads the latest [`HapticSnapshot`].
 
+mod biliary;
 mod cautery;
 mod components;
 mod cutting;
@@ -22,6 +23,7 @@ use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
 use snapshot::SnapshotPublisher;
 
+pub use biliary::{Biliary, SceneBiliary};
 pub use cautery::{HookWork, OrganBurns};
 pub use components::{
     HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, organ_with_law,
@@ -38,7 +40,8 @@ pub use runner::{
 };
 pub use scoring::{ExerciseLink, ExerciseRun};
 pub use snapshot::{
-    BedView, BurnsView, HandSnapshot, HapticSnapshot, LoopTiming, OrganSnapshot, TieView,
+    BedView, BiliaryView, BurnsView, ClipView, HandSnapshot, HapticSnapshot, LeakView, LoopTiming,
+    OrganSnapshot, TieView, TubeView,
 };
 pub use swap::SceneSwap;
 #[cfg(not(target_arch = "wasm32"))]
@@ -54,7 +57,7 @@ pub enum HapticSet {
     ReadDevice,
     ToolContact,
     EvaluateModes,
-    /// Organ against organ, attachments, and the hook's energy.
+    /// Organ against organ, attachments, the hook's energy and the biliary tree.
     OrganContact,
     ComputeForce,
     Safety,
@@ -100,6 +103,7 @@ pub fn haptic_schedule() -> Schedule {
         (
             systems::organ_contact.run_if(resource_exists::<OrganCoupling>),
             cautery::cauterize.run_if(resource_exists::<cautery::OrganBurns>),
+            biliary::tick_biliary.run_if(resource_exists::<Biliary>),
         )
             .chain()
             .in_set(HapticSet::OrganContact),
@@ -116,7 +120,11 @@ pub fn haptic_schedule() -> Schedule {
             .in_set(HapticSet::Score),
         (
             systems::trace_force.run_if(any_with_component::<ForceTrace>),
-            (scoring::publish_progress, systems::publish_snapshot)
+            (
+                scoring::publish_progress,
+                biliary::publish_biliary.run_if(resource_exists::<Biliary>),
+                systems::publish_snapshot,
+            )
                 .chain()
                 .run_if(resource_exists::<SnapshotPublisher>),
         )

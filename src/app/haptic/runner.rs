@@ -10,6 +10,7 @@ use bevy::platform::time::Instant;
 use bevy::ecs::component::Mutable;
 use bevy::prelude::*;
 
+use super::biliary::{Biliary, SceneBiliary};
 use super::cautery::{HookWork, OrganBurns};
 use super::components::{
     HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, organ_with_law,
@@ -21,7 +22,7 @@ use super::hand::{
 use super::report::{FaultSummary, ForceSummary, HeadlessReport, RangeSummary};
 use super::resources::{OrganBeds, OrganCoupling, SceneScope, Scope, TickClock};
 use super::snapshot::{
-    BedView, BurnsView, HandSnapshot, HapticSnapshot, OrganSnapshot, SnapshotPublisher,
+    BedView, BiliaryView, BurnsView, HandSnapshot, HapticSnapshot, OrganSnapshot, SnapshotPublisher,
 };
 use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
 use crate::cutting::{Blade, CutError, CutWorker, LatestCut, Scalpel};
@@ -57,6 +58,8 @@ pub struct HapticScene {
     pub cutting: Option<SceneCutting>,
     /// The laparoscope, if the trainee looks through one.
     pub scope: Option<SceneScope>,
+    /// The cystic duct, the common duct and the cystic artery, if the scene has them.
+    pub biliary: Option<SceneBiliary>,
     /// The nonlinear vademecums building in the background while their organs run linear
     /// tissue here: the window loads the scene again once they are built.
     pub meanwhile: Vec<PathBuf>,
@@ -76,6 +79,7 @@ impl HapticScene {
             dynamics: None,
             cutting: None,
             scope: None,
+            biliary: None,
             meanwhile: Vec::new(),
         }
     }
@@ -320,6 +324,9 @@ impl HapticLoop {
         if let Some(scope) = &scene.scope {
             world.insert_resource(Scope::new(scope.clone()));
         }
+        if let Some(biliary) = &scene.biliary {
+            world.insert_resource(Biliary::new(biliary, &scene.organs));
+        }
         if scene.has_hook() {
             let walls = (scene.organs.iter()).map(|(name, _)| Wall::of_name(name));
             let burns = WallBurns::new(walls.collect(), TissueHeat::SOFT_TISSUE);
@@ -409,6 +416,7 @@ impl HapticLoop {
             organs: organs.into_iter().map(|(_, organ)| organ).collect(),
             beds: beds.iter().map(BedView::at_rest).collect(),
             burns: BurnsView::with_room(),
+            biliary: self.world.get_resource::<Biliary>().map(BiliaryView::of),
             ..HapticSnapshot::default()
         };
         let (input, output) = triple_buffer::triple_buffer(&template);

@@ -13,6 +13,7 @@ use std::sync::{Arc, Mutex};
 use bevy::ecs::query::QueryData;
 use bevy::prelude::*;
 
+use super::biliary::Biliary;
 use super::cautery::{HookWork, OrganBurns, released_share};
 use super::components::{HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion};
 use super::cutting::OrganCut;
@@ -191,6 +192,7 @@ pub fn score_tick(
     beds: Option<Res<OrganBeds>>,
     mut run: ResMut<ExerciseRun>,
     mut scope: Option<ResMut<Scope>>,
+    biliary: Option<Res<Biliary>>,
 ) {
     if !run.link.started() {
         return;
@@ -246,7 +248,7 @@ pub fn score_tick(
         left,
         hook,
         released_share: released_share(beds.as_deref()),
-        biliary: BiliarySample::default(),
+        biliary: biliary.map_or_else(BiliarySample::default, |b| b.sample),
     });
     if exercise.finished() {
         let run = &mut *run;
@@ -340,12 +342,13 @@ pub fn heal_on_retry(run: Res<ExerciseRun>, mut organs: Query<&mut OrganCut>) {
 }
 
 /// A new attempt starts on whole tissue: once the run has taken its next attempt, the beds
-/// are healed and the burns gone.
+/// are healed, the burns gone and the biliary tree as it was at rest.
 pub fn heal_beds_on_retry(
     run: Res<ExerciseRun>,
     mut healed_for: Local<u32>,
     mut beds: Option<ResMut<OrganBeds>>,
     mut burns: Option<ResMut<OrganBurns>>,
+    mut biliary: Option<ResMut<Biliary>>,
 ) {
     let attempts = run.attempts();
     if *healed_for == attempts {
@@ -357,6 +360,9 @@ pub fn heal_beds_on_retry(
             .for_each(|bed| bed.heal());
         if let Some(burns) = burns.as_mut() {
             burns.0.clear();
+        }
+        if let Some(biliary) = biliary.as_mut() {
+            biliary.heal();
         }
     }
     *healed_for = attempts;

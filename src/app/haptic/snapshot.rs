@@ -5,12 +5,15 @@
 use bevy::prelude::*;
 use nalgebra::Vector3;
 
+use super::biliary::Biliary;
+use crate::biliary::{FatStrand, Fluid, Structure};
 use crate::contact::ToolContact;
 use crate::cutting::Stroke;
 use crate::devices::{MAX_INSTRUMENTS, Rack};
 use crate::dissection::{BurnMark, MAX_BURN_MARKS, TieEnds, TiedOrgans};
 use crate::pgd::{Deformation, SurfacePoint};
 use crate::scenario::Progress;
+use crate::scenario::ViewSample;
 
 #[derive(Clone, Debug, Default)]
 pub struct OrganSnapshot {
@@ -41,6 +44,103 @@ pub struct HapticSnapshot {
     pub beds: Vec<BedView>,
     /// The burns the hook left on the organs' walls.
     pub burns: BurnsView,
+    /// The ducts, the artery, the triangle's fat, the clips and what the open stumps let out.
+    pub biliary: Option<BiliaryView>,
+}
+
+/// The biliary tree as the window draws it, with room for every clip and stump the tree
+/// keeps (so that the loop allocates nothing).
+#[derive(Clone, Debug, Default)]
+pub struct BiliaryView {
+    pub tubes: Vec<TubeView>,
+    pub fat: Vec<FatStrand>,
+    pub clips: Vec<ClipView>,
+    pub leaks: Vec<LeakView>,
+    /// The critical view of safety as last judged.
+    pub view: ViewSample,
+}
+
+/// A tube where it is: its nodes (m), which of its segments are divided, its outer radius.
+#[derive(Clone, Debug)]
+pub struct TubeView {
+    pub structure: Structure,
+    pub nodes_m: Vec<Vector3<f64>>,
+    pub divided: Vec<bool>,
+    pub radius_m: f64,
+}
+
+/// A clip where it is: on its tube's axis, the tube's direction there and its radius.
+#[derive(Clone, Copy, Debug)]
+pub struct ClipView {
+    pub at_m: Vector3<f64>,
+    pub along: Vector3<f64>,
+    pub radius_m: f64,
+    pub closes: bool,
+}
+
+/// An open stump: where it is, what it lets out and how much it has (m³).
+#[derive(Clone, Copy, Debug)]
+pub struct LeakView {
+    pub at_m: Vector3<f64>,
+    pub fluid: Fluid,
+    pub lost_m3: f64,
+    pub stopped: bool,
+}
+
+impl BiliaryView {
+    /// `biliary` as it stands, with room for all it may come to hold.
+    pub fn of(biliary: &Biliary) -> Self {
+        let tree = biliary.tree();
+        let mut view = Self {
+            tubes: (tree.tubes.iter())
+                .map(|tube| TubeView {
+                    structure: tube.structure,
+                    nodes_m: tube.rod.positions.clone(),
+                    divided: vec![false; tube.rod.nodes() - 1],
+                    radius_m: tube.section.outer_radius_m,
+                })
+                .collect(),
+            fat: tree.fat.strands.clone(),
+            clips: Vec::with_capacity(biliary.room().clips),
+            leaks: Vec::with_capacity(biliary.room().leaks),
+            view: ViewSample::default(),
+        };
+        view.update(biliary);
+        view
+    }
+
+    /// The tree as `biliary` stands this tick.
+    pub fn update(&mut self, biliary: &Biliary) {
+        let tree = biliary.tree();
+        for (view, tube) in self.tubes.iter_mut().zip(&tree.tubes) {
+            view.nodes_m.copy_from_slice(&tube.rod.positions);
+            for (segment, divided) in view.divided.iter_mut().enumerate() {
+                *divided = tube.rod.is_divided(segment);
+            }
+        }
+        self.fat.copy_from_slice(&tree.fat.strands);
+        self.clips.clear();
+        self.clips.extend(biliary.clips().iter().map(|clip| {
+            let tube = tree.tube(clip.structure);
+            let at = clip.arc_length_m;
+            let along = tube.point_at(at + 1e-4) - tube.point_at(at - 1e-4);
+            ClipView {
+                at_m: clip.position_m(tree),
+                along: along.try_normalize(1e-12).unwrap_or_else(Vector3::x),
+                radius_m: tube.section.outer_radius_m,
+                closes: clip.closes_lumen(),
+            }
+        }));
+        self.leaks.clear();
+        self.leaks
+            .extend(biliary.leaks().iter().map(|leak| LeakView {
+                at_m: tree.tube(leak.structure).point_at(leak.arc_length_m),
+                fluid: leak.fluid,
+                lost_m3: leak.lost_m3,
+                stopped: leak.stopped,
+            }));
+        self.view = biliary.sample.view;
+    }
 }
 
 /// A bed's ties as the window draws them, in the bed's order.

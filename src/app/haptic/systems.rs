@@ -4,6 +4,7 @@ use bevy::ecs::query::QueryData;
 use bevy::prelude::*;
 use nalgebra::Vector3;
 
+use super::biliary::Biliary;
 use super::cautery::OrganBurns;
 use super::components::{
     HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch,
@@ -367,18 +368,23 @@ pub struct CoupledOrgan {
     motion: Option<&'static mut OrganMotion>,
 }
 
-/// The force on each hand's tool: the opposite of what it applies to the organs; through a
-/// port, as the hand feels it through the shaft's lever.
+/// The force on each hand's tool: the opposite of what it applies to the organs, and what the
+/// biliary tree's tubes push it with; through a port, as the hand feels it through the
+/// shaft's lever.
 pub fn compute_force(
     mut hands: Query<(&HandIndex, &Tool, &GraspForce, &mut DeviceForce)>,
     touches: Query<&HandTouches>,
+    biliary: Option<Res<Biliary>>,
 ) {
     for (hand, tool, grasp, mut force) in &mut hands {
         let pressed: Vector3<f64> = touches
             .iter()
             .filter_map(|t| t.0[hand.0].contact.map(|c| c.felt_n()))
             .sum();
-        let at_tip = grasp.0 - pressed;
+        let tubes = biliary
+            .as_ref()
+            .map_or(Vector3::zeros(), |b| b.push_n(hand.0));
+        let at_tip = grasp.0 - pressed + tubes;
         force.desired_n = match &tool.pose {
             Some(pose) => Fulcrum::hand_force(pose, &at_tip),
             None => at_tip,

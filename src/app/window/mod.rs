@@ -3,6 +3,7 @@
 //! device. The haptic loop runs apart; this side only reads its snapshots.
 
 mod abdomen;
+mod biliary;
 mod bridge;
 mod camera;
 mod cut_surface;
@@ -181,6 +182,7 @@ impl PluginGroup for TrainerWindowPlugins {
             .add(tool::ToolPlugin)
             .add(incision::IncisionPlugin)
             .add(dissection::DissectionPlugin)
+            .add(biliary::BiliaryPlugin)
             .add(input::InputPlugin)
             .add(hud::HudPlugin)
             .add(frames::FramesPlugin(self.log));

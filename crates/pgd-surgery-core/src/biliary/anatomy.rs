@@ -210,13 +210,12 @@ impl Anatomy {
     }
 }
 
-/// The walls and moduli the tubes are made of (assumptions, stated in `docs/biliary.md`): a
-/// duct's wall a sixth of its diameter (1 mm for a 6 mm common duct), the artery's an eighth;
-/// the ducts' wall 4.7 MPa (the pancreatic duct's, the nearest duct measured), the artery's
-/// 1 MPa.
+/// The walls and moduli the tubes are made of (`docs/biliary.md` has their sources): a duct's
+/// wall a sixth of its diameter (1 mm for a 6 mm common duct), the artery's an eighth; the
+/// ducts' wall 0.3 MPa (the porcine common bile duct distended to 5 kPa), the artery's 1 MPa.
 const DUCT_WALL_SHARE: f64 = 1.0 / 6.0;
 const ARTERY_WALL_SHARE: f64 = 1.0 / 8.0;
-pub const DUCT_YOUNG_PA: f64 = 4.7e6;
+pub const DUCT_YOUNG_PA: f64 = 0.3e6;
 pub const ARTERY_YOUNG_PA: f64 = 1.0e6;
 
 /// The rods' segments are about this long (m).

@@ -49,11 +49,13 @@ pub struct Entering {
 }
 
 /// The three criteria as measured, and the rule they were judged by.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct CriticalView {
     pub triangle_cleared: f64,
     pub lower_third_released: f64,
-    pub entering: Vec<Entering>,
+    /// The tubes entering the gallbladder, in the tree's order (room for every tube, so that
+    /// judging allocates nothing).
+    entering: [Option<Entering>; 3],
     pub rule: CriticalViewRule,
 }
 
@@ -68,18 +70,24 @@ impl CriticalView {
         organs_hide: impl Fn(&Segment) -> bool,
         rule: CriticalViewRule,
     ) -> Self {
-        let entering = (tree.tubes.iter().filter(|t| t.enters_gallbladder))
-            .map(|tube| Entering {
+        let entering = std::array::from_fn(|k| {
+            let tube = tree.tubes.get(k).filter(|t| t.enters_gallbladder)?;
+            Some(Entering {
                 structure: tube.structure,
                 seen_share: seen_share(tree, tube, optic_m, &organs_hide),
             })
-            .collect();
+        });
         Self {
             triangle_cleared: tree.fat.cleared_share(),
             lower_third_released,
             entering,
             rule,
         }
+    }
+
+    /// The tubes entering the gallbladder, and how much of each is seen.
+    pub fn entering(&self) -> impl Iterator<Item = &Entering> {
+        self.entering.iter().flatten()
     }
 
     pub fn triangle_met(&self) -> bool {
@@ -92,14 +100,14 @@ impl CriticalView {
 
     /// The tubes seen entering the gallbladder.
     pub fn seen(&self) -> usize {
-        (self.entering.iter())
+        (self.entering())
             .filter(|e| e.seen_share >= self.rule.seen_share)
             .count()
     }
 
     /// Two tubes enter the gallbladder, and both are seen.
     pub fn two_structures_met(&self) -> bool {
-        self.entering.len() == 2 && self.seen() == 2
+        self.entering().count() == 2 && self.seen() == 2
     }
 
     /// All three criteria met.

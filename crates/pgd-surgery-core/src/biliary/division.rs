@@ -43,8 +43,13 @@ pub struct Division {
 
 impl Division {
     /// The division made by `blades` closing across a tube of `tree` among `clips`, with the
-    /// stumps it leaves open; `None` where the blades close on no tube.
-    pub fn cut(tree: &BiliaryTree, clips: &[Clip], blades: &Segment) -> Option<(Self, Vec<Leak>)> {
+    /// stumps it leaves open (none, one or two: the patient's first); `None` where the blades
+    /// close on no tube.
+    pub fn cut(
+        tree: &BiliaryTree,
+        clips: &[Clip],
+        blades: &Segment,
+    ) -> Option<(Self, [Option<Leak>; 2])> {
         let crossing = crossing(tree, blades)?;
         let (structure, at_m) = (crossing.structure, crossing.arc_length_m);
         let part = tree.part_at(structure, at_m);
@@ -80,7 +85,7 @@ impl Division {
     /// artery's patient side and back from the gallbladder on its other side; bile from a
     /// duct's. The common duct's lower stump is held by the duodenum's sphincter and leaks
     /// nothing.
-    fn open_stumps(&self, tree: &BiliaryTree) -> Vec<Leak> {
+    fn open_stumps(&self, tree: &BiliaryTree) -> [Option<Leak>; 2] {
         let tube = tree.tube(self.structure);
         let lumen_m = tube.section.outer_radius_m - tube.section.wall_m;
         let sides = [
@@ -91,23 +96,26 @@ impl Division {
                 tube.length_m() - self.arc_length_m,
             ),
         ];
-        sides
-            .into_iter()
-            .filter(|&(side, clips, _)| {
-                clips == 0
-                    && !(self.structure == Structure::CommonDuct && side == Side::Gallbladder)
-            })
-            .map(|(side, _, from_source_m)| {
-                let (fluid, law) = match (self.structure, side) {
-                    (Structure::CysticArtery, Side::Patient) => (Fluid::Blood, FlowLaw::ARTERIAL),
-                    (Structure::CysticArtery, Side::Gallbladder) => {
-                        (Fluid::Blood, FlowLaw::BACK_BLEEDING)
-                    }
-                    _ => (Fluid::Bile, FlowLaw::BILE),
-                };
-                let flow = law.flow_m3_per_s(lumen_m, from_source_m);
-                Leak::new(fluid, self.structure, side, self.arc_length_m, flow)
-            })
-            .collect()
+        sides.map(|(side, clips, from_source_m)| {
+            let held = self.structure == Structure::CommonDuct && side == Side::Gallbladder;
+            if clips > 0 || held {
+                return None;
+            }
+            let (fluid, law) = match (self.structure, side) {
+                (Structure::CysticArtery, Side::Patient) => (Fluid::Blood, FlowLaw::ARTERIAL),
+                (Structure::CysticArtery, Side::Gallbladder) => {
+                    (Fluid::Blood, FlowLaw::BACK_BLEEDING)
+                }
+                _ => (Fluid::Bile, FlowLaw::BILE),
+            };
+            let flow = law.flow_m3_per_s(lumen_m, from_source_m);
+            Some(Leak::new(
+                fluid,
+                self.structure,
+                side,
+                self.arc_length_m,
+                flow,
+            ))
+        })
     }
 }

@@ -311,6 +311,11 @@ impl TiedOrgans {
         });
     }
 
+    /// The freed organ's index in the scene.
+    pub fn freed_index(&self) -> usize {
+        self.freed.index
+    }
+
     /// The freed organ's index in the coupling and the live ties' stiffness over its kept
     /// modes as the last tick left them (`modes × modes`, row-major, s⁻²), if the ties hold
     /// its kept modes ([`Self::restrain_kept_modes`]).

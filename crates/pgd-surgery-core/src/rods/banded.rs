@@ -31,6 +31,14 @@ impl Banded {
         self.n == 0
     }
 
+    /// Makes it `n × n`, every entry zero, within the storage it has (a matrix that shrinks
+    /// and grows back allocates nothing).
+    pub fn resize(&mut self, n: usize) {
+        self.n = n;
+        self.values.clear();
+        self.values.resize(n * (2 * self.band + 1), 0.0);
+    }
+
     /// Zeroes every entry, keeping the storage.
     pub fn clear(&mut self) {
         self.values.fill(0.0);

@@ -183,6 +183,18 @@ impl Rod {
         Ok(())
     }
 
+    /// Takes `before`'s shape, holds and divisions without allocating: `before` is this rod
+    /// as it was (a new attempt starts from the rod at rest).
+    ///
+    /// # Panics
+    /// If `before` has another number of nodes.
+    pub fn restore(&mut self, before: &Rod) {
+        self.positions.copy_from_slice(&before.positions);
+        self.held.copy_from_slice(&before.held);
+        self.cut.copy_from_slice(&before.cut);
+        self.clamp = before.clamp;
+    }
+
     /// Lets node `node` go, if it was held.
     pub fn release(&mut self, node: usize) {
         if let Some(held) = self.held.get_mut(node) {
@@ -256,12 +268,32 @@ impl Rod {
         loads: &[(usize, Vector3<f64>)],
         tolerance_n: f64,
     ) -> Result<Settled, RodError> {
+        let settled = self.step(loads, tolerance_n, MAX_STEPS)?;
+        match settled.residual_n < tolerance_n {
+            true => Ok(settled),
+            false => Err(RodError::Unsettled {
+                iterations: settled.newton_steps,
+                residual_n: settled.residual_n,
+            }),
+        }
+    }
+
+    /// [`Self::solve`] for at most `steps` Newton steps: what a tick can spend, the rod
+    /// settling on over the next ticks where these are not enough. Returns the steps taken
+    /// and the forces left; an error only for a load on a node the rod lacks, a rod held
+    /// nowhere, or a tangent that could not be solved.
+    pub fn step(
+        &mut self,
+        loads: &[(usize, Vector3<f64>)],
+        tolerance_n: f64,
+        steps: usize,
+    ) -> Result<Settled, RodError> {
         let nodes = self.nodes();
         if let Some(&(node, _)) = loads.iter().find(|(n, _)| *n >= nodes) {
             return Err(RodError::NoNode { node, nodes });
         }
         let mut scratch = std::mem::take(&mut self.scratch);
-        let settled = self.settle(loads, tolerance_n, &mut scratch);
+        let settled = self.settle(loads, tolerance_n, steps, &mut scratch);
         self.scratch = scratch;
         settled
     }
@@ -270,6 +302,7 @@ impl Rod {
         &mut self,
         loads: &[(usize, Vector3<f64>)],
         tolerance_n: f64,
+        steps: usize,
         scratch: &mut Scratch,
     ) -> Result<Settled, RodError> {
         self.dof_numbers(&mut scratch.dof);
@@ -277,8 +310,13 @@ impl Rod {
         if unknowns == 3 * self.nodes() {
             return Err(RodError::Unheld);
         }
-        if scratch.tangent.as_ref().is_none_or(|t| t.len() != unknowns) {
-            scratch.tangent = Some(Banded::zeros(unknowns, BAND));
+        // Made once for every node free, so that the nodes held from tick to tick (by an
+        // instrument) change its size without allocating.
+        let tangent = scratch
+            .tangent
+            .get_or_insert_with(|| Banded::zeros(3 * self.nodes(), BAND));
+        if tangent.len() != unknowns {
+            tangent.resize(unknowns);
         }
         let Scratch {
             dof,
@@ -290,7 +328,7 @@ impl Rod {
         let tangent = tangent.as_mut().expect("made above");
         residual.resize(unknowns, 0.0);
         forces.resize(self.nodes(), Vector3::zeros());
-        for step in 0..=MAX_STEPS {
+        for step in 0..=steps {
             turns.clear();
             turns.extend(self.turning().map(|i| self.turn(i)));
             self.internal_forces(turns, forces);
@@ -303,19 +341,17 @@ impl Rod {
                 }
             }
             let residual_n = residual.iter().map(|r| r * r).sum::<f64>().sqrt();
-            if residual_n < tolerance_n {
-                return Ok(Settled {
-                    newton_steps: step,
-                    residual_n,
-                });
+            let settled = Settled {
+                newton_steps: step,
+                residual_n,
+            };
+            if residual_n < tolerance_n || step == steps {
+                return Ok(settled);
             }
             let unsettled = RodError::Unsettled {
                 iterations: step,
                 residual_n,
             };
-            if step == MAX_STEPS {
-                return Err(unsettled);
-            }
             tangent.clear();
             self.add_tangent(dof, turns, tangent);
             residual.iter_mut().for_each(|r| *r = -*r);

@@ -60,6 +60,8 @@ pub struct BiliarySample {
     pub division: Option<Division>,
     pub blood_lost_m3: f64,
     pub bile_spilled_m3: f64,
+    /// Whether an open stump still bleeds (neither clipped nor coagulated).
+    pub bleeding: bool,
     pub view: ViewSample,
 }
 
@@ -79,7 +81,7 @@ impl ViewSample {
         Self {
             triangle_cleared: view.triangle_cleared,
             lower_third_released: view.lower_third_released,
-            entering: view.entering.len() as u8,
+            entering: view.entering().count() as u8,
             seen: view.seen() as u8,
             reached: view.reached(),
         }

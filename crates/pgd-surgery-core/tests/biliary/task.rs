@@ -94,7 +94,7 @@ fn run(events: &[(f64, Event)]) -> (Scenario, Vec<pgd_surgery_core::scenario::ta
                 Event::Cut(s, share) => {
                     let (division, open) =
                         Division::cut(&tree, &clips, &jaws(&tree, s, share, 15e-3)).unwrap();
-                    leaks.extend(open);
+                    leaks.extend(open.into_iter().flatten());
                     biliary.division = Some(division);
                 }
             }

@@ -12,7 +12,7 @@ use crate::scenario::task::{
 /// `ClipAndCut(organ: "gallbladder", divide, max_force_n, time_limit_s)`: reach the critical
 /// view of safety, then clip and divide each structure of `divide` (the cystic duct and the
 /// cystic artery when left out) between two clips on the patient's side and one on the
-/// gallbladder's. A clip or a cut before the critical view, a clip that does not close its
+/// gallbladder's; a stump that bleeds must be clipped or coagulated before the task is done. A clip or a cut before the critical view, a clip that does not close its
 /// tube, a cut with fewer clips, a stump left open are mistakes; a clip across the common
 /// hepatic or bile duct is a major one; dividing either is a bile duct injury, which ends
 /// the attempt.
@@ -111,6 +111,7 @@ impl TaskType for ClipAndCut {
             bile_duct_injury: false,
             blood_lost_m3: 0.0,
             bile_spilled_m3: 0.0,
+            bleeding: false,
         }
     }
 
@@ -154,6 +155,7 @@ pub struct ClipAndCutRun {
     bile_duct_injury: bool,
     blood_lost_m3: f64,
     bile_spilled_m3: f64,
+    bleeding: bool,
 }
 
 impl ClipAndCutRun {
@@ -212,7 +214,8 @@ impl ClipAndCutRun {
 impl TaskRun for ClipAndCutRun {
     type Result = ClipAndCutResult;
 
-    /// Done once every structure to divide is divided, without a bile duct injury.
+    /// Done once every structure to divide is divided and nothing bleeds, without a bile duct
+    /// injury.
     fn step(&mut self, tick: &mut Tick<'_>) {
         let biliary = tick.sample.biliary;
         if biliary.view.reached && self.view_reached_s.is_none() {
@@ -226,7 +229,8 @@ impl TaskRun for ClipAndCutRun {
         }
         self.blood_lost_m3 = biliary.blood_lost_m3;
         self.bile_spilled_m3 = biliary.bile_spilled_m3;
-        tick.metrics.completed = self.all_divided() && !self.bile_duct_injury;
+        self.bleeding = biliary.bleeding;
+        tick.metrics.completed = self.all_divided() && !self.bleeding && !self.bile_duct_injury;
     }
 
     fn over(&self) -> bool {
@@ -255,6 +259,7 @@ impl TaskRun for ClipAndCutRun {
             artery_clips: clips_on(Part::CysticArtery),
             blood_lost_ml: self.blood_lost_m3 * 1e6,
             bile_spilled_ml: self.bile_spilled_m3 * 1e6,
+            still_bleeding: self.bleeding,
             bile_duct_injury: self.bile_duct_injury,
         }
     }
@@ -271,6 +276,8 @@ pub struct ClipAndCutResult {
     pub artery_clips: usize,
     pub blood_lost_ml: f64,
     pub bile_spilled_ml: f64,
+    /// Whether a stump still bled when the task ended.
+    pub still_bleeding: bool,
     pub bile_duct_injury: bool,
 }
 
@@ -307,6 +314,13 @@ impl TaskResult for ClipAndCutResult {
             )
         });
         early_clips.chain(early_cuts).chain(open).collect()
+    }
+
+    fn unfinished(&self) -> Option<String> {
+        Some(match self.still_bleeding {
+            true => " (a stump still bleeding)".into(),
+            false => String::new(),
+        })
     }
 
     fn complication(&self) -> Option<String> {

@@ -1,0 +1,304 @@
+//! Calot's triangle through the haptic loop: the clip-and-cut scenario's competent run (the
+//! triangle's fat cleared with the hook to the critical view of safety, then three clips on
+//! each of the cystic duct and artery and a cut between them) passes with no mistake; its
+//! careless run (a clip and two cuts before the view, each leaving a stump open, the artery
+//! left bleeding) fails, its report naming the mistakes in time order, and scores lower. The runs are the scripts
+//! `write_the_clip_and_cut_runs` writes from the scenario's own tree and port.
+
+use std::fmt::Write as _;
+
+use nalgebra::Vector3;
+use pgd_surgery::app::attempt::scenario_scene;
+use pgd_surgery::app::scene::Detail;
+use pgd_surgery::biliary::{BiliaryTree, FatStrand, Structure};
+use pgd_surgery::devices::{Fulcrum, Instrument, Rack};
+use pgd_surgery::mesh::organs::{Abdomen, Organ, OrganSettings};
+use pgd_surgery::scenario::tasks::ClipAndCutResult;
+use pgd_surgery::scenario::{Scenario, load};
+use pgd_surgery::store::OnStale;
+
+const NAME: &str = "lap-chole-clip-and-cut";
+
+fn scenario() -> Scenario {
+    load(&super::root().join(format!("scenarios/{NAME}.scenario.ron"))).unwrap()
+}
+
+#[test]
+fn the_competent_clip_and_cut_reaches_the_view_then_clips_and_divides_as_taught() {
+    let outcome = super::run(NAME, "competent");
+    let card = &outcome.card;
+    let metrics = &card.tasks[0].metrics;
+    let result = metrics.result::<ClipAndCutResult>().unwrap();
+    eprintln!("{:#?}", result);
+    eprintln!("score {:.1}, errors {:?}", card.score, metrics.errors);
+    assert!(metrics.completed, "{metrics:#?}");
+    assert!(metrics.errors.is_empty(), "{:?}", metrics.errors);
+    let view_s = result.view_reached_s.expect("the critical view reached");
+    assert!(
+        result
+            .clips
+            .iter()
+            .all(|c| c.time_s > view_s && c.clip.closes_lumen())
+    );
+    assert_eq!((result.cystic_duct_clips, result.artery_clips), (3, 3));
+    assert_eq!(result.blood_lost_ml, 0.0);
+    assert!(card.passed, "{card:#?}");
+}
+
+#[test]
+fn the_careless_clip_and_cut_fails_naming_what_it_did_before_the_view() {
+    let careless = super::run(NAME, "careless").card;
+    let metrics = &careless.tasks[0].metrics;
+    eprintln!("score {:.1}, errors {:?}", careless.score, metrics.errors);
+    let result = metrics.result::<ClipAndCutResult>().unwrap();
+    assert_eq!(result.view_reached_s, None);
+    let said: Vec<&str> = (metrics.errors.iter())
+        .map(|e| e.split_once(": ").map_or(e.as_str(), |(_, what)| what))
+        .collect();
+    assert_eq!(
+        said,
+        [
+            "placed a clip before the critical view of safety",
+            "divided a structure before the critical view of safety",
+            "divided a structure with a stump left open",
+            "divided a structure before the critical view of safety",
+            "divided a structure with a stump left open",
+        ]
+    );
+    assert!(
+        result.still_bleeding && result.blood_lost_ml > 1.0,
+        "{result:#?}"
+    );
+    assert!(!metrics.completed, "the artery still bleeds");
+    assert!(!careless.passed);
+    let competent = super::run(NAME, "competent").card;
+    assert!(
+        competent.score > careless.score + 20.0,
+        "{} against {}",
+        competent.score,
+        careless.score
+    );
+}
+
+/// A script of the right hand's device through the scenario's one port: its rows, the time,
+/// the instruments' rack (whose offset the second button changes) and the tip.
+struct Script {
+    csv: String,
+    tip_radius_m: f64,
+    time_s: f64,
+    port: Fulcrum,
+    rack: Rack,
+    tip_m: Vector3<f64>,
+}
+
+/// Instruments take a moment to move between points and to close (s); the hook is held on
+/// the fat while its energy divides the strands within reach (30 W: about 7 J a strand).
+const MOVE_S: f64 = 0.6;
+const CLOSE_S: f64 = 0.25;
+const BURN_S: f64 = 1.2;
+/// Where the competent run clips each tube (two on the patient's side, one on the
+/// gallbladder's) and cuts it, as shares of its length from the patient's end.
+const CLIPS_AT: [f64; 3] = [0.2, 0.35, 0.8];
+const CUT_AT: f64 = 0.6;
+/// The clip applier's jaws and the scissors' blades (m), as the scenario gives them.
+const JAW_M: f64 = 9e-3;
+const BLADE_M: f64 = 15e-3;
+
+impl Script {
+    fn new(scenario: &Scenario, start_m: Vector3<f64>, tip_radius_m: f64) -> Self {
+        let port = scenario.instruments[0].port.fulcrum();
+        let instruments: Vec<Instrument> = (scenario.instruments.iter())
+            .map(|i| Instrument {
+                action: i.tool.action(),
+                port: Some(i.port.fulcrum()),
+            })
+            .collect();
+        let mut script = Self {
+            csv: "time_s,x_m,y_m,z_m,buttons\n".into(),
+            tip_radius_m,
+            time_s: 0.0,
+            port,
+            rack: Rack::new(&instruments),
+            tip_m: start_m,
+        };
+        script.row(0);
+        script
+    }
+
+    fn device_m(&self) -> Vector3<f64> {
+        self.port.handle_for(&self.tip_m).unwrap() - self.rack.offset_m()
+    }
+
+    fn row(&mut self, buttons: u32) {
+        let d = self.device_m();
+        writeln!(
+            self.csv,
+            "{:.3},{:.6},{:.6},{:.6},{buttons}",
+            self.time_s, d.x, d.y, d.z
+        )
+        .unwrap();
+    }
+
+    /// Moves the tip to `to_m`, buttons up.
+    fn go(&mut self, to_m: Vector3<f64>) {
+        self.time_s += MOVE_S;
+        self.tip_m = to_m;
+        self.row(0);
+    }
+
+    /// Holds the first button down where the tip is for `hold_s`.
+    fn press(&mut self, hold_s: f64) {
+        self.time_s += 0.001;
+        self.row(1);
+        self.time_s += hold_s;
+        self.row(1);
+        self.time_s += 0.001;
+        self.row(0);
+    }
+
+    /// Changes to the next instrument where the tip is; the new one's tip goes where the
+    /// rack puts it, and the script moves it back to `self.tip_m`.
+    fn change(&mut self) {
+        let device = self.device_m();
+        self.time_s += 0.001;
+        self.row(2);
+        self.rack.take(2, &device, &self.tip_m, || true);
+        self.rack.take(0, &device, &self.tip_m, || true);
+        let taken_up = self
+            .port
+            .pose(&(device + self.rack.offset_m()))
+            .unwrap()
+            .tip_m;
+        let back_to = std::mem::replace(&mut self.tip_m, taken_up);
+        self.time_s += 0.05;
+        self.row(0);
+        self.go(back_to);
+    }
+
+    /// Closes the jaws (or blades), `jaw_m` long beyond the tip's sphere, across `structure`
+    /// at `share` of its length, the tube halfway along them.
+    fn close_across(&mut self, tree: &BiliaryTree, structure: Structure, share: f64, jaw_m: f64) {
+        let tube = tree.tube(structure);
+        let on = tube.point_at(share * tube.length_m());
+        let along = (on - self.port.port_m).normalize();
+        let tip = on - along * (self.tip_radius_m + jaw_m / 2.0);
+        self.go(tip - along * 0.01);
+        self.go(tip);
+        self.press(CLOSE_S);
+        self.go(tip - along * 0.01);
+    }
+
+    fn write(&self, script: &str) {
+        let path = super::root().join(format!("scenarios/runs/{NAME}.{script}.csv"));
+        std::fs::write(&path, &self.csv).unwrap();
+    }
+}
+
+/// The hook's tip `tip_m` in radius beside a strand, on its side away from the tubes and
+/// clear of them (along the normal of the ducts' plane), where it keeps clearest of the
+/// organs.
+fn by_strand(abdomen: &Abdomen, strand: &FatStrand, plane: &Plane, tip_m: f64) -> Vector3<f64> {
+    let clearance = |p: &Vector3<f64>| {
+        [Organ::Liver, Organ::Gallbladder, Organ::Duodenum]
+            .map(|o| abdomen.value(o, &(*p).into()))
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
+    };
+    let axis = strand.axis;
+    let depth = (axis.at(0.5) - plane.point).dot(&plane.normal);
+    let beyond = (tip_m + COMMON_DUCT_RADIUS_M + CLEAR_OF_TUBES_M - depth.abs()).max(0.0);
+    (1..10)
+        .map(|k| axis.at(k as f64 / 10.0) + plane.normal * (depth.signum() * beyond))
+        .max_by(|a, b| clearance(a).total_cmp(&clearance(b)))
+        .unwrap()
+}
+
+/// The hook keeps this far clear of the tubes (m) beyond its tip's radius.
+const CLEAR_OF_TUBES_M: f64 = 1e-3;
+
+/// The usual common duct's radius (m).
+const COMMON_DUCT_RADIUS_M: f64 = 3e-3;
+
+/// The plane of the cystic and common hepatic ducts.
+struct Plane {
+    point: Vector3<f64>,
+    normal: Vector3<f64>,
+}
+
+impl Plane {
+    fn of(tree: &BiliaryTree) -> Self {
+        let junction = tree.tube(Structure::CommonDuct).rod.positions[tree.junction_node];
+        let cystic = tree.tube(Structure::CysticDuct);
+        let gallbladder_end = cystic.rod.positions[cystic.rod.nodes() - 1];
+        let hilum = tree.tube(Structure::CommonDuct).rod.positions[0];
+        let normal = (gallbladder_end - junction)
+            .cross(&(hilum - junction))
+            .normalize();
+        Self {
+            point: junction,
+            normal,
+        }
+    }
+}
+
+/// Writes the scenario's two scripted runs from its own tree and port (run once by hand when
+/// the scene changes: `cargo test --test scenarios write_the_clip_and_cut_runs -- --ignored`).
+#[test]
+#[ignore = "writes scenarios/runs/lap-chole-clip-and-cut.*.csv"]
+fn write_the_clip_and_cut_runs() {
+    let scenario = scenario();
+    let tree = scenario.biliary.as_ref().unwrap().tree().unwrap();
+    let abdomen = Abdomen::new(&OrganSettings::default());
+    let start = Vector3::new(0.0, 0.02, -0.075);
+    let duct = Structure::CysticDuct;
+    let artery = Structure::CysticArtery;
+
+    let plane = Plane::of(&tree);
+    let scene = scenario_scene(
+        &scenario,
+        super::vademecums(),
+        Detail::Coarse,
+        OnStale::Refuse,
+    );
+    let tip_m = scene.unwrap().probe.tip_radius_m;
+    let mut competent = Script::new(&scenario, start, tip_m);
+    for strand in &tree.fat.strands {
+        competent.go(by_strand(&abdomen, strand, &plane, tip_m));
+        competent.press(BURN_S);
+    }
+    competent.go(start);
+    competent.time_s += 1.0;
+    competent.row(0);
+    competent.change();
+    for structure in [duct, artery] {
+        for share in CLIPS_AT {
+            competent.close_across(&tree, structure, share, JAW_M);
+        }
+    }
+    competent.go(start);
+    competent.change();
+    for structure in [duct, artery] {
+        competent.close_across(&tree, structure, CUT_AT, BLADE_M);
+    }
+    competent.go(start);
+    competent.time_s += 1.0;
+    competent.row(0);
+    competent.write("competent");
+
+    let mut careless = Script::new(&scenario, start, tip_m);
+    for strand in &tree.fat.strands[..4] {
+        careless.go(by_strand(&abdomen, strand, &plane, tip_m));
+        careless.press(CLOSE_S);
+    }
+    careless.go(start);
+    careless.change();
+    careless.close_across(&tree, duct, 0.8, JAW_M);
+    careless.go(start);
+    careless.change();
+    careless.close_across(&tree, duct, 0.5, BLADE_M);
+    careless.close_across(&tree, artery, 0.5, BLADE_M);
+    careless.go(start);
+    careless.time_s += 3.0;
+    careless.row(0);
+    careless.write("careless");
+}
