@@ -16,8 +16,10 @@
 //! A panic or a signal halts every link at once through [`halt_every_link`], which takes no
 //! lock: whatever thread holds the release registry, no servo renders force after it.
 
+#[cfg(not(target_arch = "wasm32"))]
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
+#[cfg(not(target_arch = "wasm32"))]
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -293,10 +295,13 @@ impl ServoLink {
 
 /// A servo thread of ours (for an SDK without a scheduler of its own), stopped once when its
 /// device is released: joined, unless the release runs on the servo thread itself, which
-/// cannot wait for itself. A poisoned lock is taken as it is: release must not fail.
+/// cannot wait for itself. A poisoned lock is taken as it is: release must not fail. (No
+/// vendor backend runs in a web page, which has no threads.)
+#[cfg(not(target_arch = "wasm32"))]
 #[derive(Debug, Default)]
 pub struct ServoThread(Mutex<Option<JoinHandle<()>>>);
 
+#[cfg(not(target_arch = "wasm32"))]
 impl ServoThread {
     /// The thread started for the device.
     pub fn set(&self, thread: JoinHandle<()>) {
