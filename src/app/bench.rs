@@ -10,10 +10,12 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 
 use super::haptic::{
-    HapticLoop, HapticScene, HapticThread, RealTimeReport, SceneHand, Scheduling, TickTimes,
+    HapticLoop, HapticScene, HapticThread, RealTimeReport, SceneBiliary, SceneHand, Scheduling,
+    TickTimes,
 };
 use super::scene::{press_targets, tie_organs};
 use crate::bench::fem::median_ms;
+use crate::biliary::CriticalViewRule;
 use crate::devices::{
     Action, HapticDevice, Instrument, PressMotion, PressTarget, Scripted, TICK_S, TimerMode,
     grasp_and_hold, press_and_slide,
@@ -22,7 +24,7 @@ use crate::fem::{FemError, Law, Loads, NewtonSettings};
 use crate::mesh::Surface;
 use crate::mesh::organs::{self, Organ, OrganSettings};
 use crate::pgd::{self, SurfaceModes};
-use crate::scenario::AttachmentEntry;
+use crate::scenario::{AttachmentEntry, BiliaryEntry};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct SweepFigures {
@@ -77,6 +79,18 @@ pub struct HapticBenchReport {
     /// with the gallbladder tied to the liver by its bed and without, in the same run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bed: Option<BedTick>,
+    /// Where the scene has the liver, the gallbladder and the duodenum: the four-organ sweep
+    /// with the biliary tree among them and without, in the same run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub biliary: Option<BiliaryTick>,
+}
+
+/// The tick's compute with the biliary tree (its tubes' nodes all told) and without (µs).
+#[derive(Clone, Debug, Serialize)]
+pub struct BiliaryTick {
+    pub tube_nodes: usize,
+    pub with_tree: HandsTick,
+    pub without_tree: HandsTick,
 }
 
 /// The tick's compute with the gallbladder's bed and without (µs, as [`HandsTick`]).
@@ -139,6 +153,7 @@ pub fn run(
         _ => (None, None),
     };
     let bed = bed_tick(scene, &targets, motion, repeats, hands);
+    let biliary = biliary_tick(scene, &targets, motion, repeats);
     let fem_contact = fem_contact(&targets[0], repeats, sweeps[0].compute_p50_us)?;
     let render_cpu_ms = render_cpu(scene, &targets, repeats);
     let realtime = [
@@ -164,6 +179,37 @@ pub fn run(
         one_hand,
         two_hands,
         bed,
+        biliary,
+    })
+}
+
+/// The four-organ sweep with the usual biliary tree in the scene and without; none where the
+/// scene lacks an organ the tree runs between.
+fn biliary_tick(
+    scene: &HapticScene,
+    targets: &[PressTarget],
+    motion: &PressMotion,
+    repeats: usize,
+) -> Option<BiliaryTick> {
+    let between = ["liver", "gallbladder", "duodenum"];
+    if !between
+        .iter()
+        .all(|name| scene.organs.iter().any(|(n, _)| n == name))
+    {
+        return None;
+    }
+    let tree = BiliaryEntry::default().tree().ok()?;
+    let tube_nodes = tree.tubes.iter().map(|t| t.rod.nodes()).sum();
+    let mut with = scene.clone();
+    with.biliary = Some(SceneBiliary {
+        tree,
+        rule: CriticalViewRule::default(),
+    });
+    let run = |scene: &HapticScene| HandsTick::from(&sweep(scene, "all", targets, motion, repeats));
+    Some(BiliaryTick {
+        tube_nodes,
+        without_tree: run(scene),
+        with_tree: run(&with),
     })
 }
 
@@ -399,6 +445,20 @@ impl fmt::Display for HapticBenchReport {
                 bed.with_bed.tick_p99_us,
                 bed.without_bed.tick_p99_us,
                 bed.with_bed.tick_p99_us / bed.without_bed.tick_p99_us.max(f64::MIN_POSITIVE),
+            )?;
+        }
+        if let Some(biliary) = &self.biliary {
+            let (with, without) = (&biliary.with_tree, &biliary.without_tree);
+            writeln!(
+                f,
+                "the biliary tree in the scene ({} tube nodes): tick p50 {:.1} µs, p99 {:.1} µs \
+                 against {:.1} µs and {:.1} µs without ({:.2}x at p99)",
+                biliary.tube_nodes,
+                with.tick_p50_us,
+                with.tick_p99_us,
+                without.tick_p50_us,
+                without.tick_p99_us,
+                with.tick_p99_us / without.tick_p99_us.max(f64::MIN_POSITIVE),
             )?;
         }
         writeln!(

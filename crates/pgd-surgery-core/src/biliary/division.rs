@@ -83,7 +83,8 @@ impl Division {
 
     /// The stumps left open and what they let out: blood at arterial pressure from the
     /// artery's patient side and back from the gallbladder on its other side; bile from a
-    /// duct's. The common duct's lower stump is held by the duodenum's sphincter and leaks
+    /// duct's, what the liver secretes on the patient's side and the gallbladder's content on
+    /// the other. The common duct's lower stump is held by the duodenum's sphincter and leaks
     /// nothing.
     fn open_stumps(&self, tree: &BiliaryTree) -> [Option<Leak>; 2] {
         let tube = tree.tube(self.structure);
@@ -106,16 +107,11 @@ impl Division {
                 (Structure::CysticArtery, Side::Gallbladder) => {
                     (Fluid::Blood, FlowLaw::BACK_BLEEDING)
                 }
-                _ => (Fluid::Bile, FlowLaw::BILE),
+                (_, Side::Patient) => (Fluid::Bile, FlowLaw::HEPATIC_BILE),
+                (_, Side::Gallbladder) => (Fluid::Bile, FlowLaw::GALLBLADDER_BILE),
             };
-            let flow = law.flow_m3_per_s(lumen_m, from_source_m);
-            Some(Leak::new(
-                fluid,
-                self.structure,
-                side,
-                self.arc_length_m,
-                flow,
-            ))
+            let at = (self.structure, side, self.arc_length_m);
+            Some(Leak::new(at, fluid, &law, lumen_m, from_source_m))
         })
     }
 }

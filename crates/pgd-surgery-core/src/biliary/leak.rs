@@ -19,11 +19,14 @@ pub enum Fluid {
     Bile,
 }
 
-/// The pressure driving a fluid through a tube and its viscosity.
+/// The pressure driving a fluid through a tube and its viscosity, what feeds it at most
+/// (m³/s), and how much there is to let out (m³).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct FlowLaw {
     pub pressure_pa: f64,
     pub viscosity_pa_s: f64,
+    pub supply_m3_per_s: f64,
+    pub reservoir_m3: f64,
 }
 
 /// Poiseuille's law holds over a tube many times longer than wide: a cut nearer its source
@@ -31,27 +34,43 @@ pub struct FlowLaw {
 pub const SHORTEST_TUBE_M: f64 = 5e-3;
 
 impl FlowLaw {
-    /// Mean arterial pressure (90 mmHg) and whole blood's viscosity (3.5 mPa·s).
+    /// Mean arterial pressure (90 mmHg) and whole blood's viscosity (3.5 mPa·s), fed by the
+    /// hepatic artery without a limit the trainer sets.
     pub const ARTERIAL: Self = Self {
         pressure_pa: 12_000.0,
         viscosity_pa_s: 3.5e-3,
+        supply_m3_per_s: f64::INFINITY,
+        reservoir_m3: f64::INFINITY,
     };
     /// Blood back from the gallbladder's wall: capillary pressure (15 mmHg).
     pub const BACK_BLEEDING: Self = Self {
         pressure_pa: 2_000.0,
         viscosity_pa_s: 3.5e-3,
+        supply_m3_per_s: f64::INFINITY,
+        reservoir_m3: f64::INFINITY,
     };
-    /// Bile in the ducts (12 cm of water) at about water's viscosity.
-    pub const BILE: Self = Self {
+    /// Bile from the liver's side: at most what the liver secretes (600 mL a day).
+    pub const HEPATIC_BILE: Self = Self {
         pressure_pa: 1_200.0,
         viscosity_pa_s: 1.0e-3,
+        supply_m3_per_s: 600e-6 / 86_400.0,
+        reservoir_m3: f64::INFINITY,
+    };
+    /// Bile from the gallbladder's side: its content (40 mL) runs out at the ducts' pressure
+    /// (12 cm of water), at about water's viscosity.
+    pub const GALLBLADDER_BILE: Self = Self {
+        pressure_pa: 1_200.0,
+        viscosity_pa_s: 1.0e-3,
+        supply_m3_per_s: f64::INFINITY,
+        reservoir_m3: 40e-6,
     };
 
     /// The flow through a lumen of radius `lumen_m` over `length_m` of tube (m³/s):
-    /// `π r⁴ Δp / 8 μ L`.
+    /// `π r⁴ Δp / 8 μ L`, or the supply where that is less.
     pub fn flow_m3_per_s(&self, lumen_m: f64, length_m: f64) -> f64 {
-        std::f64::consts::PI * lumen_m.powi(4) * self.pressure_pa
-            / (8.0 * self.viscosity_pa_s * length_m.max(SHORTEST_TUBE_M))
+        let poiseuille = std::f64::consts::PI * lumen_m.powi(4) * self.pressure_pa
+            / (8.0 * self.viscosity_pa_s * length_m.max(SHORTEST_TUBE_M));
+        poiseuille.min(self.supply_m3_per_s)
     }
 }
 
@@ -64,34 +83,39 @@ pub struct Leak {
     /// Where the tube was cut, along it from its patient end (m).
     pub arc_length_m: f64,
     pub flow_m3_per_s: f64,
+    /// What there is to let out (m³; infinite for a stump its source keeps feeding).
+    pub reservoir_m3: f64,
     /// What it has let out so far (m³).
     pub lost_m3: f64,
     pub stopped: bool,
 }
 
 impl Leak {
+    /// The stump of `structure` cut at `arc_length_m`, on `side`, letting out `fluid` by
+    /// `law` through a lumen of `lumen_m` and `from_source_m` of tube.
     pub fn new(
+        (structure, side, arc_length_m): (Structure, Side, f64),
         fluid: Fluid,
-        structure: Structure,
-        side: Side,
-        arc_length_m: f64,
-        flow_m3_per_s: f64,
+        law: &FlowLaw,
+        lumen_m: f64,
+        from_source_m: f64,
     ) -> Self {
         Self {
             fluid,
             structure,
             side,
             arc_length_m,
-            flow_m3_per_s,
+            flow_m3_per_s: law.flow_m3_per_s(lumen_m, from_source_m),
+            reservoir_m3: law.reservoir_m3,
             lost_m3: 0.0,
             stopped: false,
         }
     }
 
-    /// Lets it flow for `dt_s` unless it has been stopped.
+    /// Lets it flow for `dt_s` unless it has been stopped or has nothing left.
     pub fn advance(&mut self, dt_s: f64) {
         if !self.stopped {
-            self.lost_m3 += self.flow_m3_per_s * dt_s;
+            self.lost_m3 = (self.lost_m3 + self.flow_m3_per_s * dt_s).min(self.reservoir_m3);
         }
     }
 

@@ -452,6 +452,38 @@ fn a_bleed_loses_what_poiseuilles_law_lets_through() {
     assert_eq!(FlowLaw::ARTERIAL.pressure_pa, pressure_pa);
 }
 
+/// The cystic duct divided unclipped: its patient's stump lets out what the liver secretes
+/// (600 mL a day), less than the duct's Poiseuille flow; its gallbladder's stump lets out the
+/// gallbladder's 40 mL, then nothing more.
+#[test]
+fn bile_flows_no_faster_than_the_liver_makes_it_and_no_more_than_the_gallbladder_holds() {
+    let tree = tree(&Anatomy::default());
+    let duct = tree.tube(Structure::CysticDuct);
+    let at = 0.5 * duct.length_m();
+    let (_, mut leaks) = cut(&tree, &[], &blades_at(&tree, Structure::CysticDuct, at)).unwrap();
+    let lumen = duct.section.outer_radius_m - duct.section.wall_m;
+    let poiseuille = std::f64::consts::PI * lumen.powi(4) * 1200.0 / (8.0 * 1e-3 * at);
+    let secreted = 600e-6 / 86_400.0;
+    assert!(secreted < poiseuille);
+    let sides: Vec<_> = leaks.iter().map(|l| (l.fluid, l.side)).collect();
+    assert_eq!(
+        sides,
+        [
+            (Fluid::Bile, Side::Patient),
+            (Fluid::Bile, Side::Gallbladder)
+        ]
+    );
+    assert!((leaks[0].flow_m3_per_s - secreted).abs() < 1e-12 * secreted);
+    for _ in 0..60_000 {
+        leaks.iter_mut().for_each(|l| l.advance(1e-3));
+    }
+    assert!((leaks[0].lost_m3 - secreted * 60.0).abs() < 1e-9 * secreted * 60.0);
+    assert_eq!(
+        leaks[1].lost_m3, 40e-6,
+        "the gallbladder emptied, and no more"
+    );
+}
+
 /// An optic in front of and below the triangle, as the laparoscope is in the scenarios.
 fn optic() -> Vector3<f64> {
     Vector3::new(0.0, 0.123, -0.2)
