@@ -2,8 +2,8 @@
 //! triangle's fat cleared with the hook to the critical view of safety, then three clips on
 //! each of the cystic duct and artery and a cut between them) passes with no mistake; its
 //! careless run (a clip and two cuts before the view, each leaving a stump open, the artery
-//! left bleeding) fails, its report naming the mistakes in time order, and scores lower. The runs are the scripts
-//! `write_the_clip_and_cut_runs` writes from the scenario's own tree and port.
+//! left bleeding) fails, its report naming the mistakes in time order, and scores lower. The
+//! runs are made from the scenario's own tree and port, and checked to be.
 
 use std::fmt::Write as _;
 
@@ -188,9 +188,20 @@ impl Script {
         self.go(tip - along * 0.01);
     }
 
-    fn write(&self, script: &str) {
+    /// Checks that the shipped run `script` is this one; with `PGD_WRITE_RUNS` set, writes it.
+    fn check_or_write(&self, script: &str) {
         let path = super::root().join(format!("scenarios/runs/{NAME}.{script}.csv"));
-        std::fs::write(&path, &self.csv).unwrap();
+        if std::env::var_os("PGD_WRITE_RUNS").is_some() {
+            std::fs::write(&path, &self.csv).unwrap();
+            return;
+        }
+        let shipped = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            shipped == self.csv,
+            "{} is not what the scene's tree and port make now: write it anew with \
+             PGD_WRITE_RUNS=1 cargo test --test scenarios clip_and_cut_runs",
+            path.display()
+        );
     }
 }
 
@@ -241,11 +252,10 @@ impl Plane {
     }
 }
 
-/// Writes the scenario's two scripted runs from its own tree and port (run once by hand when
-/// the scene changes: `cargo test --test scenarios write_the_clip_and_cut_runs -- --ignored`).
+/// The scenario's two scripted runs are what its own tree and port make (with
+/// `PGD_WRITE_RUNS` set, they are written anew: after a change to the scene).
 #[test]
-#[ignore = "writes scenarios/runs/lap-chole-clip-and-cut.*.csv"]
-fn write_the_clip_and_cut_runs() {
+fn the_clip_and_cut_runs_are_made_from_the_scenes_tree() {
     let scenario = scenario();
     let tree = scenario.biliary.as_ref().unwrap().tree().unwrap();
     let abdomen = Abdomen::new(&OrganSettings::default());
@@ -283,7 +293,7 @@ fn write_the_clip_and_cut_runs() {
     competent.go(start);
     competent.time_s += 1.0;
     competent.row(0);
-    competent.write("competent");
+    competent.check_or_write("competent");
 
     let mut careless = Script::new(&scenario, start, tip_m);
     for strand in &tree.fat.strands[..4] {
@@ -300,5 +310,5 @@ fn write_the_clip_and_cut_runs() {
     careless.go(start);
     careless.time_s += 3.0;
     careless.row(0);
-    careless.write("careless");
+    careless.check_or_write("careless");
 }
