@@ -12,7 +12,6 @@ use nalgebra::Vector3;
 use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion};
 use super::hand::{HandIndex, MAX_HANDS, Tool};
 use super::resources::{OrganBeds, Scope};
-use super::snapshot::SnapshotPublisher;
 use crate::biliary::critical_view::lower_third_released;
 use crate::biliary::{
     BiliaryTree, Clip, CriticalView, CriticalViewRule, Division, Leak, Segment, Structure,
@@ -492,11 +491,4 @@ pub fn tick_biliary(
         biliary.judge(optic, beds.as_deref(), &organs);
     }
     biliary.sample.view = biliary.view;
-}
-
-/// Hands the tree as it stands to the snapshot the tick publishes.
-pub fn publish_biliary(biliary: Res<Biliary>, mut publisher: ResMut<SnapshotPublisher>) {
-    if let Some(view) = publisher.0.input_buffer_mut().biliary.as_mut() {
-        view.update(&biliary);
-    }
 }

@@ -122,7 +122,7 @@ pub fn haptic_schedule() -> Schedule {
             systems::trace_force.run_if(any_with_component::<ForceTrace>),
             (
                 scoring::publish_progress,
-                biliary::publish_biliary.run_if(resource_exists::<Biliary>),
+                systems::publish_biliary.run_if(resource_exists::<Biliary>),
                 systems::publish_snapshot,
             )
                 .chain()

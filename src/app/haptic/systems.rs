@@ -535,6 +535,13 @@ pub fn publish_snapshot(
     publisher.0.publish();
 }
 
+/// Hands the biliary tree as it stands to the snapshot the tick publishes.
+pub fn publish_biliary(biliary: Res<Biliary>, mut publisher: ResMut<SnapshotPublisher>) {
+    if let Some(view) = publisher.0.input_buffer_mut().biliary.as_mut() {
+        view.update(&biliary);
+    }
+}
+
 /// A hand's instrument and force as the window draws them.
 fn publish_hand(hand: &PublishedHandItem, cut_organs: bool, published: &mut HandSnapshot) {
     let tool = hand.tool;
