@@ -20,16 +20,21 @@ fn flexural() -> f64 {
     YOUNG_PA * SECTION.second_moment_m4()
 }
 
-/// The duct in `segments`, clamped at x = 0.
-fn cantilever(segments: usize) -> Rod {
-    let mut rod = Rod::straight(
+/// The duct in `segments` along x, held nowhere.
+fn duct(segments: usize) -> Rod {
+    Rod::straight(
         Vector3::zeros(),
         Vector3::x() * LENGTH_M,
         segments,
         SECTION,
         YOUNG_PA,
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// The duct in `segments`, clamped at x = 0.
+fn cantilever(segments: usize) -> Rod {
+    let mut rod = duct(segments);
     rod.clamp_start();
     rod
 }
@@ -162,14 +167,7 @@ fn bad_rods_and_loads_are_refused() {
 #[test]
 fn a_divided_tube_carries_nothing_across_its_cut() {
     let segments = 20;
-    let mut rod = Rod::straight(
-        Vector3::zeros(),
-        Vector3::x() * LENGTH_M,
-        segments,
-        SECTION,
-        YOUNG_PA,
-    )
-    .unwrap();
+    let mut rod = duct(segments);
     let (first, last) = (0, segments);
     rod.hold(first).unwrap();
     rod.hold(last).unwrap();
