@@ -143,10 +143,11 @@ fn update_hud(
         force,
         status,
         guidance: format!(
-            "{}{help}{}{}",
+            "{}{help}{}{}{}",
             building_line(),
             instrument_line(&link, &snapshot.0),
-            camera_line(&link, &snapshot.0, *view.mode)
+            camera_line(&link, &snapshot.0, *view.mode),
+            critical_view_line(&link, &snapshot.0)
         ),
         details: format!(
             "device: {}\nhaptic {:.0} Hz | tick p99 {:.0} us, late p99 {:.0} us, {} skipped | \
@@ -266,6 +267,26 @@ fn status_line(link: &HapticLink, snapshot: &HapticSnapshot) -> String {
     } else {
         format!("touching {}{}", touching.join(", "), beyond_range(snapshot))
     }
+}
+
+/// With a biliary tree, the critical view of safety as last judged: each criterion against
+/// what the scenario asks.
+fn critical_view_line(link: &HapticLink, snapshot: &HapticSnapshot) -> String {
+    let (Some(tree), Some(biliary)) = (&snapshot.biliary, &link.scene.biliary) else {
+        return String::new();
+    };
+    let (view, rule) = (tree.view, biliary.rule);
+    format!(
+        "\ncritical view of safety{}: triangle cleared {:.0} % (of {:.0}) | lower third off its \
+         bed {:.0} % (of {:.0}) | structures seen entering the gallbladder {} of {}",
+        if view.reached { " REACHED" } else { "" },
+        100.0 * view.triangle_cleared,
+        100.0 * rule.triangle_cleared,
+        100.0 * view.lower_third_released,
+        100.0 * rule.lower_third_released,
+        view.seen,
+        view.entering
+    )
 }
 
 /// The HUD's parts: what the trainee reads first, then the details behind F3.
