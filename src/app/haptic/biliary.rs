@@ -223,6 +223,7 @@ impl Biliary {
         self.button_was_down[hand] = down;
         let tip = sample.tip_m;
         let radius = tool.probe.tip_radius_m;
+        // Along the shaft through a port; in open surgery, whose tool has no shaft, downwards.
         let along = tool.pose.map_or(-Vector3::z(), |p| p.along);
         // Jaws and blades reach on beyond the instrument's tip, from their hinge at its
         // surface.
