@@ -14,7 +14,7 @@ use super::hand::{HandIndex, MAX_HANDS, Tool};
 use super::resources::{OrganBeds, Scope};
 use crate::biliary::critical_view::lower_third_released;
 use crate::biliary::{
-    BiliaryTree, Clip, CriticalView, CriticalViewRule, Division, Leak, Segment, Structure,
+    BiliaryTree, Clip, CriticalView, CriticalViewRule, Division, Fluid, Leak, Segment, Structure,
 };
 use crate::devices::{Action, DeviceSample, TICK_S};
 use crate::dissection::CauteryMode;
@@ -278,7 +278,7 @@ impl Biliary {
         let Some((division, open)) = Division::cut(&self.tree, &self.clips, blades) else {
             return;
         };
-        let tube = &mut self.tree.tubes[structure_index(division.structure)];
+        let tube = self.tree.tube_mut(division.structure);
         let segment = (division.arc_length_m / tube.rod.segment_m()) as usize;
         let segment = segment.min(tube.rod.nodes() - 2);
         if tube.rod.is_divided(segment) {
@@ -296,7 +296,7 @@ impl Biliary {
     /// Stops the open stumps within `reach` of `tip`.
     fn coagulate(&mut self, tip: &Vector3<f64>, reach: f64) {
         for leak in self.leaks.iter_mut().filter(|l| !l.stopped) {
-            let tube = &self.tree.tubes[structure_index(leak.structure)];
+            let tube = self.tree.tube(leak.structure);
             if (tube.point_at(leak.arc_length_m) - tip).norm()
                 <= reach + tube.section.outer_radius_m
             {
@@ -393,14 +393,13 @@ impl Biliary {
         for leak in &mut self.leaks {
             leak.advance(TICK_S);
             match leak.fluid {
-                crate::biliary::Fluid::Blood => blood += leak.lost_m3,
-                crate::biliary::Fluid::Bile => bile += leak.lost_m3,
+                Fluid::Blood => blood += leak.lost_m3,
+                Fluid::Bile => bile += leak.lost_m3,
             }
         }
         self.sample.blood_lost_m3 = blood;
         self.sample.bile_spilled_m3 = bile;
-        self.sample.bleeding =
-            (self.leaks.iter()).any(|l| l.fluid == crate::biliary::Fluid::Blood && !l.stopped);
+        self.sample.bleeding = (self.leaks.iter()).any(|l| l.fluid == Fluid::Blood && !l.stopped);
     }
 
     /// Judges the critical view from `optic_m`, the gallbladder's lower third as its bed in
@@ -447,13 +446,6 @@ fn moved_at(vademecum: &Vademecum, at: &SurfacePoint, moved: &[f64]) -> Vector3<
         }
     }
     u
-}
-
-fn structure_index(structure: Structure) -> usize {
-    Structure::ALL
-        .iter()
-        .position(|&s| s == structure)
-        .expect("one of them")
 }
 
 type OrganState = (
