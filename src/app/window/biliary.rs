@@ -22,15 +22,21 @@ struct TubeSegment {
 #[derive(Component)]
 struct FatPiece(usize);
 
-/// The `k`th clip, the `k`th open stump's pool: drawn once there is one.
+/// The `k`th clip, drawn once there is one.
 #[derive(Component)]
 struct ClipMark(usize);
-#[derive(Component)]
-struct Pool(usize);
 
-/// Room for this many clips and pools drawn (the tree keeps as many).
+/// The pool of the `leak`th open stump, drawn when it lets out `fluid` (each stump has one
+/// of each fluid's colour).
+#[derive(Component)]
+struct Pool {
+    leak: usize,
+    fluid: Fluid,
+}
+
+/// Room for this many clips and open stumps drawn (the tree keeps as many).
 const CLIPS_DRAWN: usize = 32;
-const POOLS_DRAWN: usize = 64;
+const LEAKS_DRAWN: usize = 64;
 
 /// A clip's size across its tube beyond the tube's diameter, along it, and its depth (m).
 const CLIP_OVERHANG_M: f32 = 0.001;
@@ -122,9 +128,10 @@ fn spawn_tree(
     let disc = meshes.add(Cylinder::new(1.0, 1.0));
     let blood = tissue(&mut materials, Color::srgb(0.45, 0.02, 0.02), 1.0);
     let bile = tissue(&mut materials, Color::srgb(0.42, 0.55, 0.08), 0.8);
-    for k in 0..POOLS_DRAWN {
-        let material = if k % 2 == 0 { &blood } else { &bile };
-        commands.spawn((Pool(k), hidden(&disc, material)));
+    for leak in 0..LEAKS_DRAWN {
+        for (fluid, material) in [(Fluid::Blood, &blood), (Fluid::Bile, &bile)] {
+            commands.spawn((Pool { leak, fluid }, hidden(&disc, material)));
+        }
     }
 }
 
@@ -240,7 +247,7 @@ fn pool_transform(leak: &LeakView) -> Option<Transform> {
     )))
 }
 
-/// Each open stump's pool, blood on the even entities and bile on the odd ones.
+/// Each open stump's pool, in its fluid's colour.
 fn draw_pools(snapshot: Res<Snapshot>, mut pools: Query<(&Pool, &mut Transform, &mut Visibility)>) {
     let leaks = snapshot
         .0
@@ -248,12 +255,7 @@ fn draw_pools(snapshot: Res<Snapshot>, mut pools: Query<(&Pool, &mut Transform, 
         .as_ref()
         .map_or(&[][..], |v| &v.leaks[..]);
     for (pool, mut transform, mut visibility) in &mut pools {
-        let fluid = if pool.0 % 2 == 0 {
-            Fluid::Blood
-        } else {
-            Fluid::Bile
-        };
-        let leak = leaks.get(pool.0 / 2).filter(|leak| leak.fluid == fluid);
+        let leak = (leaks.get(pool.leak)).filter(|leak| leak.fluid == pool.fluid);
         match leak.and_then(pool_transform) {
             Some(at) => {
                 *transform = at;
