@@ -92,9 +92,10 @@ impl TriangleFat {
     /// The share of the fat's volume cleared.
     pub fn cleared_share(&self) -> f64 {
         let total: f64 = self.strands.iter().map(FatStrand::volume_m3).sum();
-        let cleared: f64 = (self.strands.iter().filter(|s| s.cleared))
+        // Folded from +0: a sum of no strands would start at -0, which prints as "-0 %".
+        let cleared = (self.strands.iter().filter(|s| s.cleared))
             .map(FatStrand::volume_m3)
-            .sum();
+            .fold(0.0, |sum, v| sum + v);
         if total > 0.0 { cleared / total } else { 1.0 }
     }
 

@@ -499,7 +499,7 @@ fn the_triangle_and_the_two_structures_criteria_follow_the_scene() {
     let rule = CriticalViewRule::default();
     let nothing_hides = |_: &Segment| false;
     let view = CriticalView::judge(&tree, 1.0, optic(), nothing_hides, rule);
-    assert_eq!(view.triangle_cleared, 0.0);
+    assert!(view.triangle_cleared == 0.0 && view.triangle_cleared.is_sign_positive());
     assert!(!view.triangle_met());
     assert_eq!(view.entering().count(), 2);
     assert!(!view.two_structures_met(), "hidden by the fat: {view:?}");
