@@ -9,7 +9,7 @@ use nalgebra::Vector3;
 
 use super::haptic::{
     ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SceneBiliary,
-    SceneHand, SceneScope, SettleCuts, TickClock,
+    SceneHand, SceneScope, SettleCuts, TickClock, view_record,
 };
 use super::scene::{Detail, SceneOrgan, scene_files, scene_of, scene_vademecums, tie_organs};
 use crate::contact::{ContactSurface, CouplingSettings};
@@ -253,6 +253,8 @@ pub fn sites_on(scene: &HapticScene, scenario: &Scenario) -> Sites {
             .iter()
             .map(|task| keratometer(scene, scenario, task))
             .collect(),
+        critical_view: (scene.biliary.as_ref())
+            .map(|biliary| view_record(biliary, &scene.organs, &scene.beds)),
     }
 }
 
@@ -332,9 +334,11 @@ pub fn cuts_made(haptic: &mut HapticLoop) -> Vec<CutMade> {
 
 /// Ends `exercise` (unfinished tasks are not completed) and scores it.
 pub fn outcome_of(exercise: Exercise) -> Outcome {
-    let (scenario, tasks, force_trace) = exercise.finish();
+    let finished = exercise.finish();
+    let mut card = score(&finished.scenario, finished.tasks);
+    card.critical_view = finished.critical_view;
     Outcome {
-        card: score(&scenario, tasks),
-        force_trace,
+        card,
+        force_trace: finished.force_trace,
     }
 }

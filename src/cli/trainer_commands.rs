@@ -212,10 +212,10 @@ pub fn debrief(
         print!("{}", report::summary(&outcome.card));
     }
     let (report, code) = match written {
-        Ok(paths) => {
-            let shown: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+        Ok(files) => {
+            let shown: Vec<String> = files.paths().map(|p| p.display().to_string()).collect();
             eprintln!("report: {}", shown.join(", "));
-            (Some(paths[0].clone()), ExitCode::SUCCESS)
+            (Some(files.json), ExitCode::SUCCESS)
         }
         Err(e) => {
             eprintln!("trainer: the report was not written: {e}");

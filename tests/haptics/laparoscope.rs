@@ -209,7 +209,8 @@ fn the_exercise_times_the_tip_out_of_view() {
             ..Sample::default()
         });
     }
-    let (scenario, tasks, _) = exercise.finish();
+    let finished = exercise.finish();
+    let (scenario, tasks) = (finished.scenario, finished.tasks);
     let out_s = tasks[0].motion.out_of_view_s.unwrap();
     assert!((out_s - 0.7).abs() < 1.5e-3, "{out_s}");
     assert_eq!(tasks[0].target_out_of_view_s, Some(0.0));

@@ -8,11 +8,14 @@
 use std::fmt::Write as _;
 
 use nalgebra::Vector3;
+use pgd_surgery::app::attempt::Outcome;
 use pgd_surgery::app::attempt::scenario_scene;
 use pgd_surgery::app::scene::Detail;
-use pgd_surgery::biliary::{BiliaryTree, FatStrand, Structure};
+use pgd_surgery::biliary::{BiliaryTree, FatStrand, Structure, ViewRecord};
 use pgd_surgery::devices::{Fulcrum, Instrument, Rack};
 use pgd_surgery::mesh::organs::{Abdomen, Organ, OrganSettings};
+use pgd_surgery::report::critical_view::{FAT, Projection, SIZE, Side, colour_of, rgb};
+use pgd_surgery::report::write_report;
 use pgd_surgery::scenario::tasks::ClipAndCutResult;
 use pgd_surgery::scenario::{Scenario, load};
 use pgd_surgery::store::OnStale;
@@ -43,11 +46,62 @@ fn the_competent_clip_and_cut_reaches_the_view_then_clips_and_divides_as_taught(
     assert_eq!((result.cystic_duct_clips, result.artery_clips), (3, 3));
     assert_eq!(result.blood_lost_ml, 0.0);
     assert!(card.passed, "{card:#?}");
+    let (picture, record) = doublet("competent", &outcome);
+    assert!(record.reached() && record.time_s == Some(view_s));
+    assert!(
+        record.clips.is_empty(),
+        "kept as it was when the view was reached"
+    );
+    let duct = colour_at(&picture, &record, Side::Front, Structure::CysticDuct);
+    assert!(
+        nearer(duct, rgb(colour_of(Structure::CysticDuct)), rgb(FAT)),
+        "{duct:?}"
+    );
+}
+
+/// The report's critical view of `outcome`, written and read back (RGB rows), and what it
+/// was drawn from.
+fn doublet(stem: &str, outcome: &Outcome) -> (Vec<u8>, ViewRecord) {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("clip-and-cut-report");
+    let files = write_report(&dir, stem, &outcome.card, &outcome.force_trace).unwrap();
+    let path = files.critical_view.expect("a critical view picture");
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut pixels).unwrap();
+    assert_eq!((info.width, info.height), SIZE);
+    let record = outcome.card.critical_view.clone().unwrap();
+    (pixels, record)
+}
+
+/// The colour drawn from `side` where a quarter of `structure`'s length from its patient
+/// end falls (away from the careless run's cuts).
+fn colour_at(pixels: &[u8], record: &ViewRecord, side: Side, structure: Structure) -> [u8; 3] {
+    let tube = record
+        .tubes
+        .iter()
+        .find(|t| t.structure == structure)
+        .unwrap();
+    let at = tube.positions_m[tube.positions_m.len() / 4];
+    let (x, y) = Projection::new(record, side).in_picture(&at).unwrap();
+    let at = 3 * (y as usize * SIZE.0 as usize + x as usize);
+    [pixels[at], pixels[at + 1], pixels[at + 2]]
+}
+
+/// Whether `colour` is nearer `this` than `that`.
+fn nearer(colour: [u8; 3], this: [u8; 3], that: [u8; 3]) -> bool {
+    let distance = |c: [u8; 3]| {
+        (colour.iter().zip(c))
+            .map(|(&a, b)| (i32::from(a) - i32::from(b)).pow(2))
+            .sum::<i32>()
+    };
+    distance(this) < distance(that)
 }
 
 #[test]
 fn the_careless_clip_and_cut_fails_naming_what_it_did_before_the_view() {
-    let careless = super::run(NAME, "careless").card;
+    let careless_outcome = super::run(NAME, "careless");
+    let careless = &careless_outcome.card;
     let metrics = &careless.tasks[0].metrics;
     eprintln!("score {:.1}, errors {:?}", careless.score, metrics.errors);
     let result = metrics.result::<ClipAndCutResult>().unwrap();
@@ -71,6 +125,14 @@ fn the_careless_clip_and_cut_fails_naming_what_it_did_before_the_view() {
     );
     assert!(!metrics.completed, "the artery still bleeds");
     assert!(!careless.passed);
+    let (picture, record) = doublet("careless", &careless_outcome);
+    assert!(!record.reached());
+    // The fat left hides the artery from the front; from behind it lies in front of the fat.
+    let artery = rgb(colour_of(Structure::CysticArtery));
+    let front = colour_at(&picture, &record, Side::Front, Structure::CysticArtery);
+    assert!(nearer(front, rgb(FAT), artery), "{front:?}");
+    let behind = colour_at(&picture, &record, Side::Behind, Structure::CysticArtery);
+    assert!(nearer(behind, artery, rgb(FAT)), "{behind:?}");
     let competent = super::run(NAME, "competent").card;
     assert!(
         competent.score > careless.score + 20.0,

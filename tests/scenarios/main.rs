@@ -199,8 +199,8 @@ fn metrics_say_what_went_wrong() {
 fn the_report_is_written_as_json_text_and_plot() {
     let outcome = run("abdomen-tour", "competent");
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenario-report");
-    let [json, text, png] =
-        write_report(&dir, "tour", &outcome.card, &outcome.force_trace).unwrap();
+    let files = write_report(&dir, "tour", &outcome.card, &outcome.force_trace).unwrap();
+    let (json, text, png) = (files.json, files.summary, files.plot);
     let value: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
     assert_eq!(value["passed"], true);
@@ -262,7 +262,9 @@ fn a_keratotomy_is_scored_on_its_incisions_and_a_perforation_fails_it() {
 
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenario-report");
     for (stem, outcome) in [("rk-competent", &competent), ("rk-careless", &careless)] {
-        let [.., png] = write_report(&dir, stem, &outcome.card, &outcome.force_trace).unwrap();
+        let png = write_report(&dir, stem, &outcome.card, &outcome.force_trace)
+            .unwrap()
+            .plot;
         let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(png).unwrap()));
         assert_eq!(decoder.read_info().unwrap().info().height, 900, "{stem}");
     }
@@ -284,7 +286,9 @@ fn the_incision_report_draws_the_cuts_over_the_line() {
     assert!(!outcome.card.cuts.is_empty());
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenario-report");
     let height = |stem: &str, outcome: &Outcome| {
-        let [.., png] = write_report(&dir, stem, &outcome.card, &outcome.force_trace).unwrap();
+        let png = write_report(&dir, stem, &outcome.card, &outcome.force_trace)
+            .unwrap()
+            .plot;
         let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(png).unwrap()));
         decoder.read_info().unwrap().info().height
     };

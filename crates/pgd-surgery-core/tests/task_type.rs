@@ -159,7 +159,8 @@ fn a_task_type_registered_in_a_test_module_reads_runs_and_scores() {
     }
     assert!(exercise.finished());
     assert!(progress.contains(&"taps 2 of 3".to_owned()), "{progress:?}");
-    let (scenario, metrics, _) = exercise.finish();
+    let finished = exercise.finish();
+    let (scenario, metrics) = (finished.scenario, finished.tasks);
     let m = &metrics[0];
     assert!(m.completed, "{m:#?}");
     assert_eq!((m.kind, m.time_s.round()), ("tap", 2.0));

@@ -12,12 +12,13 @@ use nalgebra::Vector3;
 use super::components::{OrganBody, OrganDeformation, OrganIndex, OrganMotion};
 use super::hand::{HandIndex, MAX_HANDS, Tool};
 use super::resources::{OrganBeds, Scope};
-use crate::biliary::critical_view::lower_third_released;
+use crate::biliary::critical_view::{LowerThird, lower_third_released};
 use crate::biliary::{
-    BiliaryTree, Clip, CriticalView, CriticalViewRule, Division, Fluid, Leak, Segment, Structure,
+    BiliaryTree, Clip, CriticalView, CriticalViewRule, Division, Fluid, Judging, Leak, OrganPatch,
+    Segment, Structure, ViewRecord,
 };
 use crate::devices::{Action, DeviceSample, TICK_S};
-use crate::dissection::CauteryMode;
+use crate::dissection::{CauteryMode, TiedOrgans};
 use crate::mesh::organs::{Abdomen, OrganSettings};
 use crate::parry_interop::SightBlockers;
 use crate::pgd::{SurfacePoint, Vademecum};
@@ -77,7 +78,7 @@ pub struct Biliary {
     anchored: bool,
     /// The organs at rest, for the sight lines to the optic.
     occluders: SightBlockers,
-    gallbladder_axis: (Vector3<f64>, Vector3<f64>),
+    lower_third: LowerThird,
     clips: Vec<Clip>,
     divisions: Vec<Division>,
     leaks: Vec<Leak>,
@@ -87,6 +88,9 @@ pub struct Biliary {
     button_was_down: [bool; MAX_HANDS],
     push_n: [Vector3<f64>; MAX_HANDS],
     view: ViewSample,
+    /// The critical view as judged last, from where, and whether that was this tick.
+    judged: Option<(CriticalView, Vector3<f64>)>,
+    judged_now: bool,
     pub sample: BiliarySample,
 }
 
@@ -96,7 +100,6 @@ impl Biliary {
         let occluders = SightBlockers::new(
             (organs.iter()).map(|(_, v)| (&v.position_coords_m[..], &v.triangles[..])),
         );
-        let (fundus, neck) = Abdomen::new(&OrganSettings::default()).gallbladder_axis_m();
         let nodes: usize = scene.tree.tubes.iter().map(|t| t.rod.nodes()).sum();
         Self {
             tree: scene.tree.clone(),
@@ -106,7 +109,7 @@ impl Biliary {
             anchors: [None; 3],
             anchored: false,
             occluders,
-            gallbladder_axis: (fundus.coords, neck.coords),
+            lower_third: lower_third(),
             clips: Vec::with_capacity(ROOM),
             divisions: Vec::with_capacity(ROOM),
             leaks: Vec::with_capacity(2 * ROOM),
@@ -115,6 +118,8 @@ impl Biliary {
             button_was_down: [false; MAX_HANDS],
             push_n: [Vector3::zeros(); MAX_HANDS],
             view: ViewSample::default(),
+            judged: None,
+            judged_now: false,
             sample: BiliarySample::default(),
         }
     }
@@ -136,6 +141,8 @@ impl Biliary {
         self.grasped = [None; MAX_HANDS];
         self.push_n = [Vector3::zeros(); MAX_HANDS];
         self.view = ViewSample::default();
+        self.judged = None;
+        self.judged_now = false;
         self.sample = BiliarySample::default();
     }
 
@@ -417,6 +424,27 @@ impl Biliary {
         let organs_hide = |sight: &Segment| occluders.block(&sight.from_m, &sight.to_m, OFF_M);
         let view = CriticalView::judge(&self.tree, lower_third, optic_m, organs_hide, self.rule);
         self.view = ViewSample::of(&view);
+        self.judged = Some((view, optic_m));
+        self.judged_now = true;
+    }
+
+    /// Keeps in `record` what the critical view was judged on this tick, at `time_s`
+    /// (nothing on a tick it was not judged); `beds` hold the gallbladder's ties.
+    pub fn keep_judging(&self, record: &mut ViewRecord, time_s: f64, beds: Option<&OrganBeds>) {
+        let Some((view, optic_m)) = self.judged.as_ref().filter(|_| self.judged_now) else {
+            return;
+        };
+        let bed = (self.gallbladder.zip(beds))
+            .and_then(|(index, beds)| beds.0.iter().find(|b| b.freed_index() == index))
+            .map(|tied| (&tied.bed, tied.ends_m()));
+        record.keep(&Judging {
+            time_s,
+            optic_m: *optic_m,
+            view,
+            tree: &self.tree,
+            clips: &self.clips,
+            bed,
+        });
     }
 
     fn lower_third(&self, beds: Option<&OrganBeds>, organs: &Query<OrganState>) -> f64 {
@@ -429,9 +457,55 @@ impl Biliary {
         let Some(body) = self.gallbladder_body(organs) else {
             return 1.0;
         };
-        let (fundus, neck) = self.gallbladder_axis;
-        lower_third_released(&bed.bed, &body.vademecum.position_coords_m, fundus, neck)
+        lower_third_released(
+            &bed.bed,
+            &body.vademecum.position_coords_m,
+            &self.lower_third,
+        )
     }
+}
+
+/// The organs drawn around the triangle in the critical view's pictures, and how far from
+/// its centre (m).
+const PICTURED: [&str; 2] = ["gallbladder", "liver"];
+const PICTURED_WITHIN_M: f64 = 0.05;
+
+/// Room for what the critical view of `scene`'s tree is judged on, among `organs` (the
+/// scene's, in order) some of which lie in `beds`, with the organs around it at rest.
+pub fn view_record(
+    scene: &SceneBiliary,
+    organs: &[(String, std::sync::Arc<Vademecum>)],
+    beds: &[TiedOrgans],
+) -> ViewRecord {
+    let tree = &scene.tree;
+    let gallbladder = (organs.iter()).position(|(name, _)| name == "gallbladder");
+    let lower_third_ties = gallbladder
+        .and_then(|index| {
+            let tied = beds.iter().find(|b| b.freed_index() == index)?;
+            let coords = &organs[index].1.position_coords_m;
+            Some(lower_third().tie_indices(&tied.bed, coords).collect())
+        })
+        .unwrap_or_default();
+    let mut record = ViewRecord::new(tree, ROOM, lower_third_ties, Vec::new());
+    let centre_m = record.centre_m();
+    record.organs = (organs.iter())
+        .filter(|(name, _)| PICTURED.contains(&name.as_str()))
+        .map(|(name, v)| {
+            OrganPatch::near(
+                name,
+                &v.position_coords_m,
+                &v.triangles,
+                centre_m,
+                PICTURED_WITHIN_M,
+            )
+        })
+        .collect();
+    record
+}
+
+/// The generated gallbladder's lower third, whose release from its bed the critical view asks.
+pub fn lower_third() -> LowerThird {
+    LowerThird::of(&Abdomen::new(&OrganSettings::default()))
 }
 
 /// What an organ's motion adds at `at`: its modes' displacement there, `moved` the
@@ -467,6 +541,7 @@ pub fn tick_biliary(
     let biliary = &mut *biliary;
     biliary.sample.clip = None;
     biliary.sample.division = None;
+    biliary.judged_now = false;
     biliary.anchor(&organs);
     biliary.follow_gallbladder(&organs);
     biliary.release_pushed();

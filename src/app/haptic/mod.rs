@@ -23,7 +23,7 @@ use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
 use snapshot::SnapshotPublisher;
 
-pub use biliary::{Biliary, SceneBiliary};
+pub use biliary::{Biliary, SceneBiliary, view_record};
 pub use cautery::{HookWork, OrganBurns};
 pub use components::{
     HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion, ToolTouch, organ_with_law,

@@ -248,8 +248,13 @@ pub fn score_tick(
         left,
         hook,
         released_share: released_share(beds.as_deref()),
-        biliary: biliary.map_or_else(BiliarySample::default, |b| b.sample),
+        biliary: biliary
+            .as_ref()
+            .map_or_else(BiliarySample::default, |b| b.sample),
     });
+    if let (Some(biliary), Some(record)) = (&biliary, exercise.critical_view_mut()) {
+        biliary.keep_judging(record, clock.time_s, beds.as_deref());
+    }
     if exercise.finished() {
         let run = &mut *run;
         run.link.hand_over(&mut run.exercise);

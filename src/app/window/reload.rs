@@ -286,7 +286,7 @@ mod tests {
         assert!(texts(&mut app).contains("reloaded"));
         link.start();
         let taken = ExerciseRun::new(link.clone()).into_exercise().unwrap();
-        assert_eq!(taken.finish().0.briefing, "Press it gently.");
+        assert_eq!(taken.finish().scenario.briefing, "Press it gently.");
 
         std::fs::write(&file, scenario_text("Press the spleen.", "pancreas", 0.3)).unwrap();
         update_until(&mut app, "the scene change refused", |app| {

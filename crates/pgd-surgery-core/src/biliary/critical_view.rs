@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use super::anatomy::{BiliaryTree, Structure, Tube};
 use super::geometry::Segment;
 use crate::dissection::Bed;
+use crate::mesh::organs::Abdomen;
 
 /// How much of each criterion is enough; a scenario may ask for more or less.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -38,7 +39,8 @@ impl Default for CriticalViewRule {
 pub const ENTRY_M: f64 = 0.01;
 const ENTRY_SAMPLES: usize = 6;
 
-/// The gallbladder's lower third: its third nearest the neck along its axis.
+/// Where the gallbladder's lower third starts along its axis, from the fundus (0) to the
+/// neck (1).
 const LOWER_THIRD_FROM: f64 = 2.0 / 3.0;
 
 /// A tube entering the gallbladder and how much of its entry is in sight.
@@ -149,26 +151,51 @@ fn other_tubes_hide(tree: &BiliaryTree, looked_at: &Tube, sight: &Segment) -> bo
     })
 }
 
-/// The share of the area of `bed` within the freed organ's lower third (its third nearest
-/// `neck_m` along the axis from `fundus_m`) whose ties have failed; `coords_m` are the freed
-/// organ's load positions at rest. 1 where the bed has no tie there.
-pub fn lower_third_released(
-    bed: &Bed,
-    coords_m: &[[f32; 3]],
-    fundus_m: Vector3<f64>,
-    neck_m: Vector3<f64>,
-) -> f64 {
-    let axis = neck_m - fundus_m;
-    let in_lower_third = |position: usize| {
-        let at = Vector3::from(coords_m[position].map(f64::from));
-        (at - fundus_m).dot(&axis) / axis.norm_squared() >= LOWER_THIRD_FROM
-    };
+/// The share of the area of `bed` within the freed organ's lower third whose ties have
+/// failed; 1 where the bed has no tie there. `coords_m` are the freed organ's load positions
+/// at rest.
+pub fn lower_third_released(bed: &Bed, coords_m: &[[f32; 3]], third: &LowerThird) -> f64 {
     let (mut area, mut released) = (0.0, 0.0);
-    for tie in bed.ties.iter().filter(|t| in_lower_third(t.position)) {
+    for tie in third.tie_indices(bed, coords_m).map(|k| &bed.ties[k]) {
         area += tie.area_m2;
         if tie.state.failed(&bed.law) {
             released += tie.area_m2;
         }
     }
     if area > 0.0 { released / area } else { 1.0 }
+}
+
+/// The gallbladder's lower third: its third nearest the neck along its axis from the fundus.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LowerThird {
+    pub fundus_m: Vector3<f64>,
+    pub neck_m: Vector3<f64>,
+}
+
+impl LowerThird {
+    /// The gallbladder's of `abdomen`.
+    pub fn of(abdomen: &Abdomen) -> Self {
+        let (fundus, neck) = abdomen.gallbladder_axis_m();
+        Self {
+            fundus_m: fundus.coords,
+            neck_m: neck.coords,
+        }
+    }
+
+    /// Whether `at_m` lies in it.
+    pub fn holds(&self, at_m: Vector3<f64>) -> bool {
+        let axis = self.neck_m - self.fundus_m;
+        (at_m - self.fundus_m).dot(&axis) / axis.norm_squared() >= LOWER_THIRD_FROM
+    }
+
+    /// The indices of `bed`'s ties in it, `coords_m` the freed organ's load positions at rest.
+    pub fn tie_indices<'a>(
+        &'a self,
+        bed: &'a Bed,
+        coords_m: &'a [[f32; 3]],
+    ) -> impl Iterator<Item = usize> + 'a {
+        (bed.ties.iter().enumerate())
+            .filter(|(_, tie)| self.holds(Vector3::from(coords_m[tie.position].map(f64::from))))
+            .map(|(k, _)| k)
+    }
 }

@@ -1,7 +1,8 @@
 //! An attempt's report on disk: the scorecard as JSON, a summary a trainee reads, and
 //! a plot of the force against time with each task's limits drawn over its span, and for an
 //! incision, the cuts drawn over the marked line; for a keratotomy, the incisions drawn on
-//! the cornea seen from the front.
+//! the cornea seen from the front; and where the critical view of safety was judged, its
+//! doublet of pictures.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -10,6 +11,7 @@ use plotters::prelude::*;
 
 use nalgebra::Vector3;
 
+use super::critical_view::draw_critical_view;
 use super::plot::{Area, PlotResult, draw_legend, legend_stroke, save_png};
 use crate::scenario::tasks::{IncisionResult, RadialKeratotomyResult};
 use crate::scenario::{CutMade, IncisionMetrics, KeratotomyMetrics, Scorecard};
@@ -18,20 +20,52 @@ const SIZE: (u32, u32) = (1200, 500);
 /// The plot's size with an incision's or a keratotomy's panel under the force.
 const SIZE_WITH_INCISION: (u32, u32) = (1200, 900);
 
-/// Writes `<stem>.json`, `<stem>.txt` and `<stem>.png` in `dir`; returns their paths.
+/// The files of an attempt's report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReportFiles {
+    pub json: PathBuf,
+    pub summary: PathBuf,
+    pub plot: PathBuf,
+    /// The critical view of safety's doublet, in a scene with a biliary tree.
+    pub critical_view: Option<PathBuf>,
+}
+
+impl ReportFiles {
+    /// Every file, in the order above.
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        [&self.json, &self.summary, &self.plot]
+            .into_iter()
+            .chain(&self.critical_view)
+            .map(PathBuf::as_path)
+    }
+}
+
+/// Writes `<stem>.json`, `<stem>.txt`, `<stem>.png` and, where the critical view was
+/// judged, `<stem>.critical-view.png` in `dir`; returns their paths.
 pub fn write_report(
     dir: &Path,
     stem: &str,
     card: &Scorecard,
     force_trace: &[(f64, f64)],
-) -> Result<[PathBuf; 3], String> {
+) -> Result<ReportFiles, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let [json, text, png] = ["json", "txt", "png"].map(|ext| dir.join(format!("{stem}.{ext}")));
     let body = serde_json::to_string_pretty(card).map_err(|e| e.to_string())?;
     std::fs::write(&json, body).map_err(|e| format!("{}: {e}", json.display()))?;
     std::fs::write(&text, summary(card)).map_err(|e| format!("{}: {e}", text.display()))?;
     plot(&png, card, force_trace).map_err(|e| format!("{}: {e}", png.display()))?;
-    Ok([json, text, png])
+    let critical_view = (card.critical_view.as_ref())
+        .map(|record| {
+            let path = dir.join(format!("{stem}.critical-view.png"));
+            draw_critical_view(&path, record).map(|()| path)
+        })
+        .transpose()?;
+    Ok(ReportFiles {
+        json,
+        summary: text,
+        plot: png,
+        critical_view,
+    })
 }
 
 /// The scorecard in words: the verdict, each task's metrics and score, what went wrong.

@@ -10,6 +10,7 @@ use super::task::{
     AnyRun, CountertractionWatch, Hand, LimitWatch, Mistake, Mistakes, RunSetup, Task, TaskMetrics,
     TaskProgress, Tick,
 };
+use crate::biliary::ViewRecord;
 
 /// Where the scenario's points lie on the scene's organs, found when the exercise is set up.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -21,6 +22,9 @@ pub struct Sites {
     /// One per task, in order: the cut cornea's model a keratotomy task predicts its
     /// correction with.
     pub keratometers: Vec<Option<Keratometer>>,
+    /// Room for what the critical view of safety is judged on, in a scene with a biliary
+    /// tree: kept while the exercise runs, for the debrief's pictures.
+    pub critical_view: Option<ViewRecord>,
 }
 
 /// Where an exercise stands, for the trainee's display.
@@ -178,8 +182,15 @@ impl Exercise {
         self.current += 1;
     }
 
+    /// Where what the critical view is judged on is kept while a task runs (`None` before
+    /// the exercise starts, after it ends, or in a scene without a biliary tree).
+    pub fn critical_view_mut(&mut self) -> Option<&mut ViewRecord> {
+        let running = self.first_time_s.is_some() && !self.finished();
+        self.sites.critical_view.as_mut().filter(|_| running)
+    }
+
     /// Ends the exercise (unfinished tasks are not completed) and returns every task's metrics.
-    pub fn finish(mut self) -> (Scenario, Vec<TaskMetrics>, Vec<(f64, f64)>) {
+    pub fn finish(mut self) -> Finished {
         let now = self.last_time_s.unwrap_or(0.0);
         while !self.finished() {
             self.start(now);
@@ -189,8 +200,23 @@ impl Exercise {
         let done: Vec<TaskMetrics> = (self.done.into_iter().zip(tasks))
             .map(|(running, task)| running.into_metrics(task))
             .collect();
-        (self.scenario, done, self.force_trace)
+        Finished {
+            scenario: self.scenario,
+            tasks: done,
+            force_trace: self.force_trace,
+            critical_view: self.sites.critical_view.filter(|r| r.time_s.is_some()),
+        }
     }
+}
+
+/// An ended exercise: its scenario, every task's metrics, the force against time and what
+/// the critical view was judged on last, if it ever was.
+pub struct Finished {
+    pub scenario: Scenario,
+    pub tasks: Vec<TaskMetrics>,
+    /// (time s, force N) at 100 Hz.
+    pub force_trace: Vec<(f64, f64)>,
+    pub critical_view: Option<ViewRecord>,
 }
 
 /// What the `k`th task's run is given: its organ's place in the scene, the nodules in it and

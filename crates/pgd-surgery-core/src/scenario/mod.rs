@@ -29,7 +29,7 @@ mod units;
 pub use attachment::{AttachmentEntry, DEFAULT_TIE_GAP_MM};
 pub use biliary::BiliaryEntry;
 pub use bimanual::{BimanualMetrics, BimanualTracker};
-pub use exercise::{Exercise, Progress, Sites};
+pub use exercise::{Exercise, Finished, Progress, Sites};
 pub use format::{
     Contact, Device, Difficulty, Instrument, LaparoscopeEntry, Port, Rubric, Scenario, ScopeKey,
     Tool, default_law,

@@ -6,6 +6,7 @@ use serde::Serialize;
 use super::format::{Rubric, Scenario};
 use super::task::TaskMetrics;
 use super::units::Newtons;
+use crate::biliary::ViewRecord;
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TaskScore {
@@ -28,6 +29,10 @@ pub struct Scorecard {
     /// The scalpel's strokes, on every organ, in order.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub cuts: Vec<CutMade>,
+    /// What the critical view of safety was judged on when it was reached (or last, when it
+    /// never was), for the report's doublet pictures; in a scene with a biliary tree.
+    #[serde(skip)]
+    pub critical_view: Option<ViewRecord>,
 }
 
 /// One stroke of the scalpel, as the report lists it.
@@ -71,6 +76,7 @@ pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
         passed,
         feedback,
         cuts: Vec::new(),
+        critical_view: None,
     }
 }
 

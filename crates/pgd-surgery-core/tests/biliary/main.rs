@@ -8,10 +8,11 @@ mod task;
 
 use nalgebra::{Unit, Vector3};
 use pgd_surgery_core::biliary::anatomy::RANGES;
-use pgd_surgery_core::biliary::critical_view::lower_third_released;
+use pgd_surgery_core::biliary::critical_view::{LowerThird, lower_third_released};
 use pgd_surgery_core::biliary::{
     Anatomy, AnatomyError, ArteryCourse, BiliaryTree, Clip, CriticalView, CriticalViewRule,
-    Division, DivisionOutcome, FlowLaw, Fluid, Leak, Part, Segment, Side, Structure,
+    Division, DivisionOutcome, FlowLaw, Fluid, Judging, Leak, Part, Segment, Side, Structure,
+    ViewRecord,
 };
 use pgd_surgery_core::dissection::{Bed, CauteryMode, CohesiveLaw, CohesiveTie, Tie};
 use pgd_surgery_core::mesh::organs::{Abdomen, Organ, OrganSettings};
@@ -551,8 +552,10 @@ fn an_artery_in_front_is_seen_with_the_duct_once_cleared() {
 /// releases all of it.
 #[test]
 fn the_lower_third_criterion_reads_the_ties_nearest_the_neck() {
-    let fundus = Vector3::zeros();
-    let neck = Vector3::new(0.09, 0.0, 0.0);
+    let third = LowerThird {
+        fundus_m: Vector3::zeros(),
+        neck_m: Vector3::new(0.09, 0.0, 0.0),
+    };
     let coords: Vec<[f32; 3]> = (0..9)
         .map(|k| [0.005 + 0.01 * k as f32, 0.0, 0.0])
         .collect();
@@ -571,17 +574,17 @@ fn the_lower_third_criterion_reads_the_ties_nearest_the_neck() {
         law,
         ties: (0..9).map(tie).collect(),
     };
-    assert_eq!(lower_third_released(&bed, &coords, fundus, neck), 0.0);
+    assert_eq!(lower_third_released(&bed, &coords, &third), 0.0);
     for t in &mut bed.ties[..6] {
         t.state.sever(&law);
     }
-    assert_eq!(lower_third_released(&bed, &coords, fundus, neck), 0.0);
+    assert_eq!(lower_third_released(&bed, &coords, &third), 0.0);
     bed.ties[6].state.sever(&law);
-    assert!((lower_third_released(&bed, &coords, fundus, neck) - 1.0 / 3.0).abs() < 1e-12);
+    assert!((lower_third_released(&bed, &coords, &third) - 1.0 / 3.0).abs() < 1e-12);
     for t in &mut bed.ties[7..] {
         t.state.sever(&law);
     }
-    assert_eq!(lower_third_released(&bed, &coords, fundus, neck), 1.0);
+    assert_eq!(lower_third_released(&bed, &coords, &third), 1.0);
     let tree = tree(&Anatomy::default());
     let rule = CriticalViewRule::default();
     let half = CriticalView::judge(&tree, 0.5, optic(), |_: &Segment| false, rule);
@@ -643,5 +646,61 @@ fn the_hook_divides_fat_once_it_has_burned_its_cross_section() {
     assert!(
         (ratio - sharing as f64).abs() < 0.01 * sharing as f64,
         "{ticks_shared} ticks for {ticks} alone, {sharing} sharing"
+    );
+}
+
+/// The doublet's record follows each judging until the view is reached, then stays as it was
+/// then: a clip placed and a tube moved after it change nothing. A clip beyond the room made
+/// is left out rather than stored.
+#[test]
+fn the_view_record_stays_as_it_was_when_the_view_was_reached() {
+    let mut tree = tree(&Anatomy::default());
+    let rule = CriticalViewRule::default();
+    let judge =
+        |tree: &BiliaryTree| CriticalView::judge(tree, 1.0, optic(), |_: &Segment| false, rule);
+    let mut record = ViewRecord::new(&tree, 1, Vec::new(), Vec::new());
+    assert_eq!(record.time_s, None);
+    let keep = |record: &mut ViewRecord, tree: &BiliaryTree, clips: &[Clip], time_s: f64| {
+        let view = judge(tree);
+        record.keep(&Judging {
+            time_s,
+            optic_m: optic(),
+            view: &view,
+            tree,
+            clips,
+            bed: None,
+        });
+    };
+    keep(&mut record, &tree, &[], 1.0);
+    assert!(!record.reached() && record.time_s == Some(1.0));
+    assert!(record.fat.iter().all(|s| !s.cleared));
+
+    for strand in &mut tree.fat.strands {
+        strand.cleared = true;
+    }
+    keep(&mut record, &tree, &[], 2.0);
+    assert!(record.reached() && record.time_s == Some(2.0));
+    assert!(record.fat.iter().all(|s| s.cleared));
+    let kept = record.clone();
+
+    let length = tree.tube(Structure::CysticDuct).length_m();
+    let clips = clips_on(
+        &tree,
+        Structure::CysticDuct,
+        &[0.2 * length, 0.4 * length],
+        6e-3,
+    );
+    tree.tube_mut(Structure::CysticDuct).rod.positions[3].z += 5e-3;
+    keep(&mut record, &tree, &clips, 3.0);
+    assert_eq!(record, kept);
+
+    let mut fresh = ViewRecord::new(&tree, 1, Vec::new(), Vec::new());
+    keep(&mut fresh, &tree, &clips, 3.0);
+    assert_eq!(fresh.clips.len(), 1, "room for one clip");
+    let moved = tree.tube(Structure::CysticDuct).rod.positions[3];
+    let shape = &fresh.tubes[0];
+    assert_eq!(
+        (shape.structure, shape.positions_m[3]),
+        (Structure::CysticDuct, moved)
     );
 }

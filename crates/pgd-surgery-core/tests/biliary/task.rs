@@ -118,8 +118,8 @@ fn run(events: &[(f64, Event)]) -> (Scenario, Vec<pgd_surgery_core::scenario::ta
             break;
         }
     }
-    let (scenario, metrics, _) = exercise.finish();
-    (scenario, metrics)
+    let finished = exercise.finish();
+    (finished.scenario, finished.tasks)
 }
 
 const DUCT: Structure = Structure::CysticDuct;

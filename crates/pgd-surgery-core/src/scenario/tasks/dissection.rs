@@ -336,7 +336,7 @@ mod tests {
     use std::path::Path;
 
     use crate::scenario::sample::{HookSample, HookTarget, Sample, WallSample};
-    use crate::scenario::{Exercise, Sites, parse, score};
+    use crate::scenario::{Exercise, Finished, Sites, parse, score};
 
     use super::DissectionResult;
 
@@ -400,7 +400,11 @@ mod tests {
             exercise.step(sample);
         }
         assert!(exercise.finished());
-        let (scenario, metrics, _) = exercise.finish();
+        let Finished {
+            scenario,
+            tasks: metrics,
+            ..
+        } = exercise.finish();
         let m = &metrics[0];
         let done = m.result::<DissectionResult>().unwrap();
         assert!(m.completed, "{m:#?}");
@@ -442,7 +446,11 @@ mod tests {
             ..tick(0.1, wall(1, 0, true, true), 0.4)
         });
         assert!(exercise.finished());
-        let (scenario, metrics, _) = exercise.finish();
+        let Finished {
+            scenario,
+            tasks: metrics,
+            ..
+        } = exercise.finish();
         assert!(!metrics[0].completed);
         let card = score(&scenario, metrics);
         assert!(!card.passed);
