@@ -32,28 +32,31 @@ pub fn ray_distance(
     mesh.cast_local_ray(&ray, max_m, true)
 }
 
-/// Surfaces that may stand on a line of sight (organs at rest, as parry triangle meshes).
+/// Surfaces that may stand on a line of sight: organs at rest, as parry triangle meshes, each
+/// with its organ's place in the scene.
 #[derive(Clone, Default)]
-pub struct SightBlockers(Vec<parry3d::shape::TriMesh>);
+pub struct SightBlockers(Vec<(usize, parry3d::shape::TriMesh)>);
 
 impl SightBlockers {
-    /// The surfaces of `meshes` (render positions and triangles each); those parry refuses
-    /// are left out.
+    /// The surfaces of `meshes` (render positions and triangles each, in the scene's order);
+    /// those parry refuses are left out.
     pub fn new<'a>(meshes: impl IntoIterator<Item = (&'a [[f32; 3]], &'a [[u32; 3]])>) -> Self {
         Self(
-            (meshes.into_iter())
-                .filter_map(|(positions, triangles)| trimesh(positions, triangles))
+            (meshes.into_iter().enumerate())
+                .filter_map(|(k, (positions, triangles))| Some((k, trimesh(positions, triangles)?)))
                 .collect(),
         )
     }
 
     /// Whether a surface crosses the segment from `from_m` to `to_m`, leaving out its first
-    /// `skip_m` (the surface the line starts on).
+    /// `skip_m` (the surface the line starts on); each organ's surface moved from rest by its
+    /// entry in `shifts_m` (none where the slice is short).
     pub fn block(
         &self,
         from_m: &nalgebra::Vector3<f64>,
         to_m: &nalgebra::Vector3<f64>,
         skip_m: f64,
+        shifts_m: &[nalgebra::Vector3<f64>],
     ) -> bool {
         let towards = to_m - from_m;
         let length = towards.norm();
@@ -63,8 +66,11 @@ impl SightBlockers {
         let dir = towards / length;
         let start = from_m + dir * skip_m;
         let as_f32 = |v: nalgebra::Vector3<f64>| [v.x as f32, v.y as f32, v.z as f32];
-        (self.0.iter()).any(|mesh| {
-            ray_distance(mesh, as_f32(start), as_f32(dir), (length - skip_m) as f32).is_some()
+        (self.0.iter()).any(|(organ, mesh)| {
+            // The line moved back by the organ's shift meets the surface at rest.
+            let shift = shifts_m.get(*organ).copied().unwrap_or_default();
+            let origin = as_f32(start - shift);
+            ray_distance(mesh, origin, as_f32(dir), (length - skip_m) as f32).is_some()
         })
     }
 }

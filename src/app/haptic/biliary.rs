@@ -78,6 +78,10 @@ pub struct Biliary {
     anchored: bool,
     /// The organs at rest, for the sight lines to the optic.
     occluders: SightBlockers,
+    /// How far each organ (in the scene's order) has moved where the tubes enter it: the
+    /// gallbladder's is the mean of its anchors' displacements, the others' none. Sight lines
+    /// meet the organs' surfaces at rest moved by these.
+    organ_shifts_m: Vec<Vector3<f64>>,
     lower_third: LowerThird,
     clips: Vec<Clip>,
     divisions: Vec<Division>,
@@ -109,6 +113,7 @@ impl Biliary {
             anchors: [None; 3],
             anchored: false,
             occluders,
+            organ_shifts_m: vec![Vector3::zeros(); organs.len()],
             lower_third: lower_third(),
             clips: Vec::with_capacity(ROOM),
             divisions: Vec::with_capacity(ROOM),
@@ -138,6 +143,7 @@ impl Biliary {
         self.divisions.clear();
         self.leaks.clear();
         self.held.clear();
+        self.organ_shifts_m.fill(Vector3::zeros());
         self.grasped = [None; MAX_HANDS];
         self.push_n = [Vector3::zeros(); MAX_HANDS];
         self.view = ViewSample::default();
@@ -206,12 +212,18 @@ impl Biliary {
             return;
         };
         let moved = motion.map_or(&[][..], |m| &m.in_vademecum_modes[..]);
+        let (mut shift, mut anchored) = (Vector3::zeros(), 0.0);
         for (tube, anchor) in self.tree.tubes.iter_mut().zip(&self.anchors) {
             let Some(anchor) = anchor else { continue };
             let u = deformation.0.displacement(&body.vademecum, &anchor.at)
                 + moved_at(&body.vademecum, &anchor.at, moved);
             let last = tube.rod.nodes() - 1;
             tube.rod.positions[last] = anchor.rest_m + u;
+            shift += u;
+            anchored += 1.0;
+        }
+        if anchored > 0.0 {
+            self.organ_shifts_m[index] = shift / anchored;
         }
     }
 
@@ -418,10 +430,11 @@ impl Biliary {
         organs: &Query<OrganState>,
     ) {
         let lower_third = self.lower_third(beds, organs);
-        let occluders = &self.occluders;
+        let (occluders, shifts) = (&self.occluders, &self.organ_shifts_m[..]);
         // From just off the tube, so that the organ it enters does not count.
         const OFF_M: f64 = 2e-3;
-        let organs_hide = |sight: &Segment| occluders.block(&sight.from_m, &sight.to_m, OFF_M);
+        let organs_hide =
+            |sight: &Segment| occluders.block(&sight.from_m, &sight.to_m, OFF_M, shifts);
         let view = CriticalView::judge(&self.tree, lower_third, optic_m, organs_hide, self.rule);
         self.view = ViewSample::of(&view);
         self.judged = Some((view, optic_m));
@@ -444,6 +457,7 @@ impl Biliary {
             tree: &self.tree,
             clips: &self.clips,
             bed,
+            organ_shifts_m: &self.organ_shifts_m,
         });
     }
 
@@ -488,16 +502,11 @@ pub fn view_record(
         .unwrap_or_default();
     let mut record = ViewRecord::new(tree, ROOM, lower_third_ties, Vec::new());
     let centre_m = record.centre_m();
-    record.organs = (organs.iter())
-        .filter(|(name, _)| PICTURED.contains(&name.as_str()))
-        .map(|(name, v)| {
-            OrganPatch::near(
-                name,
-                &v.position_coords_m,
-                &v.triangles,
-                centre_m,
-                PICTURED_WITHIN_M,
-            )
+    record.organs = (organs.iter().enumerate())
+        .filter(|(_, (name, _))| PICTURED.contains(&name.as_str()))
+        .map(|(k, (name, v))| {
+            let (positions, triangles) = (&v.position_coords_m, &v.triangles);
+            OrganPatch::near((name, k), positions, triangles, centre_m, PICTURED_WITHIN_M)
         })
         .collect();
     record

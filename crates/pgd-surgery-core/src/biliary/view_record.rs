@@ -37,18 +37,22 @@ pub struct TieMark {
     pub released: bool,
 }
 
-/// An organ's surface near the triangle, at rest (the sight lines meet the organs at rest).
+/// An organ's surface near the triangle at rest, and how far it had moved as the sight lines
+/// met it (its shift where the tubes enter it).
 #[derive(Clone, Debug, PartialEq)]
 pub struct OrganPatch {
     pub name: String,
+    /// Its place among the scene's organs.
+    pub organ: usize,
     pub triangles_m: Vec<[Vector3<f64>; 3]>,
+    pub shift_m: Vector3<f64>,
 }
 
 impl OrganPatch {
-    /// The triangles of a surface (`positions_m`, `triangles`) with a corner within
-    /// `radius_m` of `centre_m`.
+    /// The triangles of organ `organ`'s surface (`positions_m`, `triangles`) with a corner
+    /// within `radius_m` of `centre_m`.
     pub fn near(
-        name: &str,
+        (name, organ): (&str, usize),
         positions_m: &[[f32; 3]],
         triangles: &[[u32; 3]],
         centre_m: Vector3<f64>,
@@ -61,7 +65,9 @@ impl OrganPatch {
             .collect();
         Self {
             name: name.to_owned(),
+            organ,
             triangles_m,
+            shift_m: Vector3::zeros(),
         }
     }
 }
@@ -76,6 +82,8 @@ pub struct Judging<'a> {
     pub clips: &'a [Clip],
     /// The gallbladder's bed and where its ties' ends are, if it lies in one.
     pub bed: Option<(&'a Bed, &'a [TieEnds])>,
+    /// How far each organ (in the scene's order) had moved as the sight lines met it.
+    pub organ_shifts_m: &'a [Vector3<f64>],
 }
 
 /// The scene as the critical view was judged on it.
@@ -155,6 +163,11 @@ impl ViewRecord {
                 at_m: clip.position_m(judging.tree),
                 closes_lumen: clip.closes_lumen(),
             }));
+        for patch in &mut self.organs {
+            patch.shift_m = (judging.organ_shifts_m.get(patch.organ))
+                .copied()
+                .unwrap_or_default();
+        }
         self.ties.clear();
         if let Some((bed, ends)) = judging.bed {
             let marks = (self.lower_third.iter())

@@ -216,7 +216,8 @@ fn organ_marks(record: &ViewRecord, projection: &Projection, side: Side) -> Vec<
             "gallbladder" => (95.0, 125.0, 55.0),
             _ => (150.0, 75.0, 60.0),
         };
-        for corners in &organ.triangles_m {
+        for rest in &organ.triangles_m {
+            let corners = rest.map(|c| c + organ.shift_m);
             let Some(pixels) = corners
                 .iter()
                 .map(|c| projection.pixel(c))

@@ -669,6 +669,7 @@ fn the_view_record_stays_as_it_was_when_the_view_was_reached() {
             tree,
             clips,
             bed: None,
+            organ_shifts_m: &[],
         });
     };
     keep(&mut record, &tree, &[], 1.0);
