@@ -12,6 +12,7 @@ use bevy::prelude::*;
 
 use super::FrameSet;
 use super::bridge::Snapshot;
+use super::doublet::{DOUBLET_WIDTH_PX, doublet_image, doublet_node};
 use crate::app::attempt::{outcome_of, prepare, sites_on};
 use crate::app::haptic::{ExerciseLink, HapticLoop, HapticScene};
 use crate::report;
@@ -145,6 +146,16 @@ impl Plugin for LessonPlugin {
 /// A panel of text in the middle of the window, gone when the stage ends; returns the text's
 /// entity.
 pub(super) fn spawn_panel(commands: &mut Commands, stage: Stage, text: String) -> Entity {
+    spawn_panel_with(commands, stage, text, None)
+}
+
+/// [`spawn_panel`] with a picture beside the text (the debrief's critical view).
+fn spawn_panel_with(
+    commands: &mut Commands,
+    stage: Stage,
+    text: String,
+    picture: Option<Handle<Image>>,
+) -> Entity {
     let text = commands
         .spawn((
             Text::new(text),
@@ -167,18 +178,21 @@ pub(super) fn spawn_panel(commands: &mut Commands, stage: Stage, text: String) -
             },
         ))
         .with_children(|parent| {
-            parent
-                .spawn((
-                    Node {
-                        max_width: px(720),
-                        max_height: percent(96),
-                        padding: UiRect::all(px(24)),
-                        overflow: Overflow::clip(),
-                        ..default()
-                    },
-                    BackgroundColor(Color::srgba(0.02, 0.03, 0.05, 0.88)),
-                ))
-                .add_child(text);
+            let mut panel = parent.spawn((
+                Node {
+                    max_width: px(720.0 + picture.as_ref().map_or(0.0, |_| DOUBLET_WIDTH_PX)),
+                    max_height: percent(96),
+                    padding: UiRect::all(px(24)),
+                    overflow: Overflow::clip(),
+                    align_items: AlignItems::Center,
+                    ..default()
+                },
+                BackgroundColor(Color::srgba(0.02, 0.03, 0.05, 0.88)),
+            ));
+            panel.add_child(text);
+            if let Some(picture) = picture {
+                panel.with_child(doublet_node(picture));
+            }
         });
     text
 }
@@ -243,23 +257,34 @@ const DEBRIEF_KEYS: &str = "Press R to try again, or M for the menu of scenarios
 #[derive(Resource, Clone, Debug)]
 pub(super) struct Debriefed(pub crate::scenario::Scorecard);
 
-/// Scores a copy of the ended exercise for the screen; the attempt scores the exercise itself
-/// for the report when the window closes.
-pub(super) fn show_debrief(mut commands: Commands, lesson: Res<Lesson>) {
-    let text = match lesson.link.ended_copy() {
+/// Scores a copy of the ended exercise for the screen, with the critical view's doublet
+/// beside it where the scene has a biliary tree (off the web, whose plots have no font); the
+/// attempt scores the exercise itself for the report when the window closes.
+pub(super) fn show_debrief(
+    mut commands: Commands,
+    lesson: Res<Lesson>,
+    images: Option<ResMut<Assets<Image>>>,
+) {
+    let (text, picture) = match lesson.link.ended_copy() {
         Some(exercise) => {
             let card = outcome_of(exercise).card;
             let text = report::summary(&card);
+            let picture = (card.critical_view.as_ref())
+                .filter(|_| cfg!(not(target_arch = "wasm32")))
+                .and_then(doublet_image)
+                .zip(images)
+                .map(|(image, mut images)| images.add(image));
             #[cfg(target_arch = "wasm32")]
             commands.insert_resource(Debriefed(card));
-            text
+            (text, picture)
         }
-        None => "The exercise has ended.".to_owned(),
+        None => ("The exercise has ended.".to_owned(), None),
     };
-    spawn_panel(
+    spawn_panel_with(
         &mut commands,
         Stage::Debrief,
         format!("{text}\n{DEBRIEF_KEYS}"),
+        picture,
     );
 }
 
@@ -304,7 +329,12 @@ mod tests {
 
     use super::super::testing::{scene_without_organs, stage, tap, texts};
     use super::*;
+    use crate::biliary::{
+        Anatomy, BiliaryTree, CriticalView, CriticalViewRule, Judging, Segment, ViewRecord,
+    };
+    use crate::mesh::organs::{Abdomen, OrganSettings};
     use crate::scenario::{Progress, Sample, Sites, parse};
+    use nalgebra::Vector3;
 
     const SCENARIO: &str = r#"Scenario(
         title: "Quick press",
@@ -336,8 +366,8 @@ mod tests {
     }
 
     /// The exercise ended without the trainee touching the organ: a failed force control.
-    fn ended_exercise(scenario: &Scenario) -> Exercise {
-        let mut exercise = Exercise::new(scenario.clone(), Sites::default());
+    fn ended_exercise(scenario: &Scenario, sites: Sites) -> Exercise {
+        let mut exercise = Exercise::new(scenario.clone(), sites);
         for tick in 0..20 {
             exercise.step(&Sample {
                 time_s: tick as f64 * 1e-3,
@@ -350,8 +380,13 @@ mod tests {
 
     /// The haptic side ends the exercise, unscored, and says so in its snapshot.
     fn end_exercise(app: &mut App, link: &ExerciseLink) {
+        end_exercise_at(app, link, Sites::default());
+    }
+
+    /// [`end_exercise`] of an exercise at `sites`.
+    fn end_exercise_at(app: &mut App, link: &ExerciseLink, sites: Sites) {
         let scenario = app.world().resource::<Lesson>().scenario.clone();
-        let mut ended = Some(ended_exercise(&scenario));
+        let mut ended = Some(ended_exercise(&scenario, sites));
         link.hand_over(&mut ended);
         assert!(ended.is_none());
         app.world_mut().resource_mut::<Snapshot>().0.exercise = Some(Progress {
@@ -392,6 +427,52 @@ mod tests {
             link.take_ended().is_some(),
             "the debrief must leave the exercise for the report"
         );
+    }
+
+    /// What the critical view was judged on in a generated tree, its fat intact.
+    fn judged_record() -> ViewRecord {
+        let abdomen = Abdomen::new(&OrganSettings::default());
+        let tree = BiliaryTree::generate(&Anatomy::default(), &abdomen).unwrap();
+        let optic = Vector3::new(0.0, 0.123, -0.2);
+        let rule = CriticalViewRule::default();
+        let view = CriticalView::judge(&tree, 1.0, optic, |_: &Segment| false, rule);
+        let mut record = ViewRecord::new(&tree, 4, Vec::new(), Vec::new());
+        record.keep(&Judging {
+            time_s: 0.005,
+            optic_m: optic,
+            view: &view,
+            tree: &tree,
+            clips: &[],
+            bed: None,
+            organ_shifts_m: &[],
+        });
+        record
+    }
+
+    /// Where the critical view was judged, the debrief shows its doublet beside the score:
+    /// the report's picture, at its size.
+    #[test]
+    fn the_debrief_shows_the_critical_view_beside_the_score() {
+        let (mut app, link) = app();
+        app.insert_resource(Assets::<Image>::default());
+        app.update();
+        tap(&mut app, KeyCode::Space);
+        let sites = Sites {
+            critical_view: Some(judged_record()),
+            ..Sites::default()
+        };
+        end_exercise_at(&mut app, &link, sites);
+        assert_eq!(stage(&app), Stage::Debrief);
+        assert!(texts(&mut app).contains("FAILED"));
+        let world = app.world_mut();
+        let shown: Vec<AssetId<Image>> = (world.query::<&ImageNode>().iter(world))
+            .map(|node| node.image.id())
+            .collect();
+        let images = world.resource::<Assets<Image>>();
+        let [picture] = shown[..] else {
+            panic!("{} pictures", shown.len());
+        };
+        assert_eq!(images.get(picture).unwrap().size(), UVec2::new(1200, 760));
     }
 
     /// R on the debrief goes back to the briefing for another attempt: the exercise is not

@@ -8,6 +8,7 @@ mod bridge;
 mod camera;
 mod cut_surface;
 mod dissection;
+mod doublet;
 mod frames;
 mod hud;
 mod incision;

@@ -10,7 +10,7 @@ use std::path::Path;
 use nalgebra::Vector3;
 use plotters::prelude::*;
 
-use super::plot::{Area, PlotResult, save_png};
+use super::plot::{Area, PlotResult, draw_rgb, save_png};
 use crate::biliary::view_record::{TieMark, TubeShape};
 use crate::biliary::{CriticalView, Structure, ViewRecord};
 
@@ -151,14 +151,21 @@ enum Shape {
 
 /// Writes the doublet of `record` into `path` (a 1200 × 760 PNG); errors name the file.
 pub fn draw_critical_view(path: &Path, record: &ViewRecord) -> Result<(), String> {
-    let drawn = save_png(path, SIZE, |root| {
-        root.draw(&Text::new(title(record), (16, 10), ("sans-serif", 24)))?;
-        for side in [Side::Front, Side::Behind] {
-            draw_panel(root, record, side)?;
-        }
-        draw_criteria(root, record)
-    });
+    let drawn = save_png(path, SIZE, |root| draw_doublet(root, record));
     drawn.map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The doublet of `record` as RGB rows of [`SIZE`], top first: for the window's debrief.
+pub fn critical_view_rgb(record: &ViewRecord) -> Result<Vec<u8>, String> {
+    draw_rgb(SIZE, |root| draw_doublet(root, record)).map_err(|e| e.to_string())
+}
+
+fn draw_doublet(root: &Area, record: &ViewRecord) -> PlotResult {
+    root.draw(&Text::new(title(record), (16, 10), ("sans-serif", 24)))?;
+    for side in [Side::Front, Side::Behind] {
+        draw_panel(root, record, side)?;
+    }
+    draw_criteria(root, record)
 }
 
 fn title(record: &ViewRecord) -> String {

@@ -12,8 +12,8 @@ mod scorecard;
 pub use convergence::{
     StepCurve, write as write_convergence, write_of_header as write_convergence_of,
 };
-pub use critical_view::draw_critical_view;
+pub use critical_view::{critical_view_rgb, draw_critical_view};
 pub use learning_curve::{CurvePoint, learning_curve};
-pub use plot::{FONT_DATA, LineChart, Series, line_chart, save_png, without_glyph};
+pub use plot::{FONT_DATA, LineChart, Series, draw_rgb, line_chart, save_png, without_glyph};
 pub use regions::draw_regions;
 pub use scorecard::{ReportFiles, summary, write_report};

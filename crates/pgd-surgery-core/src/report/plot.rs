@@ -58,6 +58,20 @@ pub fn save_png(
     size: (u32, u32),
     draw: impl FnOnce(&Area) -> PlotResult,
 ) -> PlotResult {
+    let pixels = draw_rgb(size, draw)?;
+    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut encoder = png::Encoder::new(file, size.0, size.1);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.write_header()?.write_image_data(&pixels)?;
+    Ok(())
+}
+
+/// Draws a `size` plot on white with `draw` into RGB rows, top first.
+pub fn draw_rgb(
+    size: (u32, u32),
+    draw: impl FnOnce(&Area) -> PlotResult,
+) -> Result<Vec<u8>, Box<dyn std::error::Error>> {
     // Plotters draws text with a registered font only off the web; the page draws no plots.
     #[cfg(not(target_arch = "wasm32"))]
     plotters::style::register_font("sans-serif", FontStyle::Normal, FONT_DATA)
@@ -70,12 +84,7 @@ pub fn save_png(
         draw(&root)?;
         root.present()?;
     }
-    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
-    let mut encoder = png::Encoder::new(file, width, height);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
-    encoder.write_header()?.write_image_data(&pixels)?;
-    Ok(())
+    Ok(pixels)
 }
 
 /// One named line of a [`LineChart`].
