@@ -9,6 +9,7 @@ mod counting;
 mod fuzz;
 mod fuzz_files;
 mod import;
+mod msh_binary;
 mod organs;
 mod quality;
 mod stuffing;

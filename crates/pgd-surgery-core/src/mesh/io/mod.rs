@@ -1,4 +1,4 @@
-//! Reading real meshes (Gmsh `.msh` v2/v4 ASCII, VTK legacy `.vtk` grids, `.vtu`, and surfaces
+//! Reading real meshes (Gmsh `.msh` v1, and v2/v4 ASCII and binary, VTK legacy `.vtk` grids, `.vtu`, and surfaces
 //! as segmentation tools write them, OBJ, STL, PLY and VTK polydata, which are mended and
 //! tetrahedralized) and writing `.vtu` for ParaView.
 //!
@@ -38,6 +38,12 @@ pub enum ImportError {
     Syntax {
         file: String,
         line: usize,
+        message: String,
+    },
+    #[error("{file}: byte {byte}: {message}")]
+    Binary {
+        file: String,
+        byte: usize,
         message: String,
     },
     #[error("{file}: {message}")]
@@ -292,7 +298,7 @@ fn read_mesh(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<Tet
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
     let mut raw = match extension.as_str() {
-        "msh" => msh::read(&file, &text(bytes)?)?,
+        "msh" => msh::read(&file, &bytes)?,
         "vtk" => match vtk::read(&file, &text(bytes)?)? {
             vtk::Dataset::Grid(raw) => raw,
             vtk::Dataset::Surface(surface) => {
