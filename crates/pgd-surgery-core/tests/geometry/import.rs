@@ -384,7 +384,7 @@ fn an_organ_surface_in_stl_becomes_a_valid_tet_mesh() {
 }
 
 /// The liver's boundary in millimetres (single precision, as segmentation tools write it),
-/// as binary STL, binary and ASCII PLY, and VTK polydata.
+/// as binary STL, binary and ASCII PLY, and VTK polydata, ASCII and binary.
 fn liver_surface_files() -> Vec<(&'static str, Vec<u8>)> {
     use pgd_surgery_core::mesh::Surface;
     let settings = OrganSettings {
@@ -418,33 +418,44 @@ fn liver_surface_files() -> Vec<(&'static str, Vec<u8>)> {
     };
     let mut binary = ply_header("binary_little_endian").into_bytes();
     let mut ascii = ply_header("ascii");
-    let mut vtk = format!(
-        "# vtk DataFile Version 3.0\nliver\nASCII\nDATASET POLYDATA\nPOINTS {vertices} float\n"
-    );
+    let vtk_header = |format: &str| {
+        format!(
+            "# vtk DataFile Version 3.0\nliver\n{format}\nDATASET POLYDATA\nPOINTS {vertices} float\n"
+        )
+    };
+    let mut vtk = vtk_header("ASCII");
+    // Binary legacy VTK is big-endian.
+    let mut vtk_binary = vtk_header("BINARY").into_bytes();
     for n in 0..vertices {
         let p = mm(n);
         binary.extend(p.iter().flat_map(|&c| (c as f32).to_le_bytes()));
         binary.push(200);
         ascii += &format!("{} {} {} 200\n", p.x, p.y, p.z);
         vtk += &format!("{} {} {}\n", p.x, p.y, p.z);
+        vtk_binary.extend(p.iter().flat_map(|&c| (c as f32).to_be_bytes()));
     }
     vtk += &format!("POLYGONS {triangles} {}\n", 4 * triangles);
+    vtk_binary.extend(format!("\nPOLYGONS {triangles} {}\n", 4 * triangles).bytes());
     for f in &surface.triangles {
         binary.push(3);
         binary.extend(f.iter().flat_map(|&n| (n as i32).to_le_bytes()));
         ascii += &format!("3 {} {} {}\n", f[0], f[1], f[2]);
         vtk += &format!("3 {} {} {}\n", f[0], f[1], f[2]);
+        vtk_binary.extend(3i32.to_be_bytes());
+        vtk_binary.extend(f.iter().flat_map(|&n| (n as i32).to_be_bytes()));
     }
+    vtk_binary.push(b'\n');
     vec![
         ("liver.stl", stl),
         ("liver-binary.ply", binary),
         ("liver-ascii.ply", ascii.into_bytes()),
         ("liver-polydata.vtk", vtk.into_bytes()),
+        ("liver-polydata-binary.vtk", vtk_binary),
     ]
 }
 
-/// The same surface in each format segmentation tools write gives the same tetrahedral mesh,
-/// node for node.
+/// The same surface in each format segmentation tools write (binary legacy VTK included) gives
+/// the same tetrahedral mesh, node for node.
 #[test]
 fn a_surface_reads_the_same_from_stl_ply_and_vtk_polydata() {
     let options = ImportOptions {

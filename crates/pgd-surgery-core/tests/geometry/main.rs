@@ -13,6 +13,7 @@ mod msh_binary;
 mod organs;
 mod quality;
 mod stuffing;
+mod vtk_binary;
 
 /// Counts a reader's allocations (`fuzz_files.rs`); the system allocator otherwise.
 #[global_allocator]

@@ -1,11 +1,12 @@
-//! Reading real meshes (Gmsh `.msh` v1, and v2/v4 ASCII and binary, VTK legacy `.vtk` grids, `.vtu`, and surfaces
-//! as segmentation tools write them, OBJ, STL, PLY and VTK polydata, which are mended and
-//! tetrahedralized) and writing `.vtu` for ParaView.
+//! Reading real meshes (Gmsh `.msh` v1, and v2/v4 ASCII and binary, VTK legacy `.vtk` grids
+//! ASCII and binary, `.vtu`, and surfaces as segmentation tools write them, OBJ, STL, PLY and
+//! VTK polydata, which are mended and tetrahedralized) and writing `.vtu` for ParaView.
 //!
 //! Every error names the file, and for text formats the line. A mesh that parses but cannot be
 //! simulated (inverted or flat elements, a surface with holes) is refused with its quality
 //! report's reason.
 
+mod cursor;
 mod mend;
 mod msh;
 mod ply;
@@ -299,7 +300,7 @@ fn read_mesh(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<Tet
         .unwrap_or_default();
     let mut raw = match extension.as_str() {
         "msh" => msh::read(&file, &bytes)?,
-        "vtk" => match vtk::read(&file, &text(bytes)?)? {
+        "vtk" => match vtk::read(&file, &bytes)? {
             vtk::Dataset::Grid(raw) => raw,
             vtk::Dataset::Surface(surface) => {
                 return meshed(surface);

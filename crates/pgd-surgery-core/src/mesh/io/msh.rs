@@ -10,6 +10,7 @@ use std::collections::{BTreeMap, HashMap};
 
 use nalgebra::Point3;
 
+use super::cursor::Cursor;
 use super::tokens::Tokens;
 use super::{ImportError, RawMesh};
 
@@ -143,111 +144,61 @@ impl Fields for Tokens<'_> {
     }
 }
 
-/// A binary `.msh` file's bytes, read from a cursor; text where the format writes text.
+/// A binary `.msh` file: numbers in the header's byte order and `size_t` width.
 struct Binary<'a> {
-    file: &'a str,
-    bytes: &'a [u8],
-    at: usize,
+    cursor: Cursor<'a>,
     size_bytes: usize,
-    little_endian: bool,
 }
 
 impl<'a> Binary<'a> {
     fn new(file: &'a str, bytes: &'a [u8]) -> Self {
         Self {
-            file,
-            bytes,
-            at: 0,
+            cursor: Cursor::new(file, bytes, true),
             size_bytes: 8,
-            little_endian: true,
         }
     }
 
     /// Reads the header's `int` 1, whose bytes say the file's byte order.
     fn endianness(&mut self, size_bytes: usize) -> Result<(), ImportError> {
         self.size_bytes = size_bytes;
-        let one: [u8; 4] = self.take("the byte-order mark (an int 1)")?;
-        self.little_endian = match one {
+        let one: [u8; 4] = self.cursor.take("the byte-order mark (an int 1)")?;
+        let little_endian = match one {
             [1, 0, 0, 0] => true,
             [0, 0, 0, 1] => false,
             _ => return Err(self.error(format!("the byte-order mark reads {one:?}, not 1"))),
         };
+        self.cursor.set_little_endian(little_endian);
         Ok(())
-    }
-
-    fn take<const N: usize>(&mut self, what: &str) -> Result<[u8; N], ImportError> {
-        let Some(bytes) = self.bytes.get(self.at..self.at + N) else {
-            return Err(self.error(format!("unexpected end of file; expected {what}")));
-        };
-        self.at += N;
-        let mut out: [u8; N] = bytes.try_into().expect("N bytes");
-        if !self.little_endian {
-            out.reverse();
-        }
-        Ok(out)
-    }
-
-    /// The next word of text, after white space.
-    fn word(&mut self, what: &str) -> Result<&'a str, ImportError> {
-        let rest = &self.bytes[self.at.min(self.bytes.len())..];
-        let start = rest.iter().position(|b| !b.is_ascii_whitespace());
-        let Some(start) = start else {
-            return Err(self.error(format!("unexpected end of file; expected {what}")));
-        };
-        let length = rest[start..]
-            .iter()
-            .position(|b| b.is_ascii_whitespace())
-            .unwrap_or(rest.len() - start);
-        self.at += start + length;
-        let word = std::str::from_utf8(&rest[start..start + length])
-            .map_err(|_| self.error(format!("expected {what}, found bytes that are not text")))?;
-        self.end_line();
-        Ok(word)
-    }
-
-    /// Passes the line end right after a word, where binary data may start.
-    fn end_line(&mut self) {
-        let rest = &self.bytes[self.at.min(self.bytes.len())..];
-        if rest.starts_with(b"\r\n") {
-            self.at += 2;
-        } else if rest.starts_with(b"\n") {
-            self.at += 1;
-        }
     }
 }
 
 impl Fields for Binary<'_> {
     fn int(&mut self, what: &str) -> Result<i64, ImportError> {
-        Ok(i32::from_le_bytes(self.take(what)?).into())
+        Ok(i32::from_le_bytes(self.cursor.take(what)?).into())
     }
 
     fn size(&mut self, what: &str) -> Result<usize, ImportError> {
         let value = match self.size_bytes {
-            4 => u64::from(u32::from_le_bytes(self.take(what)?)),
-            _ => u64::from_le_bytes(self.take(what)?),
+            4 => u64::from(u32::from_le_bytes(self.cursor.take(what)?)),
+            _ => u64::from_le_bytes(self.cursor.take(what)?),
         };
         usize::try_from(value).map_err(|_| self.error(format!("{what} {value} is too large")))
     }
 
     fn real(&mut self, what: &str) -> Result<f64, ImportError> {
-        Ok(f64::from_le_bytes(self.take(what)?))
+        Ok(f64::from_le_bytes(self.cursor.take(what)?))
     }
 
     fn ascii<T: std::str::FromStr>(&mut self, what: &str) -> Result<T, ImportError> {
-        let word = self.word(what)?;
-        word.parse()
-            .map_err(|_| self.error(format!("expected {what}, found '{word}'")))
+        self.cursor.parse(what)
     }
 
     fn rest_of_line(&mut self) -> String {
-        let rest = &self.bytes[self.at.min(self.bytes.len())..];
-        let length = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
-        self.at += length;
-        String::from_utf8_lossy(&rest[..length]).trim().to_owned()
+        self.cursor.rest_of_line()
     }
 
     fn expect(&mut self, keyword: &str) -> Result<(), ImportError> {
-        let word = self.word(keyword)?;
+        let word = self.cursor.word(keyword)?;
         match word == keyword {
             true => Ok(()),
             false => Err(self.error(format!("expected '{keyword}', found '{word}'"))),
@@ -255,32 +206,18 @@ impl Fields for Binary<'_> {
     }
 
     fn skip_past(&mut self, keyword: &str) -> Result<(), ImportError> {
-        let rest = &self.bytes[self.at.min(self.bytes.len())..];
-        let found = (rest.windows(keyword.len())).position(|w| w == keyword.as_bytes());
-        match found {
-            Some(k) => {
-                self.at += k + keyword.len();
-                Ok(())
-            }
-            None => Err(self.error(format!("unexpected end of file; expected {keyword}"))),
-        }
+        self.cursor.skip_past(keyword)
     }
 
     fn section(&mut self) -> Result<Option<String>, ImportError> {
-        let rest = &self.bytes[self.at.min(self.bytes.len())..];
-        if rest.iter().all(u8::is_ascii_whitespace) {
+        if self.cursor.at_end() {
             return Ok(None);
         }
-        self.word("a section").map(|w| Some(w.to_owned()))
+        self.cursor.word("a section").map(|w| Some(w.to_owned()))
     }
 
-    /// An error at the byte the cursor is at (lines mean nothing among binary numbers).
     fn error(&self, message: String) -> ImportError {
-        ImportError::Binary {
-            file: self.file.to_owned(),
-            byte: self.at,
-            message,
-        }
+        self.cursor.error(message)
     }
 }
 

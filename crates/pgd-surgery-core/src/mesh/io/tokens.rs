@@ -56,6 +56,18 @@ impl<'a> Tokens<'a> {
         }
     }
 
+    /// The next token, left to be read.
+    pub fn peek(&mut self) -> Option<&'a str> {
+        loop {
+            if let Some(&token) = self.current.as_slice().first() {
+                return Some(token);
+            }
+            let (i, line) = self.lines.next()?;
+            self.line = self.offset + i + 1;
+            self.current = line.split_whitespace().collect::<Vec<_>>().into_iter();
+        }
+    }
+
     /// The rest of the current line as one string, then moves to the next line.
     pub fn rest_of_line(&mut self) -> String {
         let rest: Vec<&str> = self.current.by_ref().collect();
