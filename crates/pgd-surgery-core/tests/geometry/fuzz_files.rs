@@ -1,15 +1,19 @@
 //! The mesh files a scenario may name, fuzzed (`tests/support/fuzz.rs`) from the import tests'
-//! own files: Gmsh v2 and v4, legacy VTK in both cell layouts, VTU (a written box), OBJ and
+//! own files: Gmsh v2 and v4, legacy VTK in both cell layouts, VTU (a written box), each ASCII
+//! and binary (VTU compressed in raw appended data, and in base64), OBJ and
 //! STL (ASCII and binary; their readers, not the tetrahedralizing behind them). No panic, no
 //! read past a person's patience, no allocation past the stated bound for the file's length.
 
 use std::path::Path;
 
-use pgd_surgery_core::mesh::box_mesh;
 use pgd_surgery_core::mesh::io::{ImportOptions, parse, read_obj, read_stl, write_vtu};
+use pgd_surgery_core::mesh::{TetMesh, box_mesh};
 
 use crate::fuzz::{Format, assert_refused_within, fuzz, in_proportion};
 use crate::import::{CUBE_OBJ, MSH2, MSH4, VTK_CLASSIC, VTK_V5, file, tetra_stl};
+use crate::msh_binary::{msh2, msh4};
+use crate::vtk_binary::{classic, offsets};
+use crate::vtu_binary::compressed_and_inline;
 
 /// Cases per format in `cargo test`: each reads in microseconds.
 const CASES: u32 = 2048;
@@ -31,22 +35,50 @@ fn fuzz_volume(name: &'static str, seeds: Vec<Vec<u8>>) {
     );
 }
 
+/// A small box, whose binary files seed the fuzzer.
+fn seed_box() -> TetMesh {
+    box_mesh([0.04, 0.03, 0.02], [2, 2, 1]).unwrap()
+}
+
 #[test]
 fn gmsh_files_are_fuzzed() {
-    fuzz_volume("fuzz.msh", vec![MSH2.into(), MSH4.into()]);
+    let mesh = seed_box();
+    let binary = [msh4(&mesh, "z0"), msh2(&mesh, "z0")];
+    fuzz_volume(
+        "fuzz.msh",
+        [MSH2.into(), MSH4.into()]
+            .into_iter()
+            .chain(binary)
+            .collect(),
+    );
 }
 
 #[test]
 fn legacy_vtk_files_are_fuzzed() {
-    fuzz_volume("fuzz.vtk", vec![VTK_CLASSIC.into(), VTK_V5.into()]);
+    let mesh = seed_box();
+    let binary = [classic(&mesh), offsets(&mesh)];
+    fuzz_volume(
+        "fuzz.vtk",
+        [VTK_CLASSIC.into(), VTK_V5.into()]
+            .into_iter()
+            .chain(binary)
+            .collect(),
+    );
 }
 
 #[test]
 fn vtu_files_are_fuzzed() {
-    let mesh = box_mesh([0.04, 0.03, 0.02], [2, 2, 1]).unwrap();
+    let mesh = seed_box();
     let path = file("fuzz-seed.vtu", b"");
     write_vtu(&path, &mesh, &[]).unwrap();
-    fuzz_volume("fuzz.vtu", vec![std::fs::read(&path).unwrap()]);
+    let ascii = std::fs::read(&path).unwrap();
+    // The binary seeds carry the regions as the ASCII file does.
+    let read = parse(&path, ascii.clone(), &ImportOptions::default()).unwrap();
+    let seeds = [ascii]
+        .into_iter()
+        .chain(compressed_and_inline(&read))
+        .collect();
+    fuzz_volume("fuzz.vtu", seeds);
 }
 
 #[test]

@@ -14,6 +14,7 @@ mod organs;
 mod quality;
 mod stuffing;
 mod vtk_binary;
+mod vtu_binary;
 
 /// Counts a reader's allocations (`fuzz_files.rs`); the system allocator otherwise.
 #[global_allocator]

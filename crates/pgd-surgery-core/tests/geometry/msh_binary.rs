@@ -37,11 +37,11 @@ impl Bytes {
     }
 
     /// The format's header for `version`, binary, and the physical group's name.
-    fn header(&mut self, version: &str) -> &mut Self {
+    fn header(&mut self, version: &str, group: &str) -> &mut Self {
         self.text(&format!("$MeshFormat\n{version} 1 8\n"))
             .int(1)
             .text("\n$EndMeshFormat\n$PhysicalNames\n1\n")
-            .text(&format!("2 {GROUP} \"accessible\"\n$EndPhysicalNames\n"))
+            .text(&format!("2 {GROUP} \"{group}\"\n$EndPhysicalNames\n"))
     }
 }
 
@@ -53,13 +53,13 @@ fn liver() -> TetMesh {
     organs::generate(Organ::Liver, &settings).unwrap()
 }
 
-/// Version 4.1: one surface entity in the physical group, one volume; nodes and elements in
-/// blocks, tags as `size_t`.
-fn msh4(mesh: &TetMesh) -> Vec<u8> {
-    let faces = mesh.face_set("accessible").unwrap();
+/// Version 4.1: one surface entity in the physical group of `mesh`'s face set `group`, one
+/// volume; nodes and elements in blocks, tags as `size_t`.
+pub fn msh4(mesh: &TetMesh, group: &str) -> Vec<u8> {
+    let faces = mesh.face_set(group).unwrap();
     let (nodes, tets) = (mesh.nodes(), mesh.tets());
     let mut b = Bytes::default();
-    b.header("4.1").text("$Entities\n");
+    b.header("4.1", group).text("$Entities\n");
     b.size(0).size(0).size(1).size(1);
     b.int(1);
     (0..6).for_each(|_| {
@@ -106,11 +106,12 @@ fn msh4(mesh: &TetMesh) -> Vec<u8> {
 
 /// Version 2.2: nodes as `int` tag and three doubles; elements in blocks of one type, each
 /// with its number, two tags (physical, elementary) and its nodes as `int`s.
-fn msh2(mesh: &TetMesh) -> Vec<u8> {
-    let faces = mesh.face_set("accessible").unwrap();
+pub fn msh2(mesh: &TetMesh, group: &str) -> Vec<u8> {
+    let faces = mesh.face_set(group).unwrap();
     let (nodes, tets) = (mesh.nodes(), mesh.tets());
     let mut b = Bytes::default();
-    b.header("2.2").text(&format!("$Nodes\n{}\n", nodes.len()));
+    b.header("2.2", group)
+        .text(&format!("$Nodes\n{}\n", nodes.len()));
     for (k, p) in nodes.iter().enumerate() {
         b.int(k as i32 + 1).real(p.x).real(p.y).real(p.z);
     }
@@ -152,7 +153,11 @@ fn sorted_faces(faces: &[[usize; 3]]) -> Vec<[usize; 3]> {
 #[test]
 fn binary_gmsh_v4_and_v2_read_back_as_the_mesh_written() {
     let mesh = liver();
-    for (name, bytes) in [("liver4.msh", msh4(&mesh)), ("liver2.msh", msh2(&mesh))] {
+    let group = "accessible";
+    for (name, bytes) in [
+        ("liver4.msh", msh4(&mesh, group)),
+        ("liver2.msh", msh2(&mesh, group)),
+    ] {
         let back = load(&file(name, &bytes), &ImportOptions::default())
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(back.nodes(), mesh.nodes(), "{name}");
@@ -169,7 +174,7 @@ fn binary_gmsh_v4_and_v2_read_back_as_the_mesh_written() {
 /// short starts (within the 8 bytes before the end) and what was expected.
 #[test]
 fn a_binary_gmsh_file_cut_short_names_its_byte() {
-    let bytes = msh4(&liver());
+    let bytes = msh4(&liver(), "accessible");
     let cut = &bytes[..bytes.len() / 3];
     let error = load(&file("cut.msh", cut), &ImportOptions::default()).unwrap_err();
     let ImportError::Binary {

@@ -32,7 +32,7 @@ fn cell_types(bytes: &mut Vec<u8>, cells: usize) {
 }
 
 /// Format 3: double points; `CELLS n size`, each cell its point count and points as `int`s.
-fn classic(mesh: &TetMesh) -> Vec<u8> {
+pub fn classic(mesh: &TetMesh) -> Vec<u8> {
     let (nodes, tets) = (mesh.nodes(), mesh.tets());
     let mut bytes = header("3.0", nodes.len(), "double");
     for p in nodes {
@@ -48,7 +48,7 @@ fn classic(mesh: &TetMesh) -> Vec<u8> {
 }
 
 /// Format 5.1: single-precision points; offsets and connectivity as 64-bit integers.
-fn offsets(mesh: &TetMesh) -> Vec<u8> {
+pub fn offsets(mesh: &TetMesh) -> Vec<u8> {
     let (nodes, tets) = (mesh.nodes(), mesh.tets());
     let mut bytes = header("5.1", nodes.len(), "float");
     for p in nodes {

@@ -14,6 +14,7 @@ mod surface;
 mod tokens;
 mod vtk;
 mod vtu;
+mod vtu_data;
 
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -306,7 +307,7 @@ fn read_mesh(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<Tet
                 return meshed(surface);
             }
         },
-        "vtu" => vtu::read(&file, &text(bytes)?)?,
+        "vtu" => vtu::read(&file, &bytes)?,
         "obj" => {
             let surface = read_obj(&file, &text(bytes)?)?;
             return meshed(surface);

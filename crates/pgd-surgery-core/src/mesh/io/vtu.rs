@@ -1,4 +1,6 @@
-//! VTK XML unstructured grids (`.vtu`), ASCII data arrays: read, and written for ParaView.
+//! VTK XML unstructured grids (`.vtu`): read with ASCII, binary (base64) and appended (raw or
+//! base64) data arrays, zlib-compressed or not (`vtu_data`); written with ASCII arrays for
+//! ParaView.
 //!
 //! Regions travel as `UInt8` point-data arrays named `region:<name>` (1 = in the set): node
 //! sets as they are, face sets as their faces' corners, which read back as the node set and
@@ -12,6 +14,7 @@ use quick_xml::Reader;
 use quick_xml::events::{BytesStart, Event};
 
 use super::tokens::Tokens;
+use super::vtu_data::{Layout, Scalar, decode_base64, decode_raw};
 use super::{ImportError, RawMesh};
 use crate::mesh::TetMesh;
 
@@ -29,7 +32,40 @@ enum Target {
     Ignored,
 }
 
-pub(super) fn read(file: &str, text: &str) -> Result<RawMesh, ImportError> {
+/// How a data array's values are written.
+#[derive(Clone, Debug, PartialEq)]
+enum Format {
+    Ascii,
+    /// Base64 inside the element.
+    Binary,
+    /// In the appended data, from this offset.
+    Appended(usize),
+}
+
+/// A data array as its element declares it.
+#[derive(Clone, Debug)]
+struct Declared {
+    target: Target,
+    format: Format,
+    scalar: Scalar,
+}
+
+/// A file's appended data: raw bytes or base64 text, after the `_` that starts it.
+struct Appended<'a> {
+    raw: bool,
+    bytes: &'a [u8],
+}
+
+pub(super) fn read(file: &str, bytes: &[u8]) -> Result<RawMesh, ImportError> {
+    // Raw appended data is no text: the XML is read up to it.
+    let (xml, appended) = split_appended(bytes);
+    let text = std::str::from_utf8(xml).map_err(|e| ImportError::Unsupported {
+        file: file.to_owned(),
+        message: format!(
+            "not UTF-8 text (byte {}) before any appended data",
+            e.valid_up_to()
+        ),
+    })?;
     let mut reader = Reader::from_str(text);
     let line_at = |pos: u64| 1 + text[..pos as usize].bytes().filter(|&b| b == b'\n').count();
     let syntax = |pos: u64, message: String| ImportError::Syntax {
@@ -38,44 +74,125 @@ pub(super) fn read(file: &str, text: &str) -> Result<RawMesh, ImportError> {
         message,
     };
     let mut section = String::new();
-    let mut target: Option<Target> = None;
+    let mut layout = Layout::of(None, None, None).expect("the defaults");
+    let mut open: Option<Declared> = None;
     let mut arrays: Vec<(Target, Vec<f64>)> = Vec::new();
+    let mut later: Vec<Declared> = Vec::new();
     loop {
         let pos = reader.buffer_position();
         let event = reader
             .read_event()
             .map_err(|e| syntax(reader.error_position(), format!("malformed XML: {e}")))?;
         match event {
-            Event::Start(e) if e.name().as_ref() == "DataArray" => {
-                target = Some(data_array_target(&e, &section).map_err(|m| syntax(pos, m))?);
+            Event::Start(e) | Event::Empty(e) if e.name().as_ref() == "DataArray" => {
+                let declared = declare(&e, &section).map_err(|m| syntax(pos, m))?;
+                match declared.format {
+                    Format::Appended(_) => later.push(declared),
+                    _ => open = Some(declared),
+                }
             }
             Event::Start(e) => {
                 let name = e.name().as_ref().to_owned();
                 if name == "VTKFile" {
-                    check_file_type(&e).map_err(|m| syntax(pos, m))?;
+                    layout = file_layout(&e).map_err(|m| syntax(pos, m))?;
                 }
                 section = name;
             }
             Event::Text(content) => {
-                if let Some(t) = target.take() {
+                if let Some(declared) = open.take() {
                     let body = content.xml10_content();
-                    let mut tokens = Tokens::from_line(file, &body, line_at(pos));
-                    let mut values = Vec::new();
-                    while let Ok(token) = tokens.next("a number") {
-                        let value: f64 = token.parse().map_err(|_| {
-                            tokens.error(format!("expected a number, found '{token}'"))
-                        })?;
-                        values.push(value);
-                    }
-                    arrays.push((t, values));
+                    let values = match declared.format {
+                        Format::Binary => decode_base64(&body, declared.scalar, &layout)
+                            .map_err(|m| syntax(pos, format!("a binary data array: {m}")))?,
+                        _ => ascii_values(file, &body, line_at(pos))?,
+                    };
+                    arrays.push((declared.target, values));
                 }
             }
-            Event::End(e) if e.name().as_ref() == "DataArray" => target = None,
+            Event::End(e) if e.name().as_ref() == "DataArray" => open = None,
             Event::Eof => break,
             _ => {}
         }
     }
+    let mut offsets: Vec<usize> = (later.iter())
+        .filter_map(|d| match d.format {
+            Format::Appended(offset) => Some(offset),
+            _ => None,
+        })
+        .collect();
+    offsets.sort_unstable();
+    for declared in later {
+        let next = |offset: usize| offsets.iter().copied().find(|&o| o > offset);
+        let values = appended_values(&declared, appended.as_ref(), &layout, next).map_err(|m| {
+            ImportError::Unsupported {
+                file: file.to_owned(),
+                message: format!("appended data array {:?}: {m}", declared.target),
+            }
+        })?;
+        arrays.push((declared.target, values));
+    }
     assemble(file, arrays)
+}
+
+/// The file before its `AppendedData` element, and that element's data if it has one.
+fn split_appended(bytes: &[u8]) -> (&[u8], Option<Appended<'_>>) {
+    let find = |what: &[u8], from: usize| {
+        (bytes[from..].windows(what.len()))
+            .position(|w| w == what)
+            .map(|k| from + k)
+    };
+    let Some(start) = find(b"<AppendedData", 0) else {
+        return (bytes, None);
+    };
+    let Some(underscore) = find(b"_", start) else {
+        return (&bytes[..start], None);
+    };
+    let tag = String::from_utf8_lossy(&bytes[start..underscore]);
+    let appended = Appended {
+        raw: !tag.contains("\"base64\""),
+        bytes: &bytes[underscore + 1..],
+    };
+    (&bytes[..start], Some(appended))
+}
+
+/// The values of an appended array, from its offset in the appended data; `next` gives the
+/// offset of the array after one at an offset, if there is one.
+fn appended_values(
+    declared: &Declared,
+    appended: Option<&Appended>,
+    layout: &Layout,
+    next: impl Fn(usize) -> Option<usize>,
+) -> Result<Vec<f64>, String> {
+    let Format::Appended(offset) = declared.format else {
+        return Err("not appended".into());
+    };
+    let appended = appended.ok_or("the file has no AppendedData element")?;
+    let from = (appended.bytes.get(offset..)).ok_or("its offset is past the appended data")?;
+    if appended.raw {
+        return decode_raw(from, declared.scalar, layout);
+    }
+    // Base64 runs on into the next array's characters: up to them, or to white space or the
+    // element's end after the last.
+    let end = next(offset).map(|n| n - offset).unwrap_or_else(|| {
+        (from.iter())
+            .position(|b| b.is_ascii_whitespace() || *b == b'<')
+            .unwrap_or(from.len())
+    });
+    let text = std::str::from_utf8(&from[..end]).map_err(|_| "base64 that is not text")?;
+    decode_base64(text, declared.scalar, layout)
+}
+
+/// The numbers of an ASCII data array's text, which starts at `first_line`.
+fn ascii_values(file: &str, body: &str, first_line: usize) -> Result<Vec<f64>, ImportError> {
+    let mut tokens = Tokens::from_line(file, body, first_line);
+    let mut values = Vec::new();
+    while let Ok(token) = tokens.next("a number") {
+        let value: f64 = token
+            .parse()
+            .map_err(|_| tokens.error(format!("expected a number, found '{token}'")))?;
+        values.push(value);
+    }
+    Ok(values)
 }
 
 fn attribute(e: &BytesStart, name: &str) -> Option<String> {
@@ -86,24 +203,44 @@ fn attribute(e: &BytesStart, name: &str) -> Option<String> {
     })
 }
 
-fn check_file_type(e: &BytesStart) -> Result<(), String> {
+/// An unstructured grid's layout of binary data.
+fn file_layout(e: &BytesStart) -> Result<Layout, String> {
     match attribute(e, "type").as_deref() {
-        Some("UnstructuredGrid") => Ok(()),
-        other => Err(format!(
-            "expected an UnstructuredGrid VTKFile, found type {other:?}"
-        )),
+        Some("UnstructuredGrid") => {}
+        other => {
+            return Err(format!(
+                "expected an UnstructuredGrid VTKFile, found type {other:?}"
+            ));
+        }
     }
+    Layout::of(
+        attribute(e, "byte_order").as_deref(),
+        attribute(e, "header_type").as_deref(),
+        attribute(e, "compressor").as_deref(),
+    )
 }
 
-fn data_array_target(e: &BytesStart, section: &str) -> Result<Target, String> {
-    let format = attribute(e, "format").unwrap_or_else(|| "ascii".into());
-    if format != "ascii" {
-        return Err(format!(
-            "DataArray format '{format}' is not read; save the .vtu with ASCII data (ParaView: Save Data, Data Mode: Ascii)"
-        ));
-    }
+fn declare(e: &BytesStart, section: &str) -> Result<Declared, String> {
+    let format = match attribute(e, "format").as_deref().unwrap_or("ascii") {
+        "ascii" => Format::Ascii,
+        "binary" => Format::Binary,
+        "appended" => {
+            let offset = attribute(e, "offset").ok_or("an appended DataArray has no offset")?;
+            Format::Appended(
+                offset
+                    .parse()
+                    .map_err(|_| format!("the offset '{offset}' is no byte count"))?,
+            )
+        }
+        other => {
+            return Err(format!(
+                "DataArray format '{other}' is not ascii, binary or appended"
+            ));
+        }
+    };
+    let scalar = Scalar::of(&attribute(e, "type").unwrap_or_else(|| "Float64".into()))?;
     let name = attribute(e, "Name").unwrap_or_default();
-    Ok(match (section, name.as_str()) {
+    let target = match (section, name.as_str()) {
         ("Points", _) => Target::Points,
         ("Cells", "connectivity") => Target::Connectivity,
         ("Cells", "offsets") => Target::Offsets,
@@ -112,6 +249,11 @@ fn data_array_target(e: &BytesStart, section: &str) -> Result<Target, String> {
             Target::Region(n[REGION_PREFIX.len()..].to_owned())
         }
         _ => Target::Ignored,
+    };
+    Ok(Declared {
+        target,
+        format,
+        scalar,
     })
 }
 
