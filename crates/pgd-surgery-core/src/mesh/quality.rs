@@ -20,6 +20,9 @@ pub struct QualityReport {
     pub volume_m3: f64,
     pub min_dihedral_deg: f64,
     pub max_dihedral_deg: f64,
+    /// The tetrahedra with the smallest and the largest dihedral angle.
+    pub min_dihedral_tet: Option<usize>,
+    pub max_dihedral_tet: Option<usize>,
     /// Longest edge over the inradius, normalized to 1 for the regular tetrahedron.
     pub max_aspect_ratio: f64,
     pub mean_aspect_ratio: f64,
@@ -45,6 +48,8 @@ impl QualityReport {
             volume_m3: 0.0,
             min_dihedral_deg: f64::INFINITY,
             max_dihedral_deg: 0.0,
+            min_dihedral_tet: None,
+            max_dihedral_tet: None,
             max_aspect_ratio: 0.0,
             mean_aspect_ratio: 0.0,
             inverted: 0,
@@ -69,8 +74,12 @@ impl QualityReport {
             }
             report.volume_m3 += super::signed_volume(&p);
             let (lo, hi) = dihedral_range_deg(&p);
-            report.min_dihedral_deg = report.min_dihedral_deg.min(lo);
-            report.max_dihedral_deg = report.max_dihedral_deg.max(hi);
+            if lo < report.min_dihedral_deg {
+                (report.min_dihedral_deg, report.min_dihedral_tet) = (lo, Some(t));
+            }
+            if hi > report.max_dihedral_deg {
+                (report.max_dihedral_deg, report.max_dihedral_tet) = (hi, Some(t));
+            }
             let aspect = aspect_ratio(&p);
             report.max_aspect_ratio = report.max_aspect_ratio.max(aspect);
             report.mean_aspect_ratio += aspect / tets.len() as f64;
@@ -131,15 +140,23 @@ impl QualityReport {
                 self.open_edges, self.non_manifold_edges
             ));
         }
-        if self.min_dihedral_deg < REFUSED_MIN_DIHEDRAL_DEG
-            || self.max_dihedral_deg > REFUSED_MAX_DIHEDRAL_DEG
-        {
+        if self.poorly_shaped() {
+            let tet = |t: Option<usize>| t.map_or(String::new(), |t| format!(" (tetrahedron {t})"));
             return Some(format!(
-                "dihedral angles from {:.2}° to {:.2}° (accepted: {REFUSED_MIN_DIHEDRAL_DEG}° to {REFUSED_MAX_DIHEDRAL_DEG}°)",
-                self.min_dihedral_deg, self.max_dihedral_deg
+                "dihedral angles from {:.2}°{} to {:.2}°{} (accepted: {REFUSED_MIN_DIHEDRAL_DEG}° to {REFUSED_MAX_DIHEDRAL_DEG}°)",
+                self.min_dihedral_deg,
+                tet(self.min_dihedral_tet),
+                self.max_dihedral_deg,
+                tet(self.max_dihedral_tet)
             ));
         }
         None
+    }
+
+    /// Slivers or needles: a dihedral angle outside what is accepted.
+    pub fn poorly_shaped(&self) -> bool {
+        self.min_dihedral_deg < REFUSED_MIN_DIHEDRAL_DEG
+            || self.max_dihedral_deg > REFUSED_MAX_DIHEDRAL_DEG
     }
 }
 

@@ -12,6 +12,7 @@ mod import;
 mod msh_binary;
 mod organs;
 mod quality;
+mod slivers;
 mod stuffing;
 mod vtk_binary;
 mod vtu_binary;

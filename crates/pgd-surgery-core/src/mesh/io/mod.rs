@@ -10,6 +10,7 @@ mod cursor;
 mod mend;
 mod msh;
 mod ply;
+mod remesh;
 mod surface;
 mod tokens;
 mod vtk;
@@ -68,8 +69,10 @@ struct RawMesh {
 }
 
 impl RawMesh {
-    /// Checks indices, measures quality, and refuses what cannot be simulated.
-    fn into_mesh(self, file: &str) -> Result<TetMesh, ImportError> {
+    /// Checks indices, measures quality, meshes anew from its boundary (at about
+    /// `remesh_nodes` nodes) what is too poorly shaped to solve, and refuses what cannot be
+    /// simulated.
+    fn into_mesh(self, file: &str, remesh_nodes: usize) -> Result<TetMesh, ImportError> {
         if let Some((t, _)) = self
             .tets
             .iter()
@@ -88,6 +91,31 @@ impl RawMesh {
             });
         }
         let report = QualityReport::measure(&self.nodes, &self.tets);
+        // Slivers and needles, or flat elements, in a closed mesh: meshed anew from its
+        // boundary; inverted elements (a tangle, or nodes in the wrong order) are refused.
+        let mendable = report.inverted == 0
+            && report.watertight()
+            && (report.poorly_shaped() || report.degenerate > 0);
+        if mendable {
+            let (remeshed, said) = remesh::remesh(file, self, remesh_nodes)?;
+            eprintln!("{file}: mended: {said}");
+            return remeshed.into_checked_mesh(file);
+        }
+        self.refused_or_regioned(file, &report)
+    }
+
+    /// [`Self::refused_or_regioned`] after measuring the quality.
+    fn into_checked_mesh(self, file: &str) -> Result<TetMesh, ImportError> {
+        let report = QualityReport::measure(&self.nodes, &self.tets);
+        self.refused_or_regioned(file, &report)
+    }
+
+    /// Refused for the reason `report` gives, or the mesh with its regions completed.
+    fn refused_or_regioned(
+        self,
+        file: &str,
+        report: &QualityReport,
+    ) -> Result<TetMesh, ImportError> {
         if let Some(reason) = report.refusal() {
             return Err(ImportError::Unusable {
                 file: file.to_owned(),
@@ -173,7 +201,8 @@ impl MeshFile {
 pub struct ImportOptions {
     /// Multiplies coordinates: 0.001 for files in millimetres.
     pub scale: f64,
-    /// Target node count when tetrahedralizing a surface.
+    /// Target node count when tetrahedralizing a surface, or meshing a volume anew from its
+    /// boundary (its elements too poorly shaped to solve).
     pub surface_nodes: usize,
     /// The clamped nodes and the accessible surface, picked by where they are (after
     /// `scale`); none: the file's own `clamped` and `accessible` regions.
@@ -337,5 +366,5 @@ fn read_mesh(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<Tet
         let c = p.coords * options.scale;
         *p = Point3::new(turn * c.x, turn * c.y, c.z);
     }
-    raw.into_mesh(&file)
+    raw.into_mesh(&file, options.surface_nodes)
 }
