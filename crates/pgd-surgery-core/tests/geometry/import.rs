@@ -617,3 +617,52 @@ fn a_surface_in_lps_is_turned_into_ras() {
     assert_eq!("LPS".parse::<Frame>(), Ok(Frame::Lps));
     assert!("xyz".parse::<Frame>().unwrap_err().contains("ras"));
 }
+
+/// Two cubes of 4 cm in one file, the second moved 2 cm along each axis into the first: each
+/// closed, together crossing. Refused with two triangles that cross and a point inside both
+/// cubes, where they overlap; either cube alone is meshed.
+#[test]
+fn a_surface_crossing_itself_is_refused_with_where() {
+    let moved: String = (CUBE_OBJ.lines())
+        .map(|line| match line.strip_prefix("v ") {
+            Some(v) => {
+                let c: Vec<f64> = v.split(' ').map(|x| x.parse().unwrap()).collect();
+                format!("v {} {} {}\n", c[0] + 20.0, c[1] + 20.0, c[2] + 20.0)
+            }
+            None => match line.strip_prefix("f ") {
+                Some(f) => {
+                    let ids: Vec<String> = (f.split(' '))
+                        .map(|i| (i.parse::<usize>().unwrap() + 8).to_string())
+                        .collect();
+                    format!("f {}\n", ids.join(" "))
+                }
+                None => String::new(),
+            },
+        })
+        .collect();
+    let options = ImportOptions {
+        scale: 1e-3,
+        surface_nodes: 500,
+        ..ImportOptions::default()
+    };
+    let both = format!("{CUBE_OBJ}{moved}");
+    let error = load(&file("crossing.obj", both.as_bytes()), &options)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("crossing.obj") && error.contains("crosses itself"),
+        "{error}"
+    );
+    let near: Vec<f64> = (error
+        .split_once("near (")
+        .unwrap()
+        .1
+        .split_once(") mm")
+        .unwrap()
+        .0)
+        .split(", ")
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert!(near.iter().all(|&x| (20.0..=40.0).contains(&x)), "{error}");
+    assert!(load(&file("alone.obj", CUBE_OBJ.as_bytes()), &options).is_ok());
+}

@@ -7,6 +7,7 @@
 //! report's reason.
 
 mod cursor;
+mod intersections;
 mod mend;
 mod msh;
 mod ply;

@@ -8,6 +8,7 @@ use parry3d::query::PointQuery;
 use parry3d::shape::{TriMesh, TriMeshFlags};
 
 use super::ImportError;
+use super::intersections::self_crossing;
 use super::tokens::Tokens;
 use crate::mesh::{Implicit, TetMesh, stuff_to_node_count};
 use crate::parry_interop::to_parry;
@@ -201,6 +202,15 @@ pub fn tetrahedralize(
         reason,
     };
     check_closed(&surface).map_err(refuse)?;
+    if let Some((crossing, pairs)) = self_crossing(&surface) {
+        let [i, j] = crossing.triangles;
+        let p = crossing.near_m.coords * 1e3;
+        return Err(refuse(format!(
+            "the surface crosses itself: triangles {i} and {j} cross near ({:.1}, {:.1}, {:.1}) mm \
+             ({pairs} crossing pairs in all); mend it in the segmentation tool",
+            p.x, p.y, p.z
+        )));
+    }
     let (min, max) = bounds(&surface.vertices);
     let size = (max - min).norm();
     if size > LARGEST_ORGAN_M {
