@@ -601,6 +601,24 @@ pub enum BenchTarget {
         #[arg(long)]
         json: bool,
     },
+    /// A patient's organ as a segmentation gives it: the liver's surface as binary STL in
+    /// millimetres imported (read, mended, checked for crossings, tetrahedralized), as it is
+    /// and subdivided to --triangles.
+    Import {
+        /// The subdivided surface's triangles, at least (45,000: the liver's 3,082 triangles
+        /// subdivided twice, 49,312).
+        #[arg(long, default_value_t = 45_000)]
+        triangles: usize,
+        /// The nodes to tetrahedralize at (as `pgd mesh --nodes`).
+        #[arg(long, default_value_t = 4_000)]
+        nodes: usize,
+        /// Imports timed per surface.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Assembly, factorization and solve on a liver-sized mesh (~4,300 nodes, ~21,000 tets).
     Fem {
         /// Print the report as JSON instead of a table.

@@ -342,6 +342,16 @@ fn bench_command(what: BenchTarget) -> ExitCode {
         BenchTarget::Rods { ticks, json } => {
             print_report("pgd bench rods", bench::rods::run(ticks), json)
         }
+        BenchTarget::Import {
+            triangles,
+            nodes,
+            repeats,
+            json,
+        } => print_report(
+            "pgd bench import",
+            bench::import::run(triangles, nodes, repeats),
+            json,
+        ),
         BenchTarget::Cutting { cells, json } => print_report(
             "pgd bench cutting",
             bench::cutting::run([cells[0], cells[1], cells[2]]),

@@ -7,5 +7,6 @@ pub mod cutting;
 pub mod dynamics;
 pub mod fem;
 pub mod frame;
+pub mod import;
 pub mod rods;
 pub mod vademecum;

@@ -7,7 +7,7 @@
 //! report's reason.
 
 mod cursor;
-mod intersections;
+pub mod intersections;
 mod mend;
 mod msh;
 mod ply;
@@ -25,6 +25,7 @@ use nalgebra::Point3;
 use thiserror::Error;
 
 use super::{MeshError, QualityReport, RegionSelectors, Regions, Surface, TetMesh};
+pub use intersections::{Crossing, Faces, self_crossing};
 pub use mend::{MAX_HOLE_EDGES, Mended, mend};
 pub use ply::read_ply;
 pub use surface::{SurfaceMesh, read_obj, read_stl, tetrahedralize};

@@ -8,7 +8,7 @@ use parry3d::query::PointQuery;
 use parry3d::shape::{TriMesh, TriMeshFlags};
 
 use super::ImportError;
-use super::intersections::self_crossing;
+use super::intersections::{Faces, self_crossing};
 use super::tokens::Tokens;
 use crate::mesh::{Implicit, TetMesh, stuff_to_node_count};
 use crate::parry_interop::to_parry;
@@ -202,7 +202,11 @@ pub fn tetrahedralize(
         reason,
     };
     check_closed(&surface).map_err(refuse)?;
-    if let Some((crossing, pairs)) = self_crossing(&surface) {
+    let faces = Faces {
+        vertices: &surface.vertices,
+        triangles: &surface.triangles,
+    };
+    if let Some((crossing, pairs)) = self_crossing(faces) {
         let [i, j] = crossing.triangles;
         let p = crossing.near_m.coords * 1e3;
         return Err(refuse(format!(
