@@ -20,6 +20,41 @@ pub fn file(name: &str, contents: &[u8]) -> PathBuf {
     path
 }
 
+/// `faces`, each with its corners in order, in order: a face set to compare with another.
+pub fn sorted_faces(faces: &[[usize; 3]]) -> Vec<[usize; 3]> {
+    let mut faces: Vec<[usize; 3]> = faces
+        .iter()
+        .map(|f| {
+            let mut f = *f;
+            f.sort_unstable();
+            f
+        })
+        .collect();
+    faces.sort_unstable();
+    faces
+}
+
+/// `cut`, a binary file cut short, written as `name` and read: refused with the file, the
+/// byte where the field cut short starts (within `field_bytes` of the end) and what was
+/// expected.
+pub fn assert_cut_short(name: &str, cut: &[u8], field_bytes: usize) {
+    let error = load(&file(name, cut), &ImportOptions::default()).unwrap_err();
+    let ImportError::Binary {
+        file,
+        byte,
+        message,
+    } = &error
+    else {
+        panic!("{error}");
+    };
+    assert!(file.ends_with(name), "{error}");
+    assert!(
+        cut.len() - field_bytes < *byte && *byte <= cut.len(),
+        "{error}"
+    );
+    assert!(message.contains("unexpected end of file"), "{error}");
+}
+
 fn import(name: &str, contents: &str) -> Result<pgd_surgery_core::mesh::TetMesh, ImportError> {
     load(&file(name, contents.as_bytes()), &ImportOptions::default())
 }
@@ -157,20 +192,8 @@ fn vtu_round_trip_keeps_face_sets() {
     let path = file("liver.vtu", b"");
     write_vtu(&path, &mesh, &[]).unwrap();
     let back = load(&path, &ImportOptions::default()).unwrap();
-    let faces = |m: &pgd_surgery_core::mesh::TetMesh| {
-        let mut faces: Vec<[usize; 3]> = m
-            .face_set("accessible")
-            .unwrap()
-            .iter()
-            .map(|f| {
-                let mut f = *f;
-                f.sort_unstable();
-                f
-            })
-            .collect();
-        faces.sort_unstable();
-        faces
-    };
+    let faces =
+        |m: &pgd_surgery_core::mesh::TetMesh| sorted_faces(m.face_set("accessible").unwrap());
     assert_eq!(faces(&back), faces(&mesh));
 }
 

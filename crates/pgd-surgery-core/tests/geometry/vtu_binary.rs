@@ -23,6 +23,15 @@ struct Way {
     two_streams: bool,
 }
 
+/// Inline base64 of plain arrays, 32-bit headers, little-endian, header and data each padded.
+const PLAIN: Way = Way {
+    appended: None,
+    block_bytes: None,
+    header_bytes: 4,
+    little_endian: true,
+    two_streams: true,
+};
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Encoding {
     Raw,
@@ -199,13 +208,7 @@ impl Way {
 /// `mesh` with zlib-compressed arrays in raw appended data, and with plain arrays in base64,
 /// for the fuzzer's seeds.
 pub fn compressed_and_inline(mesh: &TetMesh) -> [Vec<u8>; 2] {
-    let plain = Way {
-        appended: None,
-        block_bytes: None,
-        header_bytes: 4,
-        little_endian: true,
-        two_streams: true,
-    };
+    let plain = PLAIN;
     let compressed = Way {
         appended: Some(Encoding::Raw),
         block_bytes: Some(64),
@@ -228,13 +231,7 @@ fn binary_vtu_files_read_back_as_the_ascii_one() {
     let ascii = file("ascii.vtu", b"");
     write_vtu(&ascii, &mesh, &[]).unwrap();
     let reference = load(&ascii, &ImportOptions::default()).unwrap();
-    let plain = Way {
-        appended: None,
-        block_bytes: None,
-        header_bytes: 4,
-        little_endian: true,
-        two_streams: true,
-    };
+    let plain = PLAIN;
     let ways = [
         plain,
         Way {
