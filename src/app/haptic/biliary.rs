@@ -398,6 +398,7 @@ impl Biliary {
             // A rod that could not take a step keeps its shape; the next tick tries again.
             let _ = (self.tree.tube_mut(structure).rod).step(&[], SETTLED_N, STEPS_PER_TICK);
         }
+        self.follow_ducts_with_fat();
         self.push_n = [Vector3::zeros(); MAX_HANDS];
         for held in &self.held {
             let forces = self.tree.tubes[held.tube].rod.node_forces_n();
@@ -405,6 +406,25 @@ impl Biliary {
                 self.push_n[held.hand] -= f;
             }
         }
+    }
+
+    /// Moves the triangle's fat as its corners (the junction, the cystic duct's end and the
+    /// hilum) have moved from rest.
+    fn follow_ducts_with_fat(&mut self) {
+        let moved = |structure: Structure, node: Option<usize>| {
+            let (now, rest) = (
+                &self.tree.tube(structure).rod,
+                &self.at_rest.tube(structure).rod,
+            );
+            let node = node.unwrap_or(rest.nodes() - 1);
+            now.positions[node] - rest.positions[node]
+        };
+        let corners = [
+            moved(Structure::CysticDuct, Some(0)),
+            moved(Structure::CysticDuct, None),
+            moved(Structure::CommonDuct, Some(0)),
+        ];
+        self.tree.fat.follow(&self.at_rest.fat, corners);
     }
 
     fn bleed(&mut self) {

@@ -2,9 +2,9 @@
 //! cystic duct, the artery and the common hepatic duct, a crosshatch of strands parallel to
 //! the cystic duct and to the common hepatic duct over the parallelogram the two ducts span
 //! (the posterior layer, which a surgeon reaches by turning the gallbladder over, is not
-//! modelled). Intact, they hide what lies behind them; the hook burns
-//! them and blunt dissection tears them, and the share cleared (by volume) is the critical
-//! view's first criterion.
+//! modelled), following the triangle's corners as the tubes move. Intact, they hide what lies
+//! behind them; the hook burns them and blunt dissection tears them, and the share cleared
+//! (by volume) is the critical view's first criterion.
 
 use nalgebra::Vector3;
 
@@ -61,7 +61,13 @@ impl FatStrand {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriangleFat {
     pub strands: Vec<FatStrand>,
+    /// Each strand's ends as weights of the triangle's corners (junction, cystic end, hilum):
+    /// the strands follow the corners as the tubes move.
+    weights: Vec<[Corners; 2]>,
 }
+
+/// Weights of the triangle's three corners, summing to one.
+type Corners = [f64; 3];
 
 impl TriangleFat {
     /// The layer over the parallelogram `triangle`'s two ducts span, in front of them along
@@ -73,6 +79,7 @@ impl TriangleFat {
         let depth = common_radius_m + LAYER_CLEARANCE_M + STRAND_RADIUS_M;
         let layer = corner + anterior * depth;
         let mut strands = Vec::with_capacity(2 * STRANDS_EACH_WAY);
+        let mut weights = Vec::with_capacity(2 * STRANDS_EACH_WAY);
         for k in 0..STRANDS_EACH_WAY {
             let share = k as f64 / STRANDS_EACH_WAY as f64;
             let rows = [
@@ -85,8 +92,29 @@ impl TriangleFat {
                 cleared: false,
                 absorbed_j: 0.0,
             }));
+            // The same ends as weights of (junction, cystic end, hilum).
+            weights.push([[1.0 - share, 0.0, share], [-share, 1.0, share]]);
+            weights.push([[1.0 - share, share, 0.0], [-share, share, 1.0]]);
         }
-        Self { strands }
+        Self { strands, weights }
+    }
+
+    /// Moves each strand from where it lies in `rest` as the triangle's corners have moved
+    /// from theirs by `moved_m` (junction, cystic end, hilum): the fat goes with the ducts it
+    /// wraps when the gallbladder is drawn aside.
+    pub fn follow(&mut self, rest: &TriangleFat, moved_m: [Vector3<f64>; 3]) {
+        let shift = |w: &Corners| (0..3).map(|k| moved_m[k] * w[k]).sum::<Vector3<f64>>();
+        for ((strand, at_rest), [from, to]) in self
+            .strands
+            .iter_mut()
+            .zip(&rest.strands)
+            .zip(&self.weights)
+        {
+            strand.axis = Segment::new(
+                at_rest.axis.from_m + shift(from),
+                at_rest.axis.to_m + shift(to),
+            );
+        }
     }
 
     /// The share of the fat's volume cleared.

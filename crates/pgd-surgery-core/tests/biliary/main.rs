@@ -705,3 +705,26 @@ fn the_view_record_stays_as_it_was_when_the_view_was_reached() {
         (Structure::CysticDuct, moved)
     );
 }
+
+/// The fat goes with the triangle's corners: all three moved alike, every strand moves as
+/// they do; the cystic duct's end alone moved, each strand's end on the gallbladder side
+/// moves with it, and the strands along the hepatic duct by their share of the way to it.
+#[test]
+fn the_fat_follows_the_triangles_corners() {
+    let tree = tree(&Anatomy::default());
+    let rest = tree.fat.clone();
+    let mut fat = tree.fat.clone();
+    let shift = Vector3::new(1e-3, -2e-3, 0.5e-3);
+    fat.follow(&rest, [shift; 3]);
+    for (moved, at_rest) in fat.strands.iter().zip(&rest.strands) {
+        assert!((moved.axis.from_m - at_rest.axis.from_m - shift).norm() < 1e-15);
+        assert!((moved.axis.to_m - at_rest.axis.to_m - shift).norm() < 1e-15);
+    }
+    let end = Vector3::new(3e-3, 0.0, 0.0);
+    fat.follow(&rest, [Vector3::zeros(), end, Vector3::zeros()]);
+    let moved_by = |k: usize| fat.strands[k].axis.to_m - rest.strands[k].axis.to_m;
+    // Strand 0 runs parallel to the cystic duct from the junction: its far end is the duct's.
+    assert!((moved_by(0) - end).norm() < 1e-15);
+    // Strand 3 runs parallel to the hepatic duct from a sixth of the way along the cystic.
+    assert!((moved_by(3) - end / 6.0).norm() < 1e-15);
+}
