@@ -91,7 +91,6 @@ pub struct Biliary {
     grasped: [Option<HeldNode>; MAX_HANDS],
     button_was_down: [bool; MAX_HANDS],
     push_n: [Vector3<f64>; MAX_HANDS],
-    view: ViewSample,
     /// The critical view as judged last, from where, and whether that was this tick.
     judged: Option<(CriticalView, Vector3<f64>)>,
     judged_now: bool,
@@ -122,7 +121,6 @@ impl Biliary {
             grasped: [None; MAX_HANDS],
             button_was_down: [false; MAX_HANDS],
             push_n: [Vector3::zeros(); MAX_HANDS],
-            view: ViewSample::default(),
             judged: None,
             judged_now: false,
             sample: BiliarySample::default(),
@@ -146,7 +144,6 @@ impl Biliary {
         self.organ_shifts_m.fill(Vector3::zeros());
         self.grasped = [None; MAX_HANDS];
         self.push_n = [Vector3::zeros(); MAX_HANDS];
-        self.view = ViewSample::default();
         self.judged = None;
         self.judged_now = false;
         self.sample = BiliarySample::default();
@@ -456,7 +453,6 @@ impl Biliary {
         let organs_hide =
             |sight: &Segment| occluders.block(&sight.from_m, &sight.to_m, OFF_M, shifts);
         let view = CriticalView::judge(&self.tree, lower_third, optic_m, organs_hide, self.rule);
-        self.view = ViewSample::of(&view);
         self.judged = Some((view, optic_m));
         self.judged_now = true;
     }
@@ -587,5 +583,6 @@ pub fn tick_biliary(
             .map_or(Vector3::from(OPEN_VIEW_M), |s| s.rig.scope.eye_m(&s.pose));
         biliary.judge(optic, beds.as_deref(), &organs);
     }
-    biliary.sample.view = biliary.view;
+    biliary.sample.view = (biliary.judged.as_ref())
+        .map_or_else(ViewSample::default, |(view, _)| ViewSample::of(view));
 }

@@ -99,7 +99,7 @@ impl RawMesh {
             && report.watertight()
             && (report.poorly_shaped() || report.degenerate > 0);
         if mendable {
-            let (remeshed, said) = remesh::remesh(file, self, remesh_nodes)?;
+            let (remeshed, said) = remesh::remesh(file, self, &report, remesh_nodes)?;
             eprintln!("{file}: mended: {said}");
             return remeshed.into_checked_mesh(file);
         }

@@ -425,6 +425,21 @@ impl Reader {
         Ok(())
     }
 
+    /// Version 2's element of type `kind` from its `tag_count` tags on: the tags (the first
+    /// its physical group) and its nodes, as `int`s.
+    fn tagged_element(
+        &mut self,
+        f: &mut impl Fields,
+        kind: usize,
+        tag_count: usize,
+    ) -> Result<(), ImportError> {
+        let tags: Vec<i64> = (0..tag_count)
+            .map(|_| f.int("an element tag"))
+            .collect::<Result<_, _>>()?;
+        let nodes = Self::int_tags(f, kind)?;
+        self.element(f, kind, Self::physical_of(&tags), &nodes)
+    }
+
     /// The first of an element's tags, its physical group, unless 0.
     fn physical_of(tags: &[i64]) -> Option<usize> {
         tags.first()
@@ -438,11 +453,7 @@ impl Reader {
             let _tag = f.int("an element tag")?;
             let kind = Self::int_tag(f, "an element type")?;
             let tag_count = Self::int_tag(f, "the number of tags")?;
-            let tags: Vec<i64> = (0..tag_count)
-                .map(|_| f.int("an element tag"))
-                .collect::<Result<_, _>>()?;
-            let nodes = Self::int_tags(f, kind)?;
-            self.element(f, kind, Self::physical_of(&tags), &nodes)?;
+            self.tagged_element(f, kind, tag_count)?;
         }
         f.expect("$EndElements")
     }
@@ -458,11 +469,7 @@ impl Reader {
             let tag_count = Self::int_tag(f, "the number of tags")?;
             for _ in 0..in_block {
                 let _number = f.int("an element number")?;
-                let tags: Vec<i64> = (0..tag_count)
-                    .map(|_| f.int("an element tag"))
-                    .collect::<Result<_, _>>()?;
-                let nodes = Self::int_tags(f, kind)?;
-                self.element(f, kind, Self::physical_of(&tags), &nodes)?;
+                self.tagged_element(f, kind, tag_count)?;
             }
             read += in_block.max(1);
         }

@@ -8,29 +8,32 @@
 //! boundary node the node sets holding every corner of the old boundary face nearest it;
 //! node sets' interior nodes are not carried over.
 
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{HashMap, HashSet};
 
 use nalgebra::Point3;
 use parry3d::query::PointQueryWithLocation;
 
 use super::mend::mend;
 use super::surface::{SurfaceMesh, tetrahedralize};
-use super::{ImportError, RawMesh};
-use crate::mesh::{QualityReport, Surface};
+use super::{ImportError, RawMesh, face_nodes};
+use crate::mesh::{QualityReport, Regions, Surface, TetMesh};
 use crate::parry_interop::{to_parry, trimesh};
 
-/// A tetrahedron's faces, each turned outwards when the tetrahedron is positive.
-const OUTWARD_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
-
-/// `raw` meshed anew from its boundary at about `target_nodes` nodes, with its regions carried
-/// over, and what was done in words (the quality before and after).
+/// `raw` (its quality `before`) meshed anew from its boundary at about `target_nodes` nodes,
+/// with its regions carried over, and what was done in words (the quality before and after).
 pub(super) fn remesh(
     file: &str,
     raw: RawMesh,
+    before: &QualityReport,
     target_nodes: usize,
 ) -> Result<(RawMesh, String), ImportError> {
-    let before = QualityReport::measure(&raw.nodes, &raw.tets);
-    let boundary = boundary_faces(&raw.tets);
+    let rest = TetMesh::new(
+        file,
+        raw.nodes.clone(),
+        raw.tets.clone(),
+        Regions::default(),
+    )?;
+    let boundary = Surface::extract(&rest).triangles;
     let (surface, _) =
         mend(surface_of(&raw.nodes, &boundary)).map_err(|reason| ImportError::Unusable {
             file: file.to_owned(),
@@ -44,8 +47,8 @@ pub(super) fn remesh(
     let nearest_to_face: Vec<Option<[usize; 3]>> = (new_boundary.iter())
         .map(|face| old.nearest(&centre(&nodes, face)))
         .collect();
-    let surface_nodes = surface_nodes(&new_boundary);
-    let nearest_to_node: Vec<Option<[usize; 3]>> = (surface_nodes.iter())
+    let new_surface_nodes = face_nodes(&new_boundary);
+    let nearest_to_node: Vec<Option<[usize; 3]>> = (new_surface_nodes.iter())
         .map(|&n| old.nearest(&nodes[n]))
         .collect();
     let mut remeshed = RawMesh {
@@ -63,7 +66,7 @@ pub(super) fn remesh(
     }
     for (name, nodes) in &raw.node_sets {
         let set: HashSet<usize> = nodes.iter().copied().collect();
-        let carried = (surface_nodes.iter().zip(&nearest_to_node))
+        let carried = (new_surface_nodes.iter().zip(&nearest_to_node))
             .filter(|(_, old)| old.is_some_and(|f| f.iter().all(|n| set.contains(n))))
             .map(|(&n, _)| n)
             .collect();
@@ -81,21 +84,6 @@ pub(super) fn remesh(
         after.max_dihedral_deg
     );
     Ok((remeshed, said))
-}
-
-/// The faces that belong to one tetrahedron only, turned as that tetrahedron turns them.
-fn boundary_faces(tets: &[[usize; 4]]) -> Vec<[usize; 3]> {
-    let mut owners: BTreeMap<[usize; 3], ([usize; 3], u32)> = BTreeMap::new();
-    for tet in tets {
-        for local in OUTWARD_FACES {
-            let face = local.map(|i| tet[i]);
-            owners.entry(sorted(face)).or_insert((face, 0)).1 += 1;
-        }
-    }
-    (owners.into_values())
-        .filter(|&(_, count)| count == 1)
-        .map(|(face, _)| face)
-        .collect()
 }
 
 /// `faces` of `nodes` as a surface of its own vertices.
@@ -148,14 +136,6 @@ impl<'a> OldBoundary<'a> {
 
 fn centre(nodes: &[Point3<f64>], face: &[usize; 3]) -> Point3<f64> {
     Point3::from((nodes[face[0]].coords + nodes[face[1]].coords + nodes[face[2]].coords) / 3.0)
-}
-
-/// The nodes of `faces`, ascending, each once.
-fn surface_nodes(faces: &[[usize; 3]]) -> Vec<usize> {
-    let mut nodes: Vec<usize> = faces.iter().flatten().copied().collect();
-    nodes.sort_unstable();
-    nodes.dedup();
-    nodes
 }
 
 fn sorted(mut face: [usize; 3]) -> [usize; 3] {
