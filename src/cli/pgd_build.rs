@@ -7,6 +7,7 @@ use crate::contact::{ContactSurface, DistanceField, DistanceSettings};
 use crate::pgd::{self, BuildReport};
 use crate::report;
 use crate::store::{self, BuildJob};
+use serde::Serialize;
 
 /// Builds `job`'s vademecum with progress bars and saves it at `out` with its convergence
 /// curves beside it (named on stderr, so that `--json` output stays parseable), and its
@@ -22,6 +23,92 @@ pub fn build_vademecum(
         write_distance_field(&vademecum, &out.with_extension("vdf"))?;
     }
     Ok(report)
+}
+
+/// Joins the `parts` of `job`'s build into its vademecum at `out`, as [`build_vademecum`]
+/// saves a whole build.
+pub fn merge_vademecum(
+    job: BuildJob,
+    parts: Vec<pgd::PartFile>,
+    out: &Path,
+    distance_field: bool,
+) -> Result<BuildReport, String> {
+    let shards: f64 = parts.iter().map(|p| p.part.header.seconds).sum();
+    let (vademecum, report, curves) = store::merge_and_save(job, parts, out)?;
+    eprintln!(
+        "merged: the shards took {shards:.1} s together, the merge {:.1} s",
+        report.total_seconds
+    );
+    print_curves(curves);
+    if distance_field {
+        write_distance_field(&vademecum, &out.with_extension("vdf"))?;
+    }
+    Ok(report)
+}
+
+/// What `pgd build --shard` did.
+#[derive(Serialize)]
+pub struct PartReport {
+    pub shard: String,
+    pub file: PathBuf,
+    /// The part's load positions, from and to (exclusive), of `total_positions`.
+    pub positions: [usize; 2],
+    pub total_positions: usize,
+    pub nonlinear_steps: usize,
+    pub seconds: f64,
+    pub file_bytes: u64,
+}
+
+impl std::fmt::Display for PartReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(
+            f,
+            "shard {}: load positions {} to {} of {} ({} nonlinear steps), {:.1} s; wrote {} \
+             ({:.1} MB)",
+            self.shard,
+            self.positions[0],
+            self.positions[1],
+            self.total_positions,
+            self.nonlinear_steps,
+            self.seconds,
+            self.file.display(),
+            self.file_bytes as f64 / 1e6
+        )?;
+        writeln!(
+            f,
+            "join every shard's part with `pgd merge PART.vdp...` once all are written"
+        )
+    }
+}
+
+/// Computes shard `shard` of `job`'s build and writes its part: at `out` if it names a part
+/// (`.vdp`), else beside the vademecum `out` ([`default_part`]).
+pub fn build_part(
+    job: BuildJob,
+    shard: pgd::Shard,
+    command: Vec<String>,
+    out: &Path,
+) -> Result<PartReport, String> {
+    let file = match out.extension().is_some_and(|e| e == "vdp") {
+        true => out.to_path_buf(),
+        false => default_part(out, shard),
+    };
+    let header = store::build_part(job, shard, command, &file)?;
+    Ok(PartReport {
+        shard: shard.to_string(),
+        positions: [header.positions.start, header.positions.end],
+        total_positions: header.total_positions,
+        nonlinear_steps: header.steps.len(),
+        seconds: header.seconds,
+        file_bytes: std::fs::metadata(&file).map_or(0, |m| m.len()),
+        file,
+    })
+}
+
+/// Where shard `shard` of the vademecum `out` is written unless named: `liver.vdm` gives
+/// `liver.part-2-of-4.vdp`.
+pub fn default_part(out: &Path, shard: pgd::Shard) -> PathBuf {
+    out.with_extension(format!("part-{}-of-{}.vdp", shard.index, shard.count))
 }
 
 /// Writes the build's convergence curves beside the vademecum and names them on stderr.

@@ -8,5 +8,6 @@ mod common;
 mod fit;
 mod option_values;
 mod outputs;
+mod shards;
 #[path = "../../crates/pgd-surgery-core/tests/support/uniaxial.rs"]
 mod uniaxial;

@@ -67,6 +67,31 @@ pub enum Command {
         /// the vademecum (FILE.vdf). The trainer otherwise builds it on first use.
         #[arg(long)]
         distance_field: bool,
+        /// Compute only shard K of N (from 1) of the load positions, for a build split across
+        /// machines: writes a part (by default the vademecum's name with .part-K-of-N.vdp) that
+        /// `pgd merge` joins with the others into the vademecum. The part keeps these
+        /// arguments: every shard of one build is run with the same ones.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<pgd::Shard>,
+        /// Print the build report as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Join the parts of a build split with `pgd build --shard K/N` into its vademecum: the
+    /// same file the whole build writes. Makes the organ's model again from the arguments the
+    /// parts keep (their mesh files must be where they were), refuses parts of another build
+    /// or a missing shard, and adds the cut section, distance field and Newton baseline the
+    /// build asked for.
+    Merge {
+        /// Every part of the build, in any order.
+        #[arg(required = true, value_name = "PART.vdp")]
+        parts: Vec<PathBuf>,
+        /// Where to write the vademecum (default: where the whole build would).
+        #[arg(long, value_name = "FILE.vdm")]
+        out: Option<PathBuf>,
+        /// Also precompute the organ's distance field (FILE.vdf), as `pgd build` does.
+        #[arg(long)]
+        distance_field: bool,
         /// Print the build report as JSON.
         #[arg(long)]
         json: bool,
@@ -749,4 +774,24 @@ impl ContactBenchArgs {
 /// law, `<source>-<law>.vdm` for the others ([`vademecum_file_name`]).
 pub fn default_vademecum(mesh: &MeshArgs, law: Law) -> PathBuf {
     PathBuf::from("vademecums").join(vademecum_file_name(&mesh.stem(), law))
+}
+
+/// The `pgd build` arguments `args` (from the subcommand on) without those that differ
+/// between the shards of one build (`--shard`, `--out`) or do not change what is built
+/// (`--json`): what a part keeps for `pgd merge`.
+pub fn shard_command(args: impl Iterator<Item = String>) -> Vec<String> {
+    let mut kept = Vec::new();
+    let mut skip_value = false;
+    for arg in args {
+        if std::mem::take(&mut skip_value) {
+            continue;
+        }
+        match arg.as_str() {
+            "--shard" | "--out" => skip_value = true,
+            "--json" => {}
+            _ if arg.starts_with("--shard=") || arg.starts_with("--out=") => {}
+            _ => kept.push(arg),
+        }
+    }
+    kept
 }

@@ -74,20 +74,26 @@ fn main() -> ExitCode {
             build,
             out,
             distance_field,
+            shard,
             json,
         } => {
             let out = out.unwrap_or_else(|| args::default_vademecum(&mesh, material.law.law()));
+            if let Some(shard) = shard {
+                let command = args::shard_command(std::env::args().skip(1));
+                let part = job(&mesh, &material, &build)
+                    .and_then(|job| cli::build_part(job, shard, command, &out));
+                return print_report("pgd build --shard", part, json);
+            }
             let built = job(&mesh, &material, &build)
                 .and_then(|job| cli::build_vademecum(job, &out, distance_field));
-            match built {
-                Ok(report) if json => print_json(&report),
-                Ok(report) => {
-                    cli::print_build_report(&report, &out);
-                    ExitCode::SUCCESS
-                }
-                Err(e) => fail("pgd build", &e),
-            }
+            print_build("pgd build", built, &out, json)
         }
+        Command::Merge {
+            parts,
+            out,
+            distance_field,
+            json,
+        } => merge_command(&parts, out, distance_field, json),
         Command::Validate(options) => validate_command(options),
         Command::Cut {
             organ,
@@ -139,6 +145,66 @@ fn main() -> ExitCode {
         } => fit_command(&data, poisson, plot, json),
         Command::Bench { what } => bench_command(what),
     }
+}
+
+/// A build's report as JSON or as its table, or its error.
+fn print_build(
+    command: &str,
+    built: Result<pgd_surgery::pgd::BuildReport, String>,
+    out: &Path,
+    json: bool,
+) -> ExitCode {
+    match built {
+        Ok(report) if json => print_json(&report),
+        Ok(report) => {
+            cli::print_build_report(&report, out);
+            ExitCode::SUCCESS
+        }
+        Err(e) => fail(command, &e),
+    }
+}
+
+/// `pgd merge`: the parts read, the model made again from the build arguments they keep, and
+/// the vademecum joined from them.
+fn merge_command(
+    parts: &[std::path::PathBuf],
+    out: Option<std::path::PathBuf>,
+    distance_field: bool,
+    json: bool,
+) -> ExitCode {
+    let loaded = match parts
+        .iter()
+        .map(|p| pgd_surgery::pgd::load_part(p))
+        .collect()
+    {
+        Ok(loaded) => loaded,
+        Err(e) => return fail("pgd merge", &e.to_string()),
+    };
+    let loaded: Vec<pgd_surgery::pgd::PartFile> = loaded;
+    let command = &loaded[0].part.header.command;
+    let arguments = std::iter::once("pgd").chain(command.iter().map(String::as_str));
+    let Ok(Cli {
+        command:
+            Command::Build {
+                mesh,
+                material,
+                build,
+                ..
+            },
+    }) = Cli::try_parse_from(arguments)
+    else {
+        let message = format!(
+            "{}: its build arguments ({}) are not a `pgd build` command this version reads; \
+             build the parts again",
+            parts[0].display(),
+            command.join(" ")
+        );
+        return fail("pgd merge", &message);
+    };
+    let out = out.unwrap_or_else(|| args::default_vademecum(&mesh, material.law.law()));
+    let merged = job(&mesh, &material, &build)
+        .and_then(|job| cli::merge_vademecum(job, loaded, &out, distance_field));
+    print_build("pgd merge", merged, &out, json)
 }
 
 /// `pgd validate`: a vademecum against full FEM, or its cut section against full X-FEM.

@@ -20,7 +20,7 @@ use faer::matrix_free::conjugate_gradient::{
 use faer::matrix_free::{InitialGuessStatus, LinOp, Precond};
 use faer::sparse::SparseColMat;
 use faer::{MatMut, MatRef, Par};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::FemError;
 use super::linear_solver::{DirectSolver, Factorization};
@@ -57,7 +57,7 @@ pub struct Preconditioned<'a> {
 }
 
 /// What the preconditioned solves cost.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct KrylovStatistics {
     /// Newton directions found by conjugate gradients.
     pub directions: usize,

@@ -10,6 +10,7 @@
 //! previous iterate on the right-hand side), starting from the step before; the step keeps
 //! their correction to the linear response.
 
+use std::ops::Range;
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -23,7 +24,9 @@ use super::local::{
     AlongDirections, LocalPart, ParameterResponses, distance_neighbours, near_nodes,
 };
 use super::region::{CutHeader, RegionReport, RegionResponse, RegionSettings};
-use super::responses::{Responses, ScaledLoads, SecantReport, SecantSettings, StepStart, Trend};
+use super::responses::{
+    Offset, Responses, ScaledLoads, SecantReport, SecantSettings, StepStart, Trend,
+};
 use super::separated::SeparatedField;
 use super::settings::BuildSettings;
 use super::snapshot_modes::SnapshotModes;
@@ -151,13 +154,30 @@ fn accessible(
     })
 }
 
-/// Builds the linear vademecum of `organ`.
+/// Builds the vademecum of `organ`: every position's responses, separated step by step.
 pub fn build(
     organ: &OrganModel,
     settings: &BuildSettings,
     progress: &dyn Progress,
 ) -> Result<(Vademecum, BuildReport), FemError> {
     let started = Instant::now();
+    with_context(organ, settings, progress, |context| {
+        let mut separating = Separating::new(context);
+        let all = 0..context.patches.positions.len();
+        let ranges = position_work(context, all, &mut separating)?;
+        Ok(separating.finish(organ, ranges, started))
+    })
+}
+
+/// Runs `then` with the context every build of `organ` works in: its load positions, their
+/// patches and neighbours, the tool's patch loads (nonlinear laws) and the rest stiffness
+/// factorized.
+pub(super) fn with_context<R, E: From<FemError>>(
+    organ: &OrganModel,
+    settings: &BuildSettings,
+    progress: &dyn Progress,
+    then: impl FnOnce(&StepContext) -> Result<R, E>,
+) -> Result<R, E> {
     let model = organ.model;
     let mesh = model.mesh();
     let surface = Surface::extract(mesh);
@@ -181,58 +201,24 @@ pub fn build(
     let areas: Vec<f32> = patches.weights.iter().map(|&a| a as f32).collect();
     progress.message("factorizing the stiffness");
     let stiffness = RestStiffness::new(model)?;
-    let context = StepContext {
-        geometry: PatchGeometry {
-            coords_m: &coords,
-            areas_m2: &areas,
-            normals: &normals,
-            radius_m,
-        },
+    let geometry = PatchGeometry {
+        coords_m: &coords,
+        areas_m2: &areas,
+        normals: &normals,
+        radius_m,
+    };
+    let tool = (model.material().law != Law::Linear)
+        .then(|| ToolPatchLoads::new(patches.positions.clone(), &geometry, &neighbours));
+    then(&StepContext {
+        geometry,
+        triangles: &triangles,
         stiffness: &stiffness,
         patches: &patches,
         neighbours: &neighbours,
+        tool: tool.as_ref(),
         settings,
         progress,
-    };
-    let LoadSteps {
-        steps,
-        reports,
-        failed: failed_step,
-        reference,
-        range_level_m,
-        loaded,
-    } = load_steps(&context)?;
-    let near_field_share = steps[0].local.correction_nodes.len() as f64
-        / (patches.positions.len() * mesh.node_count()) as f64;
-    if near_field_share > WIDE_NEAR_FIELD_SHARE {
-        progress.message(&wide_near_field(settings, near_field_share));
-    }
-    let vademecum = Vademecum {
-        header: header(organ, settings, &reports, started),
-        positions: patches.positions.iter().map(|&n| n as u32).collect(),
-        position_coords_m: coords,
-        position_areas_m2: areas,
-        position_normals: normals,
-        triangles,
-        reference_compliance_m_per_n: reference,
-        range_level_m,
-        steps,
-        cuts: None,
-    };
-    let report = BuildReport {
-        positions: patches.positions.len(),
-        parameters: patches.parameter_count(),
-        free_dofs: stiffness.free_count(),
-        steps: reports,
-        failed_step,
-        positions_loaded: loaded,
-        near_field_share,
-        cuts: None,
-        newton_baseline: None,
-        total_seconds: started.elapsed().as_secs_f64(),
-        file_bytes: 0,
-    };
-    Ok((vademecum, report))
+    })
 }
 
 /// The warning for a near field holding `share` of the organ's nodes for an average load.
@@ -275,81 +261,107 @@ fn header(
 }
 
 /// What every load step is built with.
-struct StepContext<'a> {
+pub(super) struct StepContext<'a> {
     /// The load positions, for the tool's patch centred on each.
     geometry: PatchGeometry<'a>,
+    /// The accessible faces, in position numbering.
+    triangles: &'a [[u32; 3]],
     stiffness: &'a RestStiffness<'a>,
-    patches: &'a LoadPatches,
+    pub(super) patches: &'a LoadPatches,
     neighbours: &'a [Vec<u32>],
-    settings: &'a BuildSettings,
-    progress: &'a dyn Progress,
+    /// Nonlinear laws: the tool's patch centred on each position, what their steps load.
+    tool: Option<&'a ToolPatchLoads>,
+    pub(super) settings: &'a BuildSettings,
+    pub(super) progress: &'a dyn Progress,
 }
 
-/// The steps built, their reports, the report of a step left out, and per position the
-/// reference compliance that turns a force into the level picking load steps and the level
-/// its range reaches, and how many positions the nonlinear steps load.
-struct LoadSteps {
-    steps: Vec<Step>,
-    reports: Vec<StepReport>,
-    failed: Option<StepReport>,
-    reference: Vec<f32>,
-    range_level_m: Vec<f32>,
-    loaded: usize,
+impl StepContext<'_> {
+    /// The rows of every response: the free dofs.
+    pub(super) fn rows(&self) -> usize {
+        self.stiffness.free_count()
+    }
 }
 
-/// The linear step, then (nonlinear laws) one step per indentation level until the last or
-/// the first one [`kept`] refuses. A nonlinear step loads the tool's patch centred on each
-/// position, pushing along its inward normal, sized so that its linear response is the level
-/// deep, and keeps the nonlinear correction to the linear response of that patch: the trainer
-/// adds it to the exact linear response of the patch where the tool is. A position whose load
-/// fails past the first step is not loaded deeper: its range ends at the step before.
-fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
+/// Where the per-position work of the load steps goes, step by step: separated into the
+/// vademecum's steps at once (a whole build), or kept for a merge (a shard).
+pub(super) trait StepSink {
+    /// The exact responses to the unit loads of the positions worked on (step 0), which took
+    /// `seconds`.
+    fn linear(&mut self, exact: Responses, seconds: f64) -> Result<(), FemError>;
+
+    /// A nonlinear step's outcome; returns whether the steps go on.
+    fn nonlinear(&mut self, step: NonlinearStep) -> Result<bool, FemError>;
+}
+
+/// What a nonlinear load step's per-position work gives.
+pub(super) struct NonlinearStep<'a> {
+    pub level_m: f64,
+    /// The corrections `Ũ − U_lin` its secant responses make to the linear ones, one column
+    /// per position worked on.
+    pub corrections: &'a Responses,
+    /// The positions it reaches (organ numbering, sorted).
+    pub reached: Vec<usize>,
+    /// The positions (all but those a clamp holds) the nonlinear steps load.
+    pub loaded: usize,
+    pub fixed_point: SecantReport,
+    /// The time its fixed points took.
+    pub seconds: f64,
+}
+
+/// Per position worked on: the reference compliance that turns a force into the level
+/// picking load steps (nonlinear laws) and the level its range reaches.
+#[derive(Default)]
+pub(super) struct PositionRanges {
+    pub reference: Vec<f32>,
+    pub range_level_m: Vec<f32>,
+}
+
+/// The per-position work over the positions `range`: the exact responses to their unit loads,
+/// then (nonlinear laws) one step per indentation level while `sink` wants more. A nonlinear
+/// step loads the tool's patch centred on each position, pushing along its inward normal,
+/// sized so that its linear response is the level deep, and hands on the nonlinear correction
+/// to the linear response of that patch: the trainer adds it to the exact linear response of
+/// the patch where the tool is. A position whose load fails past the first step is not
+/// loaded deeper: its range ends at the step before. Every column is computed in the same
+/// blocks whatever the range, as long as it starts on a block ([`super::Shard`]).
+pub(super) fn position_work(
+    context: &StepContext,
+    range: Range<usize>,
+    sink: &mut dyn StepSink,
+) -> Result<PositionRanges, FemError> {
     let (stiffness, patches, progress) = (context.stiffness, context.patches, context.progress);
     let clock = Instant::now();
-    progress.start("exact responses", patches.parameter_count() as u64);
-    let exact = Responses::linear(stiffness, patches, &|n| progress.advance(n as u64));
-    let gram = exact.gram(stiffness, patches);
-    let (step, report) = separated_step(
-        context,
-        &exact,
-        Separation::Enrichment(patches),
-        gram,
-        clock,
-    )?;
-    if stiffness.model.material().law == Law::Linear {
-        let reference = self_compliances(&step.local);
-        return Ok(LoadSteps {
-            steps: vec![step],
-            reports: vec![report],
-            failed: None,
-            range_level_m: vec![0.0; reference.len()],
-            reference,
-            loaded: 0,
-        });
-    }
-    let tool = ToolPatchLoads::new(
-        patches.positions.clone(),
-        &context.geometry,
-        context.neighbours,
-    );
-    let linear = exact.combined(&tool.shares, &tool.inward);
-    drop(exact);
+    let count = range.len();
+    progress.start("exact responses", 3 * count as u64);
+    let unit = Offset {
+        loads: patches,
+        first: 3 * range.start,
+    };
+    let exact = Responses::solve(stiffness, &unit, 3 * count, &|n| progress.advance(n as u64));
+    sink.linear(exact, clock.elapsed().as_secs_f64())?;
+    let Some(tool) = context.tool else {
+        return Ok(PositionRanges::default());
+    };
+    let clock = Instant::now();
+    let tool = Offset {
+        loads: tool,
+        first: range.start,
+    };
+    progress.start("linear responses to the tool's patch", count as u64);
+    let linear = Responses::solve(stiffness, &tool, count, &|n| progress.advance(n as u64));
     let reference = patch_depths(stiffness, &tool, &linear);
-    let (mut steps, mut reports) = (vec![step], vec![report]);
     let mut secant = linear.clone();
     // The step before the last, and its level: with the last they give the next start's trend.
     let mut before: Option<(Responses, f64)> = None;
     let mut last_level_m = 0.0;
-    let mut range_level_m = vec![0.0f32; reference.len()];
+    let mut range_level_m = vec![0.0f32; count];
     let loaded = reference.iter().filter(|&&per_n| per_n > 0.0).count();
+    let mut seconds_before = clock.elapsed().as_secs_f64();
     for &level_m in &context.settings.load_steps_m {
         let clock = Instant::now();
         let magnitudes = step_magnitudes(&reference, &range_level_m, last_level_m, level_m);
         let law = stiffness.model.material().law.name();
-        progress.start(
-            &format!("{law} step {:.1} mm", level_m * 1e3),
-            tool.positions.len() as u64,
-        );
+        progress.start(&format!("{law} step {:.1} mm", level_m * 1e3), count as u64);
         let trend = before.take().map(|(responses, from_m)| {
             Trend::new(&responses, &secant, from_m, last_level_m, level_m)
         });
@@ -371,51 +383,163 @@ fn load_steps(context: &StepContext) -> Result<LoadSteps, FemError> {
             &|n| progress.advance(n as u64),
         );
         drop(trend); // a full copy of the responses: freed before the step's PGD
-        progress.message(&fixed_point_words(law, level_m, &fixed_point, clock));
         let secant_settings = &context.settings.secant;
         let reached = reached_positions(&magnitudes, &unconverged, &fixed_point, secant_settings);
-        if !kept(reached.len(), loaded, secant_settings) {
-            progress.message(&format!(
+        secant.add_scaled(&linear, -1.0);
+        let go_on = sink.nonlinear(NonlinearStep {
+            level_m,
+            corrections: &secant,
+            reached: reached.iter().map(|m| range.start + m).collect(),
+            loaded,
+            fixed_point,
+            seconds: seconds_before + clock.elapsed().as_secs_f64(),
+        })?;
+        secant.add_scaled(&linear, 1.0);
+        seconds_before = 0.0;
+        if !go_on {
+            break;
+        }
+        reached
+            .iter()
+            .for_each(|&m| range_level_m[m] = level_m as f32);
+    }
+    Ok(PositionRanges {
+        reference,
+        range_level_m,
+    })
+}
+
+/// The sink of a whole build: each step separated into the vademecum's as it comes.
+pub(super) struct Separating<'a> {
+    context: &'a StepContext<'a>,
+    steps: Vec<Step>,
+    reports: Vec<StepReport>,
+    /// A nonlinear step left out: the steps stop before it.
+    failed: Option<StepReport>,
+    /// The positions the nonlinear steps load.
+    loaded: usize,
+}
+
+impl<'a> Separating<'a> {
+    pub(super) fn new(context: &'a StepContext<'a>) -> Self {
+        Self {
+            context,
+            steps: Vec::new(),
+            reports: Vec::new(),
+            failed: None,
+            loaded: 0,
+        }
+    }
+
+    /// The vademecum of the steps separated, with every position's `ranges`.
+    pub(super) fn finish(
+        self,
+        organ: &OrganModel,
+        ranges: PositionRanges,
+        started: Instant,
+    ) -> (Vademecum, BuildReport) {
+        let context = self.context;
+        let (patches, settings) = (context.patches, context.settings);
+        let node_count = organ.model.mesh().node_count();
+        let near_field_share = self.steps[0].local.correction_nodes.len() as f64
+            / (patches.positions.len() * node_count) as f64;
+        if near_field_share > WIDE_NEAR_FIELD_SHARE {
+            context
+                .progress
+                .message(&wide_near_field(settings, near_field_share));
+        }
+        let PositionRanges {
+            reference,
+            range_level_m,
+        } = match context.tool {
+            Some(_) => ranges,
+            None => {
+                let reference = self_compliances(&self.steps[0].local);
+                PositionRanges {
+                    range_level_m: vec![0.0; reference.len()],
+                    reference,
+                }
+            }
+        };
+        let geometry = &context.geometry;
+        let vademecum = Vademecum {
+            header: header(organ, settings, &self.reports, started),
+            positions: patches.positions.iter().map(|&n| n as u32).collect(),
+            position_coords_m: geometry.coords_m.to_vec(),
+            position_areas_m2: geometry.areas_m2.to_vec(),
+            position_normals: geometry.normals.to_vec(),
+            triangles: context.triangles.to_vec(),
+            reference_compliance_m_per_n: reference,
+            range_level_m,
+            steps: self.steps,
+            cuts: None,
+        };
+        let report = BuildReport {
+            positions: patches.positions.len(),
+            parameters: patches.parameter_count(),
+            free_dofs: context.rows(),
+            steps: self.reports,
+            failed_step: self.failed,
+            positions_loaded: self.loaded,
+            near_field_share,
+            cuts: None,
+            newton_baseline: None,
+            total_seconds: started.elapsed().as_secs_f64(),
+            file_bytes: 0,
+        };
+        (vademecum, report)
+    }
+}
+
+impl StepSink for Separating<'_> {
+    fn linear(&mut self, exact: Responses, seconds: f64) -> Result<(), FemError> {
+        let (stiffness, patches) = (self.context.stiffness, self.context.patches);
+        let clock = Instant::now();
+        let gram = exact.gram(stiffness, patches);
+        let brute_force_seconds = seconds + clock.elapsed().as_secs_f64();
+        let separation = Separation::Enrichment(patches);
+        let (step, report) =
+            separated_step(self.context, &exact, separation, gram, brute_force_seconds)?;
+        self.steps.push(step);
+        self.reports.push(report);
+        Ok(())
+    }
+
+    /// Separates the step unless it reaches too few positions ([`kept`]): then it is
+    /// reported as left out, and the steps stop.
+    fn nonlinear(&mut self, step: NonlinearStep) -> Result<bool, FemError> {
+        let context = self.context;
+        let law = context.stiffness.model.material().law.name();
+        let (level_m, fixed_point) = (step.level_m, step.fixed_point);
+        context
+            .progress
+            .message(&fixed_point_words(law, level_m, &fixed_point, step.seconds));
+        self.loaded = step.loaded;
+        if !kept(step.reached.len(), step.loaded, &context.settings.secant) {
+            context.progress.message(&format!(
                 "{law} step {:.1} mm: the fixed point did not converge for {} of {} loads; \
                  the vademecum stops at the step before",
                 level_m * 1e3,
                 fixed_point.unconverged,
                 fixed_point.responses
             ));
-            let failed = StepReport {
+            self.failed = Some(StepReport {
                 indentation_m: level_m,
-                brute_force_seconds: clock.elapsed().as_secs_f64(),
+                brute_force_seconds: step.seconds,
                 fixed_point: Some(fixed_point),
-                positions_reached: reached.len(),
+                positions_reached: step.reached.len(),
                 ..StepReport::default()
-            };
-            return Ok(LoadSteps {
-                steps,
-                reports,
-                failed: Some(failed),
-                reference,
-                range_level_m,
-                loaded,
             });
+            return Ok(false);
         }
-        reached
-            .iter()
-            .for_each(|&m| range_level_m[m] = level_m as f32);
-        let (step, mut report) = correction_step(context, &tool, &mut secant, &linear, clock)?;
+        let (separated, mut report) = correction_step(context, step.corrections, step.seconds)?;
         report.indentation_m = level_m;
         report.fixed_point = Some(fixed_point);
-        report.positions_reached = reached.len();
-        steps.push(step);
-        reports.push(report);
+        report.positions_reached = step.reached.len();
+        self.steps.push(separated);
+        self.reports.push(report);
+        Ok(true)
     }
-    Ok(LoadSteps {
-        steps,
-        reports,
-        failed: None,
-        reference,
-        range_level_m,
-        loaded,
-    })
 }
 
 /// Each patch's push at the step to `level_m`, sized so that its linear displacement
@@ -440,12 +564,7 @@ fn step_magnitudes(
 }
 
 /// What a step's fixed point did, in words for the build's progress.
-fn fixed_point_words(
-    law: &str,
-    level_m: f64,
-    fixed_point: &SecantReport,
-    clock: Instant,
-) -> String {
+fn fixed_point_words(law: &str, level_m: f64, fixed_point: &SecantReport, seconds: f64) -> String {
     format!(
         "{law} step {:.1} mm: {} loads, {:.1} fixed-point iterations each on average, \
          {} through substeps, {} by Newton, {} left ({:.0} s)",
@@ -455,33 +574,33 @@ fn fixed_point_words(
         fixed_point.substep_solved,
         fixed_point.newton_solved,
         fixed_point.unconverged,
-        clock.elapsed().as_secs_f64()
+        seconds
     )
 }
 
-/// The step of a nonlinear level: the PGD of the corrections `Ũ − U_lin` the secant
-/// responses make to the linear ones (`secant` holds `Ũ`, and holds it again after).
+/// The step of a nonlinear level: the PGD of the `corrections` `Ũ − U_lin` its secant
+/// responses make to the linear ones, whose fixed points took `seconds`.
 fn correction_step(
     context: &StepContext,
-    tool: &ToolPatchLoads,
-    secant: &mut Responses,
-    linear: &Responses,
-    clock: Instant,
+    corrections: &Responses,
+    seconds: f64,
 ) -> Result<(Step, StepReport), FemError> {
+    let clock = Instant::now();
     let stiffness = context.stiffness;
-    secant.add_scaled(linear, -1.0);
-    let gram = secant.energy_gram(stiffness);
+    let gram = corrections.energy_gram(stiffness);
     context.progress.message("modes of the corrections");
     let max_modes = context.settings.pgd.max_modes;
     let weights = &context.patches.weights;
-    let best = SnapshotModes::new(stiffness, secant, &gram, weights, max_modes);
+    let best = SnapshotModes::new(stiffness, corrections, &gram, weights, max_modes);
+    let tool = context
+        .tool
+        .expect("a nonlinear step has the tool's patch loads");
     let separation = Separation::Snapshots {
         directions: &tool.inward,
         best,
     };
-    let built = separated_step(context, secant, separation, gram, clock);
-    secant.add_scaled(linear, 1.0);
-    built
+    let brute_force_seconds = seconds + clock.elapsed().as_secs_f64();
+    separated_step(context, corrections, separation, gram, brute_force_seconds)
 }
 
 /// The positions a step reaches: those pushed at it whose load converged, or all those
@@ -511,9 +630,9 @@ fn kept(reached: usize, loaded: usize, settings: &SecantSettings) -> bool {
 /// Per position, how deep (m) a unit force along its inward normal presses the patch centred
 /// on it, linearly (the patch's mean displacement, from the `linear` responses of `tool`'s
 /// loads): what turns a force into the level that picks a step.
-fn patch_depths(stiffness: &RestStiffness, tool: &ToolPatchLoads, linear: &Responses) -> Vec<f32> {
+fn patch_depths(stiffness: &RestStiffness, tool: &impl UnitLoads, linear: &Responses) -> Vec<f32> {
     let free_index = &stiffness.model.dofs().free_index;
-    (0..tool.positions.len())
+    (0..linear.count())
         .map(|m| {
             let column = linear.column(m);
             let depth = Vector3::from_fn(|c, _| {
@@ -560,13 +679,13 @@ impl Separation<'_> {
 }
 
 /// One load step from its exact responses: baseline, global part, local part. `gram` is the
-/// responses' energy Gram, `clock` started when its exact responses did.
+/// responses' energy Gram; they and it took `brute_force_seconds`.
 fn separated_step(
     context: &StepContext,
     exact: &Responses,
     separation: Separation,
     gram: Vec<f64>,
-    clock: Instant,
+    brute_force_seconds: f64,
 ) -> Result<(Step, StepReport), FemError> {
     let StepContext {
         stiffness,
@@ -585,7 +704,6 @@ fn separated_step(
         }
         Separation::Snapshots { best, .. } => (patches.weights.clone(), best.optimal.clone()),
     };
-    let brute_force_seconds = clock.elapsed().as_secs_f64();
 
     let clock = Instant::now();
     progress.message("local compliances");

@@ -181,6 +181,15 @@ pub fn put<T: Word>(out: &mut Vec<u8>, values: &[T]) {
     }
 }
 
+/// Appends `values` as eight-byte little-endian values, each two of the payload's words,
+/// prefixed by the words' count: exact responses kept to the last bit for a later merge.
+pub fn put_f64(out: &mut Vec<u8>, values: &[f64]) {
+    out.extend_from_slice(&(2 * values.len() as u64).to_le_bytes());
+    for &v in values {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+}
+
 /// Reads a payload back, array by array, naming the file and the array in errors.
 pub struct Reader<'a> {
     file: &'a Path,
@@ -201,6 +210,27 @@ impl<'a> Reader<'a> {
 
     /// The next array, `what` naming it in errors.
     pub fn take<T: Word>(&mut self, what: &str) -> Result<Vec<T>, VademecumError> {
+        Ok(self
+            .take_bytes(what)?
+            .chunks_exact(4)
+            .map(|c| T::from_bytes(c.try_into().expect("4 bytes")))
+            .collect())
+    }
+
+    /// The next array written by [`put_f64`].
+    pub fn take_f64(&mut self, what: &str) -> Result<Vec<f64>, VademecumError> {
+        let data = self.take_bytes(what)?;
+        if data.len() % 8 != 0 {
+            return Err(self.malformed(what));
+        }
+        Ok(data
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
+            .collect())
+    }
+
+    /// The bytes of the next array's words.
+    fn take_bytes(&mut self, what: &str) -> Result<&'a [u8], VademecumError> {
         if self.bytes.len() < 8 {
             return Err(self.malformed(what));
         }
@@ -212,10 +242,7 @@ impl<'a> Reader<'a> {
             .ok_or_else(|| self.malformed(what))? as usize;
         let (data, rest) = rest.split_at(size);
         self.bytes = rest;
-        Ok(data
-            .chunks_exact(4)
-            .map(|c| T::from_bytes(c.try_into().expect("4 bytes")))
-            .collect())
+        Ok(data)
     }
 
     /// Refuses bytes left after the last array.

@@ -18,6 +18,7 @@ mod region;
 mod responses;
 mod separated;
 mod settings;
+mod shard;
 mod snapshot_modes;
 mod statistics;
 mod stiffness;
@@ -43,6 +44,10 @@ pub use responses::{Responses, ScaledLoads, SecantReport, SecantSettings, StepSt
 pub use separated::SeparatedField;
 pub use settings::{
     BuildSettings, DEFAULT_LOAD_STEPS_M, NEO_HOOKEAN_STEPS_TOOL_RADII, default_load_steps_m,
+};
+pub use shard::{
+    MergeError, PartFile, PartHeader, Shard, ShardPart, ShardStep, build_shard, load_part, merge,
+    save_part,
 };
 pub use statistics::Statistics;
 pub use stiffness::RestStiffness;

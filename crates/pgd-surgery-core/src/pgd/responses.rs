@@ -15,7 +15,7 @@ use crate::fem::{KrylovStatistics, NewtonSettings};
 use web_time::Instant;
 
 /// Columns solved together: one pass over the factor serves them all.
-const BLOCK_COLUMNS: usize = 48;
+pub(super) const BLOCK_COLUMNS: usize = 48;
 
 /// Smaller increments a load that diverged over its step's whole increment is taken through:
 /// eight reach further than four at about the same cost (docs/pgd.md).
@@ -57,6 +57,23 @@ impl<L: UnitLoads> UnitLoads for Subset<'_, L> {
 
     fn direction(&self, j: usize) -> Vector3<f64> {
         self.loads.direction(self.parameters[j])
+    }
+}
+
+/// Unit loads renumbered from `first`: load `j` here is load `first + j` of `loads`, so that
+/// a shard's responses, numbered from zero, load its own positions.
+pub struct Offset<'a, L> {
+    pub loads: &'a L,
+    pub first: usize,
+}
+
+impl<L: UnitLoads> UnitLoads for Offset<'_, L> {
+    fn nodal_shares(&self, j: usize) -> impl Iterator<Item = (usize, f64)> {
+        self.loads.nodal_shares(self.first + j)
+    }
+
+    fn direction(&self, j: usize) -> Vector3<f64> {
+        self.loads.direction(self.first + j)
     }
 }
 
@@ -117,14 +134,25 @@ impl Responses {
         patches: &LoadPatches,
         progress: &(dyn Fn(usize) + Sync),
     ) -> Self {
+        Self::solve(stiffness, patches, patches.parameter_count(), progress)
+    }
+
+    /// Solves `K u_p = f_p` for the first `count` unit loads of `loads`, blocks of
+    /// [`BLOCK_COLUMNS`] in parallel; `progress` gets the number of columns done.
+    pub fn solve(
+        stiffness: &RestStiffness,
+        loads: &impl UnitLoads,
+        count: usize,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> Self {
         let rows = stiffness.free_count();
-        let mut columns = vec![0.0; rows * patches.parameter_count()];
+        let mut columns = vec![0.0; rows * count];
         columns
             .par_chunks_mut(rows * BLOCK_COLUMNS)
             .enumerate()
             .for_each(|(block, chunk)| {
                 for (j, column) in chunk.chunks_exact_mut(rows).enumerate() {
-                    add_unit_load(stiffness, patches, block * BLOCK_COLUMNS + j, column);
+                    add_unit_load(stiffness, loads, block * BLOCK_COLUMNS + j, column);
                 }
                 stiffness.solve_block(chunk);
                 progress(chunk.len() / rows);
@@ -132,27 +160,13 @@ impl Responses {
         Self { rows, columns }
     }
 
-    /// The responses to combinations of these responses' loads, one per entry of `shares`
-    /// and `directions`: column `m` is `Σ_j β_j Σ_d w_d u_{3j+d}` over the shares `(j, β_j)`
-    /// of `shares[m]` and the components `w_d` of `directions[m]`. By linearity, the linear
-    /// responses to the tool's patch centred on each position, pushed along its direction.
-    pub fn combined(&self, shares: &[Vec<(usize, f64)>], directions: &[Vector3<f64>]) -> Self {
-        let rows = self.rows;
-        let mut columns = vec![0.0; rows * shares.len()];
-        columns
-            .par_chunks_mut(rows)
-            .enumerate()
-            .for_each(|(m, column)| {
-                for &(j, share) in &shares[m] {
-                    for (d, w) in directions[m].iter().enumerate() {
-                        let source = self.column(3 * j + d);
-                        column
-                            .iter_mut()
-                            .zip(source)
-                            .for_each(|(c, u)| *c += share * w * u);
-                    }
-                }
-            });
+    /// Responses of `rows` rows side by side, in the order given: a whole step's columns from
+    /// its shards'.
+    pub fn joined<'a>(rows: usize, parts: impl Iterator<Item = &'a Responses>) -> Self {
+        let mut columns = Vec::new();
+        for part in parts {
+            columns.extend_from_slice(&part.columns);
+        }
         Self { rows, columns }
     }
 
@@ -510,7 +524,7 @@ fn every_position() -> f64 {
 }
 
 /// How the fixed points of one load step went.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SecantReport {
     pub responses: usize,
     pub total_iterations: usize,
@@ -535,7 +549,7 @@ pub struct SecantReport {
 }
 
 impl SecantReport {
-    fn merge(self, other: Self) -> Self {
+    pub fn merge(self, other: Self) -> Self {
         Self {
             responses: self.responses + other.responses,
             total_iterations: self.total_iterations + other.total_iterations,

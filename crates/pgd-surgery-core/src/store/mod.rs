@@ -15,5 +15,6 @@ pub use background::{BackgroundStatus, Building, background_status, build_in_bac
 pub use progress::Bar;
 pub use source::{MeshSource, OrganSource, load_source};
 pub use vademecums::{
-    BuildJob, OnStale, VademecumSpec, build_and_save, ensure_vademecum, vademecum_file_name,
+    BuildJob, OnStale, VademecumSpec, build_and_save, build_part, ensure_vademecum, merge_and_save,
+    vademecum_file_name,
 };

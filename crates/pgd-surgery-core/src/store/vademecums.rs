@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::fem::{Inclusion, Law, Material};
+use crate::fem::{FemModel, Inclusion, Law, Material};
 use crate::mesh::TetMesh;
 use crate::mesh::io::ImportOptions;
 use crate::mesh::organs::{Organ, OrganSettings, region};
@@ -244,18 +244,74 @@ fn build_and_save_with(
     file: &Path,
     progress: &dyn Progress,
 ) -> Result<(Vademecum, BuildReport, [PathBuf; 2]), String> {
+    finish_and_save(job, file, progress, |organ, settings| {
+        pgd::build(organ, settings, progress).map_err(|e| e.to_string())
+    })
+}
+
+/// Joins the `parts` of `job`'s build (`pgd build --shard`) into its vademecum and saves it as
+/// [`build_and_save`] does.
+pub fn merge_and_save(
+    job: BuildJob,
+    parts: Vec<pgd::PartFile>,
+    file: &Path,
+) -> Result<(Vademecum, BuildReport, [PathBuf; 2]), String> {
+    let progress = Bar::default();
+    finish_and_save(job, file, &progress, |organ, settings| {
+        pgd::merge(organ, settings, parts, &progress).map_err(|e| e.to_string())
+    })
+}
+
+/// Computes shard `shard` of `job`'s build and saves it at `file`; `command` is what makes
+/// the model again for the merge.
+pub fn build_part(
+    job: BuildJob,
+    shard: pgd::Shard,
+    command: Vec<String>,
+    file: &Path,
+) -> Result<pgd::PartHeader, String> {
     let source = job.source;
-    let model = pgd::organ::clamped_model(job.mesh, job.material)
+    let model = model_of(&job)?;
+    let part = pgd::build_shard(
+        &organ_model(source, &model),
+        &job.settings,
+        shard,
+        command,
+        &Bar::default(),
+    )
+    .map_err(|e| format!("{source}: {e}"))?;
+    pgd::save_part(file, &part).map_err(|e| e.to_string())?;
+    Ok(part.header)
+}
+
+/// The clamped model of `job`'s mesh, material and stiffer regions.
+fn model_of(job: &BuildJob) -> Result<FemModel, String> {
+    pgd::organ::clamped_model(job.mesh.clone(), job.material)
         .and_then(|model| model.with_inclusions(job.inclusions))
-        .map_err(|e| format!("{source}: {e}"))?;
-    let organ_model = OrganModel {
+        .map_err(|e| format!("{}: {e}", job.source))
+}
+
+fn organ_model<'a>(source: &str, model: &'a FemModel) -> OrganModel<'a> {
+    OrganModel {
         source: source.to_owned(),
-        model: &model,
+        model,
         clamped_region: region::CLAMPED.into(),
         accessible_region: region::ACCESSIBLE.into(),
-    };
+    }
+}
+
+/// Makes `job`'s vademecum with `make`, adds its cut section and Newton baseline if asked,
+/// and saves it at `file` with its convergence curves beside it.
+fn finish_and_save(
+    job: BuildJob,
+    file: &Path,
+    progress: &dyn Progress,
+    make: impl FnOnce(&OrganModel, &BuildSettings) -> Result<(Vademecum, BuildReport), String>,
+) -> Result<(Vademecum, BuildReport, [PathBuf; 2]), String> {
+    let source = job.source;
+    let model = model_of(&job)?;
     let (mut vademecum, mut built) =
-        pgd::build(&organ_model, &job.settings, progress).map_err(|e| format!("{source}: {e}"))?;
+        make(&organ_model(source, &model), &job.settings).map_err(|e| format!("{source}: {e}"))?;
     if let Some(cuts) = &job.cuts {
         let report = pgd::add_cuts(&mut vademecum, &model, cuts, progress)
             .map_err(|e| format!("{source}: cut section: {e}"))?;

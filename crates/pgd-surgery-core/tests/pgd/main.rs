@@ -7,4 +7,5 @@ mod file_format;
 mod inclusion;
 mod nonlinear;
 mod outputs;
+mod shards;
 mod surface;
