@@ -12,7 +12,7 @@ use pgd_surgery::devices::PressMotion;
 use pgd_surgery::fem::{Inclusion, Law, Material, TISSUE_DENSITY_KG_M3};
 use pgd_surgery::mesh::io::{Frame, ImportOptions};
 use pgd_surgery::mesh::organs::{CORNEA_LAYERS, Organ, OrganSettings};
-use pgd_surgery::mesh::{RegionSelectors, Selector};
+use pgd_surgery::mesh::{MeshDensity, RegionSelectors, Selector};
 use pgd_surgery::pgd::{
     self, BuildSettings, PgdSettings, RegionSettings, SecantSettings, ValidationSettings,
 };
@@ -253,9 +253,14 @@ pub struct MeshArgs {
     /// Files: multiplies coordinates (0.001 for files in millimetres).
     #[arg(long, default_value_t = 1.0)]
     pub scale: f64,
-    /// Surfaces (.obj, .stl): target node count of the tetrahedralization.
+    /// Surfaces (.obj, .stl, .ply, VTK polydata), and volumes meshed anew: target node count
+    /// of the tetrahedralization.
     #[arg(long, default_value_t = 4000)]
     pub nodes: usize,
+    /// Files, instead of --nodes: the elements' size in millimetres (after --scale); the surface is
+    /// remeshed to it too. A size that would give more than 200,000 nodes is refused.
+    #[arg(long, value_name = "MM", conflicts_with = "nodes")]
+    pub element_mm: Option<f64>,
     /// Files: the patient frame their coordinates are in, ras or lps (default: the one the
     /// file states, as 3D Slicer writes SPACE=RAS or SPACE=LPS in its header, else ras); lps
     /// is turned into the trainer's ras.
@@ -285,7 +290,10 @@ impl MeshArgs {
             },
             import: ImportOptions {
                 scale: self.scale,
-                surface_nodes: self.nodes,
+                density: match self.element_mm {
+                    Some(mm) => MeshDensity::ElementSize { size_m: mm * 1e-3 },
+                    None => MeshDensity::Nodes(self.nodes),
+                },
                 regions: RegionSelectors::default(),
                 frame: self.frame,
             },

@@ -16,7 +16,7 @@ use serde::Serialize;
 use super::fem::{median, quantile};
 use crate::mesh::io::{Faces, ImportOptions, SurfaceMesh, parse, self_crossing};
 use crate::mesh::organs::{Organ, OrganSettings, generate};
-use crate::mesh::{Surface, TetMesh};
+use crate::mesh::{MeshDensity, Surface, TetMesh};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct ImportFigures {
@@ -119,7 +119,7 @@ fn time_import(
     let stl = binary_stl(surface);
     let options = ImportOptions {
         scale: 1e-3,
-        surface_nodes: target_nodes,
+        density: MeshDensity::Nodes(target_nodes),
         ..ImportOptions::default()
     };
     let mut imports = Vec::new();

@@ -7,6 +7,16 @@ pub enum MeshError {
     #[error("{mesh}: the mesh has no tetrahedra")]
     Empty { mesh: String },
 
+    #[error(
+        "{mesh}: an element size of {size_mm} mm would mesh it with more than {most} nodes; ask for {finest_mm:.2} mm or more"
+    )]
+    TooFine {
+        mesh: String,
+        size_mm: f64,
+        finest_mm: f64,
+        most: usize,
+    },
+
     #[error("{mesh}: node {node} has a non-finite coordinate {position:?}")]
     NonFiniteNode {
         mesh: String,

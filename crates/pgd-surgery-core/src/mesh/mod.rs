@@ -19,5 +19,5 @@ pub use error::MeshError;
 pub use quality::{QualityReport, aspect_ratio, dihedral_range_deg};
 pub use select::{RegionSelectors, SELECTOR_FORMS, SelectionReport, Selector};
 pub use shell::{MidSurface, extrude, revolution, spherical_cap};
-pub use stuffing::{Implicit, stuff, stuff_to_node_count};
+pub use stuffing::{Implicit, MOST_NODES, MeshDensity, stuff, stuff_to, stuff_to_node_count};
 pub use tet_mesh::{DEGENERATE_QUALITY, Regions, TetMesh, quality, signed_volume};

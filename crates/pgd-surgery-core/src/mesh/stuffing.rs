@@ -54,6 +54,47 @@ pub fn stuff(name: &str, solid: &Implicit, spacing_m: f64) -> Result<TetMesh, Me
     TetMesh::new(name, nodes, tets, Regions::default())
 }
 
+/// How finely a solid is meshed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MeshDensity {
+    /// About this many nodes: the lattice spacing found by [`stuff_to_node_count`].
+    Nodes(usize),
+    /// Elements of about this size (m): the lattice spacing itself. The lattice's edges are
+    /// the spacing and √3/2 of it; the surface's warped and clipped ones are shorter.
+    ElementSize { size_m: f64 },
+}
+
+/// The most nodes an element size may ask for: an organ meshed finer would take hours to
+/// build and gigabytes to hold.
+pub const MOST_NODES: usize = 200_000;
+
+/// Lattice points in a solid's bounding box per node of its mesh, at most: an organ fills a
+/// quarter of its box or more.
+const LATTICE_PER_NODE: f64 = 4.0;
+
+/// Stuffs `solid` as finely as `density` asks; an element size that would give more than
+/// [`MOST_NODES`] nodes is refused with the size that would not.
+pub fn stuff_to(name: &str, solid: &Implicit, density: MeshDensity) -> Result<TetMesh, MeshError> {
+    match density {
+        MeshDensity::Nodes(target) => stuff_to_node_count(name, solid, target),
+        MeshDensity::ElementSize { size_m } => {
+            // A BCC lattice holds two points per cube; the solid fills part of its box.
+            let extent = solid.max - solid.min;
+            let box_m3 = extent.x * extent.y * extent.z;
+            let finest_m = libm::cbrt(2.0 * box_m3 / (LATTICE_PER_NODE * MOST_NODES as f64));
+            if size_m.is_nan() || size_m < finest_m {
+                return Err(MeshError::TooFine {
+                    mesh: name.to_owned(),
+                    size_mm: size_m * 1e3,
+                    finest_mm: finest_m * 1e3,
+                    most: MOST_NODES,
+                });
+            }
+            stuff(name, solid, size_m)
+        }
+    }
+}
+
 /// Stuffs a solid, choosing the lattice spacing so the node count lands near `target`: a
 /// first pass from a rough estimate, then one correction by the cube root of the miss.
 pub fn stuff_to_node_count(

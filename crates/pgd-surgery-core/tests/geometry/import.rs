@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use pgd_surgery_core::mesh::io::{ImportError, ImportOptions, load, write_vtu};
 use pgd_surgery_core::mesh::organs::{self, Organ, OrganSettings};
-use pgd_surgery_core::mesh::{QualityReport, box_mesh};
+use pgd_surgery_core::mesh::{MeshDensity, QualityReport, box_mesh};
 
 /// Writes `contents` to a fresh file with this name in a per-test directory.
 pub fn file(name: &str, contents: &[u8]) -> PathBuf {
@@ -205,7 +205,7 @@ f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
 fn a_closed_obj_surface_becomes_a_valid_tet_mesh() {
     let options = ImportOptions {
         scale: 1e-3,
-        surface_nodes: 1500,
+        density: MeshDensity::Nodes(1500),
         ..ImportOptions::default()
     };
     let mesh = load(&file("cube.obj", CUBE_OBJ.as_bytes()), &options).unwrap();
@@ -271,7 +271,7 @@ fn ascii_and_binary_stl_read_the_same_solid() {
     let (ascii, binary) = tetra_stl();
     let options = ImportOptions {
         scale: 1.0,
-        surface_nodes: 800,
+        density: MeshDensity::Nodes(800),
         ..ImportOptions::default()
     };
     let a = load(&file("t.stl", ascii.as_bytes()), &options).unwrap();
@@ -351,7 +351,7 @@ fn unusable_meshes_are_refused_with_the_reason() {
     // cube comes back whole.
     let options = ImportOptions {
         scale: 1e-3,
-        surface_nodes: 500,
+        density: MeshDensity::Nodes(500),
         ..ImportOptions::default()
     };
     let open_cube = CUBE_OBJ.replace("f 4 1 5 8\n", "");
@@ -395,7 +395,7 @@ fn an_organ_surface_in_stl_becomes_a_valid_tet_mesh() {
     }
     let options = ImportOptions {
         scale: 1e-3,
-        surface_nodes: 3000,
+        density: MeshDensity::Nodes(3000),
         ..ImportOptions::default()
     };
     let mesh = load(&file("liver.stl", &stl), &options).unwrap();
@@ -486,7 +486,7 @@ fn liver_surface_files() -> Vec<(&'static str, Vec<u8>)> {
 fn a_surface_reads_the_same_from_stl_ply_and_vtk_polydata() {
     let options = ImportOptions {
         scale: 1e-3,
-        surface_nodes: 2000,
+        density: MeshDensity::Nodes(2000),
         ..ImportOptions::default()
     };
     let meshes: Vec<_> = liver_surface_files()
@@ -580,7 +580,7 @@ fn a_damaged_surface_is_mended_or_refused_with_where() {
     };
     let options = ImportOptions {
         scale: 1e-3,
-        surface_nodes: 2000,
+        density: MeshDensity::Nodes(2000),
         ..ImportOptions::default()
     };
     let mended = load(
@@ -623,7 +623,7 @@ fn a_surface_in_lps_is_turned_into_ras() {
     };
     let options = |frame: Option<Frame>| ImportOptions {
         scale: 1e-3,
-        surface_nodes: 300,
+        density: MeshDensity::Nodes(300),
         frame,
         ..ImportOptions::default()
     };
@@ -665,7 +665,7 @@ fn a_surface_crossing_itself_is_refused_with_where() {
         .collect();
     let options = ImportOptions {
         scale: 1e-3,
-        surface_nodes: 500,
+        density: MeshDensity::Nodes(500),
         ..ImportOptions::default()
     };
     let both = format!("{CUBE_OBJ}{moved}");
@@ -688,4 +688,106 @@ fn a_surface_crossing_itself_is_refused_with_where() {
         .collect();
     assert!(near.iter().all(|&x| (20.0..=40.0).contains(&x)), "{error}");
     assert!(load(&file("alone.obj", CUBE_OBJ.as_bytes()), &options).is_ok());
+}
+
+/// The lengths of a mesh's edges, each once, sorted; and those of its boundary's.
+fn edge_lengths(mesh: &pgd_surgery_core::mesh::TetMesh) -> (Vec<f64>, Vec<f64>) {
+    use pgd_surgery_core::mesh::Surface;
+    let length = |a: usize, b: usize| (mesh.nodes()[a] - mesh.nodes()[b]).norm();
+    let sorted = |edges: std::collections::BTreeSet<(usize, usize)>| {
+        let mut lengths: Vec<f64> = edges.into_iter().map(|(a, b)| length(a, b)).collect();
+        lengths.sort_by(f64::total_cmp);
+        lengths
+    };
+    let pairs = |corners: &[usize]| {
+        let mut pairs = Vec::new();
+        for i in 0..corners.len() {
+            for j in i + 1..corners.len() {
+                pairs.push((corners[i].min(corners[j]), corners[i].max(corners[j])));
+            }
+        }
+        pairs
+    };
+    let all = mesh.tets().iter().flat_map(|t| pairs(t)).collect();
+    let boundary = Surface::extract(mesh).triangles;
+    let outer = boundary.iter().flat_map(|f| pairs(f)).collect();
+    (sorted(all), sorted(outer))
+}
+
+/// `--element-mm`: the liver's surface (in millimetres) remeshed to elements of the size asked,
+/// coarser than the file's, inside and on its surface, its volume kept; a size finer than the
+/// node limit allows refused with the finest it would take.
+#[test]
+fn a_surface_is_remeshed_to_the_element_size_asked() {
+    let (_, stl) = liver_surface_files().remove(0);
+    let source = file("sized-liver.stl", &stl);
+    let sized = |size_mm: f64| {
+        let options = ImportOptions {
+            scale: 1e-3,
+            density: MeshDensity::ElementSize {
+                size_m: size_mm * 1e-3,
+            },
+            ..ImportOptions::default()
+        };
+        load(&source, &options)
+    };
+    let median = |lengths: &[f64]| lengths[lengths.len() / 2] * 1e3;
+    let settings = OrganSettings {
+        resolution: 0.5,
+        ..OrganSettings::default()
+    };
+    let liver = organs::generate(Organ::Liver, &settings).unwrap();
+    let (_, file_surface) = edge_lengths(&liver);
+    let file_mm = median(&file_surface);
+    let file_faces = pgd_surgery_core::mesh::Surface::extract(&liver)
+        .triangles
+        .len();
+    let (mut nodes, mut coarsest) = (Vec::new(), None);
+    for size_mm in [14.0, 10.0] {
+        let mesh = sized(size_mm).unwrap();
+        let (all, outer) = edge_lengths(&mesh);
+        let (inside_mm, surface_mm) = (median(&all), median(&outer));
+        let faces = pgd_surgery_core::mesh::Surface::extract(&mesh)
+            .triangles
+            .len();
+        nodes.push(mesh.node_count() as f64);
+        coarsest.get_or_insert((faces, surface_mm));
+        // The lattice's edges are the size and √3/2 of it; the surface's are cut shorter.
+        assert!(
+            (0.75 * size_mm..=1.05 * size_mm).contains(&inside_mm),
+            "{size_mm} mm asked, median edge {inside_mm:.2} mm"
+        );
+        assert!(
+            (0.6 * size_mm..=1.05 * size_mm).contains(&surface_mm),
+            "{size_mm} mm asked, median surface edge {surface_mm:.2} mm"
+        );
+        let error = (mesh.volume() - liver.volume()).abs() / liver.volume();
+        assert!(
+            error < 0.05,
+            "{size_mm} mm: volume off by {:.1} %",
+            100.0 * error
+        );
+    }
+    // At 14 mm, half as long again as the file's triangles, its surface is decimated.
+    let (faces, surface_mm) = coarsest.unwrap();
+    assert!(
+        faces < file_faces,
+        "{faces} faces against the file's {file_faces}"
+    );
+    assert!(
+        surface_mm > file_mm,
+        "{surface_mm:.2} mm, the file's {file_mm:.2} mm"
+    );
+    // Nodes go as the inverse cube of the size, up to the surface's share.
+    let ratio = nodes[1] / nodes[0];
+    let cubed = (14.0f64 / 10.0).powi(3);
+    assert!(
+        (0.7 * cubed..=1.3 * cubed).contains(&ratio),
+        "nodes {nodes:?}: ratio {ratio:.2} against {cubed:.2}"
+    );
+    let refused = sized(0.2).unwrap_err().to_string();
+    assert!(
+        refused.contains("0.2 mm") && refused.contains("ask for") && refused.contains("200000"),
+        "{refused}"
+    );
 }

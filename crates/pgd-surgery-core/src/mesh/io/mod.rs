@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::Point3;
 use thiserror::Error;
 
-use super::{MeshError, QualityReport, RegionSelectors, Regions, Surface, TetMesh};
+use super::{MeshDensity, MeshError, QualityReport, RegionSelectors, Regions, Surface, TetMesh};
 pub use intersections::{Crossing, Faces, self_crossing};
 pub use mend::{MAX_HOLE_EDGES, Mended, mend};
 pub use ply::read_ply;
@@ -74,7 +74,7 @@ impl RawMesh {
     /// Checks indices, measures quality, meshes anew from its boundary (at about
     /// `remesh_nodes` nodes) what is too poorly shaped to solve, and refuses what cannot be
     /// simulated.
-    fn into_mesh(self, file: &str, remesh_nodes: usize) -> Result<TetMesh, ImportError> {
+    fn into_mesh(self, file: &str, density: MeshDensity) -> Result<TetMesh, ImportError> {
         if let Some((t, _)) = self
             .tets
             .iter()
@@ -99,7 +99,7 @@ impl RawMesh {
             && report.watertight()
             && (report.poorly_shaped() || report.degenerate > 0);
         if mendable {
-            let (remeshed, said) = remesh::remesh(file, self, &report, remesh_nodes)?;
+            let (remeshed, said) = remesh::remesh(file, self, &report, density)?;
             eprintln!("{file}: mended: {said}");
             return remeshed.into_checked_mesh(file);
         }
@@ -203,9 +203,9 @@ impl MeshFile {
 pub struct ImportOptions {
     /// Multiplies coordinates: 0.001 for files in millimetres.
     pub scale: f64,
-    /// Target node count when tetrahedralizing a surface, or meshing a volume anew from its
-    /// boundary (its elements too poorly shaped to solve).
-    pub surface_nodes: usize,
+    /// How finely a surface is tetrahedralized, or a volume meshed anew from its boundary
+    /// (its elements too poorly shaped to solve): about a node count, or an element size.
+    pub density: MeshDensity,
     /// The clamped nodes and the accessible surface, picked by where they are (after
     /// `scale`); none: the file's own `clamped` and `accessible` regions.
     pub regions: RegionSelectors,
@@ -254,7 +254,7 @@ impl Default for ImportOptions {
     fn default() -> Self {
         Self {
             scale: 1.0,
-            surface_nodes: 4_000,
+            density: MeshDensity::Nodes(4_000),
             regions: RegionSelectors::default(),
             frame: None,
         }
@@ -300,7 +300,7 @@ fn mended_and_meshed(
     if !mended.is_nothing() {
         eprintln!("{file}: mended: {mended}");
     }
-    tetrahedralize(file, surface, options.surface_nodes)
+    tetrahedralize(file, surface, options.density)
 }
 
 /// The mesh in the `bytes` of `path`, scaled and turned into RAS, with the regions it names.
@@ -368,5 +368,5 @@ fn read_mesh(path: &Path, bytes: Vec<u8>, options: &ImportOptions) -> Result<Tet
         let c = p.coords * options.scale;
         *p = Point3::new(turn * c.x, turn * c.y, c.z);
     }
-    raw.into_mesh(&file, options.surface_nodes)
+    raw.into_mesh(&file, options.density)
 }

@@ -16,16 +16,16 @@ use parry3d::query::PointQueryWithLocation;
 use super::mend::mend;
 use super::surface::{SurfaceMesh, tetrahedralize};
 use super::{ImportError, RawMesh, face_nodes};
-use crate::mesh::{QualityReport, Regions, Surface, TetMesh};
+use crate::mesh::{MeshDensity, QualityReport, Regions, Surface, TetMesh};
 use crate::parry_interop::{to_parry, trimesh};
 
-/// `raw` (its quality `before`) meshed anew from its boundary at about `target_nodes` nodes,
+/// `raw` (its quality `before`) meshed anew from its boundary as finely as `density` asks,
 /// with its regions carried over, and what was done in words (the quality before and after).
 pub(super) fn remesh(
     file: &str,
     raw: RawMesh,
     before: &QualityReport,
-    target_nodes: usize,
+    density: MeshDensity,
 ) -> Result<(RawMesh, String), ImportError> {
     let rest = TetMesh::new(
         file,
@@ -39,7 +39,7 @@ pub(super) fn remesh(
             file: file.to_owned(),
             reason: format!("its boundary, to mesh it anew from, cannot be mended: {reason}"),
         })?;
-    let mesh = tetrahedralize(file, surface, target_nodes)?;
+    let mesh = tetrahedralize(file, surface, density)?;
     let after = QualityReport::measure(mesh.nodes(), mesh.tets());
     let new_boundary: Vec<[usize; 3]> = Surface::extract(&mesh).triangles;
     let old = OldBoundary::new(file, &raw, &boundary)?;

@@ -10,7 +10,7 @@ use parry3d::shape::{TriMesh, TriMeshFlags};
 use super::ImportError;
 use super::intersections::{Faces, self_crossing};
 use super::tokens::Tokens;
-use crate::mesh::{Implicit, TetMesh, stuff_to_node_count};
+use crate::mesh::{Implicit, MeshDensity, TetMesh, stuff_to};
 use crate::parry_interop::to_parry;
 
 /// A surface is refused as implausibly large for an organ beyond this size (m): it was most
@@ -190,12 +190,13 @@ fn merge_vertices(triangles: Vec<[Point3<f64>; 3]>) -> SurfaceMesh {
     surface
 }
 
-/// Tetrahedralizes the inside of a closed, manifold, consistently oriented surface, with about
-/// `target_nodes` nodes.
+/// Tetrahedralizes the inside of a closed, manifold, consistently oriented surface, as finely
+/// as `density` asks. The lattice's own surface replaces the file's: a segmentation's fine
+/// triangles are remeshed to the elements' size.
 pub fn tetrahedralize(
     file: &str,
     mut surface: SurfaceMesh,
-    target_nodes: usize,
+    density: MeshDensity,
 ) -> Result<TetMesh, ImportError> {
     let refuse = |reason: String| ImportError::Unusable {
         file: file.to_owned(),
@@ -255,7 +256,7 @@ pub fn tetrahedralize(
         min,
         max,
     };
-    Ok(stuff_to_node_count(file, &solid, target_nodes)?)
+    Ok(stuff_to(file, &solid, density)?)
 }
 
 fn bounds(points: &[Point3<f64>]) -> (Point3<f64>, Point3<f64>) {
