@@ -12,6 +12,7 @@ mod import;
 mod msh_binary;
 mod organs;
 mod quality;
+mod rebuilt;
 mod slivers;
 mod stuffing;
 mod vtk_binary;
