@@ -13,6 +13,7 @@ use crate::mesh::organs::Organ;
 
 use super::attachment::AttachmentEntry;
 use super::biliary::BiliaryEntry;
+use super::operation::OperationRubric;
 use super::scene::{Nodule, OrganEntry, metres, organ_list};
 use super::task::Task;
 use super::units::{
@@ -73,6 +74,10 @@ pub struct Scenario {
     pub tasks: Vec<Task>,
     #[serde(default)]
     pub rubric: Rubric,
+    /// An operation scored step by step and error by error, as surgical educators score it
+    /// (`Operation(steps: […], errors: […])`): when present, the attempt's score is its.
+    #[serde(default)]
+    pub operation: Option<OperationRubric>,
 }
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]

@@ -8,6 +8,7 @@ use std::path::Path;
 
 use super::attachment::{AttachmentEntry, facing};
 use super::format::{LaparoscopeEntry, Scenario, Tool};
+use super::operation::{Event, OperationRubric};
 use super::problem::{Problem, REFERENCE, ScenarioError};
 use super::scene::{OrganEntry, metres};
 use super::task::{BandEnd, Countertraction, Hand, SceneFacts, Task, TaskCheck};
@@ -172,6 +173,9 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
     }
     super::biliary::check(scenario.biliary.as_ref(), &scene, &mut problems);
     check_rubric(scenario, &mut problems);
+    if let Some(operation) = &scenario.operation {
+        check_operation(scenario, operation, &mut problems);
+    }
     check_laparoscope(scenario, &mut problems);
     check_instruments(scenario, &mut problems);
     check_backend(scenario, &mut problems);
@@ -558,6 +562,76 @@ fn not_in_scene(scenario: &Scenario, organ: &str, field: String, section: &str) 
         anchors: vec![section.into(), format!("\"{organ}\"")],
         message: format!("`{organ}` is not in this scenario's organs"),
         hint: format!("the scene has: {}", scenario.organ_names()),
+    })
+}
+
+/// The operation rubric: steps to score, points that are points, and events the scenario's
+/// tasks can show.
+fn check_operation(scenario: &Scenario, operation: &OperationRubric, problems: &mut Vec<Problem>) {
+    if operation.steps.is_empty() {
+        problems.push(Problem {
+            field: "operation.steps".into(),
+            anchors: vec!["operation".into(), "steps".into()],
+            message: "the operation has no steps to score".into(),
+            hint: "add `Step(name: \"…\", points: 5, done: Finished(1))` (docs/scenarios.md)"
+                .into(),
+        });
+    }
+    let steps = (operation.steps.iter()).map(|s| ("steps", "Step", &s.name, s.points, s.done));
+    let errors = (operation.errors.iter()).map(|e| ("errors", "Error", &e.name, e.points, e.made));
+    let mut seen = [0usize; 2];
+    for (list, variant, name, points, event) in steps.chain(errors) {
+        let k = &mut seen[usize::from(list == "errors")];
+        let field = format!("operation.{list}[{k}]");
+        let anchors = || vec!["operation".into(), list.into(), format!("\"{name}\"")];
+        *k += 1;
+        if !(points.is_finite() && points > 0.0) {
+            problems.push(Problem {
+                field: format!("{field}.points"),
+                anchors: [anchors(), vec!["points".into()]].concat(),
+                message: format!("{points} points"),
+                hint: format!("a {variant}'s points are more than 0"),
+            });
+        }
+        if let Some(problem) = event_problem(scenario, event) {
+            problems.push(Problem {
+                field,
+                anchors: anchors(),
+                message: problem.0,
+                hint: problem.1,
+            });
+        }
+    }
+}
+
+/// What is wrong with `event` in `scenario`, and a hint.
+fn event_problem(scenario: &Scenario, event: Event) -> Option<(String, String)> {
+    let tasks = scenario.tasks.len();
+    if let Event::Finished(n) = event {
+        return (n == 0 || n > tasks).then(|| {
+            (
+                format!("`Finished({n})`: there is no task {n}; the scenario has {tasks}"),
+                format!("tasks are numbered from 1 to {tasks}, in the order written"),
+            )
+        });
+    }
+    let amount_ok = match event {
+        Event::Released(share) => (0.0..=1.0).contains(&share),
+        Event::BloodLost(ml) => ml.is_finite() && ml >= 0.0,
+        _ => true,
+    };
+    if !amount_ok {
+        return Some((
+            format!("{event:?}: not an amount"),
+            "`Released` takes a share from 0 to 1, `BloodLost` millilitres, 0 or more".into(),
+        ));
+    }
+    let needs = event.needs()?;
+    (!scenario.tasks.iter().any(|t| t.name() == needs)).then(|| {
+        (
+            format!("{event:?} is read from a {needs} task, and the scenario has none"),
+            format!("add a {needs} task, or score another event (docs/scenarios.md)"),
+        )
     })
 }
 

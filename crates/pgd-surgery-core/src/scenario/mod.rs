@@ -18,6 +18,7 @@ mod incision;
 mod keratotomy;
 mod load;
 mod motion;
+mod operation;
 mod problem;
 mod sample;
 mod scene;
@@ -41,6 +42,9 @@ pub use keratotomy::{
 };
 pub use load::{load, parse};
 pub use motion::{IDLE_M_PER_S, MOVING_M_PER_S, MotionMetrics, MotionTracker, STRIDE};
+pub use operation::{
+    ErrorScored, Event, OperationRubric, OperationScore, ScoredError, ScoredStep, StepScored,
+};
 pub use problem::ScenarioError;
 pub use sample::{
     BiliarySample, HandSample, HookSample, HookTarget, NoduleSite, RegionSite, Sample, ViewSample,

@@ -4,6 +4,7 @@
 use serde::Serialize;
 
 use super::format::{Rubric, Scenario};
+use super::operation::OperationScore;
 use super::task::TaskMetrics;
 use super::units::Newtons;
 use crate::biliary::ViewRecord;
@@ -29,6 +30,9 @@ pub struct Scorecard {
     /// The scalpel's strokes, on every organ, in order.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub cuts: Vec<CutMade>,
+    /// The operation's steps and errors, scored by the scenario's operation rubric.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub operation: Option<OperationScore>,
     /// What the critical view of safety was judged on when it was reached (or last, when it
     /// never was), for the report's doublet pictures; in a scene with a biliary tree.
     #[serde(skip)]
@@ -46,9 +50,12 @@ pub struct CutMade {
     pub max_depth_mm: f64,
 }
 
-/// Scores `tasks` (in the scenario's order) by the scenario's rubric.
+/// Scores `tasks` (in the scenario's order) by the scenario's rubric: the mean of the tasks'
+/// scores, or the operation's score where the scenario has an operation rubric (a major
+/// error then fails the attempt too).
 pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
     let rubric = &scenario.rubric;
+    let operation = (scenario.operation.as_ref()).map(|operation| operation.score(&tasks));
     let tasks: Vec<TaskScore> = tasks
         .into_iter()
         .map(|metrics| TaskScore {
@@ -56,12 +63,17 @@ pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
             metrics,
         })
         .collect();
-    let score = tasks.iter().map(|t| t.score).sum::<f64>() / tasks.len().max(1) as f64;
+    let mean = tasks.iter().map(|t| t.score).sum::<f64>() / tasks.len().max(1) as f64;
+    let score = operation.as_ref().map_or(mean, |o| o.score);
     let all_done = tasks.iter().all(|t| t.metrics.completed);
     let complication = tasks.iter().any(|t| t.metrics.complication.is_some());
-    let passed =
-        score >= rubric.pass_mark && (all_done || !rubric.all_tasks_required) && !complication;
+    let major_error = operation.as_ref().is_some_and(|o| o.major_error);
+    let passed = score >= rubric.pass_mark
+        && (all_done || !rubric.all_tasks_required)
+        && !complication
+        && !major_error;
     let mut feedback: Vec<String> = tasks.iter().flat_map(task_feedback).collect();
+    feedback.extend(operation.iter().flat_map(OperationScore::feedback));
     if score < rubric.pass_mark {
         feedback.push(format!(
             "the score {score:.0} is below the pass mark {:.0}",
@@ -76,6 +88,7 @@ pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
         passed,
         feedback,
         cuts: Vec::new(),
+        operation,
         critical_view: None,
     }
 }

@@ -4,6 +4,7 @@
 //! the common bile duct; a bleed's volume against Poiseuille's law; and each criterion of the
 //! critical view of safety met and not met on constructed scenes.
 
+mod operation;
 mod task;
 
 use nalgebra::{Unit, Vector3};

@@ -13,12 +13,12 @@ use pgd_surgery_core::scenario::{
     BiliarySample, Exercise, Sample, Scenario, Sites, ViewSample, parse, score,
 };
 
-const INSTRUMENTS: &str = r#"instruments: [
+pub const INSTRUMENTS: &str = r#"instruments: [
         Instrument(tool: ClipApplier(tip_radius_mm: 6.0), port: Port(at_mm: (60.0, 139.0, -120.0), shaft_mm: 300.0)),
         Instrument(tool: Scissors(tip_radius_mm: 6.0), port: Port(at_mm: (60.0, 139.0, -120.0), shaft_mm: 300.0)),
     ],"#;
 
-fn scenario_text(biliary: &str, instruments: &str, divide: &str) -> String {
+pub fn scenario_text(biliary: &str, instruments: &str, divide: &str) -> String {
     format!(
         r#"Scenario(
     title: "Clip and cut",
@@ -53,7 +53,7 @@ fn jaws(tree: &BiliaryTree, structure: Structure, share: f64, jaw_m: f64) -> Seg
 
 /// What happens at a tick: the view reached, a clip at a share of a tube, a cut there.
 #[derive(Clone, Copy)]
-enum Event {
+pub enum Event {
     View,
     Clip(Structure, f64),
     Cut(Structure, f64),
@@ -62,7 +62,14 @@ enum Event {
 /// Runs `events` (each at its second) through the scenario's exercise, the tree's clips
 /// and cuts made as the haptic loop makes them; 60 s in all.
 fn run(events: &[(f64, Event)]) -> (Scenario, Vec<pgd_surgery_core::scenario::task::TaskMetrics>) {
-    let scenario = scenario();
+    run_on(scenario(), events)
+}
+
+/// [`run`] on `scenario` (a clip-and-cut on the default tree).
+pub fn run_on(
+    scenario: Scenario,
+    events: &[(f64, Event)],
+) -> (Scenario, Vec<pgd_surgery_core::scenario::task::TaskMetrics>) {
     let tree = scenario.biliary.as_ref().unwrap().tree().unwrap();
     let mut exercise = Exercise::new(scenario, Sites::default());
     let mut clips: Vec<Clip> = Vec::new();
@@ -122,10 +129,10 @@ fn run(events: &[(f64, Event)]) -> (Scenario, Vec<pgd_surgery_core::scenario::ta
     (finished.scenario, finished.tasks)
 }
 
-const DUCT: Structure = Structure::CysticDuct;
-const ARTERY: Structure = Structure::CysticArtery;
+pub const DUCT: Structure = Structure::CysticDuct;
+pub const ARTERY: Structure = Structure::CysticArtery;
 
-fn competent() -> Vec<(f64, Event)> {
+pub fn competent() -> Vec<(f64, Event)> {
     vec![
         (5.0, Event::View),
         (8.0, Event::Clip(DUCT, 0.2)),
