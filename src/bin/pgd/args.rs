@@ -648,6 +648,10 @@ pub enum BenchTarget {
         /// Imports timed per surface.
         #[arg(long, default_value_t = 3)]
         repeats: usize,
+        /// Also write the subdivided surface as binary STL (millimetres), to build its
+        /// vademecum with `pgd build FILE --scale 0.001 --clamp …`.
+        #[arg(long, value_name = "FILE.stl")]
+        stl_out: Option<PathBuf>,
         /// Print the report as JSON instead of a table.
         #[arg(long)]
         json: bool,

@@ -412,10 +412,11 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             triangles,
             nodes,
             repeats,
+            stl_out,
             json,
         } => print_report(
             "pgd bench import",
-            bench::import::run(triangles, nodes, repeats),
+            bench::import::run(triangles, nodes, repeats, stl_out.as_deref()),
             json,
         ),
         BenchTarget::Cutting { cells, json } => print_report(

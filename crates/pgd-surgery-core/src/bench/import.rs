@@ -41,11 +41,13 @@ pub struct ImportBenchReport {
 }
 
 /// Imports the liver's surface and the surface subdivided to at least `triangles` triangles,
-/// `repeats` times each, at `target_nodes` nodes.
+/// `repeats` times each, at `target_nodes` nodes; writes the subdivided one to `stl_out` if
+/// given.
 pub fn run(
     triangles: usize,
     target_nodes: usize,
     repeats: usize,
+    stl_out: Option<&Path>,
 ) -> Result<ImportBenchReport, String> {
     let liver = generate(Organ::Liver, &OrganSettings::default()).map_err(|e| e.to_string())?;
     let mut surface = surface_mm(&liver);
@@ -54,6 +56,10 @@ pub fn run(
         surface = subdivided(&surface);
     }
     let subdivided = time_import(&surface, target_nodes, repeats)?;
+    if let Some(file) = stl_out {
+        std::fs::write(file, binary_stl(&surface))
+            .map_err(|e| format!("{}: {e}", file.display()))?;
+    }
     Ok(ImportBenchReport {
         repeats,
         target_nodes,
