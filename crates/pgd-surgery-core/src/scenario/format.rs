@@ -13,6 +13,7 @@ use crate::mesh::organs::Organ;
 
 use super::attachment::AttachmentEntry;
 use super::biliary::BiliaryEntry;
+use super::global::Benchmark;
 use super::operation::OperationRubric;
 use super::scene::{Nodule, OrganEntry, metres, organ_list};
 use super::task::Task;
@@ -78,6 +79,10 @@ pub struct Scenario {
     /// (`Operation(steps: […], errors: […])`): when present, the attempt's score is its.
     #[serde(default)]
     pub operation: Option<OperationRubric>,
+    /// The proficiency benchmark the attempt's global measures are held to
+    /// (`Benchmark(time_s: …, blood_lost_ml: …)`); none by default.
+    #[serde(default)]
+    pub benchmark: Option<Benchmark>,
 }
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]

@@ -8,6 +8,7 @@ use std::path::Path;
 
 use super::attachment::{AttachmentEntry, facing};
 use super::format::{LaparoscopeEntry, Scenario, Tool};
+use super::global::Benchmark;
 use super::operation::{Event, OperationRubric};
 use super::problem::{Problem, REFERENCE, ScenarioError};
 use super::scene::{OrganEntry, metres};
@@ -175,6 +176,9 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
     check_rubric(scenario, &mut problems);
     if let Some(operation) = &scenario.operation {
         check_operation(scenario, operation, &mut problems);
+    }
+    if let Some(benchmark) = &scenario.benchmark {
+        check_benchmark(benchmark, &mut problems);
     }
     check_laparoscope(scenario, &mut problems);
     check_instruments(scenario, &mut problems);
@@ -599,6 +603,25 @@ fn check_operation(scenario: &Scenario, operation: &OperationRubric, problems: &
                 anchors: anchors(),
                 message: problem.0,
                 hint: problem.1,
+            });
+        }
+    }
+}
+
+/// A benchmark's values: a score from 0 to 100, a share from 0 to 1, the others 0 or more.
+fn check_benchmark(benchmark: &Benchmark, problems: &mut Vec<Problem>) {
+    for (name, value) in benchmark.values() {
+        let (range, hint) = match name {
+            "score" => (0.0..=100.0, "a score from 0 to 100"),
+            "both_hands_share" => (0.0..=1.0, "a share from 0 to 1"),
+            _ => (0.0..=f64::MAX, "a value of 0 or more"),
+        };
+        if !range.contains(&value) {
+            problems.push(Problem {
+                field: format!("benchmark.{name}"),
+                anchors: vec!["benchmark".into(), name.into()],
+                message: format!("{value} is out of range"),
+                hint: hint.into(),
             });
         }
     }

@@ -14,6 +14,7 @@ mod bimanual;
 pub mod curriculum;
 mod exercise;
 mod format;
+mod global;
 mod incision;
 mod keratotomy;
 mod load;
@@ -35,6 +36,7 @@ pub use format::{
     Contact, Device, Difficulty, Instrument, LaparoscopeEntry, Port, Rubric, Scenario, ScopeKey,
     Tool, default_law,
 };
+pub use global::{Benchmark, BenchmarkLine, GlobalMeasures};
 pub use incision::{BladeSample, IncisionMetrics, IncisionTracker};
 pub use keratotomy::{
     Keratometer, KeratotomyMetrics, KeratotomyPlan, KeratotomyTracker, MIN_INCISION_M,

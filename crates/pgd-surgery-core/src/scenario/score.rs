@@ -4,6 +4,7 @@
 use serde::Serialize;
 
 use super::format::{Rubric, Scenario};
+use super::global::{BenchmarkLine, GlobalMeasures};
 use super::operation::OperationScore;
 use super::task::TaskMetrics;
 use super::units::Newtons;
@@ -33,6 +34,15 @@ pub struct Scorecard {
     /// The operation's steps and errors, scored by the scenario's operation rubric.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub operation: Option<OperationScore>,
+    /// The attempt's global measures, where the scenario scores an operation or holds the
+    /// attempt to a benchmark...
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub global: Option<GlobalMeasures>,
+    /// ...each benchmark value against the attempt's, and whether all were met.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub benchmark: Vec<BenchmarkLine>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub proficient: Option<bool>,
     /// What the critical view of safety was judged on when it was reached (or last, when it
     /// never was), for the report's doublet pictures; in a scene with a biliary tree.
     #[serde(skip)]
@@ -56,6 +66,8 @@ pub struct CutMade {
 pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
     let rubric = &scenario.rubric;
     let operation = (scenario.operation.as_ref()).map(|operation| operation.score(&tasks));
+    let global =
+        (operation.is_some() || scenario.benchmark.is_some()).then(|| GlobalMeasures::of(&tasks));
     let tasks: Vec<TaskScore> = tasks
         .into_iter()
         .map(|metrics| TaskScore {
@@ -74,6 +86,15 @@ pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
         && !major_error;
     let mut feedback: Vec<String> = tasks.iter().flat_map(task_feedback).collect();
     feedback.extend(operation.iter().flat_map(OperationScore::feedback));
+    let benchmark = match (&scenario.benchmark, &global) {
+        (Some(benchmark), Some(measures)) => benchmark.compare(measures, score),
+        _ => Vec::new(),
+    };
+    feedback.extend(benchmark.iter().map(BenchmarkLine::describe));
+    let proficient = scenario
+        .benchmark
+        .as_ref()
+        .map(|_| benchmark.iter().all(|l| l.met));
     if score < rubric.pass_mark {
         feedback.push(format!(
             "the score {score:.0} is below the pass mark {:.0}",
@@ -89,6 +110,9 @@ pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
         feedback,
         cuts: Vec::new(),
         operation,
+        global,
+        benchmark,
+        proficient,
         critical_view: None,
     }
 }

@@ -154,3 +154,50 @@ fn an_operation_rubric_that_cannot_be_scored_is_refused_at_its_line() {
     let none = error("operation: Operation(steps: []),");
     assert!(none.message.contains("no steps"), "{none}");
 }
+
+const BENCHMARK: &str = "benchmark: Benchmark(score: 90.0, time_s: 30.0, blood_lost_ml: 0.5),";
+
+/// Held to a benchmark, the competent run is proficient and the careless one not, each value
+/// said in the debrief; a benchmark value out of range is refused at its line.
+#[test]
+fn the_benchmark_says_which_run_is_proficient() {
+    let scenario = || operation_scenario(&format!("{OPERATION}\n    {BENCHMARK}")).unwrap();
+    let (scenario_run, metrics) = run_on(scenario(), &competent());
+    let card = score(&scenario_run, metrics);
+    assert_eq!(card.proficient, Some(true), "{:?}", card.benchmark);
+    assert_eq!(card.benchmark.len(), 3);
+    let global = card.global.as_ref().unwrap();
+    assert!(
+        global.time_s <= 30.0 && global.blood_lost_ml == 0.0,
+        "{global:?}"
+    );
+    assert!(
+        card.feedback
+            .iter()
+            .any(|l| l.starts_with("benchmark time (s): ") && l.ends_with("met")),
+        "{:?}",
+        card.feedback
+    );
+    let careless = [
+        (3.0, Event::Clip(DUCT, 0.2)),
+        (4.0, Event::Cut(DUCT, 0.6)),
+        (8.0, Event::Cut(ARTERY, 0.5)),
+    ];
+    let (scenario_run, metrics) = run_on(scenario(), &careless);
+    let card = score(&scenario_run, metrics);
+    assert_eq!(card.proficient, Some(false));
+    let unmet: Vec<&str> = (card.benchmark.iter().filter(|l| !l.met))
+        .map(|l| l.measure)
+        .collect();
+    assert!(
+        unmet.contains(&"score") && unmet.contains(&"blood lost (ml)"),
+        "{unmet:?}"
+    );
+
+    let wrong = operation_scenario(&format!(
+        "{OPERATION}\n    benchmark: Benchmark(both_hands_share: 1.5),"
+    ))
+    .unwrap_err();
+    assert_eq!(wrong.field, "benchmark.both_hands_share");
+    assert!(wrong.hint.contains("from 0 to 1"), "{wrong}");
+}
