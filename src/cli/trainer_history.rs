@@ -122,6 +122,7 @@ fn write_csv(attempts: &[AttemptRecord]) -> Result<(), String> {
         "peak_force_n",
         "errors",
         "report",
+        "proficient",
     ])
     .map_err(|e| e.to_string())?;
     for a in attempts {
@@ -138,26 +139,36 @@ fn write_csv(attempts: &[AttemptRecord]) -> Result<(), String> {
             format!("{:.3}", a.peak_force_n),
             a.errors.to_string(),
             a.report.clone(),
+            a.proficient.map_or_else(String::new, |p| p.to_string()),
         ])
         .map_err(|e| e.to_string())?;
     }
     out.flush().map_err(|e| e.to_string())
 }
 
+/// "passed" or "failed", and "proficient" where the attempt met its scenario's benchmark.
+fn result(a: &AttemptRecord) -> &'static str {
+    match (a.passed, a.proficient) {
+        (true, Some(true)) => "proficient",
+        (true, _) => "passed",
+        (false, _) => "failed",
+    }
+}
+
 fn print_table(attempts: &[AttemptRecord], plot: &Path) -> Result<(), String> {
     println!(
-        "{:>4}  {:<20}  {:<12}  {:<32}  {:>5}  {:<6}  {:>7}  {:>8}  {:>6}  errors",
+        "{:>4}  {:<20}  {:<12}  {:<32}  {:>5}  {:<10}  {:>7}  {:>8}  {:>6}  errors",
         "id", "when", "trainee", "scenario", "score", "result", "time s", "path mm", "peak N"
     );
     for a in attempts {
         println!(
-            "{:>4}  {:<20}  {:<12}  {:<32}  {:>5.0}  {:<6}  {:>7.1}  {:>8.0}  {:>6.2}  {}",
+            "{:>4}  {:<20}  {:<12}  {:<32}  {:>5.0}  {:<10}  {:>7.1}  {:>8.0}  {:>6.2}  {}",
             a.id,
             a.when(),
             a.trainee,
             a.title,
             a.score,
-            if a.passed { "passed" } else { "failed" },
+            result(a),
             a.time_s,
             a.path_mm,
             a.peak_force_n,

@@ -10,7 +10,7 @@ use super::{AttemptRecord, HistoryError, HistoryFilter};
 /// The schema's versions (SQLite's `user_version`), each the step from the one before.
 /// 1: the attempts. 2: each attempt's unique id, its station and whether it is still to be
 /// sent to a shared history.
-const MIGRATIONS: [&str; 2] = [
+const MIGRATIONS: [&str; 3] = [
     "CREATE TABLE attempts (
         id INTEGER PRIMARY KEY,
         trainee TEXT NOT NULL,
@@ -30,6 +30,7 @@ const MIGRATIONS: [&str; 2] = [
     ALTER TABLE attempts ADD COLUMN station TEXT NOT NULL DEFAULT '';
     ALTER TABLE attempts ADD COLUMN pending INTEGER NOT NULL DEFAULT 0;
     CREATE UNIQUE INDEX attempts_by_uid ON attempts (uid);",
+    "ALTER TABLE attempts ADD COLUMN proficient INTEGER;",
 ];
 
 /// The schema this code writes and reads.
@@ -37,7 +38,7 @@ const SCHEMA_VERSION: i64 = MIGRATIONS.len() as i64;
 
 /// The columns of an attempt, in the order [`record_of`] reads them.
 const COLUMNS: &str = "id, uid, station, trainee, scenario, title, at_unix_s, score, passed, \
-    time_s, path_mm, peak_force_n, errors, report";
+    time_s, path_mm, peak_force_n, errors, report, proficient";
 
 /// An open local history database.
 pub struct History {
@@ -95,8 +96,8 @@ impl History {
             .connection
             .execute(
                 "INSERT INTO attempts (uid, station, trainee, scenario, title, at_unix_s, score, \
-                 passed, time_s, path_mm, peak_force_n, errors, report, pending) \
-                 VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14) \
+                 passed, time_s, path_mm, peak_force_n, errors, report, pending, proficient) \
+                 VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15) \
                  ON CONFLICT (uid) DO NOTHING",
                 params![
                     uid,
@@ -112,7 +113,8 @@ impl History {
                     record.peak_force_n,
                     record.errors,
                     record.report,
-                    pending
+                    pending,
+                    record.proficient
                 ],
             )
             .map_err(|e| self.error(e))?;
@@ -199,5 +201,6 @@ fn record_of(row: &rusqlite::Row) -> rusqlite::Result<AttemptRecord> {
         peak_force_n: row.get(11)?,
         errors: row.get(12)?,
         report: row.get(13)?,
+        proficient: row.get(14)?,
     })
 }

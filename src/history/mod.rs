@@ -51,6 +51,10 @@ pub struct AttemptRecord {
     pub errors: i64,
     /// The attempt's JSON report, if one was written.
     pub report: String,
+    /// Whether it met its scenario's proficiency benchmark; none where the scenario holds no
+    /// benchmark (or the attempt was kept before benchmarks were).
+    #[serde(default)]
+    pub proficient: Option<bool>,
 }
 
 impl AttemptRecord {
@@ -302,6 +306,7 @@ impl AttemptRecord {
             peak_force_n: tasks().map(|m| m.peak_force_n).fold(0.0, f64::max),
             errors: tasks().map(|m| m.error_count() as i64).sum(),
             report: report.map_or_else(String::new, |p| p.display().to_string()),
+            proficient: card.proficient,
         }
     }
 

@@ -19,7 +19,7 @@ pub struct Migration {
 }
 
 /// The schema's steps, in order.
-pub const MIGRATIONS: [Migration; 2] = [
+pub const MIGRATIONS: [Migration; 3] = [
     Migration {
         version: 1,
         name: "attempts",
@@ -47,6 +47,11 @@ pub const MIGRATIONS: [Migration; 2] = [
         name: "attempts in time order",
         sql: "CREATE INDEX attempts_by_time ON attempts (at_unix_s, id);",
     },
+    Migration {
+        version: 3,
+        name: "whether an attempt met its scenario's benchmark",
+        sql: "ALTER TABLE attempts ADD COLUMN proficient BOOLEAN;",
+    },
 ];
 
 /// The schema this code writes and reads.
@@ -60,7 +65,7 @@ const MIGRATION_LOCK: i64 = 0x7067_645f_6869_7374;
 
 /// The columns of an attempt, in the order [`record_of`] reads them.
 const COLUMNS: &str = "id, uid, station, trainee, scenario, title, at_unix_s, score, passed, \
-    time_s, path_mm, peak_force_n, errors, report";
+    time_s, path_mm, peak_force_n, errors, report, proficient";
 
 /// A connection to the shared history.
 pub struct SharedHistory {
@@ -178,8 +183,8 @@ impl SharedHistory {
             .client
             .execute(
                 "INSERT INTO attempts (uid, station, trainee, scenario, title, at_unix_s, score, \
-                 passed, time_s, path_mm, peak_force_n, errors, report) \
-                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13) \
+                 passed, time_s, path_mm, peak_force_n, errors, report, proficient) \
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14) \
                  ON CONFLICT (uid) DO NOTHING",
                 &[
                     &record.uid,
@@ -195,6 +200,7 @@ impl SharedHistory {
                     &record.peak_force_n,
                     &record.errors,
                     &record.report,
+                    &record.proficient,
                 ],
             )
             .map_err(|e| describe(&e))?;
@@ -244,5 +250,6 @@ fn record_of(row: &postgres::Row) -> AttemptRecord {
         peak_force_n: row.get(11),
         errors: row.get(12),
         report: row.get(13),
+        proficient: row.get(14),
     }
 }

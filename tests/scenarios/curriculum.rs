@@ -28,6 +28,7 @@ fn attempt(trainee: &str, name: &str, score: f64, passed: bool, at_unix_s: i64) 
         peak_force_n: 0.3,
         errors: 0,
         report: String::new(),
+        proficient: None,
     }
 }
 

@@ -38,6 +38,8 @@ fn attempt(trainee: &str, station: &str, score: f64, at_unix_s: i64) -> AttemptR
         peak_force_n: 0.5,
         errors: 0,
         report: String::new(),
+        // Held to a benchmark on one station only: both kinds of record travel.
+        proficient: (station == "lab-1").then_some(score >= 80.0),
     }
 }
 
@@ -84,7 +86,10 @@ fn the_schema_is_created_and_migrated_in_versions() {
     let mut migrated = SharedHistory::connect(&old).unwrap();
     assert_eq!(migrated.schema_version().unwrap(), SCHEMA_VERSION);
     let kept = migrated.attempts(&HistoryFilter::default()).unwrap();
-    assert_eq!((kept.len(), kept[0].score), (1, 81.5));
+    assert_eq!(
+        (kept.len(), kept[0].score, kept[0].proficient),
+        (1, 81.5, None)
+    );
 
     server.sql(
         "fresh",
@@ -137,6 +142,10 @@ fn two_stations_write_at_once_and_each_sees_both() {
     for station in ["lab-1", "lab-2"] {
         let theirs = all.iter().filter(|a| a.station == station).count();
         assert_eq!(theirs, per_station as usize, "{station}");
+    }
+    for a in &all {
+        let wrote = attempt(&a.trainee, &a.station, a.score, a.at_unix_s);
+        assert_eq!(a.proficient, wrote.proficient, "{a:?}");
     }
     let (seen, warning) = read_attempts(&stores[0], &HistoryFilter::default()).unwrap();
     assert_eq!((seen.len(), warning), (all.len(), None));
