@@ -77,6 +77,7 @@ pub fn summary(card: &Scorecard) -> String {
         "{}: {verdict} with {:.0} / 100 (pass mark {:.0})",
         card.title, card.score, card.pass_mark
     );
+    write_operation(&mut out, card);
     for (k, task) in card.tasks.iter().enumerate() {
         let m = &task.metrics;
         let _ = writeln!(
@@ -138,6 +139,68 @@ pub fn summary(card: &Scorecard) -> String {
         }
     }
     out
+}
+
+/// The phases with their times, the operation's points and steps, and the global measures,
+/// where the scenario has them.
+fn write_operation(out: &mut String, card: &Scorecard) {
+    for (k, phase) in card.phases.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "phase {}, {}: {:.1} to {:.1} s ({:.1} s), {}",
+            k + 1,
+            phase.name,
+            phase.started_s,
+            phase.ended_s,
+            phase.ended_s - phase.started_s,
+            if phase.completed { "done" } else { "not done" }
+        );
+    }
+    if let Some(operation) = &card.operation {
+        let _ = writeln!(
+            out,
+            "operation: {:.0} of {:.0} points{}",
+            operation.points,
+            operation.possible,
+            if operation.major_error {
+                ", a major error"
+            } else {
+                ""
+            }
+        );
+        for step in &operation.steps {
+            let when = step
+                .done_s
+                .map_or("not done".into(), |t| format!("done at {t:.1} s"));
+            let _ = writeln!(out, "  {} ({} points): {when}", step.name, step.points);
+        }
+    }
+    if let Some(g) = &card.global {
+        let economy = |e: Option<f64>| e.map_or("-".into(), |e| format!("{e:.2}"));
+        let _ = writeln!(
+            out,
+            "global: {:.1} s; paths {:.0} / {:.0} mm (right / left), economy {} / {}; out of \
+             view {:.1} s, {} movements; {:.1} s above the force limits, peak {:.2} N; {} \
+             burns ({:.0} mm²); blood {:.1} ml, bile {:.1} ml",
+            g.time_s,
+            g.path_mm[0],
+            g.path_mm[1],
+            economy(g.economy[0]),
+            economy(g.economy[1]),
+            g.out_of_view_s,
+            g.movements,
+            g.over_limit_s,
+            g.peak_force_n,
+            g.burns,
+            g.burned_area_mm2,
+            g.blood_lost_ml,
+            g.bile_spilled_ml
+        );
+    }
+    if let Some(proficient) = card.proficient {
+        let verdict = if proficient { "met" } else { "not met" };
+        let _ = writeln!(out, "benchmark: {verdict}");
+    }
 }
 
 fn plot(path: &Path, card: &Scorecard, trace: &[(f64, f64)]) -> PlotResult {

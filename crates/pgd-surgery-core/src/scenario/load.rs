@@ -10,6 +10,7 @@ use super::attachment::{AttachmentEntry, facing};
 use super::format::{LaparoscopeEntry, Scenario, Tool};
 use super::global::Benchmark;
 use super::operation::{Event, OperationRubric};
+use super::phases::phase_out_of_order;
 use super::problem::{Problem, REFERENCE, ScenarioError};
 use super::scene::{OrganEntry, metres};
 use super::task::{BandEnd, Countertraction, Hand, SceneFacts, Task, TaskCheck};
@@ -179,6 +180,15 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
     }
     if let Some(benchmark) = &scenario.benchmark {
         check_benchmark(benchmark, &mut problems);
+    }
+    if let Some((k, name, between)) = phase_out_of_order(scenario) {
+        problems.push(Problem {
+            field: format!("tasks[{k}].phase"),
+            anchors: vec!["tasks".into(), format!("\"{name}\""), format!("\"{name}\"")],
+            message: format!("the phase `{name}` again, after `{between}`"),
+            hint: "a phase's tasks follow one another; give this task its own phase, or move it"
+                .into(),
+        });
     }
     check_laparoscope(scenario, &mut problems);
     check_instruments(scenario, &mut problems);

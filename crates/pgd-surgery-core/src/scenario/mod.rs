@@ -20,6 +20,7 @@ mod keratotomy;
 mod load;
 mod motion;
 mod operation;
+mod phases;
 mod problem;
 mod sample;
 mod scene;
@@ -47,6 +48,7 @@ pub use motion::{IDLE_M_PER_S, MOVING_M_PER_S, MotionMetrics, MotionTracker, STR
 pub use operation::{
     ErrorScored, Event, OperationRubric, OperationScore, ScoredError, ScoredStep, StepScored,
 };
+pub use phases::PhaseTime;
 pub use problem::ScenarioError;
 pub use sample::{
     BiliarySample, HandSample, HookSample, HookTarget, NoduleSite, RegionSite, Sample, ViewSample,

@@ -6,6 +6,7 @@ use serde::Serialize;
 use super::format::{Rubric, Scenario};
 use super::global::{BenchmarkLine, GlobalMeasures};
 use super::operation::OperationScore;
+use super::phases::{PhaseTime, phase_times};
 use super::task::TaskMetrics;
 use super::units::Newtons;
 use crate::biliary::ViewRecord;
@@ -34,6 +35,9 @@ pub struct Scorecard {
     /// The operation's steps and errors, scored by the scenario's operation rubric.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub operation: Option<OperationScore>,
+    /// The operation's phases, in order, with their times (where the tasks name phases).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub phases: Vec<PhaseTime>,
     /// The attempt's global measures, where the scenario scores an operation or holds the
     /// attempt to a benchmark...
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -68,6 +72,7 @@ pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
     let operation = (scenario.operation.as_ref()).map(|operation| operation.score(&tasks));
     let global =
         (operation.is_some() || scenario.benchmark.is_some()).then(|| GlobalMeasures::of(&tasks));
+    let phases = phase_times(scenario, &tasks);
     let tasks: Vec<TaskScore> = tasks
         .into_iter()
         .map(|metrics| TaskScore {
@@ -110,6 +115,7 @@ pub fn score(scenario: &Scenario, tasks: Vec<TaskMetrics>) -> Scorecard {
         feedback,
         cuts: Vec::new(),
         operation,
+        phases,
         global,
         benchmark,
         proficient,

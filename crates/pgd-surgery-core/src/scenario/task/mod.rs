@@ -31,7 +31,8 @@ use super::motion::MotionTracker;
 use super::sample::{NoduleSite, Sample};
 use super::units::{Newtons, Seconds};
 
-/// The fields every task has, written among its own: `organ`, `max_force_n`, `time_limit_s`.
+/// The fields every task has, written among its own: `organ`, `max_force_n`, `time_limit_s`
+/// (and, optional, `hand`, `countertraction`, `phase`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TaskShared {
     /// The organ the task works on; none for a task among them all (navigation), whose type
@@ -46,6 +47,9 @@ pub struct TaskShared {
     /// In a bimanual exercise, an organ the other hand keeps held within a force band
     /// throughout the task (traction and counter-traction).
     pub countertraction: Option<Countertraction>,
+    /// The phase of the operation the task belongs to ("Calot's triangle"): the debrief gives
+    /// each phase's times; a phase's tasks follow one another.
+    pub phase: Option<String>,
 }
 
 /// A trainee's hand, as a bimanual exercise's tasks name it.

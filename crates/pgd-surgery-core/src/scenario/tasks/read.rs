@@ -104,6 +104,7 @@ struct SharedFields {
     time_limit_s: Option<Seconds>,
     hand: Option<Hand>,
     countertraction: Option<Countertraction>,
+    phase: Option<String>,
 }
 
 impl SharedFields {
@@ -123,6 +124,7 @@ impl SharedFields {
             time_limit_s: self.time_limit_s.ok_or(E::missing_field("time_limit_s"))?,
             hand: self.hand.unwrap_or_default(),
             countertraction: self.countertraction,
+            phase: self.phase,
         })
     }
 }
@@ -197,6 +199,7 @@ fn with_shared(own: &'static [&'static str], on_an_organ: bool) -> &'static [&'s
         "time_limit_s",
         "hand",
         "countertraction",
+        "phase",
     ]
     .into_iter())
     .filter(|field| on_an_organ || *field != "organ");
@@ -261,6 +264,7 @@ impl<'de, A: MapAccess<'de>> MapAccess<'de> for Split<'_, A, A::Error> {
                 "countertraction" => {
                     self.shared_value("countertraction", |s| &mut s.countertraction)?
                 }
+                "phase" => self.shared_value("phase", |s| &mut s.phase)?,
                 own if !self.fields.is_empty() && !self.fields.contains(&own) => {
                     let expected = with_shared(self.fields, self.on_an_organ);
                     return self.keep(Err(de::Error::unknown_field(own, expected)));
