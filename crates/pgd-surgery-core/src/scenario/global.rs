@@ -9,7 +9,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::motion::MotionMetrics;
-use super::task::TaskMetrics;
+use super::task::{TaskMetrics, results_of};
 use super::tasks::{ClipAndCutResult, DissectionResult};
 
 /// What the attempt measured, by GOALS domain.
@@ -51,16 +51,8 @@ impl GlobalMeasures {
         };
         let motions: Vec<[MotionMetrics; 2]> = tasks.iter().map(hands).collect();
         let per_hand = |k: usize| motions.iter().map(move |m| &m[k]);
-        let clips = || {
-            tasks
-                .iter()
-                .filter_map(TaskMetrics::result::<ClipAndCutResult>)
-        };
-        let dissections = || {
-            tasks
-                .iter()
-                .filter_map(TaskMetrics::result::<DissectionResult>)
-        };
+        let clips = || results_of::<ClipAndCutResult>(tasks);
+        let dissections = || results_of::<DissectionResult>(tasks);
         Self {
             out_of_view_s: motions
                 .iter()

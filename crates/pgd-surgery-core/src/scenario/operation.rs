@@ -9,7 +9,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::task::TaskMetrics;
+use super::task::{TaskMetrics, results_of};
 use super::tasks::{ClipAndCutResult, DissectionResult};
 use crate::biliary::{DivisionOutcome, Structure};
 
@@ -74,16 +74,8 @@ pub enum Event {
 impl Event {
     /// When the attempt did it (s from its start), each time: empty if it never did.
     pub fn times(self, tasks: &[TaskMetrics]) -> Vec<f64> {
-        let clip_and_cut = || {
-            tasks
-                .iter()
-                .filter_map(TaskMetrics::result::<ClipAndCutResult>)
-        };
-        let dissections = || {
-            tasks
-                .iter()
-                .filter_map(TaskMetrics::result::<DissectionResult>)
-        };
+        let clip_and_cut = || results_of::<ClipAndCutResult>(tasks);
+        let dissections = || results_of::<DissectionResult>(tasks);
         let mut times: Vec<f64> = match self {
             Event::Finished(n) => (tasks.get(n.wrapping_sub(1)).into_iter())
                 .filter(|m| m.completed)

@@ -9,7 +9,7 @@ use std::path::Path;
 use pgd_surgery_core::biliary::Structure;
 use pgd_surgery_core::scenario::{OperationScore, Scenario, parse, score};
 
-use super::task::{ARTERY, DUCT, Event, INSTRUMENTS, competent, run_on, scenario_text};
+use super::task::{ARTERY, DUCT, Event, INSTRUMENTS, careless, competent, run_on, scenario_text};
 
 const OPERATION: &str = r#"operation: Operation(
         steps: [
@@ -69,14 +69,7 @@ fn the_competent_run_earns_every_step_and_makes_no_error() {
 /// clips.
 #[test]
 fn the_careless_run_pays_for_each_error_each_time_in_the_order_made() {
-    let careless = [
-        (3.0, Event::Clip(DUCT, 0.2)),
-        (4.0, Event::Cut(DUCT, 0.6)),
-        (5.0, Event::View),
-        (8.0, Event::Clip(ARTERY, 0.8)),
-        (9.0, Event::Cut(ARTERY, 0.5)),
-    ];
-    let (operation, passed, card_score, feedback) = scored(&careless);
+    let (operation, passed, card_score, feedback) = scored(&careless());
     let steps = done(&operation);
     assert_eq!(steps[1..], [None, None, None], "{operation:?}");
     let errors = made(&operation);

@@ -132,6 +132,18 @@ pub fn run_on(
 pub const DUCT: Structure = Structure::CysticDuct;
 pub const ARTERY: Structure = Structure::CysticArtery;
 
+/// A clip and a cut on the duct before the view, the artery cut with one clip on the
+/// gallbladder's side only.
+pub fn careless() -> Vec<(f64, Event)> {
+    vec![
+        (3.0, Event::Clip(DUCT, 0.2)),
+        (4.0, Event::Cut(DUCT, 0.6)),
+        (5.0, Event::View),
+        (8.0, Event::Clip(ARTERY, 0.8)),
+        (9.0, Event::Cut(ARTERY, 0.5)),
+    ]
+}
+
 pub fn competent() -> Vec<(f64, Event)> {
     vec![
         (5.0, Event::View),
@@ -163,14 +175,7 @@ fn a_competent_clip_and_cut_completes_without_a_mistake() {
 /// gallbladder's side only: its patient stump bleeds.
 #[test]
 fn a_careless_clip_and_cut_names_its_mistakes_in_time_order_and_scores_lower() {
-    let careless = [
-        (3.0, Event::Clip(DUCT, 0.2)),
-        (4.0, Event::Cut(DUCT, 0.6)),
-        (5.0, Event::View),
-        (8.0, Event::Clip(ARTERY, 0.8)),
-        (9.0, Event::Cut(ARTERY, 0.5)),
-    ];
-    let (scenario, metrics) = run(&careless);
+    let (scenario, metrics) = run(&careless());
     let m = &metrics[0];
     assert_eq!(
         m.errors,

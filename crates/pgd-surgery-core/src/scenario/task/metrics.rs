@@ -69,3 +69,8 @@ impl TaskMetrics {
         self.outcome.as_ref()?.get()
     }
 }
+
+/// The results of type `R` among `tasks`', in order.
+pub fn results_of<R: TaskResult>(tasks: &[TaskMetrics]) -> impl Iterator<Item = &R> {
+    tasks.iter().filter_map(TaskMetrics::result::<R>)
+}

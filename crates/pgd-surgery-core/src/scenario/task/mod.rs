@@ -22,7 +22,7 @@ pub use check::{BandEnd, SceneFacts, TaskCheck};
 pub use countertraction::{
     Countertraction, CountertractionMetrics, CountertractionWatch, LET_GO_S, Lapse,
 };
-pub use metrics::TaskMetrics;
+pub use metrics::{TaskMetrics, results_of};
 pub use mistakes::{MISTAKES_LISTED, Mistake, Mistakes};
 pub use watch::{HYSTERESIS, Hold, LimitWatch};
 
