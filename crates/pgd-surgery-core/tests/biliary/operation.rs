@@ -179,6 +179,9 @@ fn the_benchmark_says_which_run_is_proficient() {
     let (scenario_run, metrics) = run_on(scenario(), &careless);
     let card = score(&scenario_run, metrics);
     assert_eq!(card.proficient, Some(false));
+    let debrief = pgd_surgery_core::report::summary(&card);
+    let missing = pgd_surgery_core::report::without_glyph(&debrief);
+    assert!(missing.is_empty(), "no glyph for {missing:?} in {debrief}");
     let unmet: Vec<&str> = (card.benchmark.iter().filter(|l| !l.met))
         .map(|l| l.measure)
         .collect();
