@@ -244,8 +244,9 @@ fn build_and_save_with(
     file: &Path,
     progress: &dyn Progress,
 ) -> Result<(Vademecum, BuildReport, [PathBuf; 2]), String> {
+    let source = job.source;
     finish_and_save(job, file, progress, |organ, settings| {
-        pgd::build(organ, settings, progress).map_err(|e| e.to_string())
+        pgd::build(organ, settings, progress).map_err(|e| format!("{source}: {e}"))
     })
 }
 
@@ -256,9 +257,12 @@ pub fn merge_and_save(
     parts: Vec<pgd::PartFile>,
     file: &Path,
 ) -> Result<(Vademecum, BuildReport, [PathBuf; 2]), String> {
-    let progress = Bar::default();
+    let (source, progress) = (job.source, Bar::default());
     finish_and_save(job, file, &progress, |organ, settings| {
-        pgd::merge(organ, settings, parts, &progress).map_err(|e| e.to_string())
+        pgd::merge(organ, settings, parts, &progress).map_err(|e| match e {
+            pgd::MergeError::Fem(e) => format!("{source}: {e}"),
+            other => other.to_string(),
+        })
     })
 }
 
@@ -300,7 +304,7 @@ fn organ_model<'a>(source: &str, model: &'a FemModel) -> OrganModel<'a> {
     }
 }
 
-/// Makes `job`'s vademecum with `make`, adds its cut section and Newton baseline if asked,
+/// Makes `job`'s vademecum with `make` (its errors said in full), adds its cut section and Newton baseline if asked,
 /// and saves it at `file` with its convergence curves beside it.
 fn finish_and_save(
     job: BuildJob,
@@ -310,8 +314,7 @@ fn finish_and_save(
 ) -> Result<(Vademecum, BuildReport, [PathBuf; 2]), String> {
     let source = job.source;
     let model = model_of(&job)?;
-    let (mut vademecum, mut built) =
-        make(&organ_model(source, &model), &job.settings).map_err(|e| format!("{source}: {e}"))?;
+    let (mut vademecum, mut built) = make(&organ_model(source, &model), &job.settings)?;
     if let Some(cuts) = &job.cuts {
         let report = pgd::add_cuts(&mut vademecum, &model, cuts, progress)
             .map_err(|e| format!("{source}: cut section: {e}"))?;
