@@ -10,8 +10,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::task::{TaskMetrics, results_of};
-use super::tasks::{ClipAndCutResult, DissectionResult};
-use crate::biliary::{DivisionOutcome, Structure};
+use super::tasks::{BurnMade, ClipAndCutResult, ClipPlaced, DissectionResult, DivisionMade};
+use crate::biliary::{DivisionOutcome, Part, Structure};
 
 /// A scenario's operation-level rubric (`operation: Operation(steps: […], errors: […])`):
 /// when present, the attempt's score is this one's.
@@ -72,68 +72,74 @@ pub enum Event {
 }
 
 impl Event {
-    /// When the attempt did it (s from its start), each time: empty if it never did.
-    pub fn times(self, tasks: &[TaskMetrics]) -> Vec<f64> {
+    /// Each time the attempt did it (s from its start), in order, with where: empty if it
+    /// never did.
+    pub fn occurrences(self, tasks: &[TaskMetrics]) -> Vec<Occurrence> {
         let clip_and_cut = || results_of::<ClipAndCutResult>(tasks);
         let dissections = || results_of::<DissectionResult>(tasks);
-        let mut times: Vec<f64> = match self {
+        let clips = || clip_and_cut().flat_map(|r| r.clips.iter());
+        let divisions = || clip_and_cut().flat_map(|r| r.divisions.iter());
+        let burns = || dissections().flat_map(|r| r.burns.iter());
+        let clip_on = |c: &ClipPlaced| Occurrence::on(c.time_s, c.clip.part);
+        let cut_on = |d: &DivisionMade| Occurrence::on(d.time_s, d.division.part);
+        let mut occurrences: Vec<Occurrence> = match self {
             Event::Finished(n) => (tasks.get(n.wrapping_sub(1)).into_iter())
                 .filter(|m| m.completed)
-                .map(|m| m.started_s + m.time_s)
+                .map(|m| Occurrence::at(m.started_s + m.time_s))
                 .collect(),
-            Event::CriticalView => clip_and_cut().filter_map(view_first).collect(),
-            Event::DividedBetweenClips(structure) => clip_and_cut()
-                .flat_map(|r| r.divisions.iter())
+            Event::CriticalView => clip_and_cut()
+                .filter_map(view_first)
+                .map(Occurrence::at)
+                .collect(),
+            Event::DividedBetweenClips(structure) => divisions()
                 .filter(|d| d.division.structure == structure)
                 .filter(|d| d.division.outcome == DivisionOutcome::BetweenClips)
-                .map(|d| d.time_s)
+                .map(cut_on)
                 .take(1)
                 .collect(),
             Event::Released(share) => dissections()
                 .filter(|r| r.released_share >= share)
-                .map(|_| task_end(tasks, |m| m.result::<DissectionResult>().is_some()))
-                .collect(),
-            Event::BeforeCriticalView => clip_and_cut()
-                .flat_map(|r| {
-                    let clips = r.clips.iter().filter(|c| !c.after_view).map(|c| c.time_s);
-                    let cuts = (r.divisions.iter().filter(|d| !d.after_view)).map(|d| d.time_s);
-                    clips.chain(cuts)
+                .map(|_| {
+                    Occurrence::at(task_end(tasks, |m| {
+                        m.result::<DissectionResult>().is_some()
+                    }))
                 })
                 .collect(),
-            Event::BileDuctInjury => clip_and_cut()
-                .flat_map(|r| {
-                    let clips = (r.clips.iter())
-                        .filter(|c| c.clip.structure == Structure::CommonDuct)
-                        .map(|c| c.time_s);
-                    let cuts = (r.divisions.iter())
+            Event::BeforeCriticalView => (clips().filter(|c| !c.after_view).map(clip_on))
+                .chain(divisions().filter(|d| !d.after_view).map(cut_on))
+                .collect(),
+            Event::BileDuctInjury => (clips())
+                .filter(|c| c.clip.structure == Structure::CommonDuct)
+                .map(clip_on)
+                .chain(
+                    divisions()
                         .filter(|d| d.division.outcome == DivisionOutcome::BileDuctInjury)
-                        .map(|d| d.time_s);
-                    clips.chain(cuts)
-                })
+                        .map(cut_on),
+                )
                 .collect(),
-            Event::OpenStump => clip_and_cut()
-                .flat_map(|r| r.divisions.iter())
+            Event::OpenStump => divisions()
                 .filter(|d| d.division.outcome == DivisionOutcome::Open)
-                .map(|d| d.time_s)
+                .map(cut_on)
                 .collect(),
             Event::Perforation => (dissections().filter_map(|r| r.perforation.as_ref()))
-                .map(|p| p.time_s)
+                .map(Occurrence::burned)
                 .collect(),
-            Event::LiverInjury => (dissections().flat_map(|r| r.burns.iter()))
+            Event::LiverInjury => burns()
                 .filter(|b| b.organ == "liver" && b.through_capsule)
-                .map(|b| b.time_s)
+                .map(Occurrence::burned)
                 .collect(),
-            Event::NonTargetBurn => (dissections().flat_map(|r| r.burns.iter()))
-                .map(|b| b.time_s)
-                .collect(),
+            Event::NonTargetBurn => burns().map(Occurrence::burned).collect(),
             Event::BloodLost(ml) => {
                 let lost: f64 = clip_and_cut().map(|r| r.blood_lost_ml).sum();
                 let end = task_end(tasks, |m| m.result::<ClipAndCutResult>().is_some());
-                (lost >= ml).then_some(end).into_iter().collect()
+                (lost >= ml)
+                    .then(|| Occurrence::at(end))
+                    .into_iter()
+                    .collect()
             }
         };
-        times.sort_by(f64::total_cmp);
-        times
+        occurrences.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+        occurrences
     }
 
     /// The task type the event is read from, if it needs one in the scenario: its name as
@@ -172,6 +178,39 @@ fn task_end(tasks: &[TaskMetrics], is: impl Fn(&TaskMetrics) -> bool) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// One time an event happened: when (s from the attempt's start), and where, in words, where
+/// the measures say (the tube clipped or divided, the organ burned and the point).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Occurrence {
+    pub time_s: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub place: Option<String>,
+}
+
+impl Occurrence {
+    fn at(time_s: f64) -> Self {
+        Self {
+            time_s,
+            place: None,
+        }
+    }
+
+    fn on(time_s: f64, part: Part) -> Self {
+        Self {
+            time_s,
+            place: Some(part.name().to_owned()),
+        }
+    }
+
+    fn burned(burn: &BurnMade) -> Self {
+        let [x, y, z] = burn.at_mm;
+        Self {
+            time_s: burn.time_s,
+            place: Some(format!("the {} at ({x:.0}, {y:.0}, {z:.0}) mm", burn.organ)),
+        }
+    }
+}
+
 /// A step as scored: when it was done, if it was.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct StepScored {
@@ -186,7 +225,7 @@ pub struct ErrorScored {
     pub name: String,
     pub points_each: f64,
     pub major: bool,
-    pub made_s: Vec<f64>,
+    pub made: Vec<Occurrence>,
 }
 
 /// The operation's score: the points of the steps done less those of the errors made, as a
@@ -208,7 +247,7 @@ impl OperationRubric {
             .map(|step| StepScored {
                 name: step.name.clone(),
                 points: step.points,
-                done_s: step.done.times(tasks).first().copied(),
+                done_s: step.done.occurrences(tasks).first().map(|o| o.time_s),
             })
             .collect();
         let errors: Vec<ErrorScored> = (self.errors.iter())
@@ -216,19 +255,19 @@ impl OperationRubric {
                 name: error.name.clone(),
                 points_each: error.points,
                 major: error.major,
-                made_s: error.made.times(tasks),
+                made: error.made.occurrences(tasks),
             })
             .collect();
         let earned: f64 = (steps.iter().filter(|s| s.done_s.is_some()))
             .map(|s| s.points)
             .sum();
         let lost: f64 = (errors.iter())
-            .map(|e| e.points_each * e.made_s.len() as f64)
+            .map(|e| e.points_each * e.made.len() as f64)
             .sum();
         let possible: f64 = steps.iter().map(|s| s.points).sum();
         let points = earned - lost;
         OperationScore {
-            major_error: errors.iter().any(|e| e.major && !e.made_s.is_empty()),
+            major_error: errors.iter().any(|e| e.major && !e.made.is_empty()),
             score: (100.0 * points / possible.max(f64::MIN_POSITIVE)).clamp(0.0, 100.0),
             points,
             possible,
@@ -241,15 +280,16 @@ impl OperationRubric {
 impl OperationScore {
     /// The debrief's lines: the errors in the order they were made, then the steps not done.
     pub fn feedback(&self) -> Vec<String> {
-        let mut made: Vec<(f64, &ErrorScored)> = (self.errors.iter())
-            .flat_map(|e| e.made_s.iter().map(move |&t| (t, e)))
+        let mut made: Vec<(&Occurrence, &ErrorScored)> = (self.errors.iter())
+            .flat_map(|e| e.made.iter().map(move |o| (o, e)))
             .collect();
-        made.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let errors = made.into_iter().map(|(time_s, e)| {
+        made.sort_by(|a, b| a.0.time_s.total_cmp(&b.0.time_s));
+        let errors = made.into_iter().map(|(o, e)| {
             let major = if e.major { ", a major error" } else { "" };
+            let place = o.place.as_ref().map_or(String::new(), |p| format!(", {p}"));
             format!(
-                "{time_s:.1} s: {} (−{} points{major})",
-                e.name, e.points_each
+                "{:.1} s: {}{place} (−{} points{major})",
+                o.time_s, e.name, e.points_each
             )
         });
         let missed = (self.steps.iter().filter(|s| s.done_s.is_none()))
@@ -262,7 +302,7 @@ impl OperationScore {
 mod tests {
     use super::*;
     use crate::scenario::task::TaskOutcome;
-    use crate::scenario::tasks::{BurnMade, EnergySpent};
+    use crate::scenario::tasks::EnergySpent;
 
     fn burn(organ: &str, time_s: f64, through_capsule: bool) -> BurnMade {
         BurnMade {
@@ -327,7 +367,9 @@ mod tests {
     fn outcome(task: TaskMetrics) -> (Vec<Option<f64>>, Vec<Vec<f64>>, OperationScore) {
         let scored = rubric().score(&[task]);
         let done = scored.steps.iter().map(|s| s.done_s).collect();
-        let made = scored.errors.iter().map(|e| e.made_s.clone()).collect();
+        let made = (scored.errors.iter())
+            .map(|e| e.made.iter().map(|o| o.time_s).collect())
+            .collect();
         (done, made, scored)
     }
 
@@ -360,7 +402,9 @@ mod tests {
         assert!(scored.major_error);
         assert_eq!(
             scored.feedback(),
-            ["30.0 s: gallbladder perforated (−20 points, a major error)"]
+            [
+                "30.0 s: gallbladder perforated, the gallbladder at (0, 0, 0) mm (−20 points, a major error)"
+            ]
         );
     }
 }

@@ -48,7 +48,9 @@ fn done(operation: &OperationScore) -> Vec<Option<f64>> {
 }
 
 fn made(operation: &OperationScore) -> Vec<Vec<f64>> {
-    operation.errors.iter().map(|e| e.made_s.clone()).collect()
+    (operation.errors.iter())
+        .map(|e| e.made.iter().map(|o| o.time_s).collect())
+        .collect()
 }
 
 #[test]
@@ -83,8 +85,16 @@ fn the_careless_run_pays_for_each_error_each_time_in_the_order_made() {
     assert!(!passed);
     let lines: Vec<&String> = feedback.iter().filter(|l| l.contains("points")).collect();
     let first = |what: &str| lines.iter().position(|l| l.contains(what)).unwrap();
-    assert!(lines[0].starts_with("3.0 s: clip or division before the critical view (−5 points"));
-    assert!(first("4.0 s: a stump left open") < first("9.0 s: a stump left open"));
+    assert!(
+        lines[0].starts_with(
+            "3.0 s: clip or division before the critical view, the cystic duct (−5 points"
+        ),
+        "{lines:?}"
+    );
+    assert!(
+        first("4.0 s: a stump left open, the cystic duct")
+            < first("9.0 s: a stump left open, the cystic artery")
+    );
     assert!(
         lines
             .iter()
@@ -112,7 +122,8 @@ fn a_bile_duct_injury_fails_the_operation() {
     assert!(
         card.feedback
             .iter()
-            .any(|l| l == "6.0 s: bile duct injury (−50 points, a major error)"),
+            .any(|l| l
+                == "6.0 s: bile duct injury, the common bile duct (−50 points, a major error)"),
         "{:?}",
         card.feedback
     );
