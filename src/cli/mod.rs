@@ -35,9 +35,7 @@ pub use parse::{
     parse_subdivisions,
 };
 pub use pgd_bench_dynamics::{DynamicsRequest, bench_dynamics, plot_energy};
-pub use pgd_build::{
-    PartReport, build_part, build_vademecum, default_part, merge_vademecum, print_build_report,
-};
+pub use pgd_build::{PartReport, build_part, build_vademecum, merge_vademecum, print_build_report};
 pub use pgd_fit::{FitReport, fit_uniaxial_test, plot_fit};
 pub use pgd_indent::{
     IndentReport, IndentRequest, LawCurve, indent_organ, plot_indentation, print_indentation,

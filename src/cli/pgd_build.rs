@@ -17,7 +17,16 @@ pub fn build_vademecum(
     out: &Path,
     distance_field: bool,
 ) -> Result<BuildReport, String> {
-    let (vademecum, report, curves) = store::build_and_save(job, out)?;
+    saved(store::build_and_save(job, out)?, out, distance_field)
+}
+
+/// What a build or a merge saved at `out`: its curves named, its distance field written if
+/// asked; its report.
+fn saved(
+    (vademecum, report, curves): (pgd::Vademecum, BuildReport, [PathBuf; 2]),
+    out: &Path,
+    distance_field: bool,
+) -> Result<BuildReport, String> {
     print_curves(curves);
     if distance_field {
         write_distance_field(&vademecum, &out.with_extension("vdf"))?;
@@ -34,16 +43,12 @@ pub fn merge_vademecum(
     distance_field: bool,
 ) -> Result<BuildReport, String> {
     let shards: f64 = parts.iter().map(|p| p.part.header.seconds).sum();
-    let (vademecum, report, curves) = store::merge_and_save(job, parts, out)?;
+    let merged = store::merge_and_save(job, parts, out)?;
     eprintln!(
         "merged: the shards took {shards:.1} s together, the merge {:.1} s",
-        report.total_seconds
+        merged.1.total_seconds
     );
-    print_curves(curves);
-    if distance_field {
-        write_distance_field(&vademecum, &out.with_extension("vdf"))?;
-    }
-    Ok(report)
+    saved(merged, out, distance_field)
 }
 
 /// What `pgd build --shard` did.
@@ -107,7 +112,7 @@ pub fn build_part(
 
 /// Where shard `shard` of the vademecum `out` is written unless named: `liver.vdm` gives
 /// `liver.part-2-of-4.vdp`.
-pub fn default_part(out: &Path, shard: pgd::Shard) -> PathBuf {
+fn default_part(out: &Path, shard: pgd::Shard) -> PathBuf {
     out.with_extension(format!("part-{}-of-{}.vdp", shard.index, shard.count))
 }
 

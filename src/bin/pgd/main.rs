@@ -3,7 +3,7 @@
 
 mod args;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use args::{
@@ -19,7 +19,7 @@ use pgd_surgery::cutting::keratotomy::{Cornea, Keratotomy};
 use pgd_surgery::devices::PressMotion;
 use pgd_surgery::fem::Law;
 use pgd_surgery::mesh::organs::Organ;
-use pgd_surgery::pgd::ValidationSettings;
+use pgd_surgery::pgd::{self, ValidationSettings};
 use pgd_surgery::scenario::default_law;
 use pgd_surgery::store::{Bar, BuildJob, OnStale};
 use pgd_surgery::{app, bench};
@@ -150,7 +150,7 @@ fn main() -> ExitCode {
 /// A build's report as JSON or as its table, or its error.
 fn print_build(
     command: &str,
-    built: Result<pgd_surgery::pgd::BuildReport, String>,
+    built: Result<pgd::BuildReport, String>,
     out: &Path,
     json: bool,
 ) -> ExitCode {
@@ -167,20 +167,19 @@ fn print_build(
 /// `pgd merge`: the parts read, the model made again from the build arguments they keep, and
 /// the vademecum joined from them.
 fn merge_command(
-    parts: &[std::path::PathBuf],
-    out: Option<std::path::PathBuf>,
+    parts: &[PathBuf],
+    out: Option<PathBuf>,
     distance_field: bool,
     json: bool,
 ) -> ExitCode {
     let loaded = match parts
         .iter()
-        .map(|p| pgd_surgery::pgd::load_part(p))
-        .collect()
+        .map(|p| pgd::load_part(p))
+        .collect::<Result<Vec<_>, _>>()
     {
         Ok(loaded) => loaded,
         Err(e) => return fail("pgd merge", &e.to_string()),
     };
-    let loaded: Vec<pgd_surgery::pgd::PartFile> = loaded;
     let command = &loaded[0].part.header.command;
     let arguments = std::iter::once("pgd").chain(command.iter().map(String::as_str));
     let Ok(Cli {

@@ -102,7 +102,6 @@ pub struct PartHeader {
     pub shard: Shard,
     /// What makes the organ's model again for the merge: the `pgd build` arguments.
     pub command: Vec<String>,
-    pub source: String,
     pub mesh_hash: String,
     pub settings: BuildSettings,
     /// All the build's positions, and this part's.
@@ -194,7 +193,6 @@ pub fn build_shard(
         let header = PartHeader {
             shard,
             command,
-            source: organ.source.clone(),
             mesh_hash: mesh_hash(organ.model.mesh()),
             settings: settings.clone(),
             total_positions,
@@ -320,13 +318,14 @@ fn joined_step<'a>(parts: &[PartFile], s: usize, corrections: &'a Responses) -> 
 
 /// The parts in shard order, refused unless they are every shard of one build, once.
 fn in_order(mut parts: Vec<PartFile>) -> Result<Vec<PartFile>, MergeError> {
-    let first = parts.first().ok_or(MergeError::NoParts)?;
-    let (first_path, first_header) = (first.path.clone(), first.part.header.clone());
-    for part in &parts[1..] {
+    let (first, rest) = parts.split_first().ok_or(MergeError::NoParts)?;
+    let first_header = &first.part.header;
+    let count = first_header.shard.count;
+    for part in rest {
         let header = &part.part.header;
         let other = |what| MergeError::OtherBuild {
             file: part.path.clone(),
-            first: first_path.clone(),
+            first: first.path.clone(),
             what,
         };
         if header.command != first_header.command {
@@ -338,7 +337,7 @@ fn in_order(mut parts: Vec<PartFile>) -> Result<Vec<PartFile>, MergeError> {
         if header.settings != first_header.settings {
             return Err(other("build settings"));
         }
-        if header.shard.count != first_header.shard.count {
+        if header.shard.count != count {
             return Err(other("shard counts"));
         }
     }
@@ -353,7 +352,6 @@ fn in_order(mut parts: Vec<PartFile>) -> Result<Vec<PartFile>, MergeError> {
             shard: pair[0].part.header.shard,
         });
     }
-    let count = first_header.shard.count;
     let missing: Vec<usize> = (1..=count)
         .filter(|k| !parts.iter().any(|p| p.part.header.shard.index == *k))
         .collect();

@@ -140,82 +140,104 @@ pub struct BenchmarkLine {
     pub met: bool,
 }
 
+/// One value a benchmark can hold: its field in the scenario, its name in the debrief, the
+/// value given, whether it is a floor rather than a ceiling, the largest it may be (the
+/// smallest is 0), and the attempt's value it is held against.
+pub(super) struct Limit {
+    pub(super) field: &'static str,
+    measure: &'static str,
+    pub(super) benchmark: Option<f64>,
+    at_least: bool,
+    pub(super) most: f64,
+    attempt: fn(&GlobalMeasures, f64) -> f64,
+}
+
 impl Benchmark {
-    /// Each value the benchmark holds, against the attempt's `measures` and `score`.
-    pub fn compare(&self, measures: &GlobalMeasures, score: f64) -> Vec<BenchmarkLine> {
-        let line = |measure, value: f64, benchmark: Option<f64>, at_least: bool| {
-            benchmark.map(|benchmark| BenchmarkLine {
-                measure,
-                value,
-                benchmark,
-                at_least,
-                met: if at_least {
-                    value >= benchmark
-                } else {
-                    value <= benchmark
-                },
-            })
+    /// Every value a benchmark can hold, with this one's given where it gives them.
+    pub(super) fn limits(&self) -> [Limit; 8] {
+        let limit = |field, measure, benchmark, at_least, most, attempt| Limit {
+            field,
+            measure,
+            benchmark,
+            at_least,
+            most,
+            attempt,
         };
-        let m = measures;
+        let any = f64::MAX;
         [
-            line("score", score, self.score, true),
-            line("time (s)", m.time_s, self.time_s, false),
-            line(
+            limit("score", "score", self.score, true, 100.0, |_, score| score),
+            limit("time_s", "time (s)", self.time_s, false, any, |m, _| {
+                m.time_s
+            }),
+            limit(
+                "path_mm",
                 "path, both hands (mm)",
-                m.path_mm[0] + m.path_mm[1],
                 self.path_mm,
                 false,
+                any,
+                |m, _| m.path_mm[0] + m.path_mm[1],
             ),
-            line(
+            limit(
+                "out_of_view_s",
                 "out of view (s)",
-                m.out_of_view_s,
                 self.out_of_view_s,
                 false,
+                any,
+                |m, _| m.out_of_view_s,
             ),
-            line(
+            limit(
+                "both_hands_share",
                 "both hands together",
-                m.both_hands_share.unwrap_or(0.0),
                 self.both_hands_share,
                 true,
+                1.0,
+                |m, _| m.both_hands_share.unwrap_or(0.0),
             ),
-            line(
+            limit(
+                "over_limit_s",
                 "above the force limits (s)",
-                m.over_limit_s,
                 self.over_limit_s,
                 false,
+                any,
+                |m, _| m.over_limit_s,
             ),
-            line(
+            limit(
+                "burns",
                 "non-target burns",
-                m.burns as f64,
                 self.burns.map(|b| b as f64),
                 false,
+                any,
+                |m, _| m.burns as f64,
             ),
-            line(
+            limit(
+                "blood_lost_ml",
                 "blood lost (ml)",
-                m.blood_lost_ml,
                 self.blood_lost_ml,
                 false,
+                any,
+                |m, _| m.blood_lost_ml,
             ),
         ]
-        .into_iter()
-        .flatten()
-        .collect()
     }
 
-    /// The values it holds, named as the scenario writes them, for checking.
-    pub fn values(&self) -> Vec<(&'static str, f64)> {
-        let values = [
-            ("score", self.score),
-            ("time_s", self.time_s),
-            ("path_mm", self.path_mm),
-            ("out_of_view_s", self.out_of_view_s),
-            ("both_hands_share", self.both_hands_share),
-            ("over_limit_s", self.over_limit_s),
-            ("burns", self.burns.map(|b| b as f64)),
-            ("blood_lost_ml", self.blood_lost_ml),
-        ];
-        (values.into_iter())
-            .filter_map(|(name, v)| v.map(|v| (name, v)))
+    /// Each value the benchmark holds, against the attempt's `measures` and `score`.
+    pub fn compare(&self, measures: &GlobalMeasures, score: f64) -> Vec<BenchmarkLine> {
+        (self.limits().into_iter())
+            .filter_map(|limit| {
+                let benchmark = limit.benchmark?;
+                let value = (limit.attempt)(measures, score);
+                Some(BenchmarkLine {
+                    measure: limit.measure,
+                    value,
+                    benchmark,
+                    at_least: limit.at_least,
+                    met: if limit.at_least {
+                        value >= benchmark
+                    } else {
+                        value <= benchmark
+                    },
+                })
+            })
             .collect()
     }
 }

@@ -591,14 +591,13 @@ fn check_operation(scenario: &Scenario, operation: &OperationRubric, problems: &
                 .into(),
         });
     }
-    let steps = (operation.steps.iter()).map(|s| ("steps", "Step", &s.name, s.points, s.done));
-    let errors = (operation.errors.iter()).map(|e| ("errors", "Error", &e.name, e.points, e.made));
-    let mut seen = [0usize; 2];
-    for (list, variant, name, points, event) in steps.chain(errors) {
-        let k = &mut seen[usize::from(list == "errors")];
+    let steps = (operation.steps.iter().enumerate())
+        .map(|(k, s)| ("steps", k, "Step", &s.name, s.points, s.done));
+    let errors = (operation.errors.iter().enumerate())
+        .map(|(k, e)| ("errors", k, "Error", &e.name, e.points, e.made));
+    for (list, k, variant, name, points, event) in steps.chain(errors) {
         let field = format!("operation.{list}[{k}]");
         let anchors = || vec!["operation".into(), list.into(), format!("\"{name}\"")];
-        *k += 1;
         if !(points.is_finite() && points > 0.0) {
             problems.push(Problem {
                 field: format!("{field}.points"),
@@ -618,22 +617,22 @@ fn check_operation(scenario: &Scenario, operation: &OperationRubric, problems: &
     }
 }
 
-/// A benchmark's values: a score from 0 to 100, a share from 0 to 1, the others 0 or more.
+/// A benchmark's values, each from 0 to the most it may be (a score 100, a share 1).
 fn check_benchmark(benchmark: &Benchmark, problems: &mut Vec<Problem>) {
-    for (name, value) in benchmark.values() {
-        let (range, hint) = match name {
-            "score" => (0.0..=100.0, "a score from 0 to 100"),
-            "both_hands_share" => (0.0..=1.0, "a share from 0 to 1"),
-            _ => (0.0..=f64::MAX, "a value of 0 or more"),
+    for limit in benchmark.limits() {
+        let Some(value) = limit.benchmark.filter(|v| !(0.0..=limit.most).contains(v)) else {
+            continue;
         };
-        if !range.contains(&value) {
-            problems.push(Problem {
-                field: format!("benchmark.{name}"),
-                anchors: vec!["benchmark".into(), name.into()],
-                message: format!("{value} is out of range"),
-                hint: hint.into(),
-            });
-        }
+        let hint = match limit.most {
+            f64::MAX => "a value of 0 or more".to_owned(),
+            most => format!("a value from 0 to {most}"),
+        };
+        problems.push(Problem {
+            field: format!("benchmark.{}", limit.field),
+            anchors: vec!["benchmark".into(), limit.field.into()],
+            message: format!("{value} is out of range"),
+            hint,
+        });
     }
 }
 

@@ -275,7 +275,7 @@ pub fn build_part(
     file: &Path,
 ) -> Result<pgd::PartHeader, String> {
     let source = job.source;
-    let model = model_of(&job)?;
+    let model = model_of(source, job.mesh, job.material, job.inclusions)?;
     let part = pgd::build_shard(
         &organ_model(source, &model),
         &job.settings,
@@ -288,11 +288,16 @@ pub fn build_part(
     Ok(part.header)
 }
 
-/// The clamped model of `job`'s mesh, material and stiffer regions.
-fn model_of(job: &BuildJob) -> Result<FemModel, String> {
-    pgd::organ::clamped_model(job.mesh.clone(), job.material)
-        .and_then(|model| model.with_inclusions(job.inclusions))
-        .map_err(|e| format!("{}: {e}", job.source))
+/// The clamped model of the mesh of `source`, its material and stiffer regions.
+fn model_of(
+    source: &str,
+    mesh: TetMesh,
+    material: Material,
+    inclusions: &[Inclusion],
+) -> Result<FemModel, String> {
+    pgd::organ::clamped_model(mesh, material)
+        .and_then(|model| model.with_inclusions(inclusions))
+        .map_err(|e| format!("{source}: {e}"))
 }
 
 fn organ_model<'a>(source: &str, model: &'a FemModel) -> OrganModel<'a> {
@@ -304,8 +309,8 @@ fn organ_model<'a>(source: &str, model: &'a FemModel) -> OrganModel<'a> {
     }
 }
 
-/// Makes `job`'s vademecum with `make` (its errors said in full), adds its cut section and Newton baseline if asked,
-/// and saves it at `file` with its convergence curves beside it.
+/// Makes `job`'s vademecum with `make` (its errors said in full), adds its cut section and
+/// Newton baseline if asked, and saves it at `file` with its convergence curves beside it.
 fn finish_and_save(
     job: BuildJob,
     file: &Path,
@@ -313,7 +318,7 @@ fn finish_and_save(
     make: impl FnOnce(&OrganModel, &BuildSettings) -> Result<(Vademecum, BuildReport), String>,
 ) -> Result<(Vademecum, BuildReport, [PathBuf; 2]), String> {
     let source = job.source;
-    let model = model_of(&job)?;
+    let model = model_of(source, job.mesh, job.material, job.inclusions)?;
     let (mut vademecum, mut built) = make(&organ_model(source, &model), &job.settings)?;
     if let Some(cuts) = &job.cuts {
         let report = pgd::add_cuts(&mut vademecum, &model, cuts, progress)
