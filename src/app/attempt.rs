@@ -8,8 +8,8 @@ use std::time::Duration;
 use nalgebra::Vector3;
 
 use super::haptic::{
-    ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SceneBiliary,
-    SceneHand, SceneScope, SettleCuts, TickClock, view_record,
+    ExerciseLink, ExerciseRun, HapticLoop, HapticScene, OrganBody, OrganCut, SceneAssistant,
+    SceneBiliary, SceneHand, SceneScope, SettleCuts, TickClock, view_record,
 };
 use super::scene::{Detail, SceneOrgan, scene_files, scene_of, scene_vademecums, tie_organs};
 use crate::contact::{ContactSurface, CouplingSettings};
@@ -17,8 +17,8 @@ use crate::devices::{HapticDevice, Instrument, ScopeHandle, TICK_S, Workspace, s
 use crate::mesh::organs::Organ;
 use crate::scenario::tasks::RadialKeratotomy;
 use crate::scenario::{
-    self, CutMade, Exercise, Keratometer, LaparoscopeEntry, Nodule, NoduleSite, OrganEntry, Port,
-    RegionSite, Scenario, Scorecard, Sites, Task, Tool, score,
+    self, Assistant, CutMade, Exercise, Keratometer, LaparoscopeEntry, Nodule, NoduleSite,
+    OrganEntry, Port, RegionSite, Scenario, Scorecard, Sites, Task, Tool, score,
 };
 use crate::store::{OnStale, OrganSource, VademecumSpec};
 
@@ -49,6 +49,9 @@ pub fn scenario_scene(
             workspace,
         })
         .collect();
+    scene.assistant = (scenario.assistant.as_ref())
+        .map(scene_assistant)
+        .transpose()?;
     scene.scope = scenario.laparoscope.as_ref().and_then(scene_scope);
     if let (Some(cutting), Some(blade)) = (&mut scene.cutting, scenario.blade()) {
         cutting.blade = blade;
@@ -63,6 +66,16 @@ pub fn scenario_scene(
         });
     }
     Ok(scene)
+}
+
+/// The scenario's assistant as the haptic loop moves it.
+fn scene_assistant(assistant: &Assistant) -> Result<SceneAssistant, String> {
+    let script = (assistant.trajectory())
+        .ok_or("the assistant's script: a tip out of its instrument's reach")?;
+    Ok(SceneAssistant {
+        port: assistant.port.fulcrum(),
+        script,
+    })
 }
 
 /// An instrument of the scenario's as the haptic loop holds it.

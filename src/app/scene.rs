@@ -371,6 +371,7 @@ pub fn scene_of(
         scope: None,
         biliary: None,
         meanwhile,
+        assistant: None,
     })
 }
 

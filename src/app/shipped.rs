@@ -29,6 +29,7 @@ macro_rules! with_shipped_stems {
             "gallbladder-liver-two-ports",
             "gallbladder-retraction",
             "lap-chole-clip-and-cut",
+            "lap-chole-full",
             "liver-capsule-incision",
             "liver-laparoscopic-press",
             "pancreas-palpation",

@@ -7,22 +7,24 @@
 //! order, and scores lower. The runs are made from the scenario's own tree, as the
 //! retraction leaves it, and its ports, and checked to be.
 
-use std::fmt::Write as _;
 use std::path::Path;
 
 use nalgebra::Vector3;
 use pgd_surgery::app::attempt::Outcome;
 use pgd_surgery::app::attempt::scenario_scene;
-use pgd_surgery::app::haptic::{Biliary, HapticLoop, TickClock};
 use pgd_surgery::app::scene::Detail;
-use pgd_surgery::biliary::{BiliaryTree, FatStrand, Structure, ViewRecord};
-use pgd_surgery::devices::{Fulcrum, HapticDevice, Instrument, Rack, Scripted, TICK_S, Trajectory};
-use pgd_surgery::mesh::organs::{Abdomen, Organ, OrganSettings};
+use pgd_surgery::biliary::{Structure, ViewRecord};
+use pgd_surgery::mesh::organs::{Abdomen, OrganSettings};
 use pgd_surgery::report::critical_view::{FAT, Projection, SIZE, Side, colour_of, rgb};
 use pgd_surgery::report::write_report;
 use pgd_surgery::scenario::tasks::ClipAndCutResult;
 use pgd_surgery::scenario::{Scenario, load};
 use pgd_surgery::store::OnStale;
+
+use super::script::{
+    BLADE_M, BURN_S, CLIPS_AT, CLOSE_S, CUT_AT, JAW_M, LEFT_START_M, Plane, Script, by_strand,
+    grasp_point, retracted,
+};
 
 const NAME: &str = "lap-chole-clip-and-cut";
 
@@ -156,279 +158,6 @@ fn the_careless_clip_and_cut_fails_naming_what_it_did_before_the_view() {
     );
 }
 
-/// A script of both hands' devices: the right hand's through the scenario's one port (its
-/// rows, the time, the instruments' rack, whose offset the second button changes, and the
-/// tip) and the left hand's grasper through its own.
-struct Script {
-    csv: String,
-    tip_radius_m: f64,
-    time_s: f64,
-    port: Fulcrum,
-    rack: Rack,
-    tip_m: Vector3<f64>,
-    left: LeftHand,
-}
-
-/// The left hand's grasper: its port, its tip and whether its jaws are closed.
-struct LeftHand {
-    port: Fulcrum,
-    tip_m: Vector3<f64>,
-    closed: bool,
-}
-
-/// Instruments take a moment to move between points and to close (s); the hook is held on
-/// the fat while its energy divides the strands within reach (30 W: about 7 J a strand).
-const MOVE_S: f64 = 0.6;
-const CLOSE_S: f64 = 0.25;
-const BURN_S: f64 = 1.2;
-/// The left grasper takes the infundibulum this far along the gallbladder's axis from its
-/// fundus, its tip's sphere this far into the wall (m); then draws its tip laterally this
-/// far over this time (m, s), and keeps it there while the retraction's hold is scored.
-const INFUNDIBULUM_T: f64 = 0.75;
-const GRASP_INTO_M: f64 = 2.3e-3;
-const LEFT_DRAW_M: f64 = 0.022;
-const LEFT_DRAW_S: f64 = 1.0;
-const RETRACTION_HELD_S: f64 = 2.0;
-/// The left grasper starts this far lateral of where it takes the infundibulum (m).
-const LEFT_START_M: f64 = 0.024;
-
-/// Where the competent run clips each tube (two on the patient's side, one on the
-/// gallbladder's) and cuts it, as shares of its length from the patient's end.
-const CLIPS_AT: [f64; 3] = [0.2, 0.35, 0.62];
-const CUT_AT: f64 = 0.5;
-/// The clip applier's jaws and the scissors' blades (m), as the scenario gives them.
-const JAW_M: f64 = 9e-3;
-const BLADE_M: f64 = 15e-3;
-
-impl Script {
-    /// Both hands at their starts: the left grasper's tip `left_m` beside the infundibulum.
-    fn new(
-        scenario: &Scenario,
-        start_m: Vector3<f64>,
-        left_m: Vector3<f64>,
-        tip_radius_m: f64,
-    ) -> Self {
-        let port = scenario.instruments[0].port.fulcrum();
-        let instruments: Vec<Instrument> = (scenario.instruments.iter())
-            .map(|i| Instrument {
-                action: i.tool.action(),
-                port: Some(i.port.fulcrum()),
-            })
-            .collect();
-        let mut script = Self {
-            csv: "time_s,x_m,y_m,z_m,buttons,left_x_m,left_y_m,left_z_m,left_buttons\n".into(),
-            tip_radius_m,
-            time_s: 0.0,
-            port,
-            rack: Rack::new(&instruments),
-            tip_m: start_m,
-            left: LeftHand {
-                port: scenario.left_hand[0].port.fulcrum(),
-                tip_m: left_m,
-                closed: false,
-            },
-        };
-        script.row(0);
-        script
-    }
-
-    fn device_m(&self) -> Vector3<f64> {
-        self.port.handle_for(&self.tip_m).unwrap() - self.rack.offset_m()
-    }
-
-    fn row(&mut self, buttons: u32) {
-        let d = self.device_m();
-        let left = &self.left;
-        let l = left.port.handle_for(&left.tip_m).unwrap();
-        writeln!(
-            self.csv,
-            "{:.3},{:.6},{:.6},{:.6},{buttons},{:.6},{:.6},{:.6},{}",
-            self.time_s,
-            d.x,
-            d.y,
-            d.z,
-            l.x,
-            l.y,
-            l.z,
-            u32::from(left.closed)
-        )
-        .unwrap();
-    }
-
-    /// Moves the left grasper's tip to `to_m` over `over_s`, the right hand still.
-    fn left_to(&mut self, to_m: Vector3<f64>, over_s: f64) {
-        self.time_s += over_s;
-        self.left.tip_m = to_m;
-        self.row(0);
-    }
-
-    /// Closes or opens the left grasper's jaws where its tip is.
-    fn left_jaws(&mut self, closed: bool) {
-        self.time_s += 0.001;
-        self.left.closed = closed;
-        self.row(0);
-    }
-
-    /// The left hand takes the infundibulum at `grasp_m` and draws it laterally, then both
-    /// hands wait for the retraction's hold to be scored.
-    fn retract(&mut self, grasp_m: Vector3<f64>) {
-        self.left_to(grasp_m, MOVE_S + 0.9);
-        self.left_jaws(true);
-        self.left_to(grasp_m + Vector3::x() * LEFT_DRAW_M, LEFT_DRAW_S);
-        self.time_s += RETRACTION_HELD_S;
-        self.row(0);
-    }
-
-    /// Moves the tip to `to_m`, buttons up.
-    fn go(&mut self, to_m: Vector3<f64>) {
-        self.time_s += MOVE_S;
-        self.tip_m = to_m;
-        self.row(0);
-    }
-
-    /// Holds the first button down where the tip is for `hold_s`.
-    fn press(&mut self, hold_s: f64) {
-        self.time_s += 0.001;
-        self.row(1);
-        self.time_s += hold_s;
-        self.row(1);
-        self.time_s += 0.001;
-        self.row(0);
-    }
-
-    /// Changes to the next instrument where the tip is; the new one's tip goes where the
-    /// rack puts it, and the script moves it back to `self.tip_m`.
-    fn change(&mut self) {
-        let device = self.device_m();
-        self.time_s += 0.001;
-        self.row(2);
-        self.rack.take(2, &device, &self.tip_m, || true);
-        self.rack.take(0, &device, &self.tip_m, || true);
-        let taken_up = self
-            .port
-            .pose(&(device + self.rack.offset_m()))
-            .unwrap()
-            .tip_m;
-        let back_to = std::mem::replace(&mut self.tip_m, taken_up);
-        self.time_s += 0.05;
-        self.row(0);
-        self.go(back_to);
-    }
-
-    /// Closes the jaws (or blades), `jaw_m` long beyond the tip's sphere, across `structure`
-    /// at `share` of its length, the tube halfway along them.
-    fn close_across(&mut self, tree: &BiliaryTree, structure: Structure, share: f64, jaw_m: f64) {
-        let tube = tree.tube(structure);
-        let on = tube.point_at(share * tube.length_m());
-        let along = (on - self.port.port_m).normalize();
-        let tip = on - along * (self.tip_radius_m + jaw_m / 2.0);
-        self.go(tip - along * 0.01);
-        self.go(tip);
-        self.press(CLOSE_S);
-        self.go(tip - along * 0.01);
-    }
-
-    /// Checks that the shipped run `script` is this one; with `PGD_WRITE_RUNS` set, writes it.
-    fn check_or_write(&self, script: &str) {
-        let path = super::root().join(format!("scenarios/runs/{NAME}.{script}.csv"));
-        if std::env::var_os("PGD_WRITE_RUNS").is_some() {
-            std::fs::write(&path, &self.csv).unwrap();
-            return;
-        }
-        let shipped = std::fs::read_to_string(&path).unwrap();
-        assert!(
-            shipped == self.csv,
-            "{} is not what the scene's tree and port make now: write it anew with \
-             PGD_WRITE_RUNS=1 cargo test --test scenarios clip_and_cut_runs",
-            path.display()
-        );
-    }
-}
-
-/// The hook's tip `tip_m` in radius beside a strand, on its side away from the tubes and
-/// clear of them (along the normal of the ducts' plane), where it keeps clearest of the
-/// organs.
-fn by_strand(abdomen: &Abdomen, strand: &FatStrand, plane: &Plane, tip_m: f64) -> Vector3<f64> {
-    let clearance = |p: &Vector3<f64>| {
-        [Organ::Liver, Organ::Gallbladder, Organ::Duodenum]
-            .map(|o| abdomen.value(o, &(*p).into()))
-            .into_iter()
-            .fold(f64::INFINITY, f64::min)
-    };
-    let axis = strand.axis;
-    let depth = (axis.at(0.5) - plane.point).dot(&plane.normal);
-    let beyond = (tip_m + COMMON_DUCT_RADIUS_M + CLEAR_OF_TUBES_M - depth.abs()).max(0.0);
-    (1..10)
-        .map(|k| axis.at(k as f64 / 10.0) + plane.normal * (depth.signum() * beyond))
-        .max_by(|a, b| clearance(a).total_cmp(&clearance(b)))
-        .unwrap()
-}
-
-/// Where the left grasper's tip takes the infundibulum: lateral of its axis, its sphere
-/// `GRASP_INTO_M` into the wall.
-fn grasp_point(abdomen: &Abdomen, tip_m: f64) -> Vector3<f64> {
-    let (fundus, neck) = abdomen.gallbladder_axis_m();
-    let mut at = fundus.coords + (neck - fundus) * INFUNDIBULUM_T;
-    while abdomen.value(Organ::Gallbladder, &at.into()) < tip_m - GRASP_INTO_M {
-        at.x += 1e-4;
-    }
-    at
-}
-
-/// The tree as the left hand's retraction leaves it: `script` (the retraction, the right hand
-/// still) run on the scenario's scene.
-fn retracted(scenario: &Scenario, script: &Script) -> BiliaryTree {
-    let scene = scenario_scene(
-        scenario,
-        super::vademecums(),
-        Detail::Coarse,
-        OnStale::Refuse,
-    );
-    let scene = scene.unwrap();
-    let hands = Trajectory::read_hands(Path::new("retraction"), script.csv.as_bytes()).unwrap();
-    let devices = (hands.into_iter())
-        .map(|hand| Box::new(Scripted::new("retraction", hand)) as Box<dyn HapticDevice>)
-        .collect();
-    let mut haptic = HapticLoop::with_devices(&scene, devices).unwrap();
-    let ticks = (script.time_s / TICK_S).round() as u64;
-    for tick in 0..=ticks {
-        haptic.tick(TickClock {
-            tick,
-            time_s: tick as f64 * TICK_S,
-            overruns_in_a_row: 0,
-        });
-    }
-    haptic.world().resource::<Biliary>().tree().clone()
-}
-
-/// The hook keeps this far clear of the tubes (m) beyond its tip's radius.
-const CLEAR_OF_TUBES_M: f64 = 1e-3;
-
-/// The usual common duct's radius (m).
-const COMMON_DUCT_RADIUS_M: f64 = 3e-3;
-
-/// The plane of the cystic and common hepatic ducts.
-struct Plane {
-    point: Vector3<f64>,
-    normal: Vector3<f64>,
-}
-
-impl Plane {
-    fn of(tree: &BiliaryTree) -> Self {
-        let junction = tree.tube(Structure::CommonDuct).rod.positions[tree.junction_node];
-        let cystic = tree.tube(Structure::CysticDuct);
-        let gallbladder_end = cystic.rod.positions[cystic.rod.nodes() - 1];
-        let hilum = tree.tube(Structure::CommonDuct).rod.positions[0];
-        let normal = (gallbladder_end - junction)
-            .cross(&(hilum - junction))
-            .normalize();
-        Self {
-            point: junction,
-            normal,
-        }
-    }
-}
-
 /// The scenario's two scripted runs are what its own tree and port make (with
 /// `PGD_WRITE_RUNS` set, they are written anew: after a change to the scene).
 #[test]
@@ -460,8 +189,7 @@ fn the_clip_and_cut_runs_are_made_from_the_scenes_tree() {
         competent.press(BURN_S);
     }
     competent.go(start);
-    competent.time_s += 1.0;
-    competent.row(0);
+    competent.wait(1.0);
     competent.change();
     for structure in [duct, artery] {
         for share in CLIPS_AT {
@@ -474,9 +202,8 @@ fn the_clip_and_cut_runs_are_made_from_the_scenes_tree() {
         competent.close_across(&tree, structure, CUT_AT, BLADE_M);
     }
     competent.go(start);
-    competent.time_s += 1.0;
-    competent.row(0);
-    competent.check_or_write("competent");
+    competent.wait(1.0);
+    competent.check_or_write(NAME, "competent");
 
     let mut careless = Script::new(&scenario, start, left_start, tip_m);
     careless.retract(grasp);
@@ -494,7 +221,6 @@ fn the_clip_and_cut_runs_are_made_from_the_scenes_tree() {
     careless.close_across(&tree, duct, 0.5, BLADE_M);
     careless.close_across(&tree, artery, 0.5, BLADE_M);
     careless.go(start);
-    careless.time_s += 3.0;
-    careless.row(0);
-    careless.check_or_write("careless");
+    careless.wait(3.0);
+    careless.check_or_write(NAME, "careless");
 }

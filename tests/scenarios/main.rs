@@ -19,7 +19,9 @@ mod fuzz_files;
 mod glyphs;
 mod history;
 mod motion;
+mod operation;
 mod postgres_server;
+mod script;
 mod shared_history;
 mod soak;
 mod stiffening;
@@ -95,7 +97,7 @@ fn run_scenario(scenario: Scenario, name: &str, script: &str) -> Outcome {
     run_simulated(scenario, &scene, devices, ticks).unwrap()
 }
 
-const SHIPPED: [&str; 16] = [
+const SHIPPED: [&str; 17] = [
     "liver-steady-press",
     "pancreas-palpation",
     "gallbladder-gentle-press",
@@ -112,6 +114,7 @@ const SHIPPED: [&str; 16] = [
     "bimanual-liver-lift",
     "gallbladder-liver-bed-dissection",
     "lap-chole-clip-and-cut",
+    "lap-chole-full",
 ];
 
 #[test]
@@ -502,6 +505,18 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             5,
             "angle_deg",
             "not a laparoscope's angle",
+        ),
+        (
+            "assistant-out-of-reach",
+            10,
+            "assistant.script[1]",
+            "out of reach of a 350 mm instrument",
+        ),
+        (
+            "assistant-with-a-hook",
+            6,
+            "assistant.tool",
+            "the assistant holds a grasper",
         ),
         (
             "laparoscope-script-backwards",

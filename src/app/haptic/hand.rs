@@ -12,11 +12,15 @@ use crate::devices::{
     Action, DeviceSample, Fault, Fulcrum, HapticDevice, Pose, Rack, SafetyFilter, Workspace,
 };
 
-/// The most hands a scene has: a surgeon's two.
-pub const MAX_HANDS: usize = 2;
+/// The most hands the trainee works with: a surgeon's two.
+pub const TRAINEE_HANDS: usize = 2;
+
+/// The most hands a scene has: the trainee's two and an assistant's.
+pub const MAX_HANDS: usize = TRAINEE_HANDS + 1;
 
 /// A hand's place among the scene's hands: its organs' touch and load slot, its column of a
-/// bimanual trajectory. 0 is the right hand (the only one of a one-hand scene), 1 the left.
+/// bimanual trajectory. 0 is the right hand (the only one of a one-hand scene), 1 the left;
+/// the assistant's, when the scene has one, comes after the trainee's.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct HandIndex(pub usize);
 
@@ -26,7 +30,7 @@ impl HandIndex {
         match self.0 {
             0 => "right hand",
             1 => "left hand",
-            _ => "extra hand",
+            _ => "assistant",
         }
     }
 }

@@ -31,12 +31,14 @@ pub use components::{
 pub use cutting::{OrganCut, SettleCuts};
 pub use frame_paced::FramePaced;
 pub use hand::{
-    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, HandIndex, MAX_HANDS, Safety, Tool,
+    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, HandIndex, MAX_HANDS, Safety,
+    TRAINEE_HANDS, Tool,
 };
 pub use report::{FaultSummary, ForceSummary, HeadlessReport, RangeSummary, TickTimes};
 pub use resources::{OrganBeds, OrganCoupling, SceneScope, Scope, TickClock};
 pub use runner::{
-    CutOrgan, HapticLoop, HapticScene, SceneCutting, SceneDynamics, SceneError, SceneHand,
+    CutOrgan, HapticLoop, HapticScene, SceneAssistant, SceneCutting, SceneDynamics, SceneError,
+    SceneHand,
 };
 pub use scoring::{ExerciseLink, ExerciseRun};
 pub use snapshot::{

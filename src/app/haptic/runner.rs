@@ -17,7 +17,8 @@ use super::components::{
 };
 use super::cutting::{OrganCut, SettleCuts};
 use super::hand::{
-    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, HandIndex, MAX_HANDS, Safety, Tool,
+    Device, DeviceForce, FaultLog, ForceTrace, GraspForce, HandIndex, MAX_HANDS, Safety,
+    TRAINEE_HANDS, Tool,
 };
 use super::report::{FaultSummary, ForceSummary, HeadlessReport, RangeSummary};
 use super::resources::{OrganBeds, OrganCoupling, SceneScope, Scope, TickClock};
@@ -28,7 +29,7 @@ use crate::contact::{ContactError, ContactSurface, Coupling, Probe};
 use crate::cutting::{Blade, CutError, CutWorker, LatestCut, Scalpel};
 use crate::devices::{
     Action, Fulcrum, HapticDevice, Histogram, Instrument, Rack, SafetyFilter, SafetySettings,
-    TICK_S, Workspace, stop_requested,
+    Scripted, TICK_S, Trajectory, Workspace, stop_requested,
 };
 use crate::dissection::{TiedOrgans, TissueHeat, Wall, WallBurns};
 use crate::dynamics::{DynamicModel, GraspSettings};
@@ -63,6 +64,17 @@ pub struct HapticScene {
     /// The nonlinear vademecums building in the background while their organs run linear
     /// tissue here: the window loads the scene again once they are built.
     pub meanwhile: Vec<PathBuf>,
+    /// The assistant's instrument, which the scenario moves; none in most scenes.
+    pub assistant: Option<SceneAssistant>,
+}
+
+/// The assistant's instrument: through its own port, on a scripted device of its own, a hand
+/// after the trainee's that presses (its jaws stay shut) and that no score reads.
+#[derive(Clone, Debug)]
+pub struct SceneAssistant {
+    pub port: Fulcrum,
+    /// The device's handle, key by key.
+    pub script: Trajectory,
 }
 
 impl HapticScene {
@@ -81,6 +93,7 @@ impl HapticScene {
             scope: None,
             biliary: None,
             meanwhile: Vec::new(),
+            assistant: None,
         }
     }
 
@@ -186,10 +199,10 @@ pub enum SceneError {
     /// Safety settings the filter cannot honour (a negative force limit would reverse the force).
     #[error("the scene's safety settings: {0}")]
     Safety(String),
-    /// A device for each hand, no more and no fewer.
+    /// A device for each of the trainee's hands, no more and no fewer.
     #[error(
         "the scene has {hands} hand(s) and {devices} device(s) were opened for it: \
-         one device a hand (at most {MAX_HANDS} hands)"
+         one device a hand (at most {TRAINEE_HANDS} hands)"
     )]
     Hands { hands: usize, devices: usize },
 }
@@ -215,6 +228,28 @@ fn spawn_hand(world: &mut World, probe: Probe, index: usize, hand: &SceneHand) -
         .id()
 }
 
+/// The assistant's hand, `index`, into `world`, holding its scripted device from the start.
+fn spawn_assistant(
+    world: &mut World,
+    scene: &HapticScene,
+    index: usize,
+    assistant: &SceneAssistant,
+) -> Entity {
+    let hand = SceneHand {
+        instruments: vec![Instrument {
+            action: Action::Press,
+            port: Some(assistant.port),
+        }],
+        workspace: Workspace::default(),
+    };
+    let entity = spawn_hand(world, scene.probe, index, &hand);
+    let device = Scripted::new("the assistant's script", assistant.script.clone());
+    let safety = Safety(SafetyFilter::new(scene.safety, device.limits()));
+    let device = Device(Box::new(device));
+    world.entity_mut(entity).insert((device, safety));
+    entity
+}
+
 /// The safety settings of a loop that has no device yet.
 #[derive(Resource, Clone, Copy)]
 struct Parked(SafetySettings);
@@ -223,8 +258,10 @@ struct Parked(SafetySettings);
 pub struct HapticLoop {
     world: World,
     schedule: Schedule,
-    /// The hand entities, by hand index.
+    /// The trainee's hand entities, by hand index.
     hands: Vec<Entity>,
+    /// The assistant's hand, after the trainee's.
+    assistant: Option<Entity>,
 }
 
 impl HapticLoop {
@@ -274,10 +311,17 @@ impl HapticLoop {
     /// [`HapticLoop::take_devices`]. Ticked without them, its hands read and send nothing.
     pub fn parked(scene: &HapticScene) -> Result<Self, SceneError> {
         scene.safety.check().map_err(SceneError::Safety)?;
-        let hands = scene.hands.len();
-        if !(1..=MAX_HANDS).contains(&hands) {
+        let trainee_hands = scene.hands.len();
+        if !(1..=TRAINEE_HANDS).contains(&trainee_hands) {
+            let hands = trainee_hands;
             return Err(SceneError::Hands { hands, devices: 0 });
         }
+        // The assistant's hand is always the third, whether the trainee uses one hand or two.
+        let hands = if scene.assistant.is_some() {
+            MAX_HANDS
+        } else {
+            trainee_hands
+        };
         let mut world = World::new();
         for (index, (name, vademecum)) in scene.organs.iter().enumerate() {
             let mut organ = world.spawn((
@@ -308,6 +352,8 @@ impl HapticLoop {
         let hands = (scene.hands.iter().enumerate())
             .map(|(index, hand)| spawn_hand(&mut world, scene.probe, index, hand))
             .collect();
+        let assistant = (scene.assistant.as_ref())
+            .map(|a| spawn_assistant(&mut world, scene, TRAINEE_HANDS, a));
         world.insert_resource(TickClock::default());
         world.insert_resource(Parked(scene.safety));
         if let Some(coupling) = &scene.coupling {
@@ -336,6 +382,7 @@ impl HapticLoop {
             world,
             schedule: super::haptic_schedule(),
             hands,
+            assistant,
         })
     }
 
@@ -378,6 +425,11 @@ impl HapticLoop {
     /// has one.
     pub fn hand<T: Component>(&self, index: usize) -> Option<&T> {
         self.world.get::<T>(*self.hands.get(index)?)
+    }
+
+    /// The assistant's hand's component `T`, if the scene has an assistant.
+    pub fn assistant<T: Component>(&self) -> Option<&T> {
+        self.world.get::<T>(self.assistant?)
     }
 
     /// Hand `index`'s component `T`, to change.

@@ -49,6 +49,10 @@ pub struct Scenario {
     /// above (`tool` and `port`, or `instruments`) is the right. Empty: one hand.
     #[serde(default)]
     pub left_hand: Vec<Instrument>,
+    /// A third instrument, the assistant's: a grasper through its own port that the
+    /// scenario moves (`Assistant(tool, port, script: [Tip(…)])`); none when left out.
+    #[serde(default)]
+    pub assistant: Option<Assistant>,
     /// The camera through its own port (laparoscopy); none: the desktop view of the open
     /// abdomen.
     #[serde(default)]
@@ -336,6 +340,27 @@ impl LaparoscopeEntry {
     }
 }
 
+/// `Assistant(tool: Grasper(…), port: Port(…), script: [Tip(…), …])`.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Assistant {
+    /// The assistant's instrument: a grasper, with the trainee's tip radius.
+    pub tool: Tool,
+    pub port: Port,
+    /// Where the instrument's tip is, key by key from the exercise's start; between keys it
+    /// moves in a straight line, and after the last it stays.
+    pub script: Vec<TipKey>,
+}
+
+/// A key of the assistant's script: at `at_s` seconds the tip is at `tip_mm` (the scene's
+/// frame).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(rename = "Tip", deny_unknown_fields)]
+pub struct TipKey {
+    pub at_s: f64,
+    pub tip_mm: (f64, f64, f64),
+}
+
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Device {
@@ -468,7 +493,7 @@ impl Scenario {
 
     /// Whether an instrument in either hand grasps (and so the organs move by default).
     pub fn grasps(&self) -> bool {
-        self.hands().iter().flatten().any(|(tool, _)| tool.grasps())
+        self.hands().iter().flatten().any(|(tool, _)| tool.grasps()) || self.assistant.is_some()
     }
 
     /// Whether an instrument in either hand is an electrocautery hook.

@@ -194,6 +194,9 @@ fn check(scenario: &Scenario) -> Vec<Problem> {
     check_instruments(scenario, &mut problems);
     check_backend(scenario, &mut problems);
     check_left_hand(scenario, &mut problems);
+    if let Some(assistant) = &scenario.assistant {
+        super::assistant::check(assistant, scenario.tip_radius_m(), &mut problems);
+    }
     problems
 }
 

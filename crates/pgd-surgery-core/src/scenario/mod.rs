@@ -4,10 +4,12 @@
 //! and their reader in `tasks`), run one after another fed by the haptic loop one tick at a
 //! time (`exercise`, `sample`), with the tool's motion (`motion`), the cut against an
 //! incision's line (`incision`) and the incisions of a radial keratotomy (`keratotomy`)
-//! measured; and the rubric's score (`score`). A programme's curriculum of scenarios, read
+//! measured; the assistant's scripted instrument (`assistant`); and the rubric's score
+//! (`score`). A programme's curriculum of scenarios, read
 //! the same way, and where a trainee stands in it (`curriculum`). No Bevy here: the app layer runs an
 //! [`Exercise`] inside the haptic schedule.
 
+mod assistant;
 mod attachment;
 mod biliary;
 mod bimanual;
@@ -34,8 +36,8 @@ pub use biliary::BiliaryEntry;
 pub use bimanual::{BimanualMetrics, BimanualTracker};
 pub use exercise::{Exercise, Finished, Progress, Sites};
 pub use format::{
-    Contact, Device, Difficulty, Instrument, LaparoscopeEntry, Port, Rubric, Scenario, ScopeKey,
-    Tool, default_law,
+    Assistant, Contact, Device, Difficulty, Instrument, LaparoscopeEntry, Port, Rubric, Scenario,
+    ScopeKey, TipKey, Tool, default_law,
 };
 pub use global::{Benchmark, BenchmarkLine, GlobalMeasures};
 pub use incision::{BladeSample, IncisionMetrics, IncisionTracker};
