@@ -465,6 +465,7 @@ impl HapticLoop {
             .map_or(&[][..], |b| &b.0[..]);
         let template = HapticSnapshot {
             hands: vec![HandSnapshot::default(); self.hands.len()],
+            assistant: self.assistant.map(|_| HandSnapshot::default()),
             organs: organs.into_iter().map(|(_, organ)| organ).collect(),
             beds: beds.iter().map(BedView::at_rest).collect(),
             burns: BurnsView::with_room(),

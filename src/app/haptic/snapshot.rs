@@ -32,8 +32,11 @@ pub struct OrganSnapshot {
 pub struct HapticSnapshot {
     pub tick: u64,
     pub time_s: f64,
-    /// Each hand's instrument and force, by hand index (the right hand first).
+    /// Each of the trainee's hands' instrument and force, by hand index (the right hand
+    /// first).
     pub hands: Vec<HandSnapshot>,
+    /// The assistant's instrument, where the scene has one.
+    pub assistant: Option<HandSnapshot>,
     /// In the scene's organ order.
     pub organs: Vec<OrganSnapshot>,
     /// How the real-time loop has kept time so far (refreshed once a second).

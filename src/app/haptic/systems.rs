@@ -11,7 +11,8 @@ use super::components::{
 };
 use super::cutting::OrganCut;
 use super::hand::{
-    DeviceForce, FaultLog, ForceTrace, GraspForce, HandIndex, HandState, MAX_HANDS, Safety, Tool,
+    DeviceForce, FaultLog, ForceTrace, GraspForce, HandIndex, HandState, MAX_HANDS, Safety,
+    TRAINEE_HANDS, Tool,
 };
 use super::resources::{OrganBeds, OrganCoupling, TickClock};
 use super::snapshot::{HandSnapshot, InstrumentsView, LoopTiming, SnapshotPublisher};
@@ -501,7 +502,11 @@ pub fn publish_snapshot(
     snapshot.timing = timing.map_or_else(LoopTiming::default, |t| *t);
     let cut_organs = organs.iter().any(|o| o.cut.is_some());
     for hand in &hands {
-        if let Some(published) = snapshot.hands.get_mut(hand.index.0) {
+        let published = match hand.index.0 {
+            TRAINEE_HANDS => snapshot.assistant.as_mut(),
+            index => snapshot.hands.get_mut(index),
+        };
+        if let Some(published) = published {
             publish_hand(&hand, cut_organs, published);
         }
     }

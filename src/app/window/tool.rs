@@ -1,6 +1,7 @@
 //! The tools as the trainee sees them, one a hand: a sphere at the tip each device reports,
 //! the steel shaft of each instrument through a port (the one in hand, and those put down
-//! where they were left), and an arrow of the force each device renders.
+//! where they were left), and an arrow of the force each device renders; and the assistant's
+//! instrument, where the scene has one.
 
 use bevy::prelude::*;
 
@@ -20,6 +21,13 @@ pub(super) struct Shaft {
     index: usize,
 }
 
+/// The assistant's instrument: its tip's sphere and its shaft.
+#[derive(Component, Clone, Copy, PartialEq, Eq)]
+pub(super) enum AssistantPart {
+    Tip,
+    Shaft,
+}
+
 /// A laparoscopic instrument's shaft radius (m): 5 mm instruments.
 const SHAFT_RADIUS_M: f32 = 0.0025;
 
@@ -34,7 +42,7 @@ impl Plugin for ToolPlugin {
         super::spawn_with_scene(app, spawn_tool);
         app.add_systems(
             Update,
-            (follow_device, draw_force, draw_shaft).in_set(FrameSet::Draw),
+            (follow_device, draw_force, draw_shaft, follow_assistant).in_set(FrameSet::Draw),
         );
     }
 }
@@ -87,6 +95,16 @@ fn spawn_tool(
             ));
         }
     }
+    if link.scene.assistant.is_some() {
+        let parts = [
+            (AssistantPart::Tip, Mesh3d(sphere), MeshMaterial3d(polished)),
+            (AssistantPart::Shaft, Mesh3d(shaft), MeshMaterial3d(steel)),
+        ];
+        for (part, mesh, material) in parts {
+            let hidden = (Transform::default(), Visibility::Hidden);
+            commands.spawn((SceneView, part, mesh, material, hidden));
+        }
+    }
 }
 
 fn follow_device(
@@ -127,16 +145,41 @@ fn draw_shaft(
             *visibility = Visibility::Hidden;
             continue;
         };
-        let (handle, tip) = (to_bevy(&handle), to_bevy(&tip));
-        let along = tip - handle;
-        *transform = Transform::from_translation((handle + tip) / 2.0)
-            .with_rotation(Quat::from_rotation_arc(
-                Vec3::Y,
-                along.normalize_or(Vec3::Y),
-            ))
-            .with_scale(Vec3::new(1.0, along.length(), 1.0));
+        *transform = shaft_between(&handle, &tip);
         *visibility = Visibility::Visible;
     }
+}
+
+/// The assistant's tip and shaft where its script has them.
+fn follow_assistant(
+    snapshot: Res<Snapshot>,
+    mut parts: Query<(&AssistantPart, &mut Transform, &mut Visibility)>,
+) {
+    let assistant = snapshot.0.assistant.as_ref();
+    for (part, mut transform, mut visibility) in &mut parts {
+        let placed = match part {
+            AssistantPart::Tip => (assistant.and_then(|a| a.tip_m))
+                .map(|tip| Transform::from_translation(to_bevy(&tip))),
+            AssistantPart::Shaft => (assistant.and_then(|a| a.handle_m.zip(a.tip_m)))
+                .map(|(handle, tip)| shaft_between(&handle, &tip)),
+        };
+        match placed {
+            Some(placed) => (*transform, *visibility) = (placed, Visibility::Visible),
+            None => *visibility = Visibility::Hidden,
+        }
+    }
+}
+
+/// The unit shaft stretched along the line from `handle` to `tip`.
+fn shaft_between(handle: &nalgebra::Vector3<f64>, tip: &nalgebra::Vector3<f64>) -> Transform {
+    let (handle, tip) = (to_bevy(handle), to_bevy(tip));
+    let along = tip - handle;
+    Transform::from_translation((handle + tip) / 2.0)
+        .with_rotation(Quat::from_rotation_arc(
+            Vec3::Y,
+            along.normalize_or(Vec3::Y),
+        ))
+        .with_scale(Vec3::new(1.0, along.length(), 1.0))
 }
 
 /// Each hand's force as an arrow from its tip, red while the hand's force is faded after a
