@@ -23,6 +23,18 @@ pub struct TickFigures {
     pub max_us: f64,
 }
 
+impl TickFigures {
+    /// The quantiles of the ticks `compute` recorded.
+    pub fn of(compute: &Histogram) -> Self {
+        let us = |q: f64| compute.quantile(q).as_secs_f64() * 1e6;
+        Self {
+            p50_us: us(0.5),
+            p99_us: us(0.99),
+            max_us: compute.max().as_secs_f64() * 1e6,
+        }
+    }
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct ScalpelBenchReport {
     pub repeats: usize,
@@ -110,13 +122,7 @@ fn paced(scene: &HapticScene, stroke: &Trajectory) -> Result<(TickFigures, Hapti
             overruns_in_a_row: 0,
         }));
     }
-    let us = |q: f64| compute.quantile(q).as_secs_f64() * 1e6;
-    let figures = TickFigures {
-        p50_us: us(0.5),
-        p99_us: us(0.99),
-        max_us: compute.max().as_secs_f64() * 1e6,
-    };
-    Ok((figures, haptic))
+    Ok((TickFigures::of(&compute), haptic))
 }
 
 /// The liver's cut after a run: the worker's step times (s), and (unknowns, length m, depth m).
@@ -134,7 +140,8 @@ fn cut_of(mut haptic: HapticLoop) -> (Vec<f64>, (usize, f64, f64)) {
     (cut.worker.step_seconds(), made)
 }
 
-fn median_figures(runs: &[TickFigures]) -> TickFigures {
+/// Each quantile's median over `runs`.
+pub(super) fn median_figures(runs: &[TickFigures]) -> TickFigures {
     let median = |f: fn(&TickFigures) -> f64| {
         let mut values: Vec<f64> = runs.iter().map(f).collect();
         values.sort_by(f64::total_cmp);

@@ -7,6 +7,8 @@ pub mod attempt;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod bench;
 #[cfg(not(target_arch = "wasm32"))]
+pub mod bench_operation;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod bench_scalpel;
 pub mod haptic;
 #[cfg(not(target_arch = "wasm32"))]

@@ -93,6 +93,10 @@ fn the_curriculum_opens_its_modules_as_the_benchmarks_are_met() {
     assert!(text.contains("1. Basic skills: done"), "{text}");
     assert!(text.contains("2. Cholecystectomy tasks: open"), "{text}");
     assert!(
+        text.contains("3. The operation: locked (opens after Cholecystectomy tasks)"),
+        "{text}"
+    );
+    assert!(
         text.contains("pancreas-palpation: had (75 on 2 attempts in a row; 4 attempts, best 90)"),
         "{text}"
     );

@@ -551,6 +551,38 @@ pub enum BenchTarget {
     /// pressed until at least 400 pointshell nodes push, against parry's brute-force check of
     /// every node against the deformed master surface.
     Contact(ContactBenchArgs),
+    /// A scenario played by its scripted run through the haptic loop on the simulated clock,
+    /// every tick's compute timed, against a baseline scenario's run in the same process (by
+    /// default the whole cholecystectomy against the liver press).
+    Operation {
+        /// The scenario timed.
+        #[arg(long, default_value = "scenarios/lap-chole-full.scenario.ron")]
+        scenario: PathBuf,
+        /// Its scripted run.
+        #[arg(long, default_value = "scenarios/runs/lap-chole-full.competent.csv")]
+        run: PathBuf,
+        /// The baseline scenario, timed the same way.
+        #[arg(long, default_value = "scenarios/liver-steady-press.scenario.ron")]
+        baseline: PathBuf,
+        /// The baseline's scripted run.
+        #[arg(
+            long,
+            default_value = "scenarios/runs/liver-steady-press.competent.csv"
+        )]
+        baseline_run: PathBuf,
+        /// Runs per figure; the median is reported.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// The coarse organs and their 12 mm tool (the scripted runs are written for them).
+        #[arg(long)]
+        coarse: bool,
+        /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
+        #[arg(long, default_value = "vademecums")]
+        vademecums: PathBuf,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// A stroke of the scalpel through the liver of the four-organ scene, ticked at 1 kHz on
     /// the real clock: tick compute time against the same stroke with a probe, and the cut
     /// state's time per step on its worker thread.

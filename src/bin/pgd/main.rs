@@ -398,6 +398,28 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             json,
         } => bench_frame(frames, coarse, &vademecums, json),
         BenchTarget::Haptics(options) => bench_haptics(options),
+        BenchTarget::Operation {
+            scenario,
+            run,
+            baseline,
+            baseline_run,
+            repeats,
+            coarse,
+            vademecums,
+            json,
+        } => {
+            let operation = app::bench_operation::ScenarioRun { scenario, run };
+            let baseline = app::bench_operation::ScenarioRun {
+                scenario: baseline,
+                run: baseline_run,
+            };
+            let detail = if coarse { Detail::Coarse } else { Detail::Full };
+            print_report(
+                "pgd bench operation",
+                app::bench_operation::run(&operation, &baseline, &vademecums, detail, repeats),
+                json,
+            )
+        }
         BenchTarget::Scalpel {
             repeats,
             coarse,
