@@ -106,6 +106,7 @@ pub(super) fn counted<'a>(
             scenario: &a.scenario,
             score: a.score,
             passed: a.passed,
+            proficient: a.proficient,
         })
         .collect()
 }

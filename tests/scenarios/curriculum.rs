@@ -189,6 +189,12 @@ fn bad_curricula_are_refused_with_file_line_field_and_hint() {
             "the scenario does not load",
         ),
         (
+            "proficient-without-benchmark",
+            9,
+            "modules[0].exercises[0].proficiency",
+            "asks for the scenario's benchmark, and it sets none",
+        ),
+        (
             "score-out-of-range",
             10,
             "modules[0].exercises[0].proficiency.Benchmark.score",

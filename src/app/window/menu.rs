@@ -606,6 +606,7 @@ mod tests {
             scenario: "scenarios/liver-steady-press.scenario.ron",
             score: 90.0,
             passed: true,
+            proficient: None,
         }];
         let menu = Menu {
             entries: curriculum_entries(&curriculum, &standing(&curriculum, &made)),

@@ -55,27 +55,29 @@ pub enum Proficiency {
         count: AttemptCount,
         min_score: Score,
     },
+    /// The scenario's own `benchmark` (every measure it sets) met on `in_a_row`
+    /// consecutive attempts: proficiency as LAP Mentor's curricula define it.
+    Proficient { in_a_row: AttemptCount },
 }
 
 impl Proficiency {
-    /// Whether the attempts (in the order made, `(score, passed)`) meet the rule, and how
-    /// far they have come towards it (attempts in a row, or counted, of the ones needed).
-    pub fn progress(&self, attempts: &[(f64, bool)]) -> (usize, usize) {
+    /// How far the attempts (at this exercise, in the order made) have come towards the
+    /// rule: attempts in a row, or counted, of the ones needed.
+    pub fn progress(&self, attempts: &[CountedAttempt<'_>]) -> (usize, usize) {
         match *self {
             Proficiency::Benchmark { score, in_a_row } => {
-                let mut run = 0;
-                let mut best_run = 0;
-                for &(s, passed) in attempts {
-                    run = if passed && s >= score.0 { run + 1 } else { 0 };
-                    best_run = usize::max(best_run, run);
-                }
-                (best_run.min(in_a_row.0), in_a_row.0)
+                let met = |a: &CountedAttempt| a.passed && a.score >= score.0;
+                (longest_run(attempts, met).min(in_a_row.0), in_a_row.0)
             }
             Proficiency::Attempts { count, min_score } => {
                 let met = (attempts.iter())
-                    .filter(|&&(s, passed)| passed && s >= min_score.0)
+                    .filter(|a| a.passed && a.score >= min_score.0)
                     .count();
                 (met.min(count.0), count.0)
+            }
+            Proficiency::Proficient { in_a_row } => {
+                let met = |a: &CountedAttempt| a.passed && a.proficient == Some(true);
+                (longest_run(attempts, met).min(in_a_row.0), in_a_row.0)
             }
         }
     }
@@ -89,8 +91,22 @@ impl Proficiency {
             Proficiency::Attempts { count, min_score } => {
                 format!("{} attempts at {:.0} or more", count.0, min_score.0)
             }
+            Proficiency::Proficient { in_a_row } => {
+                format!("its benchmark met on {} attempts in a row", in_a_row.0)
+            }
         }
     }
+}
+
+/// The most consecutive attempts that `met` says meet a rule.
+fn longest_run(attempts: &[CountedAttempt<'_>], met: impl Fn(&CountedAttempt) -> bool) -> usize {
+    let mut run = 0;
+    let mut longest = 0;
+    for attempt in attempts {
+        run = if met(attempt) { run + 1 } else { 0 };
+        longest = usize::max(longest, run);
+    }
+    longest
 }
 
 /// Reads and checks the curriculum in `file`: its modules, their order, and every scenario
@@ -174,31 +190,49 @@ fn names(modules: &[Module]) -> String {
     }
 }
 
-/// A problem if exercise `j` of module `k` names a scenario that does not load.
+/// A problem if exercise `j` of module `k` names a scenario that does not load, or asks for
+/// its benchmark and it has none.
 fn check_scenario(k: usize, j: usize, exercise: &ExerciseEntry) -> Option<Problem> {
-    let error = super::load::load(&exercise.scenario).err()?;
     let written = exercise
         .scenario
         .file_name()?
         .to_string_lossy()
         .into_owned();
-    Some(Problem {
-        field: format!("modules[{k}].exercises[{j}].scenario"),
-        anchors: vec!["exercises".into(), written],
-        message: format!("the scenario does not load: {error}"),
-        hint: "scenario files are written relative to the curriculum's folder; `trainer \
-               validate FILE` checks one"
-            .into(),
-    })
+    match super::load::load(&exercise.scenario) {
+        Err(error) => Some(Problem {
+            field: format!("modules[{k}].exercises[{j}].scenario"),
+            anchors: vec!["exercises".into(), written],
+            message: format!("the scenario does not load: {error}"),
+            hint: "scenario files are written relative to the curriculum's folder; `trainer \
+                   validate FILE` checks one"
+                .into(),
+        }),
+        Ok(scenario)
+            if scenario.benchmark.is_none()
+                && matches!(exercise.proficiency, Proficiency::Proficient { .. }) =>
+        {
+            Some(Problem {
+                field: format!("modules[{k}].exercises[{j}].proficiency"),
+                anchors: vec!["exercises".into(), written, "Proficient".into()],
+                message: "the rule asks for the scenario's benchmark, and it sets none".into(),
+                hint: "give the scenario `benchmark: Benchmark(…)`, or use `Benchmark(score: …, \
+                       in_a_row: …)`"
+                    .into(),
+            })
+        }
+        Ok(_) => None,
+    }
 }
 
 /// An attempt as the curriculum counts it: the scenario file it was made at (as given to
-/// the trainer), its score and whether it passed.
+/// the trainer), its score, whether it passed and whether it met the scenario's benchmark.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CountedAttempt<'a> {
     pub scenario: &'a str,
     pub score: f64,
     pub passed: bool,
+    /// Whether it met the scenario's benchmark (none where the scenario sets none).
+    pub proficient: Option<bool>,
 }
 
 /// Where a module stands for a trainee.
@@ -268,15 +302,15 @@ fn exercise_standing(
     attempts: &[CountedAttempt<'_>],
 ) -> ExerciseStanding {
     let name = file_name(&exercise.scenario.to_string_lossy());
-    let made: Vec<(f64, bool)> = (attempts.iter())
+    let made: Vec<CountedAttempt> = (attempts.iter())
         .filter(|a| file_name(a.scenario) == name)
-        .map(|a| (a.score, a.passed))
+        .copied()
         .collect();
     ExerciseStanding {
         name: name.trim_end_matches(".scenario.ron").to_owned(),
         rule: exercise.proficiency,
         attempts: made.len(),
-        best_score: made.iter().map(|m| m.0).reduce(f64::max),
+        best_score: made.iter().map(|m| m.score).reduce(f64::max),
         progress: exercise.proficiency.progress(&made),
     }
 }
@@ -313,6 +347,7 @@ mod tests {
             scenario,
             score,
             passed,
+            proficient: None,
         }
     }
 
@@ -367,6 +402,33 @@ mod tests {
         assert_eq!(standing[1].exercises[0].best_score, Some(99.0));
         made.push(attempt("scenarios/grasp.scenario.ron", 70.0, true));
         assert_eq!(states(&made), [Done, Done]);
+    }
+
+    /// Proficiency by the scenario's benchmark: two proficient attempts in a row; one that
+    /// passed but missed the benchmark breaks the run, one that met it but failed (a major
+    /// error) never counts.
+    #[test]
+    fn the_scenarios_benchmark_met_twice_in_a_row_is_proficiency() {
+        let rule = Proficiency::Proficient {
+            in_a_row: AttemptCount(2),
+        };
+        let made = |marks: &[(bool, Option<bool>)]| -> Vec<CountedAttempt<'static>> {
+            (marks.iter())
+                .map(|&(passed, proficient)| CountedAttempt {
+                    proficient,
+                    ..attempt("op.scenario.ron", 95.0, passed)
+                })
+                .collect()
+        };
+        let broken = made(&[(true, Some(true)), (true, Some(false)), (true, Some(true))]);
+        assert_eq!(rule.progress(&broken), (1, 2));
+        let failed = made(&[(true, Some(true)), (false, Some(true))]);
+        assert_eq!(rule.progress(&failed), (1, 2));
+        let unmarked = made(&[(true, None), (true, None)]);
+        assert_eq!(rule.progress(&unmarked), (0, 2));
+        let had = made(&[(true, Some(false)), (true, Some(true)), (true, Some(true))]);
+        assert_eq!(rule.progress(&had), (2, 2));
+        assert_eq!(rule.describe(), "its benchmark met on 2 attempts in a row");
     }
 
     /// A module listed before another cannot open after it, and a module with an unknown
