@@ -21,10 +21,7 @@ use pgd_surgery::scenario::tasks::ClipAndCutResult;
 use pgd_surgery::scenario::{Scenario, load};
 use pgd_surgery::store::OnStale;
 
-use super::script::{
-    BLADE_M, BURN_S, CLIPS_AT, CLOSE_S, CUT_AT, JAW_M, LEFT_START_M, Plane, Script, by_strand,
-    grasp_point, retracted,
-};
+use super::script::{LEFT_START_M, Plane, Script, grasp_point, retracted};
 
 const NAME: &str = "lap-chole-clip-and-cut";
 
@@ -165,8 +162,6 @@ fn the_clip_and_cut_runs_are_made_from_the_scenes_tree() {
     let scenario = scenario();
     let abdomen = Abdomen::new(&OrganSettings::default());
     let start = Vector3::new(0.0, 0.02, -0.075);
-    let duct = Structure::CysticDuct;
-    let artery = Structure::CysticArtery;
     let scene = scenario_scene(
         &scenario,
         super::vademecums(),
@@ -184,42 +179,17 @@ fn the_clip_and_cut_runs_are_made_from_the_scenes_tree() {
 
     let mut competent = Script::new(&scenario, start, left_start, tip_m);
     competent.retract(grasp);
-    for strand in &tree.fat.strands {
-        competent.go(by_strand(&abdomen, strand, &plane, tip_m));
-        competent.press(BURN_S);
-    }
-    competent.go(start);
-    competent.wait(1.0);
-    competent.change();
-    for structure in [duct, artery] {
-        for share in CLIPS_AT {
-            competent.close_across(&tree, structure, share, JAW_M);
-        }
-    }
-    competent.go(start);
-    competent.change();
-    for structure in [duct, artery] {
-        competent.close_across(&tree, structure, CUT_AT, BLADE_M);
-    }
+    competent.triangle_as_taught(&abdomen, &plane, start, |_| tree.clone());
     competent.go(start);
     competent.wait(1.0);
     competent.check_or_write(NAME, "competent");
 
     let mut careless = Script::new(&scenario, start, left_start, tip_m);
     careless.retract(grasp);
-    for strand in &tree.fat.strands[..4] {
-        careless.go(by_strand(&abdomen, strand, &plane, tip_m));
-        careless.press(CLOSE_S);
-    }
-    careless.go(start);
-    careless.change();
-    careless.close_across(&tree, duct, 0.8, JAW_M);
+    careless.clip_in_haste(&abdomen, &tree, &plane, start);
     // The left hand lets go of the infundibulum while the right hand works.
     careless.left_jaws(false);
-    careless.go(start);
-    careless.change();
-    careless.close_across(&tree, duct, 0.5, BLADE_M);
-    careless.close_across(&tree, artery, 0.5, BLADE_M);
+    careless.divide_in_haste(&tree, start);
     careless.go(start);
     careless.wait(3.0);
     careless.check_or_write(NAME, "careless");

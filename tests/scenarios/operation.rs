@@ -12,17 +12,14 @@ use pgd_surgery::app::haptic::{
     Tool,
 };
 use pgd_surgery::app::scene::Detail;
-use pgd_surgery::biliary::{BiliaryTree, Structure};
+use pgd_surgery::biliary::BiliaryTree;
 use pgd_surgery::dissection::CauteryMode;
 use pgd_surgery::mesh::organs::{Abdomen, Organ, OrganSettings};
 use pgd_surgery::scenario::tasks::DissectionResult;
 use pgd_surgery::scenario::{Scenario, load};
 use pgd_surgery::store::OnStale;
 
-use super::script::{
-    BLADE_M, BURN_S, CLIPS_AT, CLOSE_S, CUT_AT, JAW_M, LEFT_START_M, Plane, Script, by_strand,
-    grasp_point,
-};
+use super::script::{LEFT_START_M, Plane, Script, grasp_point};
 
 const NAME: &str = "lap-chole-full";
 
@@ -231,25 +228,7 @@ fn the_operations_runs_are_made_from_the_scene() {
         .collect();
     assert_eq!(touched, ["gallbladder"]);
     let tree = live_tree(&mut competent);
-    for strand in &tree.fat.strands {
-        competent.go(by_strand(&abdomen, strand, &plane, tip_m));
-        competent.press(BURN_S);
-    }
-    competent.go(start);
-    competent.wait(1.0);
-    competent.change();
-    for structure in [Structure::CysticDuct, Structure::CysticArtery] {
-        for share in CLIPS_AT {
-            let tree = live_tree(&mut competent);
-            competent.close_across(&tree, structure, share, JAW_M);
-        }
-    }
-    competent.go(start);
-    competent.change();
-    for structure in [Structure::CysticDuct, Structure::CysticArtery] {
-        let tree = live_tree(&mut competent);
-        competent.close_across(&tree, structure, CUT_AT, BLADE_M);
-    }
+    competent.triangle_as_taught(&abdomen, &plane, start, live_tree);
     competent.go(start);
     competent.change();
     free_from_bed(&mut competent, &abdomen, reach_m(tip_m));
@@ -267,17 +246,8 @@ fn the_operations_runs_are_made_from_the_scene() {
 
     let mut careless = Script::new(&scenario, start, left_start, tip_m);
     careless.retract(grasp);
-    for strand in &tree.fat.strands[..4] {
-        careless.go(by_strand(&abdomen, strand, &plane, tip_m));
-        careless.press(CLOSE_S);
-    }
-    careless.go(start);
-    careless.change();
-    careless.close_across(&tree, Structure::CysticDuct, 0.8, JAW_M);
-    careless.go(start);
-    careless.change();
-    careless.close_across(&tree, Structure::CysticDuct, 0.5, BLADE_M);
-    careless.close_across(&tree, Structure::CysticArtery, 0.5, BLADE_M);
+    careless.clip_in_haste(&abdomen, &tree, &plane, start);
+    careless.divide_in_haste(&tree, start);
     careless.go(start);
     careless.change();
     // The triangle's task ends at its time limit, the artery still bleeding; in the bed's

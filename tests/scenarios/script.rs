@@ -37,7 +37,7 @@ pub(super) struct Script {
 }
 
 /// The left hand's grasper: its port, its tip and whether its jaws are closed.
-pub(super) struct LeftHand {
+struct LeftHand {
     port: Fulcrum,
     tip_m: Vector3<f64>,
     closed: bool,
@@ -45,27 +45,30 @@ pub(super) struct LeftHand {
 
 /// Instruments take a moment to move between points and to close (s); the hook is held on
 /// the fat while its energy divides the strands within reach (30 W: about 7 J a strand).
-pub(super) const MOVE_S: f64 = 0.6;
-pub(super) const CLOSE_S: f64 = 0.25;
-pub(super) const BURN_S: f64 = 1.2;
+const MOVE_S: f64 = 0.6;
+const CLOSE_S: f64 = 0.25;
+const BURN_S: f64 = 1.2;
 /// The left grasper takes the infundibulum this far along the gallbladder's axis from its
 /// fundus, its tip's sphere this far into the wall (m); then draws its tip laterally this
 /// far over this time (m, s), and keeps it there while the retraction's hold is scored.
-pub(super) const INFUNDIBULUM_T: f64 = 0.75;
-pub(super) const GRASP_INTO_M: f64 = 2.3e-3;
-pub(super) const LEFT_DRAW_M: f64 = 0.022;
-pub(super) const LEFT_DRAW_S: f64 = 1.0;
-pub(super) const RETRACTION_HELD_S: f64 = 2.0;
+const INFUNDIBULUM_T: f64 = 0.75;
+const GRASP_INTO_M: f64 = 2.3e-3;
+const LEFT_DRAW_M: f64 = 0.022;
+const LEFT_DRAW_S: f64 = 1.0;
+const RETRACTION_HELD_S: f64 = 2.0;
 /// The left grasper starts this far lateral of where it takes the infundibulum (m).
 pub(super) const LEFT_START_M: f64 = 0.024;
 
+/// The tubes clipped and divided: the cystic duct, then the artery.
+const TUBES: [Structure; 2] = [Structure::CysticDuct, Structure::CysticArtery];
+
 /// Where the competent run clips each tube (two on the patient's side, one on the
 /// gallbladder's) and cuts it, as shares of its length from the patient's end.
-pub(super) const CLIPS_AT: [f64; 3] = [0.2, 0.35, 0.62];
-pub(super) const CUT_AT: f64 = 0.5;
+const CLIPS_AT: [f64; 3] = [0.2, 0.35, 0.62];
+const CUT_AT: f64 = 0.5;
 /// The clip applier's jaws and the scissors' blades (m), as the scenario gives them.
-pub(super) const JAW_M: f64 = 9e-3;
-pub(super) const BLADE_M: f64 = 15e-3;
+const JAW_M: f64 = 9e-3;
+const BLADE_M: f64 = 15e-3;
 
 impl Script {
     /// Both hands at their starts: the left grasper's tip `left_m` beside the infundibulum.
@@ -238,6 +241,75 @@ impl Script {
         self.go(tip - along * 0.01);
     }
 
+    /// The hook beside each of `strands` in turn, clear of the tubes, its energy on for
+    /// `burn_s` at each.
+    pub(super) fn clear_strands(
+        &mut self,
+        abdomen: &Abdomen,
+        strands: &[FatStrand],
+        plane: &Plane,
+        burn_s: f64,
+    ) {
+        for strand in strands {
+            self.go(by_strand(abdomen, strand, plane, self.tip_radius_m));
+            self.press(burn_s);
+        }
+    }
+
+    /// The triangle as taught, from the hook in hand to the scissors: every strand of the
+    /// fat cleared, a second's pause at `start_m`, then the clip applier's three clips on
+    /// each of the cystic duct and artery and the scissors' cut between them, each closed
+    /// across its tube where `tree_now` has it then.
+    pub(super) fn triangle_as_taught(
+        &mut self,
+        abdomen: &Abdomen,
+        plane: &Plane,
+        start_m: Vector3<f64>,
+        tree_now: impl Fn(&mut Self) -> BiliaryTree,
+    ) {
+        let strands = tree_now(self).fat.strands;
+        self.clear_strands(abdomen, &strands, plane, BURN_S);
+        self.go(start_m);
+        self.wait(1.0);
+        self.change();
+        for structure in TUBES {
+            for share in CLIPS_AT {
+                let tree = tree_now(self);
+                self.close_across(&tree, structure, share, JAW_M);
+            }
+        }
+        self.go(start_m);
+        self.change();
+        for structure in TUBES {
+            let tree = tree_now(self);
+            self.close_across(&tree, structure, CUT_AT, BLADE_M);
+        }
+    }
+
+    /// The careless start of the triangle: four strands touched for a moment, then the clip
+    /// applier's clip on the cystic duct near the gallbladder, long before the view.
+    pub(super) fn clip_in_haste(
+        &mut self,
+        abdomen: &Abdomen,
+        tree: &BiliaryTree,
+        plane: &Plane,
+        start_m: Vector3<f64>,
+    ) {
+        self.clear_strands(abdomen, &tree.fat.strands[..4], plane, CLOSE_S);
+        self.go(start_m);
+        self.change();
+        self.close_across(tree, Structure::CysticDuct, 0.8, JAW_M);
+    }
+
+    /// Then the scissors, and both tubes divided halfway along, wherever the clips are.
+    pub(super) fn divide_in_haste(&mut self, tree: &BiliaryTree, start_m: Vector3<f64>) {
+        self.go(start_m);
+        self.change();
+        for structure in TUBES {
+            self.close_across(tree, structure, 0.5, BLADE_M);
+        }
+    }
+
     /// Checks that the shipped run `script` of scenario `name` is this one; with
     /// `PGD_WRITE_RUNS` set, writes it.
     pub(super) fn check_or_write(&self, name: &str, script: &str) {
@@ -259,12 +331,7 @@ impl Script {
 /// The hook's tip `tip_m` in radius beside a strand, on its side away from the tubes and
 /// clear of them (along the normal of the ducts' plane), where it keeps clearest of the
 /// organs.
-pub(super) fn by_strand(
-    abdomen: &Abdomen,
-    strand: &FatStrand,
-    plane: &Plane,
-    tip_m: f64,
-) -> Vector3<f64> {
+fn by_strand(abdomen: &Abdomen, strand: &FatStrand, plane: &Plane, tip_m: f64) -> Vector3<f64> {
     let clearance = |p: &Vector3<f64>| {
         [Organ::Liver, Organ::Gallbladder, Organ::Duodenum]
             .map(|o| abdomen.value(o, &(*p).into()))
@@ -300,10 +367,10 @@ pub(super) fn retracted(scenario: &Scenario, script: &Script) -> BiliaryTree {
 }
 
 /// The hook keeps this far clear of the tubes (m) beyond its tip's radius.
-pub(super) const CLEAR_OF_TUBES_M: f64 = 1e-3;
+const CLEAR_OF_TUBES_M: f64 = 1e-3;
 
 /// The usual common duct's radius (m).
-pub(super) const COMMON_DUCT_RADIUS_M: f64 = 3e-3;
+const COMMON_DUCT_RADIUS_M: f64 = 3e-3;
 
 /// The plane of the cystic and common hepatic ducts.
 pub(super) struct Plane {
