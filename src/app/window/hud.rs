@@ -418,8 +418,9 @@ fn task_line(scenario: &Scenario, progress: Option<Progress>) -> String {
     let step = progress
         .step
         .map_or(String::new(), |step| format!(" | {step}"));
+    let phase = (task.shared.phase.as_ref()).map_or(String::new(), |p| format!(" ({p})"));
     format!(
-        "task {} of {}: {}\n{:.1} s of {:.0} s{step}\n\n",
+        "task {} of {}{phase}: {}\n{:.1} s of {:.0} s{step}\n\n",
         progress.task + 1,
         progress.tasks,
         task.description(),
@@ -530,6 +531,10 @@ mod tests {
         };
         assert_eq!(task_line(&scenario, Some(ended)), "");
         assert_eq!(task_line(&scenario, None), "");
+        let mut phased = scenario.clone();
+        phased.tasks[0].shared.phase = Some("exposure".into());
+        let line = task_line(&phased, Some(progress));
+        assert!(line.starts_with("task 1 of 1 (exposure): hold"), "{line}");
     }
 
     /// The trainee reads the task, the force and what the tool touches first, and the loop's
