@@ -507,6 +507,12 @@ fn broken_scenarios_are_refused_with_file_line_field_and_hint() {
             "not a laparoscope's angle",
         ),
         (
+            "task-instrument-not-in-hand",
+            8,
+            "tasks[0].instruments[1]",
+            "`scissors` is not an instrument of the task's hand",
+        ),
+        (
             "assistant-out-of-reach",
             10,
             "assistant.script[1]",

@@ -62,6 +62,11 @@ struct Running {
     hand: Hand,
     /// The other hand's hold, when the task asks for counter-traction.
     countertraction: Option<CountertractionWatch>,
+    /// The task's instruments among its hand's: the kind of each of the hand's instruments
+    /// it is not done with (none where any will do).
+    other_instruments: Vec<Option<&'static str>>,
+    /// Whether the hand was on tissue with one of those last tick (none before the first).
+    on_with_other: Option<bool>,
     run: Box<dyn AnyRun>,
 }
 
@@ -234,6 +239,22 @@ fn setup(scenario: &Scenario, sites: &Sites, k: usize) -> RunSetup {
     }
 }
 
+/// For each instrument of `task`'s hand, its kind if the task's `instruments` leave it out
+/// (all none when the task names none).
+fn other_instruments(scenario: &Scenario, task: &Task) -> Vec<Option<&'static str>> {
+    let hand = match task.hand() {
+        Hand::Right => 0,
+        Hand::Left => 1,
+    };
+    let named = &task.shared.instruments;
+    let hands = scenario.hands();
+    let instruments = hands.get(hand).map_or(&[][..], |h| &h[..]);
+    (instruments.iter())
+        .map(|(tool, _)| tool.kind())
+        .map(|kind| (!named.is_empty() && !named.iter().any(|n| n == kind)).then_some(kind))
+        .collect()
+}
+
 /// The watch of `task`'s counter-traction, if it asks for one (on an organ of the scenario's:
 /// the scenario's check makes sure).
 fn countertraction(scenario: &Scenario, task: &Task) -> Option<CountertractionWatch> {
@@ -260,6 +281,8 @@ impl Running {
             hands: scenario.bimanual().then(BimanualTracker::default),
             hand: task.hand(),
             countertraction: countertraction(scenario, task),
+            other_instruments: other_instruments(scenario, task),
+            on_with_other: None,
             run: task.run(setup),
         }
     }
@@ -295,6 +318,7 @@ impl Running {
                 &own
             }
         };
+        self.watch_instrument(sample);
         self.motion.in_hand(sample.instrument);
         self.motion.step(sample.tip_m, dt);
         if let Some(in_view) = sample.tip_in_view {
@@ -333,6 +357,25 @@ impl Running {
         self.run.step(&mut tick);
     }
 
+    /// Notes each time the hand comes onto tissue with an instrument the task is not done
+    /// with (not when the task begins there: the instrument the last task left in hand).
+    fn watch_instrument(&mut self, sample: &Sample) {
+        let working = sample.touching != 0 || sample.grasping != 0;
+        let other = self
+            .other_instruments
+            .get(sample.instrument)
+            .copied()
+            .flatten();
+        let on_with_other = working && other.is_some();
+        if let (Some(false), Some(kind), true) = (self.on_with_other, other, on_with_other) {
+            (self.mistakes).note(Mistake::OtherInstrument {
+                time_s: sample.time_s,
+                kind,
+            });
+        }
+        self.on_with_other = Some(on_with_other);
+    }
+
     /// Watches the other hand's hold, if the task asks for one.
     fn step_countertraction(&mut self, sample: &Sample, dt: f64) {
         let (Some(watch), Some(left)) = (&mut self.countertraction, sample.left) else {
@@ -353,5 +396,53 @@ impl Running {
     /// Whether the task is over before its time: done, or ended as its type says.
     fn over(&self) -> bool {
         self.metrics.completed || self.run.over()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A press to be made with the hook, the probe also in hand: coming onto the liver with
+    /// the probe is a mistake each time (not when the task begins with it there), with the
+    /// hook it is none.
+    #[test]
+    fn tissue_touched_with_another_instrument_than_the_tasks_is_a_mistake() {
+        let scenario = crate::scenario::parse(
+            std::path::Path::new("t.scenario.ron"),
+            r#"Scenario(title: "t", briefing: "b", organs: ["liver"],
+                instruments: [
+                    Instrument(tool: Probe(tip_radius_mm: 6.0),
+                               port: Port(at_mm: (0.0, 120.0, -100.0), shaft_mm: 300.0)),
+                    Instrument(tool: Hook(tip_radius_mm: 6.0, power_w: 30.0, mode: Cut),
+                               port: Port(at_mm: (0.0, 120.0, -100.0), shaft_mm: 300.0)),
+                ],
+                tasks: [ForceControl(organ: "liver", min_force_n: 0.1, max_force_n: 0.3,
+                                     hold_s: 3.0, time_limit_s: 6.0, instruments: ["hook"])])"#,
+        )
+        .unwrap();
+        let mut exercise = Exercise::new(scenario, Sites::default());
+        // (from, to, instrument): on the liver with the probe from the start, then again
+        // with it, then with the hook.
+        let spells = [(0.0, 0.4, 0), (1.0, 1.5, 0), (2.0, 2.5, 1), (3.0, 3.5, 0)];
+        for tick in 0..5000 {
+            let time_s = f64::from(tick) * 1e-3;
+            let on = spells.iter().find(|&&(a, b, _)| (a..b).contains(&time_s));
+            exercise.step(&Sample {
+                time_s,
+                touching: u64::from(on.is_some()),
+                instrument: on.map_or(1, |s| s.2),
+                force_n: if on.is_some() { 0.2 } else { 0.0 },
+                ..Sample::default()
+            });
+        }
+        let finished = exercise.finish();
+        assert_eq!(
+            finished.tasks[0].errors,
+            [
+                "1.00 s: worked on tissue with the probe, not with the task's hook",
+                "3.00 s: worked on tissue with the probe, not with the task's hook",
+            ]
+        );
     }
 }

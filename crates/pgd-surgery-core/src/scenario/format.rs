@@ -169,6 +169,18 @@ impl Default for Tool {
 }
 
 impl Tool {
+    /// The kind of instrument in words, as a task's `instruments` names it.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Tool::Probe { .. } => "probe",
+            Tool::Grasper { .. } => "grasper",
+            Tool::Scalpel { .. } => "scalpel",
+            Tool::Hook { .. } => "hook",
+            Tool::ClipApplier { .. } => "clip applier",
+            Tool::Scissors { .. } => "scissors",
+        }
+    }
+
     pub fn tip_radius_m(&self) -> f64 {
         match self {
             Tool::Probe { tip_radius_mm }

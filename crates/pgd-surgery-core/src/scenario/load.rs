@@ -402,8 +402,34 @@ fn check_task(
     if let Some(countertraction) = &task.shared.countertraction {
         check_countertraction(scenario, countertraction, &mut check);
     }
+    check_task_instruments(scenario, task, &mut check);
     task.check(&mut check);
     problems.extend(check.problems);
+}
+
+/// The instruments a task is done with are kinds its hand holds.
+fn check_task_instruments(scenario: &Scenario, task: &Task, check: &mut TaskCheck<'_>) {
+    let hands = scenario.hands();
+    let hand = match task.hand() {
+        Hand::Right => hands.first(),
+        Hand::Left => hands.get(1),
+    };
+    let kinds: Vec<&str> = hand.map_or(Vec::new(), |h| h.iter().map(|(t, _)| t.kind()).collect());
+    for (j, name) in task.shared.instruments.iter().enumerate() {
+        if kinds.contains(&name.as_str()) {
+            continue;
+        }
+        let quoted = format!("\"{name}\"");
+        check.problem_at(
+            &format!("instruments[{j}]"),
+            &["tasks", "instruments", &quoted],
+            format!(
+                "`{name}` is not an instrument of the task's hand, which holds: {}",
+                kinds.join(", ")
+            ),
+            "name the kinds of the hand's instruments: probe, grasper, scalpel, hook, clip applier, scissors",
+        );
+    }
 }
 
 /// A task's counter-traction: in a bimanual exercise, on one of its organs, with a band the

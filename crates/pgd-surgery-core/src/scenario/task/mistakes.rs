@@ -19,6 +19,8 @@ pub enum Mistake {
     Own { time_s: f64, code: u16, amount: f64 },
     /// The other hand's counter-traction lapsed (the task's `countertraction`).
     Countertraction { time_s: f64, lapse: Lapse },
+    /// The hand came onto tissue with an instrument not among the task's `instruments`.
+    OtherInstrument { time_s: f64, kind: &'static str },
 }
 
 impl Mistake {
@@ -40,6 +42,10 @@ impl Mistake {
                 let words = countertraction.map(|c| c.describe(task.hand(), lapse));
                 format!("{time_s:.2} s: {}", words.unwrap_or_default())
             }
+            Mistake::OtherInstrument { time_s, kind } => format!(
+                "{time_s:.2} s: worked on tissue with the {kind}, not with the task's {}",
+                task.shared.instruments.join(" or ")
+            ),
         }
     }
 }

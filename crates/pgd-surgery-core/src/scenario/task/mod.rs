@@ -32,7 +32,7 @@ use super::sample::{NoduleSite, Sample};
 use super::units::{Newtons, Seconds};
 
 /// The fields every task has, written among its own: `organ`, `max_force_n`, `time_limit_s`
-/// (and, optional, `hand`, `countertraction`, `phase`).
+/// (and, optional, `hand`, `countertraction`, `phase`, `instruments`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TaskShared {
     /// The organ the task works on; none for a task among them all (navigation), whose type
@@ -50,6 +50,10 @@ pub struct TaskShared {
     /// The phase of the operation the task belongs to ("Calot's triangle"): the debrief gives
     /// each phase's times; a phase's tasks follow one another.
     pub phase: Option<String>,
+    /// The instruments of the task's hand it is done with, by kind (`["hook"]`, `["clip
+    /// applier", "scissors"]`): tissue touched with another one of the hand's is a mistake.
+    /// Empty: any of them.
+    pub instruments: Vec<String>,
 }
 
 /// A trainee's hand, as a bimanual exercise's tasks name it.

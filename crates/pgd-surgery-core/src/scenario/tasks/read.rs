@@ -105,6 +105,7 @@ struct SharedFields {
     hand: Option<Hand>,
     countertraction: Option<Countertraction>,
     phase: Option<String>,
+    instruments: Option<Vec<String>>,
 }
 
 impl SharedFields {
@@ -125,6 +126,7 @@ impl SharedFields {
             hand: self.hand.unwrap_or_default(),
             countertraction: self.countertraction,
             phase: self.phase,
+            instruments: self.instruments.unwrap_or_default(),
         })
     }
 }
@@ -200,6 +202,7 @@ fn with_shared(own: &'static [&'static str], on_an_organ: bool) -> &'static [&'s
         "hand",
         "countertraction",
         "phase",
+        "instruments",
     ]
     .into_iter())
     .filter(|field| on_an_organ || *field != "organ");
@@ -265,6 +268,7 @@ impl<'de, A: MapAccess<'de>> MapAccess<'de> for Split<'_, A, A::Error> {
                     self.shared_value("countertraction", |s| &mut s.countertraction)?
                 }
                 "phase" => self.shared_value("phase", |s| &mut s.phase)?,
+                "instruments" => self.shared_value("instruments", |s| &mut s.instruments)?,
                 own if !self.fields.is_empty() && !self.fields.contains(&own) => {
                     let expected = with_shared(self.fields, self.on_an_organ);
                     return self.keep(Err(de::Error::unknown_field(own, expected)));
