@@ -216,6 +216,7 @@ fn the_operations_runs_are_made_from_the_scene() {
     // else, pressing within the device's limit.
     let haptic = competent.live();
     let held_n = haptic.assistant::<DeviceForce>().unwrap().desired_n;
+    eprintln!("the assistant holds the fundus with {:.3} N", held_n.norm());
     assert!(
         held_n.norm() > 0.01 && held_n.norm() <= scenario.device.max_force_n.0,
         "{held_n:?}"
