@@ -167,9 +167,9 @@ const SAFE_MARGIN_M: f64 = 2e-3;
 
 /// The hook frees the gallbladder from its bed, the nearest ties first: beside them, the
 /// energy on while two ties at least are well within its reach. The organs move as ties
-/// give, and ties give under the left hand's pull as well as under the hook: with two in
-/// reach, one giving leaves the other to take the energy, which never reaches a wall. A tie
-/// left alone, beyond the reach of others, is left to the pull.
+/// give, and a tie may give, or move out of reach, within a tick without the hook: with two
+/// in reach, one going leaves the other to take the energy, which never reaches a wall. A
+/// tie left alone, beyond the reach of others, is left.
 fn free_from_bed(script: &mut Script, abdomen: &Abdomen, reach_m: f64) {
     let within_m = reach_m - SAFE_MARGIN_M;
     let mut tried: Vec<Vector3<f64>> = Vec::new();
