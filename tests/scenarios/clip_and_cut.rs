@@ -9,19 +9,14 @@
 
 use std::path::Path;
 
-use nalgebra::Vector3;
 use pgd_surgery::app::attempt::Outcome;
-use pgd_surgery::app::attempt::scenario_scene;
-use pgd_surgery::app::scene::Detail;
 use pgd_surgery::biliary::{Structure, ViewRecord};
-use pgd_surgery::mesh::organs::{Abdomen, OrganSettings};
 use pgd_surgery::report::critical_view::{FAT, Projection, SIZE, Side, colour_of, rgb};
 use pgd_surgery::report::write_report;
 use pgd_surgery::scenario::tasks::ClipAndCutResult;
 use pgd_surgery::scenario::{Scenario, load};
-use pgd_surgery::store::OnStale;
 
-use super::script::{LEFT_START_M, Plane, Script, grasp_point, retracted};
+use super::script::{Stage, retracted};
 
 const NAME: &str = "lap-chole-clip-and-cut";
 
@@ -160,33 +155,19 @@ fn the_careless_clip_and_cut_fails_naming_what_it_did_before_the_view() {
 #[test]
 fn the_clip_and_cut_runs_are_made_from_the_scenes_tree() {
     let scenario = scenario();
-    let abdomen = Abdomen::new(&OrganSettings::default());
-    let start = Vector3::new(0.0, 0.02, -0.075);
-    let scene = scenario_scene(
-        &scenario,
-        super::vademecums(),
-        Detail::Coarse,
-        OnStale::Refuse,
-    );
-    let tip_m = scene.unwrap().probe.tip_radius_m;
-    let grasp = grasp_point(&abdomen, tip_m);
-    let left_start = grasp + Vector3::x() * LEFT_START_M;
-    let mut retraction = Script::new(&scenario, start, left_start, tip_m);
-    retraction.retract(grasp);
+    let stage = Stage::of(&scenario);
+    let (abdomen, start, plane) = (&stage.abdomen, stage.start_m, &stage.plane);
     // The fat stays where it was; the tubes follow the gallbladder drawn aside.
-    let tree = retracted(&scenario, &retraction);
-    let plane = Plane::of(&scenario.biliary.as_ref().unwrap().tree().unwrap());
+    let tree = retracted(&scenario, &stage.retracted(&scenario));
 
-    let mut competent = Script::new(&scenario, start, left_start, tip_m);
-    competent.retract(grasp);
-    competent.triangle_as_taught(&abdomen, &plane, start, |_| tree.clone());
+    let mut competent = stage.retracted(&scenario);
+    competent.triangle_as_taught(abdomen, plane, start, |_| tree.clone());
     competent.go(start);
     competent.wait(1.0);
     competent.check_or_write(NAME, "competent");
 
-    let mut careless = Script::new(&scenario, start, left_start, tip_m);
-    careless.retract(grasp);
-    careless.clip_in_haste(&abdomen, &tree, &plane, start);
+    let mut careless = stage.retracted(&scenario);
+    careless.clip_in_haste(abdomen, &tree, plane, start);
     // The left hand lets go of the infundibulum while the right hand works.
     careless.left_jaws(false);
     careless.divide_in_haste(&tree, start);

@@ -6,20 +6,17 @@
 //! debrief naming its errors in time order. The runs are made from the scene they run on.
 
 use nalgebra::Vector3;
-use pgd_surgery::app::attempt::scenario_scene;
 use pgd_surgery::app::haptic::{
     Biliary, DeviceForce, HandTouches, HapticLoop, OrganBeds, OrganBody, OrganBurns, TRAINEE_HANDS,
     Tool,
 };
-use pgd_surgery::app::scene::Detail;
 use pgd_surgery::biliary::BiliaryTree;
 use pgd_surgery::dissection::CauteryMode;
-use pgd_surgery::mesh::organs::{Abdomen, Organ, OrganSettings};
+use pgd_surgery::mesh::organs::{Abdomen, Organ};
 use pgd_surgery::scenario::tasks::DissectionResult;
 use pgd_surgery::scenario::{Scenario, load};
-use pgd_surgery::store::OnStale;
 
-use super::script::{LEFT_START_M, Plane, Script, grasp_point};
+use super::script::{Script, Stage};
 
 const NAME: &str = "lap-chole-full";
 
@@ -196,22 +193,11 @@ fn free_from_bed(script: &mut Script, abdomen: &Abdomen, reach_m: f64) {
 #[test]
 fn the_operations_runs_are_made_from_the_scene() {
     let scenario = scenario();
-    let abdomen = Abdomen::new(&OrganSettings::default());
-    let start = Vector3::new(0.0, 0.02, -0.075);
-    let scene = scenario_scene(
-        &scenario,
-        super::vademecums(),
-        Detail::Coarse,
-        OnStale::Refuse,
-    );
-    let tip_m = scene.unwrap().probe.tip_radius_m;
-    let grasp = grasp_point(&abdomen, tip_m);
-    let left_start = grasp + Vector3::x() * LEFT_START_M;
-    let plane = Plane::of(&scenario.biliary.as_ref().unwrap().tree().unwrap());
+    let stage = Stage::of(&scenario);
+    let (abdomen, start, plane, tip_m) = (&stage.abdomen, stage.start_m, &stage.plane, stage.tip_m);
 
-    let mut competent = Script::new(&scenario, start, left_start, tip_m);
+    let mut competent = stage.retracted(&scenario);
     competent.drive(&scenario);
-    competent.retract(grasp);
     // The assistant's grasper holds the fundus up: it touches the gallbladder, and nothing
     // else, pressing within the device's limit.
     let haptic = competent.live();
@@ -229,10 +215,10 @@ fn the_operations_runs_are_made_from_the_scene() {
         .collect();
     assert_eq!(touched, ["gallbladder"]);
     let tree = live_tree(&mut competent);
-    competent.triangle_as_taught(&abdomen, &plane, start, live_tree);
+    competent.triangle_as_taught(abdomen, plane, start, live_tree);
     competent.go(start);
     competent.change();
-    free_from_bed(&mut competent, &abdomen, reach_m(tip_m));
+    free_from_bed(&mut competent, abdomen, reach_m(tip_m));
     let burns = competent
         .live()
         .world()
@@ -245,16 +231,15 @@ fn the_operations_runs_are_made_from_the_scene() {
     competent.wait(1.0);
     competent.check_or_write(NAME, "competent");
 
-    let mut careless = Script::new(&scenario, start, left_start, tip_m);
-    careless.retract(grasp);
-    careless.clip_in_haste(&abdomen, &tree, &plane, start);
+    let mut careless = stage.retracted(&scenario);
+    careless.clip_in_haste(abdomen, &tree, plane, start);
     careless.divide_in_haste(&tree, start);
     careless.go(start);
     careless.change();
     // The triangle's task ends at its time limit, the artery still bleeding; in the bed's
     // phase the hook's energy goes on the liver's surface, well away from the bed.
     careless.wait(CLIP_AND_CUT_S - careless.time_s + 1.0);
-    careless.go(on_the_liver(&abdomen, &careless, tip_m));
+    careless.go(on_the_liver(abdomen, &careless, tip_m));
     careless.press(LIVER_BURN_S);
     careless.go(start);
     careless.wait(3.0);

@@ -17,9 +17,51 @@ use pgd_surgery::devices::{
     DeviceError, DeviceLimits, DeviceSample, EdgeForce, Fulcrum, HapticDevice, Instrument, Rack,
     TICK_S, Trajectory,
 };
-use pgd_surgery::mesh::organs::{Abdomen, Organ};
+use pgd_surgery::mesh::organs::{Abdomen, Organ, OrganSettings};
 use pgd_surgery::scenario::Scenario;
 use pgd_surgery::store::OnStale;
+
+/// Where a biliary scenario's scripts start: the organs at rest, the right hand's tip, the
+/// scene's tip radius, where the left grasper takes the infundibulum, and the ducts' plane.
+pub(super) struct Stage {
+    pub(super) abdomen: Abdomen,
+    pub(super) start_m: Vector3<f64>,
+    pub(super) tip_m: f64,
+    pub(super) grasp_m: Vector3<f64>,
+    pub(super) plane: Plane,
+}
+
+impl Stage {
+    /// The stage of `scenario`'s coarse scene.
+    pub(super) fn of(scenario: &Scenario) -> Self {
+        let abdomen = Abdomen::new(&OrganSettings::default());
+        let scene = scenario_scene(
+            scenario,
+            super::vademecums(),
+            Detail::Coarse,
+            OnStale::Refuse,
+        );
+        let tip_m = scene.unwrap().probe.tip_radius_m;
+        let grasp_m = grasp_point(&abdomen, tip_m);
+        let plane = Plane::of(&scenario.biliary.as_ref().unwrap().tree().unwrap());
+        Self {
+            abdomen,
+            start_m: Vector3::new(0.0, 0.02, -0.075),
+            tip_m,
+            grasp_m,
+            plane,
+        }
+    }
+
+    /// Both hands' script from their starts (the left grasper beside the infundibulum) to
+    /// the infundibulum taken and drawn aside.
+    pub(super) fn retracted(&self, scenario: &Scenario) -> Script {
+        let left_start_m = self.grasp_m + Vector3::x() * LEFT_START_M;
+        let mut script = Script::new(scenario, self.start_m, left_start_m, self.tip_m);
+        script.retract(self.grasp_m);
+        script
+    }
+}
 
 /// A script of both hands' devices: the right hand's through the scenario's one port (its
 /// rows, the time, the instruments' rack, whose offset the second button changes, and the
@@ -57,7 +99,7 @@ const LEFT_DRAW_M: f64 = 0.022;
 const LEFT_DRAW_S: f64 = 1.0;
 const RETRACTION_HELD_S: f64 = 2.0;
 /// The left grasper starts this far lateral of where it takes the infundibulum (m).
-pub(super) const LEFT_START_M: f64 = 0.024;
+const LEFT_START_M: f64 = 0.024;
 
 /// The tubes clipped and divided: the cystic duct, then the artery.
 const TUBES: [Structure; 2] = [Structure::CysticDuct, Structure::CysticArtery];
@@ -349,7 +391,7 @@ fn by_strand(abdomen: &Abdomen, strand: &FatStrand, plane: &Plane, tip_m: f64) -
 
 /// Where the left grasper's tip takes the infundibulum: lateral of its axis, its sphere
 /// `GRASP_INTO_M` into the wall.
-pub(super) fn grasp_point(abdomen: &Abdomen, tip_m: f64) -> Vector3<f64> {
+fn grasp_point(abdomen: &Abdomen, tip_m: f64) -> Vector3<f64> {
     let (fundus, neck) = abdomen.gallbladder_axis_m();
     let mut at = fundus.coords + (neck - fundus) * INFUNDIBULUM_T;
     while abdomen.value(Organ::Gallbladder, &at.into()) < tip_m - GRASP_INTO_M {

@@ -570,36 +570,13 @@ pub enum BenchTarget {
             default_value = "scenarios/runs/liver-steady-press.competent.csv"
         )]
         baseline_run: PathBuf,
-        /// Runs per figure; the median is reported.
-        #[arg(long, default_value_t = 3)]
-        repeats: usize,
-        /// The coarse organs and their 12 mm tool (the scripted runs are written for them).
-        #[arg(long)]
-        coarse: bool,
-        /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
-        #[arg(long, default_value = "vademecums")]
-        vademecums: PathBuf,
-        /// Print the report as JSON instead of a table.
-        #[arg(long)]
-        json: bool,
+        #[command(flatten)]
+        runs: SceneBenchArgs,
     },
     /// A stroke of the scalpel through the liver of the four-organ scene, ticked at 1 kHz on
     /// the real clock: tick compute time against the same stroke with a probe, and the cut
     /// state's time per step on its worker thread.
-    Scalpel {
-        /// Runs per figure; the median is reported.
-        #[arg(long, default_value_t = 3)]
-        repeats: usize,
-        /// The coarse organs (the liver at half resolution, as a cut coarse organ is).
-        #[arg(long)]
-        coarse: bool,
-        /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
-        #[arg(long, default_value = "vademecums")]
-        vademecums: PathBuf,
-        /// Print the report as JSON instead of a table.
-        #[arg(long)]
-        json: bool,
-    },
+    Scalpel(SceneBenchArgs),
     /// The render side's CPU work per frame on the four-organ scene, each organ pressed by
     /// the tool: the surface vertices formed from the modes there (the trainer's path)
     /// against the whole field formed and the surface picked from it (the baseline), with
@@ -716,6 +693,25 @@ pub enum BenchTarget {
         #[arg(long)]
         json: bool,
     },
+}
+
+/// The options of a benchmark that times a scene in runs: `pgd bench scalpel`, `pgd bench
+/// operation`.
+#[derive(clap::Args)]
+pub struct SceneBenchArgs {
+    /// Runs per figure; the median is reported.
+    #[arg(long, default_value_t = 3)]
+    pub repeats: usize,
+    /// The coarse organs and their 12 mm tool (the scripted runs are written for them; a cut
+    /// coarse liver is at half resolution).
+    #[arg(long)]
+    pub coarse: bool,
+    /// Where the organs' vademecums are kept (missing or stale ones are rebuilt).
+    #[arg(long, default_value = "vademecums")]
+    pub vademecums: PathBuf,
+    /// Print the report as JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `pgd bench haptics`'s options.

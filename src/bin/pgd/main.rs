@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use args::{
     BenchTarget, BuildArgs, Cli, Command, ContactBenchArgs, HapticsBenchArgs, MaterialArgs,
-    MeshArgs, ValidateArgs,
+    MeshArgs, SceneBenchArgs, ValidateArgs,
 };
 use clap::Parser;
 use pgd_surgery::app::scene::{Detail, SCENE_ORGANS, SceneOrgan, press_targets, scene_of};
@@ -403,29 +403,28 @@ fn bench_command(what: BenchTarget) -> ExitCode {
             run,
             baseline,
             baseline_run,
-            repeats,
-            coarse,
-            vademecums,
-            json,
+            runs,
         } => {
             let operation = app::bench_operation::ScenarioRun { scenario, run };
             let baseline = app::bench_operation::ScenarioRun {
                 scenario: baseline,
                 run: baseline_run,
             };
-            let detail = if coarse { Detail::Coarse } else { Detail::Full };
-            print_report(
-                "pgd bench operation",
-                app::bench_operation::run(&operation, &baseline, &vademecums, detail, repeats),
-                json,
-            )
+            let detail = if runs.coarse {
+                Detail::Coarse
+            } else {
+                Detail::Full
+            };
+            let report = app::bench_operation::run(
+                &operation,
+                &baseline,
+                &runs.vademecums,
+                detail,
+                runs.repeats,
+            );
+            print_report("pgd bench operation", report, runs.json)
         }
-        BenchTarget::Scalpel {
-            repeats,
-            coarse,
-            vademecums,
-            json,
-        } => bench_scalpel(repeats, coarse, &vademecums, json),
+        BenchTarget::Scalpel(runs) => bench_scalpel(&runs),
         BenchTarget::Rods { ticks, json } => {
             print_report("pgd bench rods", bench::rods::run(ticks), json)
         }
@@ -520,7 +519,13 @@ fn bench_haptics(options: HapticsBenchArgs) -> ExitCode {
 }
 
 /// `pgd bench scalpel`: the haptic loop's tick with a scalpel cutting the liver.
-fn bench_scalpel(repeats: usize, coarse: bool, vademecums: &Path, json: bool) -> ExitCode {
+fn bench_scalpel(runs: &SceneBenchArgs) -> ExitCode {
+    let SceneBenchArgs {
+        repeats,
+        coarse,
+        ref vademecums,
+        json,
+    } = *runs;
     let organs = SCENE_ORGANS.map(|organ| SceneOrgan {
         cut_toughness_j_per_m2: (organ == Organ::Liver)
             .then_some(pgd_surgery::cutting::LIVER_TOUGHNESS_J_PER_M2),
