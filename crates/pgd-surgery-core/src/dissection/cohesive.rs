@@ -147,10 +147,22 @@ impl CohesiveTie {
         let sliding = separation_m - normal.into_inner() * along;
         let effective = (opening * opening + sliding.norm_squared()).sqrt();
         self.reached_m = self.reached_m.max(effective);
-        let kept = law.stiffness_pa_per_m * (1.0 - law.damage(self.reached_m));
+        let kept = self.secant_pa_per_m(law);
         let closing = along.min(0.0);
         -(sliding + normal.into_inner() * opening) * kept
             - normal.into_inner() * (closing * law.stiffness_pa_per_m)
+    }
+
+    /// The traction (Pa) of the tie opened by the effective separation `effective_m` (≥ 0)
+    /// under `law`, its damage grown with it: what a tie pulled open along a line carries.
+    pub fn open(&mut self, law: &CohesiveLaw, effective_m: f64) -> f64 {
+        self.reached_m = self.reached_m.max(effective_m);
+        self.secant_pa_per_m(law) * effective_m
+    }
+
+    /// What is left of the tie's stiffness (Pa/m): a tie let back unloads along it.
+    pub fn secant_pa_per_m(&self, law: &CohesiveLaw) -> f64 {
+        law.stiffness_pa_per_m * (1.0 - self.damage(law))
     }
 
     /// How damaged the tie is under `law` (0 intact, 1 failed).

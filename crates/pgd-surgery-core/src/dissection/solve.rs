@@ -48,18 +48,20 @@ pub struct TieSolve {
 impl TieSolve {
     /// The forces `forces_n` (the last tick's on entry) that balance the ties against the
     /// organs' give, given the separation `by_others_m` the other loads make at each tie; a
-    /// failed tie carries none. Then each tie's damage grows with the separation it ends at.
-    /// Returns the products with `C` taken.
+    /// failed tie carries none, nor one `carried` by something else (a tie beyond the slice's
+    /// end is not). Then each tie's damage grows with the separation it ends at. Returns the
+    /// products with `C` taken.
     pub fn solve(
         &mut self,
         bed: &mut Bed,
+        carried: &[bool],
         by_others_m: &[Vector3<f64>],
         compliance: &mut impl TieCompliance,
         forces_n: &mut [Vector3<f64>],
         convergence: TieConvergence,
     ) -> usize {
         let n = bed.ties.len();
-        self.prepare(bed, n);
+        self.prepare(bed, carried, n);
         let k = &self.stiffness_n_per_m;
         for (f, &k) in forces_n.iter_mut().zip(k) {
             if k == 0.0 {
@@ -120,15 +122,18 @@ impl TieSolve {
         products + 1
     }
 
-    /// Each tie's secant stiffness times its area (N/m), zero for a failed one, and room.
-    fn prepare(&mut self, bed: &Bed, n: usize) {
+    /// Each tie's secant stiffness times its area (N/m), zero for a failed or carried one,
+    /// and room.
+    fn prepare(&mut self, bed: &Bed, carried: &[bool], n: usize) {
         self.stiffness_n_per_m.clear();
         let law = &bed.law;
-        self.stiffness_n_per_m.extend(
-            bed.ties
-                .iter()
-                .map(|t| law.stiffness_pa_per_m * (1.0 - t.state.damage(law)) * t.area_m2),
-        );
+        self.stiffness_n_per_m
+            .extend(bed.ties.iter().enumerate().map(|(i, t)| {
+                match carried.get(i).copied().unwrap_or(false) {
+                    true => 0.0,
+                    false => t.state.secant_pa_per_m(law) * t.area_m2,
+                }
+            }));
         for v in [
             &mut self.residual_m,
             &mut self.direction_n,
@@ -172,8 +177,9 @@ impl TieSolve {
     ) {
         compliance.separation(forces_n, &mut self.product_m);
         let law = bed.law;
-        for ((tie, moved), d) in bed.ties.iter_mut().zip(&self.product_m).zip(by_others_m) {
-            if !tie.state.failed(&law) {
+        let solved = bed.ties.iter_mut().zip(&self.product_m).zip(by_others_m);
+        for (((tie, moved), d), &k) in solved.zip(&self.stiffness_n_per_m) {
+            if k > 0.0 {
                 tie.state.traction(&law, &(d + moved), &tie.normal);
             }
         }
@@ -267,6 +273,7 @@ mod tests {
             let mut forces = vec![Vector3::zeros(); 6];
             let products = TieSolve::default().solve(
                 &mut bed.clone(),
+                &[],
                 &delta,
                 &mut compliance,
                 &mut forces,
@@ -314,6 +321,7 @@ mod tests {
         let mut solve = TieSolve::default();
         solve.solve(
             &mut bed,
+            &[],
             &delta,
             &mut compliance,
             &mut forces,
@@ -325,11 +333,53 @@ mod tests {
         let mut none = Dense(DMatrix::zeros(18, 18));
         solve.solve(
             &mut bed,
+            &[],
             &torn,
             &mut none,
             &mut forces,
             TieConvergence::default(),
         );
         assert_eq!(bed.released_share(), 1.0);
+    }
+
+    /// A tie carried by something else (the wall, under a grasper's pull) carries no force
+    /// here and is not damaged by what the organs' fields open it by; the others balance as
+    /// before, to 1e-4 at the default stop.
+    #[test]
+    fn carried_ties_are_left_to_what_carries_them() {
+        let (mut bed, mut compliance) = bed_and_compliance();
+        let k = bed.ties[0].area_m2 * bed.law.stiffness_pa_per_m;
+        let mut carried = [false; 6];
+        carried[4] = true;
+        let torn: Vec<Vector3<f64>> = (0..6).map(|_| Vector3::z() * 0.1).collect();
+        let mut forces = vec![Vector3::zeros(); 6];
+        TieSolve::default().solve(
+            &mut bed,
+            &carried,
+            &by_others(),
+            &mut compliance,
+            &mut forces,
+            TieConvergence::default(),
+        );
+        assert_eq!(forces[4], Vector3::zeros());
+        assert_eq!(bed.ties[4].state, CohesiveTie::default());
+        let mut moved = vec![Vector3::zeros(); 6];
+        compliance.separation(&forces, &mut moved);
+        let delta = by_others();
+        for i in (0..6).filter(|&i| i != 4) {
+            let miss = (forces[i] + (delta[i] + moved[i]) * k).norm() / forces[i].norm();
+            assert!(miss < 1e-4, "tie {i}: {miss}");
+        }
+        let mut none = Dense(DMatrix::zeros(18, 18));
+        TieSolve::default().solve(
+            &mut bed,
+            &carried,
+            &torn,
+            &mut none,
+            &mut forces,
+            TieConvergence::default(),
+        );
+        assert!(!bed.ties[4].state.failed(&bed.law));
+        assert!(bed.ties[0].state.failed(&bed.law));
     }
 }

@@ -22,6 +22,11 @@
 //! go as the ties fail. The springs are taken to the liver as fixed: its give under the ties
 //! is far below theirs.
 //!
+//! A grasper's jaws on the freed organ pull the ties near them through its wall
+//! ([`WallPull`]): [`TiedOrgans::grip`] as they close, [`TiedOrgans::wall_tether`] for the
+//! grasp's tick, [`TiedOrgans::pull_wall`] after it. The ties the wall holds are left out of
+//! the fields' solve and the kept modes' restraint while it holds them.
+//!
 //! The ties load both organs through their linear modes alone: together they are a traction
 //! spread over the bed, which has no dimple under each tie for the near field to draw. The
 //! near field of other loads (the dimple under a tool) is not read at the ties either.
@@ -33,8 +38,9 @@ use nalgebra::{DMatrix, SymmetricEigen, Vector3};
 use super::bed::Bed;
 use super::cautery::{CauteryMode, TieBurns, TissueHeat};
 use super::solve::{TieCompliance, TieConvergence, TieSolve};
+use super::wall_pull::{WALL_REACH_M, WallPull, WallPullReport};
 use crate::contact::{Coupling, ModalRows, OrganPose};
-use crate::dynamics::ModalBasis;
+use crate::dynamics::{ModalBasis, Tether};
 use crate::pgd::Vademecum;
 
 /// The connective tissue layer's thickness the hook burns through (m): the bed's ties span
@@ -194,6 +200,8 @@ pub struct TiedOrgans {
     burns: TieBurns,
     report: TiedReport,
     kept: Option<KeptAtTies>,
+    wall: WallPull,
+    wall_report: WallPullReport,
 }
 
 /// The freed organ's kept vibration modes at the ties, and the ties' stiffness over them.
@@ -207,13 +215,14 @@ struct KeptAtTies {
 }
 
 impl KeptAtTies {
-    /// `K_r = Σ kᵢ Φᵢᵀ Φᵢ` over the live ties of `bed`.
-    fn restrain(&mut self, bed: &Bed) {
+    /// `K_r = Σ kᵢ Φᵢᵀ Φᵢ` over the live ties of `bed` not `carried` by the wall.
+    fn restrain(&mut self, bed: &Bed, carried: &[bool]) {
         let (law, r) = (&bed.law, self.modes);
         self.stiffness.fill(0.0);
-        for (tie, phi) in bed.ties.iter().zip(self.at_ties.chunks_exact(r)) {
-            let k = law.stiffness_pa_per_m * (1.0 - tie.state.damage(law)) * tie.area_m2;
-            if tie.state.failed(law) || k <= 0.0 {
+        let ties = bed.ties.iter().zip(carried);
+        for ((tie, &carried), phi) in ties.zip(self.at_ties.chunks_exact(r)) {
+            let k = tie.state.secant_pa_per_m(law) * tie.area_m2;
+            if carried || tie.state.failed(law) || k <= 0.0 {
                 continue;
             }
             for (a, row) in self.stiffness.chunks_exact_mut(r).enumerate() {
@@ -288,6 +297,8 @@ impl TiedOrgans {
             burns: TieBurns::new(n, TissueHeat::SOFT_TISSUE, LAYER_THICKNESS_M),
             report: TiedReport::default(),
             kept: None,
+            wall: WallPull::with_room(n),
+            wall_report: WallPullReport::default(),
         }
     }
 
@@ -363,9 +374,38 @@ impl TiedOrgans {
         outcome
     }
 
+    /// A grasper's jaws close on the freed organ at `jaws_m`: the ties within the wall's
+    /// reach hang from them ([`WallPull::grip`]).
+    pub fn grip(&mut self, jaws_m: &Vector3<f64>) {
+        (self.wall).grip(&self.bed, &self.ends_m, jaws_m, WALL_REACH_M);
+    }
+
+    /// The taut strands of wall as springs on the jaws for the grasp's tick.
+    pub fn wall_tether(&self) -> Option<Tether> {
+        self.wall.tether(&self.bed, &self.ends_m)
+    }
+
+    /// The jaws are at `jaws_m` after the grasp's tick: the wall opens the ties it holds.
+    pub fn pull_wall(&mut self, jaws_m: &Vector3<f64>) -> WallPullReport {
+        self.wall_report = self.wall.pull(&mut self.bed, &self.ends_m, jaws_m);
+        self.wall_report
+    }
+
+    /// The jaws let the freed organ go: the ties go back to the organs' fields.
+    pub fn let_go(&mut self) {
+        self.wall.let_go();
+        self.wall_report = WallPullReport::default();
+    }
+
+    /// What the wall did in the last tick.
+    pub fn wall_report(&self) -> &WallPullReport {
+        &self.wall_report
+    }
+
     /// The bed whole again for another attempt: every tie undamaged and unheated, carrying
     /// nothing until the next tick solves it.
     pub fn heal(&mut self) {
+        self.let_go();
         for tie in &mut self.bed.ties {
             tie.state = super::CohesiveTie::default();
         }
@@ -400,6 +440,7 @@ impl TiedOrgans {
                 base_m: self.base.rest_m[i] + base,
             };
         }
+        self.wall.draw_open(&mut self.ends_m);
         // What the last tick's forces add to the measurement comes out: the solve adds it
         // back for the forces it finds.
         self.compliance.apply(&self.forces_n, &mut self.by_others_m);
@@ -408,6 +449,7 @@ impl TiedOrgans {
         }
         let products = self.solve.solve(
             &mut self.bed,
+            self.wall.carried(),
             &self.by_others_m,
             &mut self.compliance,
             &mut self.forces_n,
@@ -422,7 +464,7 @@ impl TiedOrgans {
             products: products + 1,
         };
         if let Some(kept) = &mut self.kept {
-            kept.restrain(&self.bed);
+            kept.restrain(&self.bed, self.wall.carried());
         }
         self.freed.gather(&self.forces_n, 1.0);
         self.base.gather(&self.forces_n, -1.0);

@@ -20,6 +20,12 @@
 //!   modes' static share of the jaws' pull is the restrained organ's, `(Λ + K_r)⁻¹ Φₛᵀ F`:
 //!   the hand feels the organ held by its bed, and the vademecum's static field (in which the
 //!   ties hold the organ too) is what the motion corrects.
+//! - **A tether** (a wall far stiffer in tension than the tissue it encloses, carrying the
+//!   pull straight to what holds the organ, [`GraspedOrgan::set_tether`]) acts on the grasped
+//!   point beside the coupling and the remainder: the point `x` balances the coupling, the
+//!   tether's `g − K_t x` and the organ's `R⁻¹ (x − X − Φₛ q)`, so
+//!   `F = (I + kR + R K_t)⁻¹ (k e + (I + R K_t) b ė − k R (g − K_t x_hand))`. The hand feels
+//!   `−F`; the organ takes what the tether leaves of it, `F + g − K_t x`.
 //! - **Damage**: a pull above `damage_force_n`, or the grasped point drawn further than
 //!   `damage_stretch_m` from where it was grasped, marks the tissue damaged (reported once per
 //!   grasp).
@@ -145,6 +151,21 @@ impl GraspPoint {
     }
 }
 
+/// Springs on the grasped point that bypass the organ's bulk, linear within a tick: the force
+/// on the point at `x` (m) is `force_at_origin_n − stiffness_n_per_m x`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tether {
+    pub stiffness_n_per_m: Matrix3<f64>,
+    pub force_at_origin_n: Vector3<f64>,
+}
+
+impl Tether {
+    /// The tether's force on the point at `at_m` (N).
+    pub fn force_n(&self, at_m: &Vector3<f64>) -> Vector3<f64> {
+        self.force_at_origin_n - self.stiffness_n_per_m * at_m
+    }
+}
+
 /// What the jaws are doing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Jaws {
@@ -191,6 +212,8 @@ pub struct GraspedOrgan {
     applied_n: Vector3<f64>,
     /// `Λ + K_r` factored, while a restraint holds the organ.
     restrained_stiffness: Option<SmallSpd>,
+    /// Springs on the grasped point beside the organ, while the jaws hold.
+    tether: Option<Tether>,
 }
 
 impl GraspedOrgan {
@@ -213,7 +236,14 @@ impl GraspedOrgan {
             load: vec![0.0; r],
             applied_n: Vector3::zeros(),
             restrained_stiffness: None,
+            tether: None,
         }
+    }
+
+    /// Springs on the grasped point for this tick and the next until set again (none: the
+    /// point is held by the organ alone). Dropped when the jaws let go.
+    pub fn set_tether(&mut self, tether: Option<Tether>) {
+        self.tether = tether;
     }
 
     /// Springs that hold the organ where it lies (a bed's ties), as a stiffness over the kept
@@ -258,7 +288,7 @@ impl GraspedOrgan {
             slipping: false,
             damaged_now: false,
         };
-        let force = match (self.jaws, closed) {
+        let (force, on_organ) = match (self.jaws, closed) {
             (Jaws::Holding { .. }, false) => self.release(),
             (
                 Jaws::Holding {
@@ -268,15 +298,20 @@ impl GraspedOrgan {
                 },
                 true,
             ) => {
-                let error = hand_m + offset_m - self.point.rest_m - moved;
-                let force = self.coupling(&error, &(hand_velocity - velocity));
+                let target = hand_m + offset_m;
+                let error = target - self.point.rest_m - moved;
+                let force = self.coupling(&error, &(hand_velocity - velocity), &target);
                 let (force, escaped) = self.slip(force, offset_m, slipped_m, from_m, &mut tick);
-                let point_m = self.point.rest_m + moved + self.point.remainder_m_per_n * force;
+                let point_m = self.point_under(&(self.point.rest_m + moved), &force);
                 tick.point_m = Some(point_m);
                 self.check_damage(&force, &(point_m - from_m), &mut tick);
+                let on_organ = force
+                    + self
+                        .tether
+                        .map_or(Vector3::zeros(), |t| t.force_n(&point_m));
                 match escaped {
                     true => self.release(),
-                    false => force,
+                    false => (force, on_organ),
                 }
             }
             (Jaws::Releasing { force_n, elapsed_s }, _) => {
@@ -287,9 +322,9 @@ impl GraspedOrgan {
                         elapsed_s: elapsed_s + h,
                     },
                 };
-                Vector3::zeros()
+                (Vector3::zeros(), Vector3::zeros())
             }
-            (Jaws::Open, _) => Vector3::zeros(),
+            (Jaws::Open, _) => (Vector3::zeros(), Vector3::zeros()),
         };
         tick.hand_force_n = match self.jaws {
             Jaws::Holding { .. } => -force,
@@ -298,9 +333,9 @@ impl GraspedOrgan {
             }
             Jaws::Open => Vector3::zeros(),
         };
-        self.point.generalized(&force, &mut self.load);
+        self.point.generalized(&on_organ, &mut self.load);
         self.step.step(&self.reduced, &mut self.state, &self.load)?;
-        self.applied_n = force;
+        self.applied_n = on_organ;
         Ok(tick)
     }
 
@@ -356,15 +391,43 @@ impl GraspedOrgan {
         self.point.moved(&self.state).0
     }
 
-    /// `F = (I + kR)⁻¹ (k e + b ė)`: the coupling with the remainder's spring in series.
-    fn coupling(&self, error: &Vector3<f64>, rate: &Vector3<f64>) -> Vector3<f64> {
+    /// The coupling's force for the hand's target `target_m`, `error` from where the kept
+    /// modes put the point: `F = (I + kR)⁻¹ (k e + b ė)`, the remainder's spring in series, or
+    /// with a tether beside it as the module says.
+    fn coupling(
+        &self,
+        error: &Vector3<f64>,
+        rate: &Vector3<f64>,
+        target_m: &Vector3<f64>,
+    ) -> Vector3<f64> {
         let (k, b) = (
             self.settings.coupling_n_per_m,
             self.settings.coupling_damping_n_s_per_m,
         );
-        let series = Matrix3::identity() + self.point.remainder_m_per_n * k;
-        let target = error * k + rate * b;
+        let r = &self.point.remainder_m_per_n;
+        let (series, target) = match &self.tether {
+            None => (Matrix3::identity() + r * k, error * k + rate * b),
+            Some(tether) => {
+                let beside = Matrix3::identity() + r * tether.stiffness_n_per_m;
+                let pulled_back = r * tether.force_n(target_m) * k;
+                (beside + r * k, error * k + beside * rate * b - pulled_back)
+            }
+        };
         series.lu().solve(&target).unwrap_or(target)
+    }
+
+    /// Where the point balances the jaws' `force` (N), the organ and the tether, its kept
+    /// modes putting it at `with_modes_m`: `x = X + Φₛ q + R (F + g − K_t x)`.
+    fn point_under(&self, with_modes_m: &Vector3<f64>, force: &Vector3<f64>) -> Vector3<f64> {
+        let r = &self.point.remainder_m_per_n;
+        match &self.tether {
+            None => with_modes_m + r * force,
+            Some(tether) => {
+                let beside = Matrix3::identity() + r * tether.stiffness_n_per_m;
+                let right = with_modes_m + r * (force + tether.force_at_origin_n);
+                beside.lu().solve(&right).unwrap_or(right)
+            }
+        }
     }
 
     /// Caps the force at the slip limit, moving the jaws along the tissue by what the cap takes
@@ -404,13 +467,16 @@ impl GraspedOrgan {
         }
     }
 
-    /// Lets the tissue go: the organ at once, the hand's force over the release time.
-    fn release(&mut self) -> Vector3<f64> {
+    /// Lets the tissue go: the organ at once (the tether with it), the hand's force over the
+    /// release time. Nothing acts on the organ or the hand in this tick: `(0, 0)`.
+    fn release(&mut self) -> (Vector3<f64>, Vector3<f64>) {
         let (moved, velocity) = self.point.moved(&self.state);
         let force_n = match self.jaws {
             Jaws::Holding { offset_m, .. } => {
                 let hand = self.previous_hand_m.unwrap_or(self.point.rest_m);
-                self.coupling(&(hand + offset_m - self.point.rest_m - moved), &(-velocity))
+                let target = hand + offset_m;
+                let error = target - self.point.rest_m - moved;
+                self.coupling(&error, &(-velocity), &target)
             }
             _ => Vector3::zeros(),
         };
@@ -418,6 +484,7 @@ impl GraspedOrgan {
             force_n,
             elapsed_s: 0.0,
         };
-        Vector3::zeros()
+        self.tether = None;
+        (Vector3::zeros(), Vector3::zeros())
     }
 }

@@ -25,7 +25,7 @@ mod small_spd;
 
 pub use basis::ModalBasis;
 pub use error::DynamicsError;
-pub use grasp::{GraspPoint, GraspSettings, GraspTick, GraspedOrgan, Jaws};
+pub use grasp::{GraspPoint, GraspSettings, GraspTick, GraspedOrgan, Jaws, Tether};
 pub use integrator::{EnergyMomentum, RayleighDamping, ReducedState, StepReport};
 pub use mode_fit::ModeFit;
 pub use organ::{DynamicModel, TISSUE_DAMPING_RATIO, TRAINER_MODES};
