@@ -602,3 +602,58 @@ fn a_grasped_gallbladder_feels_its_bed() {
     assert!(tied.ties_n.dot(&away) < 0.0);
     assert!(largest_change <= 0.02, "{largest_change} N in a tick");
 }
+
+/// A grasper drawing the gallbladder off its bed by the face beside it (blunt dissection):
+/// the wall carries the pull to the ties within its reach of the jaws, which go taut and
+/// tear, every one of them, before the jaws open;
+/// each torn tie counts as released; the work the hand did is at least the fracture energy of
+/// the ties torn (the rest is stored or damped); the hand's force stays finite and changes by
+/// at most 20 mN a tick.
+#[test]
+fn a_grasper_tears_the_ties_near_its_jaws() {
+    use pgd_surgery::app::haptic::{DeviceForce, Tool};
+    let pull_until_s = 4.0;
+    let mut haptic = pulled_off_the_bed(30.0, pull_until_s);
+    let (mut gripped, mut most_taut_n, mut torn) = (0, 0.0_f64, 0);
+    let (mut work_j, mut largest_change, mut last_force) = (0.0, 0.0_f64, Vector3::zeros());
+    let mut last_tip: Option<Vector3<f64>> = None;
+    for tick in 0..(pull_until_s / TICK_S) as usize {
+        tick_at(&mut haptic, tick as u64);
+        let force = haptic.hand::<DeviceForce>(1).unwrap().desired_n;
+        let tip = haptic.hand::<Tool>(1).unwrap().hand.unwrap().tip_m;
+        if let Some(last) = last_tip {
+            work_j -= 0.5 * (force + last_force).dot(&(tip - last));
+        }
+        assert!(force.iter().all(|f| f.is_finite()), "tick {tick}");
+        largest_change = largest_change.max((force - last_force).norm());
+        (last_tip, last_force) = (Some(tip), force);
+        let report = *haptic.world().resource::<OrganBeds>().0[0].wall_report();
+        gripped = gripped.max(report.strands);
+        most_taut_n = most_taut_n.max(report.force_on_jaws_n.norm());
+        torn += report.torn;
+    }
+    let bed = &haptic.world().resource::<OrganBeds>().0[0].bed;
+    let failed: Vec<&pgd_surgery::dissection::Tie> = bed
+        .ties
+        .iter()
+        .filter(|t| t.state.failed(&bed.law))
+        .collect();
+    let fracture_j: f64 = (failed.iter())
+        .map(|t| t.area_m2 * bed.law.fracture_energy_j_per_m2)
+        .sum();
+    let released = bed.released_share();
+    eprintln!(
+        "blunt: {gripped} ties gripped, {torn} torn ({:.1} % of the bed); the wall pulled up to {most_taut_n:.3} N; \
+         the hand's work {:.2} mJ against {:.2} mJ of fracture; largest change {:.2} mN a tick",
+        100.0 * released,
+        work_j * 1e3,
+        fracture_j * 1e3,
+        largest_change * 1e3
+    );
+    assert!(gripped >= 3, "{gripped} ties within the wall's reach");
+    assert_eq!(torn, gripped);
+    assert_eq!(failed.len(), torn);
+    assert!(released > 0.0);
+    assert!(work_j >= fracture_j, "{work_j} J for {fracture_j} J");
+    assert!(largest_change <= 0.02, "{largest_change} N in a tick");
+}

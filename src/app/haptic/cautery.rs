@@ -84,6 +84,12 @@ fn burn_wall(
     })
 }
 
+/// The ties of the scene's beds a grasper's pull tore in the last tick.
+pub fn ties_torn(beds: Option<&OrganBeds>) -> u32 {
+    let beds = beds.map_or(&[][..], |b| &b.0[..]);
+    beds.iter().map(|b| b.wall_report().torn as u32).sum()
+}
+
 /// The share (0–1, by area) of the scene's beds released.
 pub fn released_share(beds: Option<&OrganBeds>) -> f64 {
     let beds = beds.map_or(&[][..], |b| &b.0[..]);

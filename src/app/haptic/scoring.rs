@@ -14,7 +14,7 @@ use bevy::ecs::query::QueryData;
 use bevy::prelude::*;
 
 use super::biliary::Biliary;
-use super::cautery::{HookWork, OrganBurns, released_share};
+use super::cautery::{HookWork, OrganBurns, released_share, ties_torn};
 use super::components::{HandTouches, OrganBody, OrganDeformation, OrganIndex, OrganMotion};
 use super::cutting::OrganCut;
 use super::hand::{DeviceForce, HandIndex, MAX_HANDS, Tool};
@@ -248,6 +248,7 @@ pub fn score_tick(
         left,
         hook,
         released_share: released_share(beds.as_deref()),
+        ties_torn: ties_torn(beds.as_deref()),
         biliary: biliary
             .as_ref()
             .map_or_else(BiliarySample::default, |b| b.sample),

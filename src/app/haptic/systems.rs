@@ -188,11 +188,13 @@ struct Jaws {
 /// organ its tool touches (one organ a hand, one hand an organ), and every moving organ is
 /// stepped, held or swinging back. While the jaws hold, the holding hand's load on the organ
 /// is their pull at their patch (its static field the vademecum's, the kept modes' motion the
-/// correction) and that hand feels the grasp, not a press.
+/// correction) and that hand feels the grasp, not a press. Jaws on an organ tied in a bed pull
+/// the ties near them through its wall (`TiedOrgans::grip`), solved with the grasp.
 pub fn grasp(
     mut was_closed: Local<[bool; MAX_HANDS]>,
     mut hands: Query<(&HandIndex, &Tool, &mut GraspForce, &mut FaultLog)>,
     mut organs: Query<MovingOrgan>,
+    mut beds: Option<ResMut<OrganBeds>>,
 ) {
     let mut jaws = [None; MAX_HANDS];
     for (hand, tool, mut force, _) in &mut hands {
@@ -216,7 +218,12 @@ pub fn grasp(
     }
     for (slot, hand) in jaws.iter().enumerate() {
         if hand.is_some_and(|j| j.closing) {
-            take_first(slot, &hand.expect("closing").tip_m, &mut organs);
+            take_first(
+                slot,
+                &hand.expect("closing").tip_m,
+                &mut organs,
+                beds.as_deref_mut(),
+            );
         }
     }
     for organ in &mut organs {
@@ -227,8 +234,17 @@ pub fn grasp(
             continue;
         };
         motion.tore = false;
+        let mut bed = bed_of(beds.as_deref_mut(), organ.index.0);
+        motion
+            .organ
+            .set_tether(bed.as_ref().and_then(|b| b.wall_tether()));
         match motion.organ.tick(&hand.tip_m, hand.closed) {
             Ok(outcome) => {
+                match (bed.as_mut(), outcome.point_m) {
+                    (Some(bed), Some(jaws_m)) => _ = bed.pull_wall(&jaws_m),
+                    (Some(bed), None) => bed.let_go(),
+                    (None, _) => {}
+                }
                 let holder = hands.iter_mut().find(|h| h.0.0 == motion.hand);
                 if let Some((_, _, mut force, _)) = holder {
                     force.0 += outcome.hand_force_n;
@@ -259,9 +275,19 @@ pub fn grasp(
     }
 }
 
+/// The bed that ties organ `index` to another, if any.
+fn bed_of(beds: Option<&mut OrganBeds>, index: usize) -> Option<&mut TiedOrgans> {
+    beds.and_then(|b| b.0.iter_mut().find(|bed| bed.freed_index() == index))
+}
+
 /// Hand `slot`'s jaws, closing at `tip_m`, take hold of the first free organ its tool touches,
-/// unless they hold one already.
-fn take_first(slot: usize, tip_m: &Vector3<f64>, organs: &mut Query<MovingOrgan>) {
+/// unless they hold one already; the wall of an organ tied in a bed takes the ties near them.
+fn take_first(
+    slot: usize,
+    tip_m: &Vector3<f64>,
+    organs: &mut Query<MovingOrgan>,
+    beds: Option<&mut OrganBeds>,
+) {
     let holds = |m: &OrganMotion| m.organ.holding() && m.hand == slot;
     if organs.iter().any(|o| holds(o.motion)) {
         return;
@@ -273,6 +299,10 @@ fn take_first(slot: usize, tip_m: &Vector3<f64>, organs: &mut Query<MovingOrgan>
         let motion = organ.motion.into_inner();
         take_hold(organ.body, &organ.touch.0[slot], motion, tip_m);
         motion.hand = slot;
+        if let Some(bed) = bed_of(beds, organ.index.0) {
+            let point = &motion.organ.point;
+            bed.grip(&(point.rest_m + motion.organ.point_displacement()));
+        }
     }
 }
 
@@ -280,6 +310,7 @@ fn take_first(slot: usize, tip_m: &Vector3<f64>, organs: &mut Query<MovingOrgan>
 #[derive(QueryData)]
 #[query_data(mutable)]
 pub struct MovingOrgan {
+    index: &'static OrganIndex,
     body: &'static OrganBody,
     touch: &'static mut HandTouches,
     deformation: &'static mut OrganDeformation,

@@ -336,6 +336,7 @@ mod tests {
                 released_share: 1.0,
                 target_share: 0.9,
                 ties_divided: 10,
+                ties_torn: 0,
                 burns: vec![burn(65.0), burn(70.0)],
                 burned_area_mm2: 8.0,
                 capsule_injuries: 0,

@@ -329,6 +329,7 @@ mod tests {
                 released_share: released,
                 target_share: 0.9,
                 ties_divided: 0,
+                ties_torn: 0,
                 burned_area_mm2: 4.0 * burns.len() as f64,
                 capsule_injuries: burns.iter().filter(|b| b.through_capsule).count(),
                 burns,

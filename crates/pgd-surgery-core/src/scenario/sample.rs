@@ -48,6 +48,8 @@ pub struct Sample {
     pub hook: HookSample,
     /// The share (0–1, by area) of the scene's attachments released so far.
     pub released_share: f64,
+    /// Ties a grasper's pull tore in this tick (blunt dissection).
+    pub ties_torn: u32,
     /// What happened to the biliary tree in this tick (nothing without one).
     pub biliary: BiliarySample,
 }

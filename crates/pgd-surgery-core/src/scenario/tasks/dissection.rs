@@ -70,6 +70,7 @@ impl TaskType for Dissection {
             energy: EnergySpent::default(),
             in_air_burst_j: 0.0,
             ties_divided: 0,
+            ties_torn: 0,
             perforation: None,
         }
     }
@@ -118,6 +119,7 @@ pub struct DissectionRun {
     /// The energy of the burst with the hook on nothing under way (J).
     in_air_burst_j: f64,
     ties_divided: u32,
+    ties_torn: u32,
     /// When and where a hollow organ's wall was burned through.
     perforation: Option<Burn>,
 }
@@ -192,6 +194,7 @@ impl TaskRun for DissectionRun {
                 self.in_air_burst_j += hook.energy_j;
             }
         }
+        self.ties_torn += tick.sample.ties_torn;
         self.released_share = tick.sample.released_share;
         tick.metrics.completed =
             self.released_share >= self.target_share && self.perforation.is_none();
@@ -223,6 +226,7 @@ impl TaskRun for DissectionRun {
             released_share: self.released_share,
             target_share: self.target_share,
             ties_divided: self.ties_divided,
+            ties_torn: self.ties_torn,
             burns: self.burns.iter().map(made).collect(),
             burned_area_mm2: (self.burns.iter()).fold(0.0, |sum, b| sum + b.area_m2 * 1e6),
             capsule_injuries: self.burns.iter().filter(|b| b.capsule).count(),
@@ -249,6 +253,8 @@ pub struct DissectionResult {
     pub released_share: f64,
     pub target_share: f64,
     pub ties_divided: u32,
+    /// Ties torn by the grasper's pull (blunt dissection).
+    pub ties_torn: u32,
     /// The non-target burns, in order.
     pub burns: Vec<BurnMade>,
     pub burned_area_mm2: f64,
@@ -299,12 +305,13 @@ impl TaskResult for DissectionResult {
     fn summary(&self) -> Vec<String> {
         let e = &self.energy;
         vec![format!(
-            "released {:.0} % of the attachment (target {:.0} %), {} ties divided; {} \
+            "released {:.0} % of the attachment (target {:.0} %), {} ties divided, {} torn; {} \
              non-target burns ({:.1} mm², {} through a capsule); energy {:.1} J: {:.1} J on the \
              ties, {:.1} J on the organs, {:.2} J on no tissue",
             100.0 * self.released_share,
             100.0 * self.target_share,
             self.ties_divided,
+            self.ties_torn,
             self.burns.len(),
             self.burned_area_mm2,
             self.capsule_injuries,
@@ -370,7 +377,8 @@ mod tests {
 
     /// Energy on no tissue for 0.1 s (one error, its energy), a burn of the liver whose second
     /// tick goes through its capsule (a burn and a capsule injury, on that mark), ties
-    /// divided to half the bed: done, the energy apportioned, the burn listed with its organ.
+    /// divided and torn to half the bed: done, the energy apportioned, the burn listed with
+    /// its organ, the torn ties counted apart from the divided ones.
     #[test]
     fn a_dissection_counts_its_burns_and_its_energy() {
         let scenario = parse(Path::new("t.scenario.ron"), SCENARIO).unwrap();
@@ -388,6 +396,10 @@ mod tests {
             },
             0.3,
         ));
+        samples.push(Sample {
+            ties_torn: 3,
+            ..tick(0.35, HookTarget::Off, 0.4)
+        });
         samples.push(tick(
             0.4,
             HookTarget::Ties {
@@ -408,7 +420,7 @@ mod tests {
         let m = &metrics[0];
         let done = m.result::<DissectionResult>().unwrap();
         assert!(m.completed, "{m:#?}");
-        assert_eq!(done.ties_divided, 2);
+        assert_eq!((done.ties_divided, done.ties_torn), (2, 3));
         assert_eq!(done.burns.len(), 1);
         assert_eq!(
             (done.burns[0].organ.as_str(), done.capsule_injuries),
