@@ -30,6 +30,19 @@ pub struct Tie {
     pub state: CohesiveTie,
 }
 
+/// Where a tie's two ends are (m, the scene's frame): on the freed organ and on its base.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TieEnds {
+    pub freed_m: Vector3<f64>,
+    pub base_m: Vector3<f64>,
+}
+
+impl TieEnds {
+    pub fn middle_m(&self) -> Vector3<f64> {
+        (self.freed_m + self.base_m) * 0.5
+    }
+}
+
 /// The freed organ's surface as its load positions: where each is at rest (m), its outward
 /// normal and its share of the surface (m²).
 pub struct FreedSurface<'a> {

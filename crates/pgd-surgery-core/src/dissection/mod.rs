@@ -14,10 +14,10 @@ pub mod tied;
 pub mod wall;
 pub mod wall_pull;
 
-pub use bed::{Bed, BedError, FreedSurface, Tie};
+pub use bed::{Bed, BedError, FreedSurface, Tie, TieEnds};
 pub use cautery::{Cautery, CauteryMode, POWER_RANGE_W, PowerOutOfRange, TieBurns, TissueHeat};
 pub use cohesive::{CohesiveError, CohesiveLaw, CohesiveTie};
 pub use solve::{TieCompliance, TieConvergence, TieSolve};
-pub use tied::{HookOnTies, TieEnds, TiedOrgans, TiedReport};
+pub use tied::{HookOnTies, TiedOrgans, TiedReport};
 pub use wall::{BurnMark, BurnSite, MAX_BURN_MARKS, Wall, WallBurn, WallBurns};
 pub use wall_pull::{WALL_REACH_M, WallPull, WallPullReport};

@@ -35,7 +35,7 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, SymmetricEigen, Vector3};
 
-use super::bed::Bed;
+use super::bed::{Bed, TieEnds};
 use super::cautery::{CauteryMode, TieBurns, TissueHeat};
 use super::solve::{TieCompliance, TieConvergence, TieSolve};
 use super::wall_pull::{WALL_REACH_M, WallPull, WallPullReport};
@@ -232,19 +232,6 @@ impl KeptAtTies {
                     .for_each(|(s, phi_b)| *s += phi_a.dot(phi_b));
             }
         }
-    }
-}
-
-/// Where a tie's two ends are (m, the scene's frame): on the freed organ and on its base.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct TieEnds {
-    pub freed_m: Vector3<f64>,
-    pub base_m: Vector3<f64>,
-}
-
-impl TieEnds {
-    pub fn middle_m(&self) -> Vector3<f64> {
-        (self.freed_m + self.base_m) * 0.5
     }
 }
 

@@ -22,8 +22,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::bed::Bed;
-use super::tied::TieEnds;
+use super::bed::{Bed, TieEnds};
 use crate::dynamics::Tether;
 
 /// How far from the jaws (m) the wall carries their pull to the bed: the jaws' own length
