@@ -158,6 +158,22 @@ impl Bed {
     }
 }
 
+/// A whole tie of `area_m2` at load position `position` over the plane `z = 0`, facing the
+/// first corner of triangle 0: the dissection modules' tests' bed.
+#[cfg(test)]
+pub(crate) fn tie_over_plane(position: usize, area_m2: f64) -> Tie {
+    Tie {
+        position,
+        facing: SurfacePoint {
+            triangle: 0,
+            barycentric: [1.0, 0.0, 0.0],
+        },
+        normal: Unit::new_normalize(Vector3::z()),
+        area_m2,
+        state: CohesiveTie::default(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

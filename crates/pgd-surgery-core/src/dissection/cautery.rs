@@ -183,27 +183,16 @@ impl TieBurns {
 
 #[cfg(test)]
 mod tests {
-    use nalgebra::{Unit, Vector3};
 
     use super::*;
-    use crate::dissection::{CohesiveLaw, CohesiveTie, Tie};
-    use crate::pgd::SurfacePoint;
+    use crate::dissection::CohesiveLaw;
+    use crate::dissection::bed::tie_over_plane;
 
     /// Two ties of 1 cm² and 0.25 cm².
     fn bed() -> Bed {
-        let tie = |area_m2: f64| Tie {
-            position: 0,
-            facing: SurfacePoint {
-                triangle: 0,
-                barycentric: [1.0, 0.0, 0.0],
-            },
-            normal: Unit::new_normalize(Vector3::z()),
-            area_m2,
-            state: CohesiveTie::default(),
-        };
         Bed {
             law: CohesiveLaw::gallbladder_bed(),
-            ties: vec![tie(1e-4), tie(0.25e-4)],
+            ties: vec![tie_over_plane(0, 1e-4), tie_over_plane(0, 0.25e-4)],
         }
     }
 

@@ -193,11 +193,11 @@ fn dot_weighted(r: &[Vector3<f64>], k: &[f64]) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use nalgebra::{DMatrix, DVector, Unit};
+    use nalgebra::{DMatrix, DVector};
 
     use super::*;
-    use crate::dissection::{CohesiveLaw, CohesiveTie, Tie};
-    use crate::pgd::SurfacePoint;
+    use crate::dissection::bed::tie_over_plane;
+    use crate::dissection::{CohesiveLaw, CohesiveTie};
 
     /// A compliance from a dense symmetric positive definite matrix over the ties' `3 n`
     /// components.
@@ -219,19 +219,11 @@ mod tests {
     /// Six ties of 1 cm² (50 N/m each at the bed's law) on organs whose give between them is
     /// a floppy organ's: `C = B Bᵀ` of about 0.1 m/N, five times softer than a tie is stiff.
     fn bed_and_compliance() -> (Bed, Dense) {
-        let tie = Tie {
-            position: 0,
-            facing: SurfacePoint {
-                triangle: 0,
-                barycentric: [1.0, 0.0, 0.0],
-            },
-            normal: Unit::new_normalize(Vector3::z()),
-            area_m2: 1e-5,
-            state: CohesiveTie::default(),
-        };
         let bed = Bed {
             law: CohesiveLaw::gallbladder_bed(),
-            ties: (0..6).map(|position| Tie { position, ..tie }).collect(),
+            ties: (0..6)
+                .map(|position| tie_over_plane(position, 1e-5))
+                .collect(),
         };
         let b = DMatrix::from_fn(18, 18, |i, j| ((i * 7 + j * 3) % 11) as f64 / 11.0 - 0.4);
         let c = (&b * b.transpose()) * 0.02 + DMatrix::identity(18, 18) * 1e-3;

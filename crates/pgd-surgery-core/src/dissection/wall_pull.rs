@@ -181,27 +181,16 @@ impl WallPull {
 
 #[cfg(test)]
 mod tests {
-    use nalgebra::Unit;
 
     use super::*;
-    use crate::dissection::{CohesiveLaw, CohesiveTie, Tie};
-    use crate::pgd::SurfacePoint;
+    use crate::dissection::CohesiveLaw;
+    use crate::dissection::bed::tie_over_plane;
 
     /// Ties of 1 cm² on the plane z = 0 at `xs` (m) along x, their ends on the base there.
     fn bed_along(xs: &[f64]) -> (Bed, Vec<TieEnds>) {
-        let tie = |position| Tie {
-            position,
-            facing: SurfacePoint {
-                triangle: 0,
-                barycentric: [1.0, 0.0, 0.0],
-            },
-            normal: Unit::new_normalize(Vector3::z()),
-            area_m2: 1e-4,
-            state: CohesiveTie::default(),
-        };
         let bed = Bed {
             law: CohesiveLaw::gallbladder_bed(),
-            ties: (0..xs.len()).map(tie).collect(),
+            ties: (0..xs.len()).map(|p| tie_over_plane(p, 1e-4)).collect(),
         };
         let ends = (xs.iter())
             .map(|&x| TieEnds {
