@@ -216,7 +216,7 @@ mod tests {
         }
     }
 
-    /// Six ties of 1 cm² (50 N/m each at the bed's law) on organs whose give between them is
+    /// Six ties of 0.1 cm² (50 N/m each at the bed's law) on organs whose give between them is
     /// a floppy organ's: `C = B Bᵀ` of about 0.1 m/N, five times softer than a tie is stiff.
     fn bed_and_compliance() -> (Bed, Dense) {
         let bed = Bed {

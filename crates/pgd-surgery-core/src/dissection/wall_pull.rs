@@ -3,8 +3,9 @@
 //!
 //! The organs are solids of their bulk's stiffness: the gallbladder's 1.15 kPa is what it
 //! gives under a pressing tool. Its wall is far stiffer in tension (porcine gallbladder wall:
-//! 9.03 MPa in uniaxial tension; `docs/dissection.md`): 2 mm of it carries 18 kN/m per metre
-//! of width, where a centimetre of the bed's ties holds 50 N/m. The bulk alone cannot carry a
+//! 9.03 MPa in uniaxial tension; `docs/dissection.md`): over the wall's reach of 15 mm, a
+//! strip of 2 mm wall is 16 times stiffer in tension (`E h / ℓ`) than the ties under it
+//! (`K ℓ`) at the bed's law. The bulk alone cannot carry a
 //! pull to the bed: a full FEM solve of the coarse gallbladder tied in its bed, drawn 30 mm by
 //! a point 12 mm from the nearest tie, pulls back 0.075 N and opens that tie by 0.26 mm, where
 //! it tears at 20 mm.
