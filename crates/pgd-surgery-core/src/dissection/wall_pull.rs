@@ -271,6 +271,27 @@ mod tests {
         assert_eq!(order, [0, 1, 2]);
     }
 
+    /// Jaws that let go before their ties tear hand them back to the fields with the damage
+    /// they took, and pull on nothing more.
+    #[test]
+    fn ties_let_go_keep_their_damage() {
+        let (mut bed, ends) = bed_along(&[0.002]);
+        let mut wall = WallPull::with_room(1);
+        wall.grip(&bed, &ends, &Vector3::zeros(), WALL_REACH_M);
+        wall.pull(&mut bed, &ends, &Vector3::new(0.0, 0.0, 0.01));
+        let damage = bed.ties[0].state.damage(&bed.law);
+        assert!(damage > 0.0 && damage < 1.0, "{damage}");
+        wall.let_go();
+        assert_eq!(wall.carried(), &[false]);
+        assert!(wall.tether(&bed, &ends).is_none());
+        let report = wall.pull(&mut bed, &ends, &Vector3::new(0.0, 0.0, 0.02));
+        assert_eq!(
+            (report.strands, report.force_on_jaws_n),
+            (0, Vector3::zeros())
+        );
+        assert_eq!(bed.ties[0].state.damage(&bed.law), damage);
+    }
+
     /// The tether a taut wall gives the grasp pulls the jaws, where it was made, as the
     /// strands do (to 1e-12 N); a slack wall gives none.
     #[test]
