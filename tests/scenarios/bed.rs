@@ -369,6 +369,20 @@ fn the_hook_divides_the_ties_within_its_reach() {
 /// draws it down and forward, away from the liver, `pull_mm` by `pull_until_s`, where it
 /// opens the jaws.
 fn pulled_off_the_bed(pull_mm: f64, pull_until_s: f64) -> HapticLoop {
+    let (_, scene, devices) = blunt_pull(1.0, pull_mm, pull_until_s);
+    HapticLoop::with_devices(&scene, devices).unwrap()
+}
+
+/// [`pulled_off_the_bed`]'s scenario, scene and scripted hands, the jaws closing at `from_s`.
+fn blunt_pull(
+    from_s: f64,
+    pull_mm: f64,
+    pull_until_s: f64,
+) -> (
+    pgd_surgery::scenario::Scenario,
+    HapticScene,
+    Vec<Box<dyn pgd_surgery::devices::HapticDevice>>,
+) {
     use pgd_surgery::devices::HapticDevice;
     let scenario = pgd_surgery::scenario::load(
         &super::root().join("scenarios/gallbladder-liver-bed-dissection.scenario.ron"),
@@ -393,8 +407,8 @@ fn pulled_off_the_bed(pull_mm: f64, pull_until_s: f64) -> HapticLoop {
     let left = Trajectory {
         rows: vec![
             row(0.0, on + edge.normal * 0.01, 0),
-            row(0.9, on, 0),
-            row(1.0, on, 1),
+            row(from_s - 0.1, on, 0),
+            row(from_s, on, 1),
             row(pull_until_s, away, 1),
             row(pull_until_s + 0.001, away, 0),
         ],
@@ -403,7 +417,7 @@ fn pulled_off_the_bed(pull_mm: f64, pull_until_s: f64) -> HapticLoop {
         Box::new(Scripted::new("right", right)),
         Box::new(Scripted::new("left", left)),
     ];
-    HapticLoop::with_devices(&scene, devices).unwrap()
+    (scenario, scene, devices)
 }
 
 fn tick_at(haptic: &mut HapticLoop, tick: u64) {
@@ -656,4 +670,28 @@ fn a_grasper_tears_the_ties_near_its_jaws() {
     assert!(released > 0.0);
     assert!(work_j >= fracture_j, "{work_j} J for {fracture_j} J");
     assert!(largest_change <= 0.02, "{largest_change} N in a tick");
+}
+
+/// Blunt dissection scored: the same pull as an attempt at the dissection exercise, made once
+/// the retraction task has run out (15 s, the jaws open all along): the ties it tears count as
+/// released for the `Dissection` task, which reports them torn (none divided, no energy) and
+/// says so in its summary.
+#[test]
+fn the_dissection_counts_the_ties_a_pull_tears() {
+    use pgd_surgery::app::attempt::run_simulated;
+    use pgd_surgery::scenario::tasks::DissectionResult;
+    let (scenario, scene, devices) = blunt_pull(16.0, 30.0, 19.0);
+    let outcome = run_simulated(scenario, &scene, devices, 20_000).unwrap();
+    let metrics = &outcome.card.tasks[1].metrics;
+    let done = metrics.result::<DissectionResult>().unwrap();
+    let summary = pgd_surgery::report::summary(&outcome.card);
+    eprintln!("{summary}");
+    assert!(done.ties_torn >= 3, "{} torn", done.ties_torn);
+    assert_eq!(done.ties_divided, 0);
+    assert_eq!(done.energy.total_j, 0.0);
+    assert!(done.released_share > 0.0);
+    assert!(
+        summary.contains(&format!("0 ties divided, {} torn", done.ties_torn)),
+        "{summary}"
+    );
 }
