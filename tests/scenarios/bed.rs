@@ -384,10 +384,7 @@ fn blunt_pull(
     Vec<Box<dyn pgd_surgery::devices::HapticDevice>>,
 ) {
     use pgd_surgery::devices::HapticDevice;
-    let scenario = pgd_surgery::scenario::load(
-        &super::root().join("scenarios/gallbladder-liver-bed-dissection.scenario.ron"),
-    )
-    .unwrap();
+    let scenario = super::shipped("gallbladder-liver-bed-dissection");
     let scene = scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Refuse).unwrap();
     let port = scene.hands[1].instruments[0].port.unwrap();
     let row = |time_s: f64, tip_m: Vector3<f64>, buttons: u32| TrajectoryRow {
@@ -438,10 +435,7 @@ fn the_plane_opens_under_the_hook_without_a_force_step() {
     use pgd_surgery::app::haptic::DeviceForce;
     use pgd_surgery::devices::HapticDevice;
     let root = super::root();
-    let scenario = pgd_surgery::scenario::load(
-        &root.join("scenarios/gallbladder-liver-bed-dissection.scenario.ron"),
-    )
-    .unwrap();
+    let scenario = super::shipped("gallbladder-liver-bed-dissection");
     let scene = scenario_scene(&scenario, vademecums(), Detail::Coarse, OnStale::Refuse).unwrap();
     let run = root.join("scenarios/runs/gallbladder-liver-bed-dissection.competent.csv");
     let hands = Trajectory::load_hands(&run).unwrap();

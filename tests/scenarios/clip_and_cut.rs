@@ -14,15 +14,10 @@ use pgd_surgery::biliary::{Structure, ViewRecord};
 use pgd_surgery::report::critical_view::{FAT, Projection, SIZE, Side, colour_of, rgb};
 use pgd_surgery::report::write_report;
 use pgd_surgery::scenario::tasks::ClipAndCutResult;
-use pgd_surgery::scenario::{Scenario, load};
 
 use super::script::{Stage, retracted};
 
 const NAME: &str = "lap-chole-clip-and-cut";
-
-fn scenario() -> Scenario {
-    load(&super::root().join(format!("scenarios/{NAME}.scenario.ron"))).unwrap()
-}
 
 #[test]
 fn the_competent_clip_and_cut_reaches_the_view_then_clips_and_divides_as_taught() {
@@ -154,7 +149,7 @@ fn the_careless_clip_and_cut_fails_naming_what_it_did_before_the_view() {
 /// `PGD_WRITE_RUNS` set, they are written anew: after a change to the scene).
 #[test]
 fn the_clip_and_cut_runs_are_made_from_the_scenes_tree() {
-    let scenario = scenario();
+    let scenario = super::shipped(NAME);
     let stage = Stage::of(&scenario);
     let (abdomen, start, plane) = (&stage.abdomen, stage.start_m, &stage.plane);
     // The fat stays where it was; the tubes follow the gallbladder drawn aside.

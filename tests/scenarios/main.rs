@@ -66,22 +66,27 @@ fn vademecums() -> &'static Path {
         let dir = cache::vademecum_cache().to_owned();
         default_scene(&dir, Detail::Coarse, OnStale::Rebuild).unwrap();
         for name in SHIPPED {
-            let scenario = load(&root().join(format!("scenarios/{name}.scenario.ron"))).unwrap();
+            let scenario = shipped(name);
             scenario_scene(&scenario, &dir, Detail::Coarse, OnStale::Rebuild).unwrap();
         }
         dir
     })
 }
 
+/// The shipped scenario `scenarios/<name>.scenario.ron`.
+fn shipped(name: &str) -> Scenario {
+    load(&root().join(format!("scenarios/{name}.scenario.ron"))).unwrap()
+}
+
 /// Runs a shipped scenario on the coarse organs with one of its scripts.
 fn run(name: &str, script: &str) -> Outcome {
-    let scenario = load(&root().join(format!("scenarios/{name}.scenario.ron"))).unwrap();
+    let scenario = shipped(name);
     run_scenario(scenario, name, script)
 }
 
 /// [`run`] with the organs' tissue plain: no nodules.
 fn run_without_nodules(name: &str, script: &str) -> Outcome {
-    let mut scenario = load(&root().join(format!("scenarios/{name}.scenario.ron"))).unwrap();
+    let mut scenario = shipped(name);
     scenario.nodules.clear();
     run_scenario(scenario, name, script)
 }
@@ -1196,7 +1201,7 @@ fn two_instruments_changed_and_changed_back_press_as_one() {
     use pgd_surgery::scenario::Instrument;
 
     let name = "liver-laparoscopic-press";
-    let mut scenario = load(&root().join(format!("scenarios/{name}.scenario.ron"))).unwrap();
+    let mut scenario = shipped(name);
     let port = scenario.port.take().expect("a laparoscopic scenario");
     let tool = scenario.tool.take().unwrap_or_default();
     let mut left = port.clone();

@@ -14,7 +14,6 @@ use pgd_surgery::biliary::BiliaryTree;
 use pgd_surgery::dissection::CauteryMode;
 use pgd_surgery::mesh::organs::{Abdomen, Organ};
 use pgd_surgery::scenario::tasks::DissectionResult;
-use pgd_surgery::scenario::{Scenario, load};
 
 use super::script::{Script, Stage};
 
@@ -22,10 +21,6 @@ const NAME: &str = "lap-chole-full";
 
 /// The assistant's hand index: after the trainee's two.
 const ASSISTANT: usize = TRAINEE_HANDS;
-
-fn scenario() -> Scenario {
-    load(&super::root().join(format!("scenarios/{NAME}.scenario.ron"))).unwrap()
-}
 
 #[test]
 fn the_competent_operation_earns_every_step_and_meets_the_benchmark() {
@@ -192,7 +187,7 @@ fn free_from_bed(script: &mut Script, abdomen: &Abdomen, reach_m: f64) {
 
 #[test]
 fn the_operations_runs_are_made_from_the_scene() {
-    let scenario = scenario();
+    let scenario = super::shipped(NAME);
     let stage = Stage::of(&scenario);
     let (abdomen, start, plane, tip_m) = (&stage.abdomen, stage.start_m, &stage.plane, stage.tip_m);
 

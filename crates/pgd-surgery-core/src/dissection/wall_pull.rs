@@ -93,8 +93,12 @@ impl WallPull {
         }
     }
 
-    /// The jaws let go: the ties go back to the organs' fields.
+    /// The jaws let go: the ties go back to the organs' fields. Called every tick the jaws
+    /// hold nothing, so it costs nothing then (a tie is carried only while a strand holds it).
     pub fn let_go(&mut self) {
+        if self.strands.is_empty() {
+            return;
+        }
         self.strands.clear();
         self.carried.fill(false);
     }
